@@ -1,0 +1,3 @@
+from washbench.cli import main
+
+raise SystemExit(main())

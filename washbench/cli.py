@@ -1,0 +1,131 @@
+"""The ``washbench`` command. Argument parsing lives here and nowhere else.
+
+Each sub-command hands plain values to a function in the module that owns the work;
+those functions raise :class:`washbench.errors.WashbenchError` for bad input, which is
+printed here as one line (no traceback) with exit status 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from washbench.errors import WashbenchError
+
+WASHOUT_NAMES = ("small-angle", "large-angle", "unrestricted")
+
+
+class _Parser(argparse.ArgumentParser):
+    """ArgumentParser whose usage errors are one line and exit 2 (as argparse does)."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        self.exit(2, f"{self.prog}: error: {message}\n")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The full command-line interface."""
+    parser = _Parser(prog="washbench", description=__doc__.splitlines()[0] if __doc__ else None)
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    p = sub.add_parser("cue", help="run washouts, Atlas model, vestibular models and metrics on a recorded trace")
+    p.add_argument("input", type=Path, help="CSV or Parquet: t_s, f_{x,y,z}_mps2, omega_{x,y,z}_degps (body axes)")
+    p.add_argument("--out", type=Path, required=True, help="output folder (traces.parquet, metrics.csv)")
+    p.add_argument(
+        "--washout",
+        action="append",
+        metavar="NAME",
+        help=f"washout to run, repeatable: {', '.join(WASHOUT_NAMES)} (default: all three)",
+    )
+    p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
+    p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
+
+    p = sub.add_parser("fly", help="fly a manoeuvre file with JSBSim and the scripted pilot")
+    p.add_argument("manoeuvre", type=Path, help="manoeuvre YAML file")
+    p.add_argument("--out", type=Path, required=True, help="output folder (flight.parquet, flight.json)")
+    p.add_argument("--quiet", action="store_true", help="no progress display")
+
+    p = sub.add_parser("validate", help="check manoeuvre files without flying them")
+    p.add_argument("manoeuvres", type=Path, nargs="+", help="manoeuvre YAML files")
+
+    p = sub.add_parser("schema", help="print the manoeuvre file JSON Schema")
+    p.add_argument("--out", type=Path, help="write to this file instead of standard output")
+
+    p = sub.add_parser("run", help="fly a manoeuvre with the washouts in lockstep; write traces, metrics, recording")
+    p.add_argument("manoeuvre", type=Path, help="manoeuvre YAML file")
+    p.add_argument("--out", type=Path, required=True, help="results folder; writes OUT/<aircraft>/<manoeuvre>/")
+    p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
+    p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
+    p.add_argument("--quiet", action="store_true", help="no progress display")
+
+    p = sub.add_parser("suite", help="run many manoeuvres in parallel and compare the washouts")
+    p.add_argument("inputs", type=Path, nargs="*", help="manoeuvre files or folders (default: bundled manoeuvres/)")
+    p.add_argument("--out", type=Path, required=True, help="results folder")
+    p.add_argument("--jobs", type=int, help="parallel processes (default: number of cores)")
+    p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
+    p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
+    p.add_argument("--quiet", action="store_true", help="no progress display")
+
+    p = sub.add_parser("replay", help="open a recording in the rerun viewer")
+    p.add_argument("recording", type=Path, help=".rrd file written by washbench run or suite")
+    p.add_argument("--web", action="store_true", help="always use the web viewer")
+    return parser
+
+
+def _dispatch(args: argparse.Namespace) -> int:
+    if args.command == "cue":
+        from washbench.cue import run_cue
+
+        run_cue(args.input, args.out, washouts=args.washout, params_path=args.params, platform_path=args.platform)
+        return 0
+    if args.command == "fly":
+        from washbench.flight.fly import fly_command
+
+        return fly_command(args.manoeuvre, args.out, progress=not args.quiet)
+    if args.command == "validate":
+        from washbench.manoeuvre import validate_command
+
+        return validate_command(args.manoeuvres)
+    if args.command == "schema":
+        from washbench.manoeuvre import schema_command
+
+        return schema_command(args.out)
+    if args.command == "run":
+        from washbench.pipeline import run_command
+
+        return run_command(
+            args.manoeuvre, args.out, params_path=args.params, platform_path=args.platform, progress=not args.quiet
+        )
+    if args.command == "suite":
+        from washbench.suite import suite_command
+
+        return suite_command(
+            args.inputs,
+            args.out,
+            jobs=args.jobs,
+            params_path=args.params,
+            platform_path=args.platform,
+            progress=not args.quiet,
+        )
+    if args.command == "replay":
+        from washbench.replay import replay_command
+
+        return replay_command(args.recording, web=args.web)
+    raise AssertionError(f"unhandled command {args.command}")  # unreachable: argparse restricts choices
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``washbench`` console script; returns the exit status."""
+    args = build_parser().parse_args(argv)
+    try:
+        return _dispatch(args)
+    except WashbenchError as exc:
+        print(f"washbench: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("washbench: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
