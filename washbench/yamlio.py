@@ -1,0 +1,239 @@
+"""YAML files into typed, frozen models, with one-line errors that name file, line and field.
+
+Every YAML file washbench reads (manoeuvres, washout parameters, platform limits) goes
+through :func:`load_yaml_model`. Models derive from :class:`StrictModel`: unknown keys
+are rejected, numbers must be numbers (``'thirty'`` or ``"30"`` is not a number), and the
+instances are frozen. A failure raises :class:`washbench.errors.WashbenchError` with
+a message such as::
+
+    manoeuvres/c172/turn.yaml:14: phases[2].hold.bank_deg: expected a number, got 'thirty'
+
+Validation runs in pydantic's strict JSON mode (the YAML data is passed as JSON), so a
+YAML list fills a tuple field and a string fills an enum or literal field, but no string
+is silently turned into a number.
+"""
+
+from __future__ import annotations
+
+import difflib
+import json
+from pathlib import Path
+from typing import Any, TypeVar
+
+import pydantic
+import yaml
+from pydantic import BaseModel, ConfigDict
+
+from washbench.errors import WashbenchError, located
+
+M = TypeVar("M", bound=BaseModel)
+
+Loc = tuple[str | int, ...]
+
+
+class StrictModel(BaseModel):
+    """Base for models read from YAML: unknown keys rejected, strict types, frozen."""
+
+    model_config = ConfigDict(extra="forbid", strict=True, frozen=True)
+
+
+class _UniqueKeyLoader(yaml.SafeLoader):
+    """SafeLoader that rejects duplicate mapping keys (PyYAML keeps the last silently)."""
+
+
+def _construct_mapping(loader: _UniqueKeyLoader, node: yaml.MappingNode, deep: bool = False) -> dict[Any, Any]:
+    seen: dict[Any, int] = {}
+    for key_node, _ in node.value:
+        key = loader.construct_object(key_node, deep=deep)
+        if key in seen:
+            raise yaml.constructor.ConstructorError(
+                None, None, f"duplicate key {key!r} (first on line {seen[key] + 1})", key_node.start_mark
+            )
+        seen[key] = key_node.start_mark.line
+    return loader.construct_mapping(node, deep=deep)
+
+
+_UniqueKeyLoader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_mapping)
+
+
+def _line_map(node: yaml.Node | None, loc: Loc = (), out: dict[Loc, int] | None = None) -> dict[Loc, int]:
+    """Map each data path to the 1-based line where it is written (a key's line for mapping values)."""
+    if out is None:
+        out = {}
+    if node is None:
+        return out
+    out.setdefault(loc, node.start_mark.line + 1)
+    if isinstance(node, yaml.MappingNode):
+        for key_node, value_node in node.value:
+            key = key_node.value
+            out[(*loc, key)] = key_node.start_mark.line + 1
+            _line_map(value_node, (*loc, key), out)
+    elif isinstance(node, yaml.SequenceNode):
+        for i, item in enumerate(node.value):
+            _line_map(item, (*loc, i), out)
+    return out
+
+
+def format_field_path(loc: Loc) -> str:
+    """``('phases', 2, 'hold', 'bank_deg')`` -> ``phases[2].hold.bank_deg``."""
+    text = ""
+    for part in loc:
+        if isinstance(part, int):
+            text += f"[{part}]"
+        else:
+            text += f".{part}" if text else str(part)
+    return text or "(top level)"
+
+
+def _data_loc(data: Any, loc: tuple[Any, ...]) -> Loc:
+    """Keep the parts of a pydantic error location that are real keys or indices in ``data``.
+
+    Pydantic inserts union-member tags and validator names into locations; those are
+    dropped. The last part is kept even if absent (a missing or unknown key).
+    """
+    kept: list[str | int] = []
+    node = data
+    for i, part in enumerate(loc):
+        if isinstance(node, dict) and part in node:
+            kept.append(part)
+            node = node[part]
+        elif isinstance(node, list) and isinstance(part, int) and 0 <= part < len(node):
+            kept.append(part)
+            node = node[part]
+        elif i == len(loc) - 1 and isinstance(part, str | int) and isinstance(node, dict):
+            kept.append(part)
+    return tuple(kept)
+
+
+def _describe(value: Any) -> str:
+    if isinstance(value, str):
+        return repr(value)
+    if value is None:
+        return "nothing (null)"
+    if isinstance(value, dict):
+        return "a mapping"
+    if isinstance(value, list):
+        return "a list"
+    return repr(value)
+
+
+def _problem(err: dict[str, Any], parent: Any, model: type[BaseModel], loc: Loc) -> str:
+    """A short human sentence for one pydantic error."""
+    kind = err["type"]
+    value = err.get("input")
+    if kind == "extra_forbidden":
+        key = loc[-1] if loc else ""
+        allowed = _allowed_keys(model, loc[:-1])
+        hint = difflib.get_close_matches(str(key), allowed, n=1)
+        text = "unknown key"
+        if hint:
+            text += f" (did you mean '{hint[0]}'?)"
+        elif allowed:
+            text += f" (allowed: {', '.join(sorted(allowed))})"
+        return text
+    if kind == "missing":
+        return "missing required field"
+    if kind in {"float_type", "float_parsing", "int_type", "int_parsing", "int_from_float", "finite_number"}:
+        want = "an integer" if kind.startswith("int") else "a number"
+        if kind == "finite_number":
+            want = "a finite number"
+        return f"expected {want}, got {_describe(value)}"
+    if kind in {"bool_type", "bool_parsing"}:
+        return f"expected true or false, got {_describe(value)}"
+    if kind in {"string_type"}:
+        return f"expected text, got {_describe(value)}"
+    if kind in {"list_type", "tuple_type"}:
+        return f"expected a list, got {_describe(value)}"
+    if kind in {"dict_type", "model_type", "model_attributes_type"}:
+        return f"expected a mapping, got {_describe(value)}"
+    if kind in {"too_short", "too_long"}:
+        return err["msg"].replace("Tuple", "list").replace("List", "list")
+    msg = str(err["msg"])
+    for prefix in ("Value error, ", "Assertion failed, "):
+        msg = msg.removeprefix(prefix)
+    msg = msg.replace("Input should be", "expected")
+    if value is not None and not isinstance(value, dict | list) and "got" not in msg:
+        msg += f", got {_describe(value)}"
+    return msg
+
+
+def _allowed_keys(model: type[BaseModel], loc: Loc) -> list[str]:
+    """Field names of the (sub)model at ``loc`` if it can be found without ambiguity."""
+    current: Any = model
+    for part in loc:
+        if isinstance(part, int):
+            continue
+        if not (isinstance(current, type) and issubclass(current, BaseModel)):
+            return []
+        field = current.model_fields.get(str(part))
+        if field is None:
+            return []
+        current = _unwrap_model(field.annotation)
+        if current is None:
+            return []
+    if isinstance(current, type) and issubclass(current, BaseModel):
+        return [f.alias or name for name, f in current.model_fields.items()]
+    return []
+
+
+def _unwrap_model(annotation: Any) -> type[BaseModel] | None:
+    """The single BaseModel inside ``annotation`` (through Optional, list, tuple), or None."""
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return annotation
+    args = getattr(annotation, "__args__", ()) or ()
+    found = [m for m in (_unwrap_model(a) for a in args) if m is not None]
+    return found[0] if len(found) == 1 else None
+
+
+def read_yaml(path: Path) -> tuple[Any, dict[Loc, int]]:
+    """Parse a YAML file; return its data and the line of every data path.
+
+    Raises WashbenchError for an unreadable, empty or malformed file, or duplicate keys.
+    """
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise WashbenchError(located(path, "no such file")) from None
+    except IsADirectoryError:
+        raise WashbenchError(located(path, "is a folder, not a file")) from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise WashbenchError(located(path, f"cannot read: {getattr(exc, 'strerror', None) or exc}")) from None
+    try:
+        node = yaml.compose(text, Loader=_UniqueKeyLoader)
+        data = yaml.load(text, Loader=_UniqueKeyLoader)  # a SafeLoader subclass
+    except yaml.MarkedYAMLError as exc:
+        mark = exc.problem_mark or exc.context_mark
+        line = mark.line + 1 if mark is not None else None
+        problem = exc.problem or exc.context or "malformed YAML"
+        raise WashbenchError(located(path, f"invalid YAML: {problem}", line=line)) from None
+    except yaml.YAMLError as exc:
+        raise WashbenchError(located(path, f"invalid YAML: {exc}")) from None
+    if data is None:
+        raise WashbenchError(located(path, "the file is empty"))
+    return data, _line_map(node)
+
+
+def validate_data(path: Path, data: Any, lines: dict[Loc, int], model: type[M]) -> M:
+    """Validate parsed YAML ``data`` against ``model``; errors name file, line and field."""
+    if not isinstance(data, dict):
+        raise WashbenchError(located(path, f"expected a mapping at the top level, got {_describe(data)}", line=1))
+    try:
+        payload = json.dumps(data, default=str, allow_nan=True)
+        return model.model_validate_json(payload)
+    except pydantic.ValidationError as exc:
+        err = exc.errors(include_url=False)[0]
+        loc = _data_loc(data, tuple(err["loc"]))
+        line = lines.get(loc)
+        probe = loc
+        while line is None and probe:
+            probe = probe[:-1]
+            line = lines.get(probe)
+        problem = _problem(err, None, model, loc)
+        raise WashbenchError(located(path, problem, line=line, field=format_field_path(loc))) from None
+
+
+def load_yaml_model(path: str | Path, model: type[M]) -> M:
+    """Read ``path`` and validate it into ``model``, raising a one-line WashbenchError on any problem."""
+    path = Path(path)
+    data, lines = read_yaml(path)
+    return validate_data(path, data, lines, model)
