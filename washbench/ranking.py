@@ -1,0 +1,137 @@
+"""Comparing washouts across a suite: the Table-4 style comparison and a per-manoeuvre ranking.
+
+Comparison (like the paper's Table 4). For each manoeuvre, degree of freedom and metric, every
+washout's value and its difference from the small-angle washout, signed so that POSITIVE MEANS
+BETTER than small-angle. All three metrics are "lower is better" (NPC is 1.0 for a perfect
+correlation and grows as the correlation worsens), so the difference is ``small_angle - washout``.
+An undefined NPC (flat signal) gives an empty difference.
+
+Ranking (the scoring rule). For one manoeuvre, washout W gets the score
+
+    score(W) = sum over DOFs d of  w_d * E(W, d) / M_d
+
+- ``E(W, d)`` is the integral of |aircraft perceived - simulator perceived| over the manoeuvre
+  (Eq. 22) for that DOF.
+- ``M_d`` is the aircraft pilot's own perceived motion in that DOF: the integral of
+  |perceived(t) - perceived(0)| dt, i.e. the error a simulator that stayed still (after the first
+  sample) would make. ``E/M`` is therefore a relative error: 0 is perfect, 1 is no better than
+  staying still, above 1 is worse than staying still (false cues).
+- ``w_d`` weighs each DOF by how much the aircraft pilot felt there, within its group: the three
+  specific-force DOFs (surge, sway, heave) share half the weight in proportion to their M_d, the
+  three angular DOFs (roll, pitch, yaw) the other half in proportion to theirs. A DOF with little
+  motion therefore weighs little, and one the pilot does not feel at all (M_d below the floor,
+  ``MOTION_FLOOR``) weighs nothing, so a tiny denominator cannot blow a score up. If a whole group is
+  below the floor, the other group takes all the weight.
+
+Lower score is better; ranks are 1 (best) to 3, ties broken by name for determinism. The score is
+objective (computed from the traces only) and is reported next to every rank.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
+
+TRANSLATIONAL_DOFS = ("surge", "sway", "heave")
+ROTATIONAL_DOFS = ("roll", "pitch", "yaw")
+DOFS = TRANSLATIONAL_DOFS + ROTATIONAL_DOFS
+METRICS = ("npc", "integral_error", "max_error")
+REFERENCE_WASHOUT = "small-angle"
+
+#: Motion below which a DOF is not weighed: integral of |perceived change| in m/s^2*s for the
+#: translational DOFs and deg for the rotational ones. 0.05 m/s^2 (about the otolith threshold of
+#: Zacharias) held for 1 s, and 0.5 deg/s (about the canal threshold) for 1 s.
+MOTION_FLOOR = {"surge": 0.05, "sway": 0.05, "heave": 0.05, "roll": 0.5, "pitch": 0.5, "yaw": 0.5}
+
+
+@dataclass(frozen=True)
+class MetricRow:
+    """One row of a metrics table: a washout's metrics in one DOF (units as in metrics.csv)."""
+
+    washout: str
+    dof: str
+    npc: float  # NaN when undefined
+    integral_error: float
+    max_error: float
+
+
+@dataclass(frozen=True)
+class ComparisonRow:
+    """One metric in one DOF: each washout's value and its improvement over small-angle."""
+
+    dof: str
+    metric: str
+    values: dict[str, float]  # washout -> value (NaN if undefined)
+    better_than_reference: dict[str, float]  # washout -> reference - value (positive = better)
+
+
+@dataclass(frozen=True)
+class RankRow:
+    """A washout's score (lower is better) and rank within one manoeuvre."""
+
+    washout: str
+    score: float
+    rank: int
+    weights: dict[str, float]
+
+
+def compare(rows: Sequence[MetricRow], reference: str = REFERENCE_WASHOUT) -> list[ComparisonRow]:
+    """Table-4 style comparison of every washout against ``reference`` (positive difference = better)."""
+    by_key = {(r.washout, r.dof): r for r in rows}
+    washouts = sorted({r.washout for r in rows}, key=_washout_order)
+    out: list[ComparisonRow] = []
+    for dof in DOFS:
+        if not any((w, dof) in by_key for w in washouts):
+            continue
+        for metric in METRICS:
+            values = {w: float(getattr(by_key[(w, dof)], metric)) for w in washouts if (w, dof) in by_key}
+            ref = values.get(reference, math.nan)
+            diffs = {w: (ref - v) for w, v in values.items() if w != reference}
+            out.append(ComparisonRow(dof=dof, metric=metric, values=values, better_than_reference=diffs))
+    return out
+
+
+def dof_weights(motion: Mapping[str, float]) -> dict[str, float]:
+    """Weights of the scoring rule from the aircraft pilot's perceived motion per DOF (see module doc)."""
+    weights = dict.fromkeys(DOFS, 0.0)
+    felt = {d: float(motion.get(d, 0.0)) for d in DOFS}
+    groups = [g for g in (TRANSLATIONAL_DOFS, ROTATIONAL_DOFS) if any(felt[d] >= MOTION_FLOOR[d] for d in g)]
+    for group in groups:
+        total = sum(felt[d] for d in group if felt[d] >= MOTION_FLOOR[d])
+        for d in group:
+            if felt[d] >= MOTION_FLOOR[d]:
+                weights[d] = felt[d] / total / len(groups)
+    return weights
+
+
+def rank(rows: Sequence[MetricRow], motion: Mapping[str, float]) -> list[RankRow]:
+    """Score and rank the washouts of one manoeuvre (module doc gives the rule)."""
+    weights = dof_weights(motion)
+    washouts = sorted({r.washout for r in rows}, key=_washout_order)
+    by_key = {(r.washout, r.dof): r for r in rows}
+    scores: dict[str, float] = {}
+    for w in washouts:
+        total = 0.0
+        for d, wd in weights.items():
+            if wd > 0.0:
+                total += wd * by_key[(w, d)].integral_error / motion[d]
+        scores[w] = total
+    ordered = sorted(washouts, key=lambda w: (scores[w], _washout_order(w)))
+    return [RankRow(washout=w, score=scores[w], rank=i + 1, weights=weights) for i, w in enumerate(ordered)]
+
+
+def _washout_order(name: str) -> tuple[int, str]:
+    known = ("small-angle", "large-angle", "unrestricted")
+    return (known.index(name) if name in known else len(known), name)
+
+
+def wins(rankings: Iterable[Sequence[RankRow]]) -> dict[str, int]:
+    """How many manoeuvres each washout ranked first in."""
+    count: dict[str, int] = {}
+    for ranking in rankings:
+        for r in ranking:
+            count.setdefault(r.washout, 0)
+            if r.rank == 1:
+                count[r.washout] += 1
+    return count
