@@ -1,0 +1,96 @@
+"""Washout parameters: the typed, frozen model of ``washbench/data/cw1.yaml`` and its loader.
+
+Units are in the key names (rad/s for break frequencies, deg/s for rate limits at this edge; the
+numbers are converted to SI when the compiled bank is built). Unknown keys, wrong types and
+non-positive values are rejected with one line naming file, line and field.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+from pydantic import Field
+
+from washbench.paths import DATA_DIR
+from washbench.yamlio import StrictModel, load_yaml_model
+
+WASHOUT_NAMES: tuple[str, ...] = ("small-angle", "large-angle", "unrestricted")
+DEFAULT_PARAMS_PATH = DATA_DIR / "cw1.yaml"
+
+Positive = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
+NonNegative = Annotated[float, Field(ge=0.0, allow_inf_nan=False)]
+Finite = Annotated[float, Field(allow_inf_nan=False)]
+
+
+class TranslationalAxes(StrictModel):
+    """One value per axis x, y, z (surge, sway, heave)."""
+
+    x: Positive
+    y: Positive
+    z: Positive
+
+
+class RotationalAxes(StrictModel):
+    """One value per rotational axis."""
+
+    roll: NonNegative
+    pitch: NonNegative
+    yaw: NonNegative
+
+
+class Scale(StrictModel):
+    """Scale factors applied to the aircraft motion before the washout (dimensionless)."""
+
+    specific_force: Positive
+    angular_velocity: Positive
+
+
+class Tilt(StrictModel):
+    """Tilt coordination."""
+
+    lowpass_wn_radps: TranslationalAxes
+    gain_per_s: Positive
+    rate_limit_degps: Positive
+
+
+class Rotational(StrictModel):
+    """Rotational channel."""
+
+    highpass_wn_radps: RotationalAxes
+    saturation_degps: Positive
+
+
+class Head(StrictModel):
+    """Simulator pilot-head motion (paper Eqs. 7-10, 18-19)."""
+
+    derivative_wn_radps: Positive
+    offset_m: tuple[Finite, Finite, Finite]
+
+
+class SmallAngle(StrictModel):
+    """Guards of the Euler-angle (small-angle) washout."""
+
+    min_cos_pitch: Annotated[float, Field(gt=0.0, lt=1.0)]
+
+
+class WashoutParams(StrictModel):
+    """A complete washout parameter set (e.g. CW1), shared by the three washouts."""
+
+    name: str
+    gravity_mps2: Positive
+    scale: Scale
+    translational_highpass_wn_radps: TranslationalAxes
+    tilt: Tilt
+    rotational: Rotational
+    head: Head
+    small_angle: SmallAngle
+    free_fall_threshold_mps2: Positive
+
+
+def load_washout_params(path: Path | None = None) -> WashoutParams:
+    """Load a washout parameter YAML file (``None``: the bundled CW1 set, ``washbench/data/cw1.yaml``).
+
+    Raises :class:`washbench.errors.WashbenchError` with ``file:line: field: problem`` on bad input.
+    """
+    return load_yaml_model(DEFAULT_PARAMS_PATH if path is None else Path(path), WashoutParams)

@@ -1,0 +1,438 @@
+"""Manoeuvre files: the YAML schema, loading with one-line errors, semantic checks, JSON Schema export.
+
+A manoeuvre names the aircraft, the start (in the air or at rest on a runway), the
+environment, a sequence of phases (what the pilot holds, and when the phase ends) and the
+checks that prove it was flown. Keys carry their units (``altitude_ft``, ``bank_deg``).
+The format is documented in ``docs/manoeuvres.md``.
+
+Conventions: headings and wind directions are true, in degrees; the wind is given by the
+direction it blows FROM (aviation convention: ``from_deg: 270`` is a westerly wind,
+blowing towards the east). Airspeeds are calibrated (KCAS ~ KIAS).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+from pydantic import Field
+
+from washbench.atomic import write_text_atomic
+from washbench.errors import WashbenchError, located
+from washbench.flight.columns import COLUMN_NAMES, RUNWAY_COLUMNS
+from washbench.paths import AIRCRAFT_DIR, DATA_DIR
+from washbench.yamlio import Loc, StrictModel, format_field_path, read_yaml, validate_data
+
+Positive = Annotated[float, Field(gt=0)]
+NonNegative = Annotated[float, Field(ge=0)]
+Fraction = Annotated[float, Field(ge=0, le=1)]
+Heading = Annotated[float, Field(ge=0, lt=360)]
+Latitude = Annotated[float, Field(ge=-89, le=89)]
+Longitude = Annotated[float, Field(ge=-180, le=180)]
+
+
+class Runway(StrictModel):
+    """A runway: threshold centre, true heading of the landing/takeoff direction, size."""
+
+    name: str = ""
+    latitude_deg: Latitude
+    longitude_deg: Longitude
+    heading_deg: Heading
+    elevation_ft: float = 0.0
+    length_ft: Positive
+    width_ft: Positive
+    aim_point_ft: NonNegative = 1000.0  # where the glide path meets the runway, past the threshold
+
+
+class AirStart(StrictModel):
+    """Start trimmed in level flight. Position: lat/lon, or on the runway's extended centreline."""
+
+    altitude_ft: float
+    airspeed_kts: Positive
+    heading_deg: Heading | None = None  # default: the runway heading
+    latitude_deg: Latitude | None = None
+    longitude_deg: Longitude | None = None
+    before_threshold_ft: float | None = None  # on the extended centreline, this far before the threshold
+    flaps_deg: NonNegative = 0.0
+
+
+class RunwayStart(StrictModel):
+    """Start at rest on the runway centreline, engine running, brakes set."""
+
+    past_threshold_ft: NonNegative = 0.0
+
+
+class Start(StrictModel):
+    air: AirStart | None = None
+    runway: RunwayStart | None = None
+
+
+class Wind(StrictModel):
+    """Steady wind; ``from_deg`` is the true direction the wind blows FROM."""
+
+    from_deg: Heading
+    speed_kts: NonNegative
+
+
+class Turbulence(StrictModel):
+    """JSBSim MIL-F-8785C turbulence; the seed makes it repeatable."""
+
+    severity: Literal["none", "light", "moderate", "severe"]
+    seed: Annotated[int, Field(ge=0, lt=2**31)]
+
+
+class Environment(StrictModel):
+    wind: Wind | None = None
+    turbulence: Turbulence | None = None
+
+
+LATERAL_TARGETS = ("wings_level", "bank_deg", "heading_deg", "roll_rate_degps", "centreline")
+PITCH_TARGETS = ("pitch_deg", "altitude_ft", "vertical_speed_fpm", "glide_path_deg", "pitch_rate_degps", "flare")
+
+
+class Hold(StrictModel):
+    """What the pilot holds or tracks during a phase.
+
+    At most one lateral target (ailerons): ``wings_level``, ``bank_deg``, ``heading_deg``,
+    ``roll_rate_degps``, ``centreline`` (default: wings level). At most one pitch target
+    (elevator): ``pitch_deg``, ``altitude_ft``, ``vertical_speed_fpm``, ``glide_path_deg``,
+    ``pitch_rate_degps``, ``flare``. ``airspeed_kts`` is held with the throttle when a pitch
+    target is given, and with the elevator when ``throttle`` is fixed instead. The rudder
+    always coordinates (zero sideslip) in the air and tracks the runway on the ground.
+    """
+
+    wings_level: bool | None = None
+    bank_deg: Annotated[float, Field(ge=-80, le=80)] | None = None
+    heading_deg: Heading | None = None
+    roll_rate_degps: Annotated[float, Field(ge=-90, le=90)] | None = None
+    centreline: bool | None = None
+    pitch_deg: Annotated[float, Field(ge=-45, le=45)] | None = None
+    altitude_ft: float | None = None
+    vertical_speed_fpm: float | None = None
+    glide_path_deg: Annotated[float, Field(gt=0, le=10)] | None = None
+    pitch_rate_degps: Annotated[float, Field(ge=-30, le=30)] | None = None
+    flare: bool | None = None
+    airspeed_kts: Positive | None = None
+    throttle: Fraction | None = None
+    flaps_deg: NonNegative | None = None
+    brakes: Fraction | None = None
+
+
+EVENTS = ("liftoff", "touchdown", "stopped", "stall")
+
+
+class Until(StrictModel):
+    """When a phase ends: the first of the given conditions that holds.
+
+    ``timeout_s`` is not an end condition: if none of the conditions is met by then, the
+    flight fails (a phase that cannot end must not run forever).
+    """
+
+    duration_s: Positive | None = None
+    event: Literal["liftoff", "touchdown", "stopped", "stall"] | None = None
+    turned_deg: Positive | None = None
+    airspeed_above_kts: float | None = None
+    airspeed_below_kts: float | None = None
+    altitude_above_ft: float | None = None
+    altitude_below_ft: float | None = None
+    agl_above_ft: float | None = None
+    agl_below_ft: float | None = None
+    bank_above_deg: Annotated[float, Field(ge=0, lt=90)] | None = None
+    pitch_above_deg: float | None = None
+    pitch_below_deg: float | None = None
+    alpha_above_deg: float | None = None
+    timeout_s: Positive = 120.0
+
+
+class Phase(StrictModel):
+    name: Annotated[str, Field(min_length=1)]
+    hold: Hold = Hold()
+    until: Until
+
+
+STATS = ("min", "max", "mean", "max_abs", "initial", "final", "max_rise", "max_drop", "max_deviation", "turned")
+EVENT_STATS = ("at_touchdown", "at_liftoff")
+
+
+class Check(StrictModel):
+    """A measured value that must lie within limits.
+
+    ``stat`` of ``signal`` (a flight.parquet column, or ``sink_fps`` at an event) over
+    ``phases`` (default: the whole flight). ``max_rise``/``max_drop``/``max_deviation``
+    are relative to the value at the start of the first phase listed; ``turned`` is the
+    total heading change (deg) of a heading signal.
+    """
+
+    name: Annotated[str, Field(min_length=1)]
+    signal: str
+    stat: Literal[
+        "min",
+        "max",
+        "mean",
+        "max_abs",
+        "initial",
+        "final",
+        "max_rise",
+        "max_drop",
+        "max_deviation",
+        "turned",
+        "at_touchdown",
+        "at_liftoff",
+    ]
+    phases: list[str] | None = None
+    min: float | None = None
+    max: float | None = None
+
+
+class Manoeuvre(StrictModel):
+    """One manoeuvre file. ``source`` is the file it was loaded from (not a YAML key)."""
+
+    name: Annotated[str, Field(min_length=1)]
+    description: str = ""
+    aircraft: Annotated[str, Field(min_length=1)]
+    rate_hz: Annotated[int, Field(ge=30, le=1000)] = 120
+    runway: Runway | None = None
+    start: Start
+    environment: Environment = Environment()
+    phases: Annotated[list[Phase], Field(min_length=1)]
+    checks: list[Check] = []
+
+    @property
+    def dt_s(self) -> float:
+        """The flight dynamics time step, s."""
+        return 1.0 / self.rate_hz
+
+
+# --- aircraft lookup ---------------------------------------------------------------------------
+
+
+def jsbsim_root() -> Path:
+    """The folder of the installed jsbsim package (its ``aircraft/``, ``engine/``, ``systems/``)."""
+    import jsbsim
+
+    return Path(jsbsim.__file__).resolve().parent
+
+
+def aircraft_path(name: str) -> Path | None:
+    """The folder holding ``<name>/<name>.xml``: the project's ``aircraft/`` first, then jsbsim's."""
+    for root in (AIRCRAFT_DIR, jsbsim_root() / "aircraft"):
+        if (root / name / f"{name}.xml").is_file():
+            return root
+    return None
+
+
+def pilot_profile_path(aircraft: str) -> Path:
+    """Where the scripted pilot's profile for ``aircraft`` lives."""
+    return DATA_DIR / f"pilot_{aircraft}.yaml"
+
+
+# --- semantic checks ---------------------------------------------------------------------------
+
+
+class _Where:
+    """Formats one-line errors for a file using the YAML line map."""
+
+    def __init__(self, path: Path, lines: dict[Loc, int]) -> None:
+        self.path = path
+        self.lines = lines
+
+    def error(self, loc: Loc, problem: str) -> WashbenchError:
+        line = None
+        probe = loc
+        while line is None and probe:
+            line = self.lines.get(probe)
+            probe = probe[:-1]
+        return WashbenchError(located(self.path, problem, line=line, field=format_field_path(loc)))
+
+
+def _set_fields(model: StrictModel, names: Sequence[str]) -> list[str]:
+    return [n for n in names if getattr(model, n) is not None and getattr(model, n) is not False]
+
+
+def _check_semantics(m: Manoeuvre, where: _Where) -> None:
+    """Checks a schema cannot express; raise one-line WashbenchError on the first problem."""
+    from washbench.flight.profile import load_profile  # the profile knows the aircraft's limits
+
+    if aircraft_path(m.aircraft) is None:
+        raise where.error(
+            ("aircraft",),
+            f"unknown aircraft '{m.aircraft}' (not in {AIRCRAFT_DIR} nor among JSBSim's bundled aircraft)",
+        )
+    profile_file = pilot_profile_path(m.aircraft)
+    if not profile_file.is_file():
+        raise where.error(("aircraft",), f"no scripted-pilot profile for '{m.aircraft}' (expected {profile_file})")
+    profile = load_profile(profile_file)
+
+    starts = _set_fields(m.start, ("air", "runway"))
+    if len(starts) != 1:
+        raise where.error(("start",), "give exactly one of 'air' or 'runway'")
+    if m.start.runway is not None and m.runway is None:
+        raise where.error(("start", "runway"), "a runway start needs a top-level 'runway'")
+    air = m.start.air
+    if air is not None:
+        if air.before_threshold_ft is not None and m.runway is None:
+            raise where.error(("start", "air", "before_threshold_ft"), "needs a top-level 'runway'")
+        if air.heading_deg is None and m.runway is None:
+            raise where.error(("start", "air", "heading_deg"), "missing required field (no runway to take it from)")
+        if (air.latitude_deg is None) != (air.longitude_deg is None):
+            raise where.error(("start", "air", "latitude_deg"), "give both latitude_deg and longitude_deg, or neither")
+        if air.before_threshold_ft is not None and air.latitude_deg is not None:
+            raise where.error(("start", "air", "before_threshold_ft"), "give either lat/lon or before_threshold_ft")
+        if not profile.speeds.stall_kts <= air.airspeed_kts <= profile.speeds.vne_kts:
+            raise where.error(
+                ("start", "air", "airspeed_kts"),
+                f"{air.airspeed_kts:g} kt is outside {m.aircraft}'s flight envelope "
+                f"({profile.speeds.stall_kts:g}..{profile.speeds.vne_kts:g} kt)",
+            )
+        if air.flaps_deg > profile.limits.flaps_max_deg:
+            raise where.error(("start", "air", "flaps_deg"), f"more than the {profile.limits.flaps_max_deg:g} deg max")
+
+    on_ground = m.start.runway is not None
+    names = [p.name for p in m.phases]
+    for i, phase in enumerate(m.phases):
+        base: Loc = ("phases", i)
+        if names.index(phase.name) != i:
+            raise where.error((*base, "name"), f"duplicate phase name '{phase.name}'")
+        hold, until = phase.hold, phase.until
+        lateral = _set_fields(hold, LATERAL_TARGETS)
+        pitch = _set_fields(hold, PITCH_TARGETS)
+        if len(lateral) > 1:
+            raise where.error((*base, "hold", lateral[1]), f"contradicts '{lateral[0]}' (one lateral target at a time)")
+        if len(pitch) > 1:
+            raise where.error((*base, "hold", pitch[1]), f"contradicts '{pitch[0]}' (one pitch target at a time)")
+        if hold.airspeed_kts is not None and hold.throttle is not None and pitch:
+            raise where.error(
+                (*base, "hold", "airspeed_kts"),
+                f"contradicts 'throttle' and '{pitch[0]}': airspeed needs the throttle or the elevator free",
+            )
+        if hold.airspeed_kts is not None and hold.airspeed_kts > profile.speeds.vne_kts:
+            raise where.error((*base, "hold", "airspeed_kts"), f"above {m.aircraft}'s VNE")
+        if hold.flaps_deg is not None and hold.flaps_deg > profile.limits.flaps_max_deg:
+            raise where.error((*base, "hold", "flaps_deg"), f"more than the {profile.limits.flaps_max_deg:g} deg max")
+        if (hold.centreline or hold.glide_path_deg is not None or hold.flare) and m.runway is None:
+            key = "centreline" if hold.centreline else ("flare" if hold.flare else "glide_path_deg")
+            raise where.error((*base, "hold", key), "needs a top-level 'runway'")
+        conditions = _set_fields(until, [f for f in Until.model_fields if f != "timeout_s"])
+        if not conditions:
+            raise where.error((*base, "until"), "the phase can never end: give at least one end condition")
+        reasons = [_never_reason(c, until, hold, on_ground, profile, m) for c in conditions]
+        if all(r is not None for r in reasons):
+            raise where.error((*base, "until", conditions[0]), f"the phase can never end: {reasons[0]}")
+        if until.event == "liftoff":
+            on_ground = False
+        elif until.event in ("touchdown",):
+            on_ground = True
+        elif until.agl_below_ft is not None and until.agl_below_ft <= 0 and not on_ground:
+            on_ground = True
+
+    for j, check in enumerate(m.checks):
+        base = ("checks", j)
+        if check.signal not in COLUMN_NAMES and check.signal != "sink_fps":
+            raise where.error((*base, "signal"), f"unknown signal '{check.signal}' (one of: {', '.join(COLUMN_NAMES)})")
+        if check.signal == "sink_fps" and check.stat not in EVENT_STATS:
+            raise where.error((*base, "stat"), "sink_fps is measured at an event: use at_touchdown or at_liftoff")
+        if check.signal in RUNWAY_COLUMNS and m.runway is None:
+            raise where.error((*base, "signal"), f"'{check.signal}' needs a top-level 'runway'")
+        if check.stat == "turned" and check.signal != "psi_deg":
+            raise where.error((*base, "stat"), "'turned' applies to the heading signal psi_deg")
+        if check.min is None and check.max is None:
+            raise where.error(base, "give a 'min', a 'max' or both")
+        if check.min is not None and check.max is not None and check.min > check.max:
+            raise where.error((*base, "min"), f"greater than max ({check.min:g} > {check.max:g})")
+        for k, name in enumerate(check.phases or ()):
+            if name not in names:
+                raise where.error((*base, "phases", k), f"no phase named '{name}'")
+
+
+def _never_reason(cond: str, until: Until, hold: Hold, on_ground: bool, profile: Any, m: Manoeuvre) -> str | None:
+    """Why the end condition ``cond`` can never be met in this phase, or None if it can."""
+    value = getattr(until, cond)
+    if cond == "event":
+        if value == "liftoff" and not on_ground:
+            return "waits for lift-off but the aircraft is already flying"
+        if value == "touchdown" and on_ground:
+            return "waits for touchdown but the aircraft is already on the ground"
+        if value == "touchdown" and hold.altitude_ft is not None:
+            return "waits for touchdown while holding an altitude"
+        if value == "stopped" and not on_ground and hold.altitude_ft is not None:
+            return "waits for a stop while holding an altitude"
+        if value == "stall" and on_ground:
+            return "waits for a stall on the ground"
+        return None
+    if cond == "airspeed_above_kts" and value > profile.speeds.vne_kts:
+        return f"{value:g} kt is above {m.aircraft}'s VNE ({profile.speeds.vne_kts:g} kt)"
+    if cond == "airspeed_below_kts" and value <= 0:
+        return "an airspeed below zero"
+    if cond == "agl_below_ft" and value < 0:
+        return "a height below the ground"
+    if cond == "bank_above_deg" and (hold.wings_level or (hold.bank_deg is not None and abs(hold.bank_deg) < value)):
+        return "the bank held stays below it"
+    if cond == "turned_deg" and (hold.wings_level or hold.heading_deg is not None or hold.centreline):
+        return "the heading is held, so the aircraft never turns that far"
+    if hold.altitude_ft is not None:
+        if cond == "altitude_above_ft" and value > hold.altitude_ft:
+            return f"the altitude is held at {hold.altitude_ft:g} ft"
+        if cond == "altitude_below_ft" and value < hold.altitude_ft:
+            return f"the altitude is held at {hold.altitude_ft:g} ft"
+    if hold.pitch_deg is not None and not on_ground:
+        if cond == "pitch_above_deg" and value > hold.pitch_deg + 5:
+            return f"the pitch is held at {hold.pitch_deg:g} deg"
+        if cond == "pitch_below_deg" and value < hold.pitch_deg - 5:
+            return f"the pitch is held at {hold.pitch_deg:g} deg"
+    if cond == "alpha_above_deg" and value > 30:
+        return "an angle of attack beyond 30 deg"
+    if math.isnan(value) if isinstance(value, float) else False:
+        return "not a number"
+    return None
+
+
+# --- public API ----------------------------------------------------------------------------------
+
+
+def load_manoeuvre(path: str | Path) -> Manoeuvre:
+    """Read, validate and semantically check a manoeuvre file; raise a one-line WashbenchError."""
+    path = Path(path)
+    data, lines = read_yaml(path)
+    m = validate_data(path, data, lines, Manoeuvre)
+    _check_semantics(m, _Where(path, lines))
+    _SOURCES[id(m)] = path
+    return m
+
+
+_SOURCES: dict[int, Path] = {}
+
+
+def validate_command(paths: Sequence[Path]) -> int:
+    """``washbench validate FILE...``: print ``FILE: OK`` or the error line per file; 2 if any is bad."""
+    bad = 0
+    for path in paths:
+        try:
+            load_manoeuvre(path)
+        except WashbenchError as exc:
+            print(f"washbench: error: {exc}", file=sys.stderr)
+            bad += 1
+        else:
+            print(f"{path}: OK")
+    return 2 if bad else 0
+
+
+def manoeuvre_json_schema() -> dict[str, Any]:
+    """The JSON Schema of manoeuvre files (for editors: completion and checking)."""
+    schema = Manoeuvre.model_json_schema()
+    schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
+    schema["title"] = "washbench manoeuvre"
+    return schema
+
+
+def schema_command(out: Path | None) -> int:
+    """``washbench schema [--out FILE]``: print or write the JSON Schema."""
+    text = json.dumps(manoeuvre_json_schema(), indent=2, sort_keys=True) + "\n"
+    if out is None:
+        sys.stdout.write(text)
+    else:
+        write_text_atomic(out, text)
+    return 0

@@ -1,0 +1,231 @@
+"""Vestibular models: what a pilot perceives of specific force and angular velocity.
+
+Two linear models from the paper (Eqs. 11 and 12, after Reid and Nahon, Part 1), applied
+independently to each body axis (x forward, y right, z down) of a whole trace:
+
+* otolith (Meiry and Young), specific force ``f`` [m/s^2] -> perceived specific force [m/s^2]::
+
+      f_hat / f = (K tau_a s + 1) / ((tau_L s + 1)(tau_S s + 1))     DC gain 1
+
+* semicircular canals (Young and Oman), angular velocity ``omega`` [rad/s] -> perceived angular
+  velocity [rad/s]::
+
+      w_hat / w = T_L T_a s^2 / ((T_L s + 1)(T_S s + 1)(T_a s + 1))  DC gain 0
+
+Discretisation (done once per time step ``dt``): each model is split into partial fractions
+``sum_i r_i / (s - p_i)`` (its poles are real and distinct; both models are strictly proper)
+and every first-order term is discretised exactly for an input that is linear between samples
+(first-order hold, "triangle hold"). That is the same input assumption as
+``scipy.signal.lsim``, so the discrete response equals the continuous one for the linearly
+interpolated input, for any uniform ``dt`` (1/50, 1/120, 1/1000 s ...). The parallel form keeps
+full precision where a direct polynomial form would not (poles within 3e-5 of z = 1 at 1 kHz,
+and the canal's exact DC gain of 0).
+
+Filters start in the steady state of the first sample: a trace that begins in level flight
+(f = [0, 0, -g], omega = 0) perceives [0, 0, -g] and zero rotation from the first sample on.
+
+Optional perception thresholds (:mod:`washbench.perception.thresholds`) are applied to the
+model outputs as a dead band; they are off by default.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.signal
+from pydantic import Field
+
+from washbench.perception.thresholds import Thresholds, apply_deadband
+from washbench.yamlio import StrictModel
+
+
+class OtolithParams(StrictModel):
+    """Otolith model, Eq. 11: ``(K tau_a s + 1) / ((tau_L s + 1)(tau_S s + 1))``.
+
+    Defaults are the paper's "typical values" (Reid and Nahon, Part 1).
+    """
+
+    K: float = Field(default=0.4, ge=0.0, description="lead gain [-]")
+    tau_L_s: float = Field(default=5.33, gt=0.0, description="long time constant [s]")
+    tau_S_s: float = Field(default=0.66, gt=0.0, description="short time constant [s]")
+    tau_a_s: float = Field(default=13.2, gt=0.0, description="lead time constant [s]")
+
+
+class CanalParams(StrictModel):
+    """Semicircular canal model, Eq. 12: ``T_L T_a s^2 / ((T_L s + 1)(T_S s + 1)(T_a s + 1))``.
+
+    Defaults are the paper's "typical values" (Reid and Nahon, Part 1).
+    """
+
+    T_L_s: float = Field(default=10.2, gt=0.0, description="long time constant [s]")
+    T_S_s: float = Field(default=0.1, gt=0.0, description="short time constant [s]")
+    T_a_s: float = Field(default=30.0, gt=0.0, description="adaptation time constant [s]")
+
+
+class VestibularParams(StrictModel):
+    """Both vestibular models and the optional perception thresholds (``None``: no dead band)."""
+
+    otolith: OtolithParams = OtolithParams()
+    canals: CanalParams = CanalParams()
+    thresholds: Thresholds | None = None
+
+
+def otolith_tf(p: OtolithParams) -> tuple[np.ndarray, np.ndarray]:
+    """Continuous otolith transfer function as (numerator, denominator) polynomial coefficients in s."""
+    num = np.array([p.K * p.tau_a_s, 1.0])
+    den = np.polymul([p.tau_L_s, 1.0], [p.tau_S_s, 1.0])
+    return num, den
+
+
+def canal_tf(p: CanalParams) -> tuple[np.ndarray, np.ndarray]:
+    """Continuous semicircular canal transfer function as (numerator, denominator) coefficients in s."""
+    num = np.array([p.T_L_s * p.T_a_s, 0.0, 0.0])
+    den = np.polymul(np.polymul([p.T_L_s, 1.0], [p.T_S_s, 1.0]), [p.T_a_s, 1.0])
+    return num, den
+
+
+@dataclass(frozen=True)
+class PartialFractions:
+    """``H(s) = sum_i residues[i] / (s - poles[i])`` with real, distinct, negative poles [1/s]."""
+
+    residues: tuple[float, ...]
+    poles: tuple[float, ...]
+
+
+def partial_fractions(num: np.ndarray, time_constants_s: tuple[float, ...]) -> PartialFractions:
+    """Partial fractions of ``num(s) / prod_i (tau_i s + 1)`` (degree of ``num`` below the number of taus).
+
+    Raises ValueError if two time constants are (nearly) equal: the models then have a repeated
+    pole, which this parallel form does not represent.
+    """
+    taus = tuple(float(t) for t in time_constants_s)
+    if len(num) > len(taus):
+        raise ValueError("transfer function must be strictly proper")
+    for i, a in enumerate(taus):
+        for b in taus[i + 1 :]:
+            if abs(a - b) <= 1e-6 * max(a, b):
+                raise ValueError(f"time constants {a} s and {b} s must differ (repeated pole)")
+    poles = tuple(-1.0 / t for t in taus)
+    lead = math.prod(taus)
+    residues = []
+    for i, p_i in enumerate(poles):
+        others = math.prod(p_i - p_j for j, p_j in enumerate(poles) if j != i)
+        residues.append(float(np.polyval(num, p_i)) / (lead * others))
+    return PartialFractions(residues=tuple(residues), poles=poles)
+
+
+def _foh_weights(x: float) -> tuple[float, float]:
+    """Dimensionless first-order-hold weights for ``dx/dt = -a x + u`` over one step, ``x = a dt``.
+
+    ``x[k+1] = exp(-a dt) x[k] + dt (g0 u[k] + g1 u[k+1])`` with u linear over the step.
+    ``g0 + g1 = (1 - exp(-x)) / x`` and ``g1 = (x - 1 + exp(-x)) / x^2`` (series for small x,
+    where the closed form loses digits to cancellation).
+    """
+    total = -math.expm1(-x) / x
+    if x < 1e-2:
+        g1 = 0.0
+        term = 0.5
+        n = 2
+        while abs(term) > 1e-18:
+            g1 += term
+            n += 1
+            term *= -x / n
+    else:
+        g1 = (x + math.expm1(-x)) / (x * x)
+    return total - g1, g1
+
+
+@dataclass(frozen=True)
+class DiscreteModel:
+    """A vestibular model discretised for one uniform time step, in parallel first-order sections.
+
+    Section i: ``x_i[k] = phi_i x_i[k-1] + b1_i u[k] + b0_i u[k-1]`` (residue folded into b),
+    output ``y[k] = sum_i x_i[k]``. Apply with :meth:`apply`.
+    """
+
+    dt_s: float
+    b: tuple[tuple[float, float], ...]  # per section: (coefficient of u[k], coefficient of u[k-1])
+    phi: tuple[float, ...]
+    dc_gain: float
+
+    @classmethod
+    def from_partial_fractions(cls, pf: PartialFractions, dt_s: float) -> DiscreteModel:
+        if not (dt_s > 0.0 and math.isfinite(dt_s)):
+            raise ValueError(f"time step must be positive and finite, got {dt_s}")
+        b, phi = [], []
+        for r, p in zip(pf.residues, pf.poles, strict=True):
+            a = -p
+            g0, g1 = _foh_weights(a * dt_s)
+            b.append((r * dt_s * g1, r * dt_s * g0))
+            phi.append(math.exp(-a * dt_s))
+        dc = sum(-r / p for r, p in zip(pf.residues, pf.poles, strict=True))
+        return cls(dt_s=dt_s, b=tuple(b), phi=tuple(phi), dc_gain=dc)
+
+    def apply(self, u: np.ndarray) -> np.ndarray:
+        """Filter ``u`` (N,) or (N, m) along axis 0, starting in the steady state of ``u[0]``.
+
+        Returns float64 of the same shape. Vectorised (``scipy.signal.lfilter``), no Python loop over samples.
+        """
+        u = np.asarray(u, dtype=np.float64)
+        if u.ndim not in (1, 2) or u.shape[0] == 0:
+            raise ValueError(f"expected a non-empty (N,) or (N, m) array, got shape {u.shape}")
+        y = np.zeros_like(u)
+        u0 = u[0]
+        for (b1, b0), phi in zip(self.b, self.phi, strict=True):
+            bb = np.array([b1, b0])
+            aa = np.array([1.0, -phi])
+            zi = scipy.signal.lfilter_zi(bb, aa)  # (1,): steady state for a unit constant input
+            zi = zi.reshape((1,) + (1,) * (u.ndim - 1)) * u0
+            out, _ = scipy.signal.lfilter(bb, aa, u, axis=0, zi=zi)
+            y += out
+        return y
+
+
+def otolith_model(p: OtolithParams, dt_s: float) -> DiscreteModel:
+    """The otolith model (Eq. 11) discretised for time step ``dt_s`` [s]."""
+    num, _ = otolith_tf(p)
+    return DiscreteModel.from_partial_fractions(partial_fractions(num, (p.tau_L_s, p.tau_S_s)), dt_s)
+
+
+def canal_model(p: CanalParams, dt_s: float) -> DiscreteModel:
+    """The semicircular canal model (Eq. 12) discretised for time step ``dt_s`` [s]."""
+    num, _ = canal_tf(p)
+    return DiscreteModel.from_partial_fractions(partial_fractions(num, (p.T_L_s, p.T_S_s, p.T_a_s)), dt_s)
+
+
+@dataclass(frozen=True)
+class Perceived:
+    """Perceived motion of one pilot, body axes: ``f_mps2`` (N, 3) [m/s^2], ``omega_radps`` (N, 3) [rad/s]."""
+
+    f_mps2: np.ndarray
+    omega_radps: np.ndarray
+
+
+class VestibularModel:
+    """Both models discretised once for ``dt_s``; :meth:`perceive` applies them to whole traces."""
+
+    def __init__(self, dt_s: float, params: VestibularParams | None = None) -> None:
+        self.params = params if params is not None else VestibularParams()
+        self.dt_s = float(dt_s)
+        self.otolith = otolith_model(self.params.otolith, self.dt_s)
+        self.canals = canal_model(self.params.canals, self.dt_s)
+
+    def perceive(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> Perceived:
+        """Perceived specific force and angular velocity for one pilot's head motion (N, 3) each."""
+        f = _check_n3(f_mps2, "f_mps2")
+        w = _check_n3(omega_radps, "omega_radps")
+        f_hat = self.otolith.apply(f)
+        w_hat = self.canals.apply(w)
+        th = self.params.thresholds
+        if th is not None:
+            f_hat, w_hat = apply_deadband(f_hat, w_hat, th)
+        return Perceived(f_mps2=f_hat, omega_radps=w_hat)
+
+
+def _check_n3(a: np.ndarray, name: str) -> np.ndarray:
+    a = np.asarray(a, dtype=np.float64)
+    if a.ndim != 2 or a.shape[1] != 3 or a.shape[0] == 0:
+        raise ValueError(f"{name} must have shape (N, 3) with N >= 1, got {a.shape}")
+    return a

@@ -1,0 +1,356 @@
+"""``washbench suite``: many manoeuvres in parallel processes, then a comparison of the washouts.
+
+Each manoeuvre runs through :func:`washbench.pipeline.run_manoeuvre` in its own worker process
+and writes ``OUT/<aircraft>/<manoeuvre>/`` (published atomically as a whole folder). A manoeuvre
+that fails (bad file, crash, divergence, failed check, or an unexpected error) is reported with its
+reason; the others still complete and are kept. Then the suite writes, each file atomically:
+
+- ``OUT/metrics.csv``: ``aircraft,manoeuvre,washout,dof,npc,integral_error,max_error``
+- ``OUT/comparison.csv``: every metric per washout and DOF with its difference from small-angle
+  (positive = better than small-angle), like the paper's Table 4
+- ``OUT/ranking.csv``: the three washouts ranked per manoeuvre by the rule of
+  :mod:`washbench.ranking`
+- ``OUT/report.md``: all of it, with links to each recording, written last.
+
+The exit status is 0 only if every manoeuvre ran and passed its checks.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+import multiprocessing
+import os
+import sys
+import time
+import traceback
+from collections.abc import Sequence
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from washbench.atomic import write_text_atomic
+from washbench.errors import WashbenchError, located
+from washbench.paths import MANOEUVRES_DIR
+from washbench.ranking import (
+    DOFS,
+    METRICS,
+    REFERENCE_WASHOUT,
+    MetricRow,
+    RankRow,
+    compare,
+    rank,
+    wins,
+)
+
+
+@dataclass
+class Outcome:
+    """What one manoeuvre's run gave the suite (picklable, sent back from the worker)."""
+
+    path: str
+    ok: bool
+    reason: str = ""
+    aircraft: str = ""
+    manoeuvre: str = ""
+    run_dir: str = ""
+    wall_s: float = 0.0
+    steps: int = 0
+    checks_passed: int = 0
+    checks_total: int = 0
+    metrics: list[MetricRow] = field(default_factory=list)
+    motion: dict[str, float] = field(default_factory=dict)
+    saturations: dict[str, dict[str, int]] = field(default_factory=dict)
+
+
+def find_manoeuvres(inputs: Sequence[Path]) -> list[Path]:
+    """Manoeuvre files from files and folders (folders are searched recursively for ``*.yaml``)."""
+    if not inputs:
+        inputs = [MANOEUVRES_DIR]
+    found: list[Path] = []
+    for item in inputs:
+        if item.is_dir():
+            found.extend(sorted(p for p in item.rglob("*.yaml") if p.is_file()))
+        elif item.is_file():
+            found.append(item)
+        else:
+            raise WashbenchError(located(item, "no such file or folder"))
+    unique = list(dict.fromkeys(p.resolve() for p in found))
+    if not unique:
+        raise WashbenchError(located(inputs[0], "no manoeuvre files (*.yaml) found"))
+    return unique
+
+
+def _run_one(path: str, out_dir: str, params_path: str | None, platform_path: str | None) -> Outcome:
+    """Worker: run one manoeuvre; never raises (failures come back as an Outcome)."""
+    from washbench.pipeline import run_manoeuvre
+
+    start = time.perf_counter()
+    try:
+        summary = run_manoeuvre(
+            Path(path),
+            Path(out_dir),
+            params_path=Path(params_path) if params_path else None,
+            platform_path=Path(platform_path) if platform_path else None,
+        )
+    except WashbenchError as exc:
+        return Outcome(path=path, ok=False, reason=str(exc), wall_s=time.perf_counter() - start)
+    except Exception as exc:  # an unexpected bug in one run must not take the suite down
+        tb = traceback.format_exc(limit=-3).strip().splitlines()
+        where = tb[-3].strip() if len(tb) >= 3 else ""
+        return Outcome(
+            path=path,
+            ok=False,
+            reason=f"internal error: {type(exc).__name__}: {exc} ({where})",
+            wall_s=time.perf_counter() - start,
+        )
+    return Outcome(
+        path=path,
+        ok=summary.ok,
+        reason=summary.reason,
+        aircraft=summary.aircraft,
+        manoeuvre=summary.manoeuvre,
+        run_dir=str(summary.run_dir),
+        wall_s=time.perf_counter() - start,
+        steps=summary.steps,
+        checks_passed=summary.checks_passed,
+        checks_total=summary.checks_total,
+        metrics=summary.metrics,
+        motion=summary.motion,
+        saturations=summary.saturations,
+    )
+
+
+def run_suite(
+    files: Sequence[Path],
+    out_dir: Path,
+    *,
+    jobs: int | None = None,
+    params_path: Path | None = None,
+    platform_path: Path | None = None,
+    progress: bool = True,
+) -> list[Outcome]:
+    """Run every file in parallel processes; return the outcomes in the order of ``files``."""
+    jobs = max(1, min(jobs or os.cpu_count() or 1, len(files)))
+    out_dir.mkdir(parents=True, exist_ok=True)
+    args = [
+        (str(f), str(out_dir), str(params_path) if params_path else None, str(platform_path) if platform_path else None)
+        for f in files
+    ]
+    outcomes: dict[str, Outcome] = {}
+    start = time.perf_counter()
+    if progress:
+        print(
+            f"suite: {len(files)} manoeuvres on {jobs} process{'es' if jobs > 1 else ''} -> {out_dir}", file=sys.stderr
+        )
+    if jobs == 1:
+        for a in args:
+            outcomes[a[0]] = _report(_run_one(*a), len(outcomes) + 1, len(files), start, progress)
+    else:
+        ctx = multiprocessing.get_context("forkserver")
+        with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as pool:
+            futures = [pool.submit(_run_one, *a) for a in args]
+            for fut in as_completed(futures):
+                outcome = fut.result()
+                outcomes[outcome.path] = _report(outcome, len(outcomes) + 1, len(files), start, progress)
+    return [outcomes[a[0]] for a in args]
+
+
+def _report(outcome: Outcome, done: int, total: int, start: float, progress: bool) -> Outcome:
+    if progress:
+        name = f"{outcome.aircraft}/{outcome.manoeuvre}" if outcome.aircraft else _short(outcome.path)
+        state = "ok  " if outcome.ok else "FAIL"
+        extra = f"checks {outcome.checks_passed}/{outcome.checks_total}" if outcome.checks_total else ""
+        line = f"[{done:>2}/{total}] {state} {name:<40} {outcome.wall_s:6.1f} s  {extra}"
+        if not outcome.ok:
+            line += f"\n        {outcome.reason}"
+        print(f"{line}   (elapsed {time.perf_counter() - start:.0f} s)", file=sys.stderr, flush=True)
+    return outcome
+
+
+def _short(path: str) -> str:
+    try:
+        return str(Path(path).relative_to(Path.cwd()))
+    except ValueError:
+        return path
+
+
+def _fmt(x: float) -> str:
+    return "" if math.isnan(x) else repr(float(x))
+
+
+def _csv(rows: list[list[str]]) -> str:
+    buf = io.StringIO()
+    csv.writer(buf, lineterminator="\n").writerows(rows)
+    return buf.getvalue()
+
+
+def _runs_with_metrics(outcomes: Sequence[Outcome]) -> list[Outcome]:
+    return [o for o in outcomes if o.metrics]
+
+
+def metrics_table(outcomes: Sequence[Outcome]) -> str:
+    """``metrics.csv`` of the suite (every run that produced metrics, failed checks included)."""
+    rows = [["aircraft", "manoeuvre", "washout", "dof", "npc", "integral_error", "max_error"]]
+    for o in _runs_with_metrics(outcomes):
+        for m in o.metrics:
+            rows.append(
+                [o.aircraft, o.manoeuvre, m.washout, m.dof, _fmt(m.npc), _fmt(m.integral_error), _fmt(m.max_error)]
+            )
+    return _csv(rows)
+
+
+def comparison_table(outcomes: Sequence[Outcome]) -> str:
+    """``comparison.csv``: each metric per washout and DOF and its improvement over small-angle."""
+    washouts = _washouts(outcomes)
+    others = [w for w in washouts if w != REFERENCE_WASHOUT]
+    header = ["aircraft", "manoeuvre", "dof", "metric", *washouts, *[f"{w}_better_by" for w in others]]
+    rows = [header]
+    for o in _runs_with_metrics(outcomes):
+        for c in compare(o.metrics):
+            rows.append(
+                [o.aircraft, o.manoeuvre, c.dof, c.metric]
+                + [_fmt(c.values.get(w, math.nan)) for w in washouts]
+                + [_fmt(c.better_than_reference.get(w, math.nan)) for w in others]
+            )
+    return _csv(rows)
+
+
+def ranking_table(rankings: dict[tuple[str, str], list[RankRow]]) -> str:
+    """``ranking.csv``: rank, washout and score (lower is better) per manoeuvre."""
+    rows = [["aircraft", "manoeuvre", "rank", "washout", "score"]]
+    for (aircraft, manoeuvre), ranking in rankings.items():
+        for r in ranking:
+            rows.append([aircraft, manoeuvre, str(r.rank), r.washout, _fmt(r.score)])
+    return _csv(rows)
+
+
+def _washouts(outcomes: Sequence[Outcome]) -> list[str]:
+    known = ["small-angle", "large-angle", "unrestricted"]
+    seen = {m.washout for o in outcomes for m in o.metrics}
+    return [w for w in known if w in seen] + sorted(seen - set(known))
+
+
+def report_markdown(outcomes: Sequence[Outcome], rankings: dict[tuple[str, str], list[RankRow]], out_dir: Path) -> str:
+    """``report.md``: status, ranking, Table-4 comparison and metrics of every manoeuvre."""
+    ok = [o for o in outcomes if o.ok]
+    lines = [
+        "# washbench suite report",
+        "",
+        f"{len(ok)} of {len(outcomes)} manoeuvres ran and passed their checks.",
+        "",
+        "Metrics compare the aircraft pilot's perceived motion with each simulator pilot's: NPC is the",
+        "normalized Pearson correlation (1 is perfect, larger is worse, empty where a signal is flat),",
+        "integral and maximum of |error| in m/s^2 (integral m/s^2*s) for surge, sway, heave and deg/s",
+        "(integral deg) for roll, pitch, yaw. In the comparison, `better by` is small-angle minus the",
+        "washout: positive means better than small-angle. The score (lower is better) is the weighted",
+        "relative integral error of `washbench/ranking.py`: each DOF's error over the aircraft pilot's own",
+        "perceived motion in it, DOFs weighted by how much was felt there (half the weight to specific",
+        "force, half to rotation); a DOF the pilot did not feel weighs nothing.",
+        "",
+        "## Summary",
+        "",
+        "| aircraft | manoeuvre | status | checks | best washout | scores (small / large / unrestricted) | recording |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for o in outcomes:
+        key = (o.aircraft, o.manoeuvre)
+        ranking = rankings.get(key, [])
+        best = ranking[0].washout if ranking else ""
+        by_name = {r.washout: r.score for r in ranking}
+        scores = " / ".join(
+            f"{by_name[w]:.3f}" if w in by_name else "-" for w in ("small-angle", "large-angle", "unrestricted")
+        )
+        status = "ok" if o.ok else "FAILED"
+        rec = ""
+        if o.run_dir and (Path(o.run_dir) / "recording.rrd").exists():
+            rel = os.path.relpath(Path(o.run_dir) / "recording.rrd", out_dir)
+            rec = f"[recording.rrd]({rel})"
+        name = o.manoeuvre or _short(o.path)
+        checks = f"{o.checks_passed}/{o.checks_total}" if o.checks_total else "-"
+        lines.append(f"| {o.aircraft or '-'} | {name} | {status} | {checks} | {best} | {scores} | {rec} |")
+    failed = [o for o in outcomes if not o.ok]
+    if failed:
+        lines += ["", "## Failures", ""]
+        for o in failed:
+            lines.append(f"- `{_short(o.path)}`: {o.reason}")
+    if rankings:
+        count = wins(rankings.values())
+        lines += ["", "Manoeuvres won: " + ", ".join(f"{w} {n}" for w, n in count.items()), ""]
+    for o in _runs_with_metrics(outcomes):
+        lines += ["", f"## {o.aircraft} / {o.manoeuvre}", ""]
+        if o.run_dir:
+            rel = os.path.relpath(o.run_dir, out_dir)
+            lines.append(f"Results in `{rel}/`; replay with `washbench replay {rel}/recording.rrd`.")
+            lines.append("")
+        sat = ", ".join(
+            f"{w}: " + (", ".join(f"{k} {n}" for k, n in kinds.items() if n) or "none")
+            for w, kinds in o.saturations.items()
+        )
+        if sat:
+            lines += [f"Platform saturations (steps at a limit): {sat}.", ""]
+        lines += _comparison_md(o)
+    return "\n".join(lines) + "\n"
+
+
+def _comparison_md(o: Outcome) -> list[str]:
+    washouts = _washouts([o])
+    others = [w for w in washouts if w != REFERENCE_WASHOUT]
+    head = "| DOF | metric | " + " | ".join(washouts) + " | " + " | ".join(f"{w} better by" for w in others) + " |"
+    lines = [head, "|" + "---|" * (2 + len(washouts) + len(others))]
+    for c in compare(o.metrics):
+        vals = " | ".join(_md_num(c.values.get(w, math.nan)) for w in washouts)
+        diffs = " | ".join(_md_num(c.better_than_reference.get(w, math.nan), signed=True) for w in others)
+        lines.append(f"| {c.dof} | {c.metric} | {vals} | {diffs} |")
+    return lines
+
+
+def _md_num(x: float, signed: bool = False) -> str:
+    if math.isnan(x):
+        return ""
+    return f"{x:+.4g}" if signed else f"{x:.4g}"
+
+
+def write_suite_results(outcomes: Sequence[Outcome], out_dir: Path) -> None:
+    """Write metrics.csv, comparison.csv, ranking.csv and (last) report.md, each atomically."""
+    rankings = {(o.aircraft, o.manoeuvre): rank(o.metrics, o.motion) for o in _runs_with_metrics(outcomes)}
+    write_text_atomic(out_dir / "metrics.csv", metrics_table(outcomes))
+    write_text_atomic(out_dir / "comparison.csv", comparison_table(outcomes))
+    write_text_atomic(out_dir / "ranking.csv", ranking_table(rankings))
+    write_text_atomic(out_dir / "report.md", report_markdown(outcomes, rankings, out_dir))
+
+
+def suite_command(
+    inputs: Sequence[Path],
+    out_dir: Path,
+    *,
+    jobs: int | None = None,
+    params_path: Path | None = None,
+    platform_path: Path | None = None,
+    progress: bool = True,
+) -> int:
+    """CLI entry: run the suite, write its results, print where they are; 0 if all succeeded, else 1."""
+    if jobs is not None and jobs < 1:
+        raise WashbenchError(f"--jobs: expected a whole number of at least 1, got {jobs}")
+    files = find_manoeuvres(inputs)
+    # Fail fast on a bad parameter or platform file: every run would fail the same way.
+    from washbench.cueing import load_washout_params
+    from washbench.platform import load_platform_limits
+
+    load_washout_params(params_path)
+    load_platform_limits(platform_path)
+    start = time.perf_counter()
+    outcomes = run_suite(
+        files, out_dir, jobs=jobs, params_path=params_path, platform_path=platform_path, progress=progress
+    )
+    write_suite_results(outcomes, out_dir)
+    n_ok = sum(o.ok for o in outcomes)
+    print(
+        f"suite: {n_ok}/{len(outcomes)} manoeuvres ok in {time.perf_counter() - start:.1f} s; "
+        f"report: {out_dir / 'report.md'}"
+    )
+    return 0 if n_ok == len(outcomes) else 1
+
+
+__all__ = ["DOFS", "METRICS", "Outcome", "find_manoeuvres", "run_suite", "suite_command", "write_suite_results"]
