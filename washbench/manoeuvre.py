@@ -13,7 +13,6 @@ blowing towards the east). Airspeeds are calibrated (KCAS ~ KIAS).
 from __future__ import annotations
 
 import json
-import math
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -385,8 +384,6 @@ def _never_reason(cond: str, until: Until, hold: Hold, on_ground: bool, profile:
             return f"the pitch is held at {hold.pitch_deg:g} deg"
     if cond == "alpha_above_deg" and value > 30:
         return "an angle of attack beyond 30 deg"
-    if math.isnan(value) if isinstance(value, float) else False:
-        return "not a number"
     return None
 
 
@@ -399,11 +396,7 @@ def load_manoeuvre(path: str | Path) -> Manoeuvre:
     data, lines = read_yaml(path)
     m = validate_data(path, data, lines, Manoeuvre)
     _check_semantics(m, _Where(path, lines))
-    _SOURCES[id(m)] = path
     return m
-
-
-_SOURCES: dict[int, Path] = {}
 
 
 def validate_command(paths: Sequence[Path]) -> int:

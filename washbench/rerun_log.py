@@ -8,10 +8,11 @@ A recording holds, on one timeline named ``time`` (a duration, seconds since the
 - ``/envelope/<quantity>/<washout>``: platform envelope usage, max over the three axes of |value| / limit
   (``quantity`` in position, velocity, acceleration, wheels), the limit line ``/envelope/<quantity>/limit`` at 1, and
   saturation markers ``/envelope/<panel>/saturation/<washout>/<kind>`` at value 1 at every saturated sample;
-- ``/platform/<washout>/<quantity>/<axis>``: the platform's stage position, velocity, acceleration (NED, SI) and
-  omni-wheel speeds (rad/s), with ``limit_max`` and ``limit_min`` lines;
+- ``/platform/<washout>/<quantity>/axes``: the platform's stage position, velocity, acceleration (NED, SI) and
+  omni-wheel speeds (rad/s), three scalars per row, with ``limit_max`` and ``limit_min`` lines;
 - ``/world/...``: a 3D scene (NED, x north, y east, z down) with the aircraft's attitude and, per washout, the Atlas
-  sphere (diameter 2.9 m) translated by the stage position and rotated by the simulator cockpit's attitude;
+  sphere (``envelope.sphere_diameter_m``, 2.9 m) translated by the stage position and rotated by the simulator
+  cockpit's attitude;
 - ``/events/phases`` and ``/events/saturation``: text log entries at phase starts and saturation onsets;
 - ``/metrics``: the metric table as a Markdown document.
 
@@ -33,6 +34,7 @@ import rerun as rr
 import rerun.blueprint as rrb
 
 from washbench.atomic import atomic_path
+from washbench.errors import WashbenchError, located
 
 __all__ = [
     "AIRCRAFT",
@@ -94,9 +96,6 @@ _LIMIT_COLOR = (150, 150, 150)
 _AXIS_COLORS = ((230, 80, 80), (80, 200, 80), (90, 140, 255))  # x, y, z (or wheel 1, 2, 3) inside one washout panel
 _SATURATION_MARKERS = ("Cross", "Diamond", "Square", "Up", "Down", "Plus", "Asterisk", "Left", "Right", "Circle")
 
-SPHERE_DIAMETER_M = 2.9
-"""Diameter of the Atlas sphere drawn in the 3D view, metres."""
-
 
 @dataclass(frozen=True)
 class MotionSeries:
@@ -125,17 +124,29 @@ class PlatformSeries:
 
 @dataclass(frozen=True)
 class PlatformEnvelope:
-    """Symmetric per-axis platform limits (+- value), for envelope-usage plots."""
+    """Symmetric platform limits (+- value), for envelope-usage plots.
 
-    pos_m: float
-    vel_mps: float
-    acc_mps2: float
-    wheel_radps: float
+    Each limit is one value for all three axes (wheels) or a per-axis triple (x, y, z NED or w1, w2, w3), e.g. the
+    Atlas stage's ``position_limit_m`` (1.5, 1.5, 1.0).
+    """
+
+    pos_m: float | tuple[float, float, float]
+    vel_mps: float | tuple[float, float, float]
+    acc_mps2: float | tuple[float, float, float]
+    wheel_radps: float | tuple[float, float, float]
+    sphere_diameter_m: float = 2.9  # drawn in the 3D view
+
+    def axes(self, fname: str) -> np.ndarray:
+        """The limit ``fname`` (e.g. "pos_m") as a per-axis array (3,)."""
+        return np.broadcast_to(np.asarray(getattr(self, fname), dtype=np.float64), (3,)).copy()
 
 
 @dataclass(frozen=True)
 class RecordingData:
-    """Everything one recording shows; ``washouts`` and ``platforms`` have the same keys."""
+    """Everything one recording shows; ``washouts`` and ``platforms`` have the same keys.
+
+    A washout's MotionSeries is its simulator pilot's motion; its attitude ``q`` is the Atlas sphere's orientation.
+    """
 
     title: str  # e.g. "c172p / coordinated_turn"
     t_s: np.ndarray  # (N,) = k * dt, seconds
@@ -166,9 +177,9 @@ def envelope_usage_path(quantity: str, washout: str) -> str:
     return f"/envelope/{quantity}/{washout}"
 
 
-def platform_path(washout: str, quantity: str, axis: str) -> str:
-    """Entity path of one axis ("x", "y", "z" or "w1", "w2", "w3") of a platform quantity, SI units."""
-    return f"/platform/{washout}/{quantity}/{axis}"
+def platform_path(washout: str, quantity: str) -> str:
+    """Entity path of a platform quantity: three scalars per row (axes x, y, z, or wheels w1, w2, w3), SI units."""
+    return f"/platform/{washout}/{quantity}/axes"
 
 
 def series_color(source: str, washouts: list[str] | tuple[str, ...] = ()) -> tuple[int, int, int]:
@@ -236,10 +247,14 @@ def _check(data: RecordingData) -> int:
             _check_array(f"platforms[{w}].{fname}", getattr(p, fname), (n, 3))
         for kind, flags in p.saturated.items():
             _check_array(f"platforms[{w}].saturated[{kind}]", flags, (n,), "b")
-    for _, fname, _ in ENVELOPE_QUANTITIES:
-        limit = getattr(data.envelope, fname)
-        if not (isinstance(limit, int | float) and np.isfinite(limit) and limit > 0):
-            raise ValueError(f"envelope.{fname}: expected a positive finite number, got {limit!r}")
+    for fname in [f for _, f, _ in ENVELOPE_QUANTITIES] + ["sphere_diameter_m"]:
+        limit = np.asarray(getattr(data.envelope, fname))
+        if (
+            limit.shape not in ((), (3,))
+            or limit.dtype.kind not in "fiu"
+            or not np.all(np.isfinite(limit) & (limit > 0))
+        ):
+            raise ValueError(f"envelope.{fname}: expected a positive number or three, got {limit.tolist()!r}")
     for name, t0, t1 in data.phases:
         if not (isinstance(name, str) and t0 <= t1):
             raise ValueError(f"phase {name!r}: expected a name and t_start_s <= t_end_s, got {t0}, {t1}")
@@ -267,14 +282,14 @@ def build_blueprint(washouts: list[str] | tuple[str, ...], saturation_kinds: Map
         for dof, sig, _, unit in DOFS
     ]
     usage = [
-        rrb.TimeSeriesView(
-            origin=f"/envelope/{q}", name=f"Envelope usage: {q} (|{q}| / limit, max over axes)", axis_y=None
-        )
+        rrb.TimeSeriesView(origin=f"/envelope/{q}", name=f"Envelope: {q} (max |axis| / limit)")
         for q, _, _ in ENVELOPE_QUANTITIES
     ]
     other_kinds = sorted({k for kinds in saturation_kinds.values() for k in kinds if k not in _SATURATION_PANEL})
     if other_kinds:
-        usage.append(rrb.TimeSeriesView(origin="/envelope/other", name=f"Other limits reached ({', '.join(other_kinds)})"))
+        usage.append(
+            rrb.TimeSeriesView(origin="/envelope/other", name=f"Other limits reached ({', '.join(other_kinds)})")
+        )
     per_washout = [
         rrb.Grid(
             *[
@@ -328,12 +343,24 @@ def _series(
     )
 
 
-def _limit_line(rec: rr.RecordingStream, path: str, t_s: np.ndarray, value: float, name: str) -> None:
-    """A horizontal line from the first to the last time (two samples)."""
+def _limit_line(
+    rec: rr.RecordingStream,
+    path: str,
+    t_s: np.ndarray,
+    values: list[float],
+    names: list[str],
+    colors: list[tuple[int, int, int]] | None = None,
+) -> None:
+    """Horizontal lines (one per value) from the first to the last time (two samples each)."""
     ends = np.array([t_s[0], t_s[-1]], dtype=np.float64)
-    rec.log(path, rr.SeriesLines(colors=[_LIMIT_COLOR], names=[name], widths=[1.0]), static=True, strict=True)
+    colors = colors if colors is not None else [_LIMIT_COLOR] * len(values)
+    rec.log(path, rr.SeriesLines(colors=colors, names=names, widths=[1.0] * len(values)), static=True, strict=True)
+    scalars = np.array([values, values], dtype=np.float64)
     rec.send_columns(
-        path, indexes=[_time_column(ends)], columns=rr.Scalars.columns(scalars=[value, value]), strict=True
+        path,
+        indexes=[_time_column(ends)],
+        columns=rr.Scalars.columns(scalars=scalars.ravel()).partition([len(values)] * 2),
+        strict=True,
     )
 
 
@@ -356,16 +383,34 @@ def _send_platforms(rec: rr.RecordingStream, data: RecordingData, time: rr.TimeC
     t_s = np.asarray(data.t_s, dtype=np.float64)
     washouts = list(data.washouts)
     for q, fname, unit in ENVELOPE_QUANTITIES:
-        limit = float(getattr(data.envelope, fname))
-        _limit_line(rec, f"/envelope/{q}/limit", t_s, 1.0, f"limit (+-{limit:g} {unit})")
+        limit = data.envelope.axes(fname)
+        text = f"{limit[0]:g}" if np.all(limit == limit[0]) else "/".join(f"{v:g}" for v in limit)
+        _limit_line(rec, f"/envelope/{q}/limit", t_s, [1.0], [f"limit (+-{text} {unit})"])
         for w in washouts:
             values = np.asarray(getattr(data.platforms[w], fname), dtype=np.float64)
-            usage = np.max(np.abs(values), axis=1) / limit
+            usage = np.max(np.abs(values) / limit, axis=1)
             _series(rec, envelope_usage_path(q, w), time, usage, f"{w}", series_color(w, washouts))
-            for i, axis in enumerate(_axis_names(q)):
-                _series(rec, platform_path(w, q, axis), time, values[:, i], f"{axis} ({unit})", _AXIS_COLORS[i])
-            _limit_line(rec, f"/platform/{w}/{q}/limit_max", t_s, limit, f"+limit ({unit})")
-            _limit_line(rec, f"/platform/{w}/{q}/limit_min", t_s, -limit, f"-limit ({unit})")
+            axes_path = platform_path(w, q)
+            names = [f"{axis} ({unit})" for axis in _axis_names(q)]
+            rec.log(axes_path, rr.SeriesLines(colors=list(_AXIS_COLORS), names=names), static=True, strict=True)
+            rec.send_columns(
+                axes_path,
+                indexes=[time],
+                columns=rr.Scalars.columns(scalars=values).partition(np.full(values.shape[0], 3)),
+                strict=True,
+            )
+            if np.all(limit == limit[0]):
+                _limit_line(rec, f"/platform/{w}/{q}/limit_max", t_s, [limit[0]], [f"+limit ({unit})"])
+                _limit_line(rec, f"/platform/{w}/{q}/limit_min", t_s, [-limit[0]], [f"-limit ({unit})"])
+            else:
+                axes = _axis_names(q)
+                colors = list(_AXIS_COLORS)
+                _limit_line(
+                    rec, f"/platform/{w}/{q}/limit_max", t_s, list(limit), [f"+{a} limit" for a in axes], colors
+                )
+                _limit_line(
+                    rec, f"/platform/{w}/{q}/limit_min", t_s, list(-limit), [f"-{a} limit" for a in axes], colors
+                )
     onsets: list[tuple[float, str]] = []
     for w in washouts:
         for j, (kind, flags) in enumerate(sorted(data.platforms[w].saturated.items())):
@@ -412,7 +457,9 @@ def _send_scene(rec: rr.RecordingStream, data: RecordingData, time: rr.TimeColum
     """3D scene: aircraft attitude triad, and per washout the stage-translated, attitude-rotated Atlas sphere."""
     n = np.asarray(data.t_s).size
     washouts = list(data.washouts)
-    spacing = 2.0 * float(data.envelope.pos_m) + SPHERE_DIAMETER_M + 1.0
+    travel = data.envelope.axes("pos_m")
+    diameter = float(data.envelope.sphere_diameter_m)
+    spacing = 2.0 * travel[1] + diameter + 1.0
     rec.log("/world", rr.ViewCoordinates.FRD, static=True, strict=True)  # x north, y east, z down
 
     def body_triad(path: str, length: float, color: tuple[int, int, int]) -> None:
@@ -445,7 +492,7 @@ def _send_scene(rec: rr.RecordingStream, data: RecordingData, time: rr.TimeColum
             f"/world/stage_range/{w}",
             rr.Boxes3D(
                 centers=[offset],
-                half_sizes=[[data.envelope.pos_m] * 3],
+                half_sizes=[travel],
                 colors=[_LIMIT_COLOR],
                 fill_mode="MajorWireframe",
                 labels=[f"{w} stage range"],
@@ -460,7 +507,7 @@ def _send_scene(rec: rr.RecordingStream, data: RecordingData, time: rr.TimeColum
             columns=rr.Transform3D.columns(translation=pos + offset, quaternion=quat_wxyz_to_xyzw(data.washouts[w].q)),
             strict=True,
         )
-        half = SPHERE_DIAMETER_M / 2.0
+        half = diameter / 2.0
         rec.log(
             f"/world/atlas/{w}/sphere",
             rr.Ellipsoids3D(
@@ -476,7 +523,9 @@ def _send_scene(rec: rr.RecordingStream, data: RecordingData, time: rr.TimeColum
 
 
 def _send_text(rec: rr.RecordingStream, data: RecordingData) -> None:
-    rec.log("/metrics", rr.TextDocument(data.metrics_markdown, media_type=rr.MediaType.MARKDOWN), static=True)
+    rec.log(
+        "/metrics", rr.TextDocument(data.metrics_markdown, media_type=rr.MediaType.MARKDOWN), static=True, strict=True
+    )
     if data.phases:
         rec.send_columns(
             "/events/phases",
@@ -493,7 +542,8 @@ def write_recording(path: Path, data: RecordingData) -> None:
     """Write ``data`` to the .rrd file ``path`` atomically (temp file in the same folder, then rename).
 
     No viewer and no network: the recording stream's only sink is the file. The review blueprint is stored in the same
-    file. Raises ValueError on inconsistent shapes; on any exception no .rrd (and no temp file) is left behind and an
+    file. Raises ValueError on inconsistent shapes, WashbenchError if the environment disables rerun (``RERUN=off``:
+    the file would be empty); on any exception no .rrd (and no temp file) is left behind and an
     existing ``path`` is untouched. Byte-for-byte the file differs between runs (rerun stamps row ids and a recording
     id), the logged data does not.
     """
@@ -501,8 +551,14 @@ def write_recording(path: Path, data: RecordingData) -> None:
     _check(data)
     saturation_kinds = {w: [k for k, v in p.saturated.items() if np.any(v)] for w, p in data.platforms.items()}
     blueprint = build_blueprint(list(data.washouts), saturation_kinds)
+    rec = rr.RecordingStream("washbench", recording_id=uuid.uuid4(), send_properties=False)
+    if not rec.is_enabled():
+        raise WashbenchError(
+            located(
+                path, "rerun logging is disabled by the environment (RERUN=off): unset RERUN to write the recording"
+            )
+        )
     with atomic_path(path) as tmp:
-        rec = rr.RecordingStream("washbench", recording_id=uuid.uuid4(), send_properties=False)
         try:
             rec.save(tmp, default_blueprint=blueprint)
             rec.send_recording_name(data.title)
@@ -526,11 +582,15 @@ def _time_seconds(col: pa.Array) -> np.ndarray:
 
 
 def _component_values(col: pa.Array) -> np.ndarray:
-    """A component column (one list of instances per row) -> array (rows, *shape) when every row has one instance."""
+    """A component column (a list of instances per row) -> array (rows, [instances,] *shape).
+
+    The instance axis is dropped when every row holds one instance; rows of unequal length give an object array.
+    """
     lengths = pc.list_value_length(col)
-    if col.null_count == 0 and len(col) > 0 and pc.all(pc.equal(lengths, 1)).as_py():
+    if col.null_count == 0 and len(col) > 0 and pc.min_max(lengths).as_py()["min"] == pc.max(lengths).as_py():
+        per_row = int(lengths[0].as_py())
         inner = col.flatten()
-        shape = [len(col)]
+        shape = [len(col)] if per_row == 1 else [len(col), per_row]
         while pa.types.is_fixed_size_list(inner.type):
             shape.append(inner.type.list_size)
             inner = inner.flatten()
@@ -542,8 +602,9 @@ def read_component(path: Path, component: str) -> dict[str, tuple[np.ndarray, np
     """Every entity's time-indexed values of ``component`` (e.g. "Scalars:scalars", "Transform3D:quaternion").
 
     Returns entity path -> (t_s (M,), values), sorted by time. When each row holds one instance, ``values`` has shape
-    (M,) for scalars and (M, k) for k-vectors, in the dtype rerun stores (scalars float64, vectors and quaternions
-    float32); otherwise it is an object array of per-row lists. Static data is ignored. Reads with
+    (M,) for scalars and (M, k) for k-vectors; with L > 1 instances in every row, (M, L) and (M, L, k). Values keep
+    the dtype rerun stores (scalars float64, vectors and quaternions float32); rows of unequal length give an object
+    array of per-row lists. Static data is ignored. Reads with
     ``rerun.chunk.RrdReader`` (pyarrow only, no viewer).
     """
     from rerun.chunk import RrdReader
@@ -567,7 +628,10 @@ def read_component(path: Path, component: str) -> dict[str, tuple[np.ndarray, np
 
 
 def read_scalar_series(path: Path) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """Every scalar series in the .rrd file: entity path -> (t_s (M,), values (M,) float64)."""
+    """Every scalar series in the .rrd file: entity path -> (t_s (M,), values float64).
+
+    ``values`` is (M,) for a single series and (M, 3) for the platform's per-axis entities (:func:`platform_path`).
+    """
     return read_component(path, "Scalars:scalars")
 
 

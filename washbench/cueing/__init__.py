@@ -1,0 +1,38 @@
+"""Motion cueing: the three washouts of Micomonaco et al. on a kinematic Atlas platform.
+
+Public API::
+
+    from washbench.cueing import (WASHOUT_NAMES, WashoutParams, load_washout_params,
+                                  CueingBank, WashoutTrace, cue_trace)
+
+See ``docs/cueing.md`` for the block diagrams as implemented and every interpretation of the paper.
+Frames and units: aircraft and simulator body axes x forward, y right, z down; inertial NED with
+g_I = [0, 0, +g]; specific force f = a - g (m/s^2, [0, 0, -g] at rest); body angular velocity rad/s;
+quaternions scalar first, body->inertial; break frequencies rad/s.
+
+Modules: ``params`` (cw1.yaml model), ``filters`` (transfer functions, discretisation), ``rotations``
+(quaternion and Euler kinematics), ``kernel`` (the compiled step), ``bank`` (CueingBank, cue_trace).
+The bank names are loaded lazily so that :mod:`washbench.platform` can use ``rotations`` without an
+import cycle.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+from washbench.cueing.params import WASHOUT_NAMES, WashoutParams, load_washout_params
+
+if TYPE_CHECKING:
+    from washbench.cueing.bank import CueingBank, WashoutTrace, cue_trace
+
+__all__ = ["WASHOUT_NAMES", "CueingBank", "WashoutParams", "WashoutTrace", "cue_trace", "load_washout_params"]
+
+_LAZY = {"CueingBank", "WashoutTrace", "cue_trace"}
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY:
+        from washbench.cueing import bank
+
+        return getattr(bank, name)
+    raise AttributeError(f"module 'washbench.cueing' has no attribute {name!r}")

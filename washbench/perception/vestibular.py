@@ -48,8 +48,8 @@ class OtolithParams(StrictModel):
     """
 
     K: float = Field(default=0.4, ge=0.0, description="lead gain [-]")
-    tau_L_s: float = Field(default=5.33, gt=0.0, description="long time constant [s]")
-    tau_S_s: float = Field(default=0.66, gt=0.0, description="short time constant [s]")
+    tau_L_s: float = Field(default=5.33, gt=0.0, description="long time constant [s]")  # noqa: N815 (paper notation)
+    tau_S_s: float = Field(default=0.66, gt=0.0, description="short time constant [s]")  # noqa: N815
     tau_a_s: float = Field(default=13.2, gt=0.0, description="lead time constant [s]")
 
 

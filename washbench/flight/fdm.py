@@ -1,0 +1,160 @@
+"""JSBSim set-up for a manoeuvre: model, initial conditions, environment, trim or ground start.
+
+Wind: the manoeuvre gives the direction the wind blows FROM; JSBSim's
+``atmosphere/wind-{north,east,down}-fps`` is the velocity of the air mass (blowing
+TOWARDS), so the from-direction is turned round here and nowhere else.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import os
+import sys
+from collections.abc import Iterator
+from dataclasses import dataclass
+from typing import Any
+
+from washbench.errors import WashbenchError
+from washbench.flight.geo import DEFAULT_LATITUDE_DEG, DEFAULT_LONGITUDE_DEG, LocalFrame
+from washbench.flight.profile import PilotProfile
+from washbench.manoeuvre import Manoeuvre, aircraft_path, jsbsim_root
+
+KT_TO_FPS = 1852.0 / 3600.0 / 0.3048
+FT_TO_M = 0.3048
+
+#: MIL-F-8785C: (probability-of-exceedance index of JSBSim's milspec table, wind at 20 ft in kt).
+TURBULENCE = {"none": (0, 0.0), "light": (3, 15.0), "moderate": (4, 30.0), "severe": (6, 45.0)}
+
+
+@dataclass(frozen=True)
+class Setup:
+    """Where the flight starts, in the local frame whose origin is the start point (or threshold)."""
+
+    frame: LocalFrame
+    threshold_ne_m: tuple[float, float] | None  # runway threshold, north/east of the origin
+    runway_heading_rad: float | None
+    runway_elevation_ft: float
+
+
+@contextlib.contextmanager
+def _quiet_stdout() -> Iterator[None]:
+    """Silence JSBSim's C++ console messages (trim reports) by redirecting file descriptor 1."""
+    sys.stdout.flush()
+    try:
+        saved = os.dup(1)
+    except OSError:  # no real stdout (embedded): nothing to silence
+        yield
+        return
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(devnull, 1)
+        yield
+    finally:
+        sys.stdout.flush()
+        os.dup2(saved, 1)
+        os.close(saved)
+        os.close(devnull)
+
+
+def make_fdm(m: Manoeuvre, profile: PilotProfile) -> tuple[Any, Setup]:
+    """Create and initialise the FDM for manoeuvre ``m``; return it with the start geometry.
+
+    Air start: trimmed straight and level at the given altitude, airspeed and heading.
+    Runway start: at rest on the centreline at the resting height, engine running, brakes on.
+    """
+    os.environ["JSBSIM_DEBUG"] = "0"
+    import jsbsim
+
+    root = aircraft_path(m.aircraft)
+    if root is None:  # load_manoeuvre checked it; guard against a file removed since
+        raise WashbenchError(f"{m.aircraft}: unknown aircraft")
+    fdm = jsbsim.FGFDMExec(str(jsbsim_root()), None)
+    fdm.set_aircraft_path(str(root))
+    with _quiet_stdout():
+        if not fdm.load_model(m.aircraft):
+            raise WashbenchError(f"{root / m.aircraft}: JSBSim could not load the model")
+    fdm.set_dt(m.dt_s)
+
+    rw = m.runway
+    air = m.start.air
+    if rw is not None:
+        frame = LocalFrame(rw.latitude_deg, rw.longitude_deg)
+        threshold = (0.0, 0.0)
+        rw_heading = math.radians(rw.heading_deg)
+        elevation = rw.elevation_ft
+    else:
+        lat = air.latitude_deg if air is not None and air.latitude_deg is not None else DEFAULT_LATITUDE_DEG
+        lon = air.longitude_deg if air is not None and air.longitude_deg is not None else DEFAULT_LONGITUDE_DEG
+        frame = LocalFrame(lat, lon)
+        threshold, rw_heading, elevation = None, None, 0.0
+
+    if air is not None:
+        heading_deg = air.heading_deg if air.heading_deg is not None else rw.heading_deg  # type: ignore[union-attr]
+        if air.latitude_deg is not None:
+            lat, lon = air.latitude_deg, air.longitude_deg
+        elif air.before_threshold_ft is not None and rw_heading is not None:
+            d = -air.before_threshold_ft * FT_TO_M
+            lat, lon = frame.to_latlon_deg(d * math.cos(rw_heading), d * math.sin(rw_heading))
+        else:
+            lat, lon = frame.to_latlon_deg(0.0, 0.0)
+    else:
+        assert rw is not None and m.start.runway is not None  # guaranteed by load_manoeuvre
+        heading_deg = rw.heading_deg
+        d = m.start.runway.past_threshold_ft * FT_TO_M
+        lat, lon = frame.to_latlon_deg(d * math.cos(rw_heading), d * math.sin(rw_heading))  # type: ignore[arg-type]
+
+    fdm["ic/lat-geod-deg"] = lat
+    fdm["ic/long-gc-deg"] = lon
+    fdm["ic/terrain-elevation-ft"] = elevation
+    fdm["ic/psi-true-deg"] = heading_deg
+    fdm["ic/phi-deg"] = 0.0
+    fdm["ic/gamma-deg"] = 0.0
+    wind_n = wind_e = 0.0
+    env = m.environment
+    if env.wind is not None and env.wind.speed_kts > 0:
+        towards = math.radians(env.wind.from_deg) + math.pi
+        wind_n = env.wind.speed_kts * KT_TO_FPS * math.cos(towards)
+        wind_e = env.wind.speed_kts * KT_TO_FPS * math.sin(towards)
+    fdm["ic/vw-north-fps"] = wind_n
+    fdm["ic/vw-east-fps"] = wind_e
+    fdm["ic/vw-down-fps"] = 0.0
+    if air is not None:
+        fdm["ic/h-sl-ft"] = air.altitude_ft
+        fdm["ic/vc-kts"] = air.airspeed_kts
+        fdm["fcs/flap-cmd-norm"] = air.flaps_deg / profile.limits.flaps_full_cmd_deg
+    else:
+        fdm["ic/h-agl-ft"] = profile.geometry.cg_height_on_ground_ft
+        fdm["ic/vc-kts"] = 0.0
+        fdm["ic/u-fps"] = 0.0
+    fdm["propulsion/set-running"] = -1
+    seed = env.turbulence.seed if env.turbulence is not None else 0
+    fdm["simulation/randomseed"] = seed
+    with _quiet_stdout():
+        fdm.run_ic()
+    fdm["atmosphere/wind-north-fps"] = wind_n
+    fdm["atmosphere/wind-east-fps"] = wind_e
+    fdm["atmosphere/wind-down-fps"] = 0.0
+    fdm["fcs/mixture-cmd-norm"] = 1.0
+
+    if air is not None:
+        fdm["fcs/flap-pos-deg"] = air.flaps_deg
+        try:
+            with _quiet_stdout():
+                fdm.do_trim(1)
+        except RuntimeError as exc:
+            raise WashbenchError(
+                f"{m.aircraft}: JSBSim could not trim level flight at {air.airspeed_kts:g} kt, "
+                f"{air.altitude_ft:g} ft, flaps {air.flaps_deg:g} deg ({exc})"
+            ) from None
+    else:
+        fdm["fcs/throttle-cmd-norm"] = 0.0
+        fdm["fcs/left-brake-cmd-norm"] = 1.0
+        fdm["fcs/right-brake-cmd-norm"] = 1.0
+
+    if env.turbulence is not None and env.turbulence.severity != "none":
+        index, w20_kts = TURBULENCE[env.turbulence.severity]
+        fdm["atmosphere/turb-type"] = 3  # MIL-F-8785C (Dryden) in JSBSim's milspec form
+        fdm["atmosphere/turbulence/milspec/severity"] = index
+        fdm["atmosphere/turbulence/milspec/windspeed_at_20ft_AGL-fps"] = w20_kts * KT_TO_FPS
+    return fdm, Setup(frame, threshold, rw_heading, elevation)

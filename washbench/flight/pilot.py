@@ -1,0 +1,294 @@
+"""The scripted pilot: cascaded PI loops run at every JSBSim step, in plain Python floats.
+
+Loops (angles in rad, rates in rad/s, speeds in kt, heights in ft):
+
+- roll: path target (heading, ground track to the runway centreline) -> bank command
+  (limited to ``bank_max_deg``) -> roll-rate command (P, limited to ``rate_max_degps``)
+  -> aileron (PI on roll-rate error).
+- pitch: path target (altitude -> climb-rate command; glide path -> climb rate; flare ->
+  sink proportional to wheel height) -> pitch command (PI on climb-rate error, or PI on
+  airspeed error when the throttle is fixed) -> pitch-rate command (P plus the steady
+  turn's pitch rate g/V sin^2(phi)/cos(phi)) -> elevator (PI on pitch-rate error).
+- power: airspeed on the throttle (PI) or a fixed throttle, slew-rate limited.
+- yaw: in the air the rudder drives sideslip to zero (PI) with a yaw damper about the
+  coordinated yaw rate; in the flare with ``decrab`` and on the ground it holds the runway
+  heading plus a centreline correction, with nosewheel steering on the ground.
+
+Integrators start from the current control or attitude at each phase (bumpless), stop
+integrating while their output saturates (anti-windup) and while the gear is on the
+ground for the loops the gear constrains. Proportional gains are scaled with
+(V_ref / V)^2 to keep the loop bandwidth as the dynamic pressure changes.
+"""
+
+from __future__ import annotations
+
+import math
+
+from washbench.flight.geo import wrap_pi
+from washbench.flight.profile import PilotProfile
+from washbench.manoeuvre import Hold, Runway
+
+D2R = math.pi / 180.0
+G_FPS2 = 32.174
+KT_TO_FPS = 1852.0 / 3600.0 / 0.3048
+
+# lateral modes
+LAT_LEVEL, LAT_BANK, LAT_HEADING, LAT_RATE, LAT_TRACK = range(5)
+# pitch modes
+PITCH_HOLD, PITCH_ATT, PITCH_ALT, PITCH_VS, PITCH_GLIDE, PITCH_RATE, PITCH_FLARE, PITCH_SPEED = range(8)
+
+
+def _clamp(x: float, lo: float, hi: float) -> float:
+    return lo if x < lo else hi if x > hi else x
+
+
+class Pilot:
+    """Closed-loop pilot for one flight; ``begin_phase`` at each phase, ``step`` at every FDM step.
+
+    After ``step`` the commands are in ``aileron``, ``elevator`` (+ nose down), ``rudder``
+    (+ nose left), ``steer``, ``throttle``; ``flaps_cmd`` (0..1 of full travel) and
+    ``brakes`` change only at phase starts.
+    """
+
+    def __init__(self, profile: PilotProfile, runway: Runway | None, dt_s: float) -> None:
+        g = profile.gains
+        self.dt = dt_s
+        self.vref = g.reference_airspeed_kts
+        self.vmin = profile.speeds.stall_kts
+        self.cg_h = profile.geometry.cg_height_on_ground_ft
+        self.steer_sign = profile.engine.steer_sign
+        self.flaps_full = profile.limits.flaps_full_cmd_deg
+        # roll
+        self.k_phi = g.roll.bank_to_rate
+        self.p_max = g.roll.rate_max_degps * D2R
+        self.kp_p = g.roll.kp
+        self.ki_p = g.roll.ki
+        self.bank_max = g.roll.bank_max_deg * D2R
+        # pitch
+        self.k_th = g.pitch.pitch_to_rate
+        self.q_max = g.pitch.rate_max_degps * D2R
+        self.kp_q = g.pitch.kp
+        self.ki_q = g.pitch.ki
+        self.th_min = g.pitch.pitch_min_deg * D2R
+        self.th_max = g.pitch.pitch_max_deg * D2R
+        # path
+        self.kvs = g.path.vs_kp_deg_per_fps * D2R
+        self.kvs_i = g.path.vs_ki_deg_per_ft * D2R
+        self.k_alt = g.path.altitude_to_vs
+        self.vs_max = g.path.vs_max_fps
+        self.k_gp = g.path.glide_path_to_vs
+        self.kv = g.path.speed_kp_deg_per_kt * D2R
+        self.kv_i = g.path.speed_ki_deg_per_kt_s * D2R
+        self.kt = g.path.throttle_kp_per_kt
+        self.kt_i = g.path.throttle_ki_per_kt_s
+        self.thr_rate = g.path.throttle_rate_per_s * dt_s
+        # yaw
+        self.kb = g.yaw.beta_kp
+        self.kb_i = g.yaw.beta_ki
+        self.kyd = g.yaw.yaw_damper
+        # track
+        self.k_hdg = g.track.heading_to_bank
+        self.k_trk = g.track.track_to_bank
+        self.k_y = g.track.offset_to_track_deg_per_ft * D2R
+        self.icpt_max = g.track.intercept_max_deg * D2R
+        # ground
+        self.kg_psi = g.ground.heading_kp
+        self.kg_r = g.ground.yaw_rate_kd
+        self.kg_y = g.ground.offset_to_heading_deg_per_ft * D2R
+        self.kg_ymax = g.ground.offset_heading_max_deg * D2R
+        # flare
+        self.tau = g.flare.tau_s
+        self.sink_min = g.flare.sink_min_fps
+        self.decrab = g.flare.decrab
+        # runway
+        self.rw_hdg = math.radians(runway.heading_deg) if runway is not None else 0.0
+        self.rw_elev = runway.elevation_ft if runway is not None else 0.0
+        self.aim_ft = runway.aim_point_ft if runway is not None else 0.0
+        # phase set-up
+        self.lat_mode = LAT_LEVEL
+        self.lat_target = 0.0
+        self.pitch_mode = PITCH_HOLD
+        self.pitch_target = 0.0
+        self.tan_gp = 0.0
+        self.speed_target = -1.0  # kt; < 0: none
+        self.speed_on_throttle = False
+        self.throttle_target = -1.0  # < 0: keep the current throttle
+        self.centreline = False
+        # integrators
+        self.i_p = 0.0
+        self.i_q = 0.0
+        self.i_path = 0.0
+        self.i_thr = 0.0
+        self.i_beta = 0.0
+        # outputs
+        self.aileron = 0.0
+        self.elevator = 0.0
+        self.rudder = 0.0
+        self.steer = 0.0
+        self.throttle = 0.0
+        self.flaps_cmd = 0.0
+        self.brakes = 0.0
+
+    def begin_phase(self, hold: Hold, theta: float, throttle: float, flaps_deg: float) -> None:
+        """Set the loops for a phase from the current pitch (rad), throttle and flap angle."""
+        self.centreline = bool(hold.centreline)
+        if hold.bank_deg is not None:
+            self.lat_mode, self.lat_target = LAT_BANK, hold.bank_deg * D2R
+        elif hold.heading_deg is not None:
+            self.lat_mode, self.lat_target = LAT_HEADING, hold.heading_deg * D2R
+        elif hold.roll_rate_degps is not None:
+            self.lat_mode, self.lat_target = LAT_RATE, hold.roll_rate_degps * D2R
+        elif hold.centreline:
+            self.lat_mode = LAT_TRACK
+        else:
+            self.lat_mode, self.lat_target = LAT_LEVEL, 0.0
+
+        self.throttle_target = hold.throttle if hold.throttle is not None else -1.0
+        self.speed_target = hold.airspeed_kts if hold.airspeed_kts is not None else -1.0
+        self.speed_on_throttle = hold.airspeed_kts is not None and hold.throttle is None
+        previous_mode = self.pitch_mode
+        if hold.pitch_deg is not None:
+            self.pitch_mode, self.pitch_target = PITCH_ATT, hold.pitch_deg * D2R
+        elif hold.altitude_ft is not None:
+            self.pitch_mode, self.pitch_target = PITCH_ALT, hold.altitude_ft
+        elif hold.vertical_speed_fpm is not None:
+            self.pitch_mode, self.pitch_target = PITCH_VS, hold.vertical_speed_fpm / 60.0
+        elif hold.glide_path_deg is not None:
+            self.pitch_mode, self.tan_gp = PITCH_GLIDE, math.tan(hold.glide_path_deg * D2R)
+        elif hold.pitch_rate_degps is not None:
+            self.pitch_mode, self.pitch_target = PITCH_RATE, hold.pitch_rate_degps * D2R
+        elif hold.flare:
+            self.pitch_mode = PITCH_FLARE
+        elif hold.airspeed_kts is not None and hold.throttle is not None:
+            self.pitch_mode = PITCH_SPEED
+        else:
+            self.pitch_mode, self.pitch_target = PITCH_ATT, theta
+        if self.pitch_mode != previous_mode or self.pitch_mode == PITCH_ATT:
+            self.i_path = theta  # the path loops' integrators hold a pitch command: start from the present one
+        self.i_thr = throttle
+        self.throttle = throttle
+        if hold.flaps_deg is not None:
+            self.flaps_cmd = hold.flaps_deg / self.flaps_full
+        else:
+            self.flaps_cmd = flaps_deg / self.flaps_full
+        if hold.brakes is not None:
+            self.brakes = hold.brakes
+
+    def step(
+        self,
+        phi: float,
+        theta: float,
+        psi: float,
+        p: float,
+        q: float,
+        r: float,
+        beta: float,
+        vc: float,
+        gs_fps: float,
+        track: float,
+        hdot: float,
+        h_msl: float,
+        h_agl: float,
+        x_rw_ft: float,
+        y_rw_ft: float,
+        wow: bool,
+    ) -> None:
+        """One control update from the current state (rad, rad/s, kt, ft, ft/s)."""
+        dt = self.dt
+        v = vc if vc > self.vmin else self.vmin
+        sc = (self.vref / v) ** 2
+        air = not wow
+
+        # ---- lateral: bank -> roll rate -> aileron
+        mode = self.lat_mode
+        if mode == LAT_RATE:
+            p_cmd = self.lat_target
+        else:
+            if mode == LAT_BANK:
+                phi_cmd = self.lat_target
+            elif mode == LAT_HEADING:
+                phi_cmd = _clamp(self.k_hdg * wrap_pi(self.lat_target - psi), -self.bank_max, self.bank_max)
+            elif mode == LAT_TRACK and air:
+                trk_cmd = self.rw_hdg - _clamp(self.k_y * y_rw_ft, -self.icpt_max, self.icpt_max)
+                phi_cmd = _clamp(self.k_trk * wrap_pi(trk_cmd - track), -self.bank_max, self.bank_max)
+            else:
+                phi_cmd = 0.0
+            p_cmd = _clamp(self.k_phi * (phi_cmd - phi), -self.p_max, self.p_max)
+        e = p_cmd - p
+        ail = self.i_p + sc * self.kp_p * e
+        if air and -1.0 < ail < 1.0:
+            self.i_p += self.ki_p * e * dt
+        self.aileron = _clamp(ail, -1.0, 1.0)
+
+        # ---- pitch: path -> pitch -> pitch rate -> elevator
+        mode = self.pitch_mode
+        if mode == PITCH_RATE:
+            q_cmd = self.pitch_target
+        else:
+            if mode == PITCH_ATT:
+                th_cmd = self.pitch_target
+            elif mode == PITCH_SPEED:
+                ev = vc - self.speed_target
+                th_cmd = self.i_path + self.kv * ev
+                if air and self.th_min < th_cmd < self.th_max:
+                    self.i_path += self.kv_i * ev * dt
+            else:
+                if mode == PITCH_ALT:
+                    vs_cmd = _clamp(self.k_alt * (self.pitch_target - h_msl), -self.vs_max, self.vs_max)
+                elif mode == PITCH_VS:
+                    vs_cmd = self.pitch_target
+                elif mode == PITCH_GLIDE:
+                    h_gp = self.rw_elev + (self.aim_ft - x_rw_ft) * self.tan_gp
+                    vs_cmd = -gs_fps * self.tan_gp + self.k_gp * (h_gp - h_msl)
+                else:  # flare: sink proportional to the height of the wheels
+                    hw = h_agl - self.cg_h
+                    vs_cmd = -(hw / self.tau if hw / self.tau > self.sink_min else self.sink_min)
+                evs = vs_cmd - hdot
+                th_cmd = self.i_path + self.kvs * evs
+                if air and self.th_min < th_cmd < self.th_max:
+                    self.i_path += self.kvs_i * evs * dt
+            th_cmd = _clamp(th_cmd, self.th_min, self.th_max)
+            q_cmd = _clamp(self.k_th * (th_cmd - theta), -self.q_max, self.q_max)
+            c = math.cos(phi)
+            if air and c > 0.2:
+                s = math.sin(phi)
+                q_cmd += G_FPS2 / (v * KT_TO_FPS) * s * s / c
+        e = q_cmd - q
+        u = self.i_q + sc * self.kp_q * e
+        if air and -1.0 < u < 1.0:
+            self.i_q += self.ki_q * e * dt
+        self.elevator = -_clamp(u, -1.0, 1.0)
+
+        # ---- power
+        if self.speed_on_throttle:
+            ev = self.speed_target - vc
+            thr = self.i_thr + self.kt * ev
+            if 0.0 < thr < 1.0:
+                self.i_thr += self.kt_i * ev * dt
+        elif self.throttle_target >= 0.0:
+            thr = self.throttle_target
+        else:
+            thr = self.throttle
+        thr = _clamp(thr, 0.0, 1.0)
+        d = thr - self.throttle
+        self.throttle += _clamp(d, -self.thr_rate, self.thr_rate)
+
+        # ---- yaw: coordination in the air, runway heading in the flare (decrab) and on the ground
+        if wow or (self.decrab and self.pitch_mode == PITCH_FLARE):
+            if self.centreline or self.pitch_mode == PITCH_FLARE:
+                off = _clamp(self.kg_y * y_rw_ft, -self.kg_ymax, self.kg_ymax) if wow else 0.0
+                psi_cmd = self.rw_hdg - off
+            else:
+                psi_cmd = psi
+            yaw = self.kg_psi * wrap_pi(psi_cmd - psi) - self.kg_r * r  # + : nose right wanted
+            yaw = _clamp(yaw, -1.0, 1.0)
+            self.rudder = -yaw
+            self.steer = self.steer_sign * self.rudder if wow else 0.0
+            self.i_beta = 0.0
+        else:
+            r_coord = G_FPS2 * math.sin(phi) * math.cos(theta) / (v * KT_TO_FPS)
+            rud = -(self.i_beta + sc * self.kb * beta) + sc * self.kyd * (r - r_coord)
+            if -1.0 < rud < 1.0:
+                self.i_beta += self.kb_i * beta * dt
+            self.rudder = _clamp(rud, -1.0, 1.0)
+            self.steer = 0.0

@@ -1,0 +1,131 @@
+"""Per-aircraft scripted-pilot profile: speeds, limits, geometry and control gains.
+
+The pilot's control laws are the same for every aircraft; what differs (V-speeds, load
+limits, the height of the centre of gravity at rest, the sign of nosewheel steering, the
+loop gains) is read from ``washbench/data/pilot_<aircraft>.yaml``. Gains are given at
+``reference_airspeed_kts`` and scaled with (V_ref / V)^2 so the loops keep their bandwidth
+as dynamic pressure changes.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+from pydantic import Field
+
+from washbench.yamlio import StrictModel, load_yaml_model
+
+Positive = Annotated[float, Field(gt=0)]
+NonNegative = Annotated[float, Field(ge=0)]
+
+
+class Speeds(StrictModel):
+    """Calibrated airspeeds, kt."""
+
+    stall_kts: Positive
+    vr_kts: Positive
+    vy_kts: Positive
+    vno_kts: Positive
+    vne_kts: Positive
+
+
+class Limits(StrictModel):
+    nz_max: Positive  # structural limit load factor, g
+    nz_min: Annotated[float, Field(lt=0)]
+    touchdown_sink_max_fps: Positive  # beyond it the landing is a crash
+    alpha_stall_deg: Positive  # the "stall" event
+    flaps_max_deg: Positive
+    flaps_full_cmd_deg: Positive  # flap angle that fcs/flap-cmd-norm = 1 commands
+
+
+class Geometry(StrictModel):
+    cg_height_on_ground_ft: Positive  # position/h-agl-ft at rest on level ground
+    gear_contacts: list[Annotated[int, Field(ge=0)]]  # gear/unit[i]
+    structure_contacts: list[Annotated[int, Field(ge=0)]]  # contact/unit[i] that must never touch
+
+
+class Engine(StrictModel):
+    steer_sign: Annotated[float, Field(ge=-1, le=1)]  # fcs/steer-cmd-norm = steer_sign * rudder-like command
+    mixture_schedule: list[tuple[float, float]]  # (altitude_ft, mixture 0..1), interpolated
+
+
+class RollGains(StrictModel):
+    bank_to_rate: Positive  # roll-rate command per bank error, 1/s
+    rate_max_degps: Positive
+    kp: Positive  # aileron per rad/s of roll-rate error
+    ki: NonNegative  # aileron per rad of integrated roll-rate error
+    bank_max_deg: Positive  # bank used by heading and track modes
+
+
+class PitchGains(StrictModel):
+    pitch_to_rate: Positive  # pitch-rate command per pitch error, 1/s
+    rate_max_degps: Positive
+    kp: Positive  # elevator per rad/s of pitch-rate error
+    ki: NonNegative
+    pitch_min_deg: float
+    pitch_max_deg: float
+
+
+class PathGains(StrictModel):
+    vs_kp_deg_per_fps: Positive  # pitch command per ft/s of climb-rate error
+    vs_ki_deg_per_ft: NonNegative
+    altitude_to_vs: Positive  # climb-rate command per ft of altitude error, 1/s
+    vs_max_fps: Positive
+    glide_path_to_vs: Positive  # climb-rate correction per ft below the glide path, 1/s
+    speed_kp_deg_per_kt: Positive  # pitch per kt of airspeed error (airspeed on the elevator)
+    speed_ki_deg_per_kt_s: NonNegative
+    throttle_kp_per_kt: Positive  # airspeed on the throttle
+    throttle_ki_per_kt_s: NonNegative
+    throttle_rate_per_s: Positive  # throttle slew-rate limit
+
+
+class YawGains(StrictModel):
+    beta_kp: NonNegative  # rudder per rad of sideslip
+    beta_ki: NonNegative  # rudder per rad s
+    yaw_damper: NonNegative  # rudder per rad/s of yaw-rate beyond the coordinated rate
+
+
+class TrackGains(StrictModel):
+    heading_to_bank: Positive  # bank per heading error (deg/deg)
+    track_to_bank: Positive  # bank per ground-track error (deg/deg)
+    offset_to_track_deg_per_ft: Positive  # intercept angle per ft off the centreline
+    intercept_max_deg: Positive
+
+
+class GroundGains(StrictModel):
+    heading_kp: Positive  # rudder/steer per rad of heading error
+    yaw_rate_kd: NonNegative  # per rad/s
+    offset_to_heading_deg_per_ft: Positive
+    offset_heading_max_deg: Positive
+
+
+class FlareGains(StrictModel):
+    tau_s: Positive  # commanded sink = height of the wheels / tau
+    sink_min_fps: Positive  # at the wheels' touchdown
+    decrab: bool  # align the nose with the runway (wing low) during the flare
+
+
+class Gains(StrictModel):
+    reference_airspeed_kts: Positive
+    roll: RollGains
+    pitch: PitchGains
+    path: PathGains
+    yaw: YawGains
+    track: TrackGains
+    ground: GroundGains
+    flare: FlareGains
+
+
+class PilotProfile(StrictModel):
+    aircraft: str
+    speeds: Speeds
+    limits: Limits
+    geometry: Geometry
+    engine: Engine
+    gains: Gains
+
+
+def load_profile(path: str | Path) -> PilotProfile:
+    """Load a pilot profile YAML (one-line WashbenchError on any problem)."""
+    return load_yaml_model(path, PilotProfile)

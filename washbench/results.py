@@ -1,0 +1,455 @@
+"""On-disk formats: the one place that knows column names.
+
+Input motion (``washbench cue INPUT``), CSV or Parquet, one row per sample, body axes
+(x forward, y right, z down), time uniform and increasing::
+
+    t_s, f_x_mps2, f_y_mps2, f_z_mps2, omega_x_degps, omega_y_degps, omega_z_degps
+
+Other columns are ignored by the cueing but kept in :attr:`Motion.extra` and written back
+unchanged to ``traces.parquet`` (e.g. the flight pipeline's state columns).
+
+``DIR/traces.parquet`` (see :func:`motion_columns` and :func:`washout_columns`)::
+
+    t_s
+    S.f_{x,y,z}_mps2, S.omega_{x,y,z}_degps                  head motion of pilot S
+    S.perceived_f_{x,y,z}_mps2, S.perceived_omega_{x,y,z}_degps   vestibular model output
+        for S = "aircraft" and for each washout W (its simulator pilot)
+    W.pos_{x,y,z}_m, W.vel_{x,y,z}_mps, W.acc_{x,y,z}_mps2   platform centre, NED inertial
+    W.q_{w,x,y,z}                                            platform attitude, body -> inertial
+    W.omega_platform_{x,y,z}_degps                           platform angular velocity, body axes
+    W.wheel_{1,2,3}_radps                                    Atlas omni-wheel speeds
+    W.sp_pos_{x,y,z}_m, W.sp_q_{w,x,y,z}                     the washout's set points for the platform
+    W.sat_<kind>                                             saturation flags, 0/1 (int8)
+    <extra input columns, unchanged>
+
+``DIR/metrics.csv``: ``washout,dof,npc,integral_error,max_error``, one row per washout and DOF
+(surge, sway, heave, roll, pitch, yaw). Floats are written with ``repr`` (exact round trip); an
+undefined NPC (flat signal) is an empty field; PC = -1 gives ``inf``.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.compute as pc
+import pyarrow.csv as pacsv
+import pyarrow.parquet as pq
+
+from washbench.atomic import atomic_path
+from washbench.errors import WashbenchError, located
+from washbench.metrics import MetricRow
+
+AXES = ("x", "y", "z")
+TIME_COLUMN = "t_s"
+F_COLUMNS = tuple(f"f_{a}_mps2" for a in AXES)
+OMEGA_COLUMNS = tuple(f"omega_{a}_degps" for a in AXES)
+INPUT_COLUMNS = (TIME_COLUMN, *F_COLUMNS, *OMEGA_COLUMNS)
+"""The required input columns, in order."""
+
+AIRCRAFT = "aircraft"
+"""Source name of the aircraft pilot in traces.parquet."""
+
+METRICS_COLUMNS = ("washout", "dof", "npc", "integral_error", "max_error")
+
+TIME_RTOL = 1e-6
+"""Time steps may differ from the typical (median) step by at most this fraction of it."""
+
+SUFFIXES = {".csv": "csv", ".parquet": "parquet", ".pq": "parquet"}
+
+
+# --------------------------------------------------------------------------- column names
+
+
+def f_columns(source: str) -> tuple[str, str, str]:
+    """Head specific force of pilot ``source`` [m/s^2], body x, y, z."""
+    return tuple(f"{source}.f_{a}_mps2" for a in AXES)  # type: ignore[return-value]
+
+
+def omega_columns(source: str) -> tuple[str, str, str]:
+    """Head angular velocity of pilot ``source`` [deg/s], body x, y, z."""
+    return tuple(f"{source}.omega_{a}_degps" for a in AXES)  # type: ignore[return-value]
+
+
+def perceived_f_columns(source: str) -> tuple[str, str, str]:
+    """Perceived specific force (otolith model output) of pilot ``source`` [m/s^2]."""
+    return tuple(f"{source}.perceived_f_{a}_mps2" for a in AXES)  # type: ignore[return-value]
+
+
+def perceived_omega_columns(source: str) -> tuple[str, str, str]:
+    """Perceived angular velocity (canal model output) of pilot ``source`` [deg/s]."""
+    return tuple(f"{source}.perceived_omega_{a}_degps" for a in AXES)  # type: ignore[return-value]
+
+
+def motion_columns(source: str) -> tuple[str, ...]:
+    """All 12 head-motion and perception columns of one pilot, in table order."""
+    return (
+        *f_columns(source),
+        *omega_columns(source),
+        *perceived_f_columns(source),
+        *perceived_omega_columns(source),
+    )
+
+
+def pos_columns(washout: str) -> tuple[str, str, str]:
+    """Platform position, NED inertial [m]."""
+    return tuple(f"{washout}.pos_{a}_m" for a in AXES)  # type: ignore[return-value]
+
+
+def vel_columns(washout: str) -> tuple[str, str, str]:
+    """Platform velocity, NED inertial [m/s]."""
+    return tuple(f"{washout}.vel_{a}_mps" for a in AXES)  # type: ignore[return-value]
+
+
+def acc_columns(washout: str) -> tuple[str, str, str]:
+    """Platform acceleration, NED inertial [m/s^2]."""
+    return tuple(f"{washout}.acc_{a}_mps2" for a in AXES)  # type: ignore[return-value]
+
+
+def q_columns(washout: str) -> tuple[str, str, str, str]:
+    """Platform attitude quaternion, scalar first, body -> inertial."""
+    return tuple(f"{washout}.q_{c}" for c in ("w", "x", "y", "z"))  # type: ignore[return-value]
+
+
+def omega_platform_columns(washout: str) -> tuple[str, str, str]:
+    """Platform angular velocity, body axes [deg/s]."""
+    return tuple(f"{washout}.omega_platform_{a}_degps" for a in AXES)  # type: ignore[return-value]
+
+
+def wheel_columns(washout: str) -> tuple[str, str, str]:
+    """Atlas omni-wheel speeds [rad/s]."""
+    return tuple(f"{washout}.wheel_{i}_radps" for i in (1, 2, 3))  # type: ignore[return-value]
+
+
+def sp_pos_columns(washout: str) -> tuple[str, str, str]:
+    """The washout's position set point for the platform, NED inertial [m]."""
+    return tuple(f"{washout}.sp_pos_{a}_m" for a in AXES)  # type: ignore[return-value]
+
+
+def sp_q_columns(washout: str) -> tuple[str, str, str, str]:
+    """The washout's attitude set point for the platform, scalar first, body -> inertial."""
+    return tuple(f"{washout}.sp_q_{c}" for c in ("w", "x", "y", "z"))  # type: ignore[return-value]
+
+
+def sat_column(washout: str, kind: str) -> str:
+    """Saturation flag column (0/1) of one limit ``kind``."""
+    return f"{washout}.sat_{kind}"
+
+
+def washout_columns(washout: str, sat_kinds: Iterable[str]) -> tuple[str, ...]:
+    """All columns of one washout in table order (its pilot's motion, then the platform)."""
+    return (
+        *motion_columns(washout),
+        *pos_columns(washout),
+        *vel_columns(washout),
+        *acc_columns(washout),
+        *q_columns(washout),
+        *omega_platform_columns(washout),
+        *wheel_columns(washout),
+        *sp_pos_columns(washout),
+        *sp_q_columns(washout),
+        *(sat_column(washout, k) for k in sat_kinds),
+    )
+
+
+# --------------------------------------------------------------------------- input motion
+
+
+@dataclass(frozen=True, eq=False)
+class Motion:
+    """A recorded pilot-head motion on a uniform time grid.
+
+    ``t_s`` (N,) [s]; ``dt_s`` the time step [s]; ``f_mps2`` (N, 3) specific force [m/s^2] and
+    ``omega_radps`` (N, 3) angular velocity [rad/s], body axes; ``extra`` other columns by name
+    (passed through to results). ``omega_degps`` keeps the angular velocity exactly as read
+    (deg/s) so it can be written back bit for bit; ``None`` when built in memory.
+    """
+
+    t_s: np.ndarray
+    dt_s: float
+    f_mps2: np.ndarray
+    omega_radps: np.ndarray
+    extra: dict[str, np.ndarray] = field(default_factory=dict)
+    omega_degps: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        n = self.t_s.shape[0] if self.t_s.ndim == 1 else -1
+        if n < 2:
+            raise ValueError(f"t_s must be 1-D with at least 2 samples, got shape {self.t_s.shape}")
+        for name in ("f_mps2", "omega_radps"):
+            shape = getattr(self, name).shape
+            if shape != (n, 3):
+                raise ValueError(f"{name} must have shape ({n}, 3), got {shape}")
+        if self.omega_degps is not None and self.omega_degps.shape != (n, 3):
+            raise ValueError(f"omega_degps must have shape ({n}, 3), got {self.omega_degps.shape}")
+        for name, col in self.extra.items():
+            if len(col) != n:
+                raise ValueError(f"extra column {name!r} has {len(col)} rows, expected {n}")
+        if not (self.dt_s > 0.0 and math.isfinite(self.dt_s)):
+            raise ValueError(f"dt_s must be positive and finite, got {self.dt_s}")
+
+    @property
+    def n(self) -> int:
+        """Number of samples."""
+        return int(self.t_s.shape[0])
+
+    @property
+    def duration_s(self) -> float:
+        """Time from the first to the last sample [s]."""
+        return float(self.t_s[-1] - self.t_s[0])
+
+    def omega_degps_out(self) -> np.ndarray:
+        """Angular velocity in deg/s for output: the values as read if known, else converted."""
+        return self.omega_degps if self.omega_degps is not None else np.degrees(self.omega_radps)
+
+
+def _where(path: Path, kind: str, index: int) -> tuple[int | None, str]:
+    """(line for located(), row text) for data row ``index`` (0-based)."""
+    if kind == "csv":
+        return index + 2, ""
+    return None, f"row {index + 1}: "
+
+
+def _read_csv_table(path: Path) -> pa.Table:
+    invalid: list[int | None] = []
+
+    def on_invalid(row: pacsv.InvalidRow) -> str:
+        invalid.append(row.number)
+        return "error"
+
+    try:
+        size = path.stat().st_size
+    except OSError as exc:
+        raise WashbenchError(located(path, f"cannot read: {exc.strerror or exc}")) from None
+    if size == 0:
+        raise WashbenchError(located(path, "the file is empty"))
+    read = pacsv.ReadOptions(use_threads=False, block_size=int(min(max(size + 1, 1 << 20), (1 << 31) - 1)))
+    parse = pacsv.ParseOptions(ignore_empty_lines=False, invalid_row_handler=on_invalid)
+    convert = pacsv.ConvertOptions(
+        null_values=[""],
+        strings_can_be_null=True,
+        column_types=dict.fromkeys(INPUT_COLUMNS, pa.string()),
+    )
+    try:
+        return pacsv.read_csv(path, read_options=read, parse_options=parse, convert_options=convert)
+    except pa.ArrowInvalid as exc:
+        text = str(exc)
+        if invalid:
+            raise WashbenchError(
+                located(path, f"wrong number of fields ({text.split(': ', 2)[-1]})", line=invalid[0])
+            ) from None
+        if "Empty CSV" in text:
+            raise WashbenchError(located(path, "the file is empty")) from None
+        raise WashbenchError(located(path, f"not a readable CSV file: {text}")) from None
+    except UnicodeDecodeError:
+        raise WashbenchError(located(path, "not a readable CSV file: it is not UTF-8 text")) from None
+    except OSError as exc:
+        raise WashbenchError(located(path, f"cannot read: {getattr(exc, 'strerror', None) or exc}")) from None
+
+
+def _read_parquet_table(path: Path) -> pa.Table:
+    try:
+        return pq.read_table(path)
+    except FileNotFoundError:
+        raise WashbenchError(located(path, "no such file")) from None
+    except IsADirectoryError:
+        raise WashbenchError(located(path, "is a folder, not a file")) from None
+    except PermissionError as exc:
+        raise WashbenchError(located(path, f"cannot read: {exc.strerror}")) from None
+    except (pa.ArrowException, OSError) as exc:
+        if path.is_file() and path.stat().st_size == 0:
+            raise WashbenchError(located(path, "the file is empty")) from None
+        raise WashbenchError(located(path, f"not a readable Parquet file ({exc})")) from None
+
+
+def _drop_trailing_empty_rows(table: pa.Table) -> pa.Table:
+    """Blank lines at the end of a CSV file read as all-null rows: drop them."""
+    n = table.num_rows
+    if n == 0 or table.num_columns == 0:
+        return table
+    all_null = np.ones(n, dtype=bool)
+    for col in table.columns:
+        all_null &= col.is_null().to_numpy(zero_copy_only=False)
+    end = n
+    while end > 0 and all_null[end - 1]:
+        end -= 1
+    return table.slice(0, end) if end < n else table
+
+
+def _numeric_column(path: Path, kind: str, table: pa.Table, name: str) -> np.ndarray:
+    """A required column as float64, checked: no missing, non-numeric, NaN or infinite values."""
+    col = table.column(name)
+    nulls = col.is_null().to_numpy(zero_copy_only=False)
+    if nulls.any():
+        i = int(np.argmax(nulls))
+        line, row = _where(path, kind, i)
+        raise WashbenchError(located(path, f"{row}missing value", line=line, field=name))
+    if pa.types.is_string(col.type) or pa.types.is_large_string(col.type):
+        stripped = pc.utf8_trim_whitespace(col)
+        try:
+            col = pc.cast(stripped, pa.float64())
+        except pa.ArrowInvalid:
+            values = stripped.to_pylist()
+            for i, v in enumerate(values):
+                try:
+                    float(v)
+                except ValueError:
+                    line, row = _where(path, kind, i)
+                    raise WashbenchError(located(path, f"{row}not a number: {v!r}", line=line, field=name)) from None
+            raise WashbenchError(located(path, "column is not numeric", field=name)) from None
+    elif pa.types.is_integer(col.type) or pa.types.is_floating(col.type):
+        col = pc.cast(col, pa.float64())
+    else:
+        raise WashbenchError(located(path, f"column is not numeric (type {col.type})", field=name))
+    arr = col.to_numpy()
+    bad = ~np.isfinite(arr)
+    if bad.any():
+        i = int(np.argmax(bad))
+        line, row = _where(path, kind, i)
+        what = "NaN" if np.isnan(arr[i]) else "infinite"
+        raise WashbenchError(located(path, f"{row}value is {what}", line=line, field=name))
+    return np.ascontiguousarray(arr, dtype=np.float64)
+
+
+def _check_time(path: Path, kind: str, t: np.ndarray) -> float:
+    """Check that time increases on a uniform grid; return the step [s] (mean over the trace)."""
+    steps = np.diff(t)
+    bad = steps <= 0.0
+    if bad.any():
+        i = int(np.argmax(bad)) + 1
+        line, row = _where(path, kind, i)
+        raise WashbenchError(
+            located(path, f"{row}time does not increase ({t[i]!r} after {t[i - 1]!r})", line=line, field=TIME_COLUMN)
+        )
+    typical = float(np.median(steps))
+    bad = np.abs(steps - typical) > TIME_RTOL * typical
+    if bad.any():
+        i = int(np.argmax(bad)) + 1
+        line, row = _where(path, kind, i)
+        raise WashbenchError(
+            located(
+                path,
+                f"{row}time step is not uniform: {steps[i - 1]!r} s from {t[i - 1]!r} to {t[i]!r}, "
+                f"the typical step is {typical!r} s (write t_s with full precision)",
+                line=line,
+                field=TIME_COLUMN,
+            )
+        )
+    dt = float((t[-1] - t[0]) / (t.size - 1))
+    k = np.arange(t.size, dtype=np.float64)
+    drift = np.abs(t - (t[0] + k * dt))
+    tol = TIME_RTOL * dt + 4.0 * np.spacing(np.maximum(np.abs(t), abs(dt)))
+    bad = drift > tol
+    if bad.any():
+        i = int(np.argmax(bad))
+        line, row = _where(path, kind, i)
+        raise WashbenchError(
+            located(path, f"{row}time drifts off the uniform grid of step {dt!r} s", line=line, field=TIME_COLUMN)
+        )
+    return dt
+
+
+def read_motion(path: str | Path) -> Motion:
+    """Read a motion trace from CSV or Parquet (by extension) and validate it.
+
+    Raises WashbenchError with one line naming the file (and, for CSV, the line) for: a missing,
+    unreadable or empty file, an unknown extension, no or one data row, a missing or non-numeric
+    column, missing, NaN or infinite values, time that does not increase or is not uniform.
+    """
+    path = Path(path)
+    kind = SUFFIXES.get(path.suffix.lower())
+    if kind is None:
+        raise WashbenchError(
+            located(path, f"unknown file type {path.suffix or '(no extension)'!r}: expected .csv or .parquet")
+        )
+    if not path.exists():
+        raise WashbenchError(located(path, "no such file"))
+    if path.is_dir():
+        raise WashbenchError(located(path, "is a folder, not a file"))
+    table = _read_csv_table(path) if kind == "csv" else _read_parquet_table(path)
+    if kind == "csv":
+        table = _drop_trailing_empty_rows(table)
+    names = table.column_names
+    missing = [c for c in INPUT_COLUMNS if c not in names]
+    if missing:
+        raise WashbenchError(located(path, f"missing column {missing[0]!r} (found: {', '.join(names) or 'none'})"))
+    dup = sorted({c for c in names if names.count(c) > 1})
+    if dup:
+        raise WashbenchError(located(path, f"column {dup[0]!r} appears more than once"))
+    if table.num_rows == 0:
+        raise WashbenchError(located(path, "no data rows"))
+    if table.num_rows < 2:
+        raise WashbenchError(located(path, "only one data row: need at least 2 samples"))
+    cols = {c: _numeric_column(path, kind, table, c) for c in INPUT_COLUMNS}
+    t = cols[TIME_COLUMN]
+    dt = _check_time(path, kind, t)
+    f = np.column_stack([cols[c] for c in F_COLUMNS])
+    w_deg = np.column_stack([cols[c] for c in OMEGA_COLUMNS])
+    extra = {name: table.column(name).to_numpy(zero_copy_only=False) for name in names if name not in INPUT_COLUMNS}
+    return Motion(t_s=t, dt_s=dt, f_mps2=f, omega_radps=np.radians(w_deg), extra=extra, omega_degps=w_deg)
+
+
+# --------------------------------------------------------------------------- writers and readers
+
+
+def write_traces(path: str | Path, table: Mapping[str, np.ndarray]) -> None:
+    """Write the traces table (column name -> 1-D array, all the same length) to Parquet, atomically."""
+    arrow = pa.table({name: pa.array(np.asarray(col)) for name, col in table.items()})
+    with atomic_path(path) as tmp:
+        pq.write_table(arrow, tmp, compression="zstd")
+
+
+def read_traces(path: str | Path) -> dict[str, np.ndarray]:
+    """Read a traces.parquet back as column name -> numpy array."""
+    t = pq.read_table(path)
+    return {name: t.column(name).to_numpy(zero_copy_only=False) for name in t.column_names}
+
+
+def _fmt(x: float) -> str:
+    return "" if math.isnan(x) else repr(float(x))
+
+
+def metrics_csv_text(rows: Iterable[MetricRow]) -> str:
+    """The text of metrics.csv for ``rows`` (header, then one line per row; NaN -> empty field)."""
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(METRICS_COLUMNS)
+    for r in rows:
+        w.writerow([r.washout, r.dof, _fmt(r.npc), _fmt(r.integral_error), _fmt(r.max_error)])
+    return buf.getvalue()
+
+
+def write_metrics_csv(path: str | Path, rows: Iterable[MetricRow]) -> None:
+    """Write metrics.csv atomically (floats as ``repr``: exact round trip; NaN as an empty field)."""
+    text = metrics_csv_text(rows)
+    with atomic_path(path) as tmp:
+        tmp.write_text(text, encoding="utf-8")
+
+
+def read_metrics_csv(path: str | Path) -> list[MetricRow]:
+    """Read metrics.csv back (empty fields -> NaN). Raises WashbenchError on a malformed file."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise WashbenchError(located(path, f"cannot read: {getattr(exc, 'strerror', None) or exc}")) from None
+    reader = csv.reader(io.StringIO(text))
+    header = next(reader, None)
+    if header is None or tuple(header) != METRICS_COLUMNS:
+        raise WashbenchError(located(path, f"expected header {','.join(METRICS_COLUMNS)}", line=1))
+    rows = []
+    for line, rec in enumerate(reader, start=2):
+        if len(rec) != len(METRICS_COLUMNS):
+            raise WashbenchError(located(path, f"expected {len(METRICS_COLUMNS)} fields, got {len(rec)}", line=line))
+        try:
+            nums = [math.nan if v == "" else float(v) for v in rec[2:]]
+        except ValueError as exc:
+            raise WashbenchError(located(path, f"not a number: {exc}", line=line)) from None
+        rows.append(MetricRow(rec[0], rec[1], *nums))
+    return rows
