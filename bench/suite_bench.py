@@ -65,7 +65,7 @@ def main() -> None:
         write_suite_results(outcomes, Path(tmp))
         suite_s = time.perf_counter() - start
     failed = [o for o in outcomes if not o.ok]
-    work = [(o.aircraft, o.steps, 1.0 / 120.0) for o in outcomes if o.steps]
+    work = [(o.aircraft, o.steps, o.dt_s) for o in outcomes if o.steps]
     steps = sum(s for _, s, _ in work)
     ctx = multiprocessing.get_context("forkserver")
     start = time.perf_counter()

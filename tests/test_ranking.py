@@ -4,7 +4,8 @@ import math
 
 import pytest
 
-from washbench.ranking import DOFS, MetricRow, compare, dof_weights, rank, wins
+from washbench.metrics import MetricRow
+from washbench.ranking import DOFS, compare, dof_weights, rank, wins
 
 
 def rows_for(washout: str, ie: dict[str, float], npc: float = 1.2, max_error: float = 1.0) -> list[MetricRow]:

@@ -33,6 +33,8 @@ import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
+from washbench.metrics import MetricRow
+
 TRANSLATIONAL_DOFS = ("surge", "sway", "heave")
 ROTATIONAL_DOFS = ("roll", "pitch", "yaw")
 DOFS = TRANSLATIONAL_DOFS + ROTATIONAL_DOFS
@@ -43,17 +45,6 @@ REFERENCE_WASHOUT = "small-angle"
 #: translational DOFs and deg for the rotational ones. 0.05 m/s^2 (about the otolith threshold of
 #: Zacharias) held for 1 s, and 0.5 deg/s (about the canal threshold) for 1 s.
 MOTION_FLOOR = {"surge": 0.05, "sway": 0.05, "heave": 0.05, "roll": 0.5, "pitch": 0.5, "yaw": 0.5}
-
-
-@dataclass(frozen=True)
-class MetricRow:
-    """One row of a metrics table: a washout's metrics in one DOF (units as in metrics.csv)."""
-
-    washout: str
-    dof: str
-    npc: float  # NaN when undefined
-    integral_error: float
-    max_error: float
 
 
 @dataclass(frozen=True)

@@ -32,12 +32,12 @@ from pathlib import Path
 
 from washbench.atomic import write_text_atomic
 from washbench.errors import WashbenchError, located
+from washbench.metrics import MetricRow
 from washbench.paths import MANOEUVRES_DIR
 from washbench.ranking import (
     DOFS,
     METRICS,
     REFERENCE_WASHOUT,
-    MetricRow,
     RankRow,
     compare,
     rank,
@@ -57,6 +57,7 @@ class Outcome:
     run_dir: str = ""
     wall_s: float = 0.0
     steps: int = 0
+    dt_s: float = 0.0
     checks_passed: int = 0
     checks_total: int = 0
     metrics: list[MetricRow] = field(default_factory=list)
@@ -114,6 +115,7 @@ def _run_one(path: str, out_dir: str, params_path: str | None, platform_path: st
         run_dir=str(summary.run_dir),
         wall_s=time.perf_counter() - start,
         steps=summary.steps,
+        dt_s=summary.dt_s,
         checks_passed=summary.checks_passed,
         checks_total=summary.checks_total,
         metrics=summary.metrics,

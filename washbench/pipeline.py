@@ -1,0 +1,305 @@
+"""``washbench run``: fly a manoeuvre with the three washouts in lockstep, then perceive, measure, record.
+
+At every JSBSim step the scripted pilot's flight gives one sample of pilot-head motion; the
+sample goes straight through the three washouts and the kinematic Atlas model
+(:class:`washbench.cueing.CueingBank`, the streaming form), as a real simulator would run them.
+After the flight the vestibular models, the metrics and the tables are the same code as
+``washbench cue`` (:func:`washbench.cue.analyse`), on the flight as written to
+``flight.parquet`` and read back, so ``washbench fly`` then ``washbench cue`` gives the same
+numbers bit for bit.
+
+Output, published as a whole folder (built under a temporary name, then renamed into place, so
+an interrupted run never leaves a half-written folder that looks complete)::
+
+    OUT/<aircraft>/<manoeuvre>/
+        flight.json      manoeuvre, phases, checks (as from washbench fly)
+        flight.parquet   the flown trace (washbench cue input columns + flight state)
+        traces.parquet   washbench cue columns + flight-state columns
+        metrics.csv      washout,dof,npc,integral_error,max_error
+        recording.rrd    rerun recording with its blueprint
+        run.json         summary used by washbench suite (status, motion per DOF, saturations)
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import math
+import os
+import shutil
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from washbench.atomic import write_text_atomic
+from washbench.errors import WashbenchError, located
+from washbench.metrics import MetricRow, integral_abs_error
+from washbench.ranking import DOFS
+
+if TYPE_CHECKING:
+    from washbench.cue import CueResult
+    from washbench.flight.fly import FlightResult
+    from washbench.platform import PlatformLimits
+    from washbench.rerun_log import PlatformEnvelope
+    from washbench.results import Motion
+
+RUN_FILES = ("flight.json", "flight.parquet", "traces.parquet", "metrics.csv", "recording.rrd", "run.json")
+
+
+@dataclass(frozen=True)
+class RunSummary:
+    """What one ``washbench run`` gave: status, where, and what the suite needs to compare."""
+
+    ok: bool
+    reason: str
+    aircraft: str
+    manoeuvre: str
+    run_dir: Path
+    steps: int
+    dt_s: float
+    checks_passed: int
+    checks_total: int
+    metrics: list[MetricRow] = field(default_factory=list)
+    motion: dict[str, float] = field(default_factory=dict)  # DOF -> aircraft pilot's perceived motion
+    saturations: dict[str, dict[str, int]] = field(default_factory=dict)
+
+
+def perceived_motion(perceived_f_mps2: np.ndarray, perceived_omega_radps: np.ndarray, dt_s: float) -> dict[str, float]:
+    """How much the aircraft pilot felt per DOF: integral of |perceived(t) - perceived(0)| dt.
+
+    Surge, sway, heave in m/s^2*s; roll, pitch, yaw in deg (the units of metrics.csv).
+    """
+    out: dict[str, float] = {}
+    for i, dof in enumerate(DOFS[:3]):
+        x = perceived_f_mps2[:, i]
+        out[dof] = integral_abs_error(x, np.full_like(x, x[0]), dt_s)
+    for i, dof in enumerate(DOFS[3:]):
+        x = np.degrees(perceived_omega_radps[:, i])
+        out[dof] = integral_abs_error(x, np.full_like(x, x[0]), dt_s)
+    return out
+
+
+def aircraft_attitude(phi_deg: np.ndarray, theta_deg: np.ndarray, psi_deg: np.ndarray) -> np.ndarray:
+    """Body->NED quaternions (N, 4), scalar first, from ZYX Euler angles in degrees."""
+    angles = np.column_stack([psi_deg, theta_deg, phi_deg])
+    return Rotation.from_euler("ZYX", angles, degrees=True).as_quat(scalar_first=True)
+
+
+def metrics_markdown(title: str, rows: list[MetricRow]) -> str:
+    """The metric table of one run as Markdown (for the recording and the report)."""
+    lines = [
+        f"# {title}",
+        "",
+        "Aircraft pilot's perceived motion vs each simulator pilot's. NPC: 1 is perfect, larger is worse,",
+        "empty where a signal is flat. Errors in m/s^2 (integral m/s^2*s) for surge, sway, heave and deg/s",
+        "(integral deg) for roll, pitch, yaw.",
+        "",
+        "| washout | DOF | NPC | integral error | max error |",
+        "|---|---|---|---|---|",
+    ]
+    for r in rows:
+        npc = "" if math.isnan(r.npc) else f"{r.npc:.4f}"
+        lines.append(f"| {r.washout} | {r.dof} | {npc} | {r.integral_error:.4g} | {r.max_error:.4g} |")
+    return "\n".join(lines) + "\n"
+
+
+def _publish(partial: Path, final: Path) -> None:
+    """Replace ``final`` with the finished folder ``partial`` (two renames; the old one is removed)."""
+    old = final.with_name(f".{final.name}.old-{os.getpid()}")
+    if final.exists():
+        os.replace(final, old)
+    os.replace(partial, final)
+    shutil.rmtree(old, ignore_errors=True)
+
+
+def run_manoeuvre(
+    manoeuvre_path: Path,
+    out_root: Path,
+    *,
+    params_path: Path | None = None,
+    platform_path: Path | None = None,
+    progress: bool = False,
+) -> RunSummary:
+    """Fly one manoeuvre with the washouts in lockstep and write its results folder.
+
+    Raises WashbenchError for a bad manoeuvre, parameter or platform file (nothing written).
+    A flight that crashes or fails a check still writes its results (what was flown), with
+    ``ok`` False and the reason.
+    """
+    from washbench.cue import analyse, write_results
+    from washbench.cueing import WASHOUT_NAMES, CueingBank, WashoutTrace, load_washout_params
+    from washbench.flight.fly import fly, write_flight
+    from washbench.manoeuvre import load_manoeuvre
+    from washbench.platform import load_platform_limits
+    from washbench.results import read_motion
+
+    manoeuvre = load_manoeuvre(manoeuvre_path)
+    params = load_washout_params(params_path)
+    limits = load_platform_limits(platform_path)
+    washouts = tuple(WASHOUT_NAMES)
+    bank = CueingBank(washouts, params, limits, manoeuvre.dt_s)
+    rows: list[np.ndarray] = []
+    step = bank.step
+    omega_deg = np.empty(3)
+
+    def lockstep(k: int, f_mps2: np.ndarray, omega_radps: np.ndarray) -> None:
+        # The washouts see the angular velocity exactly as flight.parquet stores it (deg/s) and
+        # washbench cue reads it back (np.radians), so both paths give the same bits.
+        np.degrees(omega_radps, out=omega_deg)
+        rows.append(step(f_mps2, np.radians(omega_deg)).copy())
+
+    start = time.perf_counter()
+    flight = fly(manoeuvre, step_hook=lockstep, progress=progress)
+    n = len(flight.t_s)
+    if len(rows) != n:
+        raise RuntimeError(f"washouts ran {len(rows)} steps for {n} recorded samples")
+
+    final = Path(out_root) / manoeuvre.aircraft / manoeuvre.name
+    partial = final.with_name(f".{final.name}.partial-{os.getpid()}")
+    shutil.rmtree(partial, ignore_errors=True)
+    partial.mkdir(parents=True)
+    try:
+        write_flight(partial, flight)
+        if n < 2:
+            raise WashbenchError(located(manoeuvre_path, f"the flight recorded {n} sample(s): nothing to cue"))
+        motion = read_motion(partial / "flight.parquet")
+        block = np.stack(rows)  # (N, washouts, fields)
+        traces = {w: WashoutTrace.from_rows(block[:, i, :]) for i, w in enumerate(washouts)}
+        result = analyse(motion, traces)
+        write_results(partial, result)
+        title = f"{manoeuvre.aircraft} / {manoeuvre.name}"
+        _write_recording(partial / "recording.rrd", title, motion, flight, result, limits)
+        felt = perceived_motion(
+            result.perceived["aircraft"].f_mps2, result.perceived["aircraft"].omega_radps, motion.dt_s
+        )
+        checks_passed = sum(1 for c in flight.checks if c.passed)
+        ok = flight.status == "ok" and checks_passed == len(flight.checks)
+        reason = flight.reason if flight.status != "ok" else ""
+        if not reason and not ok:
+            failed = [c.name for c in flight.checks if not c.passed]
+            reason = f"checks failed: {', '.join(failed)}"
+        summary = RunSummary(
+            ok=ok,
+            reason=reason,
+            aircraft=manoeuvre.aircraft,
+            manoeuvre=manoeuvre.name,
+            run_dir=final,
+            steps=n,
+            dt_s=motion.dt_s,
+            checks_passed=checks_passed,
+            checks_total=len(flight.checks),
+            metrics=list(result.metrics),
+            motion=felt,
+            saturations={w: dict(traces[w].saturation_counts) for w in washouts},
+        )
+        _write_run_json(partial / "run.json", summary, time.perf_counter() - start)
+        _publish(partial, final)
+    finally:
+        with contextlib.suppress(FileNotFoundError):
+            shutil.rmtree(partial)
+    return summary
+
+
+def _write_run_json(path: Path, s: RunSummary, wall_s: float) -> None:
+    doc = {
+        "aircraft": s.aircraft,
+        "manoeuvre": s.manoeuvre,
+        "ok": s.ok,
+        "reason": s.reason,
+        "steps": s.steps,
+        "dt_s": s.dt_s,
+        "wall_s": round(wall_s, 3),
+        "checks_passed": s.checks_passed,
+        "checks_total": s.checks_total,
+        "perceived_motion": {
+            d: {"value": v, "unit": "m/s^2*s" if d in DOFS[:3] else "deg"} for d, v in s.motion.items()
+        },
+        "saturations": s.saturations,
+    }
+    write_text_atomic(path, json.dumps(doc, indent=2) + "\n")
+
+
+def _write_recording(
+    path: Path, title: str, motion: Motion, flight: FlightResult, result: CueResult, limits: PlatformLimits
+) -> None:
+    from washbench.rerun_log import MotionSeries, PlatformSeries, RecordingData, write_recording
+
+    cols = flight.columns
+    ac_q = aircraft_attitude(cols["phi_deg"], cols["theta_deg"], cols["psi_deg"])
+    ac = result.perceived["aircraft"]
+    washouts: dict[str, MotionSeries] = {}
+    platforms: dict[str, PlatformSeries] = {}
+    for name, tr in result.traces.items():
+        p = result.perceived[name]
+        washouts[name] = MotionSeries(
+            f_mps2=tr.head_f_mps2,
+            omega_radps=tr.head_omega_radps,
+            perceived_f_mps2=p.f_mps2,
+            perceived_omega_radps=p.omega_radps,
+            q=tr.q,
+        )
+        platforms[name] = PlatformSeries(
+            pos_m=tr.pos_m, vel_mps=tr.vel_mps, acc_mps2=tr.acc_mps2, wheel_radps=tr.wheel_radps, saturated=tr.saturated
+        )
+    data = RecordingData(
+        title=title,
+        t_s=motion.t_s,
+        aircraft=MotionSeries(
+            f_mps2=motion.f_mps2,
+            omega_radps=motion.omega_radps,
+            perceived_f_mps2=ac.f_mps2,
+            perceived_omega_radps=ac.omega_radps,
+            q=ac_q,
+        ),
+        washouts=washouts,
+        platforms=platforms,
+        envelope=platform_envelope(limits),
+        phases=[(p[0], float(p[1]), float(p[2])) for p in flight.phases],
+        metrics_markdown=metrics_markdown(title, list(result.metrics)),
+    )
+    write_recording(path, data)
+
+
+def platform_envelope(limits: PlatformLimits) -> PlatformEnvelope:
+    """The recording's envelope lines from the platform limits (wheel limit from the rate limit)."""
+    from washbench.platform.limits import wheel_jacobian
+    from washbench.rerun_log import PlatformEnvelope
+
+    t = limits.translation
+    jac = wheel_jacobian(limits)
+    # the fastest any wheel can turn with the sphere at its angular-rate limit
+    wheel_max = float(np.max(np.linalg.norm(jac, axis=1)) * math.radians(limits.rotation.rate_limit_degps))
+    return PlatformEnvelope(
+        pos_m=(t.position_limit_m.x, t.position_limit_m.y, t.position_limit_m.z),
+        vel_mps=(t.velocity_limit_mps.x, t.velocity_limit_mps.y, t.velocity_limit_mps.z),
+        acc_mps2=(t.acceleration_limit_mps2.x, t.acceleration_limit_mps2.y, t.acceleration_limit_mps2.z),
+        wheel_radps=wheel_max,
+        sphere_diameter_m=limits.sphere_diameter_m,
+    )
+
+
+def run_command(
+    manoeuvre_path: Path,
+    out_root: Path,
+    *,
+    params_path: Path | None = None,
+    platform_path: Path | None = None,
+    progress: bool = True,
+) -> int:
+    """CLI entry of ``washbench run``: 0 if the flight ran and passed its checks, else 1."""
+    start = time.perf_counter()
+    s = run_manoeuvre(manoeuvre_path, out_root, params_path=params_path, platform_path=platform_path, progress=progress)
+    state = "ok" if s.ok else f"FAILED ({s.reason})"
+    print(
+        f"{s.aircraft}/{s.manoeuvre}: {state}; checks {s.checks_passed}/{s.checks_total}; "
+        f"{s.steps * s.dt_s:.1f} s flown in {time.perf_counter() - start:.1f} s; results in {s.run_dir}"
+    )
+    for w, kinds in s.saturations.items():
+        sat = ", ".join(f"{k} {v}" for k, v in kinds.items() if v) or "none"
+        print(f"  {w}: platform saturations (steps): {sat}", file=sys.stdout)
+    return 0 if s.ok else 1
