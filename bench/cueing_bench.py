@@ -88,7 +88,7 @@ def main() -> None:
     print(f"JSBSim c172p fdm.run():                    {fdm * 1e6:8.2f} us/step")
     print(f"ratio cueing / fdm.run:                    {cue / fdm:8.3f}  (goal <= 1.0)")
 
-    n = int(round(args.trace_minutes * 60.0 / DT_S))
+    n = round(args.trace_minutes * 60.0 / DT_S)
     f, w = synthetic_motion(n, DT_S)
     params, limits = load_washout_params(), load_platform_limits()
     cue_trace(f[:10], w[:10], DT_S, WASHOUT_NAMES, params, limits)  # warm-up (compile or cache load)

@@ -12,6 +12,7 @@ import pytest
 
 from washbench.cueing import WASHOUT_NAMES
 from washbench.metrics import DOFS
+from washbench.paths import DATA_DIR
 from washbench.perception import VestibularModel
 from washbench.results import (
     INPUT_COLUMNS,
@@ -144,7 +145,9 @@ def bad_cases(d: Path) -> dict[str, tuple[list[str | Path], str]]:
     junk = d / "junk.parquet"
     junk.write_bytes(b"PAR1 but not really")
     params = d / "params.yaml"
-    params.write_text("surge_gain: 1.0\n")
+    cw1 = (DATA_DIR / "cw1.yaml").read_text()
+    params.write_text(cw1 + "surge_gain: 1.0\n")  # the bundled set plus one unknown key
+    params_line = len(cw1.splitlines()) + 1
     return {
         "missing column": ([variant("m.csv", f_y_mps2=None)], "m.csv: missing column 'f_y_mps2'"),
         "non-uniform": ([variant("u.csv", t_s=(100, t[100] + 0.2 * DT))], "u.csv:102: t_s: time step is not uniform"),
@@ -155,7 +158,7 @@ def bad_cases(d: Path) -> dict[str, tuple[list[str | Path], str]]:
         "unreadable": ([junk], "junk.parquet: not a readable Parquet file"),
         "extension": ([d / "trace.txt"], "trace.txt: unknown file type '.txt'"),
         "washout": ([d / "ok.csv", "--washout", "big-angle"], "unknown washout 'big-angle' (valid: small-angle"),
-        "params": ([d / "ok.csv", "--params", params], "params.yaml:1: surge_gain: unknown key"),
+        "params": ([d / "ok.csv", "--params", params], f"params.yaml:{params_line}: surge_gain: unknown key"),
     }
 
 
@@ -189,6 +192,9 @@ def test_bad_inputs_one_line_exit_2_nothing_written(tmp_path: Path) -> None:
         assert expected in lines[0], (name, lines[0])
     assert sorted(p.name for p in out.iterdir()) == ["metrics.csv"]
     assert (out / "metrics.csv").read_text() == "earlier results\n"
+    # a failing run does not even create a missing output folder
+    res = cue(cases["nan"][0][0], "--out", tmp_path / "never")
+    assert res.returncode == 2 and not (tmp_path / "never").exists()
 
 
 def test_library_reads_what_the_cli_reads(inputs: dict[str, Path]) -> None:

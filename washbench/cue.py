@@ -158,8 +158,9 @@ def analyse(motion: Motion, traces: Mapping[str, TraceLike], vestibular: Vestibu
 
 
 def _put(table: dict[str, np.ndarray], names: Sequence[str], values: np.ndarray) -> None:
+    columns = np.ascontiguousarray(values.T)  # one transposing copy, then each column is a contiguous row
     for i, name in enumerate(names):
-        table[name] = np.ascontiguousarray(values[:, i])
+        table[name] = columns[i]
 
 
 def cue_motion(

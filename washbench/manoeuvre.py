@@ -101,7 +101,9 @@ class Hold(StrictModel):
     (elevator): ``pitch_deg``, ``altitude_ft``, ``vertical_speed_fpm``, ``glide_path_deg``,
     ``pitch_rate_degps``, ``flare``. ``airspeed_kts`` is held with the throttle when a pitch
     target is given, and with the elevator when ``throttle`` is fixed instead. The rudder
-    always coordinates (zero sideslip) in the air and tracks the runway on the ground.
+    coordinates (zero sideslip) in the air and tracks the runway on the ground; with
+    ``wing_low`` (needs ``centreline``) it aligns the nose with the runway in the air while
+    the ailerons bank into the wind to hold the centreline (crosswind landing technique).
     """
 
     wings_level: bool | None = None
@@ -109,6 +111,7 @@ class Hold(StrictModel):
     heading_deg: Heading | None = None
     roll_rate_degps: Annotated[float, Field(ge=-90, le=90)] | None = None
     centreline: bool | None = None
+    wing_low: bool | None = None
     pitch_deg: Annotated[float, Field(ge=-45, le=45)] | None = None
     altitude_ft: float | None = None
     vertical_speed_fpm: float | None = None
@@ -312,6 +315,8 @@ def _check_semantics(m: Manoeuvre, where: _Where) -> None:
             raise where.error((*base, "hold", "airspeed_kts"), f"above {m.aircraft}'s VNE")
         if hold.flaps_deg is not None and hold.flaps_deg > profile.limits.flaps_max_deg:
             raise where.error((*base, "hold", "flaps_deg"), f"more than the {profile.limits.flaps_max_deg:g} deg max")
+        if hold.wing_low and not hold.centreline:
+            raise where.error((*base, "hold", "wing_low"), "needs 'centreline: true' (the track it holds)")
         if (hold.centreline or hold.glide_path_deg is not None or hold.flare) and m.runway is None:
             key = "centreline" if hold.centreline else ("flare" if hold.flare else "glide_path_deg")
             raise where.error((*base, "hold", key), "needs a top-level 'runway'")

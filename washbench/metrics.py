@@ -128,10 +128,10 @@ def dof_metrics(
     pairs = [(aircraft_f_mps2, sim_f_mps2, 1.0), (aircraft_omega_radps, sim_omega_radps, 180.0 / math.pi)]
     dofs = iter(DOFS)
     for a, s, scale in pairs:
-        a = np.asarray(a, dtype=np.float64) * scale
-        s = np.asarray(s, dtype=np.float64) * scale
+        a = np.ascontiguousarray(np.asarray(a, dtype=np.float64).T) * scale  # (3, N): contiguous per axis
+        s = np.ascontiguousarray(np.asarray(s, dtype=np.float64).T) * scale
         for axis in range(3):
-            x, y = a[:, axis], s[:, axis]
+            x, y = a[axis], s[axis]
             rows.append(
                 MetricRow(
                     washout=washout,

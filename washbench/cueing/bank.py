@@ -78,7 +78,7 @@ def _check_washouts(washouts: Sequence[str]) -> tuple[str, ...]:
         raise WashbenchError("no washout selected")
     for name in names:
         if name not in _KINDS:
-            raise WashbenchError(f"unknown washout {name!r} (choose from {', '.join(WASHOUT_NAMES)})")
+            raise WashbenchError(f"unknown washout {name!r} (valid: {', '.join(WASHOUT_NAMES)})")
     if len(set(names)) != len(names):
         raise WashbenchError(f"washout listed twice: {', '.join(names)}")
     return names
@@ -227,9 +227,7 @@ class CueingBank:
     FIELDS: tuple[str, ...] = FIELDS
     SAT_KINDS: tuple[str, ...] = SAT_KINDS
 
-    def __init__(
-        self, washouts: Sequence[str], params: WashoutParams, limits: PlatformLimits, dt_s: float
-    ) -> None:
+    def __init__(self, washouts: Sequence[str], params: WashoutParams, limits: PlatformLimits, dt_s: float) -> None:
         self.washouts = _check_washouts(washouts)
         self.dt_s = _check_dt(dt_s)
         self._cfg, self._coef = build_arrays(self.washouts, params, limits, self.dt_s)

@@ -228,7 +228,6 @@ def step_one(f, om, c, coef, state, counts, row):
     sat_pos = 0
     sat_vel = 0
     sat_acc = 0
-    acc = (0.0, 0.0, 0.0)
     for j in range(3):
         v_prev = state[S_V + j]
         p, v, s_p, s_v, s_a = track_axis(
@@ -251,9 +250,7 @@ def step_one(f, om, c, coef, state, counts, row):
     acc = (row[O_ACC], row[O_ACC + 1], row[O_ACC + 2])
     q_prev = (state[S_Q], state[S_Q + 1], state[S_Q + 2], state[S_Q + 3])
     w_prev = (state[S_W], state[S_W + 1], state[S_W + 2])
-    q, w, sat_rate, sat_angacc = track_rotation(
-        q_prev, w_prev, q_sp_prev, q_sp, c[C_WMAX], c[C_ALPHA], c[C_CATCH], dt
-    )
+    q, w, sat_rate, sat_angacc = track_rotation(q_prev, w_prev, q_sp_prev, q_sp, c[C_WMAX], c[C_ALPHA], c[C_CATCH], dt)
     for j in range(4):
         state[S_Q + j] = q[j]
     for j in range(3):

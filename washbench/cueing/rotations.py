@@ -92,11 +92,8 @@ def qexp_body(w: Vec3, dt: float) -> Quat:
     """Rotation quaternion [cos(|w| dt/2), w/|w| sin(|w| dt/2)] for a constant body rate w (rad/s) over dt (s)."""
     n = norm3(w)
     half = 0.5 * n * dt
-    if half < 1e-8:
-        # sin(half)/n to double precision; avoids 0/0 at rest.
-        k = 0.5 * dt * (1.0 - half * half / 6.0)
-    else:
-        k = math.sin(half) / n
+    # k = sin(half) / n; near rest its series, exact to double precision, avoids 0/0
+    k = 0.5 * dt * (1.0 - half * half / 6.0) if half < 1e-8 else math.sin(half) / n
     return (math.cos(half), w[0] * k, w[1] * k, w[2] * k)
 
 
@@ -138,10 +135,7 @@ def qrotvec(q: Quat) -> Vec3:
     if w < 0.0:
         w, x, y, z = -w, -x, -y, -z
     n = math.sqrt(x * x + y * y + z * z)
-    if n < 1e-12:
-        k = 2.0 / w if w > 0.0 else 0.0
-    else:
-        k = 2.0 * math.atan2(n, w) / n
+    k = (2.0 / w if w > 0.0 else 0.0) if n < 1e-12 else 2.0 * math.atan2(n, w) / n
     return (x * k, y * k, z * k)
 
 

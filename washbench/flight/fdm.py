@@ -116,9 +116,6 @@ def make_fdm(m: Manoeuvre, profile: PilotProfile) -> tuple[Any, Setup]:
         towards = math.radians(env.wind.from_deg) + math.pi
         wind_n = env.wind.speed_kts * KT_TO_FPS * math.cos(towards)
         wind_e = env.wind.speed_kts * KT_TO_FPS * math.sin(towards)
-    fdm["ic/vw-north-fps"] = wind_n
-    fdm["ic/vw-east-fps"] = wind_e
-    fdm["ic/vw-down-fps"] = 0.0
     if air is not None:
         fdm["ic/h-sl-ft"] = air.altitude_ft
         fdm["ic/vc-kts"] = air.airspeed_kts
@@ -132,9 +129,6 @@ def make_fdm(m: Manoeuvre, profile: PilotProfile) -> tuple[Any, Setup]:
     fdm["simulation/randomseed"] = seed
     with _quiet_stdout():
         fdm.run_ic()
-    fdm["atmosphere/wind-north-fps"] = wind_n
-    fdm["atmosphere/wind-east-fps"] = wind_e
-    fdm["atmosphere/wind-down-fps"] = 0.0
     fdm["fcs/mixture-cmd-norm"] = 1.0
 
     if air is not None:
@@ -147,14 +141,50 @@ def make_fdm(m: Manoeuvre, profile: PilotProfile) -> tuple[Any, Setup]:
                 f"{m.aircraft}: JSBSim could not trim level flight at {air.airspeed_kts:g} kt, "
                 f"{air.altitude_ft:g} ft, flaps {air.flaps_deg:g} deg ({exc})"
             ) from None
+        if wind_n or wind_e:
+            crab = air.heading_deg is None  # on a runway's extended centreline: crab to track it
+            _add_wind_to_trimmed_state(fdm, wind_n, wind_e, crab)
     else:
         fdm["fcs/throttle-cmd-norm"] = 0.0
         fdm["fcs/left-brake-cmd-norm"] = 1.0
         fdm["fcs/right-brake-cmd-norm"] = 1.0
 
+    fdm["atmosphere/wind-north-fps"] = wind_n
+    fdm["atmosphere/wind-east-fps"] = wind_e
+    fdm["atmosphere/wind-down-fps"] = 0.0
     if env.turbulence is not None and env.turbulence.severity != "none":
         index, w20_kts = TURBULENCE[env.turbulence.severity]
         fdm["atmosphere/turb-type"] = 3  # MIL-F-8785C (Dryden) in JSBSim's milspec form
         fdm["atmosphere/turbulence/milspec/severity"] = index
         fdm["atmosphere/turbulence/milspec/windspeed_at_20ft_AGL-fps"] = w20_kts * KT_TO_FPS
     return fdm, Setup(frame, threshold, rw_heading, elevation)
+
+
+def _add_wind_to_trimmed_state(fdm: Any, wind_n: float, wind_e: float, crab: bool) -> None:
+    """Re-initialise a state trimmed in still air so that it flies the same air-relative state in the wind.
+
+    JSBSim's own initial-condition wind (``ic/vw-*``) does not keep the airspeed and sideslip
+    it is given (measured on 1.3.3), so the trim is done in still air and the wind is added
+    here: body ground velocity = trimmed air velocity + wind in body axes. With ``crab`` the
+    heading is turned into the wind so the ground track stays the trimmed heading.
+    """
+    u, v, w = fdm["velocities/u-fps"], fdm["velocities/v-fps"], fdm["velocities/w-fps"]
+    phi, theta, psi = fdm["attitude/phi-rad"], fdm["attitude/theta-rad"], fdm["attitude/psi-rad"]
+    if crab:
+        right = -wind_n * math.sin(psi) + wind_e * math.cos(psi)  # wind component to the right of the track
+        vt = fdm["velocities/vt-fps"]
+        psi -= math.asin(max(-0.9, min(0.9, right / vt)))
+    cps, sps, cth, sth = math.cos(psi), math.sin(psi), math.cos(theta), math.sin(theta)
+    cph, sph = math.cos(phi), math.sin(phi)
+    # NED -> body (3-2-1 Euler angles), applied to the wind (down component zero)
+    xb = cth * cps * wind_n + cth * sps * wind_e
+    yb = (sph * sth * cps - cph * sps) * wind_n + (sph * sth * sps + cph * cps) * wind_e
+    zb = (cph * sth * cps + sph * sps) * wind_n + (cph * sth * sps - sph * cps) * wind_e
+    fdm["ic/phi-rad"] = phi
+    fdm["ic/theta-rad"] = theta
+    fdm["ic/psi-true-rad"] = psi
+    fdm["ic/u-fps"] = u + xb
+    fdm["ic/v-fps"] = v + yb
+    fdm["ic/w-fps"] = w + zb
+    with _quiet_stdout():
+        fdm.run_ic()

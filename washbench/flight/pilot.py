@@ -11,8 +11,9 @@ Loops (angles in rad, rates in rad/s, speeds in kt, heights in ft):
   turn's pitch rate g/V sin^2(phi)/cos(phi)) -> elevator (PI on pitch-rate error).
 - power: airspeed on the throttle (PI) or a fixed throttle, slew-rate limited.
 - yaw: in the air the rudder drives sideslip to zero (PI) with a yaw damper about the
-  coordinated yaw rate; in the flare with ``decrab`` and on the ground it holds the runway
-  heading plus a centreline correction, with nosewheel steering on the ground.
+  coordinated yaw rate; with ``wing_low`` (crosswind landing: the ailerons then bank into the
+  wind to hold the track) and on the ground it holds the runway heading (PI, with yaw-rate
+  damping) plus a centreline correction on the ground, with nosewheel steering.
 
 Integrators start from the current control or attitude at each phase (bumpless), stop
 integrating while their output saturates (anti-windup) and while the gear is on the
@@ -72,8 +73,8 @@ class Pilot:
         self.th_min = g.pitch.pitch_min_deg * D2R
         self.th_max = g.pitch.pitch_max_deg * D2R
         # path
-        self.kvs = g.path.vs_kp_deg_per_fps * D2R
-        self.kvs_i = g.path.vs_ki_deg_per_ft * D2R
+        self.kvs = g.path.climb_to_pitch
+        self.kvs_i = g.path.climb_to_pitch_i
         self.k_alt = g.path.altitude_to_vs
         self.vs_max = g.path.vs_max_fps
         self.k_gp = g.path.glide_path_to_vs
@@ -94,12 +95,12 @@ class Pilot:
         # ground
         self.kg_psi = g.ground.heading_kp
         self.kg_r = g.ground.yaw_rate_kd
+        self.kg_i = g.ground.heading_ki
         self.kg_y = g.ground.offset_to_heading_deg_per_ft * D2R
         self.kg_ymax = g.ground.offset_heading_max_deg * D2R
         # flare
         self.tau = g.flare.tau_s
         self.sink_min = g.flare.sink_min_fps
-        self.decrab = g.flare.decrab
         # runway
         self.rw_hdg = math.radians(runway.heading_deg) if runway is not None else 0.0
         self.rw_elev = runway.elevation_ft if runway is not None else 0.0
@@ -114,12 +115,14 @@ class Pilot:
         self.speed_on_throttle = False
         self.throttle_target = -1.0  # < 0: keep the current throttle
         self.centreline = False
+        self.wing_low = False
         # integrators
         self.i_p = 0.0
         self.i_q = 0.0
         self.i_path = 0.0
         self.i_thr = 0.0
         self.i_beta = 0.0
+        self.i_psi = 0.0
         # outputs
         self.aileron = 0.0
         self.elevator = 0.0
@@ -132,6 +135,7 @@ class Pilot:
     def begin_phase(self, hold: Hold, theta: float, throttle: float, flaps_deg: float) -> None:
         """Set the loops for a phase from the current pitch (rad), throttle and flap angle."""
         self.centreline = bool(hold.centreline)
+        self.wing_low = bool(hold.wing_low)
         if hold.bank_deg is not None:
             self.lat_mode, self.lat_target = LAT_BANK, hold.bank_deg * D2R
         elif hold.heading_deg is not None:
@@ -243,7 +247,7 @@ class Pilot:
                 else:  # flare: sink proportional to the height of the wheels
                     hw = h_agl - self.cg_h
                     vs_cmd = -(hw / self.tau if hw / self.tau > self.sink_min else self.sink_min)
-                evs = vs_cmd - hdot
+                evs = (vs_cmd - hdot) / (v * KT_TO_FPS)  # flight-path angle error, rad
                 th_cmd = self.i_path + self.kvs * evs
                 if air and self.th_min < th_cmd < self.th_max:
                     self.i_path += self.kvs_i * evs * dt
@@ -274,17 +278,21 @@ class Pilot:
         self.throttle += _clamp(d, -self.thr_rate, self.thr_rate)
 
         # ---- yaw: coordination in the air, runway heading in the flare (decrab) and on the ground
-        if wow or (self.decrab and self.pitch_mode == PITCH_FLARE):
-            if self.centreline or self.pitch_mode == PITCH_FLARE:
+        if wow or self.wing_low:
+            if self.centreline:
                 off = _clamp(self.kg_y * y_rw_ft, -self.kg_ymax, self.kg_ymax) if wow else 0.0
                 psi_cmd = self.rw_hdg - off
             else:
                 psi_cmd = psi
-            yaw = self.kg_psi * wrap_pi(psi_cmd - psi) - self.kg_r * r  # + : nose right wanted
+            e = wrap_pi(psi_cmd - psi)
+            k = 1.0 if wow else sc
+            yaw = self.i_psi + k * (self.kg_psi * e - self.kg_r * r)  # + : nose right wanted
+            if -1.0 < yaw < 1.0:
+                self.i_psi += self.kg_i * e * dt
             yaw = _clamp(yaw, -1.0, 1.0)
             self.rudder = -yaw
             self.steer = self.steer_sign * self.rudder if wow else 0.0
-            self.i_beta = 0.0
+            self.i_beta = -self.rudder
         else:
             r_coord = G_FPS2 * math.sin(phi) * math.cos(theta) / (v * KT_TO_FPS)
             rud = -(self.i_beta + sc * self.kb * beta) + sc * self.kyd * (r - r_coord)
@@ -292,3 +300,4 @@ class Pilot:
                 self.i_beta += self.kb_i * beta * dt
             self.rudder = _clamp(rud, -1.0, 1.0)
             self.steer = 0.0
+            self.i_psi = -self.rudder

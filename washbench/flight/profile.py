@@ -68,8 +68,8 @@ class PitchGains(StrictModel):
 
 
 class PathGains(StrictModel):
-    vs_kp_deg_per_fps: Positive  # pitch command per ft/s of climb-rate error
-    vs_ki_deg_per_ft: NonNegative
+    climb_to_pitch: Positive  # pitch command per flight-path-angle error (climb-rate error / V), rad/rad
+    climb_to_pitch_i: NonNegative  # integral gain of the same, 1/s
     altitude_to_vs: Positive  # climb-rate command per ft of altitude error, 1/s
     vs_max_fps: Positive
     glide_path_to_vs: Positive  # climb-rate correction per ft below the glide path, 1/s
@@ -95,6 +95,7 @@ class TrackGains(StrictModel):
 
 class GroundGains(StrictModel):
     heading_kp: Positive  # rudder/steer per rad of heading error
+    heading_ki: NonNegative  # per rad s
     yaw_rate_kd: NonNegative  # per rad/s
     offset_to_heading_deg_per_ft: Positive
     offset_heading_max_deg: Positive
@@ -103,7 +104,6 @@ class GroundGains(StrictModel):
 class FlareGains(StrictModel):
     tau_s: Positive  # commanded sink = height of the wheels / tau
     sink_min_fps: Positive  # at the wheels' touchdown
-    decrab: bool  # align the nose with the runway (wing low) during the flare
 
 
 class Gains(StrictModel):

@@ -110,10 +110,8 @@ def track_axis(
             sat_acc = 1
     else:
         v = v_des
-    if full and sat_pos + sat_vel + sat_acc == 0:
-        p = sp  # exact tracking inside the limits
-    else:
-        p = p_prev + v * dt
+    # inside the limits the set point is reached exactly (not just to rounding)
+    p = sp if full and sat_pos + sat_vel + sat_acc == 0 else p_prev + v * dt
     if p > p_max:
         p = p_max
         v = (p - p_prev) / dt
@@ -181,10 +179,8 @@ def track_rotation(
         wz *= s
         sat_rate = 1
     w = (wx, wy, wz)
-    if full and sat_rate + sat_angacc == 0:
-        q = q_sp  # exact tracking inside the limits
-    else:
-        q = qintegrate(q_prev, w, dt)
+    # inside the limits the set point is reached exactly (not just to rounding)
+    q = q_sp if full and sat_rate + sat_angacc == 0 else qintegrate(q_prev, w, dt)
     return q, w, sat_rate, sat_angacc
 
 

@@ -1,0 +1,103 @@
+"""Cost of ``washbench cue`` on a 30-minute 120 Hz recording (216,000 rows), stage by stage.
+
+    .venv/bin/python bench/cue_bench.py [--minutes 30]
+
+Baselines measured in the same run, printed as ratios:
+
+* reading the input: ``read_motion`` (with validation) against a bare ``pyarrow.csv.read_csv`` of the same file;
+* vestibular models: one pilot's otolith + canal models (discretised parallel first-order sections,
+  ``lfilter`` over axis 0) against ``scipy.signal.lsim`` of the continuous transfer functions on the same 6 axes;
+* whole command: read + cue_trace + analyse + write against the bare CSV read.
+"""
+
+from __future__ import annotations
+
+import argparse
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.csv as pacsv
+import scipy.signal
+
+from washbench.cue import analyse, write_results
+from washbench.cueing import WASHOUT_NAMES, cue_trace, load_washout_params
+from washbench.perception import VestibularModel
+from washbench.perception.vestibular import CanalParams, OtolithParams, canal_tf, otolith_tf
+from washbench.platform import load_platform_limits
+from washbench.results import read_motion
+
+DT_S = 1.0 / 120.0
+
+
+def write_input(path: Path, n: int) -> None:
+    t = np.arange(n) * DT_S
+    cols = {
+        "t_s": t,
+        "f_x_mps2": 1.5 * np.sin(0.3 * t) + 0.3 * np.sin(7.1 * t),
+        "f_y_mps2": 0.8 * np.sin(0.17 * t + 1.0),
+        "f_z_mps2": -9.80665 * (1.0 + 0.3 * np.sin(0.11 * t)),
+        "omega_x_degps": 15.0 * np.sin(0.5 * t),
+        "omega_y_degps": 5.0 * np.sin(0.23 * t + 0.4),
+        "omega_z_degps": 3.0 * np.sin(0.07 * t),
+        "altitude_ft": 3000.0 + t,
+    }
+    pacsv.write_csv(pa.table(cols), path)
+
+
+def best_of(fn, repeat: int = 3) -> float:
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return min(times)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--minutes", type=float, default=30.0)
+    args = ap.parse_args()
+    n = round(args.minutes * 60 / DT_S)
+    params, limits = load_washout_params(None), load_platform_limits(None)
+    with tempfile.TemporaryDirectory() as tmp:
+        src = Path(tmp) / "in.csv"
+        write_input(src, n)
+        t_bare = best_of(lambda: pacsv.read_csv(src))
+        t_read = best_of(lambda: read_motion(src))
+        motion = read_motion(src)
+        cue_trace(motion.f_mps2[:10], motion.omega_radps[:10], DT_S, WASHOUT_NAMES, params, limits)  # compile
+        t_cue = best_of(lambda: cue_trace(motion.f_mps2, motion.omega_radps, DT_S, WASHOUT_NAMES, params, limits), 1)
+        traces = cue_trace(motion.f_mps2, motion.omega_radps, DT_S, WASHOUT_NAMES, params, limits)
+        t_analyse = best_of(lambda: analyse(motion, traces))
+        result = analyse(motion, traces)
+        t_write = best_of(lambda: write_results(Path(tmp) / "out", result), 1)
+
+        vm = VestibularModel(DT_S)
+        t_vest = best_of(lambda: vm.perceive(motion.f_mps2, motion.omega_radps))
+        t = motion.t_s - motion.t_s[0]
+        oto, can = otolith_tf(OtolithParams()), canal_tf(CanalParams())
+
+        def lsim_all() -> None:
+            for i in range(3):
+                scipy.signal.lsim(oto, motion.f_mps2[:, i], t)
+                scipy.signal.lsim(can, motion.omega_radps[:, i], t)
+
+        t_lsim = best_of(lsim_all, 1)
+
+    total = t_read + t_cue + t_analyse + t_write
+    print(f"{n} rows ({args.minutes:g} min at 120 Hz), 3 washouts")
+    print(f"  bare pyarrow CSV read        {t_bare:7.3f} s   (baseline)")
+    print(f"  read_motion (validated)      {t_read:7.3f} s   {t_read / t_bare:6.2f} x baseline")
+    print(f"  cue_trace (3 washouts)       {t_cue:7.3f} s   {t_cue / t_bare:6.2f} x baseline")
+    print(f"  analyse (4 pilots, metrics)  {t_analyse:7.3f} s   {t_analyse / t_bare:6.2f} x baseline")
+    print(f"  write traces + metrics       {t_write:7.3f} s   {t_write / t_bare:6.2f} x baseline")
+    print(f"  total                        {total:7.3f} s   {total / t_bare:6.2f} x baseline")
+    print(f"  vestibular, one pilot        {t_vest:7.3f} s   (baseline: scipy.signal.lsim {t_lsim:.3f} s,", end=" ")
+    print(f"{t_lsim / t_vest:.1f}x slower)")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,397 @@
+"""Fly a manoeuvre: JSBSim + scripted pilot + recorder + monitor, and write the results.
+
+Time base: sample ``k`` is the state at ``t = k * dt``. JSBSim's eyepoint acceleration
+(``accelerations/a-pilot-*``) and ``accelerations/Nz`` are computed before the forces of the
+step, so they lag one frame: the value read after step ``k + 1`` belongs to sample ``k``.
+The loop therefore reads the state at ``k``, runs the pilot, steps the FDM, then reads the
+accelerations and completes row ``k``.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+import time
+from array import array
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from washbench.atomic import atomic_path, write_text_atomic
+from washbench.errors import WashbenchError
+from washbench.flight.checks import evaluate
+from washbench.flight.columns import COLUMN_NAMES
+from washbench.flight.fdm import FT_TO_M, make_fdm
+from washbench.flight.geo import runway_xy
+from washbench.flight.monitor import Monitor
+from washbench.flight.pilot import Pilot
+from washbench.flight.profile import load_profile
+from washbench.manoeuvre import Manoeuvre, Until, load_manoeuvre, pilot_profile_path
+
+FT_S2_TO_M_S2 = 0.3048
+R2D = 180.0 / math.pi
+FPS_TO_KT = 3600.0 * 0.3048 / 1852.0
+
+StepHook = Callable[[int, np.ndarray, np.ndarray], None]
+
+#: Properties read every step (verified to exist at start-up: JSBSim ignores typos silently).
+STATE_PROPERTIES = (
+    "attitude/phi-rad",
+    "attitude/theta-rad",
+    "attitude/psi-rad",
+    "velocities/p-rad_sec",
+    "velocities/q-rad_sec",
+    "velocities/r-rad_sec",
+    "aero/alpha-rad",
+    "aero/beta-rad",
+    "velocities/vc-kts",
+    "velocities/vg-fps",
+    "flight-path/psi-gt-rad",
+    "velocities/h-dot-fps",
+    "position/h-sl-ft",
+    "position/h-agl-ft",
+    "position/lat-geod-rad",
+    "position/long-gc-rad",
+    "gear/wow",
+    "fcs/flap-pos-deg",
+    "propulsion/engine/engine-rpm",
+    "accelerations/a-pilot-x-ft_sec2",
+    "accelerations/a-pilot-y-ft_sec2",
+    "accelerations/a-pilot-z-ft_sec2",
+    "accelerations/Nz",
+)
+CONTROL_PROPERTIES = (
+    "fcs/aileron-cmd-norm",
+    "fcs/elevator-cmd-norm",
+    "fcs/rudder-cmd-norm",
+    "fcs/steer-cmd-norm",
+    "fcs/throttle-cmd-norm",
+    "fcs/mixture-cmd-norm",
+    "fcs/flap-cmd-norm",
+    "fcs/left-brake-cmd-norm",
+    "fcs/right-brake-cmd-norm",
+)
+
+
+@dataclass
+class FlightResult:
+    """A flown manoeuvre: the recorded columns (flight.parquet) and the summary (flight.json)."""
+
+    name: str
+    aircraft: str
+    dt_s: float
+    t_s: np.ndarray
+    columns: dict[str, np.ndarray]
+    phases: list[tuple[str, float, float]]
+    checks: list[tuple[str, float, str, bool]]
+    status: str  # "ok" or "failed"
+    reason: str = ""
+    events: dict[str, list[float]] = field(default_factory=dict)
+
+    @property
+    def ok(self) -> bool:
+        return self.status == "ok"
+
+
+def _nodes(fdm: object, names: tuple[str, ...]) -> list[object]:
+    pm = fdm.get_property_manager()  # type: ignore[attr-defined]
+    missing = [n for n in names if not pm.hasNode(n)]
+    if missing:
+        raise WashbenchError(f"the JSBSim model lacks the properties {', '.join(missing)}")
+    return [pm.get_node(n) for n in names]
+
+
+def _end_reached(u: Until, t_phase: float, turned: float, vc: float, h: float, agl: float, phi: float,
+                 theta: float, alpha: float, events: set[str]) -> bool:  # fmt: skip
+    """Whether any end condition of the phase holds (angles in deg, heights in ft)."""
+    if u.duration_s is not None and t_phase >= u.duration_s - 1e-9:
+        return True
+    if u.event is not None and u.event in events:
+        return True
+    return (
+        (u.turned_deg is not None and turned >= u.turned_deg)
+        or (u.airspeed_above_kts is not None and vc >= u.airspeed_above_kts)
+        or (u.airspeed_below_kts is not None and vc <= u.airspeed_below_kts)
+        or (u.altitude_above_ft is not None and h >= u.altitude_above_ft)
+        or (u.altitude_below_ft is not None and h <= u.altitude_below_ft)
+        or (u.agl_above_ft is not None and agl >= u.agl_above_ft)
+        or (u.agl_below_ft is not None and agl <= u.agl_below_ft)
+        or (u.bank_above_deg is not None and abs(phi) >= u.bank_above_deg)
+        or (u.pitch_above_deg is not None and theta >= u.pitch_above_deg)
+        or (u.pitch_below_deg is not None and theta <= u.pitch_below_deg)
+        or (u.alpha_above_deg is not None and alpha >= u.alpha_above_deg)
+    )
+
+
+def _mixture(schedule: list[tuple[float, float]], h_ft: float) -> float:
+    return float(np.interp(h_ft, [a for a, _ in schedule], [m for _, m in schedule]))
+
+
+def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool = False) -> FlightResult:
+    """Fly ``manoeuvre`` to its end (or to a crash) and return the recording and check results.
+
+    ``step_hook(k, f_mps2, omega_radps)`` is called once per recorded sample, in order, as soon
+    as the sample is final (specific force at the eyepoint in m/s^2 and body rates in rad/s,
+    body axes x forward, y right, z down).
+    """
+    m = manoeuvre
+    profile = load_profile(pilot_profile_path(m.aircraft))
+    fdm, setup = make_fdm(m, profile)
+    dt = m.dt_s
+    (phi_n, theta_n, psi_n, p_n, q_n, r_n, alpha_n, beta_n, vc_n, vg_n, trk_n, hdot_n, h_n, agl_n, lat_n, lon_n,
+     wow_n, flap_n, rpm_n, ax_n, ay_n, az_n, nz_n) = _nodes(fdm, STATE_PROPERTIES)  # fmt: skip
+    ail_w, elev_w, rud_w, steer_w, thr_w, mix_w, flapc_w, lbrk_w, rbrk_w = _nodes(fdm, CONTROL_PROPERTIES)
+    structure = _nodes(fdm, tuple(f"contact/unit[{i}]/WOW" for i in profile.geometry.structure_contacts))
+    phi_get, theta_get, psi_get = phi_n.get_double_value, theta_n.get_double_value, psi_n.get_double_value
+    p_get, q_get, r_get = p_n.get_double_value, q_n.get_double_value, r_n.get_double_value
+    alpha_get, beta_get, vc_get = alpha_n.get_double_value, beta_n.get_double_value, vc_n.get_double_value
+    vg_get, trk_get, hdot_get = vg_n.get_double_value, trk_n.get_double_value, hdot_n.get_double_value
+    h_get, agl_get, lat_get, lon_get = h_n.get_double_value, agl_n.get_double_value, lat_n.get_double_value, \
+        lon_n.get_double_value  # fmt: skip
+    wow_get, flap_get, rpm_get = wow_n.get_double_value, flap_n.get_double_value, rpm_n.get_double_value
+    ax_get, ay_get, az_get, nz_get = ax_n.get_double_value, ay_n.get_double_value, az_n.get_double_value, \
+        nz_n.get_double_value  # fmt: skip
+    ail_set, elev_set, rud_set = ail_w.set_double_value, elev_w.set_double_value, rud_w.set_double_value
+    steer_set, thr_set = steer_w.set_double_value, thr_w.set_double_value
+    struct_gets = [n.get_double_value for n in structure]
+
+    pilot = Pilot(profile, m.runway, dt)
+    monitor = Monitor(profile)
+    frame = setup.frame
+    lat0, lon0, mlat, mlon = frame.lat0, frame.lon0, frame.m_per_rad_lat, frame.m_per_rad_lon
+    has_runway = setup.threshold_ne_m is not None
+    rw_c = math.cos(setup.runway_heading_rad or 0.0)
+    rw_s = math.sin(setup.runway_heading_rad or 0.0)
+    nan = math.nan
+    mix_schedule = [tuple(x) for x in profile.engine.mixture_schedule]
+    mix_every = max(1, round(1.0 / dt))
+    cg_h = profile.geometry.cg_height_on_ground_ft
+
+    rows = array("d")
+    ncol = len(COLUMN_NAMES)
+    phases_out: list[tuple[str, float, float]] = []
+    events: dict[str, list[float]] = {"touchdown_times_s": [], "touchdown_sinks_fps": [], "liftoff_times_s": []}
+    reason = ""
+    iphase = -1
+    phase_k0 = 0
+    u: Until | None = None
+    psi_prev = 0.0
+    turned = 0.0
+    phase_events: set[str] = set()
+    was_wow = wow_get() > 0.5
+    airborne_since = 0.0
+    lifted = not was_wow  # an air start has no lift-off to report
+    k = 0
+    wall0 = time.monotonic()
+    next_report = wall0 + 0.5
+    nphases = len(m.phases)
+
+    while True:
+        t = k * dt
+        phi, theta, psi = phi_get(), theta_get(), psi_get()
+        p, q, r = p_get(), q_get(), r_get()
+        alpha, beta, vc = alpha_get(), beta_get(), vc_get()
+        vg, trk, hdot = vg_get(), trk_get(), hdot_get()
+        h, agl, lat, lon = h_get(), agl_get(), lat_get(), lon_get()
+        wow = wow_get() > 0.5
+        north = (lat - lat0) * mlat
+        east = (lon - lon0) * mlon
+        if has_runway:
+            x_rw = north * rw_c + east * rw_s
+            y_rw = -north * rw_s + east * rw_c
+        else:
+            x_rw = y_rw = nan
+        sw = 0.0
+        for g in struct_gets:
+            sw += g()
+
+        problem = monitor.state(phi + theta + p + q + r + vc + h + agl + alpha, vc, alpha, agl, wow, sw)
+        # events at this sample
+        if wow and not was_wow:
+            sink = -hdot
+            events["touchdown_times_s"].append(t)
+            events["touchdown_sinks_fps"].append(sink)
+            phase_events.add("touchdown")
+            problem = problem or monitor.touchdown(sink)
+        if not wow:
+            if was_wow:
+                airborne_since = t
+                lifted = False
+            if not lifted and agl - cg_h > 3.0 and t - airborne_since >= 0.5:
+                lifted = True
+                events["liftoff_times_s"].append(t)
+                phase_events.add("liftoff")
+        elif vg * FPS_TO_KT < 1.0:
+            phase_events.add("stopped")
+        if alpha * R2D >= profile.limits.alpha_stall_deg:
+            phase_events.add("stall")
+        was_wow = wow
+        if problem:
+            reason = f"t={t:.2f} s: {problem}"
+            break
+
+        # phase sequencing
+        if iphase >= 0:
+            d = psi - psi_prev
+            if d > math.pi:
+                d -= 2 * math.pi
+            elif d < -math.pi:
+                d += 2 * math.pi
+            turned += d
+        psi_prev = psi
+        advance = iphase < 0
+        if u is not None:
+            t_phase = (k - phase_k0) * dt
+            if _end_reached(u, t_phase, abs(turned) * R2D, vc, h, agl, phi * R2D, theta * R2D, alpha * R2D,
+                            phase_events):  # fmt: skip
+                advance = True
+            elif u.duration_s is None and t_phase >= u.timeout_s:
+                reason = (
+                    f"t={t:.2f} s: phase '{m.phases[iphase].name}' did not reach its end condition "
+                    f"within {u.timeout_s:g} s"
+                )
+                break
+        final = False
+        if advance:
+            if iphase >= 0:
+                phases_out.append((m.phases[iphase].name, phase_k0 * dt, t))
+            iphase += 1
+            if iphase == nphases:
+                final = True
+            else:
+                phase = m.phases[iphase]
+                u = phase.until
+                phase_k0 = k
+                turned = 0.0
+                phase_events = set()
+                pilot.begin_phase(phase.hold, theta, thr_w.get_double_value(), flap_get())
+                flapc_w.set_double_value(pilot.flaps_cmd)
+                lbrk_w.set_double_value(pilot.brakes)
+                rbrk_w.set_double_value(pilot.brakes)
+                if progress:
+                    _progress(m.name, iphase, nphases, phase.name, t)
+
+        if not final:
+            pilot.step(phi, theta, psi, p, q, r, beta, vc, vg, trk, hdot, h, agl, x_rw * 3.2808399,
+                       y_rw * 3.2808399, wow)  # fmt: skip
+            ail_set(pilot.aileron)
+            elev_set(pilot.elevator)
+            rud_set(pilot.rudder)
+            steer_set(pilot.steer)
+            thr_set(pilot.throttle)
+            if k % mix_every == 0:
+                mix_w.set_double_value(_mixture(mix_schedule, h))
+        fdm.run()
+        fx = ax_get() * FT_S2_TO_M_S2
+        fy = ay_get() * FT_S2_TO_M_S2
+        fz = az_get() * FT_S2_TO_M_S2
+        nz = nz_get()
+        rows.extend((t, fx, fy, fz, p * R2D, q * R2D, r * R2D, phi * R2D, theta * R2D, psi * R2D % 360.0,
+                     alpha * R2D, beta * R2D, vc, vg * FPS_TO_KT, h, agl, hdot * 60.0, north, east, lat * R2D,
+                     lon * R2D, x_rw, y_rw, nz, pilot.aileron, pilot.elevator, pilot.rudder, pilot.throttle,
+                     flap_get(), pilot.brakes, rpm_get(), 1.0 if wow else 0.0, float(iphase if not final
+                                                                                      else nphases - 1)))  # fmt: skip
+        if step_hook is not None:
+            step_hook(k, np.array((fx, fy, fz)), np.array((p, q, r)))
+        if final:
+            break
+        if not wow:
+            problem = monitor.load_factor(nz)
+            if problem:
+                reason = f"t={t:.2f} s: {problem}"
+                phases_out.append((m.phases[iphase].name, phase_k0 * dt, t))
+                k += 1
+                break
+        k += 1
+        if progress and k % 600 == 0 and time.monotonic() > next_report:
+            next_report = time.monotonic() + 0.5
+            _progress(m.name, iphase, nphases, m.phases[iphase].name, t)
+
+    if reason and (not phases_out or phases_out[-1][0] != m.phases[max(iphase, 0)].name) and iphase < nphases:
+        phases_out.append((m.phases[max(iphase, 0)].name, phase_k0 * dt, max(k - 1, 0) * dt))
+    if progress:
+        sys.stderr.write("\r\033[K")
+        sys.stderr.flush()
+
+    data = np.frombuffer(rows, dtype=np.float64).reshape(-1, ncol) if rows else np.zeros((0, ncol))
+    columns = {name: np.ascontiguousarray(data[:, i]) for i, name in enumerate(COLUMN_NAMES)}
+    columns["wow"] = columns["wow"].astype(np.int8)
+    columns["phase"] = columns["phase"].astype(np.int16)
+    phase_names = [ph.name for ph in m.phases]
+    results = evaluate(list(m.checks), columns, phase_names, events, dt) if not reason else []
+    checks = [(c.name, c.measured, c.limit, c.passed) for c in results]
+    status = "ok"
+    if reason:
+        status = "failed"
+    elif not all(c.passed for c in results):
+        status = "failed"
+        reason = "checks failed: " + ", ".join(c.name for c in results if not c.passed)
+    return FlightResult(m.name, m.aircraft, dt, columns["t_s"], columns, phases_out, checks, status, reason, events)
+
+
+def _progress(name: str, iphase: int, nphases: int, phase: str, t: float) -> None:
+    sys.stderr.write(f"\r\033[K{name}: phase {iphase + 1}/{nphases} '{phase}', t = {t:6.1f} s")
+    sys.stderr.flush()
+
+
+def flight_summary(result: FlightResult, source: str = "") -> dict[str, object]:
+    """The content of flight.json."""
+
+    def num(x: float) -> float | None:
+        return None if math.isnan(x) else round(float(x), 6)
+
+    return {
+        "name": result.name,
+        "aircraft": result.aircraft,
+        "manoeuvre_file": source,
+        "status": result.status,
+        "reason": result.reason,
+        "dt_s": result.dt_s,
+        "samples": len(result.t_s),
+        "duration_s": float(result.t_s[-1]) if len(result.t_s) else 0.0,
+        "phases": [{"name": n, "t_start_s": a, "t_end_s": b} for n, a, b in result.phases],
+        "checks": [
+            {"name": n, "measured": num(v), "limit": lim, "passed": ok} for n, v, lim, ok in result.checks
+        ],
+        "events": {k: [round(x, 6) for x in v] for k, v in result.events.items()},
+    }
+
+
+def write_flight(out_dir: str | Path, result: FlightResult, source: str = "") -> None:
+    """Write ``out_dir/flight.parquet`` and ``out_dir/flight.json`` atomically."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    out = Path(out_dir)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise WashbenchError(f"{out}: cannot create the output folder ({exc.strerror or exc})") from None
+    table = pa.table({name: result.columns[name] for name in COLUMN_NAMES})
+    table = table.replace_schema_metadata({"washbench.manoeuvre": result.name, "washbench.aircraft": result.aircraft})
+    with atomic_path(out / "flight.parquet") as tmp:
+        pq.write_table(table, tmp)
+    write_text_atomic(out / "flight.json", json.dumps(flight_summary(result, source), indent=2) + "\n")
+
+
+def fly_command(manoeuvre_path: Path, out_dir: Path, progress: bool = True) -> int:
+    """``washbench fly FILE --out DIR``: 0 if flown with every check passing, else 1."""
+    m = load_manoeuvre(manoeuvre_path)
+    show = progress and sys.stderr.isatty()
+    wall = time.monotonic()
+    result = fly(m, progress=show)
+    wall = time.monotonic() - wall
+    write_flight(out_dir, result, str(manoeuvre_path))
+    passed = sum(1 for c in result.checks if c[3])
+    duration = float(result.t_s[-1]) if len(result.t_s) else 0.0
+    line = (
+        f"{m.name} ({m.aircraft}): {result.status}, {passed}/{len(m.checks)} checks passed, "
+        f"{duration:.1f} s flown in {wall:.1f} s -> {out_dir}"
+    )
+    if not result.ok:
+        line += f" ({result.reason})"
+    print(line)
+    return 0 if result.ok else 1
