@@ -104,8 +104,8 @@ class Pilot:
         if not self.hold_elevator:
             if self.v_ref_kcas is not None:
                 err = v - self.v_ref_kcas  # too fast -> pitch up
-                self.theta_int += 0.0006 * err * DT_S
-                theta_cmd = self.theta_int + 0.006 * err
+                self.theta_int += 0.003 * err * DT_S
+                theta_cmd = self.theta_int + 0.02 * err
             else:
                 err = self.h_ref_ft - f["position/h-sl-ft"]
                 self.theta_int += 0.00015 * err * DT_S

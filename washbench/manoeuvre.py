@@ -48,7 +48,7 @@ class Runway(StrictModel):
 
 
 class AirStart(StrictModel):
-    """Start trimmed in level flight. Position: lat/lon, or on the runway's extended centreline."""
+    """Start trimmed in straight flight (level unless ``flight_path_deg``). Position: lat/lon, or on the runway's extended centreline."""
 
     altitude_ft: float
     airspeed_kts: Positive
@@ -56,6 +56,7 @@ class AirStart(StrictModel):
     latitude_deg: Latitude | None = None
     longitude_deg: Longitude | None = None
     before_threshold_ft: float | None = None  # on the extended centreline, this far before the threshold
+    flight_path_deg: Annotated[float, Field(ge=-10, le=10)] = 0.0  # trimmed climb (+) or descent (-)
     flaps_deg: NonNegative = 0.0
 
 

@@ -29,17 +29,24 @@ def limit_text(check: Check) -> str:
 def measure(
     check: Check,
     columns: dict[str, np.ndarray],
-    phase_names: list[str],
-    events: dict[str, float],
+    phases: list[tuple[str, float, float]],
+    events: dict[str, list[float]],
     dt_s: float,
 ) -> float:
-    """The value of ``check.stat`` of ``check.signal`` over the selected phases (NaN if none)."""
-    phase = columns["phase"]
+    """The value of ``check.stat`` of ``check.signal`` over the selected phases (NaN if none).
+
+    A phase covers its start and end samples (t_start <= t <= t_end), so the sample at which
+    an end condition was met (say, the stall) belongs to the phase it ends as well.
+    """
+    t = columns["t_s"]
     if check.phases:
-        wanted = [phase_names.index(n) for n in check.phases]
-        mask = np.isin(phase, wanted)
+        mask = np.zeros(t.shape, dtype=bool)
+        half = 0.5 * dt_s
+        for name, t0, t1 in phases:
+            if name in check.phases:
+                mask |= (t >= t0 - half) & (t <= t1 + half)
     else:
-        mask = np.ones(phase.shape, dtype=bool)
+        mask = np.ones(t.shape, dtype=bool)
     if check.stat in ("at_touchdown", "at_liftoff"):
         event = "touchdown" if check.stat == "at_touchdown" else "liftoff"
         times = [t for t in events.get(f"{event}_times_s", []) if mask[min(round(t / dt_s), len(mask) - 1)]]
@@ -79,14 +86,14 @@ def measure(
 def evaluate(
     checks: list[Check],
     columns: dict[str, np.ndarray],
-    phase_names: list[str],
-    events: dict[str, float],
+    phases: list[tuple[str, float, float]],
+    events: dict[str, list[float]],
     dt_s: float,
 ) -> list[CheckResult]:
     """Measure every check; a check that cannot be measured fails."""
     out = []
     for check in checks:
-        value = measure(check, columns, phase_names, events, dt_s)
+        value = measure(check, columns, phases, events, dt_s)
         ok = not math.isnan(value)
         if ok and check.min is not None and value < check.min:
             ok = False

@@ -109,7 +109,6 @@ def make_fdm(m: Manoeuvre, profile: PilotProfile) -> tuple[Any, Setup]:
     fdm["ic/terrain-elevation-ft"] = elevation
     fdm["ic/psi-true-deg"] = heading_deg
     fdm["ic/phi-deg"] = 0.0
-    fdm["ic/gamma-deg"] = 0.0
     wind_n = wind_e = 0.0
     env = m.environment
     if env.wind is not None and env.wind.speed_kts > 0:
@@ -119,6 +118,7 @@ def make_fdm(m: Manoeuvre, profile: PilotProfile) -> tuple[Any, Setup]:
     if air is not None:
         fdm["ic/h-sl-ft"] = air.altitude_ft
         fdm["ic/vc-kts"] = air.airspeed_kts
+        fdm["ic/gamma-deg"] = air.flight_path_deg
         fdm["fcs/flap-cmd-norm"] = air.flaps_deg / profile.limits.flaps_full_cmd_deg
     else:
         fdm["ic/h-agl-ft"] = profile.geometry.cg_height_on_ground_ft
@@ -138,7 +138,7 @@ def make_fdm(m: Manoeuvre, profile: PilotProfile) -> tuple[Any, Setup]:
                 fdm.do_trim(1)
         except RuntimeError as exc:
             raise WashbenchError(
-                f"{m.aircraft}: JSBSim could not trim level flight at {air.airspeed_kts:g} kt, "
+                f"{m.aircraft}: JSBSim could not trim straight flight at {air.airspeed_kts:g} kt, "
                 f"{air.altitude_ft:g} ft, flaps {air.flaps_deg:g} deg ({exc})"
             ) from None
         if wind_n or wind_e:
@@ -157,6 +157,12 @@ def make_fdm(m: Manoeuvre, profile: PilotProfile) -> tuple[Any, Setup]:
         fdm["atmosphere/turb-type"] = 3  # MIL-F-8785C (Dryden) in JSBSim's milspec form
         fdm["atmosphere/turbulence/milspec/severity"] = index
         fdm["atmosphere/turbulence/milspec/windspeed_at_20ft_AGL-fps"] = w20_kts * KT_TO_FPS
+    # recompute the derived values (airspeed, sideslip) for the wind without advancing time
+    fdm.suspend_integration()
+    fdm.run()
+    fdm.resume_integration()
+    if fdm["simulation/sim-time-sec"] != 0.0:
+        raise WashbenchError("JSBSim advanced time while initialising")  # guards the t = k * dt time base
     return fdm, Setup(frame, threshold, rw_heading, elevation)
 
 

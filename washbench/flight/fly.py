@@ -159,6 +159,7 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
     struct_gets = [n.get_double_value for n in structure]
 
     pilot = Pilot(profile, m.runway, dt)
+    pilot.set_controls(ail_w.get_double_value(), elev_w.get_double_value(), rud_w.get_double_value())
     monitor = Monitor(profile)
     frame = setup.frame
     lat0, lon0, mlat, mlon = frame.lat0, frame.lon0, frame.m_per_rad_lat, frame.m_per_rad_lon
@@ -320,8 +321,7 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
     columns = {name: np.ascontiguousarray(data[:, i]) for i, name in enumerate(COLUMN_NAMES)}
     columns["wow"] = columns["wow"].astype(np.int8)
     columns["phase"] = columns["phase"].astype(np.int16)
-    phase_names = [ph.name for ph in m.phases]
-    results = evaluate(list(m.checks), columns, phase_names, events, dt) if not reason else []
+    results = evaluate(list(m.checks), columns, phases_out, events, dt) if not reason else []
     checks = [(c.name, c.measured, c.limit, c.passed) for c in results]
     status = "ok"
     if reason:

@@ -15,6 +15,7 @@ Loops (angles in rad, rates in rad/s, speeds in kt, heights in ft):
   wind to hold the track) and on the ground it holds the runway heading (PI, with yaw-rate
   damping) plus a centreline correction on the ground, with nosewheel steering.
 
+Surface commands are rate limited (``surface_rate_per_s``), as a pilot's hands are.
 Integrators start from the current control or attitude at each phase (bumpless), stop
 integrating while their output saturates (anti-windup) and while the gear is on the
 ground for the loops the gear constrains. Proportional gains are scaled with
@@ -83,6 +84,7 @@ class Pilot:
         self.kt = g.path.throttle_kp_per_kt
         self.kt_i = g.path.throttle_ki_per_kt_s
         self.thr_rate = g.path.throttle_rate_per_s * dt_s
+        self.surf_rate = g.surface_rate_per_s * dt_s
         # yaw
         self.kb = g.yaw.beta_kp
         self.kb_i = g.yaw.beta_ki
@@ -131,6 +133,10 @@ class Pilot:
         self.throttle = 0.0
         self.flaps_cmd = 0.0
         self.brakes = 0.0
+
+    def set_controls(self, aileron: float, elevator: float, rudder: float) -> None:
+        """Start from the control positions the trim left (the rate limits act from there)."""
+        self.aileron, self.elevator, self.rudder = aileron, elevator, rudder
 
     def begin_phase(self, hold: Hold, theta: float, throttle: float, flaps_deg: float) -> None:
         """Set the loops for a phase from the current pitch (rad), throttle and flap angle."""
@@ -222,7 +228,8 @@ class Pilot:
         ail = self.i_p + sc * self.kp_p * e
         if air and -1.0 < ail < 1.0:
             self.i_p += self.ki_p * e * dt
-        self.aileron = _clamp(ail, -1.0, 1.0)
+        d = _clamp(ail, -1.0, 1.0) - self.aileron
+        self.aileron += _clamp(d, -self.surf_rate, self.surf_rate)
 
         # ---- pitch: path -> pitch -> pitch rate -> elevator
         mode = self.pitch_mode
@@ -261,7 +268,8 @@ class Pilot:
         u = self.i_q + sc * self.kp_q * e
         if air and -1.0 < u < 1.0:
             self.i_q += self.ki_q * e * dt
-        self.elevator = -_clamp(u, -1.0, 1.0)
+        d = -_clamp(u, -1.0, 1.0) - self.elevator
+        self.elevator += _clamp(d, -self.surf_rate, self.surf_rate)
 
         # ---- power
         if self.speed_on_throttle:
@@ -290,7 +298,8 @@ class Pilot:
             if -1.0 < yaw < 1.0:
                 self.i_psi += self.kg_i * e * dt
             yaw = _clamp(yaw, -1.0, 1.0)
-            self.rudder = -yaw
+            d = -yaw - self.rudder
+            self.rudder += _clamp(d, -self.surf_rate, self.surf_rate)
             self.steer = self.steer_sign * self.rudder if wow else 0.0
             self.i_beta = -self.rudder
         else:
@@ -298,6 +307,7 @@ class Pilot:
             rud = -(self.i_beta + sc * self.kb * beta) + sc * self.kyd * (r - r_coord)
             if -1.0 < rud < 1.0:
                 self.i_beta += self.kb_i * beta * dt
-            self.rudder = _clamp(rud, -1.0, 1.0)
+            d = _clamp(rud, -1.0, 1.0) - self.rudder
+            self.rudder += _clamp(d, -self.surf_rate, self.surf_rate)
             self.steer = 0.0
             self.i_psi = -self.rudder

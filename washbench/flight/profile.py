@@ -108,6 +108,7 @@ class FlareGains(StrictModel):
 
 class Gains(StrictModel):
     reference_airspeed_kts: Positive
+    surface_rate_per_s: Positive  # largest rate of aileron, elevator and rudder commands (full travel = 1)
     roll: RollGains
     pitch: PitchGains
     path: PathGains
