@@ -186,3 +186,18 @@ def test_metrics_csv_exact_round_trip_nan_empty_inf(tmp_path: Path) -> None:
     assert back[0] == rows[0] and back[2] == rows[2]
     assert math.isnan(back[1].npc) and back[1].integral_error == 2.0
     assert [p.name for p in tmp_path.iterdir()] == ["metrics.csv"]  # no temporary files left behind
+
+
+def test_dt_of_a_fixed_step_grid_is_recovered_exactly(tmp_path: Path) -> None:
+    """t = k*dt written by a fixed-step simulator gives back dt itself, not the mean step."""
+    from washbench.results import INPUT_COLUMNS, read_motion
+
+    for hz in (30, 47, 120, 333, 1000):
+        dt = 1.0 / hz
+        n = 7201
+        cols = {c: np.zeros(n) for c in INPUT_COLUMNS}
+        cols["t_s"] = np.arange(n) * dt
+        cols["f_z_mps2"] = np.full(n, -9.81)
+        path = tmp_path / f"grid{hz}.parquet"
+        pq.write_table(pa.table(cols), path)
+        assert read_motion(path).dt_s == dt

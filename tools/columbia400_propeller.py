@@ -10,7 +10,7 @@ reaches at 235 KTAS. This script estimates the tables with blade-element / momen
 - section: a cambered Clark-Y-like section (estimated): lift slope 5.7 /rad, zero-lift angle -4 deg,
   cl_max 1.25 with a flat post-stall cl of 0.9, drag cd = 0.016 + 0.015 (cl - 0.4)^2 (+ stall drag);
 - annulus momentum balance for the axial induced velocity with the Prandtl tip loss; swirl is not solved
-  for, its loss is taken as a flat 4 % thrust reduction (SWIRL_THRUST_FACTOR, estimated: typical
+  for, its loss is taken as a flat 3 % thrust reduction (SWIRL_THRUST_FACTOR, estimated: typical
   light-aircraft propellers lose 3-5 % to swirl);
 - incompressible: no tip-Mach correction (the table is used at all altitudes).
 
@@ -36,7 +36,7 @@ BLADES = 3
 CHORD_OVER_D = 0.065
 HUB_R = 0.2
 N_STATIONS = 40
-SWIRL_THRUST_FACTOR = 0.96
+SWIRL_THRUST_FACTOR = 0.97
 PITCHES_DEG = (10.0, 15.0, 20.0, 25.0, 30.0, 35.0, 40.0, 45.0, 50.0, 55.0)
 ADVANCE_RATIOS = tuple(round(0.1 * i, 2) for i in range(0, 31))
 
@@ -221,11 +221,11 @@ def main() -> None:
 <!--
   Columbia-400-like propeller: Hartzell-type 78 in, 3-blade, constant speed.
   Tables ESTIMATED by blade-element / momentum theory in tools/columbia400_propeller.py
-  (chord c/D {CHORD_OVER_D}, Clark-Y-like section, Prandtl tip loss, swirl as a 4 % thrust loss, incompressible).
+  (chord c/D {CHORD_OVER_D}, Clark-Y-like section, Prandtl tip loss, swirl as a 3 % thrust loss, incompressible).
   Generated file: edit the script, not this file.
 -->
 <propeller name="prop_hartzell78in3v">
-  <ixx unit="SLUG*FT2"> 3.0 </ixx> <!-- propeller plus crankshaft, estimated -->
+  <ixx unit="SLUG*FT2"> 6.0 </ixx> <!-- propeller plus crankshaft, estimated -->
   <diameter unit="IN"> 78.0 </diameter>
   <numblades> {BLADES} </numblades>
   <minpitch> {PITCHES_DEG[0]:.0f} </minpitch>

@@ -1,0 +1,57 @@
+"""Flight speed: steps per second of a whole flown manoeuvre against bare ``fdm.run()``.
+
+Both are measured in this process on the same aircraft and step, so the printed ratio does
+not depend on the machine. The flight includes the pilot, the monitor, the recording and
+the check evaluation; the baseline is JSBSim alone, trimmed at the manoeuvre's start.
+
+    .venv/bin/python bench/flight_bench.py [MANOEUVRE.yaml ...]
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+from washbench.flight.fdm import make_fdm
+from washbench.flight.fly import fly
+from washbench.flight.profile import load_profile
+from washbench.manoeuvre import load_manoeuvre, pilot_profile_path
+from washbench.paths import MANOEUVRES_DIR
+
+
+def bare_steps_per_s(path: Path, steps: int) -> float:
+    """JSBSim alone: ``fdm.run()`` with constant controls from the manoeuvre's start."""
+    m = load_manoeuvre(path)
+    fdm, _ = make_fdm(m, load_profile(pilot_profile_path(m.aircraft)))
+    run = fdm.run
+    t0 = time.perf_counter()
+    for _ in range(steps):
+        run()
+    return steps / (time.perf_counter() - t0)
+
+
+def flight_steps_per_s(path: Path) -> tuple[float, int]:
+    m = load_manoeuvre(path)
+    t0 = time.perf_counter()
+    result = fly(m)
+    wall = time.perf_counter() - t0
+    return len(result.t_s) / wall, len(result.t_s)
+
+
+def main(argv: list[str]) -> int:
+    paths = [Path(a) for a in argv] or sorted((MANOEUVRES_DIR / "c172").glob("*.yaml"))
+    print(f"{'manoeuvre':28s} {'steps':>7s} {'flight/s':>10s} {'bare/s':>10s} {'slowdown':>9s}")
+    worst = 0.0
+    for path in paths:
+        best_flight, n = max(flight_steps_per_s(path) for _ in range(3))
+        best_bare = max(bare_steps_per_s(path, n) for _ in range(3))
+        ratio = best_bare / best_flight
+        worst = max(worst, ratio)
+        print(f"{path.stem:28s} {n:7d} {best_flight:10.0f} {best_bare:10.0f} {ratio:8.2f}x")
+    print(f"worst slowdown of the whole flight against bare JSBSim: {worst:.2f}x (target <= 3x)")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main(sys.argv[1:]))
