@@ -26,6 +26,8 @@ the C_POWER table as JSBSim interpolates it, so the governor holds the commanded
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 from scipy.optimize import brentq
 
@@ -70,7 +72,7 @@ def coefficients(advance_ratio: float, pitch75_deg: float) -> tuple[float, float
     thrust = torque = 0.0
     tan75 = np.tan(np.radians(pitch75_deg))
     chord = CHORD_OVER_D * diameter
-    for r0, r1 in zip(edges[:-1], edges[1:], strict=True):
+    for r0, r1 in itertools.pairwise(edges):
         r = 0.5 * (r0 + r1)
         dr = r1 - r0
         beta = np.arctan(0.75 * radius * tan75 / r)

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 import os
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -178,7 +179,9 @@ class LevelTrim:
     vertical_speed_fpm: float
 
 
-def level_trim(name: str, altitude_ft: float, kcas: float, *, loading: Loading | None = None, settle_s: float = 60.0) -> LevelTrim:
+def level_trim(
+    name: str, altitude_ft: float, kcas: float, *, loading: Loading | None = None, settle_s: float = 60.0
+) -> LevelTrim:
     """Fly level at ``kcas`` and report the settled controls (flying-start trim)."""
     fdm, _ = flying_start(name, altitude_ft, kcas, loading=loading, settle_s=settle_s, advance_norm=0.83)
     return LevelTrim(
@@ -232,20 +235,38 @@ def stall_speed(
 
 
 def level_speed(
-    name: str, altitude_ft: float, *, loading: Loading | None = None, start_kcas: float, throttle: float = 1.0,
-    advance_norm: float = 1.0, duration_s: float = 300.0
+    name: str,
+    altitude_ft: float,
+    *,
+    loading: Loading | None = None,
+    start_kcas: float,
+    throttle: float = 1.0,
+    advance_norm: float = 1.0,
+    duration_s: float = 300.0,
 ) -> tuple[float, float]:
     """Steady level (KTAS, KCAS) at ``altitude_ft`` with a fixed throttle, altitude held by the elevator."""
     fdm, _ = flying_start(
-        name, altitude_ft, start_kcas, loading=loading, throttle=throttle, advance_norm=advance_norm,
+        name,
+        altitude_ft,
+        start_kcas,
+        loading=loading,
+        throttle=throttle,
+        advance_norm=advance_norm,
         settle_s=duration_s,
     )
     return fdm["velocities/vtrue-kts"], fdm["velocities/vc-kts"]
 
 
 def climb_rate(
-    name: str, kcas: float, *, loading: Loading | None = None, altitude_ft: float = 200.0, throttle: float = 1.0,
-    advance_norm: float = 1.0, settle_s: float = 15.0, measure_s: float = 30.0
+    name: str,
+    kcas: float,
+    *,
+    loading: Loading | None = None,
+    altitude_ft: float = 200.0,
+    throttle: float = 1.0,
+    advance_norm: float = 1.0,
+    settle_s: float = 30.0,
+    measure_s: float = 30.0,
 ) -> float:
     """Steady rate of climb (ft/min) at ``kcas`` with a fixed throttle; speed held with pitch.
 
@@ -300,8 +321,14 @@ def _damped(t: np.ndarray, amp: float, zeta: float, wn: float, phase: float, off
 
 
 def doublet_damping(
-    name: str, kcas: float, *, loading: Loading | None = None, altitude_ft: float = 5000.0,
-    amplitude_norm: float = 0.1, half_period_s: float = 0.5, record_s: float = 4.0
+    name: str,
+    kcas: float,
+    *,
+    loading: Loading | None = None,
+    altitude_ft: float = 5000.0,
+    amplitude_norm: float = 0.1,
+    half_period_s: float = 0.5,
+    record_s: float = 4.0,
 ) -> DoubletResponse:
     """Elevator doublet (+a for T, -a for T, back to trim) and a damped-sinusoid fit to the free q(t).
 
@@ -332,7 +359,9 @@ def doublet_damping(
     best = None
     for p0 in guesses:
         try:
-            popt, _ = curve_fit(_damped, t, q, p0=p0, maxfev=20000)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")  # covariance not needed, only the fitted parameters
+                popt, _ = curve_fit(_damped, t, q, p0=p0, maxfev=20000)
         except RuntimeError:
             continue
         err = float(np.sum((_damped(t, *popt) - q) ** 2))

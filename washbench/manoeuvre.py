@@ -12,6 +12,7 @@ blowing towards the east). Airspeeds are calibrated (KCAS ~ KIAS).
 
 from __future__ import annotations
 
+import difflib
 import json
 import sys
 from collections.abc import Sequence
@@ -48,7 +49,11 @@ class Runway(StrictModel):
 
 
 class AirStart(StrictModel):
-    """Start trimmed in straight flight (level unless ``flight_path_deg``). Position: lat/lon, or on the runway's extended centreline."""
+    """Start trimmed in straight flight (level unless ``flight_path_deg``).
+
+    Position: lat/lon, or ``before_threshold_ft`` on the runway's extended centreline (then
+    the heading defaults to the runway's and the aircraft starts crabbed into the wind).
+    """
 
     altitude_ft: float
     airspeed_kts: Positive
@@ -202,7 +207,7 @@ class Manoeuvre(StrictModel):
     start: Start
     environment: Environment = Environment()
     phases: Annotated[list[Phase], Field(min_length=1)]
-    checks: list[Check] = []
+    checks: list[Check] = Field(default_factory=list)
 
     @property
     def dt_s(self) -> float:
@@ -263,7 +268,7 @@ def _check_semantics(m: Manoeuvre, where: _Where) -> None:
     if aircraft_path(m.aircraft) is None:
         raise where.error(
             ("aircraft",),
-            f"unknown aircraft '{m.aircraft}' (not in {AIRCRAFT_DIR} nor among JSBSim's bundled aircraft)",
+            f"unknown aircraft '{m.aircraft}' (neither in the project's aircraft/ folder nor bundled with JSBSim)",
         )
     profile_file = pilot_profile_path(m.aircraft)
     if not profile_file.is_file():
@@ -337,7 +342,9 @@ def _check_semantics(m: Manoeuvre, where: _Where) -> None:
     for j, check in enumerate(m.checks):
         base = ("checks", j)
         if check.signal not in COLUMN_NAMES and check.signal != "sink_fps":
-            raise where.error((*base, "signal"), f"unknown signal '{check.signal}' (one of: {', '.join(COLUMN_NAMES)})")
+            close = difflib.get_close_matches(check.signal, [*COLUMN_NAMES, "sink_fps"], n=1, cutoff=0.7)
+            hint = f"did you mean '{close[0]}'?" if close else "see docs/manoeuvres.md for the signals"
+            raise where.error((*base, "signal"), f"unknown signal '{check.signal}' ({hint})")
         if check.signal == "sink_fps" and check.stat not in EVENT_STATS:
             raise where.error((*base, "stat"), "sink_fps is measured at an event: use at_touchdown or at_liftoff")
         if check.signal in RUNWAY_COLUMNS and m.runway is None:

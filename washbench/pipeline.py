@@ -164,7 +164,7 @@ def run_manoeuvre(
     shutil.rmtree(partial, ignore_errors=True)
     partial.mkdir(parents=True)
     try:
-        write_flight(partial, flight)
+        write_flight(partial, flight, str(manoeuvre_path))
         if n < 2:
             raise WashbenchError(located(manoeuvre_path, f"the flight recorded {n} sample(s): nothing to cue"))
         motion = read_motion(partial / "flight.parquet")
@@ -177,11 +177,11 @@ def run_manoeuvre(
         felt = perceived_motion(
             result.perceived["aircraft"].f_mps2, result.perceived["aircraft"].omega_radps, motion.dt_s
         )
-        checks_passed = sum(1 for c in flight.checks if c.passed)
+        checks_passed = sum(1 for c in flight.checks if c[3])
         ok = flight.status == "ok" and checks_passed == len(flight.checks)
         reason = flight.reason if flight.status != "ok" else ""
         if not reason and not ok:
-            failed = [c.name for c in flight.checks if not c.passed]
+            failed = [c[0] for c in flight.checks if not c[3]]
             reason = f"checks failed: {', '.join(failed)}"
         summary = RunSummary(
             ok=ok,
@@ -293,7 +293,13 @@ def run_command(
 ) -> int:
     """CLI entry of ``washbench run``: 0 if the flight ran and passed its checks, else 1."""
     start = time.perf_counter()
-    s = run_manoeuvre(manoeuvre_path, out_root, params_path=params_path, platform_path=platform_path, progress=progress)
+    s = run_manoeuvre(
+        manoeuvre_path,
+        out_root,
+        params_path=params_path,
+        platform_path=platform_path,
+        progress=progress and sys.stderr.isatty(),
+    )
     state = "ok" if s.ok else f"FAILED ({s.reason})"
     print(
         f"{s.aircraft}/{s.manoeuvre}: {state}; checks {s.checks_passed}/{s.checks_total}; "

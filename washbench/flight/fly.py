@@ -24,8 +24,7 @@ from washbench.atomic import atomic_path, write_text_atomic
 from washbench.errors import WashbenchError
 from washbench.flight.checks import evaluate
 from washbench.flight.columns import COLUMN_NAMES
-from washbench.flight.fdm import FT_TO_M, make_fdm
-from washbench.flight.geo import runway_xy
+from washbench.flight.fdm import make_fdm
 from washbench.flight.monitor import Monitor
 from washbench.flight.pilot import Pilot
 from washbench.flight.profile import load_profile
@@ -141,21 +140,13 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
     profile = load_profile(pilot_profile_path(m.aircraft))
     fdm, setup = make_fdm(m, profile)
     dt = m.dt_s
-    (phi_n, theta_n, psi_n, p_n, q_n, r_n, alpha_n, beta_n, vc_n, vg_n, trk_n, hdot_n, h_n, agl_n, lat_n, lon_n,
-     wow_n, flap_n, rpm_n, ax_n, ay_n, az_n, nz_n) = _nodes(fdm, STATE_PROPERTIES)  # fmt: skip
+    (phi_get, theta_get, psi_get, p_get, q_get, r_get, alpha_get, beta_get, vc_get, vg_get, trk_get, hdot_get,
+     h_get, agl_get, lat_get, lon_get, wow_get, flap_get, rpm_get, ax_get, ay_get, az_get,
+     nz_get) = [n.get_double_value for n in _nodes(fdm, STATE_PROPERTIES)]  # fmt: skip
     ail_w, elev_w, rud_w, steer_w, thr_w, mix_w, flapc_w, lbrk_w, rbrk_w = _nodes(fdm, CONTROL_PROPERTIES)
-    structure = _nodes(fdm, tuple(f"contact/unit[{i}]/WOW" for i in profile.geometry.structure_contacts))
-    phi_get, theta_get, psi_get = phi_n.get_double_value, theta_n.get_double_value, psi_n.get_double_value
-    p_get, q_get, r_get = p_n.get_double_value, q_n.get_double_value, r_n.get_double_value
-    alpha_get, beta_get, vc_get = alpha_n.get_double_value, beta_n.get_double_value, vc_n.get_double_value
-    vg_get, trk_get, hdot_get = vg_n.get_double_value, trk_n.get_double_value, hdot_n.get_double_value
-    h_get, agl_get, lat_get, lon_get = h_n.get_double_value, agl_n.get_double_value, lat_n.get_double_value, \
-        lon_n.get_double_value  # fmt: skip
-    wow_get, flap_get, rpm_get = wow_n.get_double_value, flap_n.get_double_value, rpm_n.get_double_value
-    ax_get, ay_get, az_get, nz_get = ax_n.get_double_value, ay_n.get_double_value, az_n.get_double_value, \
-        nz_n.get_double_value  # fmt: skip
     ail_set, elev_set, rud_set = ail_w.set_double_value, elev_w.set_double_value, rud_w.set_double_value
     steer_set, thr_set = steer_w.set_double_value, thr_w.set_double_value
+    structure = _nodes(fdm, tuple(f"contact/unit[{i}]/WOW" for i in profile.geometry.structure_contacts))
     struct_gets = [n.get_double_value for n in structure]
 
     pilot = Pilot(profile, m.runway, dt)
@@ -303,16 +294,14 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
             problem = monitor.load_factor(nz)
             if problem:
                 reason = f"t={t:.2f} s: {problem}"
-                phases_out.append((m.phases[iphase].name, phase_k0 * dt, t))
-                k += 1
                 break
         k += 1
         if progress and k % 600 == 0 and time.monotonic() > next_report:
             next_report = time.monotonic() + 0.5
             _progress(m.name, iphase, nphases, m.phases[iphase].name, t)
 
-    if reason and (not phases_out or phases_out[-1][0] != m.phases[max(iphase, 0)].name) and iphase < nphases:
-        phases_out.append((m.phases[max(iphase, 0)].name, phase_k0 * dt, max(k - 1, 0) * dt))
+    if reason and 0 <= iphase < nphases:  # the phase the flight stopped in, up to the last recorded sample
+        phases_out.append((m.phases[iphase].name, phase_k0 * dt, max(len(rows) // ncol - 1, 0) * dt))
     if progress:
         sys.stderr.write("\r\033[K")
         sys.stderr.flush()
@@ -353,9 +342,7 @@ def flight_summary(result: FlightResult, source: str = "") -> dict[str, object]:
         "samples": len(result.t_s),
         "duration_s": float(result.t_s[-1]) if len(result.t_s) else 0.0,
         "phases": [{"name": n, "t_start_s": a, "t_end_s": b} for n, a, b in result.phases],
-        "checks": [
-            {"name": n, "measured": num(v), "limit": lim, "passed": ok} for n, v, lim, ok in result.checks
-        ],
+        "checks": [{"name": n, "measured": num(v), "limit": lim, "passed": ok} for n, v, lim, ok in result.checks],
         "events": {k: [round(x, 6) for x in v] for k, v in result.events.items()},
     }
 

@@ -1,0 +1,110 @@
+"""washbench run end to end: real JSBSim flights, washouts in lockstep, files and the recording read back."""
+
+from __future__ import annotations
+
+import csv
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pyarrow.parquet as pq
+import pytest
+
+from washbench.paths import MANOEUVRES_DIR
+from washbench.rerun_log import read_scalar_series, read_text_documents
+
+MANOEUVRES = [MANOEUVRES_DIR / "c172" / "coordinated_turn.yaml", MANOEUVRES_DIR / "c172" / "takeoff.yaml"]
+DOF_COLUMNS = {
+    "surge": "perceived_f_x_mps2",
+    "sway": "perceived_f_y_mps2",
+    "heave": "perceived_f_z_mps2",
+    "roll": "perceived_omega_x_degps",
+    "pitch": "perceived_omega_y_degps",
+    "yaw": "perceived_omega_z_degps",
+}
+
+
+def washbench(*args: str | Path) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "washbench", *map(str, args)], capture_output=True, text=True, timeout=600
+    )
+
+
+@pytest.fixture(scope="module", params=MANOEUVRES, ids=lambda p: p.stem)
+def run_dir(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    out = tmp_path_factory.mktemp("run")
+    proc = washbench("run", request.param, "--out", out, "--quiet")
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    (folder,) = [p for p in out.glob("*/*") if p.is_dir()]
+    return folder
+
+
+def test_run_writes_every_file_and_nothing_else(run_dir: Path) -> None:
+    names = sorted(p.name for p in run_dir.iterdir())
+    assert names == sorted(
+        ["flight.json", "flight.parquet", "traces.parquet", "metrics.csv", "recording.rrd", "run.json"]
+    )
+    assert not list(run_dir.parent.glob(".*")), "temporary folders left behind"
+    flight = json.loads((run_dir / "flight.json").read_text())
+    assert flight["status"] == "ok"
+    assert all(c["passed"] for c in flight["checks"])
+    with (run_dir / "metrics.csv").open() as f:
+        rows = list(csv.DictReader(f))
+    assert len(rows) == 18
+    assert {r["washout"] for r in rows} == {"small-angle", "large-angle", "unrestricted"}
+    for r in rows:
+        assert float(r["integral_error"]) >= 0.0 and float(r["max_error"]) >= 0.0
+        assert r["npc"] == "" or float(r["npc"]) >= 0.5  # NPC >= K/2 for K = 1
+
+
+def test_traces_hold_cue_columns_and_flight_state(run_dir: Path) -> None:
+    table = pq.read_table(run_dir / "traces.parquet")
+    names = set(table.column_names)
+    for col in ("t_s", "aircraft.f_x_mps2", "aircraft.perceived_omega_z_degps", "phi_deg", "h_agl_ft", "wow"):
+        assert col in names
+    for w in ("small-angle", "large-angle", "unrestricted"):
+        for col in ("pos_x_m", "q_w", "wheel_1_radps", "perceived_f_z_mps2"):
+            assert f"{w}.{col}" in names
+    flight = pq.read_table(run_dir / "flight.parquet")
+    assert np.array_equal(table.column("t_s").to_numpy(), flight.column("t_s").to_numpy())
+    assert np.array_equal(table.column("aircraft.f_z_mps2").to_numpy(), flight.column("f_z_mps2").to_numpy())
+
+
+def test_fly_then_cue_gives_the_same_numbers_bit_for_bit(run_dir: Path, tmp_path: Path) -> None:
+    manoeuvre = MANOEUVRES_DIR / "c172" / f"{run_dir.name}.yaml"
+    assert washbench("fly", manoeuvre, "--out", tmp_path / "fly", "--quiet").returncode == 0
+    proc = washbench("cue", tmp_path / "fly" / "flight.parquet", "--out", tmp_path / "cue")
+    assert proc.returncode == 0, proc.stderr
+    assert (tmp_path / "cue" / "metrics.csv").read_bytes() == (run_dir / "metrics.csv").read_bytes()
+    a = pq.read_table(tmp_path / "cue" / "traces.parquet")
+    b = pq.read_table(run_dir / "traces.parquet")
+    assert a.column_names == b.column_names
+    for name in a.column_names:
+        x, y = a.column(name).to_numpy(), b.column(name).to_numpy()
+        assert np.array_equal(x, y, equal_nan=x.dtype.kind == "f"), name
+
+
+def test_recording_holds_the_computed_traces(run_dir: Path) -> None:
+    traces = pq.read_table(run_dir / "traces.parquet")
+    t = traces.column("t_s").to_numpy()
+    series = read_scalar_series(run_dir / "recording.rrd")
+    for dof, col in DOF_COLUMNS.items():
+        for source in ("aircraft", "small-angle", "large-angle", "unrestricted"):
+            rec_t, rec_v = series[f"/perceived/{dof}/{source}"]
+            expected = traces.column(f"{source}.{col}").to_numpy()
+            assert np.allclose(rec_t, t, rtol=0, atol=1e-9)
+            assert np.allclose(np.ravel(rec_v), expected, rtol=1e-12, atol=1e-12), (dof, source)
+    text = "\n".join(read_text_documents(run_dir / "recording.rrd").values())
+    assert "integral error" in text and "large-angle" in text
+
+
+def test_run_summary_is_consistent(run_dir: Path) -> None:
+    summary = json.loads((run_dir / "run.json").read_text())
+    flight = json.loads((run_dir / "flight.json").read_text())
+    assert summary["ok"] is True
+    assert summary["checks_total"] == len(flight["checks"])
+    n = pq.read_metadata(run_dir / "traces.parquet").num_rows
+    assert summary["steps"] == n
+    assert set(summary["perceived_motion"]) == set(DOF_COLUMNS)

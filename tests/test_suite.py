@@ -1,0 +1,91 @@
+"""washbench suite: parallel runs, a broken manoeuvre reported while the others complete, determinism."""
+
+from __future__ import annotations
+
+import csv
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from washbench.paths import MANOEUVRES_DIR
+
+GOOD = [MANOEUVRES_DIR / "c172" / "coordinated_turn.yaml", MANOEUVRES_DIR / "c172" / "stall_recovery.yaml"]
+
+
+def suite(*args: str | Path) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "washbench", "suite", *map(str, args)], capture_output=True, text=True, timeout=900
+    )
+
+
+@pytest.fixture(scope="module")
+def inputs(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    folder = tmp_path_factory.mktemp("manoeuvres")
+    for f in GOOD:
+        shutil.copy(f, folder / f.name)
+    broken = GOOD[0].read_text().replace("phases:", "phasez:", 1)
+    (folder / "broken.yaml").write_text(broken)
+    return folder
+
+
+@pytest.fixture(scope="module")
+def first(inputs: Path, tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, subprocess.CompletedProcess[str]]:
+    out = tmp_path_factory.mktemp("suite1")
+    return out, suite(inputs, "--out", out, "--jobs", "2")
+
+
+def test_broken_file_is_reported_and_the_others_complete(first: tuple[Path, subprocess.CompletedProcess[str]]) -> None:
+    out, proc = first
+    assert proc.returncode == 1, proc.stdout + proc.stderr
+    assert "Traceback" not in proc.stderr
+    assert "broken.yaml" in proc.stderr and "phasez" in proc.stderr
+    report = (out / "report.md").read_text()
+    assert "2 of 3 manoeuvres" in report
+    assert "broken.yaml" in report and "unknown key" in report
+    with (out / "metrics.csv").open() as f:
+        rows = list(csv.DictReader(f))
+    assert len(rows) == 2 * 3 * 6
+    assert list(rows[0]) == ["aircraft", "manoeuvre", "washout", "dof", "npc", "integral_error", "max_error"]
+    assert {r["manoeuvre"] for r in rows} == {"coordinated_turn", "stall_recovery"}
+    for name in ("coordinated_turn", "stall_recovery"):
+        run = out / "c172p" / name
+        assert (run / "recording.rrd").is_file() and (run / "metrics.csv").is_file()
+        assert f"c172p/{name}/recording.rrd" in report
+
+
+def test_ranking_and_comparison_tables(first: tuple[Path, subprocess.CompletedProcess[str]]) -> None:
+    out, _ = first
+    with (out / "ranking.csv").open() as f:
+        ranking = list(csv.DictReader(f))
+    assert len(ranking) == 2 * 3
+    for name in ("coordinated_turn", "stall_recovery"):
+        ranks = sorted((int(r["rank"]), float(r["score"])) for r in ranking if r["manoeuvre"] == name)
+        assert [r for r, _ in ranks] == [1, 2, 3]
+        assert [s for _, s in ranks] == sorted(s for _, s in ranks)
+    with (out / "comparison.csv").open() as f:
+        comparison = list(csv.DictReader(f))
+    assert len(comparison) == 2 * 6 * 3
+    for row in comparison:
+        for w in ("large-angle", "unrestricted"):
+            if row["small-angle"] and row[w]:
+                diff = float(row["small-angle"]) - float(row[w])
+                assert float(row[f"{w}_better_by"]) == pytest.approx(diff)
+
+
+def test_same_suite_twice_gives_identical_metrics(
+    inputs: Path, first: tuple[Path, subprocess.CompletedProcess[str]], tmp_path: Path
+) -> None:
+    out, _ = first
+    again = suite(inputs, "--out", tmp_path, "--jobs", "1", "--quiet")
+    assert again.returncode == 1
+    for name in ("metrics.csv", "comparison.csv", "ranking.csv"):
+        assert (tmp_path / name).read_bytes() == (out / name).read_bytes(), name
+
+
+def test_bad_arguments_are_one_line(tmp_path: Path) -> None:
+    proc = suite(tmp_path / "nope", "--out", tmp_path / "o")
+    assert proc.returncode == 2
+    assert proc.stderr.strip().count("\n") == 0 and "no such file or folder" in proc.stderr
