@@ -104,3 +104,8 @@ def test_empty_and_missing_files(tmp_path: Path) -> None:
 
 def test_top_level_must_be_mapping(tmp_path: Path) -> None:
     assert error(tmp_path, "- 1\n- 2\n") == "m.yaml:1: expected a mapping at the top level, got a list"
+
+
+def test_misspelt_required_key_is_reported_as_unknown(tmp_path: Path) -> None:
+    msg = error(tmp_path, GOOD.replace("phases:", "phasez:"))
+    assert msg == "m.yaml:3: phasez: unknown key (did you mean 'phases'?)"

@@ -221,7 +221,9 @@ def validate_data(path: Path, data: Any, lines: dict[Loc, int], model: type[M]) 
         payload = json.dumps(data, default=str, allow_nan=True)
         return model.model_validate_json(payload)
     except pydantic.ValidationError as exc:
-        err = exc.errors(include_url=False)[0]
+        # A misspelt key gives both "unknown key" and "missing field": name the unknown key.
+        rank = {"extra_forbidden": 0, "missing": 2}
+        err = min(exc.errors(include_url=False), key=lambda e: rank.get(e["type"], 1))
         loc = _data_loc(data, tuple(err["loc"]))
         line = lines.get(loc)
         probe = loc

@@ -1,0 +1,271 @@
+"""Flying manoeuvres with real JSBSim: results files, physics of the recording, monitor, determinism."""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+from textwrap import dedent
+
+import numpy as np
+import pyarrow.parquet as pq
+import pytest
+
+from washbench.flight.columns import COLUMN_NAMES
+from washbench.flight.fly import FlightResult, fly, write_flight
+from washbench.manoeuvre import load_manoeuvre
+from washbench.paths import MANOEUVRES_DIR
+
+C172 = MANOEUVRES_DIR / "c172"
+BUNDLED = sorted(C172.glob("*.yaml"))
+CUE_COLUMNS = ("t_s", "f_x_mps2", "f_y_mps2", "f_z_mps2", "omega_x_degps", "omega_y_degps", "omega_z_degps")
+FT = 0.3048
+
+
+def normal_gravity(lat_deg: float, h_m: float) -> float:
+    """WGS-84 normal gravity (Somigliana) with the free-air correction, m/s^2."""
+    s2 = math.sin(math.radians(lat_deg)) ** 2
+    g0 = 9.7803253359 * (1 + 0.00193185265241 * s2) / math.sqrt(1 - 0.00669437999013 * s2)
+    return g0 - 3.086e-6 * h_m
+
+
+@pytest.fixture(scope="module")
+def flights() -> dict[str, FlightResult]:
+    """Each bundled manoeuvre flown once (about 0.2 s of CPU each)."""
+    return {p.stem: fly(load_manoeuvre(p)) for p in BUNDLED}
+
+
+def phase_mask(result: FlightResult, name: str, skip_s: float = 0.0) -> np.ndarray:
+    (t0, t1) = next((a, b) for n, a, b in result.phases if n == name)
+    t = result.t_s
+    return (t >= t0 + skip_s) & (t <= t1)
+
+
+@pytest.mark.parametrize("path", BUNDLED, ids=lambda p: p.stem)
+def test_bundled_manoeuvre_flies_with_every_check_passing_and_files_read_back(
+    path: Path, flights: dict[str, FlightResult], tmp_path: Path
+) -> None:
+    result = flights[path.stem]
+    assert result.status == "ok", result.reason
+    assert result.checks and all(c[3] for c in result.checks), result.checks
+    m = load_manoeuvre(path)
+    assert [p[0] for p in result.phases] == [p.name for p in m.phases]
+    duration = result.t_s[-1]
+    assert 40.0 <= duration <= 120.0  # "one to two minutes" of flying, give or take the settling
+    write_flight(tmp_path, result, str(path))
+    table = pq.read_table(tmp_path / "flight.parquet")
+    assert table.column_names == list(COLUMN_NAMES)
+    cols = {n: table.column(n).to_numpy() for n in table.column_names}
+    n = len(cols["t_s"])
+    assert np.array_equal(cols["t_s"], np.arange(n) * m.dt_s)  # t = k * dt exactly
+    for name in CUE_COLUMNS:
+        assert np.all(np.isfinite(cols[name])), name
+        assert np.array_equal(cols[name], result.columns[name])
+    assert set(np.unique(cols["wow"])) <= {0, 1}
+    summary = json.loads((tmp_path / "flight.json").read_text())
+    assert summary["status"] == "ok" and summary["name"] == m.name and summary["aircraft"] == "c172p"
+    assert summary["samples"] == n and summary["dt_s"] == m.dt_s
+    assert [c["name"] for c in summary["checks"]] == [c.name for c in m.checks]
+    assert all(c["passed"] for c in summary["checks"])
+    assert not list(tmp_path.glob(".*tmp"))  # no temporary files left behind
+
+
+def test_steady_turn_load_factor_and_turn_rate(flights: dict[str, FlightResult]) -> None:
+    """Level coordinated turn: n = 1/cos(phi) and psi_dot = g tan(phi) / V (no wind: V = ground speed)."""
+    r = flights["coordinated_turn"]
+    c = r.columns
+    sel = phase_mask(r, "turn", skip_s=10.0)
+    phi = np.radians(c["phi_deg"][sel])
+    assert np.degrees(np.mean(np.abs(phi))) == pytest.approx(30.0, abs=1.0)
+    n_expected = np.mean(1.0 / np.cos(phi))
+    assert np.mean(c["nz"][sel]) == pytest.approx(n_expected, rel=0.02)
+    g = normal_gravity(45.3, 4000 * FT)
+    assert np.mean(-c["f_z_mps2"][sel]) / g == pytest.approx(n_expected, rel=0.02)
+    psi = np.unwrap(np.radians(c["psi_deg"][sel]))
+    psi_dot = np.gradient(psi, r.dt_s)
+    v = c["gs_kts"][sel] * 1852.0 / 3600.0
+    expected = -g * np.tan(np.abs(phi)) / v  # left turn: heading decreasing
+    assert np.mean(psi_dot) == pytest.approx(np.mean(expected), rel=0.03)
+    # the body yaw rate of a level turn is psi_dot cos(phi) cos(theta)
+    theta = np.radians(c["theta_deg"][sel])
+    r_body = np.radians(c["omega_z_degps"][sel])
+    assert np.mean(r_body) == pytest.approx(np.mean(psi_dot * np.cos(phi) * np.cos(theta)), rel=0.02)
+
+
+def test_trimmed_level_flight_specific_force(flights: dict[str, FlightResult]) -> None:
+    """Straight and level, unaccelerated: f = (g sin(theta), 0, -g cos(theta)) in body axes."""
+    r = flights["coordinated_turn"]
+    c = r.columns
+    sel = r.t_s <= 2.0
+    theta = np.radians(c["theta_deg"][sel])
+    g = normal_gravity(45.3, 4000 * FT)
+    np.testing.assert_allclose(c["f_x_mps2"][sel], g * np.sin(theta), atol=0.03)
+    np.testing.assert_allclose(c["f_y_mps2"][sel], 0.0, atol=0.03)
+    np.testing.assert_allclose(c["f_z_mps2"][sel], -g * np.cos(theta), atol=0.03)
+
+
+def test_recorded_specific_force_is_aligned_with_the_motion(flights: dict[str, FlightResult]) -> None:
+    """JSBSim's a-pilot lags one frame; the recorder removes the lag.
+
+    Independent check: the vertical component of the recorded specific force, rotated to the
+    local level frame with the recorded attitude, must equal the vertical acceleration from a
+    central difference of the recorded climb rate, minus gravity. The recorded alignment must
+    fit better than the series shifted one frame either way (the raw JSBSim alignment is the
+    series delayed by one frame).
+    """
+    r = flights["spiral_dive"]
+    c = r.columns
+    phi, theta = np.radians(c["phi_deg"]), np.radians(c["theta_deg"])
+    f_down = -np.sin(theta) * c["f_x_mps2"] + np.sin(phi) * np.cos(theta) * c["f_y_mps2"]
+    f_down += np.cos(phi) * np.cos(theta) * c["f_z_mps2"]
+    v_down = -c["climb_fpm"] * FT / 60.0
+    a_down = (v_down[2:] - v_down[:-2]) / (2 * r.dt_s)  # at samples 1..N-2
+    g = normal_gravity(45.3, c["altitude_ft"][1:-1] * FT)
+    rms = {}
+    for shift in (-1, 0, 1):
+        f = f_down[1 + shift : len(f_down) - 1 + shift]
+        rms[shift] = float(np.sqrt(np.mean((f + g - a_down)[2:-2] ** 2)))
+    assert rms[0] < 0.05
+    assert rms[0] < 0.7 * min(rms[-1], rms[1]), rms
+
+
+TURBULENT = """\
+name: turbulent_level
+aircraft: c172p
+start:
+  air: {altitude_ft: 3000, airspeed_kts: 90, heading_deg: 45}
+environment:
+  wind: {from_deg: 300, speed_kts: 15}
+  turbulence: {severity: moderate, seed: SEED}
+phases:
+  - name: level
+    hold: {wings_level: true, altitude_ft: 3000, airspeed_kts: 90}
+    until: {duration_s: 8}
+"""
+
+
+def write(tmp_path: Path, name: str, text: str) -> Path:
+    path = tmp_path / name
+    path.write_text(dedent(text))
+    return path
+
+
+def test_same_file_flown_twice_is_bit_identical_with_turbulence(tmp_path: Path) -> None:
+    path = write(tmp_path, "turb.yaml", TURBULENT.replace("SEED", "7"))
+    a = fly(load_manoeuvre(path))
+    b = fly(load_manoeuvre(path))
+    assert a.status == b.status == "ok"
+    for name in COLUMN_NAMES:
+        assert a.columns[name].tobytes() == b.columns[name].tobytes(), name
+    other = fly(load_manoeuvre(write(tmp_path, "turb2.yaml", TURBULENT.replace("SEED", "8"))))
+    assert not np.array_equal(a.columns["f_z_mps2"], other.columns["f_z_mps2"])  # the seed matters
+    assert np.std(a.columns["f_z_mps2"]) > 0.1  # and turbulence is really there
+
+
+def test_wind_start_keeps_airspeed_and_tracks_the_runway(flights: dict[str, FlightResult]) -> None:
+    """The landing starts crabbed into a 12 kt crosswind: no sideslip jump, track along the runway."""
+    c = flights["crosswind_landing"].columns
+    assert abs(c["beta_deg"][0]) < 0.1
+    assert c["vc_kts"][0] == pytest.approx(65.0, abs=0.2)
+    crab = 70.0 - c["psi_deg"][0]
+    tas = 65.0 * 1.01 * 1852 / 3600  # about 1% above calibrated at 740 ft
+    assert crab == pytest.approx(math.degrees(math.asin(12 * 1852 / 3600 / tas)), abs=0.5)
+
+
+def test_step_hook_sees_every_final_sample_in_order(tmp_path: Path) -> None:
+    path = write(tmp_path, "turb.yaml", TURBULENT.replace("SEED", "3"))
+    seen: list[tuple[int, np.ndarray, np.ndarray]] = []
+    result = fly(load_manoeuvre(path), step_hook=lambda k, f, w: seen.append((k, f.copy(), w.copy())))
+    assert [k for k, _, _ in seen] == list(range(len(result.t_s)))
+    f = np.array([s[1] for s in seen])
+    w = np.array([s[2] for s in seen])
+    c = result.columns
+    np.testing.assert_array_equal(f, np.column_stack([c["f_x_mps2"], c["f_y_mps2"], c["f_z_mps2"]]))
+    np.testing.assert_allclose(
+        np.degrees(w), np.column_stack([c["omega_x_degps"], c["omega_y_degps"], c["omega_z_degps"]]), rtol=1e-12
+    )
+
+
+DIVE = """\
+name: dive
+aircraft: c172p
+start:
+  air: {altitude_ft: 5000, airspeed_kts: 110, heading_deg: 0}
+phases:
+  - name: dive
+    hold: {wings_level: true, pitch_deg: -35, throttle: 1}
+    until: {altitude_below_ft: 0, timeout_s: 100}
+"""
+
+INTO_THE_GROUND = """\
+name: into_the_ground
+aircraft: c172p
+start:
+  air: {altitude_ft: 300, airspeed_kts: 80, heading_deg: 0}
+phases:
+  - name: descend
+    hold: {wings_level: true, pitch_deg: -12, throttle: 0.5}
+    until: {duration_s: 60}
+"""
+
+NEVER = """\
+name: never
+aircraft: c172p
+start:
+  air: {altitude_ft: 4000, airspeed_kts: 90, heading_deg: 0}
+phases:
+  - name: slow
+    hold: {wings_level: true, altitude_ft: 4000, throttle: 0.2}
+    until: {airspeed_above_kts: 150, timeout_s: 5}
+"""
+
+
+@pytest.mark.parametrize(
+    ("text", "cause"),
+    [
+        (DIVE, "beyond VNE 158 kt"),
+        (INTO_THE_GROUND, "hard landing: sink rate"),
+        (NEVER, "phase 'slow' did not reach its end condition within 5 s"),
+    ],
+    ids=["vne", "ground", "timeout"],
+)
+def test_monitor_stops_the_flight_keeps_the_record_and_fails(text: str, cause: str, tmp_path: Path) -> None:
+    path = write(tmp_path, "bad_flight.yaml", text)
+    out_dir = tmp_path / "out"
+    proc = subprocess.run(
+        [sys.executable, "-m", "washbench", "fly", str(path), "--out", str(out_dir)], capture_output=True, text=True
+    )
+    assert proc.returncode == 1
+    assert "Traceback" not in proc.stderr
+    summary = json.loads((out_dir / "flight.json").read_text())
+    assert summary["status"] == "failed"
+    assert summary["reason"].startswith("t=") and cause in summary["reason"], summary["reason"]
+    t_fail = float(summary["reason"][2:].split(" s:")[0])
+    table = pq.read_table(out_dir / "flight.parquet")
+    t = table.column("t_s").to_numpy()
+    assert len(t) > 100 and t[-1] <= t_fail
+    assert summary["phases"][-1]["t_end_s"] == pytest.approx(t[-1])
+    assert cause in proc.stdout and "failed" in proc.stdout
+
+
+def test_fly_cli_writes_files_and_prints_one_summary_line(tmp_path: Path) -> None:
+    out_dir = tmp_path / "turn"
+    proc = subprocess.run(
+        [sys.executable, "-m", "washbench", "fly", str(C172 / "coordinated_turn.yaml"), "--out", str(out_dir)],
+        capture_output=True,
+        text=True,
+    )
+    assert proc.returncode == 0, proc.stderr
+    lines = proc.stdout.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("coordinated_turn (c172p): ok, 6/6 checks passed")
+    assert proc.stderr == ""  # no progress display when stderr is not a terminal
+    assert (out_dir / "flight.parquet").is_file() and (out_dir / "flight.json").is_file()
+
+
+def test_progress_when_asked(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    path = write(tmp_path, "turb.yaml", TURBULENT.replace("SEED", "1"))
+    fly(load_manoeuvre(path), progress=True)
+    err = capsys.readouterr().err
+    assert "turbulent_level: phase 1/1 'level'" in err
