@@ -101,9 +101,10 @@ def test_trimmed_level_flight_specific_force(flights: dict[str, FlightResult]) -
     sel = r.t_s <= 2.0
     theta = np.radians(c["theta_deg"][sel])
     g = normal_gravity(45.3, 4000 * FT)
-    np.testing.assert_allclose(c["f_x_mps2"][sel], g * np.sin(theta), atol=0.03)
-    np.testing.assert_allclose(c["f_y_mps2"][sel], 0.0, atol=0.03)
-    np.testing.assert_allclose(c["f_z_mps2"][sel], -g * np.cos(theta), atol=0.03)
+    # within 0.5 % of g: the trimmed c172p flies with a little sideslip (propeller effects)
+    np.testing.assert_allclose(c["f_x_mps2"][sel], g * np.sin(theta), atol=0.05)
+    np.testing.assert_allclose(c["f_y_mps2"][sel], 0.0, atol=0.05)
+    np.testing.assert_allclose(c["f_z_mps2"][sel], -g * np.cos(theta), atol=0.05)
 
 
 def test_recorded_specific_force_is_aligned_with_the_motion(flights: dict[str, FlightResult]) -> None:
@@ -115,19 +116,22 @@ def test_recorded_specific_force_is_aligned_with_the_motion(flights: dict[str, F
     fit better than the series shifted one frame either way (the raw JSBSim alignment is the
     series delayed by one frame).
     """
-    r = flights["spiral_dive"]
-    c = r.columns
-    phi, theta = np.radians(c["phi_deg"]), np.radians(c["theta_deg"])
-    f_down = -np.sin(theta) * c["f_x_mps2"] + np.sin(phi) * np.cos(theta) * c["f_y_mps2"]
-    f_down += np.cos(phi) * np.cos(theta) * c["f_z_mps2"]
-    v_down = -c["climb_fpm"] * FT / 60.0
-    a_down = (v_down[2:] - v_down[:-2]) / (2 * r.dt_s)  # at samples 1..N-2
-    g = normal_gravity(45.3, c["altitude_ft"][1:-1] * FT)
-    rms = {}
-    for shift in (-1, 0, 1):
+
+    def residual_rms(result: FlightResult, shift: int) -> float:
+        c = result.columns
+        phi, theta = np.radians(c["phi_deg"]), np.radians(c["theta_deg"])
+        f_down = -np.sin(theta) * c["f_x_mps2"] + np.sin(phi) * np.cos(theta) * c["f_y_mps2"]
+        f_down += np.cos(phi) * np.cos(theta) * c["f_z_mps2"]
+        v_down = -c["climb_fpm"] * FT / 60.0
+        a_down = (v_down[2:] - v_down[:-2]) / (2 * result.dt_s)  # at samples 1..N-2
+        g = normal_gravity(45.3, c["altitude_ft"][1:-1] * FT)
         f = f_down[1 + shift : len(f_down) - 1 + shift]
-        rms[shift] = float(np.sqrt(np.mean((f + g - a_down)[2:-2] ** 2)))
-    assert rms[0] < 0.05
+        return float(np.sqrt(np.mean((f + g - a_down)[2:-2] ** 2)))
+
+    # smooth flight: the recorded force and the motion agree to a few mm/s^2
+    assert residual_rms(flights["stall_recovery"], 0) < 0.01
+    # the touchdown (a sharp change of vertical force) tells the alignments apart
+    rms = {s: residual_rms(flights["crosswind_landing"], s) for s in (-1, 0, 1)}
     assert rms[0] < 0.7 * min(rms[-1], rms[1]), rms
 
 
@@ -168,9 +172,9 @@ def test_wind_start_keeps_airspeed_and_tracks_the_runway(flights: dict[str, Flig
     """The landing starts crabbed into a 12 kt crosswind: no sideslip jump, track along the runway."""
     c = flights["crosswind_landing"].columns
     assert abs(c["beta_deg"][0]) < 0.1
-    assert c["vc_kts"][0] == pytest.approx(65.0, abs=0.2)
+    assert c["vc_kts"][0] == pytest.approx(60.0, abs=0.2)
     crab = 70.0 - c["psi_deg"][0]
-    tas = 65.0 * 1.01 * 1852 / 3600  # about 1% above calibrated at 740 ft
+    tas = 60.0 * 1.01 * 1852 / 3600  # about 1% above calibrated at 740 ft
     assert crab == pytest.approx(math.degrees(math.asin(12 * 1852 / 3600 / tas)), abs=0.5)
 
 
@@ -269,3 +273,10 @@ def test_progress_when_asked(tmp_path: Path, capsys: pytest.CaptureFixture[str])
     fly(load_manoeuvre(path), progress=True)
     err = capsys.readouterr().err
     assert "turbulent_level: phase 1/1 'level'" in err
+
+
+def test_the_documented_example_flies_with_its_checks_passing(tmp_path: Path) -> None:
+    docs = Path(__file__).resolve().parents[1] / "docs" / "manoeuvres.md"
+    example = docs.read_text().split("```yaml\n", 1)[1].split("```", 1)[0]
+    result = fly(load_manoeuvre(write(tmp_path, "example.yaml", example)))
+    assert result.status == "ok", result.reason

@@ -21,7 +21,9 @@ BUNDLED = sorted((MANOEUVRES_DIR / "c172").glob("*.yaml"))
 EXPECTED = {
     "check_unknown_phase.yaml": ":15: checks[0].phases[0]: no phase named 'turnn'",
     "check_without_limit.yaml": ":15: checks[0]: give a 'min', a 'max' or both",
-    "contradictory_lateral.yaml": ":12: phases[1].hold.heading_deg: contradicts 'bank_deg' (one lateral target at a time)",
+    "contradictory_lateral.yaml": (
+        ":12: phases[1].hold.heading_deg: contradicts 'bank_deg' (one lateral target at a time)"
+    ),
     "contradictory_pitch.yaml": ":12: phases[1].hold.altitude_ft: contradicts 'pitch_deg' (one pitch target at a time)",
     "duplicate_key.yaml": ":9: invalid YAML: duplicate key 'until' (first on line 8)",
     "duplicate_phase_name.yaml": ":9: phases[1].name: duplicate phase name 'level'",
@@ -41,9 +43,7 @@ EXPECTED = {
     "not_a_mapping.yaml": ":1: expected a mapping at the top level, got 'just a string'",
     "quoted_number.yaml": ":11: phases[1].hold.bank_deg: expected a number, got '30'",
     "runway_start_without_runway.yaml": ":4: start.runway: a runway start needs a top-level 'runway'",
-    "start_below_stall.yaml": (
-        ":4: start.air.airspeed_kts: 30 kt is outside c172p's flight envelope (48..158 kt)"
-    ),
+    "start_below_stall.yaml": (":4: start.air.airspeed_kts: 30 kt is outside c172p's flight envelope (48..158 kt)"),
     "unknown_aircraft.yaml": (
         ":2: aircraft: unknown aircraft 'c999x' (neither in the project's aircraft/ folder nor bundled with JSBSim)"
     ),

@@ -1,0 +1,1 @@
+"""The JSBSim side: fdm set-up, scripted pilot, crash monitor, recorder and the fly loop."""

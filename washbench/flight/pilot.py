@@ -135,8 +135,9 @@ class Pilot:
         self.brakes = 0.0
 
     def set_controls(self, aileron: float, elevator: float, rudder: float) -> None:
-        """Start from the control positions the trim left (the rate limits act from there)."""
+        """Start from the control positions the trim left: outputs and integrators (bumpless start)."""
         self.aileron, self.elevator, self.rudder = aileron, elevator, rudder
+        self.i_p, self.i_q, self.i_beta, self.i_psi = aileron, -elevator, -rudder, -rudder
 
     def begin_phase(self, hold: Hold, theta: float, throttle: float, flaps_deg: float) -> None:
         """Set the loops for a phase from the current pitch (rad), throttle and flap angle."""
