@@ -151,6 +151,9 @@ def run_suite(
             outcomes[a[0]] = _report(_run_one(*a), len(outcomes) + 1, len(files), start, progress)
     else:
         ctx = multiprocessing.get_context("forkserver")
+        # Workers fork from a server that has already imported the heavy modules (JSBSim, numba
+        # kernels, rerun, pyarrow), so each worker starts in milliseconds instead of seconds.
+        ctx.set_forkserver_preload(["washbench.preload"])
         with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as pool:
             futures = [pool.submit(_run_one, *a) for a in args]
             for fut in as_completed(futures):
