@@ -53,7 +53,7 @@ def test_bundled_manoeuvre_flies_with_every_check_passing_and_files_read_back(
     m = load_manoeuvre(path)
     assert [p[0] for p in result.phases] == [p.name for p in m.phases]
     duration = result.t_s[-1]
-    assert 40.0 <= duration <= 120.0  # "one to two minutes" of flying, give or take the settling
+    assert 60.0 <= duration <= 120.0  # "one to two minutes" of flying
     write_flight(tmp_path, result, str(path))
     table = pq.read_table(tmp_path / "flight.parquet")
     assert table.column_names == list(COLUMN_NAMES)
@@ -263,7 +263,8 @@ def test_fly_cli_writes_files_and_prints_one_summary_line(tmp_path: Path) -> Non
     )
     assert proc.returncode == 0, proc.stderr
     lines = proc.stdout.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("coordinated_turn (c172p): ok, 6/6 checks passed")
+    n_checks = len(load_manoeuvre(C172 / "coordinated_turn.yaml").checks)
+    assert len(lines) == 1 and lines[0].startswith(f"coordinated_turn (c172p): ok, {n_checks}/{n_checks} checks passed")
     assert proc.stderr == ""  # no progress display when stderr is not a terminal
     assert (out_dir / "flight.parquet").is_file() and (out_dir / "flight.json").is_file()
 
