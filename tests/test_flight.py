@@ -19,7 +19,15 @@ from washbench.manoeuvre import load_manoeuvre
 from washbench.paths import MANOEUVRES_DIR
 
 C172 = MANOEUVRES_DIR / "c172"
-BUNDLED = sorted(C172.glob("*.yaml"))
+#: Every bundled manoeuvre, of every aircraft (manoeuvres/<aircraft>/<name>.yaml).
+BUNDLED = sorted(MANOEUVRES_DIR.glob("*/*.yaml"))
+
+
+def key(path: Path) -> str:
+    """``folder/name`` of a bundled manoeuvre (the same name is flown by several aircraft)."""
+    return f"{path.parent.name}/{path.stem}"
+
+
 CUE_COLUMNS = ("t_s", "f_x_mps2", "f_y_mps2", "f_z_mps2", "omega_x_degps", "omega_y_degps", "omega_z_degps")
 FT = 0.3048
 
@@ -34,7 +42,7 @@ def normal_gravity(lat_deg: float, h_m: float) -> float:
 @pytest.fixture(scope="module")
 def flights() -> dict[str, FlightResult]:
     """Each bundled manoeuvre flown once (about 0.2 s of CPU each)."""
-    return {p.stem: fly(load_manoeuvre(p)) for p in BUNDLED}
+    return {key(p): fly(load_manoeuvre(p)) for p in BUNDLED}
 
 
 def phase_mask(result: FlightResult, name: str, skip_s: float = 0.0) -> np.ndarray:
@@ -43,11 +51,11 @@ def phase_mask(result: FlightResult, name: str, skip_s: float = 0.0) -> np.ndarr
     return (t >= t0 + skip_s) & (t <= t1)
 
 
-@pytest.mark.parametrize("path", BUNDLED, ids=lambda p: p.stem)
+@pytest.mark.parametrize("path", BUNDLED, ids=key)
 def test_bundled_manoeuvre_flies_with_every_check_passing_and_files_read_back(
     path: Path, flights: dict[str, FlightResult], tmp_path: Path
 ) -> None:
-    result = flights[path.stem]
+    result = flights[key(path)]
     assert result.status == "ok", result.reason
     assert result.checks and all(c[3] for c in result.checks), result.checks
     m = load_manoeuvre(path)
@@ -65,7 +73,7 @@ def test_bundled_manoeuvre_flies_with_every_check_passing_and_files_read_back(
         assert np.array_equal(cols[name], result.columns[name])
     assert set(np.unique(cols["wow"])) <= {0, 1}
     summary = json.loads((tmp_path / "flight.json").read_text())
-    assert summary["status"] == "ok" and summary["name"] == m.name and summary["aircraft"] == "c172p"
+    assert summary["status"] == "ok" and summary["name"] == m.name and summary["aircraft"] == m.aircraft
     assert summary["samples"] == n and summary["dt_s"] == m.dt_s
     assert [c["name"] for c in summary["checks"]] == [c.name for c in m.checks]
     assert all(c["passed"] for c in summary["checks"])
@@ -74,7 +82,7 @@ def test_bundled_manoeuvre_flies_with_every_check_passing_and_files_read_back(
 
 def test_steady_turn_load_factor_and_turn_rate(flights: dict[str, FlightResult]) -> None:
     """Level coordinated turn: n = 1/cos(phi) and psi_dot = g tan(phi) / V (no wind: V = ground speed)."""
-    r = flights["coordinated_turn"]
+    r = flights["c172/coordinated_turn"]
     c = r.columns
     sel = phase_mask(r, "turn", skip_s=10.0)
     phi = np.radians(c["phi_deg"][sel])
@@ -96,7 +104,7 @@ def test_steady_turn_load_factor_and_turn_rate(flights: dict[str, FlightResult])
 
 def test_trimmed_level_flight_specific_force(flights: dict[str, FlightResult]) -> None:
     """Straight and level, unaccelerated: f = (g sin(theta), 0, -g cos(theta)) in body axes."""
-    r = flights["coordinated_turn"]
+    r = flights["c172/coordinated_turn"]
     c = r.columns
     sel = r.t_s <= 2.0
     theta = np.radians(c["theta_deg"][sel])
@@ -129,9 +137,9 @@ def test_recorded_specific_force_is_aligned_with_the_motion(flights: dict[str, F
         return float(np.sqrt(np.mean((f + g - a_down)[2:-2] ** 2)))
 
     # smooth flight: the recorded force and the motion agree to a few mm/s^2
-    assert residual_rms(flights["stall_recovery"], 0) < 0.01
+    assert residual_rms(flights["c172/stall_recovery"], 0) < 0.01
     # the touchdown (a sharp change of vertical force) tells the alignments apart
-    rms = {s: residual_rms(flights["crosswind_landing"], s) for s in (-1, 0, 1)}
+    rms = {s: residual_rms(flights["c172/crosswind_landing"], s) for s in (-1, 0, 1)}
     assert rms[0] < 0.7 * min(rms[-1], rms[1]), rms
 
 
@@ -170,7 +178,7 @@ def test_same_file_flown_twice_is_bit_identical_with_turbulence(tmp_path: Path) 
 
 def test_wind_start_keeps_airspeed_and_tracks_the_runway(flights: dict[str, FlightResult]) -> None:
     """The landing starts crabbed into a 12 kt crosswind: no sideslip jump, track along the runway."""
-    c = flights["crosswind_landing"].columns
+    c = flights["c172/crosswind_landing"].columns
     assert abs(c["beta_deg"][0]) < 0.1
     assert c["vc_kts"][0] == pytest.approx(60.0, abs=0.2)
     crab = 70.0 - c["psi_deg"][0]

@@ -15,7 +15,7 @@ from washbench.paths import MANOEUVRES_DIR
 from washbench.yamlio import read_yaml
 
 BAD = Path(__file__).parent / "data" / "bad_manoeuvres"
-BUNDLED = sorted((MANOEUVRES_DIR / "c172").glob("*.yaml"))
+BUNDLED = sorted(MANOEUVRES_DIR.glob("*/*.yaml"))  # manoeuvres/<aircraft folder>/<name>.yaml
 
 #: file -> the error line after "washbench: error: FILE" (":LINE: field: problem" or ": problem").
 EXPECTED = {
@@ -103,18 +103,18 @@ def test_missing_file_is_one_line(tmp_path: Path) -> None:
     assert out.stderr.strip() == f"washbench: error: {tmp_path / 'nope.yaml'}: no such file"
 
 
-@pytest.mark.parametrize("path", BUNDLED, ids=lambda p: p.stem)
+@pytest.mark.parametrize("path", BUNDLED, ids=lambda p: f"{p.parent.name}/{p.stem}")
 def test_bundled_manoeuvres_validate(path: Path) -> None:
     m = load_manoeuvre(path)
     assert m.name == path.stem
-    assert m.aircraft == "c172p"
+    assert m.aircraft == {"c172": "c172p", "columbia400": "columbia400"}[path.parent.name]
     out = cli("validate", str(path))
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == f"{path}: OK"
 
 
 def test_all_five_c172_manoeuvres_are_there() -> None:
-    assert {p.stem for p in BUNDLED} >= {
+    assert {p.stem for p in BUNDLED if p.parent.name == "c172"} >= {
         "coordinated_turn",
         "crosswind_landing",
         "takeoff",

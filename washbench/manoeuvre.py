@@ -96,7 +96,15 @@ class Environment(StrictModel):
 
 
 LATERAL_TARGETS = ("wings_level", "bank_deg", "heading_deg", "roll_rate_degps", "centreline")
-PITCH_TARGETS = ("pitch_deg", "altitude_ft", "vertical_speed_fpm", "glide_path_deg", "pitch_rate_degps", "flare")
+PITCH_TARGETS = (
+    "pitch_deg",
+    "altitude_ft",
+    "vertical_speed_fpm",
+    "glide_path_deg",
+    "pitch_rate_degps",
+    "load_factor",
+    "flare",
+)
 
 
 class Hold(StrictModel):
@@ -105,8 +113,11 @@ class Hold(StrictModel):
     At most one lateral target (ailerons): ``wings_level``, ``bank_deg``, ``heading_deg``,
     ``roll_rate_degps``, ``centreline`` (default: wings level). At most one pitch target
     (elevator): ``pitch_deg``, ``altitude_ft``, ``vertical_speed_fpm``, ``glide_path_deg``,
-    ``pitch_rate_degps``, ``flare``. ``airspeed_kts`` is held with the throttle when a pitch
-    target is given, and with the elevator when ``throttle`` is fixed instead. The rudder
+    ``pitch_rate_degps``, ``load_factor``, ``flare``. The body-rate targets (``roll_rate_degps``,
+    ``pitch_rate_degps``, ``load_factor``) use no Euler angle, so they work through the vertical
+    and inverted (aerobatics); ``roll_rate_degps: 0`` keeps the roll attitude about the body x
+    axis. ``airspeed_kts`` is held with the throttle when a pitch target is given, and with
+    the elevator when ``throttle`` is fixed instead. The rudder
     coordinates (zero sideslip) in the air and tracks the runway on the ground; with
     ``wing_low`` (needs ``centreline``) it aligns the nose with the runway in the air while
     the ailerons bank into the wind to hold the centreline (crosswind landing technique).
@@ -123,6 +134,7 @@ class Hold(StrictModel):
     vertical_speed_fpm: float | None = None
     glide_path_deg: Annotated[float, Field(gt=0, le=10)] | None = None
     pitch_rate_degps: Annotated[float, Field(ge=-30, le=30)] | None = None
+    load_factor: Annotated[float, Field(ge=-3, le=6)] | None = None  # g, +1 in level flight
     flare: bool | None = None
     airspeed_kts: Positive | None = None
     throttle: Fraction | None = None
@@ -136,6 +148,8 @@ EVENTS = ("liftoff", "touchdown", "stopped", "stall")
 class Until(StrictModel):
     """When a phase ends: the first of the given conditions that holds.
 
+    ``rolled_deg`` and ``pitched_deg`` are the magnitudes of the integrals of the body rates p
+    and q since the phase began (rotation about the body x and y axes, not Euler angles).
     ``timeout_s`` is not an end condition: if none of the conditions is met by then, the
     flight fails (a phase that cannot end must not run forever).
     """
@@ -143,6 +157,8 @@ class Until(StrictModel):
     duration_s: Positive | None = None
     event: Literal["liftoff", "touchdown", "stopped", "stall"] | None = None
     turned_deg: Positive | None = None
+    rolled_deg: Positive | None = None
+    pitched_deg: Positive | None = None
     airspeed_above_kts: float | None = None
     airspeed_below_kts: float | None = None
     altitude_above_ft: float | None = None
@@ -162,7 +178,21 @@ class Phase(StrictModel):
     until: Until
 
 
-STATS = ("min", "max", "mean", "max_abs", "initial", "final", "max_rise", "max_drop", "max_deviation", "turned")
+STATS = (
+    "min",
+    "max",
+    "mean",
+    "max_abs",
+    "initial",
+    "final",
+    "max_rise",
+    "max_drop",
+    "max_deviation",
+    "turned",
+    "rotated",
+)
+#: Signals the ``rotated`` statistic integrates (body angular velocity, deg/s).
+RATE_SIGNALS = ("omega_x_degps", "omega_y_degps", "omega_z_degps")
 EVENT_STATS = ("at_touchdown", "at_liftoff")
 
 
@@ -172,7 +202,8 @@ class Check(StrictModel):
     ``stat`` of ``signal`` (a flight.parquet column, or ``sink_fps`` at an event) over
     ``phases`` (default: the whole flight). ``max_rise``/``max_drop``/``max_deviation``
     are relative to the value at the start of the first phase listed; ``turned`` is the
-    total heading change (deg) of a heading signal.
+    total heading change (deg) of a heading signal; ``rotated`` is the magnitude of the time
+    integral (deg) of a body-rate signal over the selected phases (trapezoidal rule).
     """
 
     name: Annotated[str, Field(min_length=1)]
@@ -188,6 +219,7 @@ class Check(StrictModel):
         "max_drop",
         "max_deviation",
         "turned",
+        "rotated",
         "at_touchdown",
         "at_liftoff",
     ]
@@ -317,6 +349,12 @@ def _check_semantics(m: Manoeuvre, where: _Where) -> None:
                 (*base, "hold", "airspeed_kts"),
                 f"contradicts 'throttle' and '{pitch[0]}': airspeed needs the throttle or the elevator free",
             )
+        if hold.load_factor is not None and not profile.limits.nz_min <= hold.load_factor <= profile.limits.nz_max:
+            raise where.error(
+                (*base, "hold", "load_factor"),
+                f"{hold.load_factor:g} g is outside {m.aircraft}'s load-factor limits "
+                f"({profile.limits.nz_min:g}..{profile.limits.nz_max:g} g)",
+            )
         if hold.airspeed_kts is not None and hold.airspeed_kts > profile.speeds.vne_kts:
             raise where.error((*base, "hold", "airspeed_kts"), f"above {m.aircraft}'s VNE")
         if hold.flaps_deg is not None and hold.flaps_deg > profile.limits.flaps_max_deg:
@@ -351,6 +389,8 @@ def _check_semantics(m: Manoeuvre, where: _Where) -> None:
             raise where.error((*base, "signal"), f"'{check.signal}' needs a top-level 'runway'")
         if check.stat == "turned" and check.signal != "psi_deg":
             raise where.error((*base, "stat"), "'turned' applies to the heading signal psi_deg")
+        if check.stat == "rotated" and check.signal not in RATE_SIGNALS:
+            raise where.error((*base, "stat"), f"'rotated' integrates a body rate: {', '.join(RATE_SIGNALS)}")
         if check.min is None and check.max is None:
             raise where.error(base, "give a 'min', a 'max' or both")
         if check.min is not None and check.max is not None and check.min > check.max:
@@ -383,6 +423,8 @@ def _never_reason(cond: str, until: Until, hold: Hold, on_ground: bool, profile:
         return "a height below the ground"
     if cond == "bank_above_deg" and (hold.wings_level or (hold.bank_deg is not None and abs(hold.bank_deg) < value)):
         return "the bank held stays below it"
+    if cond == "rolled_deg" and not hold.roll_rate_degps:
+        return "no roll rate is held, so the aircraft does not keep rolling"
     if cond == "turned_deg" and (hold.wings_level or hold.heading_deg is not None or hold.centreline):
         return "the heading is held, so the aircraft never turns that far"
     if hold.altitude_ft is not None:

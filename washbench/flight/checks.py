@@ -78,6 +78,11 @@ def measure(
         return float(x[0] - np.min(x))
     if stat == "max_deviation":
         return float(np.max(np.abs(x - x[0])))
+    if stat == "rotated":
+        # trapezoidal integral over the intervals whose both ends are selected
+        full = columns[check.signal]
+        both = mask[:-1] & mask[1:]
+        return float(abs(np.sum((full[:-1][both] + full[1:][both]) * (0.5 * dt_s))))
     # turned: net heading change over the selection, from the unwrapped heading
     unwrapped = np.unwrap(np.radians(x))
     return float(np.degrees(abs(unwrapped[-1] - unwrapped[0])))

@@ -125,6 +125,7 @@ def make_fdm(m: Manoeuvre, profile: PilotProfile) -> tuple[Any, Setup]:
         fdm["ic/vc-kts"] = 0.0
         fdm["ic/u-fps"] = 0.0
     fdm["propulsion/set-running"] = -1
+    _set_engine_levers(fdm, m.aircraft, profile)
     seed = env.turbulence.seed if env.turbulence is not None else 0
     fdm["simulation/randomseed"] = seed
     with _quiet_stdout():
@@ -133,14 +134,17 @@ def make_fdm(m: Manoeuvre, profile: PilotProfile) -> tuple[Any, Setup]:
 
     if air is not None:
         fdm["fcs/flap-pos-deg"] = air.flaps_deg
-        try:
-            with _quiet_stdout():
-                fdm.do_trim(1)
-        except RuntimeError as exc:
-            raise WashbenchError(
-                f"{m.aircraft}: JSBSim could not trim straight flight at {air.airspeed_kts:g} kt, "
-                f"{air.altitude_ft:g} ft, flaps {air.flaps_deg:g} deg ({exc})"
-            ) from None
+        if profile.start.air == "flying":
+            _flying_start(fdm, m, profile, heading_deg)
+        else:
+            try:
+                with _quiet_stdout():
+                    fdm.do_trim(1)
+            except RuntimeError as exc:
+                raise WashbenchError(
+                    f"{m.aircraft}: JSBSim could not trim straight flight at {air.airspeed_kts:g} kt, "
+                    f"{air.altitude_ft:g} ft, flaps {air.flaps_deg:g} deg ({exc})"
+                ) from None
         if wind_n or wind_e:
             crab = air.heading_deg is None  # on a runway's extended centreline: crab to track it
             _add_wind_to_trimmed_state(fdm, wind_n, wind_e, crab)
@@ -164,6 +168,93 @@ def make_fdm(m: Manoeuvre, profile: PilotProfile) -> tuple[Any, Setup]:
     if fdm["simulation/sim-time-sec"] != 0.0:
         raise WashbenchError("JSBSim advanced time while initialising")  # guards the t = k * dt time base
     return fdm, Setup(frame, threshold, rw_heading, elevation)
+
+
+def _set_engine_levers(fdm: Any, aircraft: str, profile: PilotProfile) -> None:
+    """Magnetos and propeller lever from the profile (checked to exist: JSBSim ignores unknown names)."""
+    pm = fdm.get_property_manager()
+    for name, value in (
+        ("propulsion/magneto_cmd", profile.engine.magneto_cmd),
+        ("fcs/advance-cmd-norm[0]", profile.engine.propeller_advance_norm),
+    ):
+        if value is None:
+            continue
+        if not pm.hasNode(name):
+            raise WashbenchError(f"{aircraft}: the pilot profile sets {name}, which the JSBSim model lacks")
+        fdm[name] = float(value)
+
+
+#: Flying start: largest differences from the asked-for start after settling (kt, ft/s, rad/s).
+SETTLED_KTS = 1.0
+SETTLED_FPS = 1.0
+SETTLED_RADPS = 0.005
+
+
+def _flying_start(fdm: Any, m: Manoeuvre, profile: PilotProfile, heading_deg: float) -> None:
+    """Bring the aircraft to the air start by flying it (for models ``do_trim(1)`` cannot trim).
+
+    The scripted pilot holds the heading, the start's flight-path angle (as a climb rate) with the
+    elevator and the airspeed with the throttle, in still air, for ``profile.start.settle_s``. The
+    settled air-relative state (body velocities, bank and pitch) and the controls are then put back
+    at the start position, altitude and heading with ``run_ic`` and the clock is reset to zero, so the
+    manoeuvre starts in steady flight at t = 0. Raises WashbenchError if the flight has not settled.
+    """
+    from washbench.flight.pilot import Pilot  # the pilot imports the manoeuvre schema, as this module does
+    from washbench.manoeuvre import Hold
+
+    air = m.start.air
+    assert air is not None  # only called for air starts
+    dt = m.dt_s
+    with _quiet_stdout():
+        fdm.run_ic()
+    fdm["fcs/mixture-cmd-norm"] = 1.0
+    fdm["fcs/flap-cmd-norm"] = air.flaps_deg / profile.limits.flaps_full_cmd_deg
+    fdm["fcs/throttle-cmd-norm"] = 0.5
+    gamma = math.radians(air.flight_path_deg)
+    vs_fpm = 60.0 * fdm["velocities/vt-fps"] * math.sin(gamma)
+    pilot = Pilot(profile, None, dt)
+    pilot.set_controls(fdm["fcs/aileron-cmd-norm"], fdm["fcs/elevator-cmd-norm"], fdm["fcs/rudder-cmd-norm"])
+    hold = Hold(heading_deg=float(heading_deg) % 360.0, vertical_speed_fpm=vs_fpm, airspeed_kts=float(air.airspeed_kts))
+    pilot.begin_phase(hold, fdm["attitude/theta-rad"], 0.5, air.flaps_deg)
+    names = ("attitude/phi-rad", "attitude/theta-rad", "attitude/psi-rad", "velocities/p-rad_sec",
+             "velocities/q-rad_sec", "velocities/r-rad_sec", "aero/beta-rad", "velocities/vc-kts",
+             "velocities/vg-fps", "flight-path/psi-gt-rad", "velocities/h-dot-fps", "position/h-sl-ft",
+             "position/h-agl-ft")  # fmt: skip
+    pm = fdm.get_property_manager()
+    gets = [pm.get_node(n).get_double_value for n in names]
+    nz = pm.get_node("accelerations/Nz").get_double_value
+    alpha = pm.get_node("aero/alpha-rad").get_double_value
+    vt = pm.get_node("velocities/vtrue-kts").get_double_value
+    writes = [pm.get_node(n).set_double_value for n in (
+        "fcs/aileron-cmd-norm", "fcs/elevator-cmd-norm", "fcs/rudder-cmd-norm", "fcs/throttle-cmd-norm")]  # fmt: skip
+    for _ in range(round(profile.start.settle_s / dt)):
+        phi, theta, psi, p, q, r, beta, vc, vg, trk, hdot, h, agl = (g() for g in gets)
+        pilot.step(phi, theta, psi, p, q, r, beta, vc, vg, trk, hdot, h, agl, 0.0, 0.0, False, nz(), alpha(), vt())
+        for w, value in zip(writes, (pilot.aileron, pilot.elevator, pilot.rudder, pilot.throttle), strict=True):
+            w(value)
+        fdm.run()
+    phi, theta, psi, p, q, r, beta, vc, vg, trk, hdot, h, agl = (g() for g in gets)
+    off = (abs(vc - air.airspeed_kts), abs(hdot - vs_fpm / 60.0), max(abs(p), abs(q), abs(r)))
+    if off[0] > SETTLED_KTS or off[1] > SETTLED_FPS or off[2] > SETTLED_RADPS:
+        raise WashbenchError(
+            f"{m.aircraft}: the flying start did not settle at {air.airspeed_kts:g} kt, {air.altitude_ft:g} ft, "
+            f"flight path {air.flight_path_deg:g} deg in {profile.start.settle_s:g} s (airspeed off by "
+            f"{off[0]:.1f} kt, climb rate by {off[1]:.1f} ft/s, body rates up to {off[2]:.3f} rad/s)"
+        )
+    u, v, w = fdm["velocities/u-fps"], fdm["velocities/v-fps"], fdm["velocities/w-fps"]
+    fdm["ic/h-sl-ft"] = air.altitude_ft
+    fdm["ic/psi-true-deg"] = heading_deg
+    fdm["ic/phi-rad"] = phi
+    fdm["ic/theta-rad"] = theta
+    fdm["ic/u-fps"] = u
+    fdm["ic/v-fps"] = v
+    fdm["ic/w-fps"] = w
+    fdm["ic/p-rad_sec"] = 0.0
+    fdm["ic/q-rad_sec"] = 0.0
+    fdm["ic/r-rad_sec"] = 0.0
+    with _quiet_stdout():
+        fdm.run_ic()
+    fdm.set_sim_time(0.0)
 
 
 def _add_wind_to_trimmed_state(fdm: Any, wind_n: float, wind_e: float, crab: bool) -> None:

@@ -61,6 +61,7 @@ STATE_PROPERTIES = (
     "accelerations/a-pilot-y-ft_sec2",
     "accelerations/a-pilot-z-ft_sec2",
     "accelerations/Nz",
+    "velocities/vtrue-kts",
 )
 CONTROL_PROPERTIES = (
     "fcs/aileron-cmd-norm",
@@ -103,15 +104,21 @@ def _nodes(fdm: object, names: tuple[str, ...]) -> list[object]:
     return [pm.get_node(n) for n in names]
 
 
-def _end_reached(u: Until, t_phase: float, turned: float, vc: float, h: float, agl: float, phi: float,
-                 theta: float, alpha: float, events: set[str]) -> bool:  # fmt: skip
-    """Whether any end condition of the phase holds (angles in deg, heights in ft)."""
+def _end_reached(u: Until, t_phase: float, turned: float, rolled: float, pitched: float, vc: float, h: float,
+                 agl: float, phi: float, theta: float, alpha: float, events: set[str]) -> bool:  # fmt: skip
+    """Whether any end condition of the phase holds (angles in deg, heights in ft).
+
+    ``turned``, ``rolled`` and ``pitched`` are magnitudes since the phase began: of the heading
+    change, and of the integrals of the body rates p and q.
+    """
     if u.duration_s is not None and t_phase >= u.duration_s - 1e-9:
         return True
     if u.event is not None and u.event in events:
         return True
     return (
         (u.turned_deg is not None and turned >= u.turned_deg)
+        or (u.rolled_deg is not None and rolled >= u.rolled_deg)
+        or (u.pitched_deg is not None and pitched >= u.pitched_deg)
         or (u.airspeed_above_kts is not None and vc >= u.airspeed_above_kts)
         or (u.airspeed_below_kts is not None and vc <= u.airspeed_below_kts)
         or (u.altitude_above_ft is not None and h >= u.altitude_above_ft)
@@ -142,7 +149,7 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
     dt = m.dt_s
     (phi_get, theta_get, psi_get, p_get, q_get, r_get, alpha_get, beta_get, vc_get, vg_get, trk_get, hdot_get,
      h_get, agl_get, lat_get, lon_get, wow_get, flap_get, rpm_get, ax_get, ay_get, az_get,
-     nz_get) = [n.get_double_value for n in _nodes(fdm, STATE_PROPERTIES)]  # fmt: skip
+     nz_get, vt_get) = [n.get_double_value for n in _nodes(fdm, STATE_PROPERTIES)]  # fmt: skip
     ail_w, elev_w, rud_w, steer_w, thr_w, mix_w, flapc_w, lbrk_w, rbrk_w = _nodes(fdm, CONTROL_PROPERTIES)
     ail_set, elev_set, rud_set = ail_w.set_double_value, elev_w.set_double_value, rud_w.set_double_value
     steer_set, thr_set = steer_w.set_double_value, thr_w.set_double_value
@@ -170,12 +177,14 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
     iphase = -1
     phase_k0 = 0
     u: Until | None = None
-    psi_prev = 0.0
+    psi_prev = p_prev = q_prev = 0.0
     turned = 0.0
+    rolled = pitched = 0.0  # integrals of the body rates p and q over the phase, rad (trapezoidal rule)
     phase_events: set[str] = set()
     was_wow = wow_get() > 0.5
     airborne_since = 0.0
     lifted = not was_wow  # an air start has no lift-off to report
+    nz_last = 1.0  # load factor of the last sample (before the first step: level flight or at rest)
     k = 0
     wall0 = time.monotonic()
     next_report = wall0 + 0.5
@@ -233,12 +242,15 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
             elif d < -math.pi:
                 d += 2 * math.pi
             turned += d
+            rolled += 0.5 * (p_prev + p) * dt
+            pitched += 0.5 * (q_prev + q) * dt
         psi_prev = psi
+        p_prev, q_prev = p, q
         advance = iphase < 0
         if u is not None:
             t_phase = (k - phase_k0) * dt
-            if _end_reached(u, t_phase, abs(turned) * R2D, vc, h, agl, phi * R2D, theta * R2D, alpha * R2D,
-                            phase_events):  # fmt: skip
+            if _end_reached(u, t_phase, abs(turned) * R2D, abs(rolled) * R2D, abs(pitched) * R2D, vc, h, agl,
+                            phi * R2D, theta * R2D, alpha * R2D, phase_events):  # fmt: skip
                 advance = True
             elif u.duration_s is None and t_phase >= u.timeout_s:
                 reason = (
@@ -257,7 +269,7 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
                 phase = m.phases[iphase]
                 u = phase.until
                 phase_k0 = k
-                turned = 0.0
+                turned = rolled = pitched = 0.0
                 phase_events = set()
                 pilot.begin_phase(phase.hold, theta, thr_w.get_double_value(), flap_get())
                 flapc_w.set_double_value(pilot.flaps_cmd)
@@ -268,7 +280,7 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
 
         if not final:
             pilot.step(phi, theta, psi, p, q, r, beta, vc, vg, trk, hdot, h, agl, x_rw * 3.2808399,
-                       y_rw * 3.2808399, wow)  # fmt: skip
+                       y_rw * 3.2808399, wow, nz_last, alpha, vt_get())  # fmt: skip
             ail_set(pilot.aileron)
             elev_set(pilot.elevator)
             rud_set(pilot.rudder)
@@ -281,6 +293,7 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
         fy = ay_get() * FT_S2_TO_M_S2
         fz = az_get() * FT_S2_TO_M_S2
         nz = nz_get()
+        nz_last = nz
         rows.extend((t, fx, fy, fz, p * R2D, q * R2D, r * R2D, phi * R2D, theta * R2D, psi * R2D % 360.0,
                      alpha * R2D, beta * R2D, vc, vg * FPS_TO_KT, h, agl, hdot * 60.0, north, east, lat * R2D,
                      lon * R2D, x_rw, y_rw, nz, pilot.aileron, pilot.elevator, pilot.rudder, pilot.throttle,

@@ -9,6 +9,18 @@ Loops (angles in rad, rates in rad/s, speeds in kt, heights in ft):
   sink proportional to wheel height) -> pitch command (PI on climb-rate error, or PI on
   airspeed error when the throttle is fixed) -> pitch-rate command (P plus the steady
   turn's pitch rate g/V sin^2(phi)/cos(phi)) -> elevator (PI on pitch-rate error).
+- body-rate modes (aerobatics: no Euler angle in the loop, so nothing jumps through the
+  vertical or inverted): the ailerons track the roll angle about the body x axis of a
+  constant roll rate (``roll_rate_degps``: p_cmd = p_target + K (p_target t - integral of p),
+  so 0 holds the roll attitude of the phase start), the elevator a pitch rate or a load factor. The load-factor loop
+  commands the pitch rate of a pull in the plane of symmetry, q = g (n - z_D) / V with
+  z_D = cos(phi) cos(theta) the vertical component of the body z axis (continuous through
+  the vertical), plus a PI correction on the measured load factor; it never pulls the wing
+  past ``alpha_max_deg`` (a pilot eases the pull at the buffet: over the top of a loop the
+  load factor asked for may be more than the wing can give).
+- load-factor protection (when the profile gives ``nz_pull_max``/``nz_push_min``): in the
+  air every pitch-rate command is clamped to the rates that keep the load factor inside
+  those limits, as a pilot eases off the pull before the limit.
 - power: airspeed on the throttle (PI) or a fixed throttle, slew-rate limited.
 - yaw: in the air the rudder drives sideslip to zero (PI) with a yaw damper about the
   coordinated yaw rate; with ``wing_low`` (crosswind landing: the ailerons then bank into the
@@ -37,7 +49,7 @@ KT_TO_FPS = 1852.0 / 3600.0 / 0.3048
 # lateral modes
 LAT_LEVEL, LAT_BANK, LAT_HEADING, LAT_RATE, LAT_TRACK = range(5)
 # pitch modes
-PITCH_HOLD, PITCH_ATT, PITCH_ALT, PITCH_VS, PITCH_GLIDE, PITCH_RATE, PITCH_FLARE, PITCH_SPEED = range(8)
+PITCH_HOLD, PITCH_ATT, PITCH_ALT, PITCH_VS, PITCH_GLIDE, PITCH_RATE, PITCH_FLARE, PITCH_SPEED, PITCH_NZ = range(9)
 
 
 def _clamp(x: float, lo: float, hi: float) -> float:
@@ -57,6 +69,7 @@ class Pilot:
         self.dt = dt_s
         self.vref = g.reference_airspeed_kts
         self.vmin = profile.speeds.stall_kts
+        self.vr = profile.speeds.vr_kts
         self.cg_h = profile.geometry.cg_height_on_ground_ft
         self.steer_sign = profile.engine.steer_sign
         self.flaps_full = profile.limits.flaps_full_cmd_deg
@@ -73,6 +86,12 @@ class Pilot:
         self.ki_q = g.pitch.ki
         self.th_min = g.pitch.pitch_min_deg * D2R
         self.th_max = g.pitch.pitch_max_deg * D2R
+        self.n_hi = g.pitch.nz_pull_max if g.pitch.nz_pull_max is not None else math.inf
+        self.n_lo = g.pitch.nz_push_min if g.pitch.nz_push_min is not None else -math.inf
+        self.k_n = g.pitch.nz_kp
+        self.k_n_i = g.pitch.nz_ki
+        self.alpha_max = g.pitch.alpha_max_deg * D2R
+        self.k_alpha = g.pitch.alpha_to_rate
         # path
         self.kvs = g.path.climb_to_pitch
         self.kvs_i = g.path.climb_to_pitch_i
@@ -120,7 +139,10 @@ class Pilot:
         self.wing_low = False
         # integrators
         self.i_p = 0.0
+        self.rolled = 0.0  # roll-rate mode: integral of p since the phase start, rad
+        self.t_phase = 0.0  # and the time since then, s
         self.i_q = 0.0
+        self.i_n = 0.0
         self.i_path = 0.0
         self.i_thr = 0.0
         self.i_beta = 0.0
@@ -149,6 +171,7 @@ class Pilot:
             self.lat_mode, self.lat_target = LAT_HEADING, hold.heading_deg * D2R
         elif hold.roll_rate_degps is not None:
             self.lat_mode, self.lat_target = LAT_RATE, hold.roll_rate_degps * D2R
+            self.rolled = self.t_phase = 0.0
         elif hold.centreline:
             self.lat_mode = LAT_TRACK
         else:
@@ -168,6 +191,9 @@ class Pilot:
             self.pitch_mode, self.tan_gp = PITCH_GLIDE, math.tan(hold.glide_path_deg * D2R)
         elif hold.pitch_rate_degps is not None:
             self.pitch_mode, self.pitch_target = PITCH_RATE, hold.pitch_rate_degps * D2R
+        elif hold.load_factor is not None:
+            self.pitch_mode, self.pitch_target = PITCH_NZ, hold.load_factor
+            self.i_n = 0.0
         elif hold.flare:
             self.pitch_mode = PITCH_FLARE
         elif hold.airspeed_kts is not None and hold.throttle is not None:
@@ -203,8 +229,15 @@ class Pilot:
         x_rw_ft: float,
         y_rw_ft: float,
         wow: bool,
+        nz: float,
+        alpha: float,
+        vt: float,
     ) -> None:
-        """One control update from the current state (rad, rad/s, kt, ft, ft/s)."""
+        """One control update from the current state (rad, rad/s, kt, ft, ft/s).
+
+        ``vc`` and ``vt`` are the calibrated and true airspeeds (kt), ``nz`` the last measured load
+        factor (g) and ``alpha`` the angle of attack (rad).
+        """
         dt = self.dt
         v = vc if vc > self.vmin else self.vmin
         sc = (self.vref / v) ** 2
@@ -212,8 +245,12 @@ class Pilot:
 
         # ---- lateral: bank -> roll rate -> aileron
         mode = self.lat_mode
-        if mode == LAT_RATE:
-            p_cmd = self.lat_target
+        if mode == LAT_RATE:  # track the roll angle about the body x axis: target rate x time in the phase
+            self.rolled += p * dt
+            self.t_phase += dt
+            p_cmd = self.lat_target + _clamp(
+                self.k_phi * (self.lat_target * self.t_phase - self.rolled), -self.p_max, self.p_max
+            )
         else:
             if mode == LAT_BANK:
                 phi_cmd = self.lat_target
@@ -234,8 +271,18 @@ class Pilot:
 
         # ---- pitch: path -> pitch -> pitch rate -> elevator
         mode = self.pitch_mode
+        g_v = G_FPS2 / ((vt if vt > self.vmin else self.vmin) * KT_TO_FPS)  # pitch rate per g of a pull, rad/s
+        z_down = math.cos(phi) * math.cos(theta)  # vertical component of the body z axis
         if mode == PITCH_RATE:
             q_cmd = self.pitch_target
+        elif mode == PITCH_NZ:
+            en = self.pitch_target - nz
+            q_cmd = g_v * (self.pitch_target - z_down) + self.i_n + self.k_n * en
+            q_stall = q + self.k_alpha * (self.alpha_max - alpha)  # the pitch rate that keeps alpha at its limit
+            if q_cmd > q_stall:
+                q_cmd = q_stall
+            elif air:
+                self.i_n += self.k_n_i * en * dt
         else:
             if mode == PITCH_ATT:
                 th_cmd = self.pitch_target
@@ -264,10 +311,14 @@ class Pilot:
             c = math.cos(phi)
             if air and c > 0.2:
                 s = math.sin(phi)
-                q_cmd += G_FPS2 / (v * KT_TO_FPS) * s * s / c
+                q_cmd += g_v * s * s / c
+        if air:  # load-factor protection
+            q_hi = g_v * (self.n_hi - z_down) + self.k_n * (self.n_hi - nz)
+            q_lo = g_v * (self.n_lo - z_down) + self.k_n * (self.n_lo - nz)
+            q_cmd = q_hi if q_cmd > q_hi else q_lo if q_cmd < q_lo else q_cmd
         e = q_cmd - q
         u = self.i_q + sc * self.kp_q * e
-        if air and -1.0 < u < 1.0:
+        if (air or (vc >= self.vr and e > 0.0)) and -1.0 < u < 1.0:  # on the ground: the rotation from Vr
             self.i_q += self.ki_q * e * dt
         d = -_clamp(u, -1.0, 1.0) - self.elevator
         self.elevator += _clamp(d, -self.surf_rate, self.surf_rate)
@@ -304,7 +355,7 @@ class Pilot:
             self.steer = self.steer_sign * self.rudder if wow else 0.0
             self.i_beta = -self.rudder
         else:
-            r_coord = G_FPS2 * math.sin(phi) * math.cos(theta) / (v * KT_TO_FPS)
+            r_coord = g_v * math.sin(phi) * math.cos(theta)
             rud = -(self.i_beta + sc * self.kb * beta) + sc * self.kyd * (r - r_coord)
             if -1.0 < rud < 1.0:
                 self.i_beta += self.kb_i * beta * dt

@@ -10,7 +10,7 @@ as dynamic pressure changes.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Literal
 
 from pydantic import Field
 
@@ -48,6 +48,21 @@ class Geometry(StrictModel):
 class Engine(StrictModel):
     steer_sign: Annotated[float, Field(ge=-1, le=1)]  # fcs/steer-cmd-norm = steer_sign * rudder-like command
     mixture_schedule: list[tuple[float, float]]  # (altitude_ft, mixture 0..1), interpolated
+    magneto_cmd: Annotated[int, Field(ge=0, le=3)] | None = None  # propulsion/magneto_cmd at engine start
+    propeller_advance_norm: Annotated[float, Field(ge=0, le=1)] | None = None  # fcs/advance-cmd-norm[0] (lever)
+
+
+class StartOptions(StrictModel):
+    """How an air start reaches steady flight.
+
+    ``trim``: JSBSim's ``do_trim(1)``. ``flying``: a flying start, for models JSBSim's trim cannot
+    handle (it evaluates the engine alone, without the flight control system): the scripted pilot
+    flies the start condition in still air for ``settle_s`` seconds, then the aircraft is put back
+    at the start point with the settled attitude, velocities and controls, and the clock at zero.
+    """
+
+    air: Literal["trim", "flying"] = "trim"
+    settle_s: Positive = 30.0  # flying start: settling time, s
 
 
 class RollGains(StrictModel):
@@ -65,6 +80,12 @@ class PitchGains(StrictModel):
     ki: NonNegative
     pitch_min_deg: float
     pitch_max_deg: float
+    nz_kp: NonNegative = 0.05  # load-factor loop: pitch rate per g of load-factor error, rad/s/g
+    nz_ki: NonNegative = 0.1  # its integral gain, rad/s/g/s
+    alpha_max_deg: Positive = 14.0  # load-factor loop: the largest angle of attack it pulls to, deg
+    alpha_to_rate: Positive = 2.0  # pitch rate per angle-of-attack excess, 1/s
+    nz_pull_max: Positive | None = None  # load-factor protection: largest load factor the pilot pulls, g
+    nz_push_min: Annotated[float, Field(lt=0)] | None = None  # and the most negative one pushed, g
 
 
 class PathGains(StrictModel):
@@ -125,6 +146,7 @@ class PilotProfile(StrictModel):
     geometry: Geometry
     engine: Engine
     gains: Gains
+    start: StartOptions = StartOptions()
 
 
 def load_profile(path: str | Path) -> PilotProfile:
