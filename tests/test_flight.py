@@ -285,7 +285,8 @@ def test_progress_when_asked(tmp_path: Path, capsys: pytest.CaptureFixture[str])
 
 
 def test_the_documented_example_flies_with_its_checks_passing(tmp_path: Path) -> None:
-    docs = Path(__file__).resolve().parents[1] / "docs" / "manoeuvres.md"
-    example = docs.read_text().split("```yaml\n", 1)[1].split("```", 1)[0]
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    section = readme.split("## Manoeuvre files", 1)[1]
+    example = section.split("```yaml\n", 1)[1].split("```", 1)[0]
     result = fly(load_manoeuvre(write(tmp_path, "example.yaml", example)))
     assert result.status == "ok", result.reason

@@ -48,7 +48,9 @@ EXPECTED = {
         ":2: aircraft: unknown aircraft 'c999x' (neither in the project's aircraft/ folder nor bundled with JSBSim)"
     ),
     "unknown_key.yaml": ":11: phases[1].hold.bank_dge: unknown key (did you mean 'bank_deg'?)",
-    "unknown_signal.yaml": ":15: checks[0].signal: unknown signal 'bank' (see docs/manoeuvres.md for the signals)",
+    "unknown_signal.yaml": (
+        ":15: checks[0].signal: unknown signal 'bank' (a signal is a flight.parquet column, see README.md)"
+    ),
     "unreadable_yaml.yaml": ":8: invalid YAML: expected ',' or '}', but got ':'",
     "wrong_type.yaml": ":11: phases[1].hold.bank_deg: expected a number, got 'thirty'",
 }
