@@ -1,10 +1,11 @@
 """Whole-suite wall time against bare JSBSim ``fdm.run()`` for the same steps, on the same cores.
 
-Runs ``washbench suite`` (flight, scripted pilot, three washouts in lockstep, Atlas model,
-vestibular models, metrics, traces.parquet and recording.rrd) on the bundled manoeuvres with
-``--jobs`` processes, counts the JSBSim steps it flew per aircraft, then runs bare ``fdm.run()``
-for the same number of steps per aircraft, spread over the same number of processes, and prints
-both wall times and their ratio (the suite's cost over JSBSim's own).
+Runs ``washbench suite`` (flight with the scripted pilot, three washouts in lockstep, Atlas model,
+vestibular models, metrics, traces.parquet and recording.rrd, report) on the bundled manoeuvres
+with ``--jobs`` processes and times it. Then, for every manoeuvre, it sets JSBSim up at the
+manoeuvre's own start (the same set-up the flight uses) and times bare ``fdm.run()`` for as many
+steps as the flight recorded, spread over the same number of processes. It prints both, their
+ratio, and the per-step figures.
 
     .venv/bin/python bench/suite_bench.py [--jobs 2] [MANOEUVRE_OR_DIR ...]
 """
@@ -20,29 +21,14 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 
-def bare_run(aircraft: str, steps: int, dt_s: float) -> float:
-    """Seconds for ``steps`` calls of ``fdm.run()`` on ``aircraft`` flying level at 4000 ft, 100 kt."""
-    os.environ["JSBSIM_DEBUG"] = "0"
-    import jsbsim
+def bare_run(path: str, steps: int) -> float:
+    """Seconds of ``steps`` bare ``fdm.run()`` calls from the start of manoeuvre ``path``."""
+    from washbench.flight.fdm import make_fdm
+    from washbench.flight.profile import load_profile
+    from washbench.manoeuvre import load_manoeuvre, pilot_profile_path
 
-    from washbench.manoeuvre import aircraft_path
-
-    root = aircraft_path(aircraft)
-    if root is None:
-        raise SystemExit(f"unknown aircraft {aircraft}")
-    fdm = jsbsim.FGFDMExec(str(Path(jsbsim.__file__).resolve().parent))
-    fdm.set_aircraft_path(str(root))
-    fdm.set_debug_level(0)
-    fdm.load_model(aircraft)
-    fdm.set_dt(dt_s)
-    fdm["ic/h-sl-ft"] = 4000.0
-    fdm["ic/vc-kts"] = 100.0
-    fdm["ic/lat-geod-deg"] = 45.0
-    fdm["ic/psi-true-deg"] = 90.0
-    fdm.run_ic()
-    fdm["propulsion/set-running"] = -1
-    fdm["fcs/throttle-cmd-norm"] = 0.7
-    fdm["fcs/mixture-cmd-norm"] = 0.9
+    m = load_manoeuvre(Path(path))
+    fdm, _ = make_fdm(m, load_profile(pilot_profile_path(m.aircraft)))
     run = fdm.run
     start = time.perf_counter()
     for _ in range(steps):
@@ -65,17 +51,19 @@ def main() -> None:
         write_suite_results(outcomes, Path(tmp))
         suite_s = time.perf_counter() - start
     failed = [o for o in outcomes if not o.ok]
-    work = [(o.aircraft, o.steps, o.dt_s) for o in outcomes if o.steps]
-    steps = sum(s for _, s, _ in work)
+    work = [(o.path, o.steps) for o in outcomes if o.steps]
+    steps = sum(s for _, s in work)
     ctx = multiprocessing.get_context("forkserver")
-    start = time.perf_counter()
     with ProcessPoolExecutor(max_workers=args.jobs, mp_context=ctx) as pool:
-        list(pool.map(bare_run, *zip(*work, strict=True)))
-    bare_s = time.perf_counter() - start
+        bare = list(pool.map(bare_run, *zip(*work, strict=True)))
+    # the bare runs are independent: on `jobs` processes their wall time is their sum over `jobs`
+    bare_s = sum(bare) / args.jobs
     print(f"manoeuvres: {len(outcomes)} ({len(failed)} failed), JSBSim steps: {steps}, processes: {args.jobs}")
-    print(f"washbench suite wall time: {suite_s:8.2f} s")
-    print(f"bare fdm.run() wall time:  {bare_s:8.2f} s  (same steps per aircraft, same processes)")
+    print(f"washbench suite wall time: {suite_s:8.2f} s  ({suite_s / steps * args.jobs * 1e6:6.1f} us per step)")
+    print(f"bare fdm.run() wall time:  {bare_s:8.2f} s  ({bare_s / steps * args.jobs * 1e6:6.1f} us per step)")
     print(f"ratio suite / bare JSBSim: {suite_s / bare_s:8.2f}")
+    per_run = sum(o.wall_s for o in outcomes)
+    print(f"of which inside the runs:  {per_run / args.jobs:8.2f} s (the rest: process start, suite files)")
 
 
 if __name__ == "__main__":
