@@ -144,7 +144,9 @@ def run_suite(
     start = time.perf_counter()
     if progress:
         print(
-            f"suite: {len(files)} manoeuvres on {jobs} process{'es' if jobs > 1 else ''} -> {out_dir}", file=sys.stderr
+            f"suite: {len(files)} manoeuvres on {jobs} process{'es' if jobs > 1 else ''} -> {out_dir}\n"
+            "suite: loading JSBSim, rerun and the washout kernel (compiled once after install: a few seconds)",
+            file=sys.stderr,
         )
     if jobs == 1:
         for a in args:
