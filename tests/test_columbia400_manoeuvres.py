@@ -217,7 +217,9 @@ def test_inverted_flight_does_not_trip_the_monitor(tmp_path: Path) -> None:
     assert result.status == "ok", result.reason
     c = result.columns
     sel = phase_mask(result, "inverted")
-    assert np.min(np.abs(c["phi_deg"][sel])) > 140.0  # inverted throughout (the roll overshoots, then returns)
+    # inverted throughout: stopping a 60 deg/s roll, the aileron feed-forward comes off at once, so the roll
+    # overshoots less than 25 deg (about 0.4 s of the roll: the surface rate limit and the roll mode's lag)
+    assert np.min(np.abs(c["phi_deg"][sel])) > 155.0
     assert abs(c["phi_deg"][sel][-1]) > 170.0
     assert np.mean(c["nz"][sel & (result.t_s > result.phases[2][1] + 1.5)]) == pytest.approx(-1.0, abs=0.1)
     assert abs(c["phi_deg"][-1]) < 5.0

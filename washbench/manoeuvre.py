@@ -17,7 +17,7 @@ import json
 import sys
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any, Literal, get_args
 
 from pydantic import Field
 
@@ -142,7 +142,8 @@ class Hold(StrictModel):
     brakes: Fraction | None = None
 
 
-EVENTS = ("liftoff", "touchdown", "stopped", "stall")
+Event = Literal["liftoff", "touchdown", "stopped", "stall"]
+EVENTS: tuple[str, ...] = get_args(Event)
 
 
 class Until(StrictModel):
@@ -155,7 +156,7 @@ class Until(StrictModel):
     """
 
     duration_s: Positive | None = None
-    event: Literal["liftoff", "touchdown", "stopped", "stall"] | None = None
+    event: Event | None = None
     turned_deg: Positive | None = None
     rolled_deg: Positive | None = None
     pitched_deg: Positive | None = None
@@ -178,7 +179,8 @@ class Phase(StrictModel):
     until: Until
 
 
-STATS = (
+#: Statistics over the selected samples, and those taken at an event (the first touchdown or lift-off).
+SampleStat = Literal[
     "min",
     "max",
     "mean",
@@ -190,10 +192,12 @@ STATS = (
     "max_deviation",
     "turned",
     "rotated",
-)
+]
+EventStat = Literal["at_touchdown", "at_liftoff"]
+STATS: tuple[str, ...] = get_args(SampleStat)
+EVENT_STATS: tuple[str, ...] = get_args(EventStat)
 #: Signals the ``rotated`` statistic integrates (body angular velocity, deg/s).
 RATE_SIGNALS = ("omega_x_degps", "omega_y_degps", "omega_z_degps")
-EVENT_STATS = ("at_touchdown", "at_liftoff")
 
 
 class Check(StrictModel):
@@ -208,21 +212,7 @@ class Check(StrictModel):
 
     name: Annotated[str, Field(min_length=1)]
     signal: str
-    stat: Literal[
-        "min",
-        "max",
-        "mean",
-        "max_abs",
-        "initial",
-        "final",
-        "max_rise",
-        "max_drop",
-        "max_deviation",
-        "turned",
-        "rotated",
-        "at_touchdown",
-        "at_liftoff",
-    ]
+    stat: Literal[SampleStat, EventStat]  # one literal type (nested literals flatten): one error message
     phases: list[str] | None = None
     min: float | None = None
     max: float | None = None
@@ -381,11 +371,7 @@ def _check_semantics(m: Manoeuvre, where: _Where) -> None:
         base = ("checks", j)
         if check.signal not in COLUMN_NAMES and check.signal != "sink_fps":
             close = difflib.get_close_matches(check.signal, [*COLUMN_NAMES, "sink_fps"], n=1, cutoff=0.7)
-            hint = (
-                f"did you mean '{close[0]}'?"
-                if close
-                else "a signal is a flight.parquet column, see README.md"
-            )
+            hint = f"did you mean '{close[0]}'?" if close else "a signal is a flight.parquet column, see README.md"
             raise where.error((*base, "signal"), f"unknown signal '{check.signal}' ({hint})")
         if check.signal == "sink_fps" and check.stat not in EVENT_STATS:
             raise where.error((*base, "stat"), "sink_fps is measured at an event: use at_touchdown or at_liftoff")

@@ -185,6 +185,7 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
     airborne_since = 0.0
     lifted = not was_wow  # an air start has no lift-off to report
     nz_last = 1.0  # load factor of the last sample (before the first step: level flight or at rest)
+    fy_last = 0.0  # and its lateral specific force, m/s^2
     k = 0
     wall0 = time.monotonic()
     next_report = wall0 + 0.5
@@ -280,7 +281,7 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
 
         if not final:
             pilot.step(phi, theta, psi, p, q, r, beta, vc, vg, trk, hdot, h, agl, x_rw * 3.2808399,
-                       y_rw * 3.2808399, wow, nz_last, alpha, vt_get())  # fmt: skip
+                       y_rw * 3.2808399, wow, nz_last, alpha, vt_get(), fy_last)  # fmt: skip
             ail_set(pilot.aileron)
             elev_set(pilot.elevator)
             rud_set(pilot.rudder)
@@ -294,6 +295,7 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
         fz = az_get() * FT_S2_TO_M_S2
         nz = nz_get()
         nz_last = nz
+        fy_last = fy
         rows.extend((t, fx, fy, fz, p * R2D, q * R2D, r * R2D, phi * R2D, theta * R2D, psi * R2D % 360.0,
                      alpha * R2D, beta * R2D, vc, vg * FPS_TO_KT, h, agl, hdot * 60.0, north, east, lat * R2D,
                      lon * R2D, x_rw, y_rw, nz, pilot.aileron, pilot.elevator, pilot.rudder, pilot.throttle,

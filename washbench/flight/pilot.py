@@ -4,10 +4,14 @@ Loops (angles in rad, rates in rad/s, speeds in kt, heights in ft):
 
 - roll: path target (heading, ground track to the runway centreline) -> bank command
   (limited to ``bank_max_deg``) -> roll-rate command (P, limited to ``rate_max_degps``)
-  -> aileron (PI on roll-rate error).
+  -> aileron (feed-forward of the steady-roll aileron, proportional to p / V, plus PI on the
+  roll-rate error, so a roll stops as soon as its command does). The heading hold leads the
+  roll-out by the turn rate times half the roll-out time; the centreline track is PI on the
+  offset, and with ``wing_low`` the bank also balances the measured side force of the slip.
 - pitch: path target (altitude -> climb-rate command; glide path -> climb rate; flare ->
-  sink proportional to wheel height) -> pitch command (PI on climb-rate error, or PI on
-  airspeed error when the throttle is fixed) -> pitch-rate command (P plus the steady
+  sink proportional to wheel height) -> pitch command (PI on the flight-path-angle error; with
+  the throttle fixed, airspeed is held by energy: the path angle that gives the wanted airspeed
+  rate, gamma + (vdot - vdot_cmd) / g) -> pitch-rate command (P plus the steady
   turn's pitch rate g/V sin^2(phi)/cos(phi)) -> elevator (PI on pitch-rate error).
 - body-rate modes (aerobatics: no Euler angle in the loop, so nothing jumps through the
   vertical or inverted): the ailerons track the roll angle about the body x axis of a
@@ -21,11 +25,15 @@ Loops (angles in rad, rates in rad/s, speeds in kt, heights in ft):
 - load-factor protection (when the profile gives ``nz_pull_max``/``nz_push_min``): in the
   air every pitch-rate command is clamped to the rates that keep the load factor inside
   those limits, as a pilot eases off the pull before the limit.
-- power: airspeed on the throttle (PI) or a fixed throttle, slew-rate limited.
+- power: airspeed on the throttle or a fixed throttle, slew-rate limited. The throttle holds the
+  specific energy rate gamma + vdot / g at what the path and the airspeed command
+  (vdot_cmd = speed error / ``speed_tau_s``, limited) need together (PI, TECS-like), so it cuts
+  power when the elevator levels off and the airspeed settles without overshoot.
 - yaw: in the air the rudder drives sideslip to zero (PI) with a yaw damper about the
-  coordinated yaw rate; with ``wing_low`` (crosswind landing: the ailerons then bank into the
-  wind to hold the track) and on the ground it holds the runway heading (PI, with yaw-rate
-  damping) plus a centreline correction on the ground, with nosewheel steering.
+  coordinated yaw rate and a rudder feed-forward from the roll (against adverse yaw); with
+  ``wing_low`` (crosswind landing: the ailerons then bank into the wind to hold the track) and
+  on the ground it holds the runway heading (PI, with yaw-rate damping; the rudder starts
+  central at touchdown) plus a PI correction of the centreline offset, with nosewheel steering.
 
 Surface commands are rate limited (``surface_rate_per_s``), as a pilot's hands are.
 Integrators start from the current control or attitude at each phase (bumpless), stop
@@ -45,6 +53,9 @@ from washbench.manoeuvre import Hold, Runway
 D2R = math.pi / 180.0
 G_FPS2 = 32.174
 KT_TO_FPS = 1852.0 / 3600.0 / 0.3048
+G_KTPS = G_FPS2 / KT_TO_FPS  # standard gravity in kt/s
+G_MPS2 = 9.80665
+SIDE_FORCE_FILTER_S = 0.5  # time constant of the filter on the lateral specific force, s
 
 # lateral modes
 LAT_LEVEL, LAT_BANK, LAT_HEADING, LAT_RATE, LAT_TRACK = range(5)
@@ -78,6 +89,7 @@ class Pilot:
         self.p_max = g.roll.rate_max_degps * D2R
         self.kp_p = g.roll.kp
         self.ki_p = g.roll.ki
+        self.k_pff = g.roll.rate_feedforward
         self.bank_max = g.roll.bank_max_deg * D2R
         # pitch
         self.k_th = g.pitch.pitch_to_rate
@@ -98,27 +110,33 @@ class Pilot:
         self.k_alt = g.path.altitude_to_vs
         self.vs_max = g.path.vs_max_fps
         self.k_gp = g.path.glide_path_to_vs
-        self.kv = g.path.speed_kp_deg_per_kt * D2R
-        self.kv_i = g.path.speed_ki_deg_per_kt_s * D2R
-        self.kt = g.path.throttle_kp_per_kt
-        self.kt_i = g.path.throttle_ki_per_kt_s
+        self.tau_v = g.path.speed_tau_s
+        self.vdot_max = g.path.accel_max_ktps
+        self.tau_vdot = g.path.speed_rate_filter_s
+        self.kt = g.path.energy_to_throttle
+        self.kt_i = g.path.energy_to_throttle_i
         self.thr_rate = g.path.throttle_rate_per_s * dt_s
         self.surf_rate = g.surface_rate_per_s * dt_s
         # yaw
         self.kb = g.yaw.beta_kp
         self.kb_i = g.yaw.beta_ki
         self.kyd = g.yaw.yaw_damper
+        self.k_ari = g.yaw.aileron_to_rudder
         # track
         self.k_hdg = g.track.heading_to_bank
         self.k_trk = g.track.track_to_bank
         self.k_y = g.track.offset_to_track_deg_per_ft * D2R
         self.icpt_max = g.track.intercept_max_deg * D2R
+        self.k_y_i = g.track.offset_ki
+        self.i_y_max = g.track.offset_integral_max_deg * D2R / self.k_y  # ft s
         # ground
         self.kg_psi = g.ground.heading_kp
         self.kg_r = g.ground.yaw_rate_kd
         self.kg_i = g.ground.heading_ki
         self.kg_y = g.ground.offset_to_heading_deg_per_ft * D2R
         self.kg_ymax = g.ground.offset_heading_max_deg * D2R
+        self.kg_y_i = g.ground.offset_ki
+        self.ig_y_max = g.ground.offset_integral_max_deg * D2R / self.kg_y  # ft s
         # flare
         self.tau = g.flare.tau_s
         self.sink_min = g.flare.sink_min_fps
@@ -147,6 +165,13 @@ class Pilot:
         self.i_thr = 0.0
         self.i_beta = 0.0
         self.i_psi = 0.0
+        self.i_y = 0.0  # centreline offset integrals (in the air, on the ground), ft s x their gain
+        self.i_y_ground = 0.0
+        # airspeed rate (true, kt/s), a filtered derivative
+        self.vdot = 0.0
+        self.vt_prev = -1.0
+        self.fy_f = 0.0  # lateral specific force, filtered, m/s^2
+        self.was_wow = False
         # outputs
         self.aileron = 0.0
         self.elevator = 0.0
@@ -155,6 +180,11 @@ class Pilot:
         self.throttle = 0.0
         self.flaps_cmd = 0.0
         self.brakes = 0.0
+
+    def _vdot_cmd(self, vc: float, vt: float) -> float:
+        """The true-airspeed rate (kt/s) that closes the calibrated airspeed error in ``speed_tau_s``, limited."""
+        a = _clamp((self.speed_target - vc) / self.tau_v, -self.vdot_max, self.vdot_max)
+        return a * vt / vc if vc > 1.0 else a
 
     def set_controls(self, aileron: float, elevator: float, rudder: float) -> None:
         """Start from the control positions the trim left: outputs and integrators (bumpless start)."""
@@ -232,16 +262,24 @@ class Pilot:
         nz: float,
         alpha: float,
         vt: float,
+        fy_mps2: float = 0.0,
     ) -> None:
         """One control update from the current state (rad, rad/s, kt, ft, ft/s).
 
         ``vc`` and ``vt`` are the calibrated and true airspeeds (kt), ``nz`` the last measured load
-        factor (g) and ``alpha`` the angle of attack (rad).
+        factor (g), ``alpha`` the angle of attack (rad) and ``fy_mps2`` the last measured lateral specific force
+        (body y, m/s^2).
         """
         dt = self.dt
         v = vc if vc > self.vmin else self.vmin
         sc = (self.vref / v) ** 2
         air = not wow
+        vt_min = vt if vt > self.vmin else self.vmin
+        if self.vt_prev < 0.0:
+            self.vt_prev = vt
+        self.vdot += ((vt - self.vt_prev) / dt - self.vdot) * (dt / (self.tau_vdot + dt))
+        self.vt_prev = vt
+        self.fy_f += (fy_mps2 - self.fy_f) * (dt / (SIDE_FORCE_FILTER_S + dt))
 
         # ---- lateral: bank -> roll rate -> aileron
         mode = self.lat_mode
@@ -255,15 +293,28 @@ class Pilot:
             if mode == LAT_BANK:
                 phi_cmd = self.lat_target
             elif mode == LAT_HEADING:
-                phi_cmd = _clamp(self.k_hdg * wrap_pi(self.lat_target - psi), -self.bank_max, self.bank_max)
+                # lead the roll-out: aim at the heading the turn reaches while the bank comes off, the
+                # turn rate g tan(phi) / V times half the roll-out time |phi| / p_max + 1 / k_phi
+                bank = _clamp(phi, -1.0, 1.0)
+                lead = G_FPS2 * math.tan(bank) / (vt_min * KT_TO_FPS) * 0.5 * (abs(bank) / self.p_max + 1 / self.k_phi)
+                phi_cmd = _clamp(self.k_hdg * wrap_pi(self.lat_target - psi - lead), -self.bank_max, self.bank_max)
             elif mode == LAT_TRACK and air:
-                trk_cmd = self.rw_hdg - _clamp(self.k_y * y_rw_ft, -self.icpt_max, self.icpt_max)
-                phi_cmd = _clamp(self.k_trk * wrap_pi(trk_cmd - track), -self.bank_max, self.bank_max)
+                # PI on the offset: the integral finds the bank a wing-low slip needs with no offset left
+                off = self.k_y * (y_rw_ft + self.i_y)
+                if -self.icpt_max < off < self.icpt_max:
+                    self.i_y = _clamp(self.i_y + self.k_y_i * y_rw_ft * dt, -self.i_y_max, self.i_y_max)
+                trk_cmd = self.rw_hdg - _clamp(off, -self.icpt_max, self.icpt_max)
+                phi_cmd = self.k_trk * wrap_pi(trk_cmd - track)
+                if self.wing_low:  # bank into the wind as far as the side force of the slip needs: g sin(phi) = -f_y
+                    phi_cmd += math.asin(_clamp(-self.fy_f / (G_MPS2 * math.cos(theta)), -0.5, 0.5))
+                phi_cmd = _clamp(phi_cmd, -self.bank_max, self.bank_max)
             else:
                 phi_cmd = 0.0
             p_cmd = _clamp(self.k_phi * (phi_cmd - phi), -self.p_max, self.p_max)
         e = p_cmd - p
-        ail = self.i_p + sc * self.kp_p * e
+        # feed-forward of the aileron a steady roll at p_cmd needs (roll damping: proportional to p / V)
+        ail_ff = self.k_pff * p_cmd * (self.vref / vt_min)
+        ail = ail_ff + self.i_p + sc * self.kp_p * e
         if air and -1.0 < ail < 1.0:
             self.i_p += self.ki_p * e * dt
         d = _clamp(ail, -1.0, 1.0) - self.aileron
@@ -271,6 +322,7 @@ class Pilot:
 
         # ---- pitch: path -> pitch -> pitch rate -> elevator
         mode = self.pitch_mode
+        path_err = 0.0  # flight-path-angle error of the path modes (rad), for the throttle
         g_v = G_FPS2 / ((vt if vt > self.vmin else self.vmin) * KT_TO_FPS)  # pitch rate per g of a pull, rad/s
         z_down = math.cos(phi) * math.cos(theta)  # vertical component of the body z axis
         if mode == PITCH_RATE:
@@ -286,13 +338,12 @@ class Pilot:
         else:
             if mode == PITCH_ATT:
                 th_cmd = self.pitch_target
-            elif mode == PITCH_SPEED:
-                ev = vc - self.speed_target
-                th_cmd = self.i_path + self.kv * ev
-                if air and self.th_min < th_cmd < self.th_max:
-                    self.i_path += self.kv_i * ev * dt
             else:
-                if mode == PITCH_ALT:
+                if mode == PITCH_SPEED:
+                    # energy split: at a fixed throttle the power fixes gamma + vdot / g, so the path angle
+                    # that gives the wanted acceleration differs from the present one by (vdot - vdot_cmd) / g
+                    evs = (self.vdot - self._vdot_cmd(vc, vt)) / G_KTPS
+                elif mode == PITCH_ALT:
                     vs_cmd = _clamp(self.k_alt * (self.pitch_target - h_msl), -self.vs_max, self.vs_max)
                 elif mode == PITCH_VS:
                     vs_cmd = self.pitch_target
@@ -302,7 +353,9 @@ class Pilot:
                 else:  # flare: sink proportional to the height of the wheels
                     hw = h_agl - self.cg_h
                     vs_cmd = -(hw / self.tau if hw / self.tau > self.sink_min else self.sink_min)
-                evs = (vs_cmd - hdot) / (v * KT_TO_FPS)  # flight-path angle error, rad
+                if mode != PITCH_SPEED:
+                    evs = (vs_cmd - hdot) / (v * KT_TO_FPS)  # flight-path angle error, rad
+                    path_err = (vs_cmd - hdot) / (vt_min * KT_TO_FPS)
                 th_cmd = self.i_path + self.kvs * evs
                 if air and self.th_min < th_cmd < self.th_max:
                     self.i_path += self.kvs_i * evs * dt
@@ -325,10 +378,12 @@ class Pilot:
 
         # ---- power
         if self.speed_on_throttle:
-            ev = self.speed_target - vc
-            thr = self.i_thr + self.kt * ev
-            if 0.0 < thr < 1.0:
-                self.i_thr += self.kt_i * ev * dt
+            # total energy: the throttle holds the specific energy rate gamma + vdot / g at what the path and
+            # the speed commands need together (PI; the integrator stops where it would push a limit further)
+            e = path_err + (self._vdot_cmd(vc, vt) - self.vdot) / G_KTPS
+            thr = self.i_thr + self.kt * e
+            if (thr < 1.0 or e < 0.0) and (thr > 0.0 or e > 0.0):
+                self.i_thr = _clamp(self.i_thr + self.kt_i * e * dt, 0.0, 1.0)
         elif self.throttle_target >= 0.0:
             thr = self.throttle_target
         else:
@@ -339,9 +394,17 @@ class Pilot:
 
         # ---- yaw: coordination in the air, runway heading in the flare (decrab) and on the ground
         if wow or self.wing_low:
-            if self.centreline:
-                off = _clamp(self.kg_y * y_rw_ft, -self.kg_ymax, self.kg_ymax) if wow else 0.0
-                psi_cmd = self.rw_hdg - off
+            if wow and not self.was_wow:  # touchdown: the tyres now hold the side force, the rudder starts central
+                self.i_psi = 0.0
+            if self.centreline and wow:  # PI on the centreline offset: aim the nose back at it
+                off = self.kg_y * (y_rw_ft + self.i_y_ground)
+                if -self.kg_ymax < off < self.kg_ymax:
+                    self.i_y_ground = _clamp(
+                        self.i_y_ground + self.kg_y_i * y_rw_ft * dt, -self.ig_y_max, self.ig_y_max
+                    )
+                psi_cmd = self.rw_hdg - _clamp(off, -self.kg_ymax, self.kg_ymax)
+            elif self.centreline:
+                psi_cmd = self.rw_hdg
             else:
                 psi_cmd = psi
             e = wrap_pi(psi_cmd - psi)
@@ -356,10 +419,12 @@ class Pilot:
             self.i_beta = -self.rudder
         else:
             r_coord = g_v * math.sin(phi) * math.cos(theta)
-            rud = -(self.i_beta + sc * self.kb * beta) + sc * self.kyd * (r - r_coord)
+            # rudder with the roll (aileron-rudder interconnect: against the adverse yaw), then PI on the sideslip
+            rud = -self.k_ari * ail_ff - (self.i_beta + sc * self.kb * beta) + sc * self.kyd * (r - r_coord)
             if -1.0 < rud < 1.0:
                 self.i_beta += self.kb_i * beta * dt
             d = _clamp(rud, -1.0, 1.0) - self.rudder
             self.rudder += _clamp(d, -self.surf_rate, self.surf_rate)
             self.steer = 0.0
             self.i_psi = -self.rudder
+        self.was_wow = wow

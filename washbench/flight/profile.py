@@ -70,6 +70,7 @@ class RollGains(StrictModel):
     rate_max_degps: Positive
     kp: Positive  # aileron per rad/s of roll-rate error
     ki: NonNegative  # aileron per rad of integrated roll-rate error
+    rate_feedforward: NonNegative  # aileron a steady roll needs, per rad/s at a true airspeed of the reference
     bank_max_deg: Positive  # bank used by heading and track modes
 
 
@@ -94,10 +95,11 @@ class PathGains(StrictModel):
     altitude_to_vs: Positive  # climb-rate command per ft of altitude error, 1/s
     vs_max_fps: Positive
     glide_path_to_vs: Positive  # climb-rate correction per ft below the glide path, 1/s
-    speed_kp_deg_per_kt: Positive  # pitch per kt of airspeed error (airspeed on the elevator)
-    speed_ki_deg_per_kt_s: NonNegative
-    throttle_kp_per_kt: Positive  # airspeed on the throttle
-    throttle_ki_per_kt_s: NonNegative
+    speed_tau_s: Positive  # airspeed held (elevator or throttle): an error closes at error / tau kt/s ...
+    accel_max_ktps: Positive  # ... up to this rate
+    speed_rate_filter_s: Positive  # time constant of the filter on the airspeed rate, s
+    energy_to_throttle: Positive  # throttle per rad of specific energy-rate error (gamma + vdot / g)
+    energy_to_throttle_i: NonNegative  # its integral gain, 1/s
     throttle_rate_per_s: Positive  # throttle slew-rate limit
 
 
@@ -105,6 +107,7 @@ class YawGains(StrictModel):
     beta_kp: NonNegative  # rudder per rad of sideslip
     beta_ki: NonNegative  # rudder per rad s
     yaw_damper: NonNegative  # rudder per rad/s of yaw-rate beyond the coordinated rate
+    aileron_to_rudder: NonNegative  # rudder per aileron of the roll-rate feed-forward (against adverse yaw)
 
 
 class TrackGains(StrictModel):
@@ -112,6 +115,8 @@ class TrackGains(StrictModel):
     track_to_bank: Positive  # bank per ground-track error (deg/deg)
     offset_to_track_deg_per_ft: Positive  # intercept angle per ft off the centreline
     intercept_max_deg: Positive
+    offset_ki: NonNegative  # integral of the centreline offset: 1/s (added to the offset the intercept uses)
+    offset_integral_max_deg: NonNegative  # the largest intercept angle the integral may ask for
 
 
 class GroundGains(StrictModel):
@@ -120,6 +125,8 @@ class GroundGains(StrictModel):
     yaw_rate_kd: NonNegative  # per rad/s
     offset_to_heading_deg_per_ft: Positive
     offset_heading_max_deg: Positive
+    offset_ki: NonNegative  # on the ground: the same integral of the offset
+    offset_integral_max_deg: NonNegative
 
 
 class FlareGains(StrictModel):
