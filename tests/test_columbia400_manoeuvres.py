@@ -11,10 +11,10 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from textwrap import dedent
 
 import numpy as np
 import pytest
+from flight_helpers import FT, normal_gravity, phase_mask, write
 from scipy.spatial.transform import Rotation
 
 from washbench.errors import WashbenchError
@@ -24,14 +24,6 @@ from washbench.manoeuvre import Check, load_manoeuvre
 from washbench.paths import MANOEUVRES_DIR
 
 COLUMBIA = MANOEUVRES_DIR / "columbia400"
-FT = 0.3048
-
-
-def normal_gravity(lat_deg: float, h_m: float) -> float:
-    """WGS-84 normal gravity (Somigliana) with the free-air correction, m/s^2."""
-    s2 = math.sin(math.radians(lat_deg)) ** 2
-    g0 = 9.7803253359 * (1 + 0.00193185265241 * s2) / math.sqrt(1 - 0.00669437999013 * s2)
-    return g0 - 3.086e-6 * h_m
 
 
 @pytest.fixture(scope="module")
@@ -42,12 +34,6 @@ def aerobatics() -> FlightResult:
 @pytest.fixture(scope="module")
 def turn() -> FlightResult:
     return fly(load_manoeuvre(COLUMBIA / "coordinated_turn.yaml"))
-
-
-def phase_mask(result: FlightResult, name: str) -> np.ndarray:
-    (t0, t1) = next((a, b) for n, a, b in result.phases if n == name)
-    half = 0.5 * result.dt_s
-    return (result.t_s >= t0 - half) & (result.t_s <= t1 + half)
 
 
 def attitudes(result: FlightResult, sel: np.ndarray) -> Rotation:
@@ -203,12 +189,6 @@ phases:
     hold: {roll_rate_degps: 0, load_factor: 1.0, throttle: 1}
     until: {duration_s: 30}
 """
-
-
-def write(tmp_path: Path, name: str, text: str) -> Path:
-    path = tmp_path / name
-    path.write_text(dedent(text))
-    return path
 
 
 def test_inverted_flight_does_not_trip_the_monitor(tmp_path: Path) -> None:

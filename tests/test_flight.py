@@ -7,11 +7,11 @@ import math
 import subprocess
 import sys
 from pathlib import Path
-from textwrap import dedent
 
 import numpy as np
 import pyarrow.parquet as pq
 import pytest
+from flight_helpers import FT, normal_gravity, phase_mask, write
 
 from washbench.flight.columns import COLUMN_NAMES
 from washbench.flight.fly import FlightResult, fly, write_flight
@@ -29,26 +29,12 @@ def key(path: Path) -> str:
 
 
 CUE_COLUMNS = ("t_s", "f_x_mps2", "f_y_mps2", "f_z_mps2", "omega_x_degps", "omega_y_degps", "omega_z_degps")
-FT = 0.3048
-
-
-def normal_gravity(lat_deg: float, h_m: float) -> float:
-    """WGS-84 normal gravity (Somigliana) with the free-air correction, m/s^2."""
-    s2 = math.sin(math.radians(lat_deg)) ** 2
-    g0 = 9.7803253359 * (1 + 0.00193185265241 * s2) / math.sqrt(1 - 0.00669437999013 * s2)
-    return g0 - 3.086e-6 * h_m
 
 
 @pytest.fixture(scope="module")
 def flights() -> dict[str, FlightResult]:
     """Each bundled manoeuvre flown once (about 0.2 s of CPU each)."""
     return {key(p): fly(load_manoeuvre(p)) for p in BUNDLED}
-
-
-def phase_mask(result: FlightResult, name: str, skip_s: float = 0.0) -> np.ndarray:
-    (t0, t1) = next((a, b) for n, a, b in result.phases if n == name)
-    t = result.t_s
-    return (t >= t0 + skip_s) & (t <= t1)
 
 
 @pytest.mark.parametrize("path", BUNDLED, ids=key)
@@ -156,12 +142,6 @@ phases:
     hold: {wings_level: true, altitude_ft: 3000, airspeed_kts: 90}
     until: {duration_s: 8}
 """
-
-
-def write(tmp_path: Path, name: str, text: str) -> Path:
-    path = tmp_path / name
-    path.write_text(dedent(text))
-    return path
 
 
 def test_same_file_flown_twice_is_bit_identical_with_turbulence(tmp_path: Path) -> None:
