@@ -11,9 +11,8 @@ import argparse
 import sys
 from pathlib import Path
 
+from washbench.cueing.params import WASHOUT_NAMES
 from washbench.errors import WashbenchError
-
-WASHOUT_NAMES = ("small-angle", "large-angle", "unrestricted")
 
 
 class _Parser(argparse.ArgumentParser):

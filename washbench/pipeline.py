@@ -74,14 +74,8 @@ def perceived_motion(perceived_f_mps2: np.ndarray, perceived_omega_radps: np.nda
 
     Surge, sway, heave in m/s^2*s; roll, pitch, yaw in deg (the units of metrics.csv).
     """
-    out: dict[str, float] = {}
-    for i, dof in enumerate(DOFS[:3]):
-        x = perceived_f_mps2[:, i]
-        out[dof] = integral_abs_error(x, np.full_like(x, x[0]), dt_s)
-    for i, dof in enumerate(DOFS[3:]):
-        x = np.degrees(perceived_omega_radps[:, i])
-        out[dof] = integral_abs_error(x, np.full_like(x, x[0]), dt_s)
-    return out
+    columns = np.column_stack([perceived_f_mps2, np.degrees(perceived_omega_radps)])
+    return {dof: integral_abs_error(x, np.full_like(x, x[0]), dt_s) for dof, x in zip(DOFS, columns.T, strict=True)}
 
 
 def aircraft_attitude(phi_deg: np.ndarray, theta_deg: np.ndarray, psi_deg: np.ndarray) -> np.ndarray:
@@ -177,21 +171,16 @@ def run_manoeuvre(
         felt = perceived_motion(
             result.perceived["aircraft"].f_mps2, result.perceived["aircraft"].omega_radps, motion.dt_s
         )
-        checks_passed = sum(1 for c in flight.checks if c[3])
-        ok = flight.status == "ok" and checks_passed == len(flight.checks)
-        reason = flight.reason if flight.status != "ok" else ""
-        if not reason and not ok:
-            failed = [c[0] for c in flight.checks if not c[3]]
-            reason = f"checks failed: {', '.join(failed)}"
+        # the flight is "failed" when the monitor stopped it or a check failed, with the reason
         summary = RunSummary(
-            ok=ok,
-            reason=reason,
+            ok=flight.ok,
+            reason=flight.reason,
             aircraft=manoeuvre.aircraft,
             manoeuvre=manoeuvre.name,
             run_dir=final,
             steps=n,
             dt_s=motion.dt_s,
-            checks_passed=checks_passed,
+            checks_passed=sum(1 for c in flight.checks if c[3]),
             checks_total=len(flight.checks),
             metrics=list(result.metrics),
             motion=felt,

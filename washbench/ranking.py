@@ -33,6 +33,7 @@ import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
+from washbench.cueing.params import WASHOUT_NAMES
 from washbench.metrics import MetricRow
 
 TRANSLATIONAL_DOFS = ("surge", "sway", "heave")
@@ -113,7 +114,7 @@ def rank(rows: Sequence[MetricRow], motion: Mapping[str, float]) -> list[RankRow
 
 
 def _washout_order(name: str) -> tuple[int, str]:
-    known = ("small-angle", "large-angle", "unrestricted")
+    known = WASHOUT_NAMES
     return (known.index(name) if name in known else len(known), name)
 
 

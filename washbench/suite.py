@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from washbench.atomic import write_text_atomic
+from washbench.cueing.params import WASHOUT_NAMES
 from washbench.errors import WashbenchError, located
 from washbench.metrics import MetricRow
 from washbench.paths import MANOEUVRES_DIR
@@ -234,9 +235,8 @@ def ranking_table(rankings: dict[tuple[str, str], list[RankRow]]) -> str:
 
 
 def _washouts(outcomes: Sequence[Outcome]) -> list[str]:
-    known = ["small-angle", "large-angle", "unrestricted"]
     seen = {m.washout for o in outcomes for m in o.metrics}
-    return [w for w in known if w in seen] + sorted(seen - set(known))
+    return [w for w in WASHOUT_NAMES if w in seen] + sorted(seen - set(WASHOUT_NAMES))
 
 
 def report_markdown(outcomes: Sequence[Outcome], rankings: dict[tuple[str, str], list[RankRow]], out_dir: Path) -> str:
@@ -266,9 +266,7 @@ def report_markdown(outcomes: Sequence[Outcome], rankings: dict[tuple[str, str],
         ranking = rankings.get(key, [])
         best = ranking[0].washout if ranking else ""
         by_name = {r.washout: r.score for r in ranking}
-        scores = " / ".join(
-            f"{by_name[w]:.3f}" if w in by_name else "-" for w in ("small-angle", "large-angle", "unrestricted")
-        )
+        scores = " / ".join(f"{by_name[w]:.3f}" if w in by_name else "-" for w in WASHOUT_NAMES)
         status = "ok" if o.ok else "FAILED"
         rec = ""
         if o.run_dir and (Path(o.run_dir) / "recording.rrd").exists():
