@@ -50,8 +50,8 @@ def main() -> None:
         outcomes = run_suite(files, Path(tmp), jobs=args.jobs, progress=False)
         write_suite_results(outcomes, Path(tmp))
         suite_s = time.perf_counter() - start
-    failed = [o for o in outcomes if not o.ok]
-    work = [(o.path, o.steps) for o in outcomes if o.steps]
+    failed = [o for o in outcomes if not o.run.ok]
+    work = [(o.path, o.run.steps) for o in outcomes if o.run.steps]
     steps = sum(s for _, s in work)
     ctx = multiprocessing.get_context("forkserver")
     with ProcessPoolExecutor(max_workers=args.jobs, mp_context=ctx) as pool:

@@ -53,17 +53,20 @@ RUN_FILES = ("flight.json", "flight.parquet", "traces.parquet", "metrics.csv", "
 
 @dataclass(frozen=True)
 class RunSummary:
-    """What one ``washbench run`` gave: status, where, and what the suite needs to compare."""
+    """What one ``washbench run`` gave: status, where, and what the suite needs to compare.
+
+    A run that could not start (bad file) or broke has only ``ok`` False and the ``reason``.
+    """
 
     ok: bool
-    reason: str
-    aircraft: str
-    manoeuvre: str
-    run_dir: Path
-    steps: int
-    dt_s: float
-    checks_passed: int
-    checks_total: int
+    reason: str = ""
+    aircraft: str = ""
+    manoeuvre: str = ""
+    run_dir: Path | None = None
+    steps: int = 0
+    dt_s: float = 0.0
+    checks_passed: int = 0
+    checks_total: int = 0
     metrics: list[MetricRow] = field(default_factory=list)
     motion: dict[str, float] = field(default_factory=dict)  # DOF -> aircraft pilot's perceived motion
     saturations: dict[str, dict[str, int]] = field(default_factory=dict)

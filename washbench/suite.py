@@ -27,14 +27,14 @@ import time
 import traceback
 from collections.abc import Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 from washbench.atomic import write_text_atomic
 from washbench.cueing.params import WASHOUT_NAMES
 from washbench.errors import WashbenchError, located
-from washbench.metrics import MetricRow
 from washbench.paths import MANOEUVRES_DIR
+from washbench.pipeline import RunSummary
 from washbench.ranking import (
     DOFS,
     METRICS,
@@ -51,19 +51,8 @@ class Outcome:
     """What one manoeuvre's run gave the suite (picklable, sent back from the worker)."""
 
     path: str
-    ok: bool
-    reason: str = ""
-    aircraft: str = ""
-    manoeuvre: str = ""
-    run_dir: str = ""
-    wall_s: float = 0.0
-    steps: int = 0
-    dt_s: float = 0.0
-    checks_passed: int = 0
-    checks_total: int = 0
-    metrics: list[MetricRow] = field(default_factory=list)
-    motion: dict[str, float] = field(default_factory=dict)
-    saturations: dict[str, dict[str, int]] = field(default_factory=dict)
+    wall_s: float
+    run: RunSummary
 
 
 def find_manoeuvres(inputs: Sequence[Path]) -> list[Path]:
@@ -97,32 +86,12 @@ def _run_one(path: str, out_dir: str, params_path: str | None, platform_path: st
             platform_path=Path(platform_path) if platform_path else None,
         )
     except WashbenchError as exc:
-        return Outcome(path=path, ok=False, reason=str(exc), wall_s=time.perf_counter() - start)
+        summary = RunSummary(ok=False, reason=str(exc))
     except Exception as exc:  # an unexpected bug in one run must not take the suite down
         tb = traceback.format_exc(limit=-3).strip().splitlines()
         where = tb[-3].strip() if len(tb) >= 3 else ""
-        return Outcome(
-            path=path,
-            ok=False,
-            reason=f"internal error: {type(exc).__name__}: {exc} ({where})",
-            wall_s=time.perf_counter() - start,
-        )
-    return Outcome(
-        path=path,
-        ok=summary.ok,
-        reason=summary.reason,
-        aircraft=summary.aircraft,
-        manoeuvre=summary.manoeuvre,
-        run_dir=str(summary.run_dir),
-        wall_s=time.perf_counter() - start,
-        steps=summary.steps,
-        dt_s=summary.dt_s,
-        checks_passed=summary.checks_passed,
-        checks_total=summary.checks_total,
-        metrics=summary.metrics,
-        motion=summary.motion,
-        saturations=summary.saturations,
-    )
+        summary = RunSummary(ok=False, reason=f"internal error: {type(exc).__name__}: {exc} ({where})")
+    return Outcome(path=path, wall_s=time.perf_counter() - start, run=summary)
 
 
 def run_suite(
@@ -167,12 +136,12 @@ def run_suite(
 
 def _report(outcome: Outcome, done: int, total: int, start: float, progress: bool) -> Outcome:
     if progress:
-        name = f"{outcome.aircraft}/{outcome.manoeuvre}" if outcome.aircraft else _short(outcome.path)
-        state = "ok  " if outcome.ok else "FAIL"
-        extra = f"checks {outcome.checks_passed}/{outcome.checks_total}" if outcome.checks_total else ""
+        name = f"{outcome.run.aircraft}/{outcome.run.manoeuvre}" if outcome.run.aircraft else _short(outcome.path)
+        state = "ok  " if outcome.run.ok else "FAIL"
+        extra = f"checks {outcome.run.checks_passed}/{outcome.run.checks_total}" if outcome.run.checks_total else ""
         line = f"[{done:>2}/{total}] {state} {name:<40} {outcome.wall_s:6.1f} s  {extra}"
-        if not outcome.ok:
-            line += f"\n        {outcome.reason}"
+        if not outcome.run.ok:
+            line += f"\n        {outcome.run.reason}"
         print(f"{line}   (elapsed {time.perf_counter() - start:.0f} s)", file=sys.stderr, flush=True)
     return outcome
 
@@ -195,16 +164,24 @@ def _csv(rows: list[list[str]]) -> str:
 
 
 def _runs_with_metrics(outcomes: Sequence[Outcome]) -> list[Outcome]:
-    return [o for o in outcomes if o.metrics]
+    return [o for o in outcomes if o.run.metrics]
 
 
 def metrics_table(outcomes: Sequence[Outcome]) -> str:
     """``metrics.csv`` of the suite (every run that produced metrics, failed checks included)."""
     rows = [["aircraft", "manoeuvre", "washout", "dof", "npc", "integral_error", "max_error"]]
     for o in _runs_with_metrics(outcomes):
-        for m in o.metrics:
+        for m in o.run.metrics:
             rows.append(
-                [o.aircraft, o.manoeuvre, m.washout, m.dof, _fmt(m.npc), _fmt(m.integral_error), _fmt(m.max_error)]
+                [
+                    o.run.aircraft,
+                    o.run.manoeuvre,
+                    m.washout,
+                    m.dof,
+                    _fmt(m.npc),
+                    _fmt(m.integral_error),
+                    _fmt(m.max_error),
+                ]
             )
     return _csv(rows)
 
@@ -216,9 +193,9 @@ def comparison_table(outcomes: Sequence[Outcome]) -> str:
     header = ["aircraft", "manoeuvre", "dof", "metric", *washouts, *[f"{w}_better_by" for w in others]]
     rows = [header]
     for o in _runs_with_metrics(outcomes):
-        for c in compare(o.metrics):
+        for c in compare(o.run.metrics):
             rows.append(
-                [o.aircraft, o.manoeuvre, c.dof, c.metric]
+                [o.run.aircraft, o.run.manoeuvre, c.dof, c.metric]
                 + [_fmt(c.values.get(w, math.nan)) for w in washouts]
                 + [_fmt(c.better_than_reference.get(w, math.nan)) for w in others]
             )
@@ -235,13 +212,13 @@ def ranking_table(rankings: dict[tuple[str, str], list[RankRow]]) -> str:
 
 
 def _washouts(outcomes: Sequence[Outcome]) -> list[str]:
-    seen = {m.washout for o in outcomes for m in o.metrics}
+    seen = {m.washout for o in outcomes for m in o.run.metrics}
     return [w for w in WASHOUT_NAMES if w in seen] + sorted(seen - set(WASHOUT_NAMES))
 
 
 def report_markdown(outcomes: Sequence[Outcome], rankings: dict[tuple[str, str], list[RankRow]], out_dir: Path) -> str:
     """``report.md``: status, ranking, Table-4 comparison and metrics of every manoeuvre."""
-    ok = [o for o in outcomes if o.ok]
+    ok = [o for o in outcomes if o.run.ok]
     lines = [
         "# washbench suite report",
         "",
@@ -262,36 +239,36 @@ def report_markdown(outcomes: Sequence[Outcome], rankings: dict[tuple[str, str],
         "|---|---|---|---|---|---|---|",
     ]
     for o in outcomes:
-        key = (o.aircraft, o.manoeuvre)
+        key = (o.run.aircraft, o.run.manoeuvre)
         ranking = rankings.get(key, [])
         best = ranking[0].washout if ranking else ""
         by_name = {r.washout: r.score for r in ranking}
         scores = " / ".join(f"{by_name[w]:.3f}" if w in by_name else "-" for w in WASHOUT_NAMES)
-        status = "ok" if o.ok else "FAILED"
+        status = "ok" if o.run.ok else "FAILED"
         rec = ""
-        if o.run_dir and (Path(o.run_dir) / "recording.rrd").exists():
-            rel = os.path.relpath(Path(o.run_dir) / "recording.rrd", out_dir)
+        if o.run.run_dir and (o.run.run_dir / "recording.rrd").exists():
+            rel = os.path.relpath(o.run.run_dir / "recording.rrd", out_dir)
             rec = f"[recording.rrd]({rel})"
-        name = o.manoeuvre or _short(o.path)
-        checks = f"{o.checks_passed}/{o.checks_total}" if o.checks_total else "-"
-        lines.append(f"| {o.aircraft or '-'} | {name} | {status} | {checks} | {best} | {scores} | {rec} |")
-    failed = [o for o in outcomes if not o.ok]
+        name = o.run.manoeuvre or _short(o.path)
+        checks = f"{o.run.checks_passed}/{o.run.checks_total}" if o.run.checks_total else "-"
+        lines.append(f"| {o.run.aircraft or '-'} | {name} | {status} | {checks} | {best} | {scores} | {rec} |")
+    failed = [o for o in outcomes if not o.run.ok]
     if failed:
         lines += ["", "## Failures", ""]
         for o in failed:
-            lines.append(f"- `{_short(o.path)}`: {o.reason}")
+            lines.append(f"- `{_short(o.path)}`: {o.run.reason}")
     if rankings:
         count = wins(rankings.values())
         lines += ["", "Manoeuvres won: " + ", ".join(f"{w} {n}" for w, n in count.items()), ""]
     for o in _runs_with_metrics(outcomes):
-        lines += ["", f"## {o.aircraft} / {o.manoeuvre}", ""]
-        if o.run_dir:
-            rel = os.path.relpath(o.run_dir, out_dir)
+        lines += ["", f"## {o.run.aircraft} / {o.run.manoeuvre}", ""]
+        if o.run.run_dir:
+            rel = os.path.relpath(o.run.run_dir, out_dir)
             lines.append(f"Results in `{rel}/`; replay with `washbench replay {rel}/recording.rrd`.")
             lines.append("")
         sat = ", ".join(
             f"{w}: " + (", ".join(f"{k} {n}" for k, n in kinds.items() if n) or "none")
-            for w, kinds in o.saturations.items()
+            for w, kinds in o.run.saturations.items()
         )
         if sat:
             lines += [f"Platform saturations (steps at a limit): {sat}.", ""]
@@ -304,7 +281,7 @@ def _comparison_md(o: Outcome) -> list[str]:
     others = [w for w in washouts if w != REFERENCE_WASHOUT]
     head = "| DOF | metric | " + " | ".join(washouts) + " | " + " | ".join(f"{w} better by" for w in others) + " |"
     lines = [head, "|" + "---|" * (2 + len(washouts) + len(others))]
-    for c in compare(o.metrics):
+    for c in compare(o.run.metrics):
         vals = " | ".join(_md_num(c.values.get(w, math.nan)) for w in washouts)
         diffs = " | ".join(_md_num(c.better_than_reference.get(w, math.nan), signed=True) for w in others)
         lines.append(f"| {c.dof} | {c.metric} | {vals} | {diffs} |")
@@ -319,7 +296,9 @@ def _md_num(x: float, signed: bool = False) -> str:
 
 def write_suite_results(outcomes: Sequence[Outcome], out_dir: Path) -> None:
     """Write metrics.csv, comparison.csv, ranking.csv and (last) report.md, each atomically."""
-    rankings = {(o.aircraft, o.manoeuvre): rank(o.metrics, o.motion) for o in _runs_with_metrics(outcomes)}
+    rankings = {
+        (o.run.aircraft, o.run.manoeuvre): rank(o.run.metrics, o.run.motion) for o in _runs_with_metrics(outcomes)
+    }
     write_text_atomic(out_dir / "metrics.csv", metrics_table(outcomes))
     write_text_atomic(out_dir / "comparison.csv", comparison_table(outcomes))
     write_text_atomic(out_dir / "ranking.csv", ranking_table(rankings))
@@ -350,7 +329,7 @@ def suite_command(
         files, out_dir, jobs=jobs, params_path=params_path, platform_path=platform_path, progress=progress
     )
     write_suite_results(outcomes, out_dir)
-    n_ok = sum(o.ok for o in outcomes)
+    n_ok = sum(o.run.ok for o in outcomes)
     print(
         f"suite: {n_ok}/{len(outcomes)} manoeuvres ok in {time.perf_counter() - start:.1f} s; "
         f"report: {out_dir / 'report.md'}"

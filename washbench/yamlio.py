@@ -82,6 +82,13 @@ def _line_map(node: yaml.Node | None, loc: Loc = (), out: dict[Loc, int] | None 
     return out
 
 
+def line_of(lines: dict[Loc, int], loc: Loc) -> int | None:
+    """The line of ``loc``, or of its nearest ancestor written in the file (a missing key's parent)."""
+    while loc not in lines and loc:
+        loc = loc[:-1]
+    return lines.get(loc)
+
+
 def format_field_path(loc: Loc) -> str:
     """``('phases', 2, 'hold', 'bank_deg')`` -> ``phases[2].hold.bank_deg``."""
     text = ""
@@ -125,7 +132,7 @@ def _describe(value: Any) -> str:
     return repr(value)
 
 
-def _problem(err: dict[str, Any], parent: Any, model: type[BaseModel], loc: Loc) -> str:
+def _problem(err: dict[str, Any], model: type[BaseModel], loc: Loc) -> str:
     """A short human sentence for one pydantic error."""
     kind = err["type"]
     value = err.get("input")
@@ -245,13 +252,8 @@ def validate_data(path: Path, data: Any, lines: dict[Loc, int], model: type[M]) 
         rank = {"extra_forbidden": 0, "missing": 2}
         err = min(exc.errors(include_url=False), key=lambda e: rank.get(e["type"], 1))
         loc = _data_loc(data, tuple(err["loc"]))
-        line = lines.get(loc)
-        probe = loc
-        while line is None and probe:
-            probe = probe[:-1]
-            line = lines.get(probe)
-        problem = _problem(err, None, model, loc)
-        raise WashbenchError(located(path, problem, line=line, field=format_field_path(loc))) from None
+        problem = _problem(err, model, loc)
+        raise WashbenchError(located(path, problem, line=line_of(lines, loc), field=format_field_path(loc))) from None
 
 
 def load_yaml_model(path: str | Path, model: type[M]) -> M:
