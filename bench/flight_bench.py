@@ -18,13 +18,12 @@ from pathlib import Path
 from washbench.flight.fdm import make_fdm
 from washbench.flight.fly import fly
 from washbench.flight.profile import load_profile
-from washbench.manoeuvre import load_manoeuvre, pilot_profile_path
+from washbench.manoeuvre import Manoeuvre, load_manoeuvre, pilot_profile_path
 from washbench.paths import MANOEUVRES_DIR
 
 
-def bare_steps_per_s(path: Path, steps: int) -> float:
+def bare_steps_per_s(m: Manoeuvre, steps: int) -> float:
     """JSBSim alone: ``fdm.run()`` with constant controls from the manoeuvre's start."""
-    m = load_manoeuvre(path)
     fdm, _ = make_fdm(m, load_profile(pilot_profile_path(m.aircraft)))
     run = fdm.run
     t0 = time.perf_counter()
@@ -33,8 +32,7 @@ def bare_steps_per_s(path: Path, steps: int) -> float:
     return steps / (time.perf_counter() - t0)
 
 
-def flight_steps_per_s(path: Path) -> tuple[float, int]:
-    m = load_manoeuvre(path)
+def flight_steps_per_s(m: Manoeuvre) -> tuple[float, int]:
     t0 = time.perf_counter()
     result = fly(m)
     wall = time.perf_counter() - t0
@@ -46,8 +44,9 @@ def main(argv: list[str]) -> int:
     print(f"{'manoeuvre':34s} {'steps':>7s} {'flight/s':>10s} {'bare/s':>10s} {'slowdown':>9s}")
     worst = 0.0
     for path in paths:
-        best_flight, n = max(flight_steps_per_s(path) for _ in range(3))
-        best_bare = max(bare_steps_per_s(path, n) for _ in range(3))
+        m = load_manoeuvre(path)
+        best_flight, n = max(flight_steps_per_s(m) for _ in range(3))
+        best_bare = max(bare_steps_per_s(m, n) for _ in range(3))
         ratio = best_bare / best_flight
         worst = max(worst, ratio)
         print(f"{path.parent.name + '/' + path.stem:34s} {n:7d} {best_flight:10.0f} {best_bare:10.0f} {ratio:8.2f}x")

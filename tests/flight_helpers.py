@@ -1,4 +1,4 @@
-"""Helpers shared by the flight tests: an independent gravity model, phase selection, file writing."""
+"""Helpers shared by the flight tests: bundled files, an independent gravity model, phase selection, file writing."""
 
 from __future__ import annotations
 
@@ -9,8 +9,17 @@ from textwrap import dedent
 import numpy as np
 
 from washbench.flight.fly import FlightResult
+from washbench.paths import MANOEUVRES_DIR
 
 FT = 0.3048  # m per ft
+
+#: Every bundled manoeuvre, of every aircraft (manoeuvres/<aircraft>/<name>.yaml).
+BUNDLED = sorted(MANOEUVRES_DIR.glob("*/*.yaml"))
+
+
+def manoeuvre_id(path: Path) -> str:
+    """``folder/name`` of a bundled manoeuvre (the same name is flown by several aircraft)."""
+    return f"{path.parent.name}/{path.stem}"
 
 
 def normal_gravity(lat_deg: float, h_m: float) -> float:

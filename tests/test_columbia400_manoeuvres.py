@@ -43,6 +43,12 @@ def attitudes(result: FlightResult, sel: np.ndarray) -> Rotation:
                                degrees=True)  # fmt: skip
 
 
+def rotated(result: FlightResult, signal: str, phase: str) -> float:
+    """The ``rotated`` statistic (deg) of a body-rate signal over one phase, as a check measures it."""
+    check = Check(name=phase, signal=signal, stat="rotated", phases=[phase], min=0.0)
+    return measure(check, result.columns, result.phases, result.events, result.dt_s)
+
+
 def test_all_six_columbia_manoeuvres_are_there() -> None:
     assert {p.stem for p in COLUMBIA.glob("*.yaml")} == {
         "coordinated_turn",
@@ -101,15 +107,8 @@ def test_loop_is_a_full_pitch_rotation_measured_from_the_attitude(aerobatics: Fl
     up0 = Rotation.from_rotvec(wing0 * math.pi / 2).apply(fwd0)  # the nose after +90 deg of pitch (q > 0)
     angle = np.unwrap(np.arctan2(nose @ up0, nose @ fwd0))
     pitched_geometric = math.degrees(angle[-1] - angle[0])
-    rotated = measure(
-        Check(name="loop", signal="omega_y_degps", stat="rotated", phases=["loop"], min=0.0),
-        r.columns,
-        r.phases,
-        r.events,
-        r.dt_s,
-    )
     assert pitched_geometric >= 330.0
-    assert pitched_geometric == pytest.approx(rotated, abs=5.0)
+    assert pitched_geometric == pytest.approx(rotated(r, "omega_y_degps", "loop"), abs=5.0)
     # the wing axis hardly moves: a loop, not a barrel roll (within 10 deg)
     wings = att.apply([0.0, 1.0, 0.0])
     assert np.degrees(np.arccos(np.clip(wings @ wing0, -1, 1))).max() < 10.0
@@ -127,16 +126,10 @@ def test_roll_is_a_full_rotation_about_the_longitudinal_axis(aerobatics: FlightR
     att = attitudes(r, sel)
     steps = (att[:-1].inv() * att[1:]).as_rotvec()  # body-frame increments
     rolled_geometric = math.degrees(np.sum(steps[:, 0]))
-    rotated = measure(
-        Check(name="roll", signal="omega_x_degps", stat="rotated", phases=["roll"], min=0.0),
-        r.columns,
-        r.phases,
-        r.events,
-        r.dt_s,
-    )
+    rolled = rotated(r, "omega_x_degps", "roll")
     assert rolled_geometric >= 355.0
-    assert rolled_geometric == pytest.approx(rotated, abs=3.0)
-    assert rotated >= 360.0
+    assert rolled_geometric == pytest.approx(rolled, abs=3.0)
+    assert rolled >= 360.0
 
 
 def test_recorded_body_rates_integrate_to_the_recorded_attitude_through_the_loop(aerobatics: FlightResult) -> None:

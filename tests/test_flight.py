@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pyarrow.parquet as pq
 import pytest
-from flight_helpers import FT, normal_gravity, phase_mask, write
+from flight_helpers import BUNDLED, FT, manoeuvre_id, normal_gravity, phase_mask, write
 
 from washbench.flight.columns import COLUMN_NAMES
 from washbench.flight.fly import FlightResult, fly, write_flight
@@ -19,29 +19,20 @@ from washbench.manoeuvre import load_manoeuvre
 from washbench.paths import MANOEUVRES_DIR
 
 C172 = MANOEUVRES_DIR / "c172"
-#: Every bundled manoeuvre, of every aircraft (manoeuvres/<aircraft>/<name>.yaml).
-BUNDLED = sorted(MANOEUVRES_DIR.glob("*/*.yaml"))
-
-
-def key(path: Path) -> str:
-    """``folder/name`` of a bundled manoeuvre (the same name is flown by several aircraft)."""
-    return f"{path.parent.name}/{path.stem}"
-
-
 CUE_COLUMNS = ("t_s", "f_x_mps2", "f_y_mps2", "f_z_mps2", "omega_x_degps", "omega_y_degps", "omega_z_degps")
 
 
 @pytest.fixture(scope="module")
 def flights() -> dict[str, FlightResult]:
     """Each bundled manoeuvre flown once (about 0.2 s of CPU each)."""
-    return {key(p): fly(load_manoeuvre(p)) for p in BUNDLED}
+    return {manoeuvre_id(p): fly(load_manoeuvre(p)) for p in BUNDLED}
 
 
-@pytest.mark.parametrize("path", BUNDLED, ids=key)
+@pytest.mark.parametrize("path", BUNDLED, ids=manoeuvre_id)
 def test_bundled_manoeuvre_flies_with_every_check_passing_and_files_read_back(
     path: Path, flights: dict[str, FlightResult], tmp_path: Path
 ) -> None:
-    result = flights[key(path)]
+    result = flights[manoeuvre_id(path)]
     assert result.status == "ok", result.reason
     assert result.checks and all(c[3] for c in result.checks), result.checks
     m = load_manoeuvre(path)

@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from flight_helpers import BUNDLED, manoeuvre_id
 
 from washbench.errors import WashbenchError
 from washbench.manoeuvre import Manoeuvre, load_manoeuvre, manoeuvre_json_schema
@@ -15,7 +16,6 @@ from washbench.paths import MANOEUVRES_DIR
 from washbench.yamlio import read_yaml
 
 BAD = Path(__file__).parent / "data" / "bad_manoeuvres"
-BUNDLED = sorted(MANOEUVRES_DIR.glob("*/*.yaml"))  # manoeuvres/<aircraft folder>/<name>.yaml
 
 #: file -> the error line after "washbench: error: FILE" (":LINE: field: problem" or ": problem").
 EXPECTED = {
@@ -105,7 +105,7 @@ def test_missing_file_is_one_line(tmp_path: Path) -> None:
     assert out.stderr.strip() == f"washbench: error: {tmp_path / 'nope.yaml'}: no such file"
 
 
-@pytest.mark.parametrize("path", BUNDLED, ids=lambda p: f"{p.parent.name}/{p.stem}")
+@pytest.mark.parametrize("path", BUNDLED, ids=manoeuvre_id)
 def test_bundled_manoeuvres_validate(path: Path) -> None:
     m = load_manoeuvre(path)
     assert m.name == path.stem

@@ -33,10 +33,10 @@ import numpy as np
 from scipy.optimize import curve_fit
 
 from washbench.errors import WashbenchError
+from washbench.manoeuvre import aircraft_path, jsbsim_root
 from washbench.paths import AIRCRAFT_DIR
 from washbench.yamlio import StrictModel, load_yaml_model
 
-KT_TO_FPS = 1.6878098571011957
 DT_S = 1.0 / 120.0
 
 
@@ -50,12 +50,10 @@ class Loading:
 
 def aircraft_root(name: str) -> Path:
     """Folder holding ``name/name.xml``: washbench's ``aircraft/`` first, then the jsbsim package's."""
-    if (AIRCRAFT_DIR / name / f"{name}.xml").is_file():
-        return AIRCRAFT_DIR
-    pkg = Path(jsbsim.get_default_root_dir()) / "aircraft"
-    if (pkg / name / f"{name}.xml").is_file():
-        return pkg
-    raise WashbenchError(f"{name}: no such aircraft in {AIRCRAFT_DIR} or {pkg}")
+    root = aircraft_path(name)
+    if root is None:
+        raise WashbenchError(f"{name}: no such aircraft in {AIRCRAFT_DIR} or {jsbsim_root() / 'aircraft'}")
+    return root
 
 
 def make_fdm(name: str, loading: Loading | None = None) -> jsbsim.FGFDMExec:
@@ -122,6 +120,12 @@ class Pilot:
             self.thr_int = min(max(self.thr_int + 0.01 * err * DT_S, 0.0), 1.0)
             f["fcs/throttle-cmd-norm[0]"] = min(max(self.thr_int + 0.05 * err, 0.0), 1.0)
 
+    def fly(self, seconds: float) -> None:
+        """Step the pilot and the FDM for ``seconds`` (rounded to whole frames)."""
+        for _ in range(round(seconds / DT_S)):
+            self.step()
+            self.fdm.run()
+
 
 def flying_start(
     name: str,
@@ -157,9 +161,7 @@ def flying_start(
     pilot = Pilot(fdm)
     pilot.h_ref_ft = altitude_ft
     pilot.throttle_v_ref_kcas = kcas if throttle is None else None
-    for _ in range(round(settle_s / DT_S)):
-        pilot.step()
-        fdm.run()
+    pilot.fly(settle_s)
     return fdm, pilot
 
 
@@ -277,14 +279,10 @@ def climb_rate(
     pilot.throttle_v_ref_kcas = None
     pilot.v_ref_kcas = kcas
     fdm["fcs/throttle-cmd-norm[0]"] = throttle
-    for _ in range(round(settle_s / DT_S)):
-        pilot.step()
-        fdm.run()
-    h0, n = fdm["position/h-sl-ft"], round(measure_s / DT_S)
-    for _ in range(n):
-        pilot.step()
-        fdm.run()
-    return 60.0 * (fdm["position/h-sl-ft"] - h0) / (n * DT_S)
+    pilot.fly(settle_s)
+    h0 = fdm["position/h-sl-ft"]
+    pilot.fly(measure_s)
+    return 60.0 * (fdm["position/h-sl-ft"] - h0) / (round(measure_s / DT_S) * DT_S)
 
 
 def roll_rate(name: str, kcas: float, *, loading: Loading | None = None, altitude_ft: float = 5000.0) -> float:

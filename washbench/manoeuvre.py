@@ -24,6 +24,7 @@ from pydantic import Field
 from washbench.atomic import write_text_atomic
 from washbench.errors import WashbenchError, located
 from washbench.flight.columns import COLUMN_NAMES, RUNWAY_COLUMNS
+from washbench.flight.profile import PilotProfile, load_profile
 from washbench.paths import AIRCRAFT_DIR, DATA_DIR
 from washbench.yamlio import Loc, StrictModel, format_field_path, read_yaml, validate_data
 
@@ -285,8 +286,6 @@ def _set_fields(model: StrictModel, names: Sequence[str]) -> list[str]:
 
 def _check_semantics(m: Manoeuvre, where: _Where) -> None:
     """Checks a schema cannot express; raise one-line WashbenchError on the first problem."""
-    from washbench.flight.profile import load_profile  # the profile knows the aircraft's limits
-
     if aircraft_path(m.aircraft) is None:
         raise where.error(
             ("aircraft",),
@@ -390,7 +389,9 @@ def _check_semantics(m: Manoeuvre, where: _Where) -> None:
                 raise where.error((*base, "phases", k), f"no phase named '{name}'")
 
 
-def _never_reason(cond: str, until: Until, hold: Hold, on_ground: bool, profile: Any, m: Manoeuvre) -> str | None:
+def _never_reason(
+    cond: str, until: Until, hold: Hold, on_ground: bool, profile: PilotProfile, m: Manoeuvre
+) -> str | None:
     """Why the end condition ``cond`` can never be met in this phase, or None if it can."""
     value = getattr(until, cond)
     if cond == "event":

@@ -17,8 +17,9 @@ from typing import Any
 
 from washbench.errors import WashbenchError
 from washbench.flight.geo import DEFAULT_LATITUDE_DEG, DEFAULT_LONGITUDE_DEG, LocalFrame
+from washbench.flight.pilot import Pilot
 from washbench.flight.profile import PilotProfile
-from washbench.manoeuvre import Manoeuvre, aircraft_path, jsbsim_root
+from washbench.manoeuvre import Hold, Manoeuvre, aircraft_path, jsbsim_root
 
 KT_TO_FPS = 1852.0 / 3600.0 / 0.3048
 FT_TO_M = 0.3048
@@ -199,9 +200,6 @@ def _flying_start(fdm: Any, m: Manoeuvre, profile: PilotProfile, heading_deg: fl
     at the start position, altitude and heading with ``run_ic`` and the clock is reset to zero, so the
     manoeuvre starts in steady flight at t = 0. Raises WashbenchError if the flight has not settled.
     """
-    from washbench.flight.pilot import Pilot  # the pilot imports the manoeuvre schema, as this module does
-    from washbench.manoeuvre import Hold
-
     air = m.start.air
     assert air is not None  # only called for air starts
     dt = m.dt_s

@@ -83,7 +83,6 @@ class FlightResult:
     name: str
     aircraft: str
     dt_s: float
-    t_s: np.ndarray
     columns: dict[str, np.ndarray]
     phases: list[tuple[str, float, float]]
     checks: list[tuple[str, float, str, bool]]
@@ -94,6 +93,16 @@ class FlightResult:
     @property
     def ok(self) -> bool:
         return self.status == "ok"
+
+    @property
+    def t_s(self) -> np.ndarray:
+        """The time base, s (``k * dt``): the ``t_s`` column."""
+        return self.columns["t_s"]
+
+    @property
+    def duration_s(self) -> float:
+        """Time of the last recorded sample, s (0 when nothing was recorded)."""
+        return float(self.t_s[-1]) if len(self.t_s) else 0.0
 
 
 def _nodes(fdm: object, names: tuple[str, ...]) -> list[object]:
@@ -132,10 +141,6 @@ def _end_reached(u: Until, t_phase: float, turned: float, rolled: float, pitched
     )
 
 
-def _mixture(schedule: list[tuple[float, float]], h_ft: float) -> float:
-    return float(np.interp(h_ft, [a for a, _ in schedule], [m for _, m in schedule]))
-
-
 def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool = False) -> FlightResult:
     """Fly ``manoeuvre`` to its end (or to a crash) and return the recording and check results.
 
@@ -165,9 +170,10 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
     rw_c = math.cos(setup.runway_heading_rad or 0.0)
     rw_s = math.sin(setup.runway_heading_rad or 0.0)
     nan = math.nan
-    mix_schedule = [tuple(x) for x in profile.engine.mixture_schedule]
+    mix_h_ft, mix_norm = zip(*profile.engine.mixture_schedule, strict=True)  # interpolated once a second
     mix_every = max(1, round(1.0 / dt))
     cg_h = profile.geometry.cg_height_on_ground_ft
+    alpha_stall_deg = profile.limits.alpha_stall_deg
 
     rows = array("d")
     ncol = len(COLUMN_NAMES)
@@ -199,7 +205,7 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
         vg, trk, hdot = vg_get(), trk_get(), hdot_get()
         h, agl, lat, lon = h_get(), agl_get(), lat_get(), lon_get()
         wow = wow_get() > 0.5
-        north = (lat - lat0) * mlat
+        north = (lat - lat0) * mlat  # LocalFrame and the runway frame, inline (hot path)
         east = (lon - lon0) * mlon
         if has_runway:
             x_rw = north * rw_c + east * rw_s
@@ -228,7 +234,7 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
                 phase_events.add("liftoff")
         elif vg * FPS_TO_KT < 1.0:
             phase_events.add("stopped")
-        if alpha * R2D >= profile.limits.alpha_stall_deg:
+        if alpha * R2D >= alpha_stall_deg:
             phase_events.add("stall")
         was_wow = wow
         if problem:
@@ -288,7 +294,7 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
             steer_set(pilot.steer)
             thr_set(pilot.throttle)
             if k % mix_every == 0:
-                mix_w.set_double_value(_mixture(mix_schedule, h))
+                mix_w.set_double_value(float(np.interp(h, mix_h_ft, mix_norm)))
         fdm.run()
         fx = ax_get() * FT_S2_TO_M_S2
         fy = ay_get() * FT_S2_TO_M_S2
@@ -333,7 +339,7 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
     elif not all(c.passed for c in results):
         status = "failed"
         reason = "checks failed: " + ", ".join(c.name for c in results if not c.passed)
-    return FlightResult(m.name, m.aircraft, dt, columns["t_s"], columns, phases_out, checks, status, reason, events)
+    return FlightResult(m.name, m.aircraft, dt, columns, phases_out, checks, status, reason, events)
 
 
 def _progress(name: str, iphase: int, nphases: int, phase: str, t: float) -> None:
@@ -355,7 +361,7 @@ def flight_summary(result: FlightResult, source: str = "") -> dict[str, object]:
         "reason": result.reason,
         "dt_s": result.dt_s,
         "samples": len(result.t_s),
-        "duration_s": float(result.t_s[-1]) if len(result.t_s) else 0.0,
+        "duration_s": result.duration_s,
         "phases": [{"name": n, "t_start_s": a, "t_end_s": b} for n, a, b in result.phases],
         "checks": [{"name": n, "measured": num(v), "limit": lim, "passed": ok} for n, v, lim, ok in result.checks],
         "events": {k: [round(x, 6) for x in v] for k, v in result.events.items()},
@@ -388,10 +394,9 @@ def fly_command(manoeuvre_path: Path, out_dir: Path, progress: bool = True) -> i
     wall = time.monotonic() - wall
     write_flight(out_dir, result, str(manoeuvre_path))
     passed = sum(1 for c in result.checks if c[3])
-    duration = float(result.t_s[-1]) if len(result.t_s) else 0.0
     line = (
         f"{m.name} ({m.aircraft}): {result.status}, {passed}/{len(m.checks)} checks passed, "
-        f"{duration:.1f} s flown in {wall:.1f} s -> {out_dir}"
+        f"{result.duration_s:.1f} s flown in {wall:.1f} s -> {out_dir}"
     )
     if not result.ok:
         line += f" ({result.reason})"

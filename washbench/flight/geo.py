@@ -3,6 +3,8 @@
 Good to well under a metre over the few kilometres a manoeuvre covers. North/east in
 metres from the reference latitude/longitude (WGS-84 radii of curvature at the reference
 latitude). Runway frame: x along the centreline past the threshold, y to the right of it.
+The fly loop converts each sample to north/east and the runway frame inline (per-step hot
+path), from the radii held here.
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ DEFAULT_LONGITUDE_DEG = -75.6692
 
 
 class LocalFrame:
-    """North/east metres about (lat0, lon0); converts both ways."""
+    """North/east metres about (lat0, lon0): ``north = (lat - lat0) * m_per_rad_lat``, likewise east."""
 
     def __init__(self, lat0_deg: float, lon0_deg: float) -> None:
         self.lat0 = math.radians(lat0_deg)
@@ -27,22 +29,12 @@ class LocalFrame:
         self.m_per_rad_lat = _A * (1.0 - _E2) / (w * w * w)  # meridional radius
         self.m_per_rad_lon = _A / w * math.cos(self.lat0)  # prime-vertical radius times cos(lat)
 
-    def to_ne(self, lat_rad: float, lon_rad: float) -> tuple[float, float]:
-        """(north_m, east_m) of a geodetic point given in radians."""
-        return (lat_rad - self.lat0) * self.m_per_rad_lat, (lon_rad - self.lon0) * self.m_per_rad_lon
-
     def to_latlon_deg(self, north_m: float, east_m: float) -> tuple[float, float]:
         """(lat_deg, lon_deg) of a local point."""
         return (
             math.degrees(self.lat0 + north_m / self.m_per_rad_lat),
             math.degrees(self.lon0 + east_m / self.m_per_rad_lon),
         )
-
-
-def runway_xy(north_m: float, east_m: float, heading_rad: float) -> tuple[float, float]:
-    """Runway frame of a point given north/east of the threshold: (along, right of centreline), m."""
-    c, s = math.cos(heading_rad), math.sin(heading_rad)
-    return north_m * c + east_m * s, -north_m * s + east_m * c
 
 
 def wrap_pi(angle_rad: float) -> float:

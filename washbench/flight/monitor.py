@@ -20,7 +20,7 @@ class Monitor:
         self.nz_max = profile.limits.nz_max
         self.nz_min = profile.limits.nz_min
         self.sink_max = profile.limits.touchdown_sink_max_fps
-        self.cg_h = profile.geometry.cg_height_on_ground_ft
+        self.h_collapsed = 0.5 * profile.geometry.cg_height_on_ground_ft  # centre of gravity this low: gear gone
 
     def state(self, total: float, vc: float, alpha: float, h_agl: float, wow: bool, structure_wow: float) -> str | None:
         """Checks on the current state. ``total`` is a sum of state values (NaN/inf propagate into it)."""
@@ -32,7 +32,7 @@ class Monitor:
             return f"airspeed {vc:.1f} kt beyond VNE {self.vne:g} kt"
         if not wow and (alpha > ALPHA_MAX_RAD or alpha < -ALPHA_MAX_RAD):
             return f"angle of attack {alpha * 57.29578:.1f} deg: out of the flight envelope"
-        if h_agl < 0.5 * self.cg_h:
+        if h_agl < self.h_collapsed:
             return f"the centre of gravity is {h_agl:.1f} ft above the ground: the gear has collapsed"
         return None
 

@@ -323,7 +323,7 @@ class Pilot:
         # ---- pitch: path -> pitch -> pitch rate -> elevator
         mode = self.pitch_mode
         path_err = 0.0  # flight-path-angle error of the path modes (rad), for the throttle
-        g_v = G_FPS2 / ((vt if vt > self.vmin else self.vmin) * KT_TO_FPS)  # pitch rate per g of a pull, rad/s
+        g_v = G_FPS2 / (vt_min * KT_TO_FPS)  # pitch rate per g of a pull, rad/s
         z_down = math.cos(phi) * math.cos(theta)  # vertical component of the body z axis
         if mode == PITCH_RATE:
             q_cmd = self.pitch_target

@@ -47,7 +47,7 @@ class Geometry(StrictModel):
 
 class Engine(StrictModel):
     steer_sign: Annotated[float, Field(ge=-1, le=1)]  # fcs/steer-cmd-norm = steer_sign * rudder-like command
-    mixture_schedule: list[tuple[float, float]]  # (altitude_ft, mixture 0..1), interpolated
+    mixture_schedule: Annotated[list[tuple[float, float]], Field(min_length=1)]  # (altitude_ft, mixture 0..1)
     magneto_cmd: Annotated[int, Field(ge=0, le=3)] | None = None  # propulsion/magneto_cmd at engine start
     propeller_advance_norm: Annotated[float, Field(ge=0, le=1)] | None = None  # fcs/advance-cmd-norm[0] (lever)
 
