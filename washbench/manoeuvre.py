@@ -26,7 +26,7 @@ from washbench.errors import WashbenchError, located
 from washbench.flight.columns import COLUMN_NAMES, RUNWAY_COLUMNS
 from washbench.flight.profile import PilotProfile, load_profile
 from washbench.paths import AIRCRAFT_DIR, DATA_DIR
-from washbench.yamlio import Loc, StrictModel, format_field_path, read_yaml, validate_data
+from washbench.yamlio import Loc, StrictModel, format_field_path, line_of, read_yaml, validate_data
 
 Positive = Annotated[float, Field(gt=0)]
 NonNegative = Annotated[float, Field(ge=0)]
@@ -272,12 +272,7 @@ class _Where:
         self.lines = lines
 
     def error(self, loc: Loc, problem: str) -> WashbenchError:
-        line = None
-        probe = loc
-        while line is None and probe:
-            line = self.lines.get(probe)
-            probe = probe[:-1]
-        return WashbenchError(located(self.path, problem, line=line, field=format_field_path(loc)))
+        return WashbenchError(located(self.path, problem, line=line_of(self.lines, loc), field=format_field_path(loc)))
 
 
 def _set_fields(model: StrictModel, names: Sequence[str]) -> list[str]:
