@@ -163,9 +163,7 @@ def test_harness_climb_rate_equals_specific_excess_power() -> None:
     pilot.throttle_v_ref_kcas = None
     pilot.v_ref_kcas = 74.0
     fdm["fcs/throttle-cmd-norm[0]"] = 1.0
-    for _ in range(round(30.0 / airdata.DT_S)):
-        pilot.step()
-        fdm.run()
+    pilot.fly(30.0)
     n = round(30.0 / airdata.DT_S)
     total = 0.0
     v_prev = fdm["velocities/vtrue-fps"]

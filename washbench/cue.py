@@ -19,6 +19,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
+from washbench.atomic import atomic_path
 from washbench.errors import WashbenchError, located
 from washbench.metrics import MetricRow, dof_metrics
 from washbench.perception.vestibular import Perceived, VestibularModel, VestibularParams
@@ -173,23 +174,15 @@ def cue_motion(
     """Run the named washouts and the Atlas model over ``motion`` (``cueing.cue_trace``), then :func:`analyse`."""
     from washbench.cueing import cue_trace
 
-    traces = cue_trace(motion.f_mps2, motion.omega_radps, motion.dt_s, tuple(washouts), params, limits)
-    return analyse(motion, {w: traces[w] for w in washouts}, vestibular)
+    traces = cue_trace(motion.f_mps2, motion.omega_radps, motion.dt_s, washouts, params, limits)
+    return analyse(motion, traces, vestibular)
 
 
 def check_washout_names(names: Sequence[str] | None) -> tuple[str, ...]:
     """Validated washout names in the order given, duplicates dropped; ``None`` -> all of them."""
-    from washbench.cueing import WASHOUT_NAMES
+    from washbench.cueing import WASHOUT_NAMES, check_washouts
 
-    if not names:
-        return tuple(WASHOUT_NAMES)
-    out: list[str] = []
-    for name in names:
-        if name not in WASHOUT_NAMES:
-            raise WashbenchError(f"unknown washout {name!r} (valid: {', '.join(WASHOUT_NAMES)})")
-        if name not in out:
-            out.append(name)
-    return tuple(out)
+    return check_washouts(dict.fromkeys(names) if names else WASHOUT_NAMES)
 
 
 def write_results(out_dir: Path, result: CueResult) -> tuple[Path, Path]:
@@ -197,8 +190,6 @@ def write_results(out_dir: Path, result: CueResult) -> tuple[Path, Path]:
 
     Each file is written to a temporary name and renamed into place only after both are complete.
     """
-    from washbench.atomic import atomic_path
-
     out_dir = Path(out_dir)
     traces_path, metrics_path = out_dir / TRACES_FILE, out_dir / METRICS_FILE
     if out_dir.exists() and not out_dir.is_dir():

@@ -37,16 +37,6 @@ ANTI_CORRELATED_TOL = 1e-12
 DOFS = ("surge", "sway", "heave", "roll", "pitch", "yaw")
 """Degrees of freedom, in the order rows are written."""
 
-DOF_UNITS = {
-    "surge": ("m/s^2", "m/s^2*s"),
-    "sway": ("m/s^2", "m/s^2*s"),
-    "heave": ("m/s^2", "m/s^2*s"),
-    "roll": ("deg/s", "deg"),
-    "pitch": ("deg/s", "deg"),
-    "yaw": ("deg/s", "deg"),
-}
-"""Per DOF: (unit of max_error, unit of integral_error)."""
-
 
 def _as_pair(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     x = np.asarray(x, dtype=np.float64)

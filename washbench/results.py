@@ -42,7 +42,7 @@ import pyarrow.compute as pc
 import pyarrow.csv as pacsv
 import pyarrow.parquet as pq
 
-from washbench.atomic import atomic_path
+from washbench.atomic import atomic_path, write_text_atomic
 from washbench.errors import WashbenchError, located
 from washbench.metrics import MetricRow
 
@@ -209,7 +209,7 @@ class Motion:
         return self.omega_degps if self.omega_degps is not None else np.degrees(self.omega_radps)
 
 
-def _where(path: Path, kind: str, index: int) -> tuple[int | None, str]:
+def _where(kind: str, index: int) -> tuple[int | None, str]:
     """(line for located(), row text) for data row ``index`` (0-based)."""
     if kind == "csv":
         return index + 2, ""
@@ -288,7 +288,7 @@ def _numeric_column(path: Path, kind: str, table: pa.Table, name: str) -> np.nda
     nulls = col.is_null().to_numpy(zero_copy_only=False)
     if nulls.any():
         i = int(np.argmax(nulls))
-        line, row = _where(path, kind, i)
+        line, row = _where(kind, i)
         raise WashbenchError(located(path, f"{row}missing value", line=line, field=name))
     if pa.types.is_string(col.type) or pa.types.is_large_string(col.type):
         stripped = pc.utf8_trim_whitespace(col)
@@ -300,7 +300,7 @@ def _numeric_column(path: Path, kind: str, table: pa.Table, name: str) -> np.nda
                 try:
                     float(v)
                 except ValueError:
-                    line, row = _where(path, kind, i)
+                    line, row = _where(kind, i)
                     raise WashbenchError(located(path, f"{row}not a number: {v!r}", line=line, field=name)) from None
             raise WashbenchError(located(path, "column is not numeric", field=name)) from None
     elif pa.types.is_integer(col.type) or pa.types.is_floating(col.type):
@@ -311,7 +311,7 @@ def _numeric_column(path: Path, kind: str, table: pa.Table, name: str) -> np.nda
     bad = ~np.isfinite(arr)
     if bad.any():
         i = int(np.argmax(bad))
-        line, row = _where(path, kind, i)
+        line, row = _where(kind, i)
         what = "NaN" if np.isnan(arr[i]) else "infinite"
         raise WashbenchError(located(path, f"{row}value is {what}", line=line, field=name))
     return np.ascontiguousarray(arr, dtype=np.float64)
@@ -323,7 +323,7 @@ def _check_time(path: Path, kind: str, t: np.ndarray) -> float:
     bad = steps <= 0.0
     if bad.any():
         i = int(np.argmax(bad)) + 1
-        line, row = _where(path, kind, i)
+        line, row = _where(kind, i)
         raise WashbenchError(
             located(
                 path, f"{row}time does not increase ({t[i]:.9g} after {t[i - 1]:.9g})", line=line, field=TIME_COLUMN
@@ -333,7 +333,7 @@ def _check_time(path: Path, kind: str, t: np.ndarray) -> float:
     bad = np.abs(steps - typical) > TIME_RTOL * typical
     if bad.any():
         i = int(np.argmax(bad)) + 1
-        line, row = _where(path, kind, i)
+        line, row = _where(kind, i)
         raise WashbenchError(
             located(
                 path,
@@ -350,7 +350,7 @@ def _check_time(path: Path, kind: str, t: np.ndarray) -> float:
     bad = drift > tol
     if bad.any():
         i = int(np.argmax(bad))
-        line, row = _where(path, kind, i)
+        line, row = _where(kind, i)
         raise WashbenchError(
             located(path, f"{row}time drifts off the uniform grid of step {dt:.9g} s", line=line, field=TIME_COLUMN)
         )
@@ -438,9 +438,7 @@ def metrics_csv_text(rows: Iterable[MetricRow]) -> str:
 
 def write_metrics_csv(path: str | Path, rows: Iterable[MetricRow]) -> None:
     """Write metrics.csv atomically (floats as ``repr``: exact round trip; NaN as an empty field)."""
-    text = metrics_csv_text(rows)
-    with atomic_path(path) as tmp:
-        tmp.write_text(text, encoding="utf-8")
+    write_text_atomic(path, metrics_csv_text(rows))
 
 
 def read_metrics_csv(path: str | Path) -> list[MetricRow]:

@@ -2,7 +2,7 @@
 
 Public API::
 
-    from washbench.cueing import (WASHOUT_NAMES, WashoutParams, load_washout_params,
+    from washbench.cueing import (WASHOUT_NAMES, check_washouts, WashoutParams, load_washout_params,
                                   CueingBank, WashoutTrace, cue_trace)
 
 See ``docs/cueing.md`` for the block diagrams as implemented and every interpretation of the paper.
@@ -20,12 +20,20 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from washbench.cueing.params import WASHOUT_NAMES, WashoutParams, load_washout_params
+from washbench.cueing.params import WASHOUT_NAMES, WashoutParams, check_washouts, load_washout_params
 
 if TYPE_CHECKING:
     from washbench.cueing.bank import CueingBank, WashoutTrace, cue_trace
 
-__all__ = ["WASHOUT_NAMES", "CueingBank", "WashoutParams", "WashoutTrace", "cue_trace", "load_washout_params"]
+__all__ = [
+    "WASHOUT_NAMES",
+    "CueingBank",
+    "WashoutParams",
+    "WashoutTrace",
+    "check_washouts",
+    "cue_trace",
+    "load_washout_params",
+]
 
 _LAZY = {"CueingBank", "WashoutTrace", "cue_trace"}
 

@@ -17,6 +17,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -46,6 +47,9 @@ from washbench.cueing.kernel import (
     F_TILT_LP,
     F_TRANS_HP,
     FIELDS,
+    KIND_LARGE,
+    KIND_SMALL,
+    KIND_UNRESTRICTED,
     NCFG,
     NFIELDS,
     NFILT,
@@ -65,23 +69,11 @@ from washbench.cueing.kernel import (
     bank_step,
     bank_trace,
 )
-from washbench.cueing.params import WASHOUT_NAMES, WashoutParams
+from washbench.cueing.params import WashoutParams, check_washouts
 from washbench.errors import WashbenchError
 from washbench.platform.limits import PlatformLimits, wheel_jacobian
 
-_KINDS = {name: i for i, name in enumerate(WASHOUT_NAMES)}
-
-
-def _check_washouts(washouts: Sequence[str]) -> tuple[str, ...]:
-    names = tuple(washouts)
-    if not names:
-        raise WashbenchError("no washout selected")
-    for name in names:
-        if name not in _KINDS:
-            raise WashbenchError(f"unknown washout {name!r} (valid: {', '.join(WASHOUT_NAMES)})")
-    if len(set(names)) != len(names):
-        raise WashbenchError(f"washout listed twice: {', '.join(names)}")
-    return names
+_KINDS = {"small-angle": KIND_SMALL, "large-angle": KIND_LARGE, "unrestricted": KIND_UNRESTRICTED}
 
 
 def _check_dt(dt_s: float) -> float:
@@ -91,55 +83,57 @@ def _check_dt(dt_s: float) -> float:
     return dt
 
 
-def build_arrays(
-    washouts: Sequence[str], params: WashoutParams, limits: PlatformLimits, dt_s: float
+def _xyz(axes: Any) -> tuple[float, float, float]:
+    return (axes.x, axes.y, axes.z)
+
+
+def _build_arrays(
+    names: tuple[str, ...], params: WashoutParams, limits: PlatformLimits, dt: float
 ) -> tuple[np.ndarray, np.ndarray]:
-    """The compiled bank's configuration (n, NCFG) and discretised filters (n, NFILT, 9), all SI."""
-    names = _check_washouts(washouts)
-    dt = _check_dt(dt_s)
-    cfg = np.zeros((len(names), NCFG))
+    """The compiled bank's configuration (n, NCFG) and discretised filters (n, NFILT, 9), all SI.
+
+    ``names`` (:func:`check_washouts`) and ``dt`` (s, :func:`_check_dt`) are already checked. Only the kind,
+    the tilt low-pass and the rotational high-pass differ between washouts.
+    """
+    lim = limits.translation
+    common = np.zeros(NCFG)
+    common[C_DT] = dt
+    common[C_G] = params.gravity_mps2
+    common[C_SF] = params.scale.specific_force
+    common[C_SW] = params.scale.angular_velocity
+    common[C_TILT_K] = params.tilt.gain_per_s
+    common[C_TILT_RATE] = math.radians(params.tilt.rate_limit_degps)
+    common[C_ROT_SAT] = math.radians(params.rotational.saturation_degps)
+    common[C_COSMIN] = params.small_angle.min_cos_pitch
+    common[C_FREEFALL] = params.free_fall_threshold_mps2
+    common[C_R : C_R + 3] = params.head.offset_m
+    common[C_PMAX : C_PMAX + 3] = _xyz(lim.position_limit_m)
+    common[C_VMAX : C_VMAX + 3] = _xyz(lim.velocity_limit_mps)
+    common[C_AMAX : C_AMAX + 3] = _xyz(lim.acceleration_limit_mps2)
+    common[C_WMAX] = math.radians(limits.rotation.rate_limit_degps)
+    common[C_ALPHA] = math.radians(limits.rotation.acceleration_limit_degps2)
+    common[C_CATCH] = limits.rotation.catch_up_fraction
+    common[C_JAC : C_JAC + 9] = wheel_jacobian(limits).ravel()
+    cfg = np.tile(common, (len(names), 1))
+
     coef = np.zeros((len(names), NFILT, filters.NCOEF))
-    jac = wheel_jacobian(limits).ravel()
-    tr = params.translational_highpass_wn_radps
+    for j, wn in enumerate(_xyz(params.translational_highpass_wn_radps)):
+        coef[:, F_TRANS_HP + j] = filters.discretise(filters.translational_highpass(wn), dt)
+    derivative = filters.discretise(filters.derivative_estimator(params.head.derivative_wn_radps), dt)
+    coef[:, F_EULER_D : F_EULER_D + 3] = derivative
+    coef[:, F_OMEGA_D : F_OMEGA_D + 3] = derivative
     lp = params.tilt.lowpass_wn_radps
     rot = params.rotational.highpass_wn_radps
-    w2 = params.head.derivative_wn_radps
-    lim = limits.translation
     for i, name in enumerate(names):
         kind = _KINDS[name]
-        c = cfg[i]
-        c[C_KIND] = kind
-        c[C_DT] = dt
-        c[C_G] = params.gravity_mps2
-        c[C_SF] = params.scale.specific_force
-        c[C_SW] = params.scale.angular_velocity
-        c[C_TILT_K] = params.tilt.gain_per_s
-        c[C_TILT_RATE] = math.radians(params.tilt.rate_limit_degps)
-        c[C_ROT_SAT] = math.radians(params.rotational.saturation_degps)
-        c[C_COSMIN] = params.small_angle.min_cos_pitch
-        c[C_FREEFALL] = params.free_fall_threshold_mps2
-        c[C_R : C_R + 3] = params.head.offset_m
-        c[C_PMAX : C_PMAX + 3] = (lim.position_limit_m.x, lim.position_limit_m.y, lim.position_limit_m.z)
-        c[C_VMAX : C_VMAX + 3] = (lim.velocity_limit_mps.x, lim.velocity_limit_mps.y, lim.velocity_limit_mps.z)
-        c[C_AMAX : C_AMAX + 3] = (
-            lim.acceleration_limit_mps2.x,
-            lim.acceleration_limit_mps2.y,
-            lim.acceleration_limit_mps2.z,
-        )
-        c[C_WMAX] = math.radians(limits.rotation.rate_limit_degps)
-        c[C_ALPHA] = math.radians(limits.rotation.acceleration_limit_degps2)
-        c[C_CATCH] = limits.rotation.catch_up_fraction
-        c[C_JAC : C_JAC + 9] = jac
+        cfg[i, C_KIND] = kind
         # small-angle: the tilt low-pass filters the roll, pitch, yaw tilt rates; roll is made by f_y
         # (sway wn), pitch by f_x (surge wn), yaw by the z wn. Large-angle: it filters f_x, f_y, f_z.
-        tilt_wn = (lp.y, lp.x, lp.z) if kind == 0 else (lp.x, lp.y, lp.z)
-        rot_wn = (0.0, 0.0, 0.0) if name == "unrestricted" else (rot.roll, rot.pitch, rot.yaw)
+        tilt_wn = (lp.y, lp.x, lp.z) if kind == KIND_SMALL else (lp.x, lp.y, lp.z)
+        rot_wn = (0.0, 0.0, 0.0) if kind == KIND_UNRESTRICTED else (rot.roll, rot.pitch, rot.yaw)
         for j in range(3):
-            coef[i, F_TRANS_HP + j] = filters.discretise(filters.translational_highpass((tr.x, tr.y, tr.z)[j]), dt)
             coef[i, F_TILT_LP + j] = filters.discretise(filters.tilt_lowpass(tilt_wn[j]), dt)
             coef[i, F_ROT_HP + j] = filters.discretise(filters.rotational_highpass(rot_wn[j]), dt)
-            coef[i, F_EULER_D + j] = filters.discretise(filters.derivative_estimator(w2), dt)
-            coef[i, F_OMEGA_D + j] = filters.discretise(filters.derivative_estimator(w2), dt)
     return cfg, coef
 
 
@@ -228,9 +222,9 @@ class CueingBank:
     SAT_KINDS: tuple[str, ...] = SAT_KINDS
 
     def __init__(self, washouts: Sequence[str], params: WashoutParams, limits: PlatformLimits, dt_s: float) -> None:
-        self.washouts = _check_washouts(washouts)
+        self.washouts = check_washouts(washouts)
         self.dt_s = _check_dt(dt_s)
-        self._cfg, self._coef = build_arrays(self.washouts, params, limits, self.dt_s)
+        self._cfg, self._coef = _build_arrays(self.washouts, params, limits, self.dt_s)
         n = len(self.washouts)
         self._state = np.zeros((n, NSTATE))
         self._counts = np.zeros((n, len(SAT_KINDS)), dtype=np.int64)
@@ -267,7 +261,7 @@ def cue_trace(
     Uses the same compiled step as :class:`CueingBank` and gives identical results. Raises WashbenchError
     for wrong shapes or non-finite samples (naming the first bad sample).
     """
-    names = _check_washouts(washouts)
+    names = check_washouts(washouts)
     dt = _check_dt(dt_s)
     f = np.ascontiguousarray(f_mps2, dtype=np.float64)
     w = np.ascontiguousarray(omega_radps, dtype=np.float64)
@@ -276,7 +270,7 @@ def cue_trace(
     bad = ~(np.isfinite(f).all(axis=1) & np.isfinite(w).all(axis=1))
     if bad.any():
         raise WashbenchError(f"non-finite specific force or angular velocity at sample {int(np.argmax(bad))}")
-    cfg, coef = build_arrays(names, params, limits, dt)
+    cfg, coef = _build_arrays(names, params, limits, dt)
     state = np.zeros((len(names), NSTATE))
     counts = np.zeros((len(names), len(SAT_KINDS)), dtype=np.int64)
     out = np.zeros((len(names), f.shape[0], NFIELDS))

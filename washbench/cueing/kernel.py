@@ -30,6 +30,7 @@ from washbench.cueing.rotations import (
     cross,
     euler_from_quat,
     euler_rates,
+    limit_norm,
     norm3,
     qintegrate,
     qrate_body,
@@ -99,19 +100,29 @@ def _tilt_rate(g_s, f, gain, eps):
 
 
 @njit(cache=True)
-def _limit_norm(v, vmax):
-    """v scaled down to norm vmax if longer (direction kept); returns (v, 1 if limited else 0)."""
-    n = norm3(v)
-    if n > vmax:
-        s = vmax / n
-        return (v[0] * s, v[1] * s, v[2] * s), 1
-    return v, 0
-
-
-@njit(cache=True)
 def _fx(state, i):
     """View of filter i's two states."""
     return state[S_FX + 2 * i : S_FX + 2 * i + 2]
+
+
+@njit(cache=True, inline="always")
+def _filt3(coef, state, i, u):
+    """Step filters i, i + 1, i + 2 (one per axis) with the components of ``u``; return their outputs.
+
+    Inlined into the step (``inline="always"``): as a call it made the streaming step about 7% slower.
+    """
+    return (
+        filt_step(coef[i], _fx(state, i), u[0]),
+        filt_step(coef[i + 1], _fx(state, i + 1), u[1]),
+        filt_step(coef[i + 2], _fx(state, i + 2), u[2]),
+    )
+
+
+@njit(cache=True)
+def _init3(coef, state, i, u):
+    """Start filters i, i + 1, i + 2 in the steady state of the components of ``u``."""
+    for j in range(3):
+        filt_init(coef[i + j], _fx(state, i + j), u[j])
 
 
 @njit(cache=True)
@@ -148,11 +159,9 @@ def _init_washout(kind, c, coef, state, fs, ws):
         a_i = qrot(q0, fs)
         tilt_in = fs
         rot_in = ws
-    a_i = (a_i[0], a_i[1], a_i[2] + g)
-    for j in range(3):
-        filt_init(coef[F_TRANS_HP + j], _fx(state, F_TRANS_HP + j), a_i[j])
-        filt_init(coef[F_TILT_LP + j], _fx(state, F_TILT_LP + j), tilt_in[j])
-        filt_init(coef[F_ROT_HP + j], _fx(state, F_ROT_HP + j), rot_in[j])
+    _init3(coef, state, F_TRANS_HP, (a_i[0], a_i[1], a_i[2] + g))
+    _init3(coef, state, F_TILT_LP, tilt_in)
+    _init3(coef, state, F_ROT_HP, rot_in)
 
 
 @njit(cache=True)
@@ -162,7 +171,7 @@ def step_one(f, om, c, coef, state, counts, row):
     dt = c[C_DT]
     g = c[C_G]
     fs = (c[C_SF] * f[0], c[C_SF] * f[1], c[C_SF] * f[2])
-    ws, sat_rot = _limit_norm((c[C_SW] * om[0], c[C_SW] * om[1], c[C_SW] * om[2]), c[C_ROT_SAT])
+    ws, sat_rot = limit_norm((c[C_SW] * om[0], c[C_SW] * om[1], c[C_SW] * om[2]), c[C_ROT_SAT])
     first = state[S_INIT] == 0.0
     if first:
         _init_washout(kind, c, coef, state, fs, ws)
@@ -178,41 +187,28 @@ def step_one(f, om, c, coef, state, counts, row):
         a_i = rot_euler(phi, theta, psi, fs)
         g_s = rot_euler_inv(phi, theta, psi, g_i)
         wt = _tilt_rate(g_s, fs, c[C_TILT_K], c[C_FREEFALL])
-        wt = (
-            filt_step(coef[F_TILT_LP], _fx(state, F_TILT_LP), wt[0]),
-            filt_step(coef[F_TILT_LP + 1], _fx(state, F_TILT_LP + 1), wt[1]),
-            filt_step(coef[F_TILT_LP + 2], _fx(state, F_TILT_LP + 2), wt[2]),
-        )
-        bdot_t, sat_tilt = _limit_norm(euler_rates(phi, theta, wt, c[C_COSMIN]), c[C_TILT_RATE])
-        bdot_r = euler_rates(phi, theta, ws, c[C_COSMIN])
+        wt = _filt3(coef, state, F_TILT_LP, wt)
+        bdot_t, sat_tilt = limit_norm(euler_rates(phi, theta, wt, c[C_COSMIN]), c[C_TILT_RATE])
+        bdot_r = _filt3(coef, state, F_ROT_HP, euler_rates(phi, theta, ws, c[C_COSMIN]))
         for j in range(3):
             state[S_BT + j] += bdot_t[j] * dt
-            state[S_BR + j] += filt_step(coef[F_ROT_HP + j], _fx(state, F_ROT_HP + j), bdot_r[j]) * dt
+            state[S_BR + j] += bdot_r[j] * dt
         q_sp = quat_from_euler(
             state[S_BT] + state[S_BR], state[S_BT + 1] + state[S_BR + 1], state[S_BT + 2] + state[S_BR + 2]
         )
     else:
         a_i = qrot(q_sp_prev, fs)
         g_s = qrot_inv(q_sp_prev, g_i)
-        f_lp = (
-            filt_step(coef[F_TILT_LP], _fx(state, F_TILT_LP), fs[0]),
-            filt_step(coef[F_TILT_LP + 1], _fx(state, F_TILT_LP + 1), fs[1]),
-            filt_step(coef[F_TILT_LP + 2], _fx(state, F_TILT_LP + 2), fs[2]),
-        )
-        wt, sat_tilt = _limit_norm(_tilt_rate(g_s, f_lp, c[C_TILT_K], c[C_FREEFALL]), c[C_TILT_RATE])
-        w_sum = (
-            wt[0] + filt_step(coef[F_ROT_HP], _fx(state, F_ROT_HP), ws[0]),
-            wt[1] + filt_step(coef[F_ROT_HP + 1], _fx(state, F_ROT_HP + 1), ws[1]),
-            wt[2] + filt_step(coef[F_ROT_HP + 2], _fx(state, F_ROT_HP + 2), ws[2]),
-        )
-        q_sp = qintegrate(q_sp_prev, w_sum, dt)
+        f_lp = _filt3(coef, state, F_TILT_LP, fs)
+        wt, sat_tilt = limit_norm(_tilt_rate(g_s, f_lp, c[C_TILT_K], c[C_FREEFALL]), c[C_TILT_RATE])
+        wr = _filt3(coef, state, F_ROT_HP, ws)
+        q_sp = qintegrate(q_sp_prev, (wt[0] + wr[0], wt[1] + wr[1], wt[2] + wr[2]), dt)
     for j in range(4):
         state[S_QSP + j] = q_sp[j]
     # translational channel: + g_I, high-pass, double integration (semi-implicit Euler)
-    a_i = (a_i[0], a_i[1], a_i[2] + g)
+    a_hp = _filt3(coef, state, F_TRANS_HP, (a_i[0], a_i[1], a_i[2] + g))
     for j in range(3):
-        a_hp = filt_step(coef[F_TRANS_HP + j], _fx(state, F_TRANS_HP + j), a_i[j])
-        state[S_VSP + j] += a_hp * dt
+        state[S_VSP + j] += a_hp[j] * dt
         state[S_PSP + j] += state[S_VSP + j] * dt
 
     # ---- platform
@@ -270,13 +266,8 @@ def step_one(f, om, c, coef, state, counts, row):
         state[S_EUL + 2] = epsi
         beta = (ephi, etheta, epsi)
         if first:
-            for j in range(3):
-                filt_init(coef[F_EULER_D + j], _fx(state, F_EULER_D + j), beta[j])
-        bdot = (
-            filt_step(coef[F_EULER_D], _fx(state, F_EULER_D), beta[0]),
-            filt_step(coef[F_EULER_D + 1], _fx(state, F_EULER_D + 1), beta[1]),
-            filt_step(coef[F_EULER_D + 2], _fx(state, F_EULER_D + 2), beta[2]),
-        )
+            _init3(coef, state, F_EULER_D, beta)
+        bdot = _filt3(coef, state, F_EULER_D, beta)
         wh = body_rates(ephi, etheta, bdot)
         a_s = rot_euler_inv(ephi, etheta, epsi, acc)
         g_sh = rot_euler_inv(ephi, etheta, epsi, g_i)
@@ -285,13 +276,8 @@ def step_one(f, om, c, coef, state, counts, row):
         a_s = qrot_inv(q, acc)
         g_sh = qrot_inv(q, g_i)
     if first:
-        for j in range(3):
-            filt_init(coef[F_OMEGA_D + j], _fx(state, F_OMEGA_D + j), wh[j])
-    wdot = (
-        filt_step(coef[F_OMEGA_D], _fx(state, F_OMEGA_D), wh[0]),
-        filt_step(coef[F_OMEGA_D + 1], _fx(state, F_OMEGA_D + 1), wh[1]),
-        filt_step(coef[F_OMEGA_D + 2], _fx(state, F_OMEGA_D + 2), wh[2]),
-    )
+        _init3(coef, state, F_OMEGA_D, wh)
+    wdot = _filt3(coef, state, F_OMEGA_D, wh)
     r = (c[C_R], c[C_R + 1], c[C_R + 2])
     t1 = cross(wdot, r)
     t2 = cross(wh, cross(wh, r))
@@ -336,9 +322,11 @@ def bank_step(f, om, cfg, coef, state, counts, out):
 
 @njit(cache=True)
 def bank_trace(f, om, cfg, coef, state, counts, out):
-    """Whole-trace form: f, om (N, 3); out (n_washouts, N, NFIELDS). Same per-washout step as bank_step."""
+    """Whole-trace form: f, om (N, 3), already checked finite; out (n_washouts, N, NFIELDS).
+
+    Same per-washout step as bank_step.
+    """
     for k in range(f.shape[0]):
-        _check_input(f[k], om[k])
         for i in range(cfg.shape[0]):
             step_one(f[k], om[k], cfg[i], coef[i], state[i], counts[i], out[i, k])
 

@@ -7,16 +7,32 @@ non-positive values are rejected with one line naming file, line and field.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Annotated
 
 from pydantic import Field
 
+from washbench.errors import WashbenchError
 from washbench.paths import DATA_DIR
 from washbench.yamlio import StrictModel, load_yaml_model
 
 WASHOUT_NAMES: tuple[str, ...] = ("small-angle", "large-angle", "unrestricted")
 DEFAULT_PARAMS_PATH = DATA_DIR / "cw1.yaml"
+
+
+def check_washouts(washouts: Sequence[str]) -> tuple[str, ...]:
+    """The names as a tuple; WashbenchError if none, one is unknown or one is listed twice."""
+    names = tuple(washouts)
+    if not names:
+        raise WashbenchError("no washout selected")
+    for name in names:
+        if name not in WASHOUT_NAMES:
+            raise WashbenchError(f"unknown washout {name!r} (valid: {', '.join(WASHOUT_NAMES)})")
+    if len(set(names)) != len(names):
+        raise WashbenchError(f"washout listed twice: {', '.join(names)}")
+    return names
+
 
 Positive = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
 NonNegative = Annotated[float, Field(ge=0.0, allow_inf_nan=False)]

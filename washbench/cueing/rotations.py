@@ -39,6 +39,16 @@ def norm3(a: Vec3) -> float:
     return math.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
 
 
+@njit(cache=True, inline="always")
+def limit_norm(v: Vec3, vmax: float) -> tuple[Vec3, int]:
+    """``v`` scaled down to norm ``vmax`` if longer (direction kept); returns (v, 1 if limited else 0)."""
+    n = norm3(v)
+    if n > vmax:
+        s = vmax / n
+        return (v[0] * s, v[1] * s, v[2] * s), 1
+    return v, 0
+
+
 @njit(cache=True)
 def qmul(a: Quat, b: Quat) -> Quat:
     """Hamilton product a (x) b."""

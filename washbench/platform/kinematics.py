@@ -28,7 +28,7 @@ import numpy as np
 from numba import njit
 
 from washbench.cueing.jitcache import drop_stale_cache
-from washbench.cueing.rotations import qconj, qintegrate, qmul, qrotvec
+from washbench.cueing.rotations import limit_norm, norm3, qconj, qintegrate, qmul, qrotvec
 
 drop_stale_cache(__file__, [Path(__file__).resolve().parent.parent / "cueing" / "rotations.py"])
 
@@ -53,6 +53,19 @@ def brake_speed(r: float, a_max: float, dt: float) -> float:
     return j * a_max * dt + (r - s_j) / (dt * (j + 1))
 
 
+@njit(cache=True, inline="always")
+def catch_up_speed(lag: float, a_max: float, dt: float) -> tuple[float, bool]:
+    """Speed that closes a lag > 0 (m or rad) this step, capped to one that can still be braked at ``a_max``.
+
+    Returns (speed, True if the whole lag is closed this step).
+    """
+    speed = lag / dt
+    cap = brake_speed(lag, a_max, dt)
+    if cap < speed:
+        return cap, False
+    return speed, True
+
+
 @njit(cache=True)
 def track_axis(
     p_prev: float,
@@ -74,12 +87,7 @@ def track_axis(
     v_des = (sp - sp_prev) / dt
     full = True
     if e != 0.0:
-        ae = abs(e)
-        corr = ae / dt
-        cap = brake_speed(ae, catch_up * a_max, dt)
-        if cap < corr:
-            corr = cap
-            full = False
+        corr, full = catch_up_speed(abs(e), catch_up * a_max, dt)
         v_des += corr if e > 0.0 else -corr
     hi_a = v_prev + a_max * dt
     lo_a = v_prev - a_max * dt
@@ -143,42 +151,19 @@ def track_rotation(
     wy = ff[1] / dt
     wz = ff[2] / dt
     err = qrotvec(qmul(qconj(q_prev), q_sp_prev))
-    ne = math.sqrt(err[0] * err[0] + err[1] * err[1] + err[2] * err[2])
+    ne = norm3(err)
     full = True
     if ne > 0.0:
-        corr = ne / dt
-        cap = brake_speed(ne, catch_up * alpha_max, dt)
-        if cap < corr:
-            corr = cap
-            full = False
+        corr, full = catch_up_speed(ne, catch_up * alpha_max, dt)
         k = corr / ne
         wx += err[0] * k
         wy += err[1] * k
         wz += err[2] * k
-    sat_rate = 0
-    sat_angacc = 0
-    dx = wx - w_prev[0]
-    dy = wy - w_prev[1]
-    dz = wz - w_prev[2]
-    nd = math.sqrt(dx * dx + dy * dy + dz * dz)
-    dmax = alpha_max * dt
-    if nd > dmax:
-        s = dmax / nd
-        dx *= s
-        dy *= s
-        dz *= s
-        sat_angacc = 1
-        wx = w_prev[0] + dx
-        wy = w_prev[1] + dy
-        wz = w_prev[2] + dz
-    nw = math.sqrt(wx * wx + wy * wy + wz * wz)
-    if nw > w_max:
-        s = w_max / nw
-        wx *= s
-        wy *= s
-        wz *= s
-        sat_rate = 1
     w = (wx, wy, wz)
+    d, sat_angacc = limit_norm((wx - w_prev[0], wy - w_prev[1], wz - w_prev[2]), alpha_max * dt)
+    if sat_angacc:
+        w = (w_prev[0] + d[0], w_prev[1] + d[1], w_prev[2] + d[2])
+    w, sat_rate = limit_norm(w, w_max)
     # inside the limits the set point is reached exactly (not just to rounding)
     q = q_sp if full and sat_rate + sat_angacc == 0 else qintegrate(q_prev, w, dt)
     return q, w, sat_rate, sat_angacc
