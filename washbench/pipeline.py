@@ -267,9 +267,9 @@ def platform_envelope(limits: PlatformLimits) -> PlatformEnvelope:
     # the fastest any wheel can turn with the sphere at its angular-rate limit
     wheel_max = float(np.max(np.linalg.norm(jac, axis=1)) * math.radians(limits.rotation.rate_limit_degps))
     return PlatformEnvelope(
-        pos_m=(t.position_limit_m.x, t.position_limit_m.y, t.position_limit_m.z),
-        vel_mps=(t.velocity_limit_mps.x, t.velocity_limit_mps.y, t.velocity_limit_mps.z),
-        acc_mps2=(t.acceleration_limit_mps2.x, t.acceleration_limit_mps2.y, t.acceleration_limit_mps2.z),
+        pos_m=t.position_limit_m.xyz,
+        vel_mps=t.velocity_limit_mps.xyz,
+        acc_mps2=t.acceleration_limit_mps2.xyz,
         wheel_radps=wheel_max,
         sphere_diameter_m=limits.sphere_diameter_m,
     )

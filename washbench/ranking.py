@@ -34,11 +34,10 @@ from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
 from washbench.cueing.params import WASHOUT_NAMES
-from washbench.metrics import MetricRow
+from washbench.metrics import DOFS, MetricRow
 
-TRANSLATIONAL_DOFS = ("surge", "sway", "heave")
-ROTATIONAL_DOFS = ("roll", "pitch", "yaw")
-DOFS = TRANSLATIONAL_DOFS + ROTATIONAL_DOFS
+TRANSLATIONAL_DOFS = DOFS[:3]  # surge, sway, heave
+ROTATIONAL_DOFS = DOFS[3:]  # roll, pitch, yaw
 METRICS = ("npc", "integral_error", "max_error")
 REFERENCE_WASHOUT = "small-angle"
 

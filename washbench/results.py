@@ -422,7 +422,8 @@ def read_traces(path: str | Path) -> dict[str, np.ndarray]:
     return {name: t.column(name).to_numpy(zero_copy_only=False) for name in t.column_names}
 
 
-def _fmt(x: float) -> str:
+def csv_number(x: float) -> str:
+    """A float for CSV: full precision (repr, so reading back is exact); NaN as an empty field."""
     return "" if math.isnan(x) else repr(float(x))
 
 
@@ -432,7 +433,7 @@ def metrics_csv_text(rows: Iterable[MetricRow]) -> str:
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(METRICS_COLUMNS)
     for r in rows:
-        w.writerow([r.washout, r.dof, _fmt(r.npc), _fmt(r.integral_error), _fmt(r.max_error)])
+        w.writerow([r.washout, r.dof, csv_number(r.npc), csv_number(r.integral_error), csv_number(r.max_error)])
     return buf.getvalue()
 
 

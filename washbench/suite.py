@@ -44,6 +44,7 @@ from washbench.ranking import (
     rank,
     wins,
 )
+from washbench.results import csv_number
 
 
 @dataclass
@@ -153,10 +154,6 @@ def _short(path: str) -> str:
         return path
 
 
-def _fmt(x: float) -> str:
-    return "" if math.isnan(x) else repr(float(x))
-
-
 def _csv(rows: list[list[str]]) -> str:
     buf = io.StringIO()
     csv.writer(buf, lineterminator="\n").writerows(rows)
@@ -178,9 +175,9 @@ def metrics_table(outcomes: Sequence[Outcome]) -> str:
                     o.run.manoeuvre,
                     m.washout,
                     m.dof,
-                    _fmt(m.npc),
-                    _fmt(m.integral_error),
-                    _fmt(m.max_error),
+                    csv_number(m.npc),
+                    csv_number(m.integral_error),
+                    csv_number(m.max_error),
                 ]
             )
     return _csv(rows)
@@ -196,8 +193,8 @@ def comparison_table(outcomes: Sequence[Outcome]) -> str:
         for c in compare(o.run.metrics):
             rows.append(
                 [o.run.aircraft, o.run.manoeuvre, c.dof, c.metric]
-                + [_fmt(c.values.get(w, math.nan)) for w in washouts]
-                + [_fmt(c.better_than_reference.get(w, math.nan)) for w in others]
+                + [csv_number(c.values.get(w, math.nan)) for w in washouts]
+                + [csv_number(c.better_than_reference.get(w, math.nan)) for w in others]
             )
     return _csv(rows)
 
@@ -207,7 +204,7 @@ def ranking_table(rankings: dict[tuple[str, str], list[RankRow]]) -> str:
     rows = [["aircraft", "manoeuvre", "rank", "washout", "score"]]
     for (aircraft, manoeuvre), ranking in rankings.items():
         for r in ranking:
-            rows.append([aircraft, manoeuvre, str(r.rank), r.washout, _fmt(r.score)])
+            rows.append([aircraft, manoeuvre, str(r.rank), r.washout, csv_number(r.score)])
     return _csv(rows)
 
 

@@ -17,7 +17,6 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
@@ -83,10 +82,6 @@ def _check_dt(dt_s: float) -> float:
     return dt
 
 
-def _xyz(axes: Any) -> tuple[float, float, float]:
-    return (axes.x, axes.y, axes.z)
-
-
 def _build_arrays(
     names: tuple[str, ...], params: WashoutParams, limits: PlatformLimits, dt: float
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -107,9 +102,9 @@ def _build_arrays(
     common[C_COSMIN] = params.small_angle.min_cos_pitch
     common[C_FREEFALL] = params.free_fall_threshold_mps2
     common[C_R : C_R + 3] = params.head.offset_m
-    common[C_PMAX : C_PMAX + 3] = _xyz(lim.position_limit_m)
-    common[C_VMAX : C_VMAX + 3] = _xyz(lim.velocity_limit_mps)
-    common[C_AMAX : C_AMAX + 3] = _xyz(lim.acceleration_limit_mps2)
+    common[C_PMAX : C_PMAX + 3] = lim.position_limit_m.xyz
+    common[C_VMAX : C_VMAX + 3] = lim.velocity_limit_mps.xyz
+    common[C_AMAX : C_AMAX + 3] = lim.acceleration_limit_mps2.xyz
     common[C_WMAX] = math.radians(limits.rotation.rate_limit_degps)
     common[C_ALPHA] = math.radians(limits.rotation.acceleration_limit_degps2)
     common[C_CATCH] = limits.rotation.catch_up_fraction
@@ -117,7 +112,7 @@ def _build_arrays(
     cfg = np.tile(common, (len(names), 1))
 
     coef = np.zeros((len(names), NFILT, filters.NCOEF))
-    for j, wn in enumerate(_xyz(params.translational_highpass_wn_radps)):
+    for j, wn in enumerate(params.translational_highpass_wn_radps.xyz):
         coef[:, F_TRANS_HP + j] = filters.discretise(filters.translational_highpass(wn), dt)
     derivative = filters.discretise(filters.derivative_estimator(params.head.derivative_wn_radps), dt)
     coef[:, F_EULER_D : F_EULER_D + 3] = derivative

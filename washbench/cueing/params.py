@@ -46,6 +46,11 @@ class TranslationalAxes(StrictModel):
     y: Positive
     z: Positive
 
+    @property
+    def xyz(self) -> tuple[float, float, float]:
+        """The three values in axis order (x, y, z)."""
+        return (self.x, self.y, self.z)
+
 
 class RotationalAxes(StrictModel):
     """One value per rotational axis."""

@@ -28,6 +28,11 @@ class Axes(StrictModel):
     y: Positive
     z: Positive
 
+    @property
+    def xyz(self) -> tuple[float, float, float]:
+        """The three values in axis order (x, y, z)."""
+        return (self.x, self.y, self.z)
+
 
 class Translation(StrictModel):
     """Three-axis translational stage: symmetric limits about the centre, per axis."""
