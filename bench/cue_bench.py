@@ -22,12 +22,12 @@ import pyarrow as pa
 import pyarrow.csv as pacsv
 import scipy.signal
 
-from washbench.cue import analyse, write_results
 from washbench.cueing import WASHOUT_NAMES, cue_trace, load_washout_params
+from washbench.io.results import read_motion
 from washbench.perception import VestibularModel
 from washbench.perception.vestibular import CanalParams, OtolithParams, canal_tf, otolith_tf
 from washbench.platform import load_platform_limits
-from washbench.results import read_motion
+from washbench.runs.cue import analyse, write_results
 
 DT_S = 1.0 / 120.0
 

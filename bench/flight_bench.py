@@ -17,9 +17,9 @@ from pathlib import Path
 
 from washbench.flight.fdm import make_fdm
 from washbench.flight.fly import fly
+from washbench.flight.manoeuvre import Manoeuvre, load_manoeuvre, pilot_profile_path
 from washbench.flight.profile import load_profile
-from washbench.manoeuvre import Manoeuvre, load_manoeuvre, pilot_profile_path
-from washbench.paths import MANOEUVRES_DIR
+from washbench.io.paths import MANOEUVRES_DIR
 
 
 def bare_steps_per_s(m: Manoeuvre, steps: int) -> float:

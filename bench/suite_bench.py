@@ -24,8 +24,8 @@ from pathlib import Path
 def bare_run(path: str, steps: int) -> float:
     """Seconds of ``steps`` bare ``fdm.run()`` calls from the start of manoeuvre ``path``."""
     from washbench.flight.fdm import make_fdm
+    from washbench.flight.manoeuvre import load_manoeuvre, pilot_profile_path
     from washbench.flight.profile import load_profile
-    from washbench.manoeuvre import load_manoeuvre, pilot_profile_path
 
     m = load_manoeuvre(Path(path))
     fdm, _ = make_fdm(m, load_profile(pilot_profile_path(m.aircraft)))
@@ -42,7 +42,7 @@ def main() -> None:
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
     args = parser.parse_args()
 
-    from washbench.suite import find_manoeuvres, run_suite, write_suite_results
+    from washbench.runs.suite import find_manoeuvres, run_suite, write_suite_results
 
     files = find_manoeuvres(args.inputs)
     with tempfile.TemporaryDirectory() as tmp:

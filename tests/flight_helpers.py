@@ -9,7 +9,7 @@ from textwrap import dedent
 import numpy as np
 
 from washbench.flight.fly import FlightResult
-from washbench.paths import MANOEUVRES_DIR
+from washbench.io.paths import MANOEUVRES_DIR
 
 FT = 0.3048  # m per ft
 

@@ -1,7 +1,7 @@
 """The Columbia-400-like model is the aircraft it claims to be, and the harness that measures it is right.
 
 Every test flies real JSBSim. Published figures and tolerances are stated next to each assertion; the
-sources are listed in aircraft/columbia400/README.md. The same harness (washbench.airdata) is checked
+sources are listed in aircraft/columbia400/README.md. The same harness (washbench.flight.airdata) is checked
 against JSBSim's c172p and the Cessna 172P's published figures, independently of the new model.
 """
 
@@ -12,9 +12,9 @@ import math
 import jsbsim
 import pytest
 
-from washbench import airdata
 from washbench.errors import WashbenchError
-from washbench.paths import AIRCRAFT_DIR
+from washbench.flight import airdata
+from washbench.io.paths import AIRCRAFT_DIR
 
 C400 = "columbia400"
 MAX_WEIGHT = airdata.Loading(gross_weight_lbs=3600.0, payload_pointmass=3)  # baggage point mass

@@ -20,8 +20,8 @@ from scipy.spatial.transform import Rotation
 from washbench.errors import WashbenchError
 from washbench.flight.checks import measure
 from washbench.flight.fly import FlightResult, fly
-from washbench.manoeuvre import Check, load_manoeuvre
-from washbench.paths import MANOEUVRES_DIR
+from washbench.flight.manoeuvre import Check, load_manoeuvre
+from washbench.io.paths import MANOEUVRES_DIR
 
 COLUMBIA = MANOEUVRES_DIR / "columbia400"
 

@@ -10,17 +10,17 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
+from washbench.analysis.metrics import DOFS
 from washbench.cueing import WASHOUT_NAMES
-from washbench.metrics import DOFS
-from washbench.paths import DATA_DIR
-from washbench.perception import VestibularModel
-from washbench.results import (
+from washbench.io.paths import DATA_DIR
+from washbench.io.results import (
     INPUT_COLUMNS,
     read_metrics_csv,
     read_motion,
     read_traces,
     washout_columns,
 )
+from washbench.perception import VestibularModel
 
 G = 9.80665
 DT = 1 / 120

@@ -15,8 +15,8 @@ from flight_helpers import BUNDLED, FT, manoeuvre_id, normal_gravity, phase_mask
 
 from washbench.flight.columns import COLUMN_NAMES
 from washbench.flight.fly import FlightResult, fly, write_flight
-from washbench.manoeuvre import load_manoeuvre
-from washbench.paths import MANOEUVRES_DIR
+from washbench.flight.manoeuvre import load_manoeuvre
+from washbench.io.paths import MANOEUVRES_DIR
 
 C172 = MANOEUVRES_DIR / "c172"
 CUE_COLUMNS = ("t_s", "f_x_mps2", "f_y_mps2", "f_z_mps2", "omega_x_degps", "omega_y_degps", "omega_z_degps")

@@ -11,9 +11,9 @@ import pytest
 from flight_helpers import BUNDLED, manoeuvre_id
 
 from washbench.errors import WashbenchError
-from washbench.manoeuvre import Manoeuvre, load_manoeuvre, manoeuvre_json_schema
-from washbench.paths import MANOEUVRES_DIR
-from washbench.yamlio import read_yaml
+from washbench.flight.manoeuvre import Manoeuvre, load_manoeuvre, manoeuvre_json_schema
+from washbench.io.paths import MANOEUVRES_DIR
+from washbench.io.yamlio import read_yaml
 
 BAD = Path(__file__).parent / "data" / "bad_manoeuvres"
 

@@ -8,7 +8,7 @@ import scipy.stats
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from washbench.metrics import (
+from washbench.analysis.metrics import (
     DOFS,
     dof_metrics,
     integral_abs_error,

@@ -12,8 +12,8 @@ import numpy as np
 import pyarrow.parquet as pq
 import pytest
 
-from washbench.paths import MANOEUVRES_DIR
-from washbench.rerun_log import read_scalar_series, read_text_documents
+from washbench.io.paths import MANOEUVRES_DIR
+from washbench.review.rerun_log import read_scalar_series, read_text_documents
 
 MANOEUVRES = [MANOEUVRES_DIR / "c172" / "coordinated_turn.yaml", MANOEUVRES_DIR / "c172" / "takeoff.yaml"]
 DOF_COLUMNS = {

@@ -20,8 +20,8 @@ from scipy.spatial.transform import Rotation
 
 from washbench.cli import main
 from washbench.errors import WashbenchError
-from washbench.replay import check_recording, find_rerun, start_web_viewer, stop_viewer
-from washbench.rerun_log import MotionSeries, PlatformEnvelope, PlatformSeries, RecordingData, write_recording
+from washbench.review.replay import check_recording, find_rerun, start_web_viewer, stop_viewer
+from washbench.review.rerun_log import MotionSeries, PlatformEnvelope, PlatformSeries, RecordingData, write_recording
 
 HTTP_TIMEOUT_S = 10.0
 

@@ -18,9 +18,9 @@ import pytest
 from rerun.chunk import RrdReader
 from scipy.spatial.transform import Rotation
 
-from washbench import rerun_log
-from washbench.replay import find_rerun
-from washbench.rerun_log import (
+from washbench.review import rerun_log
+from washbench.review.replay import find_rerun
+from washbench.review.rerun_log import (
     AIRCRAFT,
     DOFS,
     ENVELOPE_QUANTITIES,
@@ -318,7 +318,7 @@ def test_write_time_15000_samples_three_washouts(tmp_path):
 def test_rerun_disabled_by_environment_is_an_error_not_an_empty_file(tmp_path):
     code = (
         "import sys; sys.path.insert(0, 'tests'); from test_rerun_log import make_data; "
-        "from washbench.rerun_log import write_recording; "
+        "from washbench.review.rerun_log import write_recording; "
         f"write_recording({str(tmp_path / 'r.rrd')!r}, make_data(n=20))"
     )
     root = Path(__file__).resolve().parent.parent

@@ -8,9 +8,9 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
+from washbench.analysis.metrics import MetricRow
 from washbench.errors import WashbenchError
-from washbench.metrics import MetricRow
-from washbench.results import (
+from washbench.io.results import (
     INPUT_COLUMNS,
     metrics_csv_text,
     read_metrics_csv,
@@ -190,7 +190,7 @@ def test_metrics_csv_exact_round_trip_nan_empty_inf(tmp_path: Path) -> None:
 
 def test_dt_of_a_fixed_step_grid_is_recovered_exactly(tmp_path: Path) -> None:
     """t = k*dt written by a fixed-step simulator gives back dt itself, not the mean step."""
-    from washbench.results import INPUT_COLUMNS, read_motion
+    from washbench.io.results import INPUT_COLUMNS, read_motion
 
     for hz in (30, 47, 120, 333, 1000):
         dt = 1.0 / hz

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from washbench.paths import MANOEUVRES_DIR
+from washbench.io.paths import MANOEUVRES_DIR
 
 GOOD = [MANOEUVRES_DIR / "c172" / "coordinated_turn.yaml", MANOEUVRES_DIR / "c172" / "stall_recovery.yaml"]
 

@@ -7,10 +7,10 @@ import pytest
 import scipy.signal
 
 from washbench.errors import WashbenchError
+from washbench.io.yamlio import load_yaml_model
 from washbench.perception import ZACHARIAS, CanalParams, OtolithParams, VestibularModel, VestibularParams
 from washbench.perception.thresholds import STANDARD_GRAVITY_MPS2, deadband
 from washbench.perception.vestibular import canal_model, otolith_model
-from washbench.yamlio import load_yaml_model
 
 DTS = (1 / 50, 1 / 120, 1 / 1000)
 G = STANDARD_GRAVITY_MPS2

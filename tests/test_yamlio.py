@@ -6,7 +6,7 @@ from typing import Literal
 import pytest
 
 from washbench.errors import WashbenchError
-from washbench.yamlio import StrictModel, load_yaml_model
+from washbench.io.yamlio import StrictModel, load_yaml_model
 
 
 class Hold(StrictModel):

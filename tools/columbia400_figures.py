@@ -2,17 +2,17 @@
 
     .venv/bin/python tools/columbia400_figures.py
 
-Flies real JSBSim with :mod:`washbench.airdata` and replaces the text between the markers
+Flies real JSBSim with :mod:`washbench.flight.airdata` and replaces the text between the markers
 ``<!-- figures:begin -->`` and ``<!-- figures:end -->`` in ``aircraft/columbia400/README.md``.
 The tolerances are the ones tests/test_columbia400.py asserts.
 """
 
 from __future__ import annotations
 
-from washbench import airdata
-from washbench.atomic import write_text_atomic
 from washbench.errors import WashbenchError
-from washbench.paths import AIRCRAFT_DIR
+from washbench.flight import airdata
+from washbench.io.atomic import write_text_atomic
+from washbench.io.paths import AIRCRAFT_DIR
 
 BEGIN, END = "<!-- figures:begin -->", "<!-- figures:end -->"
 MAX_WEIGHT = airdata.Loading(3600.0, 3)

@@ -31,8 +31,8 @@ import itertools
 import numpy as np
 from scipy.optimize import brentq
 
-from washbench.atomic import write_text_atomic
-from washbench.paths import AIRCRAFT_DIR
+from washbench.io.atomic import write_text_atomic
+from washbench.io.paths import AIRCRAFT_DIR
 
 BLADES = 3
 CHORD_OVER_D = 0.065

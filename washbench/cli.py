@@ -73,7 +73,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _dispatch(args: argparse.Namespace) -> int:
     if args.command == "cue":
-        from washbench.cue import run_cue
+        from washbench.runs.cue import run_cue
 
         run_cue(args.input, args.out, washouts=args.washout, params_path=args.params, platform_path=args.platform)
         return 0
@@ -82,21 +82,21 @@ def _dispatch(args: argparse.Namespace) -> int:
 
         return fly_command(args.manoeuvre, args.out, progress=not args.quiet)
     if args.command == "validate":
-        from washbench.manoeuvre import validate_command
+        from washbench.flight.manoeuvre import validate_command
 
         return validate_command(args.manoeuvres)
     if args.command == "schema":
-        from washbench.manoeuvre import schema_command
+        from washbench.flight.manoeuvre import schema_command
 
         return schema_command(args.out)
     if args.command == "run":
-        from washbench.pipeline import run_command
+        from washbench.runs.pipeline import run_command
 
         return run_command(
             args.manoeuvre, args.out, params_path=args.params, platform_path=args.platform, progress=not args.quiet
         )
     if args.command == "suite":
-        from washbench.suite import suite_command
+        from washbench.runs.suite import suite_command
 
         return suite_command(
             args.inputs,
@@ -107,7 +107,7 @@ def _dispatch(args: argparse.Namespace) -> int:
             progress=not args.quiet,
         )
     if args.command == "replay":
-        from washbench.replay import replay_command
+        from washbench.review.replay import replay_command
 
         return replay_command(args.recording, web=args.web)
     raise AssertionError(f"unhandled command {args.command}")  # unreachable: argparse restricts choices

@@ -14,8 +14,8 @@ from typing import Annotated
 from pydantic import Field
 
 from washbench.errors import WashbenchError
-from washbench.paths import DATA_DIR
-from washbench.yamlio import StrictModel, load_yaml_model
+from washbench.io.paths import DATA_DIR
+from washbench.io.yamlio import StrictModel, load_yaml_model
 
 WASHOUT_NAMES: tuple[str, ...] = ("small-angle", "large-angle", "unrestricted")
 DEFAULT_PARAMS_PATH = DATA_DIR / "cw1.yaml"

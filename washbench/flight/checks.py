@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from washbench.manoeuvre import Check
+from washbench.flight.manoeuvre import Check
 
 
 @dataclass(frozen=True)

@@ -17,9 +17,9 @@ from typing import Any
 
 from washbench.errors import WashbenchError
 from washbench.flight.geo import DEFAULT_LATITUDE_DEG, DEFAULT_LONGITUDE_DEG, LocalFrame
+from washbench.flight.manoeuvre import Hold, Manoeuvre, aircraft_path, jsbsim_root
 from washbench.flight.pilot import Pilot
 from washbench.flight.profile import PilotProfile
-from washbench.manoeuvre import Hold, Manoeuvre, aircraft_path, jsbsim_root
 
 KT_TO_FPS = 1852.0 / 3600.0 / 0.3048
 FT_TO_M = 0.3048

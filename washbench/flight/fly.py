@@ -20,15 +20,15 @@ from pathlib import Path
 
 import numpy as np
 
-from washbench.atomic import atomic_path, write_text_atomic
 from washbench.errors import WashbenchError
 from washbench.flight.checks import evaluate
 from washbench.flight.columns import COLUMN_NAMES
 from washbench.flight.fdm import make_fdm
+from washbench.flight.manoeuvre import Manoeuvre, Until, load_manoeuvre, pilot_profile_path
 from washbench.flight.monitor import Monitor
 from washbench.flight.pilot import Pilot
 from washbench.flight.profile import load_profile
-from washbench.manoeuvre import Manoeuvre, Until, load_manoeuvre, pilot_profile_path
+from washbench.io.atomic import atomic_path, write_text_atomic
 
 FT_S2_TO_M_S2 = 0.3048
 R2D = 180.0 / math.pi

@@ -47,8 +47,8 @@ from __future__ import annotations
 import math
 
 from washbench.flight.geo import wrap_pi
+from washbench.flight.manoeuvre import Hold, Runway
 from washbench.flight.profile import PilotProfile
-from washbench.manoeuvre import Hold, Runway
 
 D2R = math.pi / 180.0
 G_FPS2 = 32.174

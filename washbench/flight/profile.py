@@ -14,7 +14,7 @@ from typing import Annotated, Literal
 
 from pydantic import Field
 
-from washbench.yamlio import StrictModel, load_yaml_model
+from washbench.io.yamlio import StrictModel, load_yaml_model
 
 Positive = Annotated[float, Field(gt=0)]
 NonNegative = Annotated[float, Field(ge=0)]

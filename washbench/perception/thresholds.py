@@ -27,7 +27,7 @@ import math
 import numpy as np
 from pydantic import Field
 
-from washbench.yamlio import StrictModel
+from washbench.io.yamlio import StrictModel
 
 STANDARD_GRAVITY_MPS2 = 9.80665
 """Resting specific force magnitude used as the dead band's reference for heave [m/s^2]."""

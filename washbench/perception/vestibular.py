@@ -37,8 +37,8 @@ import numpy as np
 import scipy.signal
 from pydantic import Field
 
+from washbench.io.yamlio import StrictModel
 from washbench.perception.thresholds import Thresholds, apply_deadband
-from washbench.yamlio import StrictModel
 
 
 class OtolithParams(StrictModel):

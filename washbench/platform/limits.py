@@ -12,8 +12,8 @@ from typing import Annotated
 import numpy as np
 from pydantic import Field
 
-from washbench.paths import DATA_DIR
-from washbench.yamlio import StrictModel, load_yaml_model
+from washbench.io.paths import DATA_DIR
+from washbench.io.yamlio import StrictModel, load_yaml_model
 
 DEFAULT_LIMITS_PATH = DATA_DIR / "atlas.yaml"
 

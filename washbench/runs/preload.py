@@ -13,10 +13,6 @@ import pyarrow.parquet  # noqa: F401
 import rerun  # noqa: F401
 import scipy.signal  # noqa: F401
 
-import washbench.cue
-import washbench.flight.fly
-import washbench.pipeline
-import washbench.rerun_log  # noqa: F401
 from washbench.cueing.bank import _warm_up
 
 _warm_up()

@@ -33,8 +33,8 @@ import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
+from washbench.analysis.metrics import DOFS, MetricRow
 from washbench.cueing.params import WASHOUT_NAMES
-from washbench.metrics import DOFS, MetricRow
 
 TRANSLATIONAL_DOFS = DOFS[:3]  # surge, sway, heave
 ROTATIONAL_DOFS = DOFS[3:]  # roll, pitch, yaw

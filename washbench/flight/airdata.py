@@ -33,9 +33,9 @@ import numpy as np
 from scipy.optimize import curve_fit
 
 from washbench.errors import WashbenchError
-from washbench.manoeuvre import aircraft_path, jsbsim_root
-from washbench.paths import AIRCRAFT_DIR
-from washbench.yamlio import StrictModel, load_yaml_model
+from washbench.flight.manoeuvre import aircraft_path, jsbsim_root
+from washbench.io.paths import AIRCRAFT_DIR
+from washbench.io.yamlio import StrictModel, load_yaml_model
 
 DT_S = 1.0 / 120.0
 

@@ -33,8 +33,8 @@ import pyarrow.compute as pc
 import rerun as rr
 import rerun.blueprint as rrb
 
-from washbench.atomic import atomic_path
 from washbench.errors import WashbenchError, located
+from washbench.io.atomic import atomic_path
 
 __all__ = [
     "AIRCRAFT",

@@ -42,9 +42,9 @@ import pyarrow.compute as pc
 import pyarrow.csv as pacsv
 import pyarrow.parquet as pq
 
-from washbench.atomic import atomic_path, write_text_atomic
+from washbench.analysis.metrics import MetricRow
 from washbench.errors import WashbenchError, located
-from washbench.metrics import MetricRow
+from washbench.io.atomic import atomic_path, write_text_atomic
 
 AXES = ("x", "y", "z")
 TIME_COLUMN = "t_s"

@@ -19,11 +19,10 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from washbench.atomic import atomic_path
+from washbench.analysis.metrics import MetricRow, dof_metrics
 from washbench.errors import WashbenchError, located
-from washbench.metrics import MetricRow, dof_metrics
-from washbench.perception.vestibular import Perceived, VestibularModel, VestibularParams
-from washbench.results import (
+from washbench.io.atomic import atomic_path
+from washbench.io.results import (
     AIRCRAFT,
     TIME_COLUMN,
     Motion,
@@ -44,6 +43,7 @@ from washbench.results import (
     write_metrics_csv,
     write_traces,
 )
+from washbench.perception.vestibular import Perceived, VestibularModel, VestibularParams
 
 TRACES_FILE = "traces.parquet"
 METRICS_FILE = "metrics.csv"
@@ -73,8 +73,8 @@ class CueResult:
     """Everything ``washbench cue`` computes for one input trace.
 
     ``perceived``: pilot name (``"aircraft"`` or a washout name) -> perceived motion;
-    ``metrics``: six rows per washout (:mod:`washbench.metrics`); ``table``: the traces.parquet
-    columns in order (:mod:`washbench.results`); ``traces``: the washout traces themselves.
+    ``metrics``: six rows per washout (:mod:`washbench.analysis.metrics`); ``table``: the traces.parquet
+    columns in order (:mod:`washbench.io.results`); ``traces``: the washout traces themselves.
     """
 
     motion: Motion

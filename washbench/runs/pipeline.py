@@ -4,7 +4,7 @@ At every JSBSim step the scripted pilot's flight gives one sample of pilot-head 
 sample goes straight through the three washouts and the kinematic Atlas model
 (:class:`washbench.cueing.CueingBank`, the streaming form), as a real simulator would run them.
 After the flight the vestibular models, the metrics and the tables are the same code as
-``washbench cue`` (:func:`washbench.cue.analyse`), on the flight as written to
+``washbench cue`` (:func:`washbench.runs.cue.analyse`), on the flight as written to
 ``flight.parquet`` and read back, so ``washbench fly`` then ``washbench cue`` gives the same
 numbers bit for bit.
 
@@ -36,17 +36,17 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from washbench.atomic import write_text_atomic
+from washbench.analysis.metrics import MetricRow, integral_abs_error
+from washbench.analysis.ranking import DOFS
 from washbench.errors import WashbenchError, located
-from washbench.metrics import MetricRow, integral_abs_error
-from washbench.ranking import DOFS
+from washbench.io.atomic import write_text_atomic
 
 if TYPE_CHECKING:
-    from washbench.cue import CueResult
     from washbench.flight.fly import FlightResult
+    from washbench.io.results import Motion
     from washbench.platform import PlatformLimits
-    from washbench.rerun_log import PlatformEnvelope
-    from washbench.results import Motion
+    from washbench.review.rerun_log import PlatformEnvelope
+    from washbench.runs.cue import CueResult
 
 RUN_FILES = ("flight.json", "flight.parquet", "traces.parquet", "metrics.csv", "recording.rrd", "run.json")
 
@@ -128,12 +128,12 @@ def run_manoeuvre(
     A flight that crashes or fails a check still writes its results (what was flown), with
     ``ok`` False and the reason.
     """
-    from washbench.cue import analyse, write_results
     from washbench.cueing import WASHOUT_NAMES, CueingBank, WashoutTrace, load_washout_params
     from washbench.flight.fly import fly, write_flight
-    from washbench.manoeuvre import load_manoeuvre
+    from washbench.flight.manoeuvre import load_manoeuvre
+    from washbench.io.results import read_motion
     from washbench.platform import load_platform_limits
-    from washbench.results import read_motion
+    from washbench.runs.cue import analyse, write_results
 
     manoeuvre = load_manoeuvre(manoeuvre_path)
     params = load_washout_params(params_path)
@@ -219,7 +219,7 @@ def _write_run_json(path: Path, s: RunSummary, wall_s: float) -> None:
 def _write_recording(
     path: Path, title: str, motion: Motion, flight: FlightResult, result: CueResult, limits: PlatformLimits
 ) -> None:
-    from washbench.rerun_log import MotionSeries, PlatformSeries, RecordingData, write_recording
+    from washbench.review.rerun_log import MotionSeries, PlatformSeries, RecordingData, write_recording
 
     cols = flight.columns
     ac_q = aircraft_attitude(cols["phi_deg"], cols["theta_deg"], cols["psi_deg"])
@@ -260,7 +260,7 @@ def _write_recording(
 def platform_envelope(limits: PlatformLimits) -> PlatformEnvelope:
     """The recording's envelope lines from the platform limits (wheel limit from the rate limit)."""
     from washbench.platform.limits import wheel_jacobian
-    from washbench.rerun_log import PlatformEnvelope
+    from washbench.review.rerun_log import PlatformEnvelope
 
     t = limits.translation
     jac = wheel_jacobian(limits)

@@ -1,6 +1,6 @@
 """``washbench suite``: many manoeuvres in parallel processes, then a comparison of the washouts.
 
-Each manoeuvre runs through :func:`washbench.pipeline.run_manoeuvre` in its own worker process
+Each manoeuvre runs through :func:`washbench.runs.pipeline.run_manoeuvre` in its own worker process
 and writes ``OUT/<aircraft>/<manoeuvre>/`` (published atomically as a whole folder). A manoeuvre
 that fails (bad file, crash, divergence, failed check, or an unexpected error) is reported with its
 reason; the others still complete and are kept. Then the suite writes, each file atomically:
@@ -9,7 +9,7 @@ reason; the others still complete and are kept. Then the suite writes, each file
 - ``OUT/comparison.csv``: every metric per washout and DOF with its difference from small-angle
   (positive = better than small-angle), like the paper's Table 4
 - ``OUT/ranking.csv``: the three washouts ranked per manoeuvre by the rule of
-  :mod:`washbench.ranking`
+  :mod:`washbench.analysis.ranking`
 - ``OUT/report.md``: all of it, with links to each recording, written last.
 
 The exit status is 0 only if every manoeuvre ran and passed its checks.
@@ -30,12 +30,7 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
 
-from washbench.atomic import write_text_atomic
-from washbench.cueing.params import WASHOUT_NAMES
-from washbench.errors import WashbenchError, located
-from washbench.paths import MANOEUVRES_DIR
-from washbench.pipeline import RunSummary
-from washbench.ranking import (
+from washbench.analysis.ranking import (
     DOFS,
     METRICS,
     REFERENCE_WASHOUT,
@@ -44,7 +39,12 @@ from washbench.ranking import (
     rank,
     wins,
 )
-from washbench.results import csv_number
+from washbench.cueing.params import WASHOUT_NAMES
+from washbench.errors import WashbenchError, located
+from washbench.io.atomic import write_text_atomic
+from washbench.io.paths import MANOEUVRES_DIR
+from washbench.io.results import csv_number
+from washbench.runs.pipeline import RunSummary
 
 
 @dataclass
@@ -76,7 +76,7 @@ def find_manoeuvres(inputs: Sequence[Path]) -> list[Path]:
 
 def _run_one(path: str, out_dir: str, params_path: str | None, platform_path: str | None) -> Outcome:
     """Worker: run one manoeuvre; never raises (failures come back as an Outcome)."""
-    from washbench.pipeline import run_manoeuvre
+    from washbench.runs.pipeline import run_manoeuvre
 
     start = time.perf_counter()
     try:
@@ -126,7 +126,7 @@ def run_suite(
         ctx = multiprocessing.get_context("forkserver")
         # Workers fork from a server that has already imported the heavy modules (JSBSim, numba
         # kernels, rerun, pyarrow), so each worker starts in milliseconds instead of seconds.
-        ctx.set_forkserver_preload(["washbench.preload"])
+        ctx.set_forkserver_preload(["washbench.runs.preload"])
         with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as pool:
             futures = [pool.submit(_run_one, *a) for a in args]
             for fut in as_completed(futures):
@@ -226,7 +226,7 @@ def report_markdown(outcomes: Sequence[Outcome], rankings: dict[tuple[str, str],
         "integral and maximum of |error| in m/s^2 (integral m/s^2*s) for surge, sway, heave and deg/s",
         "(integral deg) for roll, pitch, yaw. In the comparison, `better by` is small-angle minus the",
         "washout: positive means better than small-angle. The score (lower is better) is the weighted",
-        "relative integral error of `washbench/ranking.py`: each DOF's error over the aircraft pilot's own",
+        "relative integral error of `washbench/analysis/ranking.py`: each DOF's error over the aircraft pilot's own",
         "perceived motion in it, DOFs weighted by how much was felt there (half the weight to specific",
         "force, half to rotation); a DOF the pilot did not feel weighs nothing.",
         "",

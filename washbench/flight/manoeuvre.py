@@ -21,12 +21,12 @@ from typing import Annotated, Any, Literal, get_args
 
 from pydantic import Field
 
-from washbench.atomic import write_text_atomic
 from washbench.errors import WashbenchError, located
 from washbench.flight.columns import COLUMN_NAMES, RUNWAY_COLUMNS
 from washbench.flight.profile import PilotProfile, load_profile
-from washbench.paths import AIRCRAFT_DIR, DATA_DIR
-from washbench.yamlio import Loc, StrictModel, format_field_path, line_of, read_yaml, validate_data
+from washbench.io.atomic import write_text_atomic
+from washbench.io.paths import AIRCRAFT_DIR, DATA_DIR
+from washbench.io.yamlio import Loc, StrictModel, format_field_path, line_of, read_yaml, validate_data
 
 Positive = Annotated[float, Field(gt=0)]
 NonNegative = Annotated[float, Field(ge=0)]

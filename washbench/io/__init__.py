@@ -1,0 +1,1 @@
+"""The ground floor: on-disk formats and their checks, atomic writes, where files are found."""

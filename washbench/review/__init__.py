@@ -1,0 +1,1 @@
+"""What a person looks at: the rerun recording and blueprint, replay."""

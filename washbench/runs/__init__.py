@@ -1,0 +1,1 @@
+"""What joins the stages: run (lockstep), cue, suite and its process pool."""
