@@ -65,6 +65,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
     p.add_argument("--quiet", action="store_true", help="no progress display")
 
+    p = sub.add_parser("report", help="write report.md and its figures again from existing results (no flying)")
+    p.add_argument("results", type=Path, help="a result folder (washbench run / cue) or a suite folder")
+
     p = sub.add_parser("replay", help="open a recording in the rerun viewer")
     p.add_argument("recording", type=Path, help=".rrd file written by washbench run or suite")
     p.add_argument("--web", action="store_true", help="always use the web viewer")
@@ -106,6 +109,10 @@ def _dispatch(args: argparse.Namespace) -> int:
             platform_path=args.platform,
             progress=not args.quiet,
         )
+    if args.command == "report":
+        from washbench.review.report import report_command
+
+        return report_command(args.results)
     if args.command == "replay":
         from washbench.review.replay import replay_command
 

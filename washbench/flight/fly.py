@@ -14,7 +14,7 @@ import math
 import sys
 import time
 from array import array
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -29,6 +29,7 @@ from washbench.flight.monitor import Monitor
 from washbench.flight.pilot import Pilot
 from washbench.flight.profile import load_profile
 from washbench.io.atomic import atomic_path, write_text_atomic
+from washbench.io.provenance import build_provenance, parquet_metadata
 
 FT_S2_TO_M_S2 = 0.3048
 R2D = 180.0 / math.pi
@@ -368,8 +369,13 @@ def flight_summary(result: FlightResult, source: str = "") -> dict[str, object]:
     }
 
 
-def write_flight(out_dir: str | Path, result: FlightResult, source: str = "") -> None:
-    """Write ``out_dir/flight.parquet`` and ``out_dir/flight.json`` atomically."""
+def write_flight(
+    out_dir: str | Path, result: FlightResult, source: str = "", provenance: Mapping[str, object] | None = None
+) -> None:
+    """Write ``out_dir/flight.parquet`` and ``out_dir/flight.json`` atomically.
+
+    ``provenance`` (:mod:`washbench.io.provenance`, no date) goes into the Parquet metadata and flight.json.
+    """
     import pyarrow as pa
     import pyarrow.parquet as pq
 
@@ -379,10 +385,16 @@ def write_flight(out_dir: str | Path, result: FlightResult, source: str = "") ->
     except OSError as exc:
         raise WashbenchError(f"{out}: cannot create the output folder ({exc.strerror or exc})") from None
     table = pa.table({name: result.columns[name] for name in COLUMN_NAMES})
-    table = table.replace_schema_metadata({"washbench.manoeuvre": result.name, "washbench.aircraft": result.aircraft})
+    meta = {b"washbench.manoeuvre": result.name.encode(), b"washbench.aircraft": result.aircraft.encode()}
+    if provenance:
+        meta.update(parquet_metadata(provenance))
+    table = table.replace_schema_metadata(meta)
     with atomic_path(out / "flight.parquet") as tmp:
         pq.write_table(table, tmp)
-    write_text_atomic(out / "flight.json", json.dumps(flight_summary(result, source), indent=2) + "\n")
+    summary = flight_summary(result, source)
+    if provenance:
+        summary["provenance"] = dict(provenance)
+    write_text_atomic(out / "flight.json", json.dumps(summary, indent=2) + "\n")
 
 
 def fly_command(manoeuvre_path: Path, out_dir: Path, progress: bool = True) -> int:
@@ -392,7 +404,8 @@ def fly_command(manoeuvre_path: Path, out_dir: Path, progress: bool = True) -> i
     wall = time.monotonic()
     result = fly(m, progress=show)
     wall = time.monotonic() - wall
-    write_flight(out_dir, result, str(manoeuvre_path))
+    prov = build_provenance(manoeuvre_path=manoeuvre_path, turbulence=m.environment.turbulence)
+    write_flight(out_dir, result, str(manoeuvre_path), prov)
     passed = sum(1 for c in result.checks if c[3])
     line = (
         f"{m.name} ({m.aircraft}): {result.status}, {passed}/{len(m.checks)} checks passed, "

@@ -406,9 +406,16 @@ def read_motion(path: str | Path) -> Motion:
 # --------------------------------------------------------------------------- writers and readers
 
 
-def write_traces(path: str | Path, table: Mapping[str, np.ndarray]) -> None:
-    """Write the traces table (column name -> 1-D array, all the same length) to Parquet, atomically."""
+def write_traces(
+    path: str | Path, table: Mapping[str, np.ndarray], metadata: Mapping[bytes, bytes] | None = None
+) -> None:
+    """Write the traces table (column name -> 1-D array, all the same length) to Parquet, atomically.
+
+    ``metadata``: the schema's key-value metadata (provenance, :func:`washbench.io.provenance.parquet_metadata`).
+    """
     arrow = pa.table({name: pa.array(np.asarray(col)) for name, col in table.items()})
+    if metadata:
+        arrow = arrow.replace_schema_metadata(dict(metadata))
     floats = [f.name for f in arrow.schema if pa.types.is_floating(f.type)]
     others = [name for name in arrow.column_names if name not in set(floats)]
     with atomic_path(path) as tmp:

@@ -185,11 +185,16 @@ def check_washout_names(names: Sequence[str] | None) -> tuple[str, ...]:
     return check_washouts(dict.fromkeys(names) if names else WASHOUT_NAMES)
 
 
-def write_results(out_dir: Path, result: CueResult) -> tuple[Path, Path]:
+def write_results(
+    out_dir: Path, result: CueResult, provenance: Mapping[str, Any] | None = None
+) -> tuple[Path, Path]:
     """Write traces.parquet and metrics.csv into ``out_dir`` (created if missing), both or neither.
 
     Each file is written to a temporary name and renamed into place only after both are complete.
+    ``provenance`` (:mod:`washbench.io.provenance`, no date) goes into the Parquet key-value metadata.
     """
+    from washbench.io.provenance import parquet_metadata
+
     out_dir = Path(out_dir)
     traces_path, metrics_path = out_dir / TRACES_FILE, out_dir / METRICS_FILE
     if out_dir.exists() and not out_dir.is_dir():
@@ -197,7 +202,7 @@ def write_results(out_dir: Path, result: CueResult) -> tuple[Path, Path]:
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
         with atomic_path(traces_path) as tmp_traces, atomic_path(metrics_path) as tmp_metrics:
-            write_traces(tmp_traces, result.table)
+            write_traces(tmp_traces, result.table, parquet_metadata(provenance) if provenance else None)
             write_metrics_csv(tmp_metrics, result.metrics)
     except OSError as exc:
         raise WashbenchError(located(out_dir, f"cannot write results: {exc.strerror or exc}")) from None
@@ -216,14 +221,25 @@ def run_cue(
     Raises WashbenchError (one line) for bad names, parameter files or input; writes nothing then.
     """
     from washbench.cueing import load_washout_params
+    from washbench.cueing.params import DEFAULT_PARAMS_PATH
+    from washbench.io.provenance import build_provenance, read_parquet_provenance
     from washbench.platform import load_platform_limits
+    from washbench.platform.limits import DEFAULT_LIMITS_PATH
 
     names = check_washout_names(washouts)
     params = load_washout_params(params_path)
     limits = load_platform_limits(platform_path)
     motion = read_motion(input_path)
     result = cue_motion(motion, names, params, limits)
-    traces_path, metrics_path = write_results(out_dir, result)
+    prov = build_provenance(
+        params_path=params_path or DEFAULT_PARAMS_PATH,
+        params=params,
+        platform_path=platform_path or DEFAULT_LIMITS_PATH,
+        platform=limits,
+        input_path=input_path,
+        input_provenance=read_parquet_provenance(input_path) if input_path.suffix.lower() != ".csv" else None,
+    )
+    traces_path, metrics_path = write_results(out_dir, result, prov)
     print(
         f"{input_path}: {motion.n} rows, {motion.duration_s:.3f} s at dt = {motion.dt_s:.6g} s "
         f"({1.0 / motion.dt_s:.6g} Hz)"

@@ -40,6 +40,7 @@ from washbench.analysis.metrics import MetricRow, integral_abs_error
 from washbench.analysis.ranking import DOFS
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
+from washbench.io.provenance import build_provenance, utc_now
 
 if TYPE_CHECKING:
     from washbench.flight.fly import FlightResult
@@ -121,6 +122,7 @@ def run_manoeuvre(
     params_path: Path | None = None,
     platform_path: Path | None = None,
     progress: bool = False,
+    figures: bool = True,
 ) -> RunSummary:
     """Fly one manoeuvre with the washouts in lockstep and write its results folder.
 
@@ -129,15 +131,27 @@ def run_manoeuvre(
     ``ok`` False and the reason.
     """
     from washbench.cueing import WASHOUT_NAMES, CueingBank, WashoutTrace, load_washout_params
+    from washbench.cueing.params import DEFAULT_PARAMS_PATH
     from washbench.flight.fly import fly, write_flight
     from washbench.flight.manoeuvre import load_manoeuvre
     from washbench.io.results import read_motion
     from washbench.platform import load_platform_limits
+    from washbench.platform.limits import DEFAULT_LIMITS_PATH
     from washbench.runs.cue import analyse, write_results
 
     manoeuvre = load_manoeuvre(manoeuvre_path)
     params = load_washout_params(params_path)
     limits = load_platform_limits(platform_path)
+    turbulence = manoeuvre.environment.turbulence
+    flight_prov = build_provenance(manoeuvre_path=manoeuvre_path, turbulence=turbulence)
+    prov = build_provenance(
+        manoeuvre_path=manoeuvre_path,
+        turbulence=turbulence,
+        params_path=params_path or DEFAULT_PARAMS_PATH,
+        params=params,
+        platform_path=platform_path or DEFAULT_LIMITS_PATH,
+        platform=limits,
+    )
     washouts = tuple(WASHOUT_NAMES)
     bank = CueingBank(washouts, params, limits, manoeuvre.dt_s)
     rows: list[np.ndarray] = []
@@ -161,14 +175,14 @@ def run_manoeuvre(
     shutil.rmtree(partial, ignore_errors=True)
     partial.mkdir(parents=True)
     try:
-        write_flight(partial, flight, str(manoeuvre_path))
+        write_flight(partial, flight, str(manoeuvre_path), flight_prov)
         if n < 2:
             raise WashbenchError(located(manoeuvre_path, f"the flight recorded {n} sample(s): nothing to cue"))
         motion = read_motion(partial / "flight.parquet")
         block = np.stack(rows)  # (N, washouts, fields)
         traces = {w: WashoutTrace.from_rows(block[:, i, :]) for i, w in enumerate(washouts)}
         result = analyse(motion, traces)
-        write_results(partial, result)
+        write_results(partial, result, prov)
         title = f"{manoeuvre.aircraft} / {manoeuvre.name}"
         _write_recording(partial / "recording.rrd", title, motion, flight, result, limits)
         felt = perceived_motion(
@@ -189,7 +203,11 @@ def run_manoeuvre(
             motion=felt,
             saturations={w: dict(traces[w].saturation_counts) for w in washouts},
         )
-        _write_run_json(partial / "run.json", summary, time.perf_counter() - start)
+        _write_run_json(partial / "run.json", summary, time.perf_counter() - start, prov)
+        if figures:
+            from washbench.review.report import write_result_report
+
+            write_result_report(partial)
         _publish(partial, final)
     finally:
         with contextlib.suppress(FileNotFoundError):
@@ -197,7 +215,7 @@ def run_manoeuvre(
     return summary
 
 
-def _write_run_json(path: Path, s: RunSummary, wall_s: float) -> None:
+def _write_run_json(path: Path, s: RunSummary, wall_s: float, provenance: dict[str, object]) -> None:
     doc = {
         "aircraft": s.aircraft,
         "manoeuvre": s.manoeuvre,
@@ -212,6 +230,8 @@ def _write_run_json(path: Path, s: RunSummary, wall_s: float) -> None:
             d: {"value": v, "unit": "m/s^2*s" if d in DOFS[:3] else "deg"} for d, v in s.motion.items()
         },
         "saturations": s.saturations,
+        "created_utc": utc_now(),
+        "provenance": provenance,
     }
     write_text_atomic(path, json.dumps(doc, indent=2) + "\n")
 

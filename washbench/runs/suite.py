@@ -10,7 +10,9 @@ reason; the others still complete and are kept. Then the suite writes, each file
   (positive = better than small-angle), like the paper's Table 4
 - ``OUT/ranking.csv``: the three washouts ranked per manoeuvre by the rule of
   :mod:`washbench.analysis.ranking`
-- ``OUT/report.md``: all of it, with links to each recording, written last.
+- ``OUT/suite.json``: every manoeuvre file with its status and reason, and the suite's provenance;
+- ``OUT/report.md`` and ``OUT/figures/``: all of it, with the failures first, a score heatmap, the Table-4 figure
+  and each manoeuvre's section, built from the files by :mod:`washbench.review.suite_report` (written last).
 
 The exit status is 0 only if every manoeuvre ran and passed its checks.
 """
@@ -37,7 +39,6 @@ from washbench.analysis.ranking import (
     RankRow,
     compare,
     rank,
-    wins,
 )
 from washbench.cueing.params import WASHOUT_NAMES
 from washbench.errors import WashbenchError, located
@@ -213,93 +214,38 @@ def _washouts(outcomes: Sequence[Outcome]) -> list[str]:
     return [w for w in WASHOUT_NAMES if w in seen] + sorted(seen - set(WASHOUT_NAMES))
 
 
-def report_markdown(outcomes: Sequence[Outcome], rankings: dict[tuple[str, str], list[RankRow]], out_dir: Path) -> str:
-    """``report.md``: status, ranking, Table-4 comparison and metrics of every manoeuvre."""
-    ok = [o for o in outcomes if o.run.ok]
-    lines = [
-        "# washbench suite report",
-        "",
-        f"{len(ok)} of {len(outcomes)} manoeuvres ran and passed their checks.",
-        "",
-        "Metrics compare the aircraft pilot's perceived motion with each simulator pilot's: NPC is the",
-        "normalized Pearson correlation (1 is perfect, larger is worse, empty where a signal is flat),",
-        "integral and maximum of |error| in m/s^2 (integral m/s^2*s) for surge, sway, heave and deg/s",
-        "(integral deg) for roll, pitch, yaw. In the comparison, `better by` is small-angle minus the",
-        "washout: positive means better than small-angle. The score (lower is better) is the weighted",
-        "relative integral error of `washbench/analysis/ranking.py`: each DOF's error over the aircraft pilot's own",
-        "perceived motion in it, DOFs weighted by how much was felt there (half the weight to specific",
-        "force, half to rotation); a DOF the pilot did not feel weighs nothing.",
-        "",
-        "## Summary",
-        "",
-        "| aircraft | manoeuvre | status | checks | best washout | scores (small / large / unrestricted) | recording |",
-        "|---|---|---|---|---|---|---|",
-    ]
-    for o in outcomes:
-        key = (o.run.aircraft, o.run.manoeuvre)
-        ranking = rankings.get(key, [])
-        best = ranking[0].washout if ranking else ""
-        by_name = {r.washout: r.score for r in ranking}
-        scores = " / ".join(f"{by_name[w]:.3f}" if w in by_name else "-" for w in WASHOUT_NAMES)
-        status = "ok" if o.run.ok else "FAILED"
-        rec = ""
-        if o.run.run_dir and (o.run.run_dir / "recording.rrd").exists():
-            rel = os.path.relpath(o.run.run_dir / "recording.rrd", out_dir)
-            rec = f"[recording.rrd]({rel})"
-        name = o.run.manoeuvre or _short(o.path)
-        checks = f"{o.run.checks_passed}/{o.run.checks_total}" if o.run.checks_total else "-"
-        lines.append(f"| {o.run.aircraft or '-'} | {name} | {status} | {checks} | {best} | {scores} | {rec} |")
-    failed = [o for o in outcomes if not o.run.ok]
-    if failed:
-        lines += ["", "## Failures", ""]
-        for o in failed:
-            lines.append(f"- `{_short(o.path)}`: {o.run.reason}")
-    if rankings:
-        count = wins(rankings.values())
-        lines += ["", "Manoeuvres won: " + ", ".join(f"{w} {n}" for w, n in count.items()), ""]
-    for o in _runs_with_metrics(outcomes):
-        lines += ["", f"## {o.run.aircraft} / {o.run.manoeuvre}", ""]
-        if o.run.run_dir:
-            rel = os.path.relpath(o.run.run_dir, out_dir)
-            lines.append(f"Results in `{rel}/`; replay with `washbench replay {rel}/recording.rrd`.")
-            lines.append("")
-        sat = ", ".join(
-            f"{w}: " + (", ".join(f"{k} {n}" for k, n in kinds.items() if n) or "none")
-            for w, kinds in o.run.saturations.items()
-        )
-        if sat:
-            lines += [f"Platform saturations (steps at a limit): {sat}.", ""]
-        lines += _comparison_md(o)
-    return "\n".join(lines) + "\n"
+def write_suite_results(
+    outcomes: Sequence[Outcome], out_dir: Path, provenance: dict[str, object] | None = None
+) -> None:
+    """Write metrics.csv, comparison.csv, ranking.csv, suite.json and (last) report.md with its figures, atomically.
 
+    The report is built from the files (:mod:`washbench.review.suite_report`), as ``washbench report`` builds it.
+    """
+    from washbench.io.provenance import utc_now
+    from washbench.review.suite_report import write_suite_json, write_suite_report
 
-def _comparison_md(o: Outcome) -> list[str]:
-    washouts = _washouts([o])
-    others = [w for w in washouts if w != REFERENCE_WASHOUT]
-    head = "| DOF | metric | " + " | ".join(washouts) + " | " + " | ".join(f"{w} better by" for w in others) + " |"
-    lines = [head, "|" + "---|" * (2 + len(washouts) + len(others))]
-    for c in compare(o.run.metrics):
-        vals = " | ".join(_md_num(c.values.get(w, math.nan)) for w in washouts)
-        diffs = " | ".join(_md_num(c.better_than_reference.get(w, math.nan), signed=True) for w in others)
-        lines.append(f"| {c.dof} | {c.metric} | {vals} | {diffs} |")
-    return lines
-
-
-def _md_num(x: float, signed: bool = False) -> str:
-    if math.isnan(x):
-        return ""
-    return f"{x:+.4g}" if signed else f"{x:.4g}"
-
-
-def write_suite_results(outcomes: Sequence[Outcome], out_dir: Path) -> None:
-    """Write metrics.csv, comparison.csv, ranking.csv and (last) report.md, each atomically."""
     rankings = {
         (o.run.aircraft, o.run.manoeuvre): rank(o.run.metrics, o.run.motion) for o in _runs_with_metrics(outcomes)
     }
     write_text_atomic(out_dir / "metrics.csv", metrics_table(outcomes))
     write_text_atomic(out_dir / "comparison.csv", comparison_table(outcomes))
     write_text_atomic(out_dir / "ranking.csv", ranking_table(rankings))
-    write_text_atomic(out_dir / "report.md", report_markdown(outcomes, rankings, out_dir))
+    entries = [
+        {
+            "file": _short(o.path),
+            "ok": o.run.ok,
+            "reason": o.run.reason,
+            "aircraft": o.run.aircraft,
+            "manoeuvre": o.run.manoeuvre,
+            "result": os.path.relpath(o.run.run_dir, out_dir) if o.run.run_dir and o.run.run_dir.is_dir() else None,
+            "checks_passed": o.run.checks_passed,
+            "checks_total": o.run.checks_total,
+            "wall_s": round(o.wall_s, 3),
+        }
+        for o in outcomes
+    ]
+    write_suite_json(out_dir / "suite.json", entries, dict(provenance or {}), utc_now())
+    write_suite_report(out_dir)
 
 
 def suite_command(
@@ -317,15 +263,22 @@ def suite_command(
     files = find_manoeuvres(inputs)
     # Fail fast on a bad parameter or platform file: every run would fail the same way.
     from washbench.cueing import load_washout_params
+    from washbench.cueing.params import DEFAULT_PARAMS_PATH
+    from washbench.io.provenance import build_provenance
     from washbench.platform import load_platform_limits
+    from washbench.platform.limits import DEFAULT_LIMITS_PATH
 
-    load_washout_params(params_path)
-    load_platform_limits(platform_path)
+    provenance = build_provenance(
+        params_path=params_path or DEFAULT_PARAMS_PATH,
+        params=load_washout_params(params_path),
+        platform_path=platform_path or DEFAULT_LIMITS_PATH,
+        platform=load_platform_limits(platform_path),
+    )
     start = time.perf_counter()
     outcomes = run_suite(
         files, out_dir, jobs=jobs, params_path=params_path, platform_path=platform_path, progress=progress
     )
-    write_suite_results(outcomes, out_dir)
+    write_suite_results(outcomes, out_dir, provenance)
     n_ok = sum(o.run.ok for o in outcomes)
     print(
         f"suite: {n_ok}/{len(outcomes)} manoeuvres ok in {time.perf_counter() - start:.1f} s; "

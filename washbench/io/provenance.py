@@ -1,0 +1,179 @@
+"""Provenance: what produced a result, recorded in every result file that can hold it.
+
+One JSON-able dict (:func:`build_provenance`) records
+
+- ``software``: the versions of washbench (and its git commit when run from a work tree), JSBSim, rerun-sdk,
+  numpy, scipy, pyarrow and Python;
+- ``manoeuvre``: the manoeuvre file's path (as given) and SHA-256 (``washbench run`` / ``fly``), or ``input``: the
+  recorded trace's path and SHA-256 (``washbench cue``), with the input's own provenance carried along when it
+  has one (a ``flight.parquet`` written by ``washbench fly``);
+- ``params`` and ``platform``: the parameter set's and platform's name (the ``name`` key of the YAML file), the path
+  and SHA-256 of the file actually used (the bundled ``cw1.yaml`` / ``atlas.yaml`` when none was given) and the
+  values read from it (so a result can be re-examined without the file);
+- ``turbulence``: severity and seed of the manoeuvre's turbulence (``None`` without turbulence).
+
+It goes into ``run.json`` (``"provenance"``, with the date ``"created_utc"`` beside it), the key-value metadata of
+``traces.parquet`` and ``flight.parquet`` (key ``washbench.provenance``, JSON) and the report header. The date is
+kept out of the Parquet files: same inputs give the same Parquet files, byte for byte.
+"""
+
+from __future__ import annotations
+
+import datetime
+import functools
+import hashlib
+import importlib.metadata
+import json
+import platform as _platform
+import subprocess
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+PARQUET_KEY = b"washbench.provenance"
+"""Key of the provenance JSON in a Parquet file's key-value metadata."""
+
+_PACKAGES = (
+    ("washbench", "washbench"),
+    ("jsbsim", "jsbsim"),
+    ("rerun", "rerun-sdk"),
+    ("numpy", "numpy"),
+    ("scipy", "scipy"),
+    ("pyarrow", "pyarrow"),
+)
+
+
+def sha256_file(path: str | Path) -> str:
+    """Hex SHA-256 of a file's bytes."""
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+@functools.lru_cache(maxsize=1)
+def _git_commit() -> str | None:
+    """The washbench work tree's commit, with ``-dirty`` when it has uncommitted changes; None outside git."""
+    root = Path(__file__).resolve().parents[2]
+    if not (root / ".git").exists():
+        return None
+    try:
+        head = subprocess.run(
+            ["git", "-C", str(root), "rev-parse", "HEAD"], capture_output=True, text=True, timeout=5, check=True
+        ).stdout.strip()
+        dirty = subprocess.run(
+            ["git", "-C", str(root), "status", "--porcelain", "--untracked-files=no", "--", "washbench"],
+            capture_output=True,
+            text=True,
+            timeout=5,
+            check=True,
+        ).stdout.strip()
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return f"{head}-dirty" if dirty else head
+
+
+@functools.lru_cache(maxsize=1)
+def software_versions() -> dict[str, str]:
+    """Installed versions of washbench and the packages that decide its numbers (read without importing them)."""
+    out: dict[str, str] = {}
+    for key, dist in _PACKAGES:
+        try:
+            out[key] = importlib.metadata.version(dist)
+        except importlib.metadata.PackageNotFoundError:
+            out[key] = "not installed"
+    commit = _git_commit()
+    if commit:
+        out["washbench_git"] = commit
+    out["python"] = _platform.python_version()
+    return out
+
+
+def file_record(path: str | Path, name: str | None = None, values: Mapping[str, Any] | None = None) -> dict[str, Any]:
+    """``{"name", "path", "sha256", "values"}`` of one input file (name and values only when given)."""
+    rec: dict[str, Any] = {}
+    if name is not None:
+        rec["name"] = name
+    rec["path"] = str(path)
+    rec["sha256"] = sha256_file(path)
+    if values is not None:
+        rec["values"] = dict(values)
+    return rec
+
+
+def build_provenance(
+    *,
+    params_path: Path | None = None,
+    params: Any = None,
+    platform_path: Path | None = None,
+    platform: Any = None,
+    manoeuvre_path: Path | None = None,
+    input_path: Path | None = None,
+    input_provenance: Mapping[str, Any] | None = None,
+    turbulence: Any = None,
+) -> dict[str, Any]:
+    """The provenance of one result (module docstring); no date in it.
+
+    ``params`` and ``platform`` are the loaded models (``WashoutParams``, ``PlatformLimits``: pydantic models with a
+    ``name``); their paths are the files actually read (left out when not given: ``washbench fly`` uses neither).
+    ``turbulence`` is the manoeuvre's ``Turbulence`` or None.
+    """
+    prov: dict[str, Any] = {"software": software_versions()}
+    if manoeuvre_path is not None:
+        prov["manoeuvre"] = file_record(manoeuvre_path)
+    if input_path is not None:
+        prov["input"] = file_record(input_path)
+        if input_provenance:
+            prov["input"]["provenance"] = dict(input_provenance)
+    if params is not None and params_path is not None:
+        prov["params"] = file_record(params_path, params.name, params.model_dump(mode="json"))
+    if platform is not None and platform_path is not None:
+        prov["platform"] = file_record(platform_path, platform.name, platform.model_dump(mode="json"))
+    if manoeuvre_path is not None:
+        prov["turbulence"] = turbulence_record(turbulence)
+    return prov
+
+
+def turbulence_record(turbulence: Any) -> dict[str, Any] | None:
+    """``{"severity", "seed"}`` of a manoeuvre's turbulence, or None when it has none."""
+    if turbulence is None:
+        return None
+    return {"severity": turbulence.severity, "seed": int(turbulence.seed)}
+
+
+def utc_now() -> str:
+    """The current date and time, UTC, ISO 8601 to the second (for run.json only: never in a Parquet file)."""
+    return datetime.datetime.now(datetime.UTC).replace(microsecond=0).isoformat().replace("+00:00", "Z")
+
+
+def parquet_metadata(prov: Mapping[str, Any]) -> dict[bytes, bytes]:
+    """Key-value metadata for a Parquet schema: the provenance as compact, key-sorted JSON (deterministic)."""
+    return {PARQUET_KEY: json.dumps(prov, sort_keys=True, separators=(",", ":")).encode()}
+
+
+def read_parquet_provenance(path: str | Path) -> dict[str, Any] | None:
+    """The provenance stored in a Parquet file's metadata, or None when it has none (or it is unreadable)."""
+    import pyarrow.parquet as pq
+
+    try:
+        meta = pq.read_schema(path).metadata or {}
+    except (OSError, ValueError):
+        return None
+    raw = meta.get(PARQUET_KEY)
+    if raw is None:
+        return None
+    try:
+        return json.loads(raw)
+    except ValueError:
+        return None
+
+
+def manoeuvre_of(prov: Mapping[str, Any] | None) -> Mapping[str, Any] | None:
+    """The manoeuvre record of a provenance, also when it is one step back (``cue`` on a flown trace)."""
+    if not prov:
+        return None
+    if "manoeuvre" in prov:
+        return prov["manoeuvre"]
+    inner = prov.get("input", {}).get("provenance")
+    return manoeuvre_of(inner) if inner else None

@@ -1,0 +1,357 @@
+"""Figures of the report, drawn with matplotlib (Agg, no display, no pyplot state): PNG for report.md, PDF for papers.
+
+Per manoeuvre (one result folder):
+
+- :func:`perceived_figure`: the six perceived-motion panels stacked on one time axis, as the paper's Figures 8, 10,
+  14 and 16: surge, sway, heave (m/s^2), roll, pitch, yaw (deg/s); the aircraft pilot in black, each washout's
+  simulator pilot in its fixed colour (:mod:`washbench.review.palette`); the phases as a lane on top and shaded
+  alternately in every panel; the perception thresholds (Zacharias, :mod:`washbench.perception.thresholds`) as
+  dashed +- lines around the resting value (0, or -g for heave), so what lies between them is not felt.
+- :func:`envelope_figure`: platform envelope usage against time, max over the axes of |value| / limit for stage
+  position, velocity, acceleration, sphere angular rate and wheel speed, the limit at 1, and one lane per washout
+  and limit kind showing when a limit was active.
+
+Per suite:
+
+- :func:`score_heatmap`: the ranking score (:mod:`washbench.analysis.ranking`) per manoeuvre and washout; green
+  below 1, red above (worse than a simulator that stands still), the best per row framed.
+- :func:`table4_figure`: the paper's Table 4 as a figure: per manoeuvre, DOF and metric, how much better than
+  small-angle each other washout is, in percent of the small-angle value (green better, red worse).
+
+matplotlib is imported inside the functions, so commands that draw nothing do not load it. Long traces are drawn
+through a min/max decimation (:func:`minmax_decimate`) that keeps every peak at the figure's resolution. Same data,
+same files: no dates or random ids are written into the PNG or PDF.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from washbench.review.palette import AIRCRAFT_COLOR_FIGURE, mpl, washout_colors
+
+FIGURE_FORMATS = ("png", "pdf")
+"""Every figure is written as STEM.png (embedded in report.md) and STEM.pdf (vector, for papers)."""
+
+PNG_DPI = 110
+
+PERCEIVED_PANELS: tuple[tuple[str, str], ...] = (
+    ("surge", "m/s²"),
+    ("sway", "m/s²"),
+    ("heave", "m/s²"),
+    ("roll", "deg/s"),
+    ("pitch", "deg/s"),
+    ("yaw", "deg/s"),
+)
+"""The six panels of :func:`perceived_figure`: (DOF, unit)."""
+
+SATURATION_LABELS = {
+    "pos": "stage position",
+    "vel": "stage velocity",
+    "acc": "stage acceleration",
+    "rate": "sphere rate",
+    "angacc": "sphere ang. acceleration",
+    "tilt_rate": "tilt-rate limit",
+    "rot_rate": "rotational saturation",
+}
+"""Readable names of the saturation kinds (``W.sat_<kind>`` columns)."""
+
+_THRESHOLD_COLOR = (0.45, 0.45, 0.45)
+_PHASE_SHADE = (0.0, 0.0, 0.0, 0.05)
+_DECIMATE_BUCKETS = 1500
+
+
+def _new_figure(width_in: float, height_in: float) -> Any:
+    """A matplotlib Figure on an Agg canvas (no pyplot, no global backend change)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(width_in, height_in), layout="constrained")
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def save_figure(fig: Any, stem: Path) -> list[Path]:
+    """Write ``stem.png`` and ``stem.pdf`` atomically (deterministic: no date, no software stamp); return the paths."""
+    from washbench.io.atomic import atomic_path
+
+    paths = []
+    for fmt in FIGURE_FORMATS:
+        path = stem.with_suffix(f".{fmt}")
+        meta = {"Software": None} if fmt == "png" else {"Creator": None, "Producer": None, "CreationDate": None}
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, format=fmt, dpi=PNG_DPI, metadata=meta)
+        paths.append(path)
+    return paths
+
+
+def minmax_decimate(t: np.ndarray, y: np.ndarray, buckets: int = _DECIMATE_BUCKETS) -> tuple[np.ndarray, np.ndarray]:
+    """At most ``2 * buckets`` points that draw like ``(t, y)``: each bucket's minimum and maximum, in time order.
+
+    Shorter traces are returned unchanged. NaNs are kept out of the min/max (a bucket of NaNs stays NaN).
+    """
+    n = t.shape[0]
+    if n <= 2 * buckets:
+        return t, y
+    size = math.ceil(n / buckets)
+    pad = size * buckets - n
+    yp = np.concatenate([y, np.full(pad, y[-1])]).reshape(buckets, size)
+    tp = np.concatenate([t, np.full(pad, t[-1])]).reshape(buckets, size)
+    finite = np.isfinite(yp)
+    lo = np.where(finite, yp, np.inf).argmin(axis=1)
+    hi = np.where(finite, yp, -np.inf).argmax(axis=1)
+    first, second = np.minimum(lo, hi), np.maximum(lo, hi)
+    rows = np.arange(buckets)
+    idx_t = np.column_stack([tp[rows, first], tp[rows, second]]).ravel()
+    idx_y = np.column_stack([yp[rows, first], yp[rows, second]]).ravel()
+    return idx_t, idx_y
+
+
+def _phase_lane(ax: Any, phases: Sequence[tuple[str, float, float]], t_end: float) -> None:
+    """Phases as labelled boxes on a lane axis (names shortened or dropped where the box is too narrow)."""
+    ax.set_ylim(0, 1)
+    ax.set_yticks([])
+    for side in ("top", "right", "left"):
+        ax.spines[side].set_visible(False)
+    span = max(t_end, 1e-9)
+    for i, (name, t0, t1) in enumerate(phases):
+        shade = (0.82, 0.86, 0.92) if i % 2 == 0 else (0.90, 0.92, 0.96)
+        ax.axvspan(t0, t1, color=shade, lw=0)
+        chars = int((t1 - t0) / span * 110)  # about 110 characters fit across the lane
+        label = name if len(name) <= chars else (name[: max(chars - 1, 0)] + "…" if chars >= 4 else "")
+        if label:
+            ax.text(0.5 * (t0 + t1), 0.5, label, ha="center", va="center", fontsize=7.5, clip_on=True)
+    ax.set_ylabel("phase", rotation=0, ha="right", va="center", fontsize=8)
+
+
+def _shade_phases(ax: Any, phases: Sequence[tuple[str, float, float]]) -> None:
+    for i, (_, t0, t1) in enumerate(phases):
+        if i % 2 == 1:
+            ax.axvspan(t0, t1, color=_PHASE_SHADE, lw=0, zorder=0)
+        ax.axvline(t0, color=(0.6, 0.6, 0.6), lw=0.5, zorder=0.5)
+
+
+def perceived_figure(
+    stem: Path,
+    title: str,
+    t_s: np.ndarray,
+    perceived: Mapping[str, np.ndarray],
+    *,
+    phases: Sequence[tuple[str, float, float]] = (),
+    thresholds: Sequence[float] | None = None,
+    rest: Sequence[float] = (0.0, 0.0, -9.80665, 0.0, 0.0, 0.0),
+) -> list[Path]:
+    """The six stacked perceived-motion panels (module docstring); returns the PNG and PDF paths.
+
+    ``perceived``: ``"aircraft"`` and each washout -> (N, 6) array, columns surge, sway, heave [m/s^2], roll, pitch,
+    yaw [deg/s]; the washouts are drawn in the mapping's order. ``thresholds`` (6,) in the same units, drawn as
+    ``rest +- threshold``; ``phases``: (name, t_start_s, t_end_s).
+    """
+    from matplotlib.lines import Line2D
+
+    washouts = [s for s in perceived if s != "aircraft"]
+    colors = washout_colors(washouts)
+    fig = _new_figure(8.6, 11.0)
+    ratios = [0.35] + [1.0] * 6 if phases else [1.0] * 6
+    axes = fig.subplots(len(ratios), 1, sharex=True, gridspec_kw={"height_ratios": ratios})
+    if phases:
+        _phase_lane(axes[0], phases, float(t_s[-1]))
+        panels = axes[1:]
+    else:
+        panels = axes
+    for i, (ax, (dof, unit)) in enumerate(zip(panels, PERCEIVED_PANELS, strict=True)):
+        _shade_phases(ax, phases)
+        if thresholds is not None:
+            for sign in (-1.0, 1.0):
+                ax.axhline(rest[i] + sign * thresholds[i], color=_THRESHOLD_COLOR, lw=0.8, ls=(0, (4, 3)), zorder=1)
+        for w in washouts:
+            tt, yy = minmax_decimate(t_s, perceived[w][:, i])
+            ax.plot(tt, yy, color=mpl(colors[w]), lw=1.0, zorder=2)
+        tt, yy = minmax_decimate(t_s, perceived["aircraft"][:, i])
+        ax.plot(tt, yy, color=mpl(AIRCRAFT_COLOR_FIGURE), lw=1.7, zorder=3)
+        ax.set_ylabel(f"{dof}\n({unit})", fontsize=9)
+        ax.tick_params(labelsize=8)
+        ax.grid(True, color=(0.9, 0.9, 0.9), lw=0.5)
+        ax.margins(x=0)
+    panels[-1].set_xlabel("time (s)", fontsize=9)
+    panels[-1].set_xlim(float(t_s[0]), float(t_s[-1]))
+    handles = [Line2D([], [], color=mpl(AIRCRAFT_COLOR_FIGURE), lw=1.7, label="aircraft pilot")]
+    handles += [Line2D([], [], color=mpl(colors[w]), lw=1.2, label=w) for w in washouts]
+    if thresholds is not None:
+        handles.append(Line2D([], [], color=_THRESHOLD_COLOR, lw=0.8, ls=(0, (4, 3)), label="perception threshold"))
+    fig.legend(handles=handles, loc="outside upper center", ncol=len(handles), fontsize=8.5, frameon=False)
+    axes[0].set_title(f"{title}: perceived motion", fontsize=11)
+    return save_figure(fig, stem)
+
+
+def _runs(flags: np.ndarray) -> list[tuple[int, int]]:
+    """(start, end) index pairs of the runs of True in a boolean array (end exclusive)."""
+    f = np.concatenate([[False], np.asarray(flags, dtype=bool), [False]])
+    edges = np.flatnonzero(np.diff(f.astype(np.int8)))
+    return list(zip(edges[::2].tolist(), edges[1::2].tolist(), strict=True))
+
+
+def envelope_figure(
+    stem: Path,
+    title: str,
+    t_s: np.ndarray,
+    usage: Mapping[str, Mapping[str, np.ndarray]],
+    saturated: Mapping[str, Mapping[str, np.ndarray]],
+    *,
+    phases: Sequence[tuple[str, float, float]] = (),
+) -> list[Path]:
+    """Platform envelope usage and saturation lanes (module docstring); returns the PNG and PDF paths.
+
+    ``usage``: panel label (e.g. "position") -> washout -> (N,) |value| / limit (dimensionless, 1 = at the limit);
+    ``saturated``: washout -> limit kind -> bool (N,) (kinds without any True are left out of the lanes).
+    """
+    from matplotlib.lines import Line2D
+
+    washouts = list(dict.fromkeys(w for per in usage.values() for w in per))
+    colors = washout_colors(washouts)
+    lanes = [(w, k, flags) for w in washouts for k, flags in saturated.get(w, {}).items() if np.any(flags)]
+    n_lanes = max(len(lanes), 1)
+    fig = _new_figure(8.6, 1.55 * len(usage) + 0.9 + 0.2 * n_lanes)
+    ratios = [1.0] * len(usage) + [0.12 * n_lanes + 0.25]
+    axes = fig.subplots(len(ratios), 1, sharex=True, gridspec_kw={"height_ratios": ratios})
+    dt = float(t_s[1] - t_s[0]) if t_s.shape[0] > 1 else 0.0
+    for ax, (label, per) in zip(axes, usage.items(), strict=False):
+        _shade_phases(ax, phases)
+        ax.axhline(1.0, color=(0.3, 0.3, 0.3), lw=0.9, ls="--", zorder=1)
+        top = 1.0
+        for w, u in per.items():
+            tt, yy = minmax_decimate(t_s, u)
+            ax.plot(tt, yy, color=mpl(colors[w]), lw=1.0, zorder=2)
+            if u.size:
+                top = max(top, float(np.nanmax(u)))
+        ax.set_ylim(0.0, 1.08 * top)
+        ax.set_ylabel(f"{label}\n(of limit)", fontsize=9)
+        ax.tick_params(labelsize=8)
+        ax.grid(True, color=(0.9, 0.9, 0.9), lw=0.5)
+    lane_ax = axes[-1]
+    if lanes:
+        # a limit active for a few samples is still drawn visibly wide (0.3 % of the manoeuvre)
+        min_width = max(dt, 0.003 * float(t_s[-1] - t_s[0]))
+        for j, (w, _, flags) in enumerate(lanes):
+            y = len(lanes) - 1 - j
+            segs = [(t_s[a], max((b - a) * dt, min_width)) for a, b in _runs(flags)]
+            lane_ax.broken_barh(segs, (y - 0.35, 0.7), color=mpl(colors[w]), lw=0)
+        lane_ax.set_yticks(range(len(lanes)))
+        lane_ax.set_yticklabels([SATURATION_LABELS.get(k, k) for _, k, _ in reversed(lanes)], fontsize=7.5)
+        for tick, (w, _, _) in zip(lane_ax.get_yticklabels(), reversed(lanes), strict=True):
+            tick.set_color(mpl(colors[w]))
+        lane_ax.set_ylim(-0.6, len(lanes) - 0.4)
+    else:
+        lane_ax.set_yticks([])
+        lane_ax.text(0.5, 0.5, "no limit reached", transform=lane_ax.transAxes, ha="center", va="center", fontsize=8)
+    lane_ax.set_ylabel("limit\nactive", fontsize=9)
+    lane_ax.tick_params(axis="x", labelsize=8)
+    lane_ax.set_xlabel("time (s)", fontsize=9)
+    lane_ax.set_xlim(float(t_s[0]), float(t_s[-1]))
+    handles = [Line2D([], [], color=mpl(colors[w]), lw=1.2, label=w) for w in washouts]
+    handles.append(Line2D([], [], color=(0.3, 0.3, 0.3), lw=0.9, ls="--", label="limit"))
+    fig.legend(handles=handles, loc="outside upper center", ncol=len(handles), fontsize=8.5, frameon=False)
+    axes[0].set_title(f"{title}: platform envelope", fontsize=11)
+    return save_figure(fig, stem)
+
+
+def _sig(x: float, digits: int = 3) -> str:
+    from washbench.review.numbers import sig
+
+    return sig(x, digits)
+
+
+def score_heatmap(
+    stem: Path, rows: Sequence[str], washouts: Sequence[str], scores: np.ndarray, title: str = "ranking score"
+) -> list[Path]:
+    """Score per manoeuvre (row) and washout (column), lower is better; best per row framed, above 1 in red.
+
+    ``scores`` (R, W), NaN where a washout did not run. Returns the PNG and PDF paths.
+    """
+    from matplotlib.colors import LinearSegmentedColormap, TwoSlopeNorm
+    from matplotlib.patches import Rectangle
+
+    scores = np.asarray(scores, dtype=np.float64).reshape(len(rows), len(washouts))
+    finite = scores[np.isfinite(scores)]
+    vmax = max(2.0, float(finite.max()) if finite.size else 2.0)
+    cmap = LinearSegmentedColormap.from_list("score", [(0.10, 0.60, 0.32), (1.0, 1.0, 0.85), (0.84, 0.19, 0.15)])
+    cmap.set_bad((0.85, 0.85, 0.85))
+    norm = TwoSlopeNorm(vmin=0.0, vcenter=1.0, vmax=vmax)
+    fig = _new_figure(1.6 + 1.35 * len(washouts), 1.3 + 0.32 * len(rows))
+    ax = fig.subplots()
+    image = ax.imshow(np.ma.masked_invalid(scores), cmap=cmap, norm=norm, aspect="auto")
+    for r in range(len(rows)):
+        row = scores[r]
+        best = np.nanmin(row) if np.isfinite(row).any() else math.nan
+        for c in range(len(washouts)):
+            v = row[c]
+            text = "-" if not math.isfinite(v) else _sig(v) + (" !" if v > 1.0 else "")
+            is_best = math.isfinite(v) and v == best
+            ax.text(c, r, text, ha="center", va="center", fontsize=8, fontweight="bold" if is_best else "normal")
+            if is_best:
+                ax.add_patch(Rectangle((c - 0.5, r - 0.5), 1, 1, fill=False, lw=1.6, ec="black"))
+    ax.set_xticks(range(len(washouts)), washouts, fontsize=8.5)
+    ax.xaxis.tick_top()
+    ax.set_yticks(range(len(rows)), rows, fontsize=8)
+    bar = fig.colorbar(image, ax=ax, shrink=0.8, pad=0.02)
+    bar.set_label("score (lower is better; above 1: worse than standing still)", fontsize=7.5)
+    bar.ax.tick_params(labelsize=7)
+    ax.set_title(f"{title}: best per manoeuvre framed, ! above 1", fontsize=9)
+    return save_figure(fig, stem)
+
+
+def table4_figure(
+    stem: Path,
+    rows: Sequence[str],
+    reference: str,
+    better_pct: Mapping[str, np.ndarray],
+    dofs: Sequence[str],
+    metrics: Sequence[str],
+) -> list[Path]:
+    """The paper's Table 4 as a figure: one panel per washout other than ``reference``.
+
+    ``better_pct``: washout -> (R, len(metrics) * len(dofs)) array of 100 * (reference - washout) / reference, columns
+    grouped by metric, then DOF; positive means better than the reference. NaN where undefined. Returns the paths.
+    """
+    from matplotlib.colors import Normalize
+
+    others = list(better_pct)
+    ncol = len(metrics) * len(dofs)
+    fig = _new_figure(2.2 + 0.42 * ncol, 0.9 + len(others) * (0.85 + 0.3 * len(rows)))
+    axes = np.atleast_1d(fig.subplots(len(others), 1, squeeze=False)[:, 0])
+    cmap = _diverging_cmap()
+    norm = Normalize(vmin=-100.0, vmax=100.0)
+    image = None
+    for ax, w in zip(axes, others, strict=True):
+        values = np.asarray(better_pct[w], dtype=np.float64).reshape(len(rows), ncol)
+        image = ax.imshow(np.ma.masked_invalid(np.clip(values, -100, 100)), cmap=cmap, norm=norm, aspect="auto")
+        for r in range(len(rows)):
+            for c in range(ncol):
+                v = values[r, c]
+                text = "-" if not math.isfinite(v) else f"{v:+.0f}" if abs(v) >= 0.5 else "0"
+                ax.text(c, r, text, ha="center", va="center", fontsize=6.5)
+        ax.set_xticks(range(ncol), [d for _ in metrics for d in dofs], fontsize=7, rotation=90)
+        ax.set_yticks(range(len(rows)), rows, fontsize=7.5)
+        for g in range(1, len(metrics)):
+            ax.axvline(g * len(dofs) - 0.5, color="black", lw=1.2)
+        sec = ax.secondary_xaxis("top")
+        sec.set_xticks([(g + 0.5) * len(dofs) - 0.5 for g in range(len(metrics))], list(metrics), fontsize=8)
+        sec.tick_params(length=0)
+        ax.set_title(f"{w} better than {reference} (% of {reference}'s value)", fontsize=9)
+    if image is not None:
+        bar = fig.colorbar(image, ax=list(axes), shrink=0.6, pad=0.01)
+        bar.set_label("% better (green) / worse (red)", fontsize=7.5)
+        bar.ax.tick_params(labelsize=7)
+    return save_figure(fig, stem)
+
+
+def _diverging_cmap() -> Any:
+    from matplotlib.colors import LinearSegmentedColormap
+
+    cmap = LinearSegmentedColormap.from_list("better", [(0.84, 0.19, 0.15), (1.0, 1.0, 0.92), (0.10, 0.60, 0.32)])
+    cmap.set_bad((0.88, 0.88, 0.88))
+    return cmap

@@ -1,0 +1,295 @@
+"""report.md and its figures, for one result folder and for a suite, from the files alone.
+
+- :func:`write_result_report` (``washbench run`` writes it into every result folder; ``washbench report DIR`` writes
+  it again): ``report.md`` and ``figures/`` (perceived motion, platform envelope; PNG embedded, PDF beside it).
+- :func:`write_suite_report` (``washbench suite``; ``washbench report SUITE_DIR``): the suite's ``report.md`` with
+  the failures first, the summary, the score heatmap and the Table-4 figure (``figures/``), then each manoeuvre's
+  section built by the same code as the single result's report.
+
+Nothing is flown or cued again: everything comes from ``metrics.csv``, ``traces.parquet``, ``run.json`` and
+``flight.json`` (see :mod:`washbench.review.result_data`) and, for a suite, ``suite.json``. Numbers have 3
+significant digits (:mod:`washbench.review.numbers`; full precision is in the CSV files); the best value of each
+DOF is bold; a score above 1 is flagged; saturation is in seconds and percent of the manoeuvre.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from washbench.analysis.metrics import DOFS
+from washbench.analysis.ranking import METRICS, REFERENCE_WASHOUT, RankRow, compare, rank
+from washbench.errors import WashbenchError, located
+from washbench.io.atomic import write_text_atomic
+from washbench.review.numbers import pct, sig
+from washbench.review.result_data import ResultData, is_result_folder, load_result
+
+REPORT_FILE = "report.md"
+FIGURES_DIR = "figures"
+SUITE_FILE = "suite.json"
+
+FLAG = "⚠"
+SCORE_NOTE = (
+    f"{FLAG} a score above 1: the washout's perceived error is larger than that of a simulator that stands still, "
+    "i.e. it gives more false cues than it gives true ones on this manoeuvre."
+)
+_UNITS = {
+    "npc": ("-", "-"),
+    "integral_error": ("m/s²·s", "deg"),
+    "max_error": ("m/s²", "deg/s"),
+}
+_METRIC_TITLES = {
+    "npc": "Normalized Pearson correlation (NPC: 1 is perfect, 1.5 uncorrelated, lower is better; - where flat)",
+    "integral_error": "Integral of |perceived error| (lower is better)",
+    "max_error": "Maximum |perceived error| (lower is better)",
+}
+
+
+def _unit(metric: str, dof: str) -> str:
+    return _UNITS[metric][0 if dof in DOFS[:3] else 1]
+
+
+def _rel(path: Path, start: Path) -> str:
+    return Path(os.path.relpath(path, start)).as_posix()
+
+
+# --------------------------------------------------------------------------------------------- pieces of a report
+
+
+def provenance_lines(prov: dict[str, Any] | None, created_utc: str | None) -> list[str]:
+    """The provenance as a two-column Markdown table (what produced the result)."""
+    if not prov:
+        return ["_No provenance recorded with this result (written by an older washbench)._", ""]
+    rows: list[tuple[str, str]] = []
+
+    def file_row(label: str, rec: dict[str, Any] | None) -> None:
+        if rec:
+            name = f"**{rec['name']}**, " if rec.get("name") else ""
+            rows.append((label, f"{name}`{rec.get('path', '?')}` (SHA-256 `{rec.get('sha256', '?')}`)"))
+
+    file_row("manoeuvre file", prov.get("manoeuvre"))
+    inp = prov.get("input")
+    file_row("input trace", inp)
+    if inp and inp.get("provenance", {}).get("manoeuvre"):
+        file_row("input's manoeuvre file", inp["provenance"]["manoeuvre"])
+    file_row("washout parameters", prov.get("params"))
+    file_row("platform", prov.get("platform"))
+    if "turbulence" in prov or (inp and "turbulence" in inp.get("provenance", {})):
+        turb = prov.get("turbulence", inp.get("provenance", {}).get("turbulence") if inp else None)
+        rows.append(("turbulence", f"{turb['severity']}, seed {turb['seed']}" if turb else "none"))
+    sw = prov.get("software", {})
+    parts = [
+        f"washbench {sw.get('washbench', '?')}"
+        + (f" (git `{sw['washbench_git'][:12]}`)" if sw.get("washbench_git") else "")
+    ]
+    parts += [f"{label} {sw[key]}" for key, label in (("jsbsim", "JSBSim"), ("rerun", "rerun-sdk"), ("numpy", "numpy"),
+                                                      ("scipy", "scipy"), ("pyarrow", "pyarrow"), ("python", "Python"))
+              if key in sw]  # fmt: skip
+    rows.append(("software", ", ".join(parts)))
+    if created_utc:
+        rows.append(("created", created_utc))
+    return ["| provenance | |", "|---|---|", *(f"| {k} | {v} |" for k, v in rows), ""]
+
+
+def _score_cell(score: float, best: bool) -> str:
+    text = sig(score)
+    if best:
+        text = f"**{text}**"
+    return f"{text} {FLAG}" if score > 1.0 else text
+
+
+def ranking_lines(data: ResultData, ranking: list[RankRow]) -> list[str]:
+    """Ranking table (rank, washout, score) and the DOF weights used."""
+    if not ranking:
+        return []
+    lines = ["| rank | washout | score (-) |", "|---|---|---|"]
+    lines += [f"| {r.rank} | {r.washout} | {_score_cell(r.score, r.rank == 1)} |" for r in ranking]
+    weights = ranking[0].weights
+    lines += [
+        "",
+        "Score: sum over DOFs of weight x integral error / the aircraft pilot's own perceived motion in that DOF (0 "
+        "perfect, 1 no better than standing still). Weights: "
+        + ", ".join(f"{d} {sig(weights[d], 2)}" for d in DOFS)
+        + ".",
+    ]
+    if any(r.score > 1.0 for r in ranking):
+        lines += ["", SCORE_NOTE]
+    return [*lines, ""]
+
+
+def metric_tables(data: ResultData) -> list[str]:
+    """Per metric a DOF-by-washout table: values, the best per DOF bold, and each washout against small-angle (%)."""
+    comparison = {(c.dof, c.metric): c for c in compare(data.metrics)}
+    dofs = [d for d in DOFS if any((d, m) in comparison for m in METRICS)]
+    others = [w for w in data.washouts if w != REFERENCE_WASHOUT] if REFERENCE_WASHOUT in data.washouts else []
+    lines: list[str] = []
+    for metric in METRICS:
+        lines += [f"**{_METRIC_TITLES[metric]}**", ""]
+        lines.append("| washout | " + " | ".join(f"{d} ({_unit(metric, d)})" for d in dofs) + " |")
+        lines.append("|---|" + "---|" * len(dofs))
+        for w in data.washouts:
+            cells = []
+            for d in dofs:
+                values = comparison[(d, metric)].values
+                v = values.get(w, math.nan)
+                finite = [x for x in values.values() if math.isfinite(x)]
+                best = bool(finite) and math.isfinite(v) and v == min(finite) and len(finite) > 1
+                cells.append(f"**{sig(v)}**" if best else sig(v))
+            lines.append(f"| {w} | " + " | ".join(cells) + " |")
+        for w in others:
+            cells = []
+            for d in dofs:
+                c = comparison[(d, metric)]
+                ref = c.values.get(REFERENCE_WASHOUT, math.nan)
+                diff = c.better_than_reference.get(w, math.nan)
+                cells.append(pct(100.0 * diff / ref) if math.isfinite(diff) and ref != 0 else "-")
+            lines.append(f"| {w} vs {REFERENCE_WASHOUT} (% better) | " + " | ".join(cells) + " |")
+        if metric == "integral_error":
+            lines.append(
+                "| _standing still (aircraft pilot's perceived motion)_ | "
+                + " | ".join(sig(data.motion.get(d, math.nan)) for d in dofs)
+                + " |"
+            )
+        lines.append("")
+    return lines
+
+
+def saturation_lines(data: ResultData) -> list[str]:
+    """Time at each limit per washout, in seconds and percent of the manoeuvre."""
+    from washbench.review.figures import SATURATION_LABELS
+
+    kinds = list(dict.fromkeys(k for w in data.washouts for k, f in data.saturated.get(w, {}).items() if f.any()))
+    if not kinds:
+        return ["No platform or washout limit was reached.", ""]
+    head = "| limit | " + " | ".join(f"{w} (s, % of manoeuvre)" for w in data.washouts) + " |"
+    lines = [head, "|---|" + "---|" * len(data.washouts)]
+    for k in kinds:
+        cells = []
+        for w in data.washouts:
+            flags = data.saturated.get(w, {}).get(k)
+            steps = int(np.count_nonzero(flags)) if flags is not None else 0
+            cells.append("-" if not steps else f"{sig(steps * data.dt_s)} s ({pct(100.0 * steps / data.n, False)})")
+        lines.append(f"| {SATURATION_LABELS.get(k, k)} (`{k}`) | " + " | ".join(cells) + " |")
+    return [*lines, ""]
+
+
+def check_lines(data: ResultData) -> list[str]:
+    """The manoeuvre's checks (flight.json): measured value, limits, passed."""
+    if not data.checks:
+        return []
+    lines = ["| check | measured | limits | result |", "|---|---|---|---|"]
+    for c in data.checks:
+        measured = c.get("measured")
+        m = "-" if measured is None else sig(float(measured), 4)
+        result = "ok" if c.get("passed") else "**FAILED**"
+        lines.append(f"| {c.get('name', '')} | {m} | {c.get('limit', '')} | {result} |")
+    return [*lines, ""]
+
+
+def result_figures(data: ResultData) -> dict[str, Path]:
+    """Draw the result's figures into ``folder/figures/``; returns figure name -> PNG path."""
+    from washbench.perception.thresholds import STANDARD_GRAVITY_MPS2, ZACHARIAS
+    from washbench.review.figures import envelope_figure, perceived_figure
+
+    fig_dir = data.folder / FIGURES_DIR
+    fig_dir.mkdir(exist_ok=True)
+    th = ZACHARIAS
+    thresholds = (th.f_x_mps2, th.f_y_mps2, th.f_z_mps2, th.omega_x_degps, th.omega_y_degps, th.omega_z_degps)
+    out = {}
+    out["perceived"] = perceived_figure(
+        fig_dir / "perceived",
+        data.title,
+        data.t_s,
+        data.perceived,
+        phases=data.phases,
+        thresholds=thresholds,
+        rest=(0.0, 0.0, -STANDARD_GRAVITY_MPS2, 0.0, 0.0, 0.0),
+    )[0]
+    if data.usage:
+        out["envelope"] = envelope_figure(
+            fig_dir / "envelope", data.title, data.t_s, data.usage, data.saturated, phases=data.phases
+        )[0]
+    return out
+
+
+def _image(png: Path, start: Path, alt: str) -> list[str]:
+    rel = _rel(png, start)
+    return [f"![{alt}]({rel})", "", f"Vector version for papers: [{Path(rel).with_suffix('.pdf').name}]"
+            f"({Path(rel).with_suffix('.pdf').as_posix()})", ""]  # fmt: skip
+
+
+def result_sections(data: ResultData, figures: dict[str, Path], start: Path, level: int) -> list[str]:
+    """The body of one result's report; links relative to ``start`` (the folder report.md is in)."""
+    h = "#" * level
+    lines: list[str] = []
+    ranking = rank(data.metrics, data.motion) if data.metrics else []
+    lines += [f"{h} Ranking", "", *ranking_lines(data, ranking)]
+    lines += [f"{h} Perceived motion", ""]
+    lines += [
+        "Aircraft pilot (black) against each washout's simulator pilot; dashed: perception thresholds (Zacharias "
+        "1978) around the resting value, what lies between them is not felt; shaded: the phases.",
+        "",
+    ]
+    lines += _image(figures["perceived"], start, "perceived motion")
+    lines += [f"{h} Metrics", "", *metric_tables(data)]
+    lines += [f"{h} Platform", ""]
+    if "envelope" in figures:
+        lines += _image(figures["envelope"], start, "platform envelope")
+    else:
+        lines += ["_No platform limits are recorded with this result: no envelope figure._", ""]
+    lines += [f"Time at a limit ({sig(data.duration_s)} s manoeuvre):", "", *saturation_lines(data)]
+    if data.checks:
+        lines += [f"{h} Checks", "", *check_lines(data)]
+    if data.phases:
+        lines += [f"{h} Phases", "", "| phase | start (s) | end (s) |", "|---|---|---|"]
+        lines += [f"| {n} | {t0:.2f} | {t1:.2f} |" for n, t0, t1 in data.phases]
+        lines.append("")
+    recording = data.folder / "recording.rrd"
+    if recording.exists():
+        rel = _rel(recording, start)
+        lines += [f"Recording: [{rel}]({rel}) (`washbench replay {rel}`).", ""]
+    return lines
+
+
+def _status_line(data: ResultData) -> list[str]:
+    if data.ok is False:
+        return [f"> **FAILED**: {data.reason or 'a check failed'}", ""]
+    return []
+
+
+def write_result_report(result_dir: Path) -> Path:
+    """Write ``report.md`` and ``figures/`` for one result folder from its files; return the report's path."""
+    data = load_result(Path(result_dir))
+    figures = result_figures(data)
+    lines = [f"# {data.title}", "", *_status_line(data)]
+    checks = f", checks {sum(bool(c.get('passed')) for c in data.checks)}/{len(data.checks)}" if data.checks else ""
+    status = {True: "ok", False: "FAILED", None: "cued"}[data.ok]
+    lines += [
+        f"{status}{checks}; {sig(data.duration_s)} s, {data.n} samples at {sig(1.0 / data.dt_s)} Hz; "
+        f"washouts: {', '.join(data.washouts)}.",
+        "",
+    ]
+    lines += provenance_lines(data.provenance, data.created_utc)
+    lines += result_sections(data, figures, data.folder, 2)
+    path = data.folder / REPORT_FILE
+    write_text_atomic(path, "\n".join(lines).rstrip() + "\n")
+    return path
+
+
+def report_command(results_dir: Path) -> int:
+    """``washbench report DIR``: write report.md and the figures again from a result or suite folder's files."""
+    folder = Path(results_dir)
+    if not folder.is_dir():
+        raise WashbenchError(located(folder, "no such folder"))
+    if is_result_folder(folder) and not (folder / SUITE_FILE).exists():
+        path = write_result_report(folder)
+    else:
+        from washbench.review.suite_report import write_suite_report
+
+        path = write_suite_report(folder, regenerate_results=True)
+    print(f"report: {path}")
+    return 0

@@ -1,0 +1,223 @@
+"""Reading one result folder back for the report: only the files in it, nothing flown or cued again.
+
+A result folder is what ``washbench run`` writes (and ``washbench cue``: the same files, fewer of them):
+``metrics.csv`` and ``traces.parquet`` are required; ``run.json`` (status, perceived motion, provenance, date) and
+``flight.json`` (phases, checks) are used when present. The washout names come from ``metrics.csv`` (in the order
+written there), so user-named washouts need no list anywhere. Platform limits for the envelope usage come from the
+provenance stored with the result (the platform file's values), never from a file outside the folder.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from washbench.analysis.metrics import DOFS, MetricRow, integral_abs_error
+from washbench.errors import WashbenchError, located
+from washbench.io.provenance import read_parquet_provenance
+from washbench.io.results import (
+    AIRCRAFT,
+    TIME_COLUMN,
+    acc_columns,
+    omega_platform_columns,
+    perceived_f_columns,
+    perceived_omega_columns,
+    pos_columns,
+    read_metrics_csv,
+    vel_columns,
+    wheel_columns,
+)
+
+METRICS_FILE = "metrics.csv"
+TRACES_FILE = "traces.parquet"
+
+
+@dataclass(eq=False)
+class ResultData:
+    """What the report shows of one result folder (arrays on the traces' time grid, N samples).
+
+    ``perceived``: source (``aircraft`` or a washout) -> (N, 6) surge, sway, heave [m/s^2], roll, pitch, yaw [deg/s];
+    ``usage``: envelope panel -> washout -> (N,) |value| / limit (empty without platform limits);
+    ``saturated``: washout -> limit kind -> bool (N,); ``motion``: DOF -> the aircraft pilot's perceived motion
+    (m/s^2*s or deg, :func:`washbench.runs.pipeline.perceived_motion`).
+    """
+
+    folder: Path
+    title: str
+    washouts: list[str]
+    metrics: list[MetricRow]
+    t_s: np.ndarray
+    dt_s: float
+    perceived: dict[str, np.ndarray]
+    saturated: dict[str, dict[str, np.ndarray]]
+    usage: dict[str, dict[str, np.ndarray]]
+    motion: dict[str, float]
+    ok: bool | None = None  # None: the folder does not say (a cue result)
+    reason: str = ""
+    phases: list[tuple[str, float, float]] = field(default_factory=list)
+    checks: list[dict[str, Any]] = field(default_factory=list)
+    provenance: dict[str, Any] | None = None
+    created_utc: str | None = None
+
+    @property
+    def n(self) -> int:
+        """Number of samples."""
+        return int(self.t_s.shape[0])
+
+    @property
+    def duration_s(self) -> float:
+        """Duration covered by the samples [s]: N steps of dt (each sample stands for one step)."""
+        return self.n * self.dt_s
+
+
+def is_result_folder(folder: Path) -> bool:
+    """True if ``folder`` holds the two files every result has (metrics.csv with a washout column, traces.parquet)."""
+    return (folder / METRICS_FILE).is_file() and (folder / TRACES_FILE).is_file()
+
+
+def _read_json(path: Path) -> dict[str, Any] | None:
+    if not path.is_file():
+        return None
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError) as exc:
+        raise WashbenchError(located(path, f"not a readable JSON file ({exc})")) from None
+    return doc if isinstance(doc, dict) else None
+
+
+def _washout_order(metrics: list[MetricRow]) -> list[str]:
+    return list(dict.fromkeys(r.washout for r in metrics))
+
+
+def perceived_motion_of(perceived_aircraft: np.ndarray, dt_s: float) -> dict[str, float]:
+    """Integral of |perceived(t) - perceived(0)| dt per DOF from the (N, 6) aircraft columns (metrics.csv units)."""
+    return {
+        d: integral_abs_error(x, np.full_like(x, x[0]), dt_s)
+        for d, x in zip(DOFS, np.ascontiguousarray(perceived_aircraft.T), strict=True)
+    }
+
+
+def _limits_from(prov: dict[str, Any] | None) -> Any:
+    """PlatformLimits from the provenance's platform values, or None when the result does not carry them."""
+    values = ((prov or {}).get("platform") or {}).get("values")
+    if not values:
+        return None
+    from pydantic import ValidationError
+
+    from washbench.platform.limits import PlatformLimits
+
+    try:
+        return PlatformLimits.model_validate_json(json.dumps(values))  # JSON mode: arrays are tuples
+    except ValidationError:
+        return None
+
+
+def envelope_usage(table: dict[str, np.ndarray], washouts: list[str], limits: Any) -> dict[str, dict[str, np.ndarray]]:
+    """Envelope usage per panel and washout: max over axes |value| / limit (stage), |omega| / rate limit (sphere).
+
+    The wheel limit is the fastest any wheel turns with the sphere at its rate limit (as in the recording).
+    """
+    from washbench.platform.limits import wheel_jacobian
+
+    t = limits.translation
+    rate_limit_degps = limits.rotation.rate_limit_degps
+    wheel_max = float(np.max(np.linalg.norm(wheel_jacobian(limits), axis=1)) * math.radians(rate_limit_degps))
+    out: dict[str, dict[str, np.ndarray]] = {
+        "position": {}, "velocity": {}, "acceleration": {}, "sphere rate": {}, "wheel speed": {}
+    }  # fmt: skip
+    for w in washouts:
+        stage = (
+            ("position", pos_columns(w), t.position_limit_m.xyz),
+            ("velocity", vel_columns(w), t.velocity_limit_mps.xyz),
+            ("acceleration", acc_columns(w), t.acceleration_limit_mps2.xyz),
+        )
+        for label, cols, lim in stage:
+            if all(c in table for c in cols):
+                ratios = [np.abs(table[c]) / m for c, m in zip(cols, lim, strict=True)]
+                out[label][w] = np.max(np.column_stack(ratios), axis=1)
+        cols = omega_platform_columns(w)
+        if all(c in table for c in cols):
+            out["sphere rate"][w] = np.linalg.norm(np.column_stack([table[c] for c in cols]), axis=1) / rate_limit_degps
+        cols = wheel_columns(w)
+        if all(c in table for c in cols):
+            out["wheel speed"][w] = np.max(np.abs(np.column_stack([table[c] for c in cols])), axis=1) / wheel_max
+    return {k: v for k, v in out.items() if v}
+
+
+def load_result(folder: Path) -> ResultData:
+    """Read one result folder (module docstring). WashbenchError naming the file when a required one is bad."""
+    import pyarrow.parquet as pq
+
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise WashbenchError(located(folder, "no such folder"))
+    if not is_result_folder(folder):
+        raise WashbenchError(located(folder, f"not a result folder: it needs {METRICS_FILE} and {TRACES_FILE}"))
+    metrics = read_metrics_csv(folder / METRICS_FILE)
+    washouts = _washout_order(metrics)
+    traces_path = folder / TRACES_FILE
+    try:
+        names = set(pq.read_schema(traces_path).names)
+    except (OSError, ValueError) as exc:
+        raise WashbenchError(located(traces_path, f"not a readable Parquet file ({exc})")) from None
+    want = [TIME_COLUMN]
+    for src in (AIRCRAFT, *washouts):
+        want += [*perceived_f_columns(src), *perceived_omega_columns(src)]
+    missing = [c for c in want if c not in names]
+    if missing:
+        raise WashbenchError(located(traces_path, f"missing column {missing[0]!r}"))
+    for w in washouts:
+        want += [c for c in (*pos_columns(w), *vel_columns(w), *acc_columns(w), *omega_platform_columns(w),
+                             *wheel_columns(w)) if c in names]  # fmt: skip
+        want += sorted(c for c in names if c.startswith(f"{w}.sat_"))
+    arrow = pq.read_table(traces_path, columns=want)
+    table = {c: arrow.column(c).to_numpy() for c in want}
+    t = np.asarray(table[TIME_COLUMN], dtype=np.float64)
+    if t.shape[0] < 2:
+        raise WashbenchError(located(traces_path, "fewer than 2 samples"))
+    run = _read_json(folder / "run.json") or {}
+    flight = _read_json(folder / "flight.json") or {}
+    dt = float(run.get("dt_s") or flight.get("dt_s") or (t[-1] - t[0]) / (t.shape[0] - 1))
+    perceived = {
+        src: np.column_stack([table[c] for c in (*perceived_f_columns(src), *perceived_omega_columns(src))])
+        for src in (AIRCRAFT, *washouts)
+    }
+    saturated = {
+        w: {c.split(".sat_", 1)[1]: table[c] != 0 for c in want if c.startswith(f"{w}.sat_")} for w in washouts
+    }
+    prov = run.get("provenance") or read_parquet_provenance(traces_path)
+    limits = _limits_from(prov)
+    usage = envelope_usage(table, washouts, limits) if limits is not None else {}
+    motion_doc = run.get("perceived_motion")
+    if isinstance(motion_doc, dict) and set(motion_doc) >= set(DOFS):
+        motion = {d: float(motion_doc[d]["value"]) for d in DOFS}  # as the suite ranked it
+    else:
+        motion = perceived_motion_of(perceived[AIRCRAFT], dt)
+    aircraft, manoeuvre = run.get("aircraft") or flight.get("aircraft"), run.get("manoeuvre") or flight.get("name")
+    title = f"{aircraft} / {manoeuvre}" if aircraft and manoeuvre else folder.name
+    ok = run.get("ok")
+    if ok is None and flight:
+        ok = flight.get("status") == "ok"
+    return ResultData(
+        folder=folder,
+        title=title,
+        washouts=washouts,
+        metrics=metrics,
+        t_s=t,
+        dt_s=dt,
+        perceived=perceived,
+        saturated=saturated,
+        usage=usage,
+        motion=motion,
+        ok=ok,
+        reason=str(run.get("reason") or flight.get("reason") or ""),
+        phases=[(str(p["name"]), float(p["t_start_s"]), float(p["t_end_s"])) for p in flight.get("phases", [])],
+        checks=list(flight.get("checks", [])),
+        provenance=prov,
+        created_utc=run.get("created_utc"),
+    )

@@ -1,0 +1,189 @@
+"""The suite's report.md and figures, from the files of a suite folder (``washbench suite``, ``washbench report``).
+
+A suite folder holds ``suite.json`` (every manoeuvre file with its status and reason, failures included, and the
+suite's provenance) and one result folder per manoeuvre that ran (``<aircraft>/<manoeuvre>/``). Without
+``suite.json`` (a folder of results put together by hand) the result folders found below it are reported.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from washbench.analysis.metrics import DOFS
+from washbench.analysis.ranking import METRICS, REFERENCE_WASHOUT, compare, rank, wins
+from washbench.errors import WashbenchError, located
+from washbench.io.atomic import write_text_atomic
+from washbench.review.numbers import sig
+from washbench.review.report import (
+    FIGURES_DIR,
+    FLAG,
+    REPORT_FILE,
+    SCORE_NOTE,
+    SUITE_FILE,
+    _image,
+    _rel,
+    provenance_lines,
+    result_sections,
+    write_result_report,
+)
+from washbench.review.result_data import ResultData, is_result_folder, load_result
+
+_HOW_TO_READ = [
+    "Metrics compare the aircraft pilot's perceived motion with each simulator pilot's, per degree of freedom: NPC",
+    "(normalized Pearson correlation, 1 perfect, larger worse), the integral and the maximum of |error|; surge, sway,",
+    "heave in m/s² (integral m/s²·s), roll, pitch, yaw in deg/s (integral deg). The score (lower is better) is the",
+    "weighted relative integral error of `washbench/analysis/ranking.py`: each DOF's error over the aircraft pilot's",
+    "own perceived motion in it (what a simulator standing still would get wrong), DOFs weighted by how much was felt",
+    "there (half the weight to specific force, half to rotation). Numbers have 3 significant digits; full precision",
+    "is in `metrics.csv`, `comparison.csv` and `ranking.csv`. Best values are bold.",
+    "",
+]
+
+
+def write_suite_json(path: Path, entries: list[dict[str, Any]], provenance: dict[str, Any], created_utc: str) -> None:
+    """``suite.json``: one entry per manoeuvre file (file, ok, reason, aircraft, manoeuvre, result folder, checks)."""
+    doc = {"created_utc": created_utc, "provenance": provenance, "manoeuvres": entries}
+    write_text_atomic(path, json.dumps(doc, indent=2) + "\n")
+
+
+def _entries(suite_dir: Path) -> tuple[list[dict[str, Any]], dict[str, Any]]:
+    """The manoeuvre entries and the suite document (suite.json, or found result folders without it)."""
+    path = suite_dir / SUITE_FILE
+    if path.is_file():
+        try:
+            doc = json.loads(path.read_text(encoding="utf-8"))
+            return list(doc["manoeuvres"]), doc
+        except (OSError, ValueError, KeyError, TypeError) as exc:
+            raise WashbenchError(located(path, f"not a readable suite.json ({exc})")) from None
+    folders = sorted({p.parent for p in suite_dir.rglob("metrics.csv") if is_result_folder(p.parent)})
+    if not folders:
+        raise WashbenchError(located(suite_dir, "neither a result folder nor a suite folder (no results found)"))
+    return [{"file": "", "result": _rel(f, suite_dir)} for f in folders], {}
+
+
+def write_suite_report(suite_dir: Path, *, regenerate_results: bool = False) -> Path:
+    """Write the suite's ``report.md`` and ``figures/`` from the suite folder's files; return the report's path.
+
+    ``regenerate_results``: first write every result folder's own report and figures again (``washbench report``);
+    otherwise the figures the runs wrote are linked.
+    """
+    from washbench.review.figures import score_heatmap, table4_figure
+
+    suite_dir = Path(suite_dir)
+    entries, doc = _entries(suite_dir)
+    results: list[tuple[dict[str, Any], ResultData | None]] = []
+    for e in entries:
+        folder = suite_dir / e["result"] if e.get("result") else None
+        if folder is not None and is_result_folder(folder):
+            if regenerate_results:
+                write_result_report(folder)
+            results.append((e, load_result(folder)))
+        else:
+            results.append((e, None))
+    loaded = [d for _, d in results if d is not None]
+    washouts = list(dict.fromkeys(w for d in loaded for w in d.washouts))
+    rankings = {id(d): rank(d.metrics, d.motion) for d in loaded}
+
+    fig_dir = suite_dir / FIGURES_DIR
+    fig_dir.mkdir(exist_ok=True)
+    figures: dict[str, Path] = {}
+    labels = [d.title for d in loaded]
+    if loaded:
+        scores = np.full((len(loaded), len(washouts)), math.nan)
+        for r, d in enumerate(loaded):
+            for row in rankings[id(d)]:
+                scores[r, washouts.index(row.washout)] = row.score
+        figures["scores"] = score_heatmap(fig_dir / "scores", labels, washouts, scores)[0]
+        others = [w for w in washouts if w != REFERENCE_WASHOUT]
+        if REFERENCE_WASHOUT in washouts and others:
+            better = {w: np.full((len(loaded), len(METRICS) * len(DOFS)), math.nan) for w in others}
+            for r, d in enumerate(loaded):
+                for c in compare(d.metrics):
+                    col = METRICS.index(c.metric) * len(DOFS) + DOFS.index(c.dof)
+                    ref = c.values.get(REFERENCE_WASHOUT, math.nan)
+                    for w, diff in c.better_than_reference.items():
+                        if math.isfinite(diff) and ref != 0:
+                            better[w][r, col] = 100.0 * diff / ref
+            figures["table4"] = table4_figure(fig_dir / "table4", labels, REFERENCE_WASHOUT, better, DOFS, METRICS)[0]
+
+    ok = [e for e, d in results if e.get("ok", d.ok if d else False)]
+    lines = ["# washbench suite report", ""]
+    lines.append(f"{len(ok)} of {len(results)} manoeuvres ran and passed their checks.")
+    lines.append("")
+    failed = [(e, d) for e, d in results if not e.get("ok", d.ok if d else False)]
+    if failed:
+        lines += ["## Failures", ""]
+        for e, d in failed:
+            name = e.get("file") or (d.title if d else "?")
+            reason = e.get("reason") or (d.reason if d else "") or "failed"
+            kept = f" (results kept in `{e['result']}/`)" if d is not None else ""
+            lines.append(f"- `{name}`: {reason}{kept}")
+        lines.append("")
+    lines += provenance_lines(doc.get("provenance"), doc.get("created_utc"))
+    lines += ["## Summary", ""]
+    head = ["aircraft", "manoeuvre", "status", "checks", "duration (s)", "best washout"]
+    head += [f"{w} score (-)" for w in washouts] + ["report", "recording"]
+    lines += ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    any_above = False
+    for e, d in results:
+        status = "ok" if e.get("ok", d.ok if d else False) else "FAILED"
+        if d is None:
+            name = Path(e.get("file", "?")).name
+            lines.append(f"| {e.get('aircraft') or '-'} | {e.get('manoeuvre') or name} | {status} | - | - | - | "
+                         + " | ".join("-" for _ in washouts) + " | - | - |")  # fmt: skip
+            continue
+        ranking = rankings[id(d)]
+        by_name = {r.washout: r.score for r in ranking}
+        best = ranking[0].washout if ranking else ""
+        cells = []
+        for w in washouts:
+            s = by_name.get(w, math.nan)
+            any_above |= s > 1.0
+            text = f"**{sig(s)}**" if w == best else sig(s)
+            cells.append(f"{text} {FLAG}" if s > 1.0 else text)
+        checks = f"{sum(bool(c.get('passed')) for c in d.checks)}/{len(d.checks)}" if d.checks else "-"
+        rel = _rel(d.folder, suite_dir)
+        rec = f"[recording.rrd]({rel}/recording.rrd)" if (d.folder / "recording.rrd").exists() else "-"
+        aircraft, _, manoeuvre = d.title.partition(" / ")
+        lines.append(f"| {aircraft} | {manoeuvre or d.title} | {status} | {checks} | {sig(d.duration_s)} | {best} | "
+                     + " | ".join(cells) + f" | [report.md]({rel}/{REPORT_FILE}) | {rec} |")  # fmt: skip
+    lines.append("")
+    if rankings:
+        count = wins(rankings.values())
+        lines += ["Manoeuvres won: " + ", ".join(f"{w} {n}" for w, n in count.items()) + ".", ""]
+    if any_above:
+        lines += [SCORE_NOTE, ""]
+    if "scores" in figures:
+        lines += _image(figures["scores"], suite_dir, "score per manoeuvre and washout")
+    if "table4" in figures:
+        lines += ["## Against small-angle (Table 4 of the paper)", ""]
+        lines += [f"Each cell: how much better than {REFERENCE_WASHOUT} the washout is, in percent of the "
+                  f"{REFERENCE_WASHOUT} value (positive, green: better). Absolute differences are in "
+                  "`comparison.csv`.", ""]  # fmt: skip
+        lines += _image(figures["table4"], suite_dir, "Table 4")
+    lines += ["## How to read the numbers", "", *_HOW_TO_READ]
+    for d in loaded:
+        rel = _rel(d.folder, suite_dir)
+        lines += [f"## {d.title}", "", f"Results in `{rel}/` ([report]({rel}/{REPORT_FILE})).", ""]
+        if d.ok is False:
+            lines += [f"> **FAILED**: {d.reason or 'a check failed'}", ""]
+        lines += result_sections(d, _existing_figures(d), suite_dir, 3)
+    path = suite_dir / REPORT_FILE
+    write_text_atomic(path, "\n".join(lines).rstrip() + "\n")
+    return path
+
+
+def _existing_figures(d: ResultData) -> dict[str, Path]:
+    """The result's figures as its report links them (drawn again when missing)."""
+    from washbench.review.report import result_figures
+
+    found = {name: d.folder / FIGURES_DIR / f"{name}.png" for name in ("perceived", "envelope")}
+    found = {k: p for k, p in found.items() if p.is_file()}
+    if "perceived" not in found:
+        return result_figures(d)
+    return found
