@@ -60,6 +60,8 @@ SATURATION_LABELS = {
 }
 """Readable names of the saturation kinds (``W.sat_<kind>`` columns)."""
 
+METRIC_LABELS = {"npc": "NPC", "integral_error": "integral of |error|", "max_error": "maximum |error|"}
+
 _THRESHOLD_COLOR = (0.45, 0.45, 0.45)
 _PHASE_SHADE = (0.0, 0.0, 0.0, 0.05)
 _DECIMATE_BUCKETS = 1500
@@ -298,9 +300,9 @@ def score_heatmap(
     ax.xaxis.tick_top()
     ax.set_yticks(range(len(rows)), rows, fontsize=8)
     bar = fig.colorbar(image, ax=ax, shrink=0.8, pad=0.02)
-    bar.set_label("score (lower is better; above 1: worse than standing still)", fontsize=7.5)
+    bar.set_label("score (lower is better)", fontsize=7.5)
     bar.ax.tick_params(labelsize=7)
-    ax.set_title(f"{title}: best per manoeuvre framed, ! above 1", fontsize=9)
+    ax.set_title(f"{title}: best per manoeuvre framed;\n! above 1 = worse than a simulator standing still", fontsize=9)
     return save_figure(fig, stem)
 
 
@@ -339,7 +341,8 @@ def table4_figure(
         for g in range(1, len(metrics)):
             ax.axvline(g * len(dofs) - 0.5, color="black", lw=1.2)
         sec = ax.secondary_xaxis("top")
-        sec.set_xticks([(g + 0.5) * len(dofs) - 0.5 for g in range(len(metrics))], list(metrics), fontsize=8)
+        names = [METRIC_LABELS.get(m, m) for m in metrics]
+        sec.set_xticks([(g + 0.5) * len(dofs) - 0.5 for g in range(len(metrics))], names, fontsize=8)
         sec.tick_params(length=0)
         ax.set_title(f"{w} better than {reference} (% of {reference}'s value)", fontsize=9)
     if image is not None:

@@ -49,7 +49,10 @@ if TYPE_CHECKING:
     from washbench.review.rerun_log import PlatformEnvelope
     from washbench.runs.cue import CueResult
 
-RUN_FILES = ("flight.json", "flight.parquet", "traces.parquet", "metrics.csv", "recording.rrd", "run.json")
+RUN_FILES = (
+    *("flight.json", "flight.parquet", "traces.parquet", "metrics.csv", "recording.rrd", "run.json"),
+    *("report.md", "figures"),
+)
 
 
 @dataclass(frozen=True)

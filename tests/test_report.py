@@ -1,0 +1,258 @@
+"""Report, figures and provenance: one short real flight with custom parameter and platform files, read back."""
+
+from __future__ import annotations
+
+import csv
+import datetime
+import hashlib
+import importlib.metadata
+import json
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import matplotlib.image
+import numpy as np
+import pyarrow.parquet as pq
+import pytest
+
+from washbench.io.paths import DATA_DIR
+from washbench.io.provenance import PARQUET_KEY
+from washbench.review.figures import minmax_decimate
+from washbench.review.numbers import sig
+from washbench.review.palette import WASHOUT_COLORS, washout_colors
+from washbench.review.report import write_result_report
+
+MANOEUVRE = """\
+name: short_bank
+aircraft: c172p
+start:
+  air: {altitude_ft: 3000, airspeed_kts: 90, heading_deg: 45}
+environment:
+  turbulence: {severity: light, seed: 7}
+phases:
+  - name: level
+    hold: {wings_level: true, altitude_ft: 3000, airspeed_kts: 90}
+    until: {duration_s: 3}
+  - name: bank
+    hold: {bank_deg: -25, altitude_ft: 3000, airspeed_kts: 90}
+    until: {duration_s: 6}
+checks:
+  - {name: banked, signal: phi_deg, stat: min, phases: [bank], max: -10}
+"""
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
+def washbench(*args: str | Path) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "washbench", *map(str, args)], capture_output=True, text=True, timeout=600
+    )
+
+
+def sha256(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+@pytest.fixture(scope="module")
+def inputs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    folder = tmp_path_factory.mktemp("inputs")
+    manoeuvre = folder / "short_bank.yaml"
+    manoeuvre.write_text(MANOEUVRE)
+    params = folder / "my_cw.yaml"
+    text = (DATA_DIR / "cw1.yaml").read_text()
+    params.write_text(re.sub(r"^name: CW1\b", "name: CW1-report-test", text, count=1, flags=re.M))
+    platform = folder / "my_atlas.yaml"
+    text = (DATA_DIR / "atlas.yaml").read_text()
+    platform.write_text(
+        re.sub(r"^name: .*$", "name: Atlas narrow", text, count=1, flags=re.M).replace("x: 1.5", "x: 0.5", 1)
+    )
+    return {"manoeuvre": manoeuvre, "params": params, "platform": platform}
+
+
+@pytest.fixture(scope="module")
+def run_dir(inputs: dict[str, Path], tmp_path_factory: pytest.TempPathFactory) -> Path:
+    out = tmp_path_factory.mktemp("run")
+    proc = washbench(
+        "run", inputs["manoeuvre"], "--out", out, "--params", inputs["params"], "--platform", inputs["platform"],
+        "--quiet",
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    return out / "c172p" / "short_bank"
+
+
+def linked_files(report: Path) -> list[Path]:
+    """Every local file a Markdown report links or embeds."""
+    targets = re.findall(r"\]\(([^)]+)\)", report.read_text())
+    return [report.parent / t for t in targets if "://" not in t]
+
+
+def check_images(report: Path) -> int:
+    """Every linked figure exists and is a valid image; returns the number of PNGs."""
+    files = linked_files(report)
+    pngs = [f for f in files if f.suffix == ".png"]
+    assert pngs, "the report embeds no figure"
+    for f in files:
+        assert f.is_file(), f
+    for f in pngs:
+        assert f.read_bytes()[:8] == PNG_SIGNATURE, f
+        image = matplotlib.image.imread(f)
+        assert image.ndim == 3 and image.shape[0] >= 200 and image.shape[1] >= 400, (f, image.shape)
+        assert np.ptp(image[..., :3]) > 0.5, f"{f} is blank"
+        pdf = f.with_suffix(".pdf")
+        assert pdf in files, f"no vector version linked for {f.name}"
+        data = pdf.read_bytes()
+        assert data.startswith(b"%PDF-") and data.rstrip().endswith(b"%%EOF"), pdf
+    return len(pngs)
+
+
+def test_run_json_records_what_made_the_result(run_dir: Path, inputs: dict[str, Path]) -> None:
+    doc = json.loads((run_dir / "run.json").read_text())
+    prov = doc["provenance"]
+    assert prov["params"]["name"] == "CW1-report-test"
+    assert prov["params"]["sha256"] == sha256(inputs["params"])
+    assert prov["params"]["path"] == str(inputs["params"])
+    assert prov["platform"]["name"] == "Atlas narrow"
+    assert prov["platform"]["sha256"] == sha256(inputs["platform"])
+    assert prov["platform"]["values"]["translation"]["position_limit_m"]["x"] == 0.5
+    assert prov["manoeuvre"] == {"path": str(inputs["manoeuvre"]), "sha256": sha256(inputs["manoeuvre"])}
+    assert prov["turbulence"] == {"severity": "light", "seed": 7}
+    sw = prov["software"]
+    for key, dist in (("jsbsim", "jsbsim"), ("rerun", "rerun-sdk"), ("numpy", "numpy"), ("washbench", "washbench")):
+        assert sw[key] == importlib.metadata.version(dist)
+    assert sw["numpy"] == np.__version__
+    created = datetime.datetime.fromisoformat(doc["created_utc"].replace("Z", "+00:00"))
+    assert abs((datetime.datetime.now(datetime.UTC) - created).total_seconds()) < 3600
+
+
+def test_parquet_metadata_holds_the_provenance_but_no_date(run_dir: Path) -> None:
+    run_prov = json.loads((run_dir / "run.json").read_text())["provenance"]
+    traces = json.loads(pq.read_schema(run_dir / "traces.parquet").metadata[PARQUET_KEY])
+    assert traces == run_prov
+    flight = json.loads(pq.read_schema(run_dir / "flight.parquet").metadata[PARQUET_KEY])
+    assert flight["manoeuvre"] == run_prov["manoeuvre"] and flight["turbulence"] == run_prov["turbulence"]
+    assert "params" not in flight  # washbench fly uses no washout parameters
+    for name in ("traces.parquet", "flight.parquet"):
+        meta = b"".join(k + v for k, v in pq.read_schema(run_dir / name).metadata.items())
+        assert b"created" not in meta and datetime.date.today().isoformat().encode() not in meta, name
+
+
+def test_report_header_names_the_inputs_and_versions(run_dir: Path, inputs: dict[str, Path]) -> None:
+    text = (run_dir / "report.md").read_text()
+    header = text.split("## Ranking")[0]
+    needles = ["CW1-report-test", sha256(inputs["params"]), "Atlas narrow", sha256(inputs["platform"])]
+    needles += [sha256(inputs["manoeuvre"]), "light, seed 7", "JSBSim 1.3.3", f"numpy {np.__version__}"]
+    for needle in needles:
+        assert needle in header, needle
+
+
+def test_every_linked_figure_exists_and_is_an_image(run_dir: Path) -> None:
+    assert check_images(run_dir / "report.md") == 2  # perceived motion, platform envelope
+
+
+def test_report_reads_like_a_table(run_dir: Path) -> None:
+    text = (run_dir / "report.md").read_text()
+    assert (
+        "| washout | surge (m/s²·s) | sway (m/s²·s) | heave (m/s²·s) | roll (deg) | pitch (deg) | yaw (deg) |" in text
+    )
+    assert "| washout | surge (m/s²) |" in text and "roll (deg/s)" in text
+    assert not re.search(r"\d[eE][+-]?\d", text.split("| provenance |")[0] + text.split("## Ranking")[1])
+    # the best value of each DOF is bold: the minimum of metrics.csv
+    with (run_dir / "metrics.csv").open() as f:
+        rows = list(csv.DictReader(f))
+    best = min(float(r["integral_error"]) for r in rows if r["dof"] == "roll")
+    table = text.split("Integral of |perceived error|")[1].split("\n\n")[1]
+    assert f"**{sig(best)}**" in table
+
+
+def test_saturation_is_given_in_seconds_and_percent(run_dir: Path) -> None:
+    text = (run_dir / "report.md").read_text()
+    traces = pq.read_table(run_dir / "traces.parquet")
+    n = traces.num_rows
+    flags = traces.column("unrestricted.sat_tilt_rate").to_numpy()
+    steps = int(flags.sum())
+    assert steps > 0  # the bank needs more tilt than the 3 deg/s tilt-rate limit gives
+    line = next(ln for ln in text.splitlines() if ln.startswith("| tilt-rate limit"))
+    cells = [c.strip() for c in line.strip("|").split("|")]
+    seconds, percent = re.fullmatch(r"([\d.]+) s \(([\d.]+) %\)", cells[3]).groups()
+    assert float(seconds) == pytest.approx(steps / 120.0, rel=5e-3)
+    assert float(percent) == pytest.approx(100.0 * steps / n, rel=5e-2)
+
+
+def test_report_is_regenerated_from_the_files_alone(run_dir: Path, inputs: dict[str, Path], tmp_path: Path) -> None:
+    copy = tmp_path / "copy"
+    shutil.copytree(run_dir, copy)
+    shutil.rmtree(copy / "figures")
+    (copy / "report.md").unlink()
+    hidden = tmp_path / "hidden"
+    hidden.mkdir()
+    for f in inputs.values():  # no manoeuvre, parameter or platform file to read: nothing can be flown or cued
+        shutil.move(f, hidden / f.name)
+    try:
+        proc = washbench("report", copy)
+    finally:
+        for f in inputs.values():
+            shutil.move(hidden / f.name, f)
+    assert proc.returncode == 0, proc.stderr
+    assert (copy / "report.md").read_text() == (run_dir / "report.md").read_text()
+    for name in ("perceived.png", "envelope.png"):
+        assert (copy / "figures" / name).read_bytes() == (run_dir / "figures" / name).read_bytes(), name
+
+
+def test_cue_results_get_the_same_report(run_dir: Path, tmp_path: Path) -> None:
+    out = tmp_path / "cue"
+    proc = washbench("cue", run_dir / "flight.parquet", "--out", out)
+    assert proc.returncode == 0, proc.stderr
+    prov = json.loads(pq.read_schema(out / "traces.parquet").metadata[PARQUET_KEY])
+    assert prov["input"]["sha256"] == sha256(run_dir / "flight.parquet")
+    flown = json.loads(pq.read_schema(run_dir / "flight.parquet").metadata[PARQUET_KEY])
+    assert prov["input"]["provenance"] == flown  # what made the input travels with it
+    assert prov["params"]["name"] == "CW1" and prov["params"]["sha256"] == sha256(DATA_DIR / "cw1.yaml")
+    text = write_result_report(out).read_text()
+    assert sha256(run_dir / "flight.parquet") in text and flown["manoeuvre"]["sha256"] in text
+    assert check_images(out / "report.md") == 2
+
+
+def test_user_named_washouts_come_from_the_data(run_dir: Path, tmp_path: Path) -> None:
+    copy = tmp_path / "renamed"
+    shutil.copytree(run_dir, copy)
+    (copy / "metrics.csv").write_text((run_dir / "metrics.csv").read_text().replace("unrestricted,", "my-variant,"))
+    table = pq.read_table(run_dir / "traces.parquet")
+    renamed = table.rename_columns([c.replace("unrestricted.", "my-variant.") for c in table.column_names])
+    pq.write_table(renamed.replace_schema_metadata(table.schema.metadata), copy / "traces.parquet")
+    text = write_result_report(copy).read_text()
+    assert "| my-variant |" in text and "my-variant vs small-angle" in text and "unrestricted" not in text
+    check_images(copy / "report.md")
+
+
+def test_report_of_a_missing_or_foreign_folder_is_one_line(tmp_path: Path) -> None:
+    for target in (tmp_path / "nope", tmp_path):
+        proc = washbench("report", target)
+        assert proc.returncode == 2 and "Traceback" not in proc.stderr
+        assert len(proc.stderr.strip().splitlines()) == 1, proc.stderr
+
+
+def test_washout_colours_are_fixed_and_distinct() -> None:
+    colors = washout_colors(["my-a", "large-angle", "my-b", "small-angle", "unrestricted"])
+    for name, rgb in WASHOUT_COLORS.items():
+        assert colors[name] == rgb
+    assert len(set(colors.values())) == len(colors)
+
+
+@pytest.mark.parametrize("x", [5.058e-05, 83.88, 0.99951, 9.996, -12345.0, 1.0, 0.1, 123.4, -0.000123456])
+def test_number_format_has_three_significant_digits_and_no_exponent(x: float) -> None:
+    text = sig(x)
+    assert "e" not in text.lower()
+    assert float(text) == pytest.approx(float(f"{x:.3g}"), rel=1e-12)
+
+
+def test_decimation_keeps_every_peak() -> None:
+    rng = np.random.default_rng(1)
+    t = np.arange(100_003) / 120.0
+    y = np.cumsum(rng.normal(size=t.size))
+    y[777] = 1e3  # a one-sample spike
+    tt, yy = minmax_decimate(t, y, buckets=500)
+    assert tt.size <= 1000 and np.all(np.diff(tt) >= 0)
+    assert yy.max() == y.max() and yy.min() == y.min()
+    assert 1e3 in yy and t[777] in tt
