@@ -13,10 +13,10 @@ import subprocess
 import sys
 from pathlib import Path
 
-import matplotlib.image
 import numpy as np
 import pyarrow.parquet as pq
 import pytest
+from report_helpers import check_images
 
 from washbench.io.paths import DATA_DIR
 from washbench.io.provenance import PARQUET_KEY
@@ -42,7 +42,6 @@ phases:
 checks:
   - {name: banked, signal: phi_deg, stat: min, phases: [bank], max: -10}
 """
-PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
 
 def washbench(*args: str | Path) -> subprocess.CompletedProcess[str]:
@@ -80,31 +79,6 @@ def run_dir(inputs: dict[str, Path], tmp_path_factory: pytest.TempPathFactory) -
     )  # fmt: skip
     assert proc.returncode == 0, proc.stdout + proc.stderr
     return out / "c172p" / "short_bank"
-
-
-def linked_files(report: Path) -> list[Path]:
-    """Every local file a Markdown report links or embeds."""
-    targets = re.findall(r"\]\(([^)]+)\)", report.read_text())
-    return [report.parent / t for t in targets if "://" not in t]
-
-
-def check_images(report: Path) -> int:
-    """Every linked figure exists and is a valid image; returns the number of PNGs."""
-    files = linked_files(report)
-    pngs = [f for f in files if f.suffix == ".png"]
-    assert pngs, "the report embeds no figure"
-    for f in files:
-        assert f.is_file(), f
-    for f in pngs:
-        assert f.read_bytes()[:8] == PNG_SIGNATURE, f
-        image = matplotlib.image.imread(f)
-        assert image.ndim == 3 and image.shape[0] >= 200 and image.shape[1] >= 400, (f, image.shape)
-        assert np.ptp(image[..., :3]) > 0.5, f"{f} is blank"
-        pdf = f.with_suffix(".pdf")
-        assert pdf in files, f"no vector version linked for {f.name}"
-        data = pdf.read_bytes()
-        assert data.startswith(b"%PDF-") and data.rstrip().endswith(b"%%EOF"), pdf
-    return len(pngs)
 
 
 def test_run_json_records_what_made_the_result(run_dir: Path, inputs: dict[str, Path]) -> None:

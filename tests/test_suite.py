@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import csv
+import json
 import shutil
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
+from report_helpers import check_images
 
 from washbench.io.paths import MANOEUVRES_DIR
 
@@ -54,6 +56,38 @@ def test_broken_file_is_reported_and_the_others_complete(first: tuple[Path, subp
         run = out / "c172p" / name
         assert (run / "recording.rrd").is_file() and (run / "metrics.csv").is_file()
         assert f"c172p/{name}/recording.rrd" in report
+
+
+def test_suite_report_puts_failures_first_and_embeds_valid_figures(
+    first: tuple[Path, subprocess.CompletedProcess[str]],
+) -> None:
+    out, _ = first
+    report = out / "report.md"
+    text = report.read_text()
+    assert text.index("## Failures") < text.index("## Summary") < text.index("## c172p / coordinated_turn")
+    assert "![score per manoeuvre and washout](figures/scores.png)" in text and "figures/table4.png" in text
+    assert "c172p/coordinated_turn/figures/perceived.png" in text
+    assert check_images(report) == 2 + 2 * 2  # scores, Table 4; perceived and envelope per manoeuvre
+    suite_doc = json.loads((out / "suite.json").read_text())
+    assert [e["ok"] for e in suite_doc["manoeuvres"]].count(False) == 1
+    assert suite_doc["provenance"]["params"]["name"] == "CW1"
+
+
+def test_report_command_rebuilds_the_suite_report(
+    first: tuple[Path, subprocess.CompletedProcess[str]], tmp_path: Path
+) -> None:
+    out, _ = first
+    copy = tmp_path / "suite"
+    shutil.copytree(out, copy)
+    (copy / "report.md").unlink()
+    shutil.rmtree(copy / "figures")
+    shutil.rmtree(copy / "c172p" / "stall_recovery" / "figures")
+    proc = subprocess.run(
+        [sys.executable, "-m", "washbench", "report", str(copy)], capture_output=True, text=True, timeout=600
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert (copy / "report.md").read_text() == (out / "report.md").read_text()
+    assert (copy / "c172p" / "stall_recovery" / "figures" / "perceived.png").is_file()
 
 
 def test_ranking_and_comparison_tables(first: tuple[Path, subprocess.CompletedProcess[str]]) -> None:

@@ -17,7 +17,12 @@ an interrupted run never leaves a half-written folder that looks complete)::
         traces.parquet   washbench cue columns + flight-state columns
         metrics.csv      washout,dof,npc,integral_error,max_error
         recording.rrd    rerun recording with its blueprint
-        run.json         summary used by washbench suite (status, motion per DOF, saturations)
+        run.json         summary used by washbench suite (status, motion per DOF, saturations),
+                         provenance (washbench.io.provenance) and the date
+        report.md        the result's report (washbench.review.report), built from the files above
+        figures/         its figures: perceived.png/.pdf, envelope.png/.pdf
+
+traces.parquet and flight.parquet carry the provenance (no date) in their key-value metadata.
 """
 
 from __future__ import annotations
@@ -319,6 +324,7 @@ def run_command(
     print(
         f"{s.aircraft}/{s.manoeuvre}: {state}; checks {s.checks_passed}/{s.checks_total}; "
         f"{s.steps * s.dt_s:.1f} s flown in {time.perf_counter() - start:.1f} s; results in {s.run_dir}"
+        + (f"; report: {s.run_dir / 'report.md'}" if s.run_dir else "")
     )
     for w, kinds in s.saturations.items():
         sat = ", ".join(f"{k} {v}" for k, v in kinds.items() if v) or "none"

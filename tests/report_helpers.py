@@ -1,0 +1,36 @@
+"""Shared by the report tests: every figure a Markdown report links exists and is a valid image."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import matplotlib.image
+import numpy as np
+
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
+def linked_files(report: Path) -> list[Path]:
+    """Every local file a Markdown report links or embeds."""
+    targets = re.findall(r"\]\(([^)]+)\)", report.read_text())
+    return [report.parent / t for t in targets if "://" not in t]
+
+
+def check_images(report: Path) -> int:
+    """Every linked figure exists and is a valid image; returns the number of PNGs."""
+    files = linked_files(report)
+    pngs = [f for f in files if f.suffix == ".png"]
+    assert pngs, "the report embeds no figure"
+    for f in files:
+        assert f.is_file(), f
+    for f in pngs:
+        assert f.read_bytes()[:8] == PNG_SIGNATURE, f
+        image = matplotlib.image.imread(f)
+        assert image.ndim == 3 and image.shape[0] >= 200 and image.shape[1] >= 400, (f, image.shape)
+        assert np.ptp(image[..., :3]) > 0.5, f"{f} is blank"
+        pdf = f.with_suffix(".pdf")
+        assert pdf in files, f"no vector version linked for {f.name}"
+        data = pdf.read_bytes()
+        assert data.startswith(b"%PDF-") and data.rstrip().endswith(b"%%EOF"), pdf
+    return len(pngs)
