@@ -312,6 +312,8 @@ def run_command(
     progress: bool = True,
 ) -> int:
     """CLI entry of ``washbench run``: 0 if the flight ran and passed its checks, else 1."""
+    from washbench.review.numbers import pct, sig
+
     start = time.perf_counter()
     s = run_manoeuvre(
         manoeuvre_path,
@@ -327,6 +329,6 @@ def run_command(
         + (f"; report: {s.run_dir / 'report.md'}" if s.run_dir else "")
     )
     for w, kinds in s.saturations.items():
-        sat = ", ".join(f"{k} {v}" for k, v in kinds.items() if v) or "none"
-        print(f"  {w}: platform saturations (steps): {sat}", file=sys.stdout)
+        sat = ", ".join(f"{k} {sig(v * s.dt_s)} s ({pct(100.0 * v / s.steps, False)})" for k, v in kinds.items() if v)
+        print(f"  {w}: time at a limit: {sat or 'none'}", file=sys.stdout)
     return 0 if s.ok else 1
