@@ -74,7 +74,9 @@ def find_manoeuvres(inputs: Sequence[Path]) -> list[Path]:
     return unique
 
 
-def _run_one(path: str, out_dir: str, params_path: str | None, platform_path: str | None) -> Outcome:
+def _run_one(
+    path: str, out_dir: str, params_path: str | None, platform_path: str | None, aircraft_dirs: tuple[str, ...] = ()
+) -> Outcome:
     """Worker: run one manoeuvre; never raises (failures come back as an Outcome)."""
     from washbench.runs.pipeline import run_manoeuvre
 
@@ -85,6 +87,7 @@ def _run_one(path: str, out_dir: str, params_path: str | None, platform_path: st
             Path(out_dir),
             params_path=Path(params_path) if params_path else None,
             platform_path=Path(platform_path) if platform_path else None,
+            aircraft_dirs=[Path(d) for d in aircraft_dirs],
         )
     except WashbenchError as exc:
         summary = RunSummary(ok=False, reason=str(exc))
@@ -103,14 +106,15 @@ def run_suite(
     params_path: Path | None = None,
     platform_path: Path | None = None,
     progress: bool = True,
+    aircraft_dirs: Sequence[Path] = (),
 ) -> list[Outcome]:
     """Run every file in parallel processes; return the outcomes in the order of ``files``."""
     jobs = max(1, min(jobs or os.cpu_count() or 1, len(files)))
     out_dir.mkdir(parents=True, exist_ok=True)
-    args = [
-        (str(f), str(out_dir), str(params_path) if params_path else None, str(platform_path) if platform_path else None)
-        for f in files
-    ]
+    dirs = tuple(str(d) for d in aircraft_dirs)
+    params = str(params_path) if params_path else None
+    platform = str(platform_path) if platform_path else None
+    args = [(str(f), str(out_dir), params, platform, dirs) for f in files]
     outcomes: dict[str, Outcome] = {}
     start = time.perf_counter()
     if progress:
@@ -310,6 +314,7 @@ def suite_command(
     params_path: Path | None = None,
     platform_path: Path | None = None,
     progress: bool = True,
+    aircraft_dirs: Sequence[Path] = (),
 ) -> int:
     """CLI entry: run the suite, write its results, print where they are; 0 if all succeeded, else 1."""
     if jobs is not None and jobs < 1:
@@ -323,7 +328,13 @@ def suite_command(
     load_platform_limits(platform_path)
     start = time.perf_counter()
     outcomes = run_suite(
-        files, out_dir, jobs=jobs, params_path=params_path, platform_path=platform_path, progress=progress
+        files,
+        out_dir,
+        jobs=jobs,
+        params_path=params_path,
+        platform_path=platform_path,
+        progress=progress,
+        aircraft_dirs=aircraft_dirs,
     )
     write_suite_results(outcomes, out_dir)
     n_ok = sum(o.run.ok for o in outcomes)
