@@ -41,7 +41,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
 
     p = sub.add_parser("fly", help="fly a manoeuvre file with JSBSim and the scripted pilot")
-    p.add_argument("manoeuvre", type=Path, help="manoeuvre YAML file")
+    p.add_argument("manoeuvre", type=Path, help="manoeuvre YAML file, or a bundled one by name (c172/takeoff)")
     p.add_argument("--out", type=Path, required=True, help="output folder (flight.parquet, flight.json)")
     _aircraft_dir_option(p)
     p.add_argument("--quiet", action="store_true", help="no progress display")
@@ -54,7 +54,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", type=Path, help="write to this file instead of standard output")
 
     p = sub.add_parser("run", help="fly a manoeuvre with the washouts in lockstep; write traces, metrics, recording")
-    p.add_argument("manoeuvre", type=Path, help="manoeuvre YAML file")
+    p.add_argument("manoeuvre", type=Path, help="manoeuvre YAML file, or a bundled one by name (c172/takeoff)")
     p.add_argument("--out", type=Path, required=True, help="results folder; writes OUT/<aircraft>/<manoeuvre>/")
     _aircraft_dir_option(p)
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
@@ -62,7 +62,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quiet", action="store_true", help="no progress display")
 
     p = sub.add_parser("suite", help="run many manoeuvres in parallel and compare the washouts")
-    p.add_argument("inputs", type=Path, nargs="*", help="manoeuvre files or folders (default: bundled manoeuvres/)")
+    p.add_argument(
+        "inputs",
+        type=Path,
+        nargs="*",
+        help="manoeuvre files or folders, or bundled ones by name (c172, columbia400/takeoff); default: all bundled",
+    )
     p.add_argument("--out", type=Path, required=True, help="results folder")
     _aircraft_dir_option(p)
     p.add_argument("--jobs", type=int, help="parallel processes (default: number of cores)")
@@ -110,6 +115,13 @@ def _version_line() -> str:
 
 
 def _dispatch(args: argparse.Namespace) -> int:
+    if hasattr(args, "manoeuvre") or hasattr(args, "manoeuvres"):
+        from washbench.io.paths import resolve_manoeuvre  # a bundled name such as c172/takeoff
+
+        if hasattr(args, "manoeuvre"):
+            args.manoeuvre = resolve_manoeuvre(args.manoeuvre)
+        else:
+            args.manoeuvres = [resolve_manoeuvre(m) for m in args.manoeuvres]
     if args.command == "cue":
         from washbench.runs.cue import run_cue
 

@@ -163,3 +163,22 @@ def find_aircraft_files(
     """Model folder and pilot profile of one manoeuvre's aircraft (see :func:`find_aircraft`, :func:`find_profile`)."""
     root = find_aircraft(name, manoeuvre_file, aircraft_dirs)
     return AircraftFiles(name, root, find_profile(name, manoeuvre_file, aircraft_dirs, pilot_profile))
+
+
+def bundled_names() -> list[str]:
+    """Names of the bundled manoeuvres, ``<aircraft>/<name>`` (what :func:`resolve_manoeuvre` accepts)."""
+    return sorted(p.relative_to(MANOEUVRES_DIR).with_suffix("").as_posix() for p in MANOEUVRES_DIR.glob("*/*.yaml"))
+
+
+def resolve_manoeuvre(item: Path) -> Path:
+    """A manoeuvre argument as given, or, when no such file or folder exists, the bundled one of that name.
+
+    ``c172/takeoff`` (or ``c172/takeoff.yaml``) names a bundled manoeuvre and ``c172`` the bundled folder of an
+    aircraft, so ``washbench run c172/takeoff`` works from any folder. An existing path always wins.
+    """
+    if item.exists() or item.is_absolute():
+        return item
+    for candidate in (MANOEUVRES_DIR / item, MANOEUVRES_DIR / f"{item}.yaml"):
+        if candidate.exists():
+            return candidate
+    return item
