@@ -92,6 +92,10 @@ def test_run_json_records_what_made_the_result(run_dir: Path, inputs: dict[str, 
     assert prov["platform"]["values"]["translation"]["position_limit_m"]["x"] == 0.5
     assert prov["manoeuvre"] == {"path": str(inputs["manoeuvre"]), "sha256": sha256(inputs["manoeuvre"])}
     assert prov["turbulence"] == {"severity": "light", "seed": 7}
+    model = Path(prov["aircraft"]["path"])
+    assert prov["aircraft"]["name"] == "c172p" and model.name == "c172p.xml"
+    assert prov["aircraft"]["sha256"] == sha256(model)
+    assert prov["pilot_profile"]["sha256"] == sha256(Path(prov["pilot_profile"]["path"]))
     sw = prov["software"]
     for key, dist in (("jsbsim", "jsbsim"), ("rerun", "rerun-sdk"), ("numpy", "numpy"), ("washbench", "washbench")):
         assert sw[key] == importlib.metadata.version(dist)
@@ -230,3 +234,14 @@ def test_decimation_keeps_every_peak() -> None:
     assert tt.size <= 1000 and np.all(np.diff(tt) >= 0)
     assert yy.max() == y.max() and yy.min() == y.min()
     assert 1e3 in yy and t[777] in tt
+
+
+def test_flat_provenance_for_the_recording(run_dir: Path, inputs: dict[str, Path]) -> None:
+    from washbench.io.provenance import flat_strings
+
+    doc = json.loads((run_dir / "run.json").read_text())
+    flat = flat_strings(doc["provenance"], doc["created_utc"])
+    assert flat["params.sha256"] == sha256(inputs["params"]) and flat["params.name"] == "CW1-report-test"
+    assert flat["turbulence.seed"] == "7" and flat["software.jsbsim"] == "1.3.3"
+    assert flat["created_utc"] == doc["created_utc"]
+    assert all(isinstance(v, str) for v in flat.values()) and not any(".values." in k for k in flat)

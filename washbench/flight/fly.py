@@ -404,7 +404,9 @@ def fly_command(manoeuvre_path: Path, out_dir: Path, progress: bool = True, airc
     wall = time.monotonic()
     result = fly(m, progress=show)
     wall = time.monotonic() - wall
-    prov = build_provenance(manoeuvre_path=manoeuvre_path, turbulence=m.environment.turbulence)
+    prov = build_provenance(
+        manoeuvre_path=manoeuvre_path, turbulence=m.environment.turbulence, aircraft_files=m.aircraft_files
+    )
     write_flight(out_dir, result, str(manoeuvre_path), prov)
     passed = sum(1 for c in result.checks if c[3])
     line = (

@@ -4,7 +4,8 @@ One JSON-able dict (:func:`build_provenance`) records
 
 - ``software``: the versions of washbench (and its git commit when run from a work tree), JSBSim, rerun-sdk,
   numpy, scipy, pyarrow and Python;
-- ``manoeuvre``: the manoeuvre file's path (as given) and SHA-256 (``washbench run`` / ``fly``), or ``input``: the
+- ``manoeuvre``: the manoeuvre file's path (as given) and SHA-256 (``washbench run`` / ``fly``), with the JSBSim
+  model file (``aircraft``) and the scripted pilot's profile (``pilot_profile``) it was flown with; or ``input``: the
   recorded trace's path and SHA-256 (``washbench cue``), with the input's own provenance carried along when it
   has one (a ``flight.parquet`` written by ``washbench fly``);
 - ``params`` and ``platform``: the parameter set's and platform's name (the ``name`` key of the YAML file), the path
@@ -112,16 +113,23 @@ def build_provenance(
     input_path: Path | None = None,
     input_provenance: Mapping[str, Any] | None = None,
     turbulence: Any = None,
+    aircraft_files: Any = None,
 ) -> dict[str, Any]:
     """The provenance of one result (module docstring); no date in it.
 
     ``params`` and ``platform`` are the loaded models (``WashoutParams``, ``PlatformLimits``: pydantic models with a
     ``name``); their paths are the files actually read (left out when not given: ``washbench fly`` uses neither).
-    ``turbulence`` is the manoeuvre's ``Turbulence`` or None.
+    ``turbulence`` is the manoeuvre's ``Turbulence`` or None. ``aircraft_files`` (``washbench.io.paths.AircraftFiles``,
+    where the manoeuvre's aircraft was found) adds the JSBSim model file ``<name>/<name>.xml`` and the pilot profile,
+    each with its path and SHA-256 (the model's own file only: engines and systems it includes are not hashed).
     """
     prov: dict[str, Any] = {"software": software_versions()}
     if manoeuvre_path is not None:
         prov["manoeuvre"] = file_record(manoeuvre_path)
+    if aircraft_files is not None:
+        model = Path(aircraft_files.model_dir) / f"{aircraft_files.name}.xml"
+        prov["aircraft"] = file_record(model, aircraft_files.name)
+        prov["pilot_profile"] = file_record(aircraft_files.profile)
     if input_path is not None:
         prov["input"] = file_record(input_path)
         if input_provenance:
@@ -177,3 +185,25 @@ def manoeuvre_of(prov: Mapping[str, Any] | None) -> Mapping[str, Any] | None:
         return prov["manoeuvre"]
     inner = prov.get("input", {}).get("provenance")
     return manoeuvre_of(inner) if inner else None
+
+
+def flat_strings(prov: Mapping[str, Any], created_utc: str | None = None) -> dict[str, str]:
+    """The provenance as flat ``"a.b.c" -> "text"`` pairs (e.g. recording properties), the file values left out.
+
+    ``{"params": {"name": "CW1", "sha256": ...}}`` becomes ``{"params.name": "CW1", "params.sha256": ...}``; a missing
+    value (no turbulence) is ``"none"``; ``created_utc`` is added when given.
+    """
+    out: dict[str, str] = {}
+
+    def walk(prefix: str, value: Any) -> None:
+        if isinstance(value, Mapping):
+            for key, item in value.items():
+                if key != "values":
+                    walk(f"{prefix}.{key}" if prefix else str(key), item)
+        else:
+            out[prefix] = "none" if value is None else str(value)
+
+    walk("", prov)
+    if created_utc:
+        out["created_utc"] = created_utc
+    return out

@@ -3,10 +3,10 @@
 Per manoeuvre (one result folder):
 
 - :func:`perceived_figure`: the six perceived-motion panels stacked on one time axis, as the paper's Figures 8, 10,
-  14 and 16: surge, sway, heave (m/s^2), roll, pitch, yaw (deg/s); the aircraft pilot in black, each washout's
-  simulator pilot in its fixed colour (:mod:`washbench.review.palette`); the phases as a lane on top and shaded
-  alternately in every panel; the perception thresholds (Zacharias, :mod:`washbench.perception.thresholds`) as
-  dashed +- lines around the resting value (0, or -g for heave), so what lies between them is not felt.
+  14 and 16: surge, sway, heave (m/s^2), roll, pitch, yaw (deg/s); the aircraft pilot in magenta (drawn wider), each
+  washout's simulator pilot in its fixed colour (:mod:`washbench.review.palette`); the phases as a lane on top
+  and shaded alternately in every panel; the perception thresholds (Zacharias, :mod:`washbench.perception.thresholds`)
+  as dashed +- lines around the resting value (0, or -g for heave), so what lies between them is not felt.
 - :func:`envelope_figure`: platform envelope usage against time, max over the axes of |value| / limit for stage
   position, velocity, acceleration, sphere angular rate and wheel speed, the limit at 1, and one lane per washout
   and limit kind showing when a limit was active.
@@ -32,7 +32,7 @@ from typing import Any
 
 import numpy as np
 
-from washbench.review.palette import AIRCRAFT_COLOR_FIGURE, mpl, washout_colors
+from washbench.review.palette import AIRCRAFT_COLOR, mpl, washout_colors
 
 FIGURE_FORMATS = ("png", "pdf")
 """Every figure is written as STEM.png (embedded in report.md) and STEM.pdf (vector, for papers)."""
@@ -174,14 +174,14 @@ def perceived_figure(
             tt, yy = minmax_decimate(t_s, perceived[w][:, i])
             ax.plot(tt, yy, color=mpl(colors[w]), lw=1.0, zorder=2)
         tt, yy = minmax_decimate(t_s, perceived["aircraft"][:, i])
-        ax.plot(tt, yy, color=mpl(AIRCRAFT_COLOR_FIGURE), lw=1.7, zorder=3)
+        ax.plot(tt, yy, color=mpl(AIRCRAFT_COLOR), lw=1.7, zorder=3)
         ax.set_ylabel(f"{dof}\n({unit})", fontsize=9)
         ax.tick_params(labelsize=8)
         ax.grid(True, color=(0.9, 0.9, 0.9), lw=0.5)
         ax.margins(x=0)
     panels[-1].set_xlabel("time (s)", fontsize=9)
     panels[-1].set_xlim(float(t_s[0]), float(t_s[-1]))
-    handles = [Line2D([], [], color=mpl(AIRCRAFT_COLOR_FIGURE), lw=1.7, label="aircraft pilot")]
+    handles = [Line2D([], [], color=mpl(AIRCRAFT_COLOR), lw=1.7, label="aircraft pilot")]
     handles += [Line2D([], [], color=mpl(colors[w]), lw=1.2, label=w) for w in washouts]
     if thresholds is not None:
         handles.append(Line2D([], [], color=_THRESHOLD_COLOR, lw=0.8, ls=(0, (4, 3)), label="perception threshold"))

@@ -1,9 +1,9 @@
 """Fixed colours of the review (figures and report), the same as the rerun recording's.
 
 The three bundled washouts keep their colours everywhere (small-angle blue, large-angle orange, unrestricted
-green: matplotlib's tab10, as in :mod:`washbench.review.rerun_log`); other washout names (user-named variants) take
-further distinct colours in the order they first appear. The aircraft pilot, the reference every washout is
-compared with, is black in figures (they have a white background).
+green: matplotlib's tab10) and other washout names (user-named variants) take further distinct colours in the order
+they are listed, as in the rerun recording; the aircraft pilot, the reference every washout is compared with, is
+the recording's strong magenta, readable on white and on dark backgrounds and distinct from every washout colour.
 """
 
 from __future__ import annotations
@@ -18,15 +18,13 @@ WASHOUT_COLORS: dict[str, RGB] = {
     "unrestricted": (44, 160, 44),  # green
 }
 EXTRA_COLORS: tuple[RGB, ...] = (
-    (214, 39, 40),  # red
-    (148, 103, 189),  # purple
-    (140, 86, 75),  # brown
-    (227, 119, 194),  # pink
     (23, 190, 207),  # cyan
+    (140, 86, 75),  # brown
     (188, 189, 34),  # olive
-    (127, 127, 127),  # grey
+    (255, 200, 0),  # gold
+    (40, 60, 140),  # navy
 )
-AIRCRAFT_COLOR_FIGURE: RGB = (0, 0, 0)
+AIRCRAFT_COLOR: RGB = (200, 0, 160)  # magenta
 
 
 def washout_colors(washouts: Sequence[str]) -> dict[str, RGB]:

@@ -72,6 +72,8 @@ def provenance_lines(prov: dict[str, Any] | None, created_utc: str | None) -> li
             rows.append((label, f"{name}`{rec.get('path', '?')}` (SHA-256 `{rec.get('sha256', '?')}`)"))
 
     file_row("manoeuvre file", prov.get("manoeuvre"))
+    file_row("aircraft model", prov.get("aircraft"))
+    file_row("pilot profile", prov.get("pilot_profile"))
     inp = prov.get("input")
     file_row("input trace", inp)
     if inp and inp.get("provenance", {}).get("manoeuvre"):
@@ -230,8 +232,8 @@ def result_sections(data: ResultData, figures: dict[str, Path], start: Path, lev
     lines += [f"{h} Ranking", "", *ranking_lines(data, ranking)]
     lines += [f"{h} Perceived motion", ""]
     lines += [
-        "Aircraft pilot (black) against each washout's simulator pilot; dashed: perception thresholds (Zacharias "
-        "1978) around the resting value, what lies between them is not felt; shaded: the phases.",
+        "Aircraft pilot (magenta, wide) against each washout's simulator pilot; dashed: perception thresholds "
+        "(Zacharias 1978) around the resting value, what lies between them is not felt; shaded: the phases.",
         "",
     ]
     lines += _image(figures["perceived"], start, "perceived motion")

@@ -153,10 +153,12 @@ def run_manoeuvre(
     params = load_washout_params(params_path)
     limits = load_platform_limits(platform_path)
     turbulence = manoeuvre.environment.turbulence
-    flight_prov = build_provenance(manoeuvre_path=manoeuvre_path, turbulence=turbulence)
+    ac_files = manoeuvre.aircraft_files
+    flight_prov = build_provenance(manoeuvre_path=manoeuvre_path, turbulence=turbulence, aircraft_files=ac_files)
     prov = build_provenance(
         manoeuvre_path=manoeuvre_path,
         turbulence=turbulence,
+        aircraft_files=ac_files,
         params_path=params_path or DEFAULT_PARAMS_PATH,
         params=params,
         platform_path=platform_path or DEFAULT_LIMITS_PATH,
