@@ -67,7 +67,9 @@ def test_suite_report_puts_failures_first_and_embeds_valid_figures(
     assert text.index("## Failures") < text.index("## Summary") < text.index("## c172p / coordinated_turn")
     assert "![score per manoeuvre and washout](figures/scores.png)" in text and "figures/table4.png" in text
     assert "c172p/coordinated_turn/figures/perceived.png" in text
-    assert check_images(report) == 2 + 2 * 2  # scores, Table 4; perceived and envelope per manoeuvre
+    assert check_images(report) == 2 + 2  # scores, Table 4; perceived motion per manoeuvre
+    for name in ("coordinated_turn", "stall_recovery"):
+        assert check_images(out / "c172p" / name / "report.md") == 2  # perceived motion, envelope
     suite_doc = json.loads((out / "suite.json").read_text())
     assert [e["ok"] for e in suite_doc["manoeuvres"]].count(False) == 1
     assert suite_doc["provenance"]["params"]["name"] == "CW1"

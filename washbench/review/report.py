@@ -224,8 +224,14 @@ def _image(png: Path, start: Path, alt: str) -> list[str]:
             f"({Path(rel).with_suffix('.pdf').as_posix()})", ""]  # fmt: skip
 
 
-def result_sections(data: ResultData, figures: dict[str, Path], start: Path, level: int) -> list[str]:
-    """The body of one result's report; links relative to ``start`` (the folder report.md is in)."""
+def result_sections(
+    data: ResultData, figures: dict[str, Path], start: Path, level: int, brief: bool = False
+) -> list[str]:
+    """The body of one result's report; links relative to ``start`` (the folder report.md is in).
+
+    ``brief`` (the suite report): without the envelope figure, checks and phases (they are in the result's own
+    report, which the suite report links).
+    """
     h = "#" * level
     lines: list[str] = []
     ranking = rank(data.metrics, data.motion) if data.metrics else []
@@ -239,14 +245,16 @@ def result_sections(data: ResultData, figures: dict[str, Path], start: Path, lev
     lines += _image(figures["perceived"], start, "perceived motion")
     lines += [f"{h} Metrics", "", *metric_tables(data)]
     lines += [f"{h} Platform", ""]
-    if "envelope" in figures:
+    if brief:
+        pass
+    elif "envelope" in figures:
         lines += _image(figures["envelope"], start, "platform envelope")
     else:
         lines += ["_No platform limits are recorded with this result: no envelope figure._", ""]
     lines += [f"Time at a limit ({sig(data.duration_s)} s manoeuvre):", "", *saturation_lines(data)]
-    if data.checks:
+    if data.checks and not brief:
         lines += [f"{h} Checks", "", *check_lines(data)]
-    if data.phases:
+    if data.phases and not brief:
         lines += [f"{h} Phases", "", "| phase | start (s) | end (s) |", "|---|---|---|"]
         lines += [f"| {n} | {t0:.2f} | {t1:.2f} |" for n, t0, t1 in data.phases]
         lines.append("")

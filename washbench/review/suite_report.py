@@ -92,7 +92,7 @@ def write_suite_report(suite_dir: Path, *, regenerate_results: bool = False) -> 
     fig_dir = suite_dir / FIGURES_DIR
     fig_dir.mkdir(exist_ok=True)
     figures: dict[str, Path] = {}
-    labels = [d.title for d in loaded]
+    labels = [d.title + (" (FAILED)" if d.ok is False else "") for d in loaded]
     if loaded:
         scores = np.full((len(loaded), len(washouts)), math.nan)
         for r, d in enumerate(loaded):
@@ -169,10 +169,12 @@ def write_suite_report(suite_dir: Path, *, regenerate_results: bool = False) -> 
     lines += ["## How to read the numbers", "", *_HOW_TO_READ]
     for d in loaded:
         rel = _rel(d.folder, suite_dir)
-        lines += [f"## {d.title}", "", f"Results in `{rel}/` ([report]({rel}/{REPORT_FILE})).", ""]
+        lines += [f"## {d.title}", ""]
+        lines += [f"Results in `{rel}/`; its [report]({rel}/{REPORT_FILE}) adds the platform envelope figure, "
+                  "the checks and the phases.", ""]  # fmt: skip
         if d.ok is False:
             lines += [f"> **FAILED**: {d.reason or 'a check failed'}", ""]
-        lines += result_sections(d, _existing_figures(d), suite_dir, 3)
+        lines += result_sections(d, _existing_figures(d), suite_dir, 3, brief=True)
     path = suite_dir / REPORT_FILE
     write_text_atomic(path, "\n".join(lines).rstrip() + "\n")
     return path
