@@ -1,14 +1,17 @@
 """Imported once by the suite's process server before it forks workers.
 
 Importing this module loads what every run needs and is slow to start: JSBSim, pyarrow, rerun,
-scipy and the compiled cueing step (numba loads it from its on-disk cache, about 0.4 s). Workers
-forked afterwards start with all of it in memory. Nothing here starts a thread (rerun's recording
-streams are created in the workers), so forking stays safe.
+scipy, matplotlib's Agg canvas (the report's figures) and the compiled cueing step (numba loads it
+from its on-disk cache, about 0.4 s). Workers forked afterwards start with all of it in memory.
+Nothing here starts a thread (rerun's recording streams are created in the workers), so forking
+stays safe.
 """
 
 from __future__ import annotations
 
 import jsbsim  # noqa: F401
+import matplotlib.backends.backend_agg
+import matplotlib.figure  # noqa: F401
 import pyarrow.parquet  # noqa: F401
 import rerun  # noqa: F401
 import scipy.signal  # noqa: F401
