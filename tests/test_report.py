@@ -245,3 +245,13 @@ def test_flat_provenance_for_the_recording(run_dir: Path, inputs: dict[str, Path
     assert flat["turbulence.seed"] == "7" and flat["software.jsbsim"] == "1.3.3"
     assert flat["created_utc"] == doc["created_utc"]
     assert all(isinstance(v, str) for v in flat.values()) and not any(".values." in k for k in flat)
+
+
+def test_time_beyond_the_threshold_counts_the_felt_samples(run_dir: Path) -> None:
+    text = (run_dir / "report.md").read_text()
+    row = next(ln for ln in text.splitlines() if "beyond the perception threshold" in ln)
+    values = [float(c) for c in row.strip("|").split("|")[1:]]
+    roll = pq.read_table(run_dir / "traces.parquet").column("aircraft.perceived_omega_x_degps").to_numpy()
+    # rolling into a 25 deg bank is felt (Zacharias roll threshold 3.0 deg/s), for less than the manoeuvre
+    assert values[3] == pytest.approx(float(np.count_nonzero(np.abs(roll) > 3.0)) / 120.0, rel=5e-3)
+    assert 0.0 < values[3] < roll.size / 120.0

@@ -86,7 +86,7 @@ def provenance_lines(prov: dict[str, Any] | None, created_utc: str | None) -> li
     sw = prov.get("software", {})
     parts = [
         f"washbench {sw.get('washbench', '?')}"
-        + (f" (git `{sw['washbench_git'][:12]}`)" if sw.get("washbench_git") else "")
+        + (f" (git `{_short_commit(sw['washbench_git'])}`)" if sw.get("washbench_git") else "")
     ]
     parts += [f"{label} {sw[key]}" for key, label in (("jsbsim", "JSBSim"), ("rerun", "rerun-sdk"), ("numpy", "numpy"),
                                                       ("scipy", "scipy"), ("pyarrow", "pyarrow"), ("python", "Python"))
@@ -95,6 +95,12 @@ def provenance_lines(prov: dict[str, Any] | None, created_utc: str | None) -> li
     if created_utc:
         rows.append(("created", created_utc))
     return ["| provenance | |", "|---|---|", *(f"| {k} | {v} |" for k, v in rows), ""]
+
+
+def _short_commit(commit: str) -> str:
+    """``1cc4a4c2678f3a99...-dirty`` -> ``1cc4a4c2678f-dirty``."""
+    head, dash, rest = commit.partition("-")
+    return head[:12] + dash + rest
 
 
 def _score_cell(score: float, best: bool) -> str:
@@ -156,6 +162,13 @@ def metric_tables(data: ResultData) -> list[str]:
                 + " | ".join(sig(data.motion.get(d, math.nan)) for d in dofs)
                 + " |"
             )
+        if metric == "max_error":
+            above = time_above_threshold(data)
+            lines.append(
+                "| _aircraft pilot beyond the perception threshold (s)_ | "
+                + " | ".join(sig(above[d]) for d in dofs)
+                + " |"
+            )
         lines.append("")
     return lines
 
@@ -192,15 +205,31 @@ def check_lines(data: ResultData) -> list[str]:
     return [*lines, ""]
 
 
+def perception_thresholds() -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """Zacharias thresholds and the resting values they are taken around, per DOF (m/s^2, deg/s)."""
+    from washbench.perception.thresholds import STANDARD_GRAVITY_MPS2, ZACHARIAS
+
+    th = ZACHARIAS
+    thresholds = (th.f_x_mps2, th.f_y_mps2, th.f_z_mps2, th.omega_x_degps, th.omega_y_degps, th.omega_z_degps)
+    return thresholds, (0.0, 0.0, -STANDARD_GRAVITY_MPS2, 0.0, 0.0, 0.0)
+
+
+def time_above_threshold(data: ResultData) -> dict[str, float]:
+    """Per DOF, how long the aircraft pilot's perceived motion lies beyond the perception threshold [s]."""
+    thresholds, rest = perception_thresholds()
+    p = data.perceived["aircraft"]
+    return {
+        d: float(np.count_nonzero(np.abs(p[:, i] - rest[i]) > thresholds[i])) * data.dt_s for i, d in enumerate(DOFS)
+    }
+
+
 def result_figures(data: ResultData) -> dict[str, Path]:
     """Draw the result's figures into ``folder/figures/``; returns figure name -> PNG path."""
-    from washbench.perception.thresholds import STANDARD_GRAVITY_MPS2, ZACHARIAS
     from washbench.review.figures import envelope_figure, perceived_figure
 
     fig_dir = data.folder / FIGURES_DIR
     fig_dir.mkdir(exist_ok=True)
-    th = ZACHARIAS
-    thresholds = (th.f_x_mps2, th.f_y_mps2, th.f_z_mps2, th.omega_x_degps, th.omega_y_degps, th.omega_z_degps)
+    thresholds, rest = perception_thresholds()
     out = {}
     out["perceived"] = perceived_figure(
         fig_dir / "perceived",
@@ -209,7 +238,7 @@ def result_figures(data: ResultData) -> dict[str, Path]:
         data.perceived,
         phases=data.phases,
         thresholds=thresholds,
-        rest=(0.0, 0.0, -STANDARD_GRAVITY_MPS2, 0.0, 0.0, 0.0),
+        rest=rest,
     )[0]
     if data.usage:
         out["envelope"] = envelope_figure(
