@@ -177,6 +177,7 @@ def run_manoeuvre(
         rows.append(step(f_mps2, np.radians(omega_deg)).copy())
 
     start = time.perf_counter()
+    created = utc_now()
     flight = fly(manoeuvre, step_hook=lockstep, progress=progress)
     n = len(flight.t_s)
     if len(rows) != n:
@@ -215,7 +216,7 @@ def run_manoeuvre(
             motion=felt,
             saturations={w: dict(traces[w].saturation_counts) for w in washouts},
         )
-        _write_run_json(partial / "run.json", summary, time.perf_counter() - start, prov)
+        _write_run_json(partial / "run.json", summary, time.perf_counter() - start, prov, created)
         if figures:
             from washbench.review.report import write_result_report
 
@@ -227,7 +228,9 @@ def run_manoeuvre(
     return summary
 
 
-def _write_run_json(path: Path, s: RunSummary, wall_s: float, provenance: dict[str, object]) -> None:
+def _write_run_json(
+    path: Path, s: RunSummary, wall_s: float, provenance: dict[str, object], created_utc: str
+) -> None:
     doc = {
         "aircraft": s.aircraft,
         "manoeuvre": s.manoeuvre,
@@ -242,7 +245,7 @@ def _write_run_json(path: Path, s: RunSummary, wall_s: float, provenance: dict[s
             d: {"value": v, "unit": "m/s^2*s" if d in DOFS[:3] else "deg"} for d, v in s.motion.items()
         },
         "saturations": s.saturations,
-        "created_utc": utc_now(),
+        "created_utc": created_utc,
         "provenance": provenance,
     }
     write_text_atomic(path, json.dumps(doc, indent=2) + "\n")
