@@ -228,9 +228,7 @@ def run_manoeuvre(
     return summary
 
 
-def _write_run_json(
-    path: Path, s: RunSummary, wall_s: float, provenance: dict[str, object], created_utc: str
-) -> None:
+def _write_run_json(path: Path, s: RunSummary, wall_s: float, provenance: dict[str, object], created_utc: str) -> None:
     doc = {
         "aircraft": s.aircraft,
         "manoeuvre": s.manoeuvre,
