@@ -34,3 +34,25 @@ def check_images(report: Path) -> int:
         data = pdf.read_bytes()
         assert data.startswith(b"%PDF-") and data.rstrip().endswith(b"%%EOF"), pdf
     return len(pngs)
+
+
+def check_tables(report: Path) -> int:
+    """Every Markdown table is well formed (a delimiter row, the same cell count in every row); returns the count."""
+    lines = report.read_text().splitlines()
+    tables = 0
+    i = 0
+    while i < len(lines):
+        if lines[i].startswith("|") and i + 1 < len(lines) and re.fullmatch(r"\|(---\|)+", lines[i + 1]):
+            width = lines[i].count("|")
+            assert lines[i + 1].count("|") == width, lines[i]
+            j = i + 2
+            while j < len(lines) and lines[j].startswith("|"):
+                assert lines[j].count("|") == width, f"{report}: {lines[j]!r} has not {width - 1} cells"
+                j += 1
+            assert j == len(lines) or lines[j] == "", f"{report}: no blank line after the table at {lines[j]!r}"
+            tables += 1
+            i = j
+        else:
+            assert not lines[i].startswith("|"), f"{report}: table row outside a table: {lines[i]!r}"
+            i += 1
+    return tables

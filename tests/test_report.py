@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import pyarrow.parquet as pq
 import pytest
-from report_helpers import check_images
+from report_helpers import check_images, check_tables
 
 from washbench.io.paths import DATA_DIR
 from washbench.io.provenance import PARQUET_KEY
@@ -127,6 +127,11 @@ def test_report_header_names_the_inputs_and_versions(run_dir: Path, inputs: dict
 
 def test_every_linked_figure_exists_and_is_an_image(run_dir: Path) -> None:
     assert check_images(run_dir / "report.md") == 2  # perceived motion, platform envelope
+
+
+def test_every_table_is_well_formed(run_dir: Path) -> None:
+    # provenance, ranking, three metric tables, time at a limit, checks, phases
+    assert check_tables(run_dir / "report.md") == 8
 
 
 def test_report_reads_like_a_table(run_dir: Path) -> None:

@@ -10,7 +10,7 @@ import sys
 from pathlib import Path
 
 import pytest
-from report_helpers import check_images
+from report_helpers import check_images, check_tables
 
 from washbench.io.paths import MANOEUVRES_DIR
 
@@ -68,6 +68,7 @@ def test_suite_report_puts_failures_first_and_embeds_valid_figures(
     assert "![score per manoeuvre and washout](figures/scores.png)" in text and "figures/table4.png" in text
     assert "c172p/coordinated_turn/figures/perceived.png" in text
     assert check_images(report) == 2 + 2  # scores, Table 4; perceived motion per manoeuvre
+    assert check_tables(report) >= 2 + 2 * 4  # provenance, summary; per manoeuvre ranking, 3 metrics (and limits)
     for name in ("coordinated_turn", "stall_recovery"):
         assert check_images(out / "c172p" / name / "report.md") == 2  # perceived motion, envelope
     suite_doc = json.loads((out / "suite.json").read_text())
