@@ -36,8 +36,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from washbench.analysis.metrics import MetricRow, integral_abs_error
-from washbench.analysis.ranking import DOFS
+from washbench.analysis.metrics import MetricRow
+from washbench.analysis.ranking import DOFS, perceived_motion
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
 
@@ -70,15 +70,6 @@ class RunSummary:
     metrics: list[MetricRow] = field(default_factory=list)
     motion: dict[str, float] = field(default_factory=dict)  # DOF -> aircraft pilot's perceived motion
     saturations: dict[str, dict[str, int]] = field(default_factory=dict)
-
-
-def perceived_motion(perceived_f_mps2: np.ndarray, perceived_omega_radps: np.ndarray, dt_s: float) -> dict[str, float]:
-    """How much the aircraft pilot felt per DOF: integral of |perceived(t) - perceived(0)| dt.
-
-    Surge, sway, heave in m/s^2*s; roll, pitch, yaw in deg (the units of metrics.csv).
-    """
-    columns = np.column_stack([perceived_f_mps2, np.degrees(perceived_omega_radps)])
-    return {dof: integral_abs_error(x, np.full_like(x, x[0]), dt_s) for dof, x in zip(DOFS, columns.T, strict=True)}
 
 
 def aircraft_attitude(phi_deg: np.ndarray, theta_deg: np.ndarray, psi_deg: np.ndarray) -> np.ndarray:
