@@ -28,10 +28,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from washbench.analysis.metric_sums import FLAT_RTOL, signal_metrics
+
 NPC_K = 1.0
 """The K of Eq. 21 used in the paper."""
-
-from washbench.analysis.metric_sums import FLAT_RTOL, signal_metrics
 
 ANTI_CORRELATED_TOL = 1e-12
 """PC within this of -1 counts as -1 (NPC reported as inf)."""

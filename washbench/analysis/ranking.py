@@ -2,7 +2,8 @@
 
 Comparison (like the paper's Table 4). For each manoeuvre, degree of freedom and metric, every
 washout's value and its difference from the reference washout (small-angle when it runs, otherwise the
-first washout listed: :func:`reference_washout`), signed so that POSITIVE MEANS BETTER than the reference. All three metrics are "lower is better" (NPC is 1.0 for a perfect
+first washout listed: :func:`reference_washout`), signed so that POSITIVE MEANS BETTER than the
+reference. All three metrics are "lower is better" (NPC is 1.0 for a perfect
 correlation and grows as the correlation worsens), so the difference is ``small_angle - washout``.
 An undefined NPC (flat signal) gives an empty difference.
 

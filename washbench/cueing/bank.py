@@ -31,8 +31,8 @@ from washbench.cueing.kernel import (
     C_G,
     C_HEAD_EULER,
     C_JAC,
-    C_LP_BEFORE,
     C_KIND,
+    C_LP_BEFORE,
     C_PMAX,
     C_R,
     C_ROT_SAT,
@@ -187,6 +187,23 @@ class WashoutTrace:
             return np.ascontiguousarray(rows[:, start : start + n])
 
         saturated = {k: rows[:, O_SAT + j] != 0.0 for j, k in enumerate(SAT_KINDS)}
+        return cls._build(cols, saturated)
+
+    @classmethod
+    def from_fields(cls, block: np.ndarray) -> WashoutTrace:
+        """Build from a field-major block (N_FIELDS, N) of one washout (no copy: the arrays are views, (N, k)
+        in column-major order, each column contiguous)."""
+        if block.ndim != 2 or block.shape[0] != NFIELDS:
+            raise ValueError(f"block must have shape ({NFIELDS}, N), got {block.shape}")
+
+        def cols(start: int, n: int) -> np.ndarray:
+            return block[start : start + n].T
+
+        saturated = {k: block[O_SAT + j] != 0.0 for j, k in enumerate(SAT_KINDS)}
+        return cls._build(cols, saturated)
+
+    @classmethod
+    def _build(cls, cols, saturated: dict[str, np.ndarray]) -> WashoutTrace:  # noqa: ANN001
         return cls(
             pos_m=cols(O_POS, 3),
             vel_mps=cols(O_VEL, 3),
@@ -297,6 +314,6 @@ def cue_trace(
     cfg, coef = build_arrays(specs, limits, dt)
     state = np.zeros((len(names), NSTATE))
     counts = np.zeros((len(names), len(SAT_KINDS)), dtype=np.int64)
-    out = np.zeros((len(names), f.shape[0], NFIELDS))
+    out = np.empty((len(names), NFIELDS, f.shape[0]))
     bank_trace(f, w, cfg, coef, state, counts, out)
-    return {name: WashoutTrace.from_rows(out[i]) for i, name in enumerate(names)}
+    return {name: WashoutTrace.from_fields(out[i]) for i, name in enumerate(names)}

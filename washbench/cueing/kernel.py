@@ -21,6 +21,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import numpy as np
 from numba import njit, prange
 
 from washbench.cueing.filters import filt_init, filt_step
@@ -342,14 +343,18 @@ def bank_step(f, om, cfg, coef, state, counts, out):
 
 @njit(cache=True, parallel=True)
 def bank_trace(f, om, cfg, coef, state, counts, out):
-    """Whole-trace form: f, om (N, 3), already checked finite; out (n_washouts, N, NFIELDS).
+    """Whole-trace form: f, om (N, 3), already checked finite; out (n_washouts, NFIELDS, N), field-major so that
+    every output column is contiguous (no copy to split it into traces).
 
     Same per-washout step as bank_step; the washouts are independent, so they run in parallel threads (one
     washout's samples in order on one thread: the same operations in the same order as streaming).
     """
     for i in prange(cfg.shape[0]):
+        row = np.zeros(NFIELDS)
         for k in range(f.shape[0]):
-            step_one(f[k], om[k], cfg[i], coef[i], state[i], counts[i], out[i, k])
+            step_one(f[k], om[k], cfg[i], coef[i], state[i], counts[i], row)
+            for j in range(NFIELDS):
+                out[i, j, k] = row[j]
 
 
 _HERE = Path(__file__).resolve().parent

@@ -144,11 +144,13 @@ def apply_overrides(
     overrides: Mapping[str, Any] | Sequence[tuple[str, Any]],
     where: str,
     lines: Mapping[str, int | None] | None = None,
+    field_prefix: str = "",
 ) -> WashoutParams:
     """``params`` with dotted-key overrides applied and validated (same rules as the parameter file).
 
     ``where`` names the source in errors (a file, or ``--variant ...``); ``lines`` optionally maps a key to the
-    line it was written on. Raises WashbenchError: ``WHERE[:LINE]: KEY: problem``.
+    line it was written on, and ``field_prefix`` is put before the key in errors (``variants.NAME.``). Raises
+    WashbenchError: ``WHERE[:LINE]: KEY: problem``.
     """
     items = list(overrides.items()) if isinstance(overrides, Mapping) else list(overrides)
     if not items:
@@ -169,7 +171,8 @@ def apply_overrides(
         loc = tuple(str(p) for p in err["loc"] if isinstance(p, str))
         key = next((k for k, _ in items if tuple(k.split(".")) == loc[: len(k.split("."))]), ".".join(loc))
         line = (lines or {}).get(key)
-        raise WashbenchError(located(where, _problem(err, WashoutParams, loc), line=line, field=key)) from None
+        problem = _problem(err, WashoutParams, loc)
+        raise WashbenchError(located(where, problem, line=line, field=field_prefix + key)) from None
 
 
 def resolve(variant: VariantText, base: WashoutParams, where: str | None = None) -> Washout:
@@ -205,7 +208,7 @@ def _file_variants(path: Path, data: Any, lines: dict[Loc, int], base: WashoutPa
         key_lines = {k: line_of(lines, where) for k, (_, where) in flat.items()}
         for key in flat:
             check_key(key, located(path, field, line=key_lines[key]))
-        params = apply_overrides(base, {k: v for k, (v, _) in flat.items()}, str(path), key_lines)
+        params = apply_overrides(base, {k: v for k, (v, _) in flat.items()}, str(path), key_lines, f"{field}.")
         out.append(Washout(str(name), kind, params))
     return tuple(out)
 

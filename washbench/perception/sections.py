@@ -33,14 +33,17 @@ def sections_step(b, phi, x, u_prev, u):
 
 @njit(cache=True, parallel=True)
 def sections_apply(b, phi, steady, u):
-    """Filter every column of ``u`` (N, m) along axis 0, each starting in its first sample's steady state."""
+    """Filter every column of ``u`` (N, m) along axis 0, each starting in its first sample's steady state.
+
+    Returns (N, m) in column-major order (each column contiguous, as the metrics and tables read them).
+    """
     n, m = u.shape
-    y = np.empty((n, m))
+    yt = np.empty((m, n))
     for j in prange(m):
         x = np.empty(phi.shape[0])
         sections_init(steady, x, u[0, j])
         u_prev = u[0, j]
         for k in range(n):
-            y[k, j] = sections_step(b, phi, x, u_prev, u[k, j])
+            yt[j, k] = sections_step(b, phi, x, u_prev, u[k, j])
             u_prev = u[k, j]
-    return y
+    return yt.T

@@ -179,7 +179,7 @@ class DiscreteModel:
         if u.ndim not in (1, 2) or u.shape[0] == 0:
             raise ValueError(f"expected a non-empty (N,) or (N, m) array, got shape {u.shape}")
         b, phi, steady = self.arrays()
-        y = sections_apply(b, phi, steady, np.ascontiguousarray(u.reshape(u.shape[0], -1)))
+        y = sections_apply(b, phi, steady, u if u.ndim == 2 else u.reshape(-1, 1))
         return y.reshape(u.shape)
 
 

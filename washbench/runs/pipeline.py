@@ -29,6 +29,7 @@ import os
 import shutil
 import sys
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -112,14 +113,20 @@ def run_manoeuvre(
     params_path: Path | None = None,
     platform_path: Path | None = None,
     progress: bool = False,
+    washouts: Sequence[str] | None = None,
+    variants: Sequence[str] = (),
 ) -> RunSummary:
     """Fly one manoeuvre with the washouts in lockstep and write its results folder.
+
+    ``washouts`` (built-in names), ``variants`` (``--variant`` texts) and the parameter file's ``variants:``
+    select the washouts (:func:`washbench.cueing.variants.select_washouts`; default the three built-in ones).
 
     Raises WashbenchError for a bad manoeuvre, parameter or platform file (nothing written).
     A flight that crashes or fails a check still writes its results (what was flown), with
     ``ok`` False and the reason.
     """
-    from washbench.cueing import WASHOUT_NAMES, CueingBank, WashoutTrace, load_washout_params
+    from washbench.cueing import CueingBank, WashoutTrace
+    from washbench.cueing.variants import select_washouts
     from washbench.flight.fly import fly, write_flight
     from washbench.flight.manoeuvre import load_manoeuvre
     from washbench.io.results import read_motion
@@ -127,10 +134,10 @@ def run_manoeuvre(
     from washbench.runs.cue import analyse, write_results
 
     manoeuvre = load_manoeuvre(manoeuvre_path)
-    params = load_washout_params(params_path)
+    specs = select_washouts(washouts, variants, params_path)
     limits = load_platform_limits(platform_path)
-    washouts = tuple(WASHOUT_NAMES)
-    bank = CueingBank(washouts, params, limits, manoeuvre.dt_s)
+    bank = CueingBank(specs, None, limits, manoeuvre.dt_s)
+    washouts = bank.washouts
     rows: list[np.ndarray] = []
     step = bank.step
     omega_deg = np.empty(3)
@@ -273,6 +280,8 @@ def run_command(
     params_path: Path | None = None,
     platform_path: Path | None = None,
     progress: bool = True,
+    washouts: Sequence[str] | None = None,
+    variants: Sequence[str] = (),
 ) -> int:
     """CLI entry of ``washbench run``: 0 if the flight ran and passed its checks, else 1."""
     start = time.perf_counter()
@@ -282,6 +291,8 @@ def run_command(
         params_path=params_path,
         platform_path=platform_path,
         progress=progress and sys.stderr.isatty(),
+        washouts=washouts,
+        variants=variants,
     )
     state = "ok" if s.ok else f"FAILED ({s.reason})"
     print(
