@@ -30,12 +30,10 @@ def client(address: str) -> Any:
 
 
 def dask_map(address: str, fn: Callable[..., Any], args: Sequence[tuple[Any, ...]]) -> Iterator[Any]:
-    """``fn(*a)`` for every ``a`` in ``args`` on the cluster; results in the order they finish."""
-    from dask.distributed import as_completed
-
+    """``fn(*a)`` for every ``a`` in ``args`` on the cluster (all submitted at once); results in the order of ``args``."""
     c = client(address)
     futures = [c.submit(fn, *a, pure=False) for a in args]
-    for fut in as_completed(futures):
+    for fut in futures:
         yield fut.result()
 
 
