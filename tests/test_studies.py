@@ -28,14 +28,23 @@ from washbench.runs.suite import Outcome, write_suite_results
 HERE = Path(__file__).parent / "data" / "study"
 MANOEUVRES = [HERE / "short_turn.yaml", HERE / "short_climb.yaml"]
 CW1_TEXT = (DATA_DIR / "cw1.yaml").read_text()
-SWEEP = ["--washout", "large-angle", "--washout", "small-angle",
-         "--set", "tilt.gain_per_s=0.4,2", "--set", "tilt.rate_limit_degps=3,off"]
+SWEEP = [
+    "--washout",
+    "large-angle",
+    "--washout",
+    "small-angle",
+    "--set",
+    "tilt.gain_per_s=0.4,2",
+    "--set",
+    "tilt.rate_limit_degps=3,off",
+]
 
 
 def params_file(folder: Path, name: str, gain: str = "0.4", limit: str = "3.0") -> Path:
     """CW1 with the tilt gain and rate limit replaced in its text (independent of the override code)."""
     text = CW1_TEXT.replace("gain_per_s: 0.4 ", f"gain_per_s: {gain} ").replace(
-        "rate_limit_degps: 3.0 ", f"rate_limit_degps: {limit} ")
+        "rate_limit_degps: 3.0 ", f"rate_limit_degps: {limit} "
+    )
     assert text.count(f"gain_per_s: {gain} ") == 1 and text.count(f"rate_limit_degps: {limit} ") == 1
     path = folder / f"{name}.yaml"
     path.write_text(text)
@@ -66,22 +75,37 @@ def sweep_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 def test_sweep_writes_the_grid(sweep_dir: Path) -> None:
     rows = read_csv(sweep_dir / "sweep.csv")
-    assert list(rows[0]) == ["tilt.gain_per_s", "tilt.rate_limit_degps", "washout", "aircraft", "manoeuvre", "score",
-                             "saturated_s"]
+    assert list(rows[0]) == [
+        "tilt.gain_per_s",
+        "tilt.rate_limit_degps",
+        "washout",
+        "aircraft",
+        "manoeuvre",
+        "score",
+        "saturated_s",
+    ]
     assert len(rows) == 4 * 2 * 2  # grid points x washouts x manoeuvres
     assert {(r["tilt.gain_per_s"], r["tilt.rate_limit_degps"]) for r in rows} == {
-        ("0.4", "3"), ("0.4", "off"), ("2", "3"), ("2", "off")}
+        ("0.4", "3"),
+        ("0.4", "off"),
+        ("2", "3"),
+        ("2", "off"),
+    }
     metrics = read_csv(sweep_dir / "sweep_metrics.csv")
     assert len(metrics) == 6 * len(rows)
     assert (sweep_dir / "sweep.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert sorted(p.parent.name for p in (sweep_dir / "flights").glob("*/*/flight.parquet")) == [
-        "short_climb", "short_turn"]
+        "short_climb",
+        "short_turn",
+    ]
 
 
-@pytest.mark.parametrize(("kind", "gain", "limit", "label"),
-                         [("large-angle", "2", "off", "off"), ("small-angle", "0.4", "3.0", "3")])
-def test_sweep_points_equal_separate_cue_runs(sweep_dir: Path, tmp_path: Path, kind: str, gain: str, limit: str,
-                                              label: str) -> None:
+@pytest.mark.parametrize(
+    ("kind", "gain", "limit", "label"), [("large-angle", "2", "off", "off"), ("small-angle", "0.4", "3.0", "3")]
+)
+def test_sweep_points_equal_separate_cue_runs(
+    sweep_dir: Path, tmp_path: Path, kind: str, gain: str, limit: str, label: str
+) -> None:
     params = params_file(tmp_path, "point", gain, limit)
     sweep = read_csv(sweep_dir / "sweep.csv")
     metrics = read_csv(sweep_dir / "sweep_metrics.csv")
@@ -89,14 +113,22 @@ def test_sweep_points_equal_separate_cue_runs(sweep_dir: Path, tmp_path: Path, k
         out = tmp_path / flight.parent.name
         assert main(["cue", str(flight), "--out", str(out), "--params", str(params), "--washout", kind]) == 0
         rows, scores = cue_score(out)
-        mine = [m for m in metrics if (m["washout"], m["manoeuvre"], m["tilt.gain_per_s"],
-                                       m["tilt.rate_limit_degps"]) == (kind, flight.parent.name, gain, label)]
+        mine = [
+            m
+            for m in metrics
+            if (m["washout"], m["manoeuvre"], m["tilt.gain_per_s"], m["tilt.rate_limit_degps"])
+            == (kind, flight.parent.name, gain, label)
+        ]
         assert [m["dof"] for m in mine] == [r.dof for r in rows]
         for m, r in zip(mine, rows, strict=True):  # bit for bit, NaN-aware
             assert (m["npc"] == "" and np.isnan(r.npc)) or float(m["npc"]) == r.npc
             assert float(m["integral_error"]) == r.integral_error and float(m["max_error"]) == r.max_error
-        [point] = [s for s in sweep if (s["washout"], s["manoeuvre"], s["tilt.gain_per_s"],
-                                         s["tilt.rate_limit_degps"]) == (kind, flight.parent.name, gain, label)]
+        [point] = [
+            s
+            for s in sweep
+            if (s["washout"], s["manoeuvre"], s["tilt.gain_per_s"], s["tilt.rate_limit_degps"])
+            == (kind, flight.parent.name, gain, label)
+        ]
         # the score from the cue run's deg/s columns read back (radians and back: last-bit differences only)
         assert float(point["score"]) == pytest.approx(scores[kind], rel=1e-13)
 
@@ -104,8 +136,17 @@ def test_sweep_points_equal_separate_cue_runs(sweep_dir: Path, tmp_path: Path, k
 @pytest.fixture(scope="module")
 def variant_run(sweep_dir: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
     out = tmp_path_factory.mktemp("run")
-    args = ["run", str(MANOEUVRES[0]), "--out", str(out), "--quiet",
-            "--variant", "cw1=large-angle", "--variant", "fast_tilt=large-angle,tilt.gain_per_s=2"]
+    args = [
+        "run",
+        str(MANOEUVRES[0]),
+        "--out",
+        str(out),
+        "--quiet",
+        "--variant",
+        "cw1=large-angle",
+        "--variant",
+        "fast_tilt=large-angle,tilt.gain_per_s=2",
+    ]
     assert main(args) == 0
     return out / "c172p" / "short_turn"
 
@@ -121,7 +162,8 @@ def test_two_variants_equal_two_runs_with_two_parameter_files(variant_run: Path,
         separate = read_metrics_csv(out / "metrics.csv")
         mine = [r for r in run_rows if r.washout == name]
         assert [(r.dof, r.integral_error, r.max_error) for r in separate] == [
-            (r.dof, r.integral_error, r.max_error) for r in mine]
+            (r.dof, r.integral_error, r.max_error) for r in mine
+        ]
 
 
 def test_variant_names_in_every_output(variant_run: Path) -> None:
@@ -134,9 +176,14 @@ def test_variant_names_in_every_output(variant_run: Path) -> None:
     assert {"/perceived/surge/cw1", "/perceived/surge/fast_tilt"} <= set(series)
     # the suite's tables: better_by against the first washout listed when small-angle does not run
     summary = json.loads((variant_run / "run.json").read_text())
-    run = RunSummary(ok=True, aircraft="c172p", manoeuvre="short_turn", run_dir=variant_run,
-                     metrics=read_metrics_csv(variant_run / "metrics.csv"),
-                     motion={d: v["value"] for d, v in summary["perceived_motion"].items()})
+    run = RunSummary(
+        ok=True,
+        aircraft="c172p",
+        manoeuvre="short_turn",
+        run_dir=variant_run,
+        metrics=read_metrics_csv(variant_run / "metrics.csv"),
+        motion={d: v["value"] for d, v in summary["perceived_motion"].items()},
+    )
     out = variant_run.parent.parent / "suite_tables"
     out.mkdir()
     write_suite_results([Outcome(path="short_turn.yaml", wall_s=0.0, run=run)], out)
@@ -150,8 +197,23 @@ def test_variant_names_in_every_output(variant_run: Path) -> None:
 @pytest.fixture(scope="module")
 def tuned(sweep_dir: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
     out = tmp_path_factory.mktemp("tune")
-    args = ["tune", *map(str, MANOEUVRES), "--washout", "large-angle", "--tune", "tilt.gain_per_s=0.2:5",
-            "--budget", "24", "--seed", "3", "--from", str(sweep_dir / "flights"), "--out", str(out), "--quiet"]
+    args = [
+        "tune",
+        *map(str, MANOEUVRES),
+        "--washout",
+        "large-angle",
+        "--tune",
+        "tilt.gain_per_s=0.2:5",
+        "--budget",
+        "24",
+        "--seed",
+        "3",
+        "--from",
+        str(sweep_dir / "flights"),
+        "--out",
+        str(out),
+        "--quiet",
+    ]
     assert main(args) == 0
     return out
 
@@ -168,7 +230,16 @@ def test_tune_beats_cw1_and_tuned_yaml_reproduces_its_score(tuned: Path, sweep_d
     scores = []
     for flight in sorted((sweep_dir / "flights").glob("*/*/flight.parquet")):
         out = tmp_path / flight.parent.name
-        args = ["cue", str(flight), "--out", str(out), "--params", str(tuned / "tuned.yaml"), "--washout", "large-angle"]
+        args = [
+            "cue",
+            str(flight),
+            "--out",
+            str(out),
+            "--params",
+            str(tuned / "tuned.yaml"),
+            "--washout",
+            "large-angle",
+        ]
         assert main(args) == 0
         scores.append(cue_score(out)[1]["large-angle"])
     assert np.mean(scores) == pytest.approx(float(best["score"]), rel=1e-12)
@@ -178,8 +249,23 @@ def test_tune_beats_cw1_and_tuned_yaml_reproduces_its_score(tuned: Path, sweep_d
 
 
 def test_tune_is_deterministic_for_a_seed(tuned: Path, sweep_dir: Path, tmp_path: Path) -> None:
-    args = ["tune", *map(str, MANOEUVRES), "--washout", "large-angle", "--tune", "tilt.gain_per_s=0.2:5",
-            "--budget", "24", "--seed", "3", "--from", str(sweep_dir / "flights"), "--out", str(tmp_path), "--quiet"]
+    args = [
+        "tune",
+        *map(str, MANOEUVRES),
+        "--washout",
+        "large-angle",
+        "--tune",
+        "tilt.gain_per_s=0.2:5",
+        "--budget",
+        "24",
+        "--seed",
+        "3",
+        "--from",
+        str(sweep_dir / "flights"),
+        "--out",
+        str(tmp_path),
+        "--quiet",
+    ]
     assert main(args) == 0
     assert (tmp_path / "tune.csv").read_bytes() == (tuned / "tune.csv").read_bytes()
 
@@ -213,9 +299,19 @@ def test_dask_cluster_gives_the_local_results(sweep_dir: Path, variant_run: Path
                 assert (remote / name).read_bytes() == (sweep_dir / name).read_bytes()
             suite = tmp_path / "suite"
             shutil.copy(MANOEUVRES[0], tmp_path / "short_turn.yaml")
-            args = ["suite", str(tmp_path / "short_turn.yaml"), "--out", str(suite), "--quiet",
-                    "--variant", "cw1=large-angle", "--variant", "fast_tilt=large-angle,tilt.gain_per_s=2",
-                    "--dask", cluster.scheduler_address]
+            args = [
+                "suite",
+                str(tmp_path / "short_turn.yaml"),
+                "--out",
+                str(suite),
+                "--quiet",
+                "--variant",
+                "cw1=large-angle",
+                "--variant",
+                "fast_tilt=large-angle,tilt.gain_per_s=2",
+                "--dask",
+                cluster.scheduler_address,
+            ]
             assert main(args) == 0
             mine = suite / "c172p" / "short_turn" / "metrics.csv"
             assert mine.read_bytes() == (variant_run / "metrics.csv").read_bytes()

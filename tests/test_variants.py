@@ -28,7 +28,9 @@ LIMITS = load_platform_limits()
 
 
 def test_parse_variant_and_dotted_keys() -> None:
-    v = parse_variant("sa_2=small-angle,tilt.gain_per_s=2,rotational.highpass_wn_radps.yaw=0.3,tilt.rate_limit_degps=off")
+    v = parse_variant(
+        "sa_2=small-angle,tilt.gain_per_s=2,rotational.highpass_wn_radps.yaw=0.3,tilt.rate_limit_degps=off"
+    )
     assert (v.name, v.kind) == ("sa_2", "small-angle")
     assert dict(v.overrides) == {
         "tilt.gain_per_s": 2,
@@ -56,11 +58,14 @@ def test_parse_variant_and_dotted_keys() -> None:
         ("a", ["NAME=KIND"]),
     ],
 )
-def test_bad_variants_are_one_line_naming_the_key(text: str, words: list[str], capsys: pytest.CaptureFixture[str],
-                                                  tmp_path: Path) -> None:
+def test_bad_variants_are_one_line_naming_the_key(
+    text: str, words: list[str], capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
     flight = tmp_path / "in.csv"
-    flight.write_text("t_s,f_x_mps2,f_y_mps2,f_z_mps2,omega_x_degps,omega_y_degps,omega_z_degps\n"
-                      "0,0,0,-9.8,0,0,0\n0.01,0,0,-9.8,0,0,0\n")
+    flight.write_text(
+        "t_s,f_x_mps2,f_y_mps2,f_z_mps2,omega_x_degps,omega_y_degps,omega_z_degps\n"
+        "0,0,0,-9.8,0,0,0\n0.01,0,0,-9.8,0,0,0\n"
+    )
     assert main(["cue", str(flight), "--out", str(tmp_path / "out"), "--variant", text]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and err.startswith("washbench: error: --variant")
@@ -88,7 +93,11 @@ def test_selection_rules(tmp_path: Path) -> None:
     path = tmp_path / "with_variants.yaml"
     path.write_text(text)
     got = select_washouts(None, ["cli=small-angle"], path)
-    assert [(w.name, w.kind) for w in got] == [("fast", "large-angle"), ("free", "unrestricted"), ("cli", "small-angle")]
+    assert [(w.name, w.kind) for w in got] == [
+        ("fast", "large-angle"),
+        ("free", "unrestricted"),
+        ("cli", "small-angle"),
+    ]
     assert got[0].params.tilt.gain_per_s == 2.0 and got[1].params.tilt.rate_limit_degps is None
     assert load_washout_params(path) == CW1  # the base set is unchanged by its variants
     bad = tmp_path / "bad.yaml"
@@ -99,8 +108,12 @@ def test_selection_rules(tmp_path: Path) -> None:
     assert str(info.value).startswith(f"{bad}:{line}: variants.fast.tilt.gain_per_s: expected a number")
 
 
-def step_input(n: int, f_xy: tuple[float, float] = (0.0, 0.0), omega_degps: tuple[float, float, float] = (0, 0, 0),
-               onset_s: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+def step_input(
+    n: int,
+    f_xy: tuple[float, float] = (0.0, 0.0),
+    omega_degps: tuple[float, float, float] = (0, 0, 0),
+    onset_s: float = 1.0,
+) -> tuple[np.ndarray, np.ndarray]:
     """Level flight, then at onset a sustained specific-force step (m/s^2) and/or body rate (deg/s)."""
     f = np.tile([0.0, 0.0, -G], (n, 1))
     w = np.zeros((n, 3))
@@ -110,7 +123,7 @@ def step_input(n: int, f_xy: tuple[float, float] = (0.0, 0.0), omega_degps: tupl
     return f, w
 
 
-def run(kind: str, f: np.ndarray, w: np.ndarray, **overrides: object):  # noqa: ANN201
+def run(kind: str, f: np.ndarray, w: np.ndarray, **overrides: object):
     params = apply_overrides(CW1, overrides, "test")
     return cue_trace(f, w, DT, [Washout("x", kind, params)], None, LIMITS)["x"]
 
@@ -128,8 +141,10 @@ def test_defaults_are_todays_behaviour() -> None:
         a, b = run(kind, f, w), run(kind, f, w, **explicit)
         assert np.array_equal(a.head_f_mps2, b.head_f_mps2) and np.array_equal(a.q, b.q)
     # auto = the paper's choice per washout, bit for bit
-    for kind, position, method in (("small-angle", "after_cross_product", "euler_estimator"),
-                                   ("large-angle", "before_cross_product", "quaternion_difference")):
+    for kind, position, method in (
+        ("small-angle", "after_cross_product", "euler_estimator"),
+        ("large-angle", "before_cross_product", "quaternion_difference"),
+    ):
         a = run(kind, f, w)
         b = run(kind, f, w, **{"tilt.lowpass_position": position, "head.rate_method": method})
         assert np.array_equal(a.head_omega_radps, b.head_omega_radps) and np.array_equal(a.sp_q, b.sp_q)

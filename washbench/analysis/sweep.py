@@ -89,8 +89,14 @@ def sweep_csv(keys: Sequence[str], rows: Sequence[SweepRow]) -> list[list[str]]:
     for r in rows:
         ev, i = r.evaluation, r.index
         out.append(
-            [*(format_value(r.point[k]) for k in keys), r.washout, r.aircraft, r.manoeuvre,
-             csv_number(float(ev.score[i])), csv_number(float(ev.saturated_s[i]))]
+            [
+                *(format_value(r.point[k]) for k in keys),
+                r.washout,
+                r.aircraft,
+                r.manoeuvre,
+                csv_number(float(ev.score[i])),
+                csv_number(float(ev.saturated_s[i])),
+            ]
         )
     return out
 
@@ -102,8 +108,15 @@ def sweep_metrics_csv(keys: Sequence[str], rows: Sequence[SweepRow]) -> list[lis
         ev, i = r.evaluation, r.index
         for j, d in enumerate(DOFS):
             out.append(
-                [*(format_value(r.point[k]) for k in keys), r.washout, r.aircraft, r.manoeuvre, d,
-                 csv_number(float(ev.npc[i, j])), csv_number(float(ev.integral_error[i, j])),
-                 csv_number(float(ev.max_error[i, j]))]
+                [
+                    *(format_value(r.point[k]) for k in keys),
+                    r.washout,
+                    r.aircraft,
+                    r.manoeuvre,
+                    d,
+                    csv_number(float(ev.npc[i, j])),
+                    csv_number(float(ev.integral_error[i, j])),
+                    csv_number(float(ev.max_error[i, j])),
+                ]
             )
     return out

@@ -203,7 +203,7 @@ class WashoutTrace:
         return cls._build(cols, saturated)
 
     @classmethod
-    def _build(cls, cols, saturated: dict[str, np.ndarray]) -> WashoutTrace:  # noqa: ANN001
+    def _build(cls, cols, saturated: dict[str, np.ndarray]) -> WashoutTrace:
         return cls(
             pos_m=cols(O_POS, 3),
             vel_mps=cols(O_VEL, 3),

@@ -192,16 +192,25 @@ def _flatten(value: Any, prefix: str, loc: Loc, out: dict[str, tuple[Any, Loc]])
 def _file_variants(path: Path, data: Any, lines: dict[Loc, int], base: WashoutParams) -> tuple[Washout, ...]:
     """The ``variants:`` section of a parameter file as Washouts (errors name file, line and field)."""
     if not isinstance(data, dict):
-        raise WashbenchError(located(path, "expected a mapping of variant name -> {kind, keys}",
-                                     line=line_of(lines, ("variants",)), field="variants"))
+        raise WashbenchError(
+            located(
+                path,
+                "expected a mapping of variant name -> {kind, keys}",
+                line=line_of(lines, ("variants",)),
+                field="variants",
+            )
+        )
     out = []
     for name, body in data.items():
         loc: Loc = ("variants", name)
         field = f"variants.{name}"
         check_name(str(name), located(path, field, line=line_of(lines, loc)))
         if not isinstance(body, dict) or "kind" not in body:
-            raise WashbenchError(located(path, "expected a mapping with 'kind' and parameter keys",
-                                         line=line_of(lines, loc), field=field))
+            raise WashbenchError(
+                located(
+                    path, "expected a mapping with 'kind' and parameter keys", line=line_of(lines, loc), field=field
+                )
+            )
         kind = check_kind(str(body["kind"]), located(path, f"{field}.kind", line=line_of(lines, (*loc, "kind"))))
         flat: dict[str, tuple[Any, Loc]] = {}
         _flatten({k: v for k, v in body.items() if k != "kind"}, "", loc, flat)

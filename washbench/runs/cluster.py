@@ -30,7 +30,7 @@ def client(address: str) -> Any:
 
 
 def dask_map(address: str, fn: Callable[..., Any], args: Sequence[tuple[Any, ...]]) -> Iterator[Any]:
-    """``fn(*a)`` for every ``a`` in ``args`` on the cluster (all submitted at once); results in the order of ``args``."""
+    """``fn(*a)`` for every ``a`` in ``args`` on the cluster (all submitted at once); results in ``args`` order."""
     c = client(address)
     futures = [c.submit(fn, *a, pure=False) for a in args]
     for fut in futures:

@@ -6,9 +6,9 @@ that fails (bad file, crash, divergence, failed check, or an unexpected error) i
 reason; the others still complete and are kept. Then the suite writes, each file atomically:
 
 - ``OUT/metrics.csv``: ``aircraft,manoeuvre,washout,dof,npc,integral_error,max_error``
-- ``OUT/comparison.csv``: every metric per washout and DOF with its difference from small-angle
-  (positive = better than small-angle), like the paper's Table 4
-- ``OUT/ranking.csv``: the three washouts ranked per manoeuvre by the rule of
+- ``OUT/comparison.csv``: every metric per washout and DOF with its difference from the reference washout
+  (small-angle when it runs, otherwise the first listed; positive = better), like the paper's Table 4
+- ``OUT/ranking.csv``: the washouts (built-in or variants) ranked per manoeuvre by the rule of
   :mod:`washbench.analysis.ranking`
 - ``OUT/report.md``: all of it, with links to each recording, written last.
 
