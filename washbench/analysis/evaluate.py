@@ -27,7 +27,7 @@ from numba import njit, prange
 from washbench.analysis.metric_sums import NACC, acc_update, finish
 from washbench.analysis.metrics import DOFS, MetricRow, npc_from_pc
 from washbench.analysis.ranking import dof_weights, perceived_motion, score_of
-from washbench.cueing.jitcache import drop_stale_cache
+from washbench.cueing.jitcache import announce_compile, drop_stale_cache
 from washbench.cueing.kernel import NFIELDS, NSTATE, O_HEAD_F, O_HEAD_OMEGA, O_SAT, SAT_KINDS, step_one
 from washbench.perception.sections import sections_init, sections_step
 
@@ -156,6 +156,7 @@ class FlightEvaluator:
         acc = np.zeros((m, len(DOFS), NACC))
         counts = np.zeros((m, len(SAT_KINDS) + 1), dtype=np.int64)
         if m:
+            announce_compile(evaluate_batch)
             evaluate_batch(self.f, self.om, cfg, coef, self.oto, self.can, self.ac_perceived, self.dt_s, acc, counts)
         npc = np.empty((m, len(DOFS)))
         integral = np.empty((m, len(DOFS)))

@@ -13,6 +13,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+import washbench.cueing.jitcache  # noqa: F401  (numba's cache folder is set before anything here is compiled)
+
 
 @njit(cache=True, inline="always")
 def sections_init(steady, x, u0):

@@ -115,6 +115,7 @@ def run_manoeuvre(
     progress: bool = False,
     washouts: Sequence[str] | None = None,
     variants: Sequence[str] = (),
+    aircraft_dirs: Sequence[Path] = (),
 ) -> RunSummary:
     """Fly one manoeuvre with the washouts in lockstep and write its results folder.
 
@@ -133,7 +134,7 @@ def run_manoeuvre(
     from washbench.platform import load_platform_limits
     from washbench.runs.cue import analyse, write_results
 
-    manoeuvre = load_manoeuvre(manoeuvre_path)
+    manoeuvre = load_manoeuvre(manoeuvre_path, aircraft_dirs)
     specs = select_washouts(washouts, variants, params_path)
     limits = load_platform_limits(platform_path)
     bank = CueingBank(specs, None, limits, manoeuvre.dt_s)
@@ -282,6 +283,7 @@ def run_command(
     progress: bool = True,
     washouts: Sequence[str] | None = None,
     variants: Sequence[str] = (),
+    aircraft_dirs: Sequence[Path] = (),
 ) -> int:
     """CLI entry of ``washbench run``: 0 if the flight ran and passed its checks, else 1."""
     start = time.perf_counter()
@@ -293,6 +295,7 @@ def run_command(
         progress=progress and sys.stderr.isatty(),
         washouts=washouts,
         variants=variants,
+        aircraft_dirs=aircraft_dirs,
     )
     state = "ok" if s.ok else f"FAILED ({s.reason})"
     print(

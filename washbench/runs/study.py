@@ -11,7 +11,6 @@ batch of candidates in one compiled call over the whole trace, parallel over can
 from __future__ import annotations
 
 import math
-import multiprocessing
 import os
 import sys
 from collections.abc import Sequence
@@ -40,24 +39,24 @@ class StudyFlight:
     evaluator: FlightEvaluator
 
 
-def _fly_one(path: str, flights_dir: str) -> tuple[str, str, bool, str]:
+def _fly_one(path: str, flights_dir: str, aircraft_dirs: tuple[str, ...] = ()) -> tuple[str, str, bool, str]:
     """Worker: fly one manoeuvre (no washouts, no recording) and write its flight; (aircraft, name, ok, reason)."""
     from washbench.flight.fly import fly, write_flight
     from washbench.flight.manoeuvre import load_manoeuvre
 
-    m = load_manoeuvre(Path(path))
+    m = load_manoeuvre(Path(path), [Path(d) for d in aircraft_dirs])
     result = fly(m)
     write_flight(Path(flights_dir) / m.aircraft / m.name, result, path)
     return m.aircraft, m.name, result.ok, result.reason
 
 
-def _identify(paths: Sequence[Path]) -> list[tuple[str, str, str]]:
+def _identify(paths: Sequence[Path], aircraft_dirs: Sequence[Path]) -> list[tuple[str, str, str]]:
     """(path, aircraft, name) of every manoeuvre file, validated (bad files stop the study before any work)."""
     from washbench.flight.manoeuvre import load_manoeuvre
 
     out = []
     for p in paths:
-        m = load_manoeuvre(p)
+        m = load_manoeuvre(p, aircraft_dirs)
         out.append((str(p), m.aircraft, m.name))
     names = [(a, n) for _, a, n in out]
     if len(set(names)) != len(names):
@@ -74,11 +73,12 @@ def load_flights(
     jobs: int | None = None,
     dask: str | None = None,
     progress: bool = True,
+    aircraft_dirs: Sequence[Path] = (),
 ) -> list[StudyFlight]:
     """The study's flights: flown once into ``out_dir/flights/`` or read from ``from_dir``; in manoeuvre order."""
     from washbench.io.results import read_motion
 
-    ids = _identify(manoeuvres)
+    ids = _identify(manoeuvres, aircraft_dirs)
     status: dict[tuple[str, str], tuple[bool, str]] = {}
     if from_dir is not None:
         root = Path(from_dir)
@@ -86,7 +86,8 @@ def load_flights(
             status[(aircraft, name)] = (True, "")
     else:
         root = Path(out_dir) / FLIGHTS_DIR
-        args = [(p, str(root)) for p, _, _ in ids]
+        dirs = tuple(str(d) for d in aircraft_dirs)
+        args = [(p, str(root), dirs) for p, _, _ in ids]
         if progress:
             print(f"study: flying {len(args)} manoeuvre(s) once -> {root}", file=sys.stderr, flush=True)
         for aircraft, name, ok, reason in _map(_fly_one, args, jobs, dask):
@@ -114,9 +115,10 @@ def _map(fn, args: list[tuple], jobs: int | None, dask: str | None) -> list:
     jobs = max(1, min(jobs or os.cpu_count() or 1, len(args)))
     if jobs == 1:
         return [fn(*a) for a in args]
-    ctx = multiprocessing.get_context("forkserver")
-    ctx.set_forkserver_preload(["washbench.runs.preload"])
-    with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as pool:
+    from washbench.runs.suite import pool_context
+
+    ctx, initializer = pool_context()
+    with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=initializer) as pool:
         return list(pool.map(fn, *zip(*args, strict=True)))
 
 

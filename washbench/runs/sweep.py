@@ -44,6 +44,7 @@ def sweep_command(
     jobs: int | None = None,
     dask: str | None = None,
     progress: bool = True,
+    aircraft_dirs: Sequence[Path] = (),
 ) -> int:
     """CLI entry of ``washbench sweep``; 0 when every flight ran and passed its checks, 1 otherwise."""
     from washbench.cueing.variants import load_param_file
@@ -62,7 +63,9 @@ def sweep_command(
     candidates = [w for k in kinds for w in point_washouts(k, base, points)]
     limits = load_platform_limits(platform_path)
     files = find_manoeuvres(manoeuvres)
-    flights = load_flights(files, out_dir, limits, from_dir=from_dir, jobs=jobs, dask=dask, progress=progress)
+    flights = load_flights(files, out_dir, limits, from_dir=from_dir, jobs=jobs, dask=dask, progress=progress,
+        aircraft_dirs=aircraft_dirs,
+    )
     t_eval = time.perf_counter()
     results = evaluate(flights, candidates, dask)
     t_eval = time.perf_counter() - t_eval

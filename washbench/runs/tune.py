@@ -62,6 +62,7 @@ def tune_command(
     jobs: int | None = None,
     dask: str | None = None,
     progress: bool = True,
+    aircraft_dirs: Sequence[Path] = (),
 ) -> int:
     """CLI entry of ``washbench tune``; 0 on success (the flights' own check results are reported, not fatal)."""
     from washbench.cueing.variants import load_param_file
@@ -87,7 +88,14 @@ def tune_command(
     train_files = find_manoeuvres(manoeuvres)
     test_files = [p for p in (find_manoeuvres(test) if test else []) if p not in train_files]
     flights = load_flights(
-        [*train_files, *test_files], out_dir, limits, from_dir=from_dir, jobs=jobs, dask=dask, progress=progress
+        [*train_files, *test_files],
+        out_dir,
+        limits,
+        from_dir=from_dir,
+        jobs=jobs,
+        dask=dask,
+        progress=progress,
+        aircraft_dirs=aircraft_dirs,
     )
     train, tests = flights[: len(train_files)], flights[len(train_files) :]
     durations = np.array([f.evaluator.n * f.evaluator.dt_s for f in train])
