@@ -76,6 +76,8 @@ def tune_command(
         raise WashbenchError("tune: give at least one --tune KEY=LOW:HIGH")
     if not (saturation_weight >= 0.0 and np.isfinite(saturation_weight)):
         raise WashbenchError(f"--saturation-weight: expected a number >= 0, got {saturation_weight}")
+    if budget < 6:
+        raise WashbenchError(f"--budget: expected at least 6 evaluations (1 for the starting set), got {budget}")
     bounds = [parse_tune(t) for t in tunes]
     keys = [b.key for b in bounds]
     if len(set(keys)) != len(keys):
