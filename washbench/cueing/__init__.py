@@ -12,7 +12,8 @@ g_I = [0, 0, +g]; specific force f = a - g (m/s^2, [0, 0, -g] at rest); body ang
 quaternions scalar first, body->inertial; break frequencies rad/s.
 
 Modules: ``params`` (cw1.yaml model), ``variants`` (named washouts with their own parameters), ``filters``
-(transfer functions, discretisation), ``rotations`` (quaternion and Euler kinematics), ``kernel`` (the compiled step), ``bank`` (CueingBank, cue_trace).
+(transfer functions, discretisation), ``rotations`` (quaternion and Euler kinematics), ``kernel`` (the
+compiled step), ``bank`` (CueingBank, cue_trace).
 The bank names are loaded lazily so that :mod:`washbench.platform` can use ``rotations`` without an
 import cycle.
 """
