@@ -284,7 +284,7 @@ def test_bad_study_options_are_one_line(capsys: pytest.CaptureFixture[str], tmp_
     assert not (tmp_path / "o").exists()
 
 
-def test_dask_cluster_gives_the_local_results(sweep_dir: Path, variant_run: Path, tmp_path: Path) -> None:
+def test_dask_cluster_gives_the_local_results(sweep_dir: Path, variant_run: Path, tuned: Path, tmp_path: Path) -> None:
     pytest.importorskip("dask.distributed")
     from dask.distributed import LocalCluster
 
@@ -315,5 +315,26 @@ def test_dask_cluster_gives_the_local_results(sweep_dir: Path, variant_run: Path
             assert main(args) == 0
             mine = suite / "c172p" / "short_turn" / "metrics.csv"
             assert mine.read_bytes() == (variant_run / "metrics.csv").read_bytes()
+            args = [
+                "tune",
+                *map(str, MANOEUVRES),
+                "--washout",
+                "large-angle",
+                "--tune",
+                "tilt.gain_per_s=0.2:5",
+                "--budget",
+                "24",
+                "--seed",
+                "3",
+                "--from",
+                str(sweep_dir / "flights"),
+                "--out",
+                str(tmp_path / "t"),
+                "--quiet",
+                "--dask",
+                cluster.scheduler_address,
+            ]
+            assert main(args) == 0
+            assert (tmp_path / "t" / "tune.csv").read_bytes() == (tuned / "tune.csv").read_bytes()
         finally:
             close_all()
