@@ -11,6 +11,7 @@ One JSON-able dict (:func:`build_provenance`) records
 - ``params`` and ``platform``: the parameter set's and platform's name (the ``name`` key of the YAML file), the path
   and SHA-256 of the file actually used (the bundled ``cw1.yaml`` / ``atlas.yaml`` when none was given) and the
   values read from it (so a result can be re-examined without the file);
+- ``washouts``: the washouts that ran, name and kind, and a variant's own parameter values;
 - ``turbulence``: severity and seed of the manoeuvre's turbulence (``None`` without turbulence).
 
 It goes into ``run.json`` (``"provenance"``, with the date ``"created_utc"`` beside it), the key-value metadata of
@@ -27,7 +28,7 @@ import importlib.metadata
 import json
 import platform as _platform
 import subprocess
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -114,6 +115,7 @@ def build_provenance(
     input_provenance: Mapping[str, Any] | None = None,
     turbulence: Any = None,
     aircraft_files: Any = None,
+    washouts: Sequence[Any] = (),
 ) -> dict[str, Any]:
     """The provenance of one result (module docstring); no date in it.
 
@@ -122,6 +124,8 @@ def build_provenance(
     ``turbulence`` is the manoeuvre's ``Turbulence`` or None. ``aircraft_files`` (``washbench.io.paths.AircraftFiles``,
     where the manoeuvre's aircraft was found) adds the JSBSim model file ``<name>/<name>.xml`` and the pilot profile,
     each with its path and SHA-256 (the model's own file only: engines and systems it includes are not hashed).
+    ``washouts`` (``washbench.cueing.variants.Washout``: name, kind, params) lists what ran; a variant's complete
+    parameter values are recorded where they differ from the file's base set.
     """
     prov: dict[str, Any] = {"software": software_versions()}
     if manoeuvre_path is not None:
@@ -136,11 +140,20 @@ def build_provenance(
             prov["input"]["provenance"] = dict(input_provenance)
     if params is not None and params_path is not None:
         prov["params"] = file_record(params_path, params.name, params.model_dump(mode="json"))
+    if washouts:
+        prov["washouts"] = [_washout_record(w, params) for w in washouts]
     if platform is not None and platform_path is not None:
         prov["platform"] = file_record(platform_path, platform.name, platform.model_dump(mode="json"))
     if manoeuvre_path is not None:
         prov["turbulence"] = turbulence_record(turbulence)
     return prov
+
+
+def _washout_record(washout: Any, base: Any) -> dict[str, Any]:
+    rec: dict[str, Any] = {"name": washout.name, "kind": washout.kind}
+    if base is None or washout.params != base:
+        rec["values"] = washout.params.model_dump(mode="json")
+    return rec
 
 
 def turbulence_record(turbulence: Any) -> dict[str, Any] | None:

@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from washbench.analysis.metrics import DOFS
-from washbench.analysis.ranking import METRICS, REFERENCE_WASHOUT, RankRow, compare, rank
+from washbench.analysis.ranking import METRICS, RankRow, compare, rank, reference_washout
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
 from washbench.review.numbers import pct, sig
@@ -130,10 +130,14 @@ def ranking_lines(data: ResultData, ranking: list[RankRow]) -> list[str]:
 
 
 def metric_tables(data: ResultData) -> list[str]:
-    """Per metric a DOF-by-washout table: values, the best per DOF bold, and each washout against small-angle (%)."""
-    comparison = {(c.dof, c.metric): c for c in compare(data.metrics)}
+    """Per metric a DOF-by-washout table: values, the best per DOF bold, each washout against the reference (%).
+
+    The reference is small-angle when it ran, otherwise the first washout listed (:func:`reference_washout`).
+    """
+    reference = reference_washout(data.washouts)
+    comparison = {(c.dof, c.metric): c for c in compare(data.metrics, reference)}
     dofs = [d for d in DOFS if any((d, m) in comparison for m in METRICS)]
-    others = [w for w in data.washouts if w != REFERENCE_WASHOUT] if REFERENCE_WASHOUT in data.washouts else []
+    others = [w for w in data.washouts if w != reference]
     lines: list[str] = []
     for metric in METRICS:
         lines += [f"**{_METRIC_TITLES[metric]}**", ""]
@@ -152,10 +156,10 @@ def metric_tables(data: ResultData) -> list[str]:
             cells = []
             for d in dofs:
                 c = comparison[(d, metric)]
-                ref = c.values.get(REFERENCE_WASHOUT, math.nan)
+                ref = c.values.get(reference, math.nan)
                 diff = c.better_than_reference.get(w, math.nan)
                 cells.append(pct(100.0 * diff / ref) if math.isfinite(diff) and ref != 0 else "-")
-            lines.append(f"| {w} vs {REFERENCE_WASHOUT} (% better) | " + " | ".join(cells) + " |")
+            lines.append(f"| {w} vs {reference} (% better) | " + " | ".join(cells) + " |")
         if metric == "integral_error":
             lines.append(
                 "| _standing still (aircraft pilot's perceived motion)_ | "

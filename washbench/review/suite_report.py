@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from washbench.analysis.metrics import DOFS
-from washbench.analysis.ranking import METRICS, REFERENCE_WASHOUT, compare, rank, wins
+from washbench.analysis.ranking import METRICS, compare, rank, reference_washout, wins
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
 from washbench.review.numbers import sig
@@ -87,6 +87,7 @@ def write_suite_report(suite_dir: Path, *, regenerate_results: bool = False) -> 
             results.append((e, None))
     loaded = [d for _, d in results if d is not None]
     washouts = list(dict.fromkeys(w for d in loaded for w in d.washouts))
+    reference = reference_washout(washouts)
     rankings = {id(d): rank(d.metrics, d.motion) for d in loaded}
 
     fig_dir = suite_dir / FIGURES_DIR
@@ -99,17 +100,17 @@ def write_suite_report(suite_dir: Path, *, regenerate_results: bool = False) -> 
             for row in rankings[id(d)]:
                 scores[r, washouts.index(row.washout)] = row.score
         figures["scores"] = score_heatmap(fig_dir / "scores", labels, washouts, scores)[0]
-        others = [w for w in washouts if w != REFERENCE_WASHOUT]
-        if REFERENCE_WASHOUT in washouts and others:
+        others = [w for w in washouts if w != reference]
+        if others:
             better = {w: np.full((len(loaded), len(METRICS) * len(DOFS)), math.nan) for w in others}
             for r, d in enumerate(loaded):
-                for c in compare(d.metrics):
+                for c in compare(d.metrics, reference):
                     col = METRICS.index(c.metric) * len(DOFS) + DOFS.index(c.dof)
-                    ref = c.values.get(REFERENCE_WASHOUT, math.nan)
+                    ref = c.values.get(reference, math.nan)
                     for w, diff in c.better_than_reference.items():
                         if math.isfinite(diff) and ref != 0:
                             better[w][r, col] = 100.0 * diff / ref
-            figures["table4"] = table4_figure(fig_dir / "table4", labels, REFERENCE_WASHOUT, better, DOFS, METRICS)[0]
+            figures["table4"] = table4_figure(fig_dir / "table4", labels, reference, better, DOFS, METRICS)[0]
 
     ok = [e for e, d in results if e.get("ok", d.ok if d else False)]
     lines = ["# washbench suite report", ""]
@@ -161,9 +162,9 @@ def write_suite_report(suite_dir: Path, *, regenerate_results: bool = False) -> 
     if "scores" in figures:
         lines += _image(figures["scores"], suite_dir, "score per manoeuvre and washout")
     if "table4" in figures:
-        lines += ["## Against small-angle (Table 4 of the paper)", ""]
-        lines += [f"Each cell: how much better than {REFERENCE_WASHOUT} the washout is, in percent of the "
-                  f"{REFERENCE_WASHOUT} value (positive, green: better). Absolute differences are in "
+        lines += [f"## Against {reference} (Table 4 of the paper)", ""]
+        lines += [f"Each cell: how much better than {reference} the washout is, in percent of the "
+                  f"{reference} value (positive, green: better). Absolute differences are in "
                   "`comparison.csv`.", ""]  # fmt: skip
         lines += _image(figures["table4"], suite_dir, "Table 4")
     lines += ["## How to read the numbers", "", *_HOW_TO_READ]

@@ -6,9 +6,9 @@ that fails (bad file, crash, divergence, failed check, or an unexpected error) i
 reason; the others still complete and are kept. Then the suite writes, each file atomically:
 
 - ``OUT/metrics.csv``: ``aircraft,manoeuvre,washout,dof,npc,integral_error,max_error``
-- ``OUT/comparison.csv``: every metric per washout and DOF with its difference from small-angle
-  (positive = better than small-angle), like the paper's Table 4
-- ``OUT/ranking.csv``: the three washouts ranked per manoeuvre by the rule of
+- ``OUT/comparison.csv``: every metric per washout and DOF with its difference from the reference washout
+  (small-angle when it runs, otherwise the first listed; positive = better), like the paper's Table 4
+- ``OUT/ranking.csv``: the washouts (built-in or variants) ranked per manoeuvre by the rule of
   :mod:`washbench.analysis.ranking`
 - ``OUT/suite.json``: every manoeuvre file with its status and reason, and the suite's provenance;
 - ``OUT/report.md`` and ``OUT/figures/``: all of it, with the failures first, a score heatmap, the Table-4 figure
@@ -35,12 +35,11 @@ from pathlib import Path
 from washbench.analysis.ranking import (
     DOFS,
     METRICS,
-    REFERENCE_WASHOUT,
     RankRow,
     compare,
     rank,
+    reference_washout,
 )
-from washbench.cueing.params import WASHOUT_NAMES
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
 from washbench.io.paths import MANOEUVRES_DIR, bundled_names, resolve_manoeuvre
@@ -78,7 +77,13 @@ def find_manoeuvres(inputs: Sequence[Path]) -> list[Path]:
 
 
 def _run_one(
-    path: str, out_dir: str, params_path: str | None, platform_path: str | None, aircraft_dirs: tuple[str, ...] = ()
+    path: str,
+    out_dir: str,
+    params_path: str | None,
+    platform_path: str | None,
+    washouts: tuple[str, ...] | None = None,
+    variants: tuple[str, ...] = (),
+    aircraft_dirs: tuple[str, ...] = (),
 ) -> Outcome:
     """Worker: run one manoeuvre; never raises (failures come back as an Outcome)."""
     from washbench.runs.pipeline import run_manoeuvre
@@ -90,6 +95,8 @@ def _run_one(
             Path(out_dir),
             params_path=Path(params_path) if params_path else None,
             platform_path=Path(platform_path) if platform_path else None,
+            washouts=washouts,
+            variants=variants,
             aircraft_dirs=[Path(d) for d in aircraft_dirs],
         )
     except WashbenchError as exc:
@@ -128,15 +135,21 @@ def run_suite(
     params_path: Path | None = None,
     platform_path: Path | None = None,
     progress: bool = True,
+    washouts: Sequence[str] | None = None,
+    variants: Sequence[str] = (),
+    dask: str | None = None,
     aircraft_dirs: Sequence[Path] = (),
 ) -> list[Outcome]:
-    """Run every file in parallel processes; return the outcomes in the order of ``files``."""
+    """Run every file in parallel processes (or on the Dask cluster at ``dask``); outcomes in the order of ``files``."""
     jobs = max(1, min(jobs or os.cpu_count() or 1, len(files)))
     out_dir.mkdir(parents=True, exist_ok=True)
     dirs = tuple(str(d) for d in aircraft_dirs)
     params = str(params_path) if params_path else None
     platform = str(platform_path) if platform_path else None
-    args = [(str(f), str(out_dir), params, platform, dirs) for f in files]
+    args = [
+        (str(f), str(out_dir), params, platform, tuple(washouts) if washouts else None, tuple(variants), dirs)
+        for f in files
+    ]
     outcomes: dict[str, Outcome] = {}
     start = time.perf_counter()
     if progress:
@@ -145,7 +158,12 @@ def run_suite(
             "suite: loading JSBSim, rerun and the washout kernel (compiled once after install: a few seconds)",
             file=sys.stderr,
         )
-    if jobs == 1:
+    if dask:
+        from washbench.runs.cluster import dask_map
+
+        for outcome in dask_map(dask, _run_one, args):
+            outcomes[outcome.path] = _report(outcome, len(outcomes) + 1, len(files), start, progress)
+    elif jobs == 1:
         for a in args:
             outcomes[a[0]] = _report(_run_one(*a), len(outcomes) + 1, len(files), start, progress)
     else:
@@ -207,13 +225,15 @@ def metrics_table(outcomes: Sequence[Outcome]) -> str:
 
 
 def comparison_table(outcomes: Sequence[Outcome]) -> str:
-    """``comparison.csv``: each metric per washout and DOF and its improvement over small-angle."""
+    """``comparison.csv``: each metric per washout and DOF and its improvement over the reference washout
+    (small-angle when it runs, otherwise the first listed: ``<washout>_better_by`` = reference - washout)."""
     washouts = _washouts(outcomes)
-    others = [w for w in washouts if w != REFERENCE_WASHOUT]
+    reference = reference_washout(washouts)
+    others = [w for w in washouts if w != reference]
     header = ["aircraft", "manoeuvre", "dof", "metric", *washouts, *[f"{w}_better_by" for w in others]]
     rows = [header]
     for o in _runs_with_metrics(outcomes):
-        for c in compare(o.run.metrics):
+        for c in compare(o.run.metrics, reference):
             rows.append(
                 [o.run.aircraft, o.run.manoeuvre, c.dof, c.metric]
                 + [csv_number(c.values.get(w, math.nan)) for w in washouts]
@@ -232,8 +252,8 @@ def ranking_table(rankings: dict[tuple[str, str], list[RankRow]]) -> str:
 
 
 def _washouts(outcomes: Sequence[Outcome]) -> list[str]:
-    seen = {m.washout for o in outcomes for m in o.run.metrics}
-    return [w for w in WASHOUT_NAMES if w in seen] + sorted(seen - set(WASHOUT_NAMES))
+    """Every washout of the suite in the order the configuration listed them."""
+    return list(dict.fromkeys(m.washout for o in outcomes for m in o.run.metrics))
 
 
 def write_suite_results(
@@ -278,15 +298,19 @@ def suite_command(
     params_path: Path | None = None,
     platform_path: Path | None = None,
     progress: bool = True,
+    washouts: Sequence[str] | None = None,
+    variants: Sequence[str] = (),
+    dask: str | None = None,
     aircraft_dirs: Sequence[Path] = (),
 ) -> int:
     """CLI entry: run the suite, write its results, print where they are; 0 if all succeeded, else 1."""
     if jobs is not None and jobs < 1:
         raise WashbenchError(f"--jobs: expected a whole number of at least 1, got {jobs}")
     files = find_manoeuvres(inputs)
-    # Fail fast on a bad parameter or platform file: every run would fail the same way.
+    # Fail fast on a bad parameter, variant or platform file: every run would fail the same way.
     from washbench.cueing import load_washout_params
     from washbench.cueing.params import DEFAULT_PARAMS_PATH
+    from washbench.cueing.variants import select_washouts
     from washbench.io.provenance import build_provenance
     from washbench.platform import load_platform_limits
     from washbench.platform.limits import DEFAULT_LIMITS_PATH
@@ -294,6 +318,7 @@ def suite_command(
     provenance = build_provenance(
         params_path=params_path or DEFAULT_PARAMS_PATH,
         params=load_washout_params(params_path),
+        washouts=select_washouts(washouts, variants, params_path),
         platform_path=platform_path or DEFAULT_LIMITS_PATH,
         platform=load_platform_limits(platform_path),
     )
@@ -305,6 +330,9 @@ def suite_command(
         params_path=params_path,
         platform_path=platform_path,
         progress=progress,
+        washouts=washouts,
+        variants=variants,
+        dask=dask,
         aircraft_dirs=aircraft_dirs,
     )
     write_suite_results(outcomes, out_dir, provenance)
