@@ -185,15 +185,21 @@ def test_report_is_regenerated_from_the_files_alone(run_dir: Path, inputs: dict[
 
 def test_cue_results_get_the_same_report(run_dir: Path, tmp_path: Path) -> None:
     out = tmp_path / "cue"
-    proc = washbench("cue", run_dir / "flight.parquet", "--out", out)
+    variant = "sa_slow_tilt=small-angle,tilt.gain_per_s=0.2"
+    proc = washbench("cue", run_dir / "flight.parquet", "--out", out, "--washout", "small-angle", "--variant", variant)
     assert proc.returncode == 0, proc.stderr
     prov = json.loads(pq.read_schema(out / "traces.parquet").metadata[PARQUET_KEY])
     assert prov["input"]["sha256"] == sha256(run_dir / "flight.parquet")
     flown = json.loads(pq.read_schema(run_dir / "flight.parquet").metadata[PARQUET_KEY])
     assert prov["input"]["provenance"] == flown  # what made the input travels with it
     assert prov["params"]["name"] == "CW1" and prov["params"]["sha256"] == sha256(DATA_DIR / "cw1.yaml")
+    small, variant_rec = prov["washouts"]
+    assert small == {"name": "small-angle", "kind": "small-angle"}  # the file's own parameters
+    assert variant_rec["name"] == "sa_slow_tilt" and variant_rec["values"]["tilt"]["gain_per_s"] == 0.2
     text = write_result_report(out).read_text()
     assert sha256(run_dir / "flight.parquet") in text and flown["manoeuvre"]["sha256"] in text
+    assert "| sa_slow_tilt |" in text and "sa_slow_tilt vs small-angle (% better)" in text
+    assert "| washouts | small-angle, sa_slow_tilt (small-angle) with its own values |" in text
     assert check_images(out / "report.md") == 2
 
 

@@ -79,6 +79,12 @@ def provenance_lines(prov: dict[str, Any] | None, created_utc: str | None) -> li
     if inp and inp.get("provenance", {}).get("manoeuvre"):
         file_row("input's manoeuvre file", inp["provenance"]["manoeuvre"])
     file_row("washout parameters", prov.get("params"))
+    if prov.get("washouts"):
+        runs = [
+            f"{w['name']}" + ("" if w["name"] == w["kind"] else f" ({w['kind']})") + (" with its own values" if "values"
+            in w else "") for w in prov["washouts"]
+        ]  # fmt: skip
+        rows.append(("washouts", ", ".join(runs)))
     file_row("platform", prov.get("platform"))
     if "turbulence" in prov or (inp and "turbulence" in inp.get("provenance", {})):
         turb = prov.get("turbulence", inp.get("provenance", {}).get("turbulence") if inp else None)
