@@ -191,7 +191,8 @@ def test_variant_names_in_every_output(variant_run: Path) -> None:
     assert header[4:] == ["cw1", "fast_tilt", "fast_tilt_better_by"]
     assert {r["washout"] for r in read_csv(out / "ranking.csv")} == names
     report = (out / "report.md").read_text()
-    assert "scores (cw1 / fast_tilt)" in report and "`better by` is cw1 minus" in report
+    assert "| cw1 score (-) | fast_tilt score (-) |" in report and "## Against cw1 (Table 4 of the paper)" in report
+    assert "| fast_tilt vs cw1 (% better) |" in report
 
 
 @pytest.fixture(scope="module")

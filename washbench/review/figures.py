@@ -280,8 +280,8 @@ def score_heatmap(
     scores = np.asarray(scores, dtype=np.float64).reshape(len(rows), len(washouts))
     finite = scores[np.isfinite(scores)]
     vmax = max(2.0, float(finite.max()) if finite.size else 2.0)
-    cmap = LinearSegmentedColormap.from_list("score", [(0.10, 0.60, 0.32), (1.0, 1.0, 0.85), (0.84, 0.19, 0.15)])
-    cmap.set_bad((0.85, 0.85, 0.85))
+    colors = [(0.10, 0.60, 0.32), (1.0, 1.0, 0.85), (0.84, 0.19, 0.15)]
+    cmap = LinearSegmentedColormap.from_list("score", colors).with_extremes(bad=(0.85, 0.85, 0.85))
     norm = TwoSlopeNorm(vmin=0.0, vcenter=1.0, vmax=vmax)
     fig = _new_figure(1.6 + 1.35 * len(washouts), 1.3 + 0.32 * len(rows))
     ax = fig.subplots()
@@ -355,6 +355,5 @@ def table4_figure(
 def _diverging_cmap() -> Any:
     from matplotlib.colors import LinearSegmentedColormap
 
-    cmap = LinearSegmentedColormap.from_list("better", [(0.84, 0.19, 0.15), (1.0, 1.0, 0.92), (0.10, 0.60, 0.32)])
-    cmap.set_bad((0.88, 0.88, 0.88))
-    return cmap
+    colors = [(0.84, 0.19, 0.15), (1.0, 1.0, 0.92), (0.10, 0.60, 0.32)]
+    return LinearSegmentedColormap.from_list("better", colors).with_extremes(bad=(0.88, 0.88, 0.88))
