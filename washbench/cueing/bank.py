@@ -33,6 +33,7 @@ from washbench.cueing.kernel import (
     C_KIND,
     C_PMAX,
     C_R,
+    C_REST,
     C_ROT_SAT,
     C_SF,
     C_SW,
@@ -82,8 +83,20 @@ def _check_dt(dt_s: float) -> float:
     return dt
 
 
+FILTER_STARTS = ("steady", "rest")
+"""Start states: ``steady`` of the first sample (a recording that begins in steady flight), or ``rest`` (the
+simulator level and still, f = [0, 0, -g]: the first sample is a change, as for a recording begun mid-manoeuvre)."""
+
+
+def check_filter_start(start: str) -> str:
+    """``start`` if it is one of :data:`FILTER_STARTS`, else WashbenchError."""
+    if start not in FILTER_STARTS:
+        raise WashbenchError(f"unknown filter start {start!r} (valid: {', '.join(FILTER_STARTS)})")
+    return start
+
+
 def _build_arrays(
-    names: tuple[str, ...], params: WashoutParams, limits: PlatformLimits, dt: float
+    names: tuple[str, ...], params: WashoutParams, limits: PlatformLimits, dt: float, start: str = "steady"
 ) -> tuple[np.ndarray, np.ndarray]:
     """The compiled bank's configuration (n, NCFG) and discretised filters (n, NFILT, 9), all SI.
 
@@ -109,6 +122,7 @@ def _build_arrays(
     common[C_ALPHA] = math.radians(limits.rotation.acceleration_limit_degps2)
     common[C_CATCH] = limits.rotation.catch_up_fraction
     common[C_JAC : C_JAC + 9] = wheel_jacobian(limits).ravel()
+    common[C_REST] = 1.0 if check_filter_start(start) == "rest" else 0.0
     cfg = np.tile(common, (len(names), 1))
 
     coef = np.zeros((len(names), NFILT, filters.NCOEF))
@@ -209,17 +223,25 @@ class CueingBank:
 
     ``step`` returns a (n_washouts, N_FIELDS) float64 array that is REUSED: the next call overwrites it,
     so copy it (e.g. into a preallocated buffer) if you keep it. The first call initialises every filter
-    to the steady state of that sample. ``f_mps2`` and ``omega_radps`` are best given as float64 arrays
+    to the steady state of that sample (``filter_start="rest"``: of rest, see :data:`FILTER_STARTS`).
+    ``f_mps2`` and ``omega_radps`` are best given as float64 arrays
     of shape (3,) (anything else is converted, more slowly). Non-finite input raises ValueError.
     """
 
     FIELDS: tuple[str, ...] = FIELDS
     SAT_KINDS: tuple[str, ...] = SAT_KINDS
 
-    def __init__(self, washouts: Sequence[str], params: WashoutParams, limits: PlatformLimits, dt_s: float) -> None:
+    def __init__(
+        self,
+        washouts: Sequence[str],
+        params: WashoutParams,
+        limits: PlatformLimits,
+        dt_s: float,
+        filter_start: str = "steady",
+    ) -> None:
         self.washouts = check_washouts(washouts)
         self.dt_s = _check_dt(dt_s)
-        self._cfg, self._coef = _build_arrays(self.washouts, params, limits, self.dt_s)
+        self._cfg, self._coef = _build_arrays(self.washouts, params, limits, self.dt_s, filter_start)
         n = len(self.washouts)
         self._state = np.zeros((n, NSTATE))
         self._counts = np.zeros((n, len(SAT_KINDS)), dtype=np.int64)
@@ -250,8 +272,11 @@ def cue_trace(
     washouts: Sequence[str],
     params: WashoutParams,
     limits: PlatformLimits,
+    filter_start: str = "steady",
 ) -> dict[str, WashoutTrace]:
     """Whole-trace form: run the washouts over arrays f (N, 3) m/s^2 and omega (N, 3) rad/s sampled every dt_s.
+
+    ``filter_start``: see :data:`FILTER_STARTS`.
 
     Uses the same compiled step as :class:`CueingBank` and gives identical results. Raises WashbenchError
     for wrong shapes or non-finite samples (naming the first bad sample).
@@ -265,7 +290,7 @@ def cue_trace(
     bad = ~(np.isfinite(f).all(axis=1) & np.isfinite(w).all(axis=1))
     if bad.any():
         raise WashbenchError(f"non-finite specific force or angular velocity at sample {int(np.argmax(bad))}")
-    cfg, coef = _build_arrays(names, params, limits, dt)
+    cfg, coef = _build_arrays(names, params, limits, dt, filter_start)
     state = np.zeros((len(names), NSTATE))
     counts = np.zeros((len(names), len(SAT_KINDS)), dtype=np.int64)
     out = np.zeros((len(names), f.shape[0], NFIELDS))
