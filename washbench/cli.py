@@ -28,8 +28,14 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
     p = sub.add_parser("cue", help="run washouts, Atlas model, vestibular models and metrics on a recorded trace")
-    p.add_argument("input", type=Path, help="CSV or Parquet: t_s, f_{x,y,z}_mps2, omega_{x,y,z}_degps (body axes)")
-    p.add_argument("--out", type=Path, required=True, help="output folder (traces.parquet, metrics.csv)")
+    p.add_argument(
+        "input",
+        type=Path,
+        help="CSV/TSV/TXT (.gz too), Parquet, X-Plane Data.txt or JSBSim CSV output; washbench's own columns "
+        "t_s, f_{x,y,z}_mps2, omega_{x,y,z}_degps unless mapped",
+    )
+    p.add_argument("--out", type=Path, required=True, help="output folder (a run result folder's files)")
+    _cue_input_options(p)
     p.add_argument(
         "--washout",
         action="append",
@@ -71,12 +77,51 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _cue_input_options(p: argparse.ArgumentParser) -> None:
+    """``washbench cue``'s options for reading, converting, cutting and checking a recording."""
+    g = p.add_argument_group("reading and converting the input")
+    g.add_argument(
+        "--columns", metavar="MAP", help="field=[-]COLUMN[:UNIT],... e.g. t=Time:ms,f_x=ax:g,omega_x=p:radps"
+    )
+    g.add_argument("--input-format", type=Path, metavar="FILE", help="YAML: format, delimiter, axes, columns")
+    g.add_argument("--axes", metavar="XYZ", help="sensor axes as body directions, e.g. flu (z up, y left); default frd")
+    g.add_argument("--delimiter", metavar="D", help="CSV delimiter (default: detected): , ; tab | or a character")
+    g = p.add_argument_group("time")
+    g.add_argument("--resample", type=float, metavar="HZ", help="interpolate onto a uniform grid at HZ (anti-alias)")
+    g.add_argument("--max-gap-s", type=float, metavar="S", help="largest allowed time step (default: 5 median steps)")
+    g.add_argument("--no-split", action="store_true", help="refuse a time reset instead of cueing each part")
+    g.add_argument("--start-s", type=float, metavar="S", help="cue from this time on (input time, s)")
+    g.add_argument("--end-s", type=float, metavar="S", help="cue up to this time (input time, s)")
+    g.add_argument("--filter-start", choices=("steady", "rest"), default="steady",
+                   help="filters start in the first sample's steady state (default) or at rest")  # fmt: skip
+    g = p.add_argument_group("checks and outputs")
+    g.add_argument("--strict", action="store_true", help="plausibility warnings are errors")
+    g.add_argument("--no-recording", action="store_true", help="do not write recording.rrd")
+
+
+def _cue(args: argparse.Namespace) -> int:
+    from washbench.io.readers import input_format
+    from washbench.runs.cue import CueOptions, run_cue
+
+    opts = CueOptions(
+        fmt=input_format(args.columns, args.input_format, args.axes, args.delimiter),
+        resample_hz=args.resample,
+        max_gap_s=args.max_gap_s,
+        split=not args.no_split,
+        start_s=args.start_s,
+        end_s=args.end_s,
+        filter_start=args.filter_start,
+        strict=args.strict,
+        recording=not args.no_recording,
+    )
+    return run_cue(
+        args.input, args.out, washouts=args.washout, params_path=args.params, platform_path=args.platform, options=opts
+    )
+
+
 def _dispatch(args: argparse.Namespace) -> int:
     if args.command == "cue":
-        from washbench.runs.cue import run_cue
-
-        run_cue(args.input, args.out, washouts=args.washout, params_path=args.params, platform_path=args.platform)
-        return 0
+        return _cue(args)
     if args.command == "fly":
         from washbench.flight.fly import fly_command
 

@@ -25,16 +25,19 @@ import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Literal
 
 import numpy as np
 import pyarrow as pa
 import pyarrow.compute as pc
 import pyarrow.csv as pacsv
 import pyarrow.parquet as pq
+from pydantic import Field
 
 from washbench.errors import WashbenchError, located
 from washbench.io import units
 from washbench.io.results import INPUT_COLUMNS
+from washbench.io.yamlio import StrictModel, line_of, read_yaml, validate_data
 
 FIELDS = ("t", "f_x", "f_y", "f_z", "omega_x", "omega_y", "omega_z")
 """The motion fields a mapping names (``t`` time, ``f_*`` specific force, ``omega_*`` angular velocity)."""
@@ -580,3 +583,71 @@ def numeric_column(src: SourceTable, name: str, label: str | None = None) -> np.
         what = "NaN" if np.isnan(arr[i]) else "infinite"
         raise WashbenchError(located(src.path, f"{row}value is {what}", line=line, field=name))
     return np.ascontiguousarray(arr, dtype=np.float64)
+
+
+# --------------------------------------------------------------------------- the input-format file
+
+
+class InputFormatFile(StrictModel):
+    """``--input-format FILE``: the same as the command-line options, in YAML::
+
+    format: csv              # auto (default) | csv | parquet | xplane | jsbsim
+    delimiter: ";"           # or comma, semicolon, tab, pipe; default: detected
+    axes: flu                # sensor axes (see washbench.io.units); default frd
+    columns:                 # FIELD: "[-]COLUMN[:UNIT]" (column names may hold commas here)
+      t: "Time:ms"
+      f_x: "ax:g"
+      omega_x: "p:radps"
+    """
+
+    format: Literal["auto", "csv", "parquet", "xplane", "jsbsim"] = "auto"
+    delimiter: str | None = None
+    axes: str = "frd"
+    columns: dict[str, str] = Field(default_factory=dict)
+
+
+def load_input_format(path: str | Path) -> InputFormat:
+    """Read an ``--input-format`` YAML file; errors name the file, line and key."""
+    path = Path(path)
+    data, lines = read_yaml(path)
+    doc = validate_data(path, data, lines, InputFormatFile)
+    columns: dict[str, ColumnSource] = {}
+    for key, spec in doc.columns.items():
+        where = f"{path}:{line_of(lines, ('columns', key)) or 1}: columns.{key}"
+        name = field_name_of(key, where)
+        columns[name] = parse_column_source(name, spec, where)
+    where = f"{path}:{line_of(lines, ('axes',)) or 1}: axes"
+    try:
+        units.axes_matrix(doc.axes)
+    except ValueError as exc:
+        raise WashbenchError(f"{where}: {exc}") from None
+    delim = check_delimiter(doc.delimiter, f"{path}:{line_of(lines, ('delimiter',)) or 1}: delimiter")
+    return InputFormat(kind=doc.format, delimiter=delim, columns=columns, axes=doc.axes, origin=str(path))
+
+
+def input_format(
+    columns: str | None = None,
+    format_file: str | Path | None = None,
+    axes: str | None = None,
+    delimiter: str | None = None,
+) -> InputFormat:
+    """The input format from the command line: ``--input-format FILE`` first, then ``--columns`` (field by
+    field), ``--axes`` and ``--delimiter`` over it."""
+    fmt = load_input_format(format_file) if format_file is not None else InputFormat()
+    cols = dict(fmt.columns)
+    origin = fmt.origin
+    if columns:
+        cols |= parse_columns_option(columns)
+        origin = "--columns" if format_file is None else f"{fmt.origin} and --columns"
+    if axes is not None:
+        try:
+            units.axes_matrix(axes)
+        except ValueError as exc:
+            raise WashbenchError(f"--axes: {exc}") from None
+    return InputFormat(
+        kind=fmt.kind,
+        delimiter=check_delimiter(delimiter, "--delimiter") if delimiter is not None else fmt.delimiter,
+        columns=cols,
+        axes=axes if axes is not None else fmt.axes,
+        origin=origin,
+    )

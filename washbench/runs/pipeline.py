@@ -42,7 +42,6 @@ from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
 
 if TYPE_CHECKING:
-    from washbench.flight.fly import FlightResult
     from washbench.io.results import Motion
     from washbench.platform import PlatformLimits
     from washbench.review.rerun_log import PlatformEnvelope
@@ -170,7 +169,9 @@ def run_manoeuvre(
         result = analyse(motion, traces)
         write_results(partial, result)
         title = f"{manoeuvre.aircraft} / {manoeuvre.name}"
-        _write_recording(partial / "recording.rrd", title, motion, flight, result, limits)
+        cols = flight.columns
+        ac_q = aircraft_attitude(cols["phi_deg"], cols["theta_deg"], cols["psi_deg"])
+        write_run_recording(partial / "recording.rrd", title, motion, result, limits, ac_q, flight.phases)
         felt = perceived_motion(
             result.perceived["aircraft"].f_mps2, result.perceived["aircraft"].omega_radps, motion.dt_s
         )
@@ -189,7 +190,7 @@ def run_manoeuvre(
             motion=felt,
             saturations={w: dict(traces[w].saturation_counts) for w in washouts},
         )
-        _write_run_json(partial / "run.json", summary, time.perf_counter() - start)
+        write_run_json(partial / "run.json", summary, time.perf_counter() - start)
         _publish(partial, final)
     finally:
         with contextlib.suppress(FileNotFoundError):
@@ -197,8 +198,9 @@ def run_manoeuvre(
     return summary
 
 
-def _write_run_json(path: Path, s: RunSummary, wall_s: float) -> None:
-    doc = {
+def write_run_json(path: Path, s: RunSummary, wall_s: float, extra: dict[str, object] | None = None) -> None:
+    """``run.json``: the summary of one result folder (``extra``: more keys, e.g. what ``cue`` read)."""
+    doc: dict[str, object] = {
         "aircraft": s.aircraft,
         "manoeuvre": s.manoeuvre,
         "ok": s.ok,
@@ -213,16 +215,25 @@ def _write_run_json(path: Path, s: RunSummary, wall_s: float) -> None:
         },
         "saturations": s.saturations,
     }
+    doc |= extra or {}
     write_text_atomic(path, json.dumps(doc, indent=2) + "\n")
 
 
-def _write_recording(
-    path: Path, title: str, motion: Motion, flight: FlightResult, result: CueResult, limits: PlatformLimits
+def write_run_recording(
+    path: Path,
+    title: str,
+    motion: Motion,
+    result: CueResult,
+    limits: PlatformLimits,
+    aircraft_q: np.ndarray,
+    phases: list[tuple[str, float, float]],
 ) -> None:
+    """The recording of one result folder (``run`` and ``cue`` alike): the one call of the recording writer.
+
+    ``aircraft_q`` (N, 4) the aircraft's attitude, body -> NED, scalar first; ``phases`` (name, start, end) [s].
+    """
     from washbench.review.rerun_log import MotionSeries, PlatformSeries, RecordingData, write_recording
 
-    cols = flight.columns
-    ac_q = aircraft_attitude(cols["phi_deg"], cols["theta_deg"], cols["psi_deg"])
     ac = result.perceived["aircraft"]
     washouts: dict[str, MotionSeries] = {}
     platforms: dict[str, PlatformSeries] = {}
@@ -246,12 +257,12 @@ def _write_recording(
             omega_radps=motion.omega_radps,
             perceived_f_mps2=ac.f_mps2,
             perceived_omega_radps=ac.omega_radps,
-            q=ac_q,
+            q=aircraft_q,
         ),
         washouts=washouts,
         platforms=platforms,
         envelope=platform_envelope(limits),
-        phases=[(p[0], float(p[1]), float(p[2])) for p in flight.phases],
+        phases=[(p[0], float(p[1]), float(p[2])) for p in phases],
         metrics_markdown=metrics_markdown(title, list(result.metrics)),
     )
     write_recording(path, data)

@@ -213,11 +213,16 @@ def _washouts(outcomes: Sequence[Outcome]) -> list[str]:
     return [w for w in WASHOUT_NAMES if w in seen] + sorted(seen - set(WASHOUT_NAMES))
 
 
-def report_markdown(outcomes: Sequence[Outcome], rankings: dict[tuple[str, str], list[RankRow]], out_dir: Path) -> str:
+def report_markdown(
+    outcomes: Sequence[Outcome],
+    rankings: dict[tuple[str, str], list[RankRow]],
+    out_dir: Path,
+    title: str = "washbench suite report",
+) -> str:
     """``report.md``: status, ranking, Table-4 comparison and metrics of every manoeuvre."""
     ok = [o for o in outcomes if o.run.ok]
     lines = [
-        "# washbench suite report",
+        f"# {title}",
         "",
         f"{len(ok)} of {len(outcomes)} manoeuvres ran and passed their checks.",
         "",
@@ -300,6 +305,19 @@ def write_suite_results(outcomes: Sequence[Outcome], out_dir: Path) -> None:
     write_text_atomic(out_dir / "comparison.csv", comparison_table(outcomes))
     write_text_atomic(out_dir / "ranking.csv", ranking_table(rankings))
     write_text_atomic(out_dir / "report.md", report_markdown(outcomes, rankings, out_dir))
+
+
+def write_run_review(run_dir: Path, summary: RunSummary, source: str = "") -> None:
+    """``ranking.csv`` and ``report.md`` of one result folder (the same tables as a suite's, for one run).
+
+    The one call site for a result folder's report (``washbench cue`` uses it; the report of the review
+    issue replaces its body).
+    """
+    rankings = {(summary.aircraft, summary.manoeuvre): rank(summary.metrics, summary.motion)} if summary.metrics else {}
+    outcome = Outcome(path=source or str(run_dir), wall_s=0.0, run=summary)
+    write_text_atomic(run_dir / "ranking.csv", ranking_table(rankings))
+    title = f"washbench report: {summary.aircraft} / {summary.manoeuvre}" if summary.aircraft else "washbench report"
+    write_text_atomic(run_dir / "report.md", report_markdown([outcome], rankings, run_dir, title=title))
 
 
 def suite_command(
