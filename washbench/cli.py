@@ -57,14 +57,20 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", type=Path, help="write to this file instead of standard output")
 
     p = sub.add_parser("run", help="fly a manoeuvre with the washouts in lockstep; write traces, metrics, recording")
-    p.add_argument("manoeuvre", type=Path, help="manoeuvre YAML file")
+    p.add_argument("manoeuvre", type=Path, help="manoeuvre YAML file or JSBSim script (.xml)")
     p.add_argument("--out", type=Path, required=True, help="results folder; writes OUT/<aircraft>/<manoeuvre>/")
+    p.add_argument("--max-time-s", type=float, metavar="S", help="JSBSim script: stop after S s simulated")
+    p.add_argument("--filter-start", choices=("steady", "rest"), default="steady", help="filters' start state")
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
     p.add_argument("--quiet", action="store_true", help="no progress display")
 
     p = sub.add_parser("suite", help="run many manoeuvres in parallel and compare the washouts")
-    p.add_argument("inputs", type=Path, nargs="*", help="manoeuvre files or folders (default: bundled manoeuvres/)")
+    p.add_argument(
+        "inputs", type=Path, nargs="*", help="manoeuvre files, JSBSim scripts or folders (default: bundled manoeuvres)"
+    )
+    p.add_argument("--jsbsim-scripts", nargs="+", default=[], metavar="NAME", help="scripts shipped with JSBSim")
+    p.add_argument("--max-time-s", type=float, metavar="S", help="JSBSim scripts: stop each after S s simulated")
     p.add_argument("--out", type=Path, required=True, help="results folder")
     p.add_argument("--jobs", type=int, help="parallel processes (default: number of cores)")
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
@@ -138,7 +144,13 @@ def _dispatch(args: argparse.Namespace) -> int:
         from washbench.runs.pipeline import run_command
 
         return run_command(
-            args.manoeuvre, args.out, params_path=args.params, platform_path=args.platform, progress=not args.quiet
+            args.manoeuvre,
+            args.out,
+            params_path=args.params,
+            platform_path=args.platform,
+            progress=not args.quiet,
+            max_time_s=args.max_time_s,
+            filter_start=args.filter_start,
         )
     if args.command == "suite":
         from washbench.runs.suite import suite_command
@@ -150,6 +162,8 @@ def _dispatch(args: argparse.Namespace) -> int:
             params_path=args.params,
             platform_path=args.platform,
             progress=not args.quiet,
+            jsbsim_scripts=args.jsbsim_scripts,
+            max_time_s=args.max_time_s,
         )
     if args.command == "replay":
         from washbench.review.replay import replay_command
