@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import math
 import re
+import tempfile
 import xml.etree.ElementTree as ET
 from array import array
 from collections.abc import Callable
@@ -197,13 +198,17 @@ def _structure_contacts(fdm: object) -> list[object]:
     return out
 
 
-def _make_fdm(info: ScriptInfo) -> object:
+def _make_fdm(info: ScriptInfo, output_dir: Path) -> object:
+    """The FDM with the script loaded and initialised. JSBSim opens the script's and the aircraft's
+    ``<output>`` files at load time (relative to its root folder, i.e. inside the jsbsim package): they are
+    sent to ``output_dir`` (a temporary folder) and switched off."""
     import jsbsim
 
     root = aircraft_path(info.aircraft)
     with quiet_stdout():
         fdm = jsbsim.FGFDMExec(str(jsbsim_root()), None)
         fdm.set_debug_level(0)
+        fdm.set_output_path(str(output_dir))
         fdm.set_aircraft_path(str(root))
         try:
             ok = fdm.load_script(str(info.path.resolve()))
@@ -229,7 +234,17 @@ def fly_script(
     force m/s^2 and body rates rad/s, body axes x forward, y right, z down).
     """
     info = load_script_info(path)
-    fdm = _make_fdm(info)
+    with tempfile.TemporaryDirectory(prefix="washbench-jsbsim-") as junk:
+        return _fly(info, _make_fdm(info, Path(junk)), max_time_s, segment_hook)
+
+
+def _fly(
+    info: ScriptInfo,
+    fdm: object,
+    max_time_s: float | None,
+    segment_hook: Callable[[int, float], StepHook | None] | None,
+) -> ScriptFlight:
+    """The recording loop of :func:`fly_script`."""
     dt = float(fdm.get_delta_t())  # type: ignore[attr-defined]
     pm = fdm.get_property_manager()  # type: ignore[attr-defined]
     missing = [n for n in (*_STATE, *_AFTER) if not pm.hasNode(n)]

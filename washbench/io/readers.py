@@ -237,9 +237,12 @@ def _header(path: Path, delimiter: str | None) -> tuple[int, list[str], str]:
         s = line.strip()
         if not s or s.startswith("#"):
             continue
-        if delimiter is None:
-            counts = {d: line.count(d) for d in DELIMITERS}
-            delimiter = max(counts, key=lambda d: counts[d]) if max(counts.values()) > 0 else ","
+        if delimiter is None:  # the one found as often in the header as in the first data line (X-Plane's
+            # header holds as many commas as pipes), the most frequent one if none is
+            data = next((x for x in lines[i + 1 :] if x.strip() and not x.lstrip().startswith("#")), line)
+            counts = {d: (min(line.count(d), data.count(d)), line.count(d)) for d in DELIMITERS}
+            best = max(counts, key=lambda d: counts[d])
+            delimiter = best if counts[best][1] > 0 else ","
         names = [n.strip().strip('"').strip() for n in line.split(delimiter)]
         if names and names[-1] == "" and len(names) > 1:  # a trailing delimiter (X-Plane writes one)
             names[-1] = "_trailing"
@@ -362,17 +365,29 @@ _JSBSIM_RATES = (
 )
 
 
+def _jsbsim_column(names: list[str], prop: str) -> str | None:
+    """The header of property ``prop`` in a JSBSim CSV (written as given or with the ``/fdm/jsbsim/`` prefix)."""
+    for n in (prop, f"/fdm/jsbsim/{prop}"):
+        if n in names:
+            return n
+    return None
+
+
 def is_jsbsim_header(names: list[str]) -> bool:
-    return "Time" in names and all(c in names for c in JSBSIM_F)
+    return "Time" in names and all(_jsbsim_column(names, c) for c in JSBSIM_F)
 
 
 def jsbsim_mapping(names: list[str]) -> dict[str, ColumnSource]:
     """JSBSim CSV output: ``Time`` [s], the pilot accelerations [ft/s^2] and the body rates."""
     out = {"t": ColumnSource("Time", "s")}
-    out |= {f"f_{a}": ColumnSource(c, "ftps2") for a, c in zip("xyz", JSBSIM_F, strict=True)}
+    for a, prop in zip("xyz", JSBSIM_F, strict=True):
+        col = _jsbsim_column(names, prop)
+        if col is not None:
+            out[f"f_{a}"] = ColumnSource(col, "ftps2")
     for cols, unit in _JSBSIM_RATES:
-        if all(c in names for c in cols):
-            out |= {f"omega_{a}": ColumnSource(c, unit) for a, c in zip("xyz", cols, strict=True)}
+        found = [_jsbsim_column(names, c) for c in cols]
+        if all(found):
+            out |= {f"omega_{a}": ColumnSource(str(c), unit) for a, c in zip("xyz", found, strict=True)}
             break
     return out
 
