@@ -57,7 +57,6 @@ AIRCRAFT = "aircraft"
 METRICS_COLUMNS = ("washout", "dof", "npc", "integral_error", "max_error")
 
 
-
 # --------------------------------------------------------------------------- column names
 
 
