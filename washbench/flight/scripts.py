@@ -30,7 +30,7 @@ import re
 import tempfile
 import xml.etree.ElementTree as ET
 from array import array
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -97,6 +97,7 @@ class ScriptInfo:
     initialize: str
     dt_s: float
     end_s: float
+    aircraft_root: Path
     description: str = ""
 
 
@@ -148,8 +149,11 @@ def is_script(path: Path) -> bool:
     return path.suffix.lower() == ".xml"
 
 
-def load_script_info(path: str | Path) -> ScriptInfo:
-    """Read a script's header; WashbenchError (file, line, what) if it is not a usable JSBSim script."""
+def load_script_info(path: str | Path, aircraft_dirs: Sequence[Path] = ()) -> ScriptInfo:
+    """Read a script's header; WashbenchError (file, line, what) if it is not a usable JSBSim script.
+
+    The aircraft is looked up along washbench's search path (``aircraft_dirs``, an ``aircraft/`` folder next
+    to the script, washbench's bundled aircraft, JSBSim's own)."""
     path = Path(path)
     try:
         root = ET.parse(path).getroot()
@@ -170,7 +174,8 @@ def load_script_info(path: str | Path) -> ScriptInfo:
     if run is None:
         raise WashbenchError(located(path, "<run> is missing"))
     aircraft = str(use.get("aircraft"))
-    if aircraft_path(aircraft) is None:
+    root_dir = aircraft_path(aircraft, path, aircraft_dirs)
+    if root_dir is None:
         raise WashbenchError(
             located(path, f"<use aircraft={aircraft!r}>: unknown aircraft (neither washbench's nor JSBSim's)")
         )
@@ -183,7 +188,7 @@ def load_script_info(path: str | Path) -> ScriptInfo:
         raise WashbenchError(located(path, f"<run>: needs dt > 0 and end > 0 s, got dt={dt:g}, end={end:g}"))
     desc = (root.findtext("description") or root.get("name") or "").strip()
     name = re.sub(r"[^A-Za-z0-9_-]", "_", path.stem)
-    return ScriptInfo(path, name, aircraft, str(use.get("initialize", "")), dt, end, " ".join(desc.split()))
+    return ScriptInfo(path, name, aircraft, str(use.get("initialize", "")), dt, end, root_dir, " ".join(desc.split()))
 
 
 def _structure_contacts(fdm: object) -> list[object]:
@@ -204,7 +209,7 @@ def _make_fdm(info: ScriptInfo, output_dir: Path) -> object:
     sent to ``output_dir`` (a temporary folder) and switched off."""
     import jsbsim
 
-    root = aircraft_path(info.aircraft)
+    root = info.aircraft_root
     with quiet_stdout():
         fdm = jsbsim.FGFDMExec(str(jsbsim_root()), None)
         fdm.set_debug_level(0)
@@ -226,6 +231,7 @@ def fly_script(
     *,
     max_time_s: float | None = None,
     segment_hook: Callable[[int, float], StepHook | None] | None = None,
+    aircraft_dirs: Sequence[Path] = (),
 ) -> ScriptFlight:
     """Fly a JSBSim script to its end, a crash or ``max_time_s`` of simulated time (summed over segments).
 
@@ -233,7 +239,7 @@ def fly_script(
     ``hook(k, f_mps2, omega_radps)`` called once per recorded sample of it, in order (eyepoint specific
     force m/s^2 and body rates rad/s, body axes x forward, y right, z down).
     """
-    info = load_script_info(path)
+    info = load_script_info(path, aircraft_dirs)
     with tempfile.TemporaryDirectory(prefix="washbench-jsbsim-") as junk:
         return _fly(info, _make_fdm(info, Path(junk)), max_time_s, segment_hook)
 

@@ -30,6 +30,7 @@ import os
 import shutil
 import sys
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -122,6 +123,7 @@ def run_manoeuvre(
     platform_path: Path | None = None,
     progress: bool = False,
     filter_start: str = "steady",
+    aircraft_dirs: Sequence[Path] = (),
 ) -> RunSummary:
     """Fly one manoeuvre with the washouts in lockstep and write its results folder.
 
@@ -136,7 +138,7 @@ def run_manoeuvre(
     from washbench.flight.manoeuvre import load_manoeuvre
     from washbench.platform import load_platform_limits
 
-    manoeuvre = load_manoeuvre(manoeuvre_path)
+    manoeuvre = load_manoeuvre(manoeuvre_path, aircraft_dirs)
     params = load_washout_params(params_path)
     limits = load_platform_limits(platform_path)
     washouts = tuple(WASHOUT_NAMES)
@@ -244,6 +246,7 @@ def run_script(
     platform_path: Path | None = None,
     max_time_s: float | None = None,
     filter_start: str = "steady",
+    aircraft_dirs: Sequence[Path] = (),
 ) -> list[RunSummary]:
     """Fly a JSBSim script (:mod:`washbench.flight.scripts`) with the washouts in lockstep, one result per run.
 
@@ -255,7 +258,7 @@ def run_script(
     from washbench.flight.scripts import fly_script, load_script_info, write_script_flight
     from washbench.platform import load_platform_limits
 
-    info = load_script_info(script_path)
+    info = load_script_info(script_path, aircraft_dirs)
     check_filter_start(filter_start)
     params = load_washout_params(params_path)
     limits = load_platform_limits(platform_path)
@@ -268,7 +271,7 @@ def run_script(
         return hook
 
     start = time.perf_counter()
-    flight = fly_script(script_path, max_time_s=max_time_s, segment_hook=segment_hook)
+    flight = fly_script(script_path, max_time_s=max_time_s, segment_hook=segment_hook, aircraft_dirs=aircraft_dirs)
     final = Path(out_root) / info.aircraft / info.name
     partial = final.with_name(f".{final.name}.partial-{os.getpid()}")
     shutil.rmtree(partial, ignore_errors=True)
@@ -400,6 +403,7 @@ def run_command(
     progress: bool = True,
     max_time_s: float | None = None,
     filter_start: str = "steady",
+    aircraft_dirs: Sequence[Path] = (),
 ) -> int:
     """CLI entry of ``washbench run`` (a YAML manoeuvre or a JSBSim script): 0 if every run was ok, else 1."""
     from washbench.cueing.bank import check_filter_start
@@ -415,6 +419,7 @@ def run_command(
             platform_path=platform_path,
             max_time_s=max_time_s,
             filter_start=filter_start,
+            aircraft_dirs=aircraft_dirs,
         )
     else:
         if max_time_s is not None:
@@ -427,15 +432,18 @@ def run_command(
                 platform_path=platform_path,
                 progress=progress and sys.stderr.isatty(),
                 filter_start=filter_start,
+                aircraft_dirs=aircraft_dirs,
             )
         ]
     wall = time.perf_counter() - start
     for s in runs:
         state = "ok" if s.ok else f"FAILED ({s.reason})"
         checks = f"; checks {s.checks_passed}/{s.checks_total}" if s.checks_total else ""
-        print(f"{s.aircraft}/{s.manoeuvre}: {state}{checks}; {s.steps * s.dt_s:.1f} s flown; results in {s.run_dir}")
+        print(
+            f"{s.aircraft}/{s.manoeuvre}: {state}{checks}; {s.steps * s.dt_s:.1f} s flown in {wall:.1f} s; "
+            f"results in {s.run_dir}"
+        )
         for w, kinds in s.saturations.items():
             sat = ", ".join(f"{k} {v}" for k, v in kinds.items() if v) or "none"
             print(f"  {w}: platform saturations (steps): {sat}", file=sys.stdout)
-    print(f"{len(runs)} run{'s' if len(runs) > 1 else ''} in {wall:.1f} s")
     return 0 if all(s.ok for s in runs) else 1

@@ -25,7 +25,7 @@ import os
 import sys
 import time
 import traceback
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
@@ -42,7 +42,7 @@ from washbench.analysis.ranking import (
 from washbench.cueing.params import WASHOUT_NAMES
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
-from washbench.io.paths import MANOEUVRES_DIR
+from washbench.io.paths import MANOEUVRES_DIR, bundled_names, resolve_manoeuvre
 from washbench.io.results import csv_number
 from washbench.runs.pipeline import RunSummary
 
@@ -75,14 +75,16 @@ def find_manoeuvres(inputs: Sequence[Path], scripts: Sequence[Path] = ()) -> lis
     if not inputs and not scripts:
         inputs = [MANOEUVRES_DIR]
     found: list[Path] = []
-    for item in inputs:
+    for item in map(resolve_manoeuvre, inputs):
         if item.is_dir():
             found.extend(sorted(p for p in item.rglob("*.yaml") if p.is_file()))
             found.extend(sorted(p for p in item.rglob("*.xml") if p.is_file() and _is_runscript(p)))
         elif item.is_file():
             found.append(item)
         else:
-            raise WashbenchError(located(item, "no such file or folder"))
+            raise WashbenchError(
+                located(item, f"no such file or folder, nor a bundled manoeuvre ({', '.join(bundled_names())})")
+            )
     found.extend(scripts)
     unique = list(dict.fromkeys(p.resolve() for p in found))
     if not unique:
@@ -91,7 +93,12 @@ def find_manoeuvres(inputs: Sequence[Path], scripts: Sequence[Path] = ()) -> lis
 
 
 def _run_one(
-    path: str, out_dir: str, params_path: str | None, platform_path: str | None, max_time_s: float | None = None
+    path: str,
+    out_dir: str,
+    params_path: str | None,
+    platform_path: str | None,
+    aircraft_dirs: tuple[str, ...] = (),
+    max_time_s: float | None = None,
 ) -> list[Outcome]:
     """Worker: run one manoeuvre or JSBSim script (one outcome per run segment); never raises (failures
     come back as an Outcome)."""
@@ -102,12 +109,20 @@ def _run_one(
     params = Path(params_path) if params_path else None
     platform = Path(platform_path) if platform_path else None
     try:
+        dirs = [Path(d) for d in aircraft_dirs]
         if is_script(Path(path)):
             runs = run_script(
-                Path(path), Path(out_dir), params_path=params, platform_path=platform, max_time_s=max_time_s
+                Path(path),
+                Path(out_dir),
+                params_path=params,
+                platform_path=platform,
+                max_time_s=max_time_s,
+                aircraft_dirs=dirs,
             )
         else:
-            runs = [run_manoeuvre(Path(path), Path(out_dir), params_path=params, platform_path=platform)]
+            runs = [
+                run_manoeuvre(Path(path), Path(out_dir), params_path=params, platform_path=platform, aircraft_dirs=dirs)
+            ]
     except WashbenchError as exc:
         runs = [RunSummary(ok=False, reason=str(exc))]
     except Exception as exc:  # an unexpected bug in one run must not take the suite down
@@ -118,6 +133,25 @@ def _run_one(
     return [Outcome(path=path, wall_s=wall / len(runs), run=r) for r in runs]
 
 
+def _preload() -> None:
+    """Worker initializer where there is no forkserver: load the heavy modules once per worker."""
+    import washbench.runs.preload  # noqa: F401
+
+
+def pool_context() -> tuple[multiprocessing.context.BaseContext, Callable[[], None] | None]:
+    """The process pool's start method and worker initializer.
+
+    ``forkserver`` (Linux, macOS) where it exists: workers fork from a server that has already imported the heavy
+    modules (JSBSim, the numba kernels, rerun, pyarrow), so each starts in milliseconds. Elsewhere (Windows)
+    ``spawn``, with every worker importing them once at its start.
+    """
+    if "forkserver" in multiprocessing.get_all_start_methods():
+        ctx = multiprocessing.get_context("forkserver")
+        ctx.set_forkserver_preload(["washbench.runs.preload"])
+        return ctx, None
+    return multiprocessing.get_context("spawn"), _preload
+
+
 def run_suite(
     files: Sequence[Path],
     out_dir: Path,
@@ -126,22 +160,17 @@ def run_suite(
     params_path: Path | None = None,
     platform_path: Path | None = None,
     progress: bool = True,
+    aircraft_dirs: Sequence[Path] = (),
     max_time_s: float | None = None,
 ) -> list[Outcome]:
     """Run every file in parallel processes; return the outcomes in the order of ``files`` (a JSBSim script
     that resets gives one outcome per run segment, in order)."""
     jobs = max(1, min(jobs or os.cpu_count() or 1, len(files)))
     out_dir.mkdir(parents=True, exist_ok=True)
-    args = [
-        (
-            str(f),
-            str(out_dir),
-            str(params_path) if params_path else None,
-            str(platform_path) if platform_path else None,
-            max_time_s,
-        )
-        for f in files
-    ]
+    dirs = tuple(str(d) for d in aircraft_dirs)
+    params = str(params_path) if params_path else None
+    platform = str(platform_path) if platform_path else None
+    args = [(str(f), str(out_dir), params, platform, dirs, max_time_s) for f in files]
     outcomes: dict[str, list[Outcome]] = {}
     start = time.perf_counter()
     if progress:
@@ -154,11 +183,8 @@ def run_suite(
         for a in args:
             outcomes[a[0]] = _report(_run_one(*a), len(outcomes) + 1, len(files), start, progress)
     else:
-        ctx = multiprocessing.get_context("forkserver")
-        # Workers fork from a server that has already imported the heavy modules (JSBSim, numba
-        # kernels, rerun, pyarrow), so each worker starts in milliseconds instead of seconds.
-        ctx.set_forkserver_preload(["washbench.runs.preload"])
-        with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as pool:
+        ctx, initializer = pool_context()
+        with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=initializer) as pool:
             futures = [pool.submit(_run_one, *a) for a in args]
             for fut in as_completed(futures):
                 runs = fut.result()
@@ -364,6 +390,7 @@ def suite_command(
     params_path: Path | None = None,
     platform_path: Path | None = None,
     progress: bool = True,
+    aircraft_dirs: Sequence[Path] = (),
     jsbsim_scripts: Sequence[str] = (),
     max_time_s: float | None = None,
 ) -> int:
@@ -390,6 +417,7 @@ def suite_command(
         params_path=params_path,
         platform_path=platform_path,
         progress=progress,
+        aircraft_dirs=aircraft_dirs,
         max_time_s=max_time_s,
     )
     write_suite_results(outcomes, out_dir)
