@@ -39,8 +39,9 @@ import numpy as np
 from washbench.errors import WashbenchError, located
 from washbench.flight.fdm import quiet_stdout
 from washbench.flight.fly import FPS_TO_KT, FT_S2_TO_M_S2, R2D, StepHook
-from washbench.flight.manoeuvre import aircraft_path, jsbsim_root
+from washbench.flight.manoeuvre import aircraft_path
 from washbench.flight.monitor import Monitor
+from washbench.io.paths import jsbsim_root
 
 SEGMENT_PREFIX = "run_"
 
