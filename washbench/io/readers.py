@@ -97,6 +97,7 @@ class Samples:
     extra: dict[str, np.ndarray]
     lines: np.ndarray | None
     notes: tuple[str, ...] = ()
+    time_column: str = "t_s"
 
     @property
     def n(self) -> int:
@@ -119,6 +120,7 @@ class Samples:
             extra={k: v[index] for k, v in self.extra.items()},
             lines=None if self.lines is None else self.lines[index],
             notes=self.notes + notes,
+            time_column=self.time_column,
         )
 
 
@@ -500,6 +502,7 @@ def convert(src: SourceTable, fmt: InputFormat) -> Samples:
         extra=extra,
         lines=src.lines,
         notes=tuple(notes),
+        time_column=t_src.column,
     )
     if src.kind == "jsbsim":
         samples = shift_jsbsim_lag(samples)
@@ -511,7 +514,7 @@ def shift_jsbsim_lag(s: Samples) -> Samples:
     n = s.n
     f = np.ascontiguousarray(s.f_mps2[1:])
     out = s.take(slice(0, n - 1), ("JSBSim's pilot accelerations shifted back one row (their one-frame lag)",))
-    return Samples(out.path, out.kind, out.t_s, f, out.omega_degps, out.extra, out.lines, out.notes)
+    return Samples(out.path, out.kind, out.t_s, f, out.omega_degps, out.extra, out.lines, out.notes, out.time_column)
 
 
 def _time_column(src: SourceTable, s: ColumnSource, notes: list[str]) -> np.ndarray:

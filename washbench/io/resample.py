@@ -26,7 +26,7 @@ import scipy.signal
 
 from washbench.errors import WashbenchError, located
 from washbench.io.readers import Samples
-from washbench.io.results import TIME_COLUMN, Motion
+from washbench.io.results import Motion
 
 GRID_TOL = 1e-3
 """Samples may lie at most this fraction of a step off the uniform grid t_0 + k dt."""
@@ -41,7 +41,7 @@ ANTIALIAS_FRACTION = 0.4
 
 def _err(s: Samples, i: int, problem: str) -> WashbenchError:
     line, row = s.where(i)
-    return WashbenchError(located(s.path, f"{row}{problem}", line=line, field=TIME_COLUMN))
+    return WashbenchError(located(s.path, f"{row}{problem}", line=line, field=s.time_column))
 
 
 def split_resets(s: Samples, split: bool = True) -> list[Samples]:
