@@ -31,7 +31,7 @@ import pytest
 from washbench.analysis.ranking import MOTION_FLOOR
 from washbench.errors import WashbenchError
 from washbench.flight.scripts import bundled_script, fly_script
-from washbench.io.readers import InputFormat, input_format
+from washbench.io.input_format import InputFormat, input_format
 from washbench.io.results import read_metrics_csv
 from washbench.runs.cue import CueOptions, run_cue
 

@@ -120,7 +120,7 @@ def _cue_input_options(p: argparse.ArgumentParser) -> None:
 
 
 def _cue(args: argparse.Namespace) -> int:
-    from washbench.io.readers import input_format
+    from washbench.io.input_format import input_format
     from washbench.runs.cue import CueOptions, run_cue
 
     opts = CueOptions(

@@ -21,62 +21,18 @@ so a ``washbench fly`` trace is read back bit for bit.
 
 from __future__ import annotations
 
-import re
-from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Literal
 
 import numpy as np
 import pyarrow as pa
 import pyarrow.compute as pc
-import pyarrow.csv as pacsv
-import pyarrow.parquet as pq
-from pydantic import Field
 
 from washbench.errors import WashbenchError, located
-from washbench.io import units
-from washbench.io.results import INPUT_COLUMNS
-from washbench.io.yamlio import StrictModel, line_of, read_yaml, validate_data
-
-FIELDS = ("t", "f_x", "f_y", "f_z", "omega_x", "omega_y", "omega_z")
-"""The motion fields a mapping names (``t`` time, ``f_*`` specific force, ``omega_*`` angular velocity)."""
-
-QUANTITY = {"t": units.TIME} | {f"f_{a}": units.FORCE for a in "xyz"} | {f"omega_{a}": units.RATE for a in "xyz"}
-CANONICAL = dict(zip(FIELDS, INPUT_COLUMNS, strict=True))
-
-KINDS = ("auto", "csv", "parquet", "xplane", "jsbsim")
-TEXT_SUFFIXES = (".csv", ".tsv", ".txt")
-PARQUET_SUFFIXES = (".parquet", ".pq")
-DELIMITERS = {",": "comma", ";": "semicolon", "\t": "tab", "|": "pipe"}
-
-
-@dataclass(frozen=True)
-class ColumnSource:
-    """Where one motion field comes from: a source column, its unit and a sign (+1 or -1)."""
-
-    column: str
-    unit: str
-    sign: float = 1.0
-
-    def describe(self) -> str:
-        return f"{'-' if self.sign < 0 else ''}{self.column}:{self.unit}"
-
-
-@dataclass(frozen=True)
-class InputFormat:
-    """How to read an input: file kind, delimiter, column mapping overrides and sensor axes.
-
-    ``columns`` maps motion fields (:data:`FIELDS`) to their sources; fields not named keep the
-    file kind's default (washbench's own column names for CSV and Parquet). ``origin`` names where the
-    mapping came from, for error messages (``--columns`` or the YAML file).
-    """
-
-    kind: str = "auto"
-    delimiter: str | None = None
-    columns: Mapping[str, ColumnSource] = field(default_factory=dict)
-    axes: str = "frd"
-    origin: str = "--columns"
+from washbench.io import units, xplane
+from washbench.io.input_format import CANONICAL, FIELDS, QUANTITY, ColumnSource, InputFormat
+from washbench.io.jsbsim_csv import is_jsbsim_header, jsbsim_mapping
+from washbench.io.tables import SourceTable, file_kind, header, read_parquet_table, read_text_table
 
 
 @dataclass(frozen=True, eq=False)
@@ -124,234 +80,11 @@ class Samples:
         )
 
 
-# --------------------------------------------------------------------------- the mapping option
-
-
-_SPEC = re.compile(r"^\s*(-?)\s*(.+?)\s*$")
-
-
-def parse_column_source(field_name: str, text: str, where: str) -> ColumnSource:
-    """``[-]COLUMN[:UNIT]`` for motion field ``field_name``; the unit defaults to washbench's own."""
-    m = _SPEC.match(text)
-    if not m or not m.group(2):
-        raise WashbenchError(f"{where}: {field_name}: expected [-]COLUMN[:UNIT], got {text!r}")
-    sign = -1.0 if m.group(1) else 1.0
-    column, unit = m.group(2), units.CANONICAL_UNIT[QUANTITY[field_name]]
-    if ":" in column:
-        head, tail = column.rsplit(":", 1)
-        column, unit = head.strip(), tail.strip()
-    try:
-        units.unit_factor(QUANTITY[field_name], unit)
-    except ValueError as exc:
-        raise WashbenchError(f"{where}: {field_name}: {exc}") from None
-    if not column:
-        raise WashbenchError(f"{where}: {field_name}: no column name in {text!r}")
-    return ColumnSource(column=column, unit=units.normalise_unit(unit), sign=sign)
-
-
-def field_name_of(key: str, where: str) -> str:
-    """The motion field for a mapping key (``t``, ``f_x`` ... or washbench's column names ``t_s``, ``f_x_mps2``)."""
-    k = key.strip()
-    for name, canonical in CANONICAL.items():
-        if k in (name, canonical):
-            return name
-    raise WashbenchError(f"{where}: unknown field {key!r} (valid: {', '.join(FIELDS)})")
-
-
-def parse_columns_option(text: str) -> dict[str, ColumnSource]:
-    """``--columns t=Time:ms,f_x=ax:g,...`` into a mapping (commas separate fields; use a YAML file for
-    column names that contain commas)."""
-    out: dict[str, ColumnSource] = {}
-    for item in (s for s in text.split(",") if s.strip()):
-        if "=" not in item:
-            raise WashbenchError(f"--columns: expected FIELD=COLUMN[:UNIT], got {item.strip()!r}")
-        key, spec = item.split("=", 1)
-        name = field_name_of(key, "--columns")
-        if name in out:
-            raise WashbenchError(f"--columns: {name} is given twice")
-        out[name] = parse_column_source(name, spec, "--columns")
-    return out
-
-
-def check_delimiter(text: str | None, where: str) -> str | None:
-    """A delimiter option: one character, or the names comma, semicolon, tab, pipe."""
-    if text is None:
-        return None
-    names = {v: k for k, v in DELIMITERS.items()}
-    d = names.get(text.lower(), text.replace("\\t", "\t"))
-    if len(d) != 1 or d in '"\n\r#':
-        raise WashbenchError(f"{where}: delimiter must be one character or one of {', '.join(names)}, got {text!r}")
-    return d
-
-
-# --------------------------------------------------------------------------- tables
-
-
-@dataclass(frozen=True)
-class SourceTable:
-    """A file read as a table: its kind, the table, and the file line of each row (text files)."""
-
-    path: Path
-    kind: str
-    table: pa.Table
-    lines: np.ndarray | None
-
-
-def file_kind(path: Path) -> str:
-    """``"text"`` or ``"parquet"`` from the extension (``.gz`` stripped); WashbenchError otherwise."""
-    suffixes = [s.lower() for s in path.suffixes]
-    if suffixes and suffixes[-1] == ".gz":
-        suffixes = suffixes[:-1]
-        if suffixes and suffixes[-1] in PARQUET_SUFFIXES:
-            raise WashbenchError(located(path, "gzip-compressed Parquet is not supported: Parquet compresses itself"))
-    last = suffixes[-1] if suffixes else ""
-    if last in TEXT_SUFFIXES:
-        return "text"
-    if last in PARQUET_SUFFIXES:
-        return "parquet"
-    shown = "".join(path.suffixes[-2:]) if path.suffixes else "(no extension)"
-    raise WashbenchError(
-        located(path, f"unknown file type {shown!r}: expected .csv, .tsv, .txt (optionally .gz) or .parquet")
-    )
-
-
-def _head_lines(path: Path, limit: int = 1 << 16) -> list[str]:
-    """The first lines of a text file (decompressed), for sniffing the header and delimiter."""
-    try:
-        with pa.input_stream(str(path), compression="detect") as f:
-            raw = f.read(limit)
-    except (OSError, pa.ArrowException) as exc:
-        raise WashbenchError(located(path, f"cannot read: {getattr(exc, 'strerror', None) or exc}")) from None
-    try:
-        text = raw.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        if exc.start < len(raw) - 4:  # not just a multi-byte character cut at the end of the block
-            raise WashbenchError(located(path, "not a readable CSV file: it is not UTF-8 text")) from None
-        text = raw[: exc.start].decode("utf-8")
-    lines = text.splitlines()
-    return lines[:-1] if len(raw) == limit and len(lines) > 1 else lines
-
-
-def _header(path: Path, delimiter: str | None) -> tuple[int, list[str], str]:
-    """(line number of the header, 1-based; trimmed column names; delimiter) of a text file."""
-    lines = _head_lines(path)
-    for i, line in enumerate(lines):
-        s = line.strip()
-        if not s or s.startswith("#"):
-            continue
-        if delimiter is None:  # the one found as often in the header as in the first data line (X-Plane's
-            # header holds as many commas as pipes), the most frequent one if none is
-            data = next((x for x in lines[i + 1 :] if x.strip() and not x.lstrip().startswith("#")), line)
-            counts = {d: (min(line.count(d), data.count(d)), line.count(d)) for d in DELIMITERS}
-            best = max(counts, key=lambda d: counts[d])
-            delimiter = best if counts[best][1] > 0 else ","
-        names = [n.strip().strip('"').strip() for n in line.split(delimiter)]
-        if names and names[-1] == "" and len(names) > 1:  # a trailing delimiter (X-Plane writes one)
-            names[-1] = "_trailing"
-        return i + 1, names, delimiter
-    raise WashbenchError(located(path, "the file is empty" if not lines else "no header line (only comments)"))
-
-
-def read_text_table(path: Path, delimiter: str | None, string_columns: set[str]) -> SourceTable:
-    """A CSV-like text file with pyarrow: header and delimiter sniffed, ``#`` lines skipped, names trimmed.
-
-    ``string_columns`` are read as text (converted later with errors that name the line and value).
-    """
-    try:
-        size = path.stat().st_size
-    except OSError as exc:
-        raise WashbenchError(located(path, f"cannot read: {exc.strerror or exc}")) from None
-    if size == 0:
-        raise WashbenchError(located(path, "the file is empty"))
-    header_line, names, delim = _header(path, delimiter)
-    dup = sorted({n for n in names if names.count(n) > 1})
-    if dup:
-        raise WashbenchError(located(path, f"column {dup[0]!r} appears more than once", line=header_line))
-    skipped: list[int] = []
-    wrong: list[tuple[int, str]] = []
-
-    def on_invalid(row: pacsv.InvalidRow) -> str:
-        if row.text.lstrip().startswith("#"):
-            skipped.append(row.number)
-            return "skip"
-        wrong.append((row.number, f"expected {row.expected_columns} fields, got {row.actual_columns}"))
-        return "error"
-
-    read = pacsv.ReadOptions(
-        use_threads=False,
-        block_size=int(min(max(size + 1, 1 << 20), (1 << 31) - 1)),
-        skip_rows=header_line,
-        column_names=names,
-    )
-    parse = pacsv.ParseOptions(delimiter=delim, ignore_empty_lines=False, invalid_row_handler=on_invalid)
-    convert = pacsv.ConvertOptions(
-        null_values=[""],
-        strings_can_be_null=True,
-        column_types={c: pa.string() for c in names if c in string_columns},
-    )
-    try:
-        table = pacsv.read_csv(path, read_options=read, parse_options=parse, convert_options=convert)
-    except pa.ArrowInvalid as exc:
-        if wrong:
-            raise WashbenchError(located(path, f"wrong number of fields ({wrong[0][1]})", line=wrong[0][0])) from None
-        text = str(exc)
-        if "Empty CSV" in text:
-            raise WashbenchError(located(path, "no data rows")) from None
-        if "UTF8" in text or "utf8" in text.lower():
-            raise WashbenchError(located(path, "not a readable CSV file: it is not UTF-8 text")) from None
-        raise WashbenchError(located(path, f"not a readable CSV file: {text}")) from None
-    except UnicodeDecodeError:
-        raise WashbenchError(located(path, "not a readable CSV file: it is not UTF-8 text")) from None
-    except OSError as exc:
-        raise WashbenchError(located(path, f"cannot read: {getattr(exc, 'strerror', None) or exc}")) from None
-    table = _drop_trailing_empty_rows(table)
-    if "_trailing" in table.column_names and table.column("_trailing").null_count == table.num_rows:
-        table = table.drop_columns(["_trailing"])
-    lines = header_line + 1 + np.arange(table.num_rows, dtype=np.int64)
-    if skipped:  # every data line after a skipped comment moves down by one
-        skip = np.asarray(sorted(skipped), dtype=np.int64)
-        for s in skip:
-            lines[lines >= s] += 1
-    return SourceTable(path=path, kind="csv", table=table, lines=lines)
-
-
-def read_parquet_table(path: Path) -> SourceTable:
-    try:
-        table = pq.read_table(path)
-    except FileNotFoundError:
-        raise WashbenchError(located(path, "no such file")) from None
-    except IsADirectoryError:
-        raise WashbenchError(located(path, "is a folder, not a file")) from None
-    except PermissionError as exc:
-        raise WashbenchError(located(path, f"cannot read: {exc.strerror}")) from None
-    except (pa.ArrowException, OSError) as exc:
-        if path.is_file() and path.stat().st_size == 0:
-            raise WashbenchError(located(path, "the file is empty")) from None
-        raise WashbenchError(located(path, f"not a readable Parquet file ({exc})")) from None
-    return SourceTable(path=path, kind="parquet", table=table, lines=None)
-
-
-def _drop_trailing_empty_rows(table: pa.Table) -> pa.Table:
-    """Blank lines at the end of a CSV file read as all-null rows: drop them."""
-    n = table.num_rows
-    if n == 0 or table.num_columns == 0:
-        return table
-    all_null = np.ones(n, dtype=bool)
-    for col in table.columns:
-        all_null &= col.is_null().to_numpy(zero_copy_only=False)
-    end = n
-    while end > 0 and all_null[end - 1]:
-        end -= 1
-    return table.slice(0, end) if end < n else table
-
-
 # --------------------------------------------------------------------------- format defaults
 
 
 def default_mapping(kind: str, names: list[str]) -> dict[str, ColumnSource]:
     """The column mapping a file kind implies (washbench's own names for CSV and Parquet)."""
-    from washbench.io import xplane
-
     if kind == "xplane":
         return xplane.default_mapping(names)
     if kind == "jsbsim":
@@ -359,45 +92,8 @@ def default_mapping(kind: str, names: list[str]) -> dict[str, ColumnSource]:
     return {f: ColumnSource(CANONICAL[f], units.CANONICAL_UNIT[QUANTITY[f]]) for f in FIELDS}
 
 
-JSBSIM_F = tuple(f"accelerations/a-pilot-{a}-ft_sec2" for a in "xyz")
-_JSBSIM_RATES = (
-    (tuple(f"velocities/{r}-rad_sec" for r in "pqr"), "radps"),
-    (("P (deg/s)", "Q (deg/s)", "R (deg/s)"), "degps"),
-    (("P_{Body} (deg/s)", "Q_{Body} (deg/s)", "R_{Body} (deg/s)"), "degps"),
-)
-
-
-def _jsbsim_column(names: list[str], prop: str) -> str | None:
-    """The header of property ``prop`` in a JSBSim CSV (written as given or with the ``/fdm/jsbsim/`` prefix)."""
-    for n in (prop, f"/fdm/jsbsim/{prop}"):
-        if n in names:
-            return n
-    return None
-
-
-def is_jsbsim_header(names: list[str]) -> bool:
-    return "Time" in names and all(_jsbsim_column(names, c) for c in JSBSIM_F)
-
-
-def jsbsim_mapping(names: list[str]) -> dict[str, ColumnSource]:
-    """JSBSim CSV output: ``Time`` [s], the pilot accelerations [ft/s^2] and the body rates."""
-    out = {"t": ColumnSource("Time", "s")}
-    for a, prop in zip("xyz", JSBSIM_F, strict=True):
-        col = _jsbsim_column(names, prop)
-        if col is not None:
-            out[f"f_{a}"] = ColumnSource(col, "ftps2")
-    for cols, unit in _JSBSIM_RATES:
-        found = [_jsbsim_column(names, c) for c in cols]
-        if all(found):
-            out |= {f"omega_{a}": ColumnSource(str(c), unit) for a, c in zip("xyz", found, strict=True)}
-            break
-    return out
-
-
 def detect_kind(path: Path, fmt: InputFormat) -> tuple[str, str | None]:
     """(kind, delimiter) of ``path`` under ``fmt`` (``auto`` looks at the extension, then the header)."""
-    from washbench.io import xplane
-
     base = file_kind(path)
     if fmt.kind == "parquet" or (fmt.kind == "auto" and base == "parquet"):
         if base != "parquet":
@@ -408,7 +104,7 @@ def detect_kind(path: Path, fmt: InputFormat) -> tuple[str, str | None]:
     if fmt.kind != "auto":
         delim = fmt.delimiter or ("|" if fmt.kind == "xplane" else None)
         return fmt.kind, delim
-    _, names, delim = _header(path, fmt.delimiter)
+    _, names, delim = header(path, fmt.delimiter)
     if xplane.is_xplane_header(names, delim):
         return "xplane", delim
     if is_jsbsim_header(names):
@@ -432,7 +128,7 @@ def read_samples(path: str | Path, fmt: InputFormat | None = None) -> Samples:
     if kind == "parquet":
         src = read_parquet_table(path)
     else:
-        _, names, delim = _header(path, delim)
+        _, names, delim = header(path, delim)
         mapping = default_mapping(kind, names) | dict(fmt.columns)
         src = read_text_table(path, delim, {s.column for s in mapping.values()})
         src = SourceTable(path=src.path, kind=kind, table=src.table, lines=src.lines)
@@ -601,71 +297,3 @@ def numeric_column(src: SourceTable, name: str, label: str | None = None) -> np.
         what = "NaN" if np.isnan(arr[i]) else "infinite"
         raise WashbenchError(located(src.path, f"{row}value is {what}", line=line, field=name))
     return np.ascontiguousarray(arr, dtype=np.float64)
-
-
-# --------------------------------------------------------------------------- the input-format file
-
-
-class InputFormatFile(StrictModel):
-    """``--input-format FILE``: the same as the command-line options, in YAML::
-
-    format: csv              # auto (default) | csv | parquet | xplane | jsbsim
-    delimiter: ";"           # or comma, semicolon, tab, pipe; default: detected
-    axes: flu                # sensor axes (see washbench.io.units); default frd
-    columns:                 # FIELD: "[-]COLUMN[:UNIT]" (column names may hold commas here)
-      t: "Time:ms"
-      f_x: "ax:g"
-      omega_x: "p:radps"
-    """
-
-    format: Literal["auto", "csv", "parquet", "xplane", "jsbsim"] = "auto"
-    delimiter: str | None = None
-    axes: str = "frd"
-    columns: dict[str, str] = Field(default_factory=dict)
-
-
-def load_input_format(path: str | Path) -> InputFormat:
-    """Read an ``--input-format`` YAML file; errors name the file, line and key."""
-    path = Path(path)
-    data, lines = read_yaml(path)
-    doc = validate_data(path, data, lines, InputFormatFile)
-    columns: dict[str, ColumnSource] = {}
-    for key, spec in doc.columns.items():
-        where = f"{path}:{line_of(lines, ('columns', key)) or 1}: columns.{key}"
-        name = field_name_of(key, where)
-        columns[name] = parse_column_source(name, spec, where)
-    where = f"{path}:{line_of(lines, ('axes',)) or 1}: axes"
-    try:
-        units.axes_matrix(doc.axes)
-    except ValueError as exc:
-        raise WashbenchError(f"{where}: {exc}") from None
-    delim = check_delimiter(doc.delimiter, f"{path}:{line_of(lines, ('delimiter',)) or 1}: delimiter")
-    return InputFormat(kind=doc.format, delimiter=delim, columns=columns, axes=doc.axes, origin=str(path))
-
-
-def input_format(
-    columns: str | None = None,
-    format_file: str | Path | None = None,
-    axes: str | None = None,
-    delimiter: str | None = None,
-) -> InputFormat:
-    """The input format from the command line: ``--input-format FILE`` first, then ``--columns`` (field by
-    field), ``--axes`` and ``--delimiter`` over it."""
-    fmt = load_input_format(format_file) if format_file is not None else InputFormat()
-    cols = dict(fmt.columns)
-    origin = fmt.origin
-    if columns:
-        cols |= parse_columns_option(columns)
-        origin = "--columns" if format_file is None else f"{fmt.origin} and --columns"
-    if axes is not None:
-        try:
-            units.axes_matrix(axes)
-        except ValueError as exc:
-            raise WashbenchError(f"--axes: {exc}") from None
-    return InputFormat(
-        kind=fmt.kind,
-        delimiter=check_delimiter(delimiter, "--delimiter") if delimiter is not None else fmt.delimiter,
-        columns=cols,
-        axes=axes if axes is not None else fmt.axes,
-        origin=origin,
-    )

@@ -20,10 +20,7 @@ Conversion to washbench's frame (body x forward, y right, z down, specific force
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
-if TYPE_CHECKING:
-    from washbench.io.readers import ColumnSource
+from washbench.io.input_format import ColumnSource
 
 _TIME = ("real,time", "totl,time")
 
@@ -41,8 +38,6 @@ def is_xplane_header(names: list[str], delimiter: str) -> bool:
 
 def default_mapping(names: list[str]) -> dict[str, ColumnSource]:
     """The mapping of a Data.txt header (fields whose columns are absent are left out)."""
-    from washbench.io.readers import ColumnSource
-
     by = {normalise(n): n for n in names}
     out: dict[str, ColumnSource] = {}
     for key in _TIME:

@@ -28,8 +28,9 @@ import numpy as np
 from washbench.analysis.metrics import MetricRow, dof_metrics
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import atomic_path
+from washbench.io.input_format import InputFormat
 from washbench.io.plausibility import Finding, check_motion
-from washbench.io.readers import InputFormat, Samples, read_samples
+from washbench.io.readers import Samples, read_samples
 from washbench.io.resample import check_gaps, resample, split_resets, to_motion, window
 from washbench.io.results import (
     AIRCRAFT,
