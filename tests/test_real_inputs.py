@@ -351,6 +351,34 @@ def test_rest_start_feels_a_mid_manoeuvre_start(trace: dict[str, np.ndarray], tm
     assert json.loads((tmp_path / "rest" / "run.json").read_text())["filter_start"] == "rest"
 
 
+def test_cli_cue_with_options(trace: dict[str, np.ndarray], tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The command line: mapping, axes, window, resampling, no recording; a bad option is one line, exit 2."""
+    from washbench.cli import main
+
+    t, f, w = columns6(trace)
+    lines = ["time_ms\tax\tay\taz\tp\tq\tr"]
+    lines += [f"{t[i] * 1000:.6f}\t" + "\t".join(repr(float(x)) for x in (*f[i], *w[i])) for i in range(len(t))]
+    p = tmp_path / "log.tsv"
+    p.write_text("\n".join(lines) + "\n")
+    out = tmp_path / "out"
+    (out).mkdir()
+    (out / "recording.rrd").write_text("an earlier run's recording")
+    cols = "t=time_ms:ms,f_x=ax,f_y=ay,f_z=az,omega_x=p,omega_y=q,omega_z=r"
+    argv = ["cue", str(p), "--out", str(out), "--columns", cols, "--start-s", "2", "--end-s", "20"]
+    assert main([*argv, "--resample", "100", "--no-recording"]) == 0
+    assert sorted(x.name for x in out.iterdir()) == ["metrics.csv", "ranking.csv", "report.md", "run.json",
+                                                      "traces.parquet"]  # fmt: skip
+    doc = json.loads((out / "run.json").read_text())
+    assert doc["dt_s"] == 0.01 and doc["t_start_s"] == pytest.approx(2.0, abs=0.01) and doc["t_end_s"] <= 20.0
+    capsys.readouterr()
+    assert main(["cue", str(p), "--out", str(tmp_path / "x"), "--columns", "t=time_ms:fortnights"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [
+        "washbench: error: --columns: t: unknown time unit 'fortnights' (valid: s, ms, us, ns, min, timestamp)"
+    ]
+    assert not (tmp_path / "x").exists()
+
+
 def test_bad_mapping_options_are_one_line(tmp_path: Path) -> None:
     with pytest.raises(WashbenchError, match=r"--columns: f_x: unknown specific force unit 'gee' \(valid: mps2"):
         input_format(columns="f_x=ax:gee")

@@ -358,10 +358,8 @@ def write_outputs(
             for seg, result in zip(segments, results, strict=True):
                 folder = out_dir / seg.name if seg.name else out_dir
                 folder.mkdir(parents=True, exist_ok=True)
-                tmp = {
-                    name: stack.enter_context(atomic_path(folder / name))
-                    for name in (TRACES_FILE, METRICS_FILE, "run.json", RECORDING_FILE)
-                }
+                names = (TRACES_FILE, METRICS_FILE, "run.json") + ((RECORDING_FILE,) if opts.recording else ())
+                tmp = {name: stack.enter_context(atomic_path(folder / name)) for name in names}
                 summary = segment_summary(input_path, seg, result, folder)
                 write_traces(tmp[TRACES_FILE], result.table)
                 write_metrics_csv(tmp[METRICS_FILE], result.metrics)
@@ -381,6 +379,8 @@ def write_outputs(
                     write_run_recording(tmp[RECORDING_FILE], title, seg.motion, result, limits, q, [])
                 summaries.append(summary)
         for summary in summaries:  # last, as a suite's report: each written atomically once the rest is in place
+            if not opts.recording:  # a recording of an earlier run would not show these results
+                (summary.run_dir / RECORDING_FILE).unlink(missing_ok=True)
             write_run_review(summary.run_dir, summary, str(input_path))
     except OSError as exc:
         raise WashbenchError(located(out_dir, f"cannot write results: {exc.strerror or exc}")) from None
