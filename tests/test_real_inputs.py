@@ -10,9 +10,10 @@ z-up frame with a mapping; JSBSim's own CSV output) must give the same metrics w
   1e-4 of the aircraft pilot's perceived motion in its DOF (``M_d``, at least the ranking's motion floor);
 * resampled (``--resample 120`` from 20 Hz): within 2 % of it, and the same ranking. The ranking's score
   is ``sum_d w_d E_d / M_d`` with weights summing to 1, so errors within 2 % of ``M_d`` move each score by
-  at most 0.02: less than the smallest gap between the washouts' scores here (0.03), so the decision a
-  user takes from the result cannot change. ``tools/resample_effect.py`` measures the effect on more
-  scripts (0.4 % for this one).
+  at most 0.02; the smallest gap between two washouts' scores here is 0.045 (1.011, 1.111, 1.156), so even
+  two scores moving 0.02 towards each other cannot swap: the decision a user takes from the result
+  stands. Measured: 0.9 % (X-Plane style), 1.4e-6 (Data.txt, 7 decimals), 4.5e-7 (g, rad/s, us, z up),
+  6.5e-7 (float32), 0 (semicolon CSV). ``tools/resample_effect.py`` measures resampling on more scripts.
 """
 
 from __future__ import annotations
