@@ -350,6 +350,17 @@ def test_rest_start_feels_a_mid_manoeuvre_start(trace: dict[str, np.ndarray], tm
     np.testing.assert_allclose(rest[120:], 2.0 * step[120:], rtol=2e-3)
     assert math.isclose(rest[-1], 2.0 * step[-1], rel_tol=1e-3)
     assert json.loads((tmp_path / "rest" / "run.json").read_text())["filter_start"] == "rest"
+    # the washouts: from steady, the platform holds the sustained surge by a constant tilt and never moves;
+    # from rest it starts level, gives an onset cue on the stage and tilts up to the same attitude
+    from scipy.spatial.transform import Rotation
+
+    for kind, moved in (("steady", False), ("rest", True)):
+        tr = read_traces(tmp_path / kind / "traces.parquet")
+        q = np.column_stack([tr[f"large-angle.q_{c}"] for c in "wxyz"])
+        pitch = Rotation.from_quat(q, scalar_first=True).as_euler("ZYX", degrees=True)[:, 1]
+        assert (np.max(np.abs(tr["large-angle.pos_x_m"])) > 0.01) == moved
+        assert abs(pitch[-1] - math.degrees(math.atan2(2.0, G0))) < 0.3  # tilt coordination: -g_S along f
+        assert (abs(pitch[0]) < 0.1) == moved
 
 
 def test_cli_cue_with_options(trace: dict[str, np.ndarray], tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
