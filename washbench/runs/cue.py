@@ -404,6 +404,9 @@ def run_cue(
     from washbench.platform import load_platform_limits
 
     opts = options or CueOptions()
+    for flag, value in (("--max-gap-s", opts.max_gap_s), ("--resample", opts.resample_hz)):
+        if value is not None and not (math.isfinite(value) and value > 0.0):
+            raise WashbenchError(f"{flag}: expected a positive number, got {value:g}")
     start = time.perf_counter()
     names = check_washout_names(washouts)
     check_filter_start(opts.filter_start)

@@ -177,6 +177,12 @@ def run_manoeuvre(
     return summary
 
 
+def check_max_time(max_time_s: float | None) -> None:
+    """``--max-time-s``: None or a positive, finite number of seconds (WashbenchError otherwise)."""
+    if max_time_s is not None and not (math.isfinite(max_time_s) and max_time_s > 0.0):
+        raise WashbenchError(f"--max-time-s: expected a positive number of seconds, got {max_time_s:g}")
+
+
 def lockstep_washouts(
     washouts: tuple[str, ...], params: Any, limits: Any, dt_s: float, filter_start: str = "steady"
 ) -> tuple[list[np.ndarray], Any]:
@@ -260,6 +266,7 @@ def run_script(
 
     info = load_script_info(script_path, aircraft_dirs)
     check_filter_start(filter_start)
+    check_max_time(max_time_s)
     params = load_washout_params(params_path)
     limits = load_platform_limits(platform_path)
     washouts = tuple(WASHOUT_NAMES)
@@ -410,6 +417,7 @@ def run_command(
     from washbench.flight.scripts import is_script
 
     check_filter_start(filter_start)
+    check_max_time(max_time_s)
     start = time.perf_counter()
     if is_script(manoeuvre_path):
         runs = run_script(

@@ -402,6 +402,9 @@ def suite_command(
 
     if jobs is not None and jobs < 1:
         raise WashbenchError(f"--jobs: expected a whole number of at least 1, got {jobs}")
+    from washbench.runs.pipeline import check_max_time
+
+    check_max_time(max_time_s)
     files = find_manoeuvres(inputs, [bundled_script(n) for n in jsbsim_scripts])
     # Fail fast on a bad parameter or platform file: every run would fail the same way.
     from washbench.cueing import load_washout_params
