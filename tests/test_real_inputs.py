@@ -403,3 +403,26 @@ def test_bad_mapping_options_are_one_line(tmp_path: Path) -> None:
     with pytest.raises(WashbenchError, match=r"fmt\.yaml:4: columns\.f_q: unknown field 'f_q'"):
         input_format(format_file=bad)
     assert InputFormat().axes == "frd"
+
+
+def test_iso_timestamps_and_a_bad_one(tmp_path: Path) -> None:
+    """Date-time text (ISO 8601, microseconds) counts from its first stamp; a broken stamp names its line."""
+    import datetime as dt
+
+    from washbench.io.readers import read_samples
+    from washbench.io.resample import to_motion
+
+    t0 = dt.datetime(2026, 12, 1, 19, 0, 0)
+    stamps = [(t0 + dt.timedelta(microseconds=round(k * 1e6 / 120))).isoformat() for k in range(240)]
+    lines = ["stamp,ax,ay,az,p,q,r", *(f"{s},0.1,0,-1,0,0,2" for s in stamps)]
+    p = tmp_path / "ts.csv"
+    p.write_text("\n".join(lines) + "\n")
+    fmt = input_format(columns="t=stamp:timestamp,f_x=ax:g,f_y=ay:g,f_z=az:g,omega_x=p,omega_y=q,omega_z=r")
+    m = to_motion(read_samples(p, fmt))
+    assert m.t_s[0] == 0.0 and m.dt_s == pytest.approx(1 / 120, rel=1e-5)
+    np.testing.assert_allclose(m.f_mps2[0], [0.1 * G0, 0.0, -G0], rtol=1e-15)
+    assert m.omega_degps_out()[0, 2] == 2.0
+    lines[101] = "yesterday,0.1,0,-1,0,0,2"
+    p.write_text("\n".join(lines) + "\n")
+    with pytest.raises(WashbenchError, match=r"ts\.csv:102: stamp: not a timestamp: 'yesterday'"):
+        read_samples(p, fmt)
