@@ -182,13 +182,14 @@ def _put(table: dict[str, np.ndarray], names: Sequence[str], values: np.ndarray)
 
 def cue_motion(
     motion: Motion,
-    washouts: Sequence[str],
+    washouts: Sequence[Any],
     params: Any,
     limits: Any,
     vestibular: VestibularParams | None = None,
     filter_start: str = "steady",
 ) -> CueResult:
-    """Run the named washouts and the Atlas model over ``motion`` (``cueing.cue_trace``), then :func:`analyse`.
+    """Run the washouts (names with ``params``, or Washout variants) and the Atlas model over ``motion``
+    (``cueing.cue_trace``, one compiled call), then :func:`analyse`.
 
     ``filter_start``: ``steady`` (every filter in the first sample's steady state) or ``rest``.
     """
@@ -293,10 +294,11 @@ def prepare_segments(samples: Samples, opts: CueOptions) -> list[Segment]:
 
 
 def cue_segments(
-    segments: Sequence[Segment], names: Sequence[str], params: Any, limits: Any, filter_start: str
+    segments: Sequence[Segment], washouts: Sequence[Any], params: Any, limits: Any, filter_start: str
 ) -> list[CueResult]:
-    """Cueing: washouts, Atlas model, perception and metrics of every segment."""
-    return [cue_motion(seg.motion, names, params, limits, filter_start=filter_start) for seg in segments]
+    """Cueing: washouts (names with ``params``, or Washout variants), Atlas model, perception and metrics of
+    every segment."""
+    return [cue_motion(seg.motion, washouts, params, limits, filter_start=filter_start) for seg in segments]
 
 
 def segment_summary(input_path: Path, seg: Segment, result: CueResult, out_dir: Path) -> Any:
@@ -393,14 +395,17 @@ def run_cue(
     washouts: Sequence[str] | None = None,
     params_path: Path | None = None,
     platform_path: Path | None = None,
+    variants: Sequence[str] = (),
     options: CueOptions | None = None,
 ) -> int:
     """The ``washbench cue`` command: read, convert, cut and check, cue, write; 0, or 1 if the data holds a crash.
 
+    ``washouts``, ``variants`` and ``params_path`` select the washouts
+    (:func:`washbench.cueing.variants.select_washouts`).
     Raises WashbenchError (one line) for bad names, parameter files or input; writes nothing then.
     """
-    from washbench.cueing import load_washout_params
     from washbench.cueing.bank import check_filter_start
+    from washbench.cueing.variants import select_washouts
     from washbench.platform import load_platform_limits
 
     opts = options or CueOptions()
@@ -408,13 +413,13 @@ def run_cue(
         if value is not None and not (math.isfinite(value) and value > 0.0):
             raise WashbenchError(f"{flag}: expected a positive number, got {value:g}")
     start = time.perf_counter()
-    names = check_washout_names(washouts)
+    specs = select_washouts(washouts, variants, params_path)
+    names = [w.name for w in specs]
     check_filter_start(opts.filter_start)
-    params = load_washout_params(params_path)
     limits = load_platform_limits(platform_path)
     samples = read_input(input_path, opts.fmt)
     segments = prepare_segments(samples, opts)
-    results = cue_segments(segments, names, params, limits, opts.filter_start)
+    results = cue_segments(segments, specs, None, limits, opts.filter_start)
     for seg in segments:
         for f in seg.findings:
             print(f"washbench: warning: {input_path}{f' ({seg.name})' if seg.name else ''}: {f.text}", file=sys.stderr)

@@ -38,8 +38,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from washbench.analysis.metrics import MetricRow, integral_abs_error
-from washbench.analysis.ranking import DOFS
+from washbench.analysis.metrics import MetricRow
+from washbench.analysis.ranking import DOFS, perceived_motion
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
 
@@ -71,15 +71,6 @@ class RunSummary:
     metrics: list[MetricRow] = field(default_factory=list)
     motion: dict[str, float] = field(default_factory=dict)  # DOF -> aircraft pilot's perceived motion
     saturations: dict[str, dict[str, int]] = field(default_factory=dict)
-
-
-def perceived_motion(perceived_f_mps2: np.ndarray, perceived_omega_radps: np.ndarray, dt_s: float) -> dict[str, float]:
-    """How much the aircraft pilot felt per DOF: integral of |perceived(t) - perceived(0)| dt.
-
-    Surge, sway, heave in m/s^2*s; roll, pitch, yaw in deg (the units of metrics.csv).
-    """
-    columns = np.column_stack([perceived_f_mps2, np.degrees(perceived_omega_radps)])
-    return {dof: integral_abs_error(x, np.full_like(x, x[0]), dt_s) for dof, x in zip(DOFS, columns.T, strict=True)}
 
 
 def aircraft_attitude(phi_deg: np.ndarray, theta_deg: np.ndarray, psi_deg: np.ndarray) -> np.ndarray:
@@ -122,27 +113,31 @@ def run_manoeuvre(
     params_path: Path | None = None,
     platform_path: Path | None = None,
     progress: bool = False,
+    washouts: Sequence[str] | None = None,
+    variants: Sequence[str] = (),
     filter_start: str = "steady",
     aircraft_dirs: Sequence[Path] = (),
 ) -> RunSummary:
     """Fly one manoeuvre with the washouts in lockstep and write its results folder.
 
+    ``washouts`` (built-in names), ``variants`` (``--variant`` texts) and the parameter file's ``variants:``
+    select the washouts (:func:`washbench.cueing.variants.select_washouts`; default the three built-in ones).
     ``filter_start``: the washouts' and vestibular models' start state (``steady`` or ``rest``).
 
     Raises WashbenchError for a bad manoeuvre, parameter or platform file (nothing written).
     A flight that crashes or fails a check still writes its results (what was flown), with
     ``ok`` False and the reason.
     """
-    from washbench.cueing import WASHOUT_NAMES, load_washout_params
+    from washbench.cueing.variants import select_washouts
     from washbench.flight.fly import fly, write_flight
     from washbench.flight.manoeuvre import load_manoeuvre
     from washbench.platform import load_platform_limits
 
     manoeuvre = load_manoeuvre(manoeuvre_path, aircraft_dirs)
-    params = load_washout_params(params_path)
+    specs = select_washouts(washouts, variants, params_path)
     limits = load_platform_limits(platform_path)
-    washouts = tuple(WASHOUT_NAMES)
-    rows, lockstep = lockstep_washouts(washouts, params, limits, manoeuvre.dt_s, filter_start)
+    washouts = tuple(w.name for w in specs)
+    rows, lockstep = lockstep_washouts(specs, limits, manoeuvre.dt_s, filter_start)
     start = time.perf_counter()
     flight = fly(manoeuvre, step_hook=lockstep, progress=progress)
     n = len(flight.t_s)
@@ -184,12 +179,13 @@ def check_max_time(max_time_s: float | None) -> None:
 
 
 def lockstep_washouts(
-    washouts: tuple[str, ...], params: Any, limits: Any, dt_s: float, filter_start: str = "steady"
+    specs: Sequence[Any], limits: Any, dt_s: float, filter_start: str = "steady"
 ) -> tuple[list[np.ndarray], Any]:
-    """A washout bank run in lockstep with a flight: (the rows it fills, the flight's step hook)."""
+    """A washout bank (selected :class:`washbench.cueing.variants.Washout` s) run in lockstep with a flight:
+    (the rows it fills, the flight's step hook)."""
     from washbench.cueing import CueingBank
 
-    bank = CueingBank(washouts, params, limits, dt_s, filter_start)
+    bank = CueingBank(specs, None, limits, dt_s, filter_start)
     rows: list[np.ndarray] = []
     step = bank.step
     omega_deg = np.empty(3)
@@ -253,27 +249,29 @@ def run_script(
     max_time_s: float | None = None,
     filter_start: str = "steady",
     aircraft_dirs: Sequence[Path] = (),
+    washouts: Sequence[str] | None = None,
+    variants: Sequence[str] = (),
 ) -> list[RunSummary]:
     """Fly a JSBSim script (:mod:`washbench.flight.scripts`) with the washouts in lockstep, one result per run.
 
     Writes ``OUT/<aircraft>/<script>/`` (one run) or ``OUT/<aircraft>/<script>/<run_i>/`` (a script that
     resets), published as one folder. A crash still writes what was flown, with ``ok`` False and the reason.
     """
-    from washbench.cueing import WASHOUT_NAMES, load_washout_params
     from washbench.cueing.bank import check_filter_start
+    from washbench.cueing.variants import select_washouts
     from washbench.flight.scripts import fly_script, load_script_info, write_script_flight
     from washbench.platform import load_platform_limits
 
     info = load_script_info(script_path, aircraft_dirs)
     check_filter_start(filter_start)
     check_max_time(max_time_s)
-    params = load_washout_params(params_path)
+    specs = select_washouts(washouts, variants, params_path)
     limits = load_platform_limits(platform_path)
-    washouts = tuple(WASHOUT_NAMES)
+    names = tuple(w.name for w in specs)
     banks: list[list[np.ndarray]] = []
 
     def segment_hook(i: int, dt_s: float) -> Any:
-        rows, hook = lockstep_washouts(washouts, params, limits, dt_s, filter_start)
+        rows, hook = lockstep_washouts(specs, limits, dt_s, filter_start)
         banks.append(rows)
         return hook
 
@@ -304,7 +302,7 @@ def run_script(
             ac_q = aircraft_attitude(cols["phi_deg"], cols["theta_deg"], cols["psi_deg"])
             extra = {"script": str(info.path), "segment": seg.name, "stopped_by_time_limit": flight.stopped_by_limit}
             summaries.append(
-                write_cued_folder(folder, summary, rows, washouts, limits, ac_q, [], start, filter_start, extra)
+                write_cued_folder(folder, summary, rows, names, limits, ac_q, [], start, filter_start, extra)
             )
         _publish(partial, final)
     finally:
@@ -410,6 +408,8 @@ def run_command(
     progress: bool = True,
     max_time_s: float | None = None,
     filter_start: str = "steady",
+    washouts: Sequence[str] | None = None,
+    variants: Sequence[str] = (),
     aircraft_dirs: Sequence[Path] = (),
 ) -> int:
     """CLI entry of ``washbench run`` (a YAML manoeuvre or a JSBSim script): 0 if every run was ok, else 1."""
@@ -428,6 +428,8 @@ def run_command(
             max_time_s=max_time_s,
             filter_start=filter_start,
             aircraft_dirs=aircraft_dirs,
+            washouts=washouts,
+            variants=variants,
         )
     else:
         if max_time_s is not None:
@@ -441,6 +443,8 @@ def run_command(
                 progress=progress and sys.stderr.isatty(),
                 filter_start=filter_start,
                 aircraft_dirs=aircraft_dirs,
+                washouts=washouts,
+                variants=variants,
             )
         ]
     wall = time.perf_counter() - start
