@@ -84,11 +84,11 @@ def test_a_script_that_resets_gives_one_result_per_run(runs: dict[str, list], ou
         assert s.ok and (s.run_dir / "recording.rrd").is_file() and len(s.metrics) == 18
 
 
-def test_reset_count_matches_jsbsim() -> None:
+def test_reset_count_matches_jsbsim(tmp_path: Path) -> None:
     """Independently: JSBSim's own loop, counting time jumping back, sees the same two resets."""
     fdm = jsbsim.FGFDMExec(jsbsim.get_default_root_dir(), None)
     fdm.set_debug_level(0)
-    fdm.set_output_path(str(Path(__file__).parent))  # outputs are switched off below; nothing is written
+    fdm.set_output_path(str(tmp_path))  # the script's output files are opened at load: not in the package
     fdm.load_script(str(bundled_script("c172_cruise_8K")))
     fdm.disable_output()
     fdm.run_ic()

@@ -135,9 +135,8 @@ def rank(rows: Sequence[MetricRow], motion: Mapping[str, float]) -> list[RankRow
     weights = dof_weights(motion)
     washouts = washout_order(rows)
     by_key = {(r.washout, r.dof): r for r in rows}
-    scores = {
-        w: float(score_of(np.array([by_key[(w, d)].integral_error for d in DOFS]), weights, motion)) for w in washouts
-    }
+    scores = {w: float(score_of(np.array([by_key[(w, d)].integral_error for d in DOFS]), weights, motion))
+              for w in washouts}
     order = {w: i for i, w in enumerate(washouts)}
     ordered = sorted(washouts, key=lambda w: (scores[w], order[w]))
     return [RankRow(washout=w, score=scores[w], rank=i + 1, weights=weights) for i, w in enumerate(ordered)]

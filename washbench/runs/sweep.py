@@ -63,14 +63,7 @@ def sweep_command(
     candidates = [w for k in kinds for w in point_washouts(k, base, points)]
     limits = load_platform_limits(platform_path)
     files = find_manoeuvres(manoeuvres)
-    flights = load_flights(
-        files,
-        out_dir,
-        limits,
-        from_dir=from_dir,
-        jobs=jobs,
-        dask=dask,
-        progress=progress,
+    flights = load_flights(files, out_dir, limits, from_dir=from_dir, jobs=jobs, dask=dask, progress=progress,
         aircraft_dirs=aircraft_dirs,
     )
     t_eval = time.perf_counter()
