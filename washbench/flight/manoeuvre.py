@@ -595,7 +595,8 @@ def _check_signal(sig: Signal, amplitude: float | None, loc: Loc, amp_key: str, 
     if sig.shape is None:
         stray = [k for k in (*_SHAPE_PARAMS, "start_s") if k in sig.model_fields_set]
         if amplitude is not None:
-            raise where.error((*loc, amp_key), "an amplitude needs a 'shape'")
+            given = next(k for k in ("amplitude_norm", "amplitude_deg", "amplitude") if getattr(sig, k, None) is not None)
+            raise where.error((*loc, given), "an amplitude needs a 'shape'")
         if stray:
             raise where.error((*loc, stray[0]), "needs a 'shape'")
         return
@@ -778,10 +779,24 @@ def validate_command(paths: Sequence[Path]) -> int:
 
 def manoeuvre_json_schema() -> dict[str, Any]:
     """The JSON Schema of manoeuvre files (for editors: completion and checking)."""
-    schema = Manoeuvre.model_json_schema()
+    schema = _plain_descriptions(Manoeuvre.model_json_schema())
     schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
     schema["title"] = "washbench manoeuvre"
     return schema
+
+
+def _plain_descriptions(node: Any) -> Any:
+    """Docstrings as editor hover text: ``code`` as Markdown `code`, lines joined within a paragraph."""
+    if isinstance(node, dict):
+        out = {k: _plain_descriptions(v) for k, v in node.items()}
+        text = node.get("description")
+        if isinstance(text, str):
+            paragraphs = [" ".join(p.split()) for p in text.replace("``", "`").split("\n\n")]
+            out["description"] = "\n\n".join(p for p in paragraphs if p)
+        return out
+    if isinstance(node, list):
+        return [_plain_descriptions(v) for v in node]
+    return node
 
 
 def schema_command(out: Path | None) -> int:
