@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 import subprocess
@@ -34,7 +35,7 @@ def test_shapes_against_their_definitions() -> None:
     np.testing.assert_array_equal(shape("doublet", n, start_s=0.5, duration_s=1.0), want)
     u = 24  # 0.2 s units of a 1.4 s 3211 from 0.5 s
     edges = 60 + u * np.array([0, 3, 5, 6, 7])
-    want = np.select([(n >= a) & (n < b) for a, b in zip(edges[:-1], edges[1:], strict=True)], [1, -1, 1, -1], 0)
+    want = np.select([(n >= a) & (n < b) for a, b in itertools.pairwise(edges)], [1, -1, 1, -1], 0)
     np.testing.assert_array_equal(shape("3211", n, start_s=0.5, duration_s=1.4), want)
     np.testing.assert_allclose(shape("sine", n, start_s=0.0, period_s=0.8), np.sin(2 * np.pi * t / 0.8), atol=1e-12)
     for sweep in ("linear", "logarithmic"):
@@ -127,24 +128,47 @@ def bad(tmp_path: Path, input_text: str, hold: str = "{altitude_ft: 4000}", limi
 @pytest.mark.parametrize(
     ("input_text", "hold", "message"),
     [
-        ("rudder: {shape: doublet, amplitude_deg: 5}", None, ":9: phases[0].inputs.rudder.shape: a doublet needs 'duration_s'"),
-        ("rudder: {shape: doublet, amplitude_deg: 5, duration_s: 2, period_s: 1}", None,
-         ":9: phases[0].inputs.rudder.period_s: not used by a doublet"),
+        (
+            "rudder: {shape: doublet, amplitude_deg: 5}",
+            None,
+            ":9: phases[0].inputs.rudder.shape: a doublet needs 'duration_s'",
+        ),
+        (
+            "rudder: {shape: doublet, amplitude_deg: 5, duration_s: 2, period_s: 1}",
+            None,
+            ":9: phases[0].inputs.rudder.period_s: not used by a doublet",
+        ),
         ("rudder: {shape: pulse, duration_s: 1}", None, "phases[0].inputs.rudder.shape: a pulse needs an amplitude"),
-        ("rudder: {shape: pulse, amplitude_deg: 1, amplitude_norm: 0.1, duration_s: 1}", None,
-         "inputs.rudder.amplitude_deg: give either amplitude_norm or amplitude_deg"),
-        ("throttle: {shape: step, amplitude_deg: 1}", None, "inputs.throttle.amplitude_deg: the throttle has no surface"),
-        ("aileron: {free: true}", "{bank_deg: 20}", "inputs.aileron: the aileron is released, which contradicts "
-         "'hold.bank_deg'"),
+        (
+            "rudder: {shape: pulse, amplitude_deg: 1, amplitude_norm: 0.1, duration_s: 1}",
+            None,
+            "inputs.rudder.amplitude_deg: give either amplitude_norm or amplitude_deg",
+        ),
+        (
+            "throttle: {shape: step, amplitude_deg: 1}",
+            None,
+            "inputs.throttle.amplitude_deg: the throttle has no surface",
+        ),
+        (
+            "aileron: {free: true}",
+            "{bank_deg: 20}",
+            "inputs.aileron: the aileron is released, which contradicts 'hold.bank_deg'",
+        ),
         ("throttle: {fixed_norm: 1.5}", None, "inputs.throttle.fixed_norm: outside the command range 0..1"),
         ("elevator: {fixed_deg: 40}", None, "inputs.elevator.fixed_deg: outside the surface travel"),
-        ("aileron: {shape: sine, amplitude_norm: 0.1, period_s: 1, start_s: 5, duration_s: 6}", None,
-         "inputs.aileron.start_s: the sine runs to 11 s, past the phase's duration_s of 10 s"),
+        (
+            "aileron: {shape: sine, amplitude_norm: 0.1, period_s: 1, start_s: 5, duration_s: 6}",
+            None,
+            "inputs.aileron.start_s: the sine runs to 11 s, past the phase's duration_s of 10 s",
+        ),
         ("aileron: {amplitude_norm: 0.1}", None, "inputs.aileron.amplitude_norm: an amplitude needs a 'shape'"),
         ("rudder: {shape: wobble, amplitude_norm: 0.1}", None, "inputs.rudder.shape:"),
         ("rudder: {}", None, "inputs.rudder: does nothing"),
-        ("properties: [{property: fcs/rudder-cmd-norm, fixed: 0.1}]", None,
-         "inputs.properties[0].property: 'fcs/rudder-cmd-norm' is written by the pilot: use the axis keys"),
+        (
+            "properties: [{property: fcs/rudder-cmd-norm, fixed: 0.1}]",
+            None,
+            "inputs.properties[0].property: 'fcs/rudder-cmd-norm' is written by the pilot: use the axis keys",
+        ),
     ],
 )
 def test_bad_inputs_are_one_line_with_file_line_and_field(
@@ -156,8 +180,8 @@ def test_bad_inputs_are_one_line_with_file_line_and_field(
 
 
 def test_unknown_jsbsim_property_is_refused_at_start_up_by_the_cli(tmp_path: Path) -> None:
-    path = write(tmp_path, "bad.yaml", BASE.replace("INPUT", "properties: [{property: fcs/speedbrak-cmd-norm, "
-                                                    "shape: step, amplitude: 1}]").replace("HOLD", "{}").replace("LIMIT", "10"))  # fmt: skip
+    typo = "properties: [{property: fcs/speedbrak-cmd-norm, shape: step, amplitude: 1}]"
+    path = write(tmp_path, "bad.yaml", BASE.replace("INPUT", typo).replace("HOLD", "{}").replace("LIMIT", "10"))
     out = subprocess.run([sys.executable, "-m", "washbench", "fly", str(path), "--out", str(tmp_path / "o")],
                          capture_output=True, text=True)  # fmt: skip
     assert out.returncode == 2 and "Traceback" not in out.stderr

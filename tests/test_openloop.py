@@ -130,7 +130,9 @@ def expected(name: str, n: np.ndarray) -> np.ndarray:
         return 2.0 * (_window(n, 0.5, 1.0).astype(float) - _window(n, 1.5, 1.0))
     if name == "multistep":  # 3-2-1-1 of 0.3 s units from 0.3 s: + + + - - + -
         u = 0.3
-        return 3.0 * (_window(n, u, 3 * u) * 1.0 - _window(n, 4 * u, 2 * u) + _window(n, 6 * u, u) - _window(n, 7 * u, u))
+        return 3.0 * (
+            _window(n, u, 3 * u) * 1.0 - _window(n, 4 * u, 2 * u) + _window(n, 6 * u, u) - _window(n, 7 * u, u)
+        )
     if name == "sine":
         return 2.0 * np.sin(2 * np.pi * tau / 1.5)
     if name == "log chirp":

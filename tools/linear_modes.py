@@ -35,7 +35,9 @@ def main(path: str) -> None:
         idx = [names.index(n) for n in states]
         for e in sorted(np.linalg.eigvals(a[np.ix_(idx, idx)]), key=lambda z: -abs(z)):
             if e.imag > 0:
-                print(f"{block}: oscillatory, period {2 * math.pi / e.imag:.3f} s, damping ratio {-e.real / abs(e):.3f}")
+                print(
+                    f"{block}: oscillatory, period {2 * math.pi / e.imag:.3f} s, damping ratio {-e.real / abs(e):.3f}"
+                )
             elif e.imag == 0:
                 print(f"{block}: real, time constant {-1 / e.real:.2f} s" if e.real else f"{block}: zero")
 

@@ -133,8 +133,5 @@ def surface_deg(u: float, min_deg: float, max_deg: float) -> float:
 
 def surface_norm(deg: float, min_deg: float, max_deg: float) -> float:
     """The normalised command (-1..1) that deflects the surface ``deg`` degrees: the inverse of :func:`surface_deg`."""
-    if deg >= 0.0:
-        u = deg / max_deg if max_deg > 0.0 else 0.0
-    else:
-        u = -deg / min_deg if min_deg < 0.0 else 0.0
+    u = (deg / max_deg if max_deg > 0.0 else 0.0) if deg >= 0.0 else (-deg / min_deg if min_deg < 0.0 else 0.0)
     return -1.0 if u < -1.0 else 1.0 if u > 1.0 else u

@@ -545,10 +545,10 @@ def _check_semantics(m: Manoeuvre, where: _Where) -> None:
             raise where.error((*base, "stat"), f"'rotated' integrates a body rate: {', '.join(RATE_SIGNALS)}")
         if check.min is None and check.max is None:
             raise where.error(base, "give a 'min', a 'max' or both")
-        if check.min is not None and check.max is not None and check.min > check.max:
-            if not (check.signal in HEADING_SIGNALS and check.stat in HEADING_VALUE_STATS):
-                raise where.error((*base, "min"), f"greater than max ({check.min:g} > {check.max:g})")
-        if check.signal in HEADING_SIGNALS and check.stat in HEADING_VALUE_STATS:
+        arc = check.signal in HEADING_SIGNALS and check.stat in HEADING_VALUE_STATS  # min > max: through north
+        if check.min is not None and check.max is not None and check.min > check.max and not arc:
+            raise where.error((*base, "min"), f"greater than max ({check.min:g} > {check.max:g})")
+        if arc:
             for key in ("min", "max"):
                 v = getattr(check, key)
                 if v is not None and not 0 <= v <= 360:
@@ -595,7 +595,8 @@ def _check_signal(sig: Signal, amplitude: float | None, loc: Loc, amp_key: str, 
     if sig.shape is None:
         stray = [k for k in (*_SHAPE_PARAMS, "start_s") if k in sig.model_fields_set]
         if amplitude is not None:
-            given = next(k for k in ("amplitude_norm", "amplitude_deg", "amplitude") if getattr(sig, k, None) is not None)
+            keys = ("amplitude_norm", "amplitude_deg", "amplitude")
+            given = next(k for k in keys if getattr(sig, k, None) is not None)
             raise where.error((*loc, given), "an amplitude needs a 'shape'")
         if stray:
             raise where.error((*loc, stray[0]), "needs a 'shape'")
