@@ -225,3 +225,30 @@ def test_every_schema_key_has_a_plain_description() -> None:
     text = json.dumps(schema)
     assert "``" not in text and ":func:" not in text and ":class:" not in text
     assert "ControlInput" in schema["$defs"] and "chirp" in json.dumps(schema["$defs"]["ControlInput"])
+
+
+@pytest.mark.parametrize("aircraft", ["c172p", "columbia400"])
+def test_profile_surface_travel_is_the_models(aircraft: str) -> None:
+    """The profile's surface travel (used for inputs in degrees) is what the model's flight-control system gives
+    at command -1 and +1 (JSBSim runs its FCS at run_ic), to 1e-3 deg."""
+    import os
+
+    import jsbsim
+
+    from washbench.flight.manoeuvre import aircraft_path, pilot_profile_path
+    from washbench.flight.profile import load_profile
+    from washbench.io.paths import jsbsim_root
+
+    os.environ["JSBSIM_DEBUG"] = "0"
+    surfaces = load_profile(pilot_profile_path(aircraft)).surfaces
+    assert surfaces is not None
+    fdm = jsbsim.FGFDMExec(str(jsbsim_root()), None)
+    fdm.set_aircraft_path(str(aircraft_path(aircraft)))
+    fdm.load_model(aircraft)
+    for axis in ("elevator", "aileron", "rudder"):
+        surface = getattr(surfaces, axis)
+        for u, want in ((-1.0, surface.min_deg), (1.0, surface.max_deg)):
+            fdm[f"fcs/{axis}-cmd-norm"] = u
+            fdm.run_ic()
+            assert fdm[surface.property] == pytest.approx(want, abs=1e-3), (axis, u)
+        fdm[f"fcs/{axis}-cmd-norm"] = 0.0

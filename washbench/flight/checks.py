@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from washbench.flight.manoeuvre import HEADING_SIGNALS, HEADING_VALUE_STATS, Check
+from washbench.flight.manoeuvre import HEADING_SIGNALS, HEADING_VALUE_STATS, OSCILLATION_STATS, Check
 
 #: Extrema smaller than this fraction of the largest swing are noise, not an oscillation's peaks.
 PEAK_PROMINENCE = 0.05
@@ -133,7 +133,7 @@ def measure(
     if x.size == 0:
         return math.nan
     stat = check.stat
-    if stat in ("oscillation_period", "damping_ratio", "oscillation_amplitude"):
+    if stat in OSCILLATION_STATS:
         osc = oscillation(x, dt_s)
         return osc.period_s if stat == "oscillation_period" else (
             osc.damping_ratio if stat == "damping_ratio" else osc.amplitude)  # fmt: skip
