@@ -252,3 +252,10 @@ def test_profile_surface_travel_is_the_models(aircraft: str) -> None:
             fdm.run_ic()
             assert fdm[surface.property] == pytest.approx(want, abs=1e-3), (axis, u)
         fdm[f"fcs/{axis}-cmd-norm"] = 0.0
+
+
+def test_an_unquoted_3211_is_the_3211_shape(tmp_path: Path) -> None:
+    text = BASE.replace("INPUT", "aileron: {shape: 3211, amplitude_norm: 0.1, duration_s: 2.1, free: true}")
+    m = load_manoeuvre(write(tmp_path, "m.yaml", text.replace("HOLD", "{altitude_ft: 4000}").replace("LIMIT", "10")))
+    inputs = m.phases[0].inputs
+    assert inputs is not None and inputs.aileron is not None and inputs.aileron.shape == "3211"

@@ -19,7 +19,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Annotated, Any, Literal, get_args
 
-from pydantic import Field, PrivateAttr
+from pydantic import Field, PrivateAttr, field_validator
 
 from washbench.errors import WashbenchError, located
 from washbench.flight.columns import COLUMN_NAMES, RUNWAY_COLUMNS
@@ -257,6 +257,12 @@ class Signal(StrictModel):
     """Chirp: frequency at the end of the sweep, Hz."""
     sweep: Literal["linear", "logarithmic"] = "linear"
     """Chirp: how the frequency moves from start_hz to end_hz: linearly or logarithmically in time."""
+
+    @field_validator("shape", mode="before")
+    @classmethod
+    def _shape_3211_unquoted(cls, value: object) -> object:
+        """YAML reads ``shape: 3211`` as a number: take it as the name it means."""
+        return "3211" if value == 3211 and type(value) is int else value
 
 
 class ControlInput(Signal):
