@@ -23,6 +23,7 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
+from washbench.errors import WashbenchError
 from washbench.flight.inputs import surface_deg, surface_norm, unit_shape
 from washbench.flight.manoeuvre import ControlInput, Inputs, PropertyInput, Signal
 from washbench.flight.pilot import Pilot
@@ -119,7 +120,9 @@ class OpenLoop:
         return _Plan(i, free, base, deg, amplitude, ci, trim, travel, lo, hi)
 
     def _property_plan(self, pi: PropertyInput) -> _Plan:
-        node = self.pm.get_node(pi.property)  # load_manoeuvre checked it exists
+        if not self.pm.hasNode(pi.property):  # load_manoeuvre checks it; a manoeuvre built in Python may not be
+            raise WashbenchError(f"unknown JSBSim property '{pi.property}' in an open-loop input")
+        node = self.pm.get_node(pi.property)
         base = pi.fixed if pi.fixed is not None else node.get_double_value()
         return _Plan(-1, True, base, False, pi.amplitude or 0.0, pi, 0.0, (-1.0, 1.0), -math.inf, math.inf, node)
 
