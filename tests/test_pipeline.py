@@ -44,9 +44,18 @@ def run_dir(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFac
 def test_run_writes_every_file_and_nothing_else(run_dir: Path) -> None:
     names = sorted(p.name for p in run_dir.iterdir())
     assert names == sorted(
-        ["flight.json", "flight.parquet", "traces.parquet", "metrics.csv", "recording.rrd", "run.json", "report.md",
-         "figures"]
-    )  # fmt: skip
+        [
+            "flight.json",
+            "flight.parquet",
+            "traces.parquet",
+            "metrics.csv",
+            "recording.rrd",
+            "run.json",
+            "ranking.csv",
+            "report.md",
+            "figures",
+        ]
+    )
     assert sorted(p.name for p in (run_dir / "figures").iterdir()) == [
         "envelope.pdf", "envelope.png", "perceived.pdf", "perceived.png"
     ]  # fmt: skip
