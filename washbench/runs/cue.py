@@ -206,11 +206,14 @@ def check_washout_names(names: Sequence[str] | None) -> tuple[str, ...]:
     return check_washouts(dict.fromkeys(names) if names else WASHOUT_NAMES)
 
 
-def write_results(out_dir: Path, result: CueResult) -> tuple[Path, Path]:
+def write_results(out_dir: Path, result: CueResult, provenance: Mapping[str, Any] | None = None) -> tuple[Path, Path]:
     """Write traces.parquet and metrics.csv into ``out_dir`` (created if missing), both or neither.
 
     Each file is written to a temporary name and renamed into place only after both are complete.
+    ``provenance`` (:mod:`washbench.io.provenance`, no date) goes into the Parquet key-value metadata.
     """
+    from washbench.io.provenance import parquet_metadata
+
     out_dir = Path(out_dir)
     traces_path, metrics_path = out_dir / TRACES_FILE, out_dir / METRICS_FILE
     if out_dir.exists() and not out_dir.is_dir():
@@ -218,7 +221,7 @@ def write_results(out_dir: Path, result: CueResult) -> tuple[Path, Path]:
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
         with atomic_path(traces_path) as tmp_traces, atomic_path(metrics_path) as tmp_metrics:
-            write_traces(tmp_traces, result.table)
+            write_traces(tmp_traces, result.table, parquet_metadata(provenance) if provenance else None)
             write_metrics_csv(tmp_metrics, result.metrics)
     except OSError as exc:
         raise WashbenchError(located(out_dir, f"cannot write results: {exc.strerror or exc}")) from None
