@@ -378,7 +378,7 @@ def test_cli_cue_with_options(trace: dict[str, np.ndarray], tmp_path: Path, caps
     cols = "t=time_ms:ms,f_x=ax,f_y=ay,f_z=az,omega_x=p,omega_y=q,omega_z=r"
     argv = ["cue", str(p), "--out", str(out), "--columns", cols, "--start-s", "2", "--end-s", "20"]
     assert main([*argv, "--resample", "100", "--no-recording"]) == 0
-    assert sorted(x.name for x in out.iterdir()) == ["metrics.csv", "ranking.csv", "report.md", "run.json",
+    assert sorted(x.name for x in out.iterdir()) == ["figures", "metrics.csv", "ranking.csv", "report.md", "run.json",
                                                       "traces.parquet"]  # fmt: skip
     doc = json.loads((out / "run.json").read_text())
     assert doc["dt_s"] == 0.01 and doc["t_start_s"] == pytest.approx(2.0, abs=0.01) and doc["t_end_s"] <= 20.0

@@ -21,8 +21,8 @@ from washbench.io.results import read_metrics_csv
 from washbench.runs.cue import CueOptions, run_cue
 from washbench.runs.pipeline import run_script
 
-FILES = ["flight.json", "flight.parquet", "metrics.csv", "ranking.csv", "recording.rrd", "report.md", "run.json",
-         "traces.parquet"]  # fmt: skip
+FILES = ["figures", "flight.json", "flight.parquet", "metrics.csv", "ranking.csv", "recording.rrd", "report.md",
+         "run.json", "traces.parquet"]  # fmt: skip
 
 
 @pytest.fixture(scope="module")
