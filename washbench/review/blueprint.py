@@ -91,6 +91,7 @@ class Layout:
     limit_lanes: tuple[tuple[str, str], ...]
     camera: tuple[tuple[float, float, float], tuple[float, float, float]]
     envelope_quantities: tuple[tuple[str, str], ...]  # (name, unit)
+    limits_text: tuple[str, ...]  # per envelope quantity, e.g. "+-1.5/1.5/1 m"
 
 
 def _whole_manoeuvre(t_end_s: float) -> rrb.TimeAxis:
@@ -172,17 +173,17 @@ def build_blueprint(layout: Layout) -> rrb.Blueprint:
     usage = [
         rrb.TimeSeriesView(
             origin=f"/envelope/{q}",
-            name=f"{q}: max |axis| / limit",
+            name=f"{q}: max |axis| / limit ({limit})",
             axis_x=_whole_manoeuvre(layout.t_end_s),
             axis_y=rrb.ScalarAxis(range=(0.0, 1.15)),
-            plot_legend=rrb.PlotLegend(corner="LeftTop", visible=j == 0),  # washouts only: no aircraft here
+            plot_legend=rrb.PlotLegend(visible=False),  # the colours are those of the one legend
             time_ranges=_all_data(),
         )
-        for j, (q, _) in enumerate(layout.envelope_quantities)
+        for (q, _), limit in zip(layout.envelope_quantities, layout.limits_text, strict=True)
     ]
-    lane_share = max(1.0, 0.3 * len(layout.limit_lanes))
+    lane_share = 1.0 + 0.45 * len(layout.limit_lanes) + 0.4 * len(layout.washouts)
     envelope = rrb.Vertical(
-        _lanes(layout, "/limits", "Limits reached (one lane per washout and limit)"),
+        _lanes(layout, "/limits", "Limits reached (one lane per washout and limit kind)"),
         *usage,
         row_shares=[lane_share] + [2.0] * len(usage),
         name="Platform envelope",
@@ -192,11 +193,13 @@ def build_blueprint(layout: Layout) -> rrb.Blueprint:
             *[
                 rrb.TimeSeriesView(
                     origin=f"/platform/{w}/{q}",
-                    name=f"{w}: {q} [{unit}]",
+                    name=f"{w}: {q} [{unit}] ({axes})",
                     axis_x=_whole_manoeuvre(layout.t_end_s),
+                    plot_legend=rrb.PlotLegend(visible=False),
                     time_ranges=_all_data(),
                 )
                 for q, unit in layout.envelope_quantities
+                for axes in ["w1 red, w2 green, w3 blue" if q == "wheels" else "x red, y green, z blue"]
             ],
             grid_columns=2,
             name=f"Atlas {w}",

@@ -13,8 +13,9 @@ the nanosecond):
   ``/envelope/<quantity>/limit`` at 1;
 - ``/platform/<washout>/<quantity>/axes``: the platform's stage position, velocity, acceleration (NED, SI) and
   omni-wheel speeds (rad/s), three scalars per row, with ``limit_max`` and ``limit_min`` lines;
-- ``/lanes/phase`` (flight phases) and ``/lanes/<washout>`` (the limits a washout is held at, joined by "+"): state
-  lanes; ``/limits/<washout>/<kind>``: one lane per washout and limit kind that is ever reached;
+- ``/lanes/0_phase`` (flight phases) and ``/lanes/<i>_<washout>`` (the limits a washout is held at, joined by "+";
+  i = 1, 2, ... in washout order, as the viewer sorts lanes by name): state lanes; ``/limits/<i>_<washout>/<kind>``:
+  one entity per washout with one lane (instance) per limit kind it ever reaches;
 - ``/world/...``: the 3D scene (:mod:`washbench.review.scene3d`);
 - ``/events/phases`` and ``/events/saturation``: text log entries at phase starts and limit onsets;
 - ``/metrics``: the metric table as a Markdown document; the recording properties ``provenance`` (strings).
@@ -63,7 +64,9 @@ __all__ = [
     "PlatformSeries",
     "RecordingData",
     "envelope_usage_path",
+    "limit_lane_path",
     "perceived_path",
+    "phase_lane_path",
     "platform_path",
     "quat_wxyz_to_xyzw",
     "raw_path",
@@ -73,6 +76,7 @@ __all__ = [
     "read_text_documents",
     "series_color",
     "sources",
+    "washout_lane_path",
     "write_recording",
 ]
 
@@ -198,6 +202,28 @@ def envelope_usage_path(quantity: str) -> str:
 def platform_path(washout: str, quantity: str) -> str:
     """Entity path of a platform quantity: three scalars per row (axes x, y, z, or wheels w1, w2, w3), SI units."""
     return f"/platform/{washout}/{quantity}/axes"
+
+
+def _lane_name(data: RecordingData, washout: str) -> str:
+    """``<i>_<washout>``, i = 1, 2, ... in data order, zero-padded: the viewer sorts lanes by name."""
+    names = list(data.washouts)
+    width = len(str(len(names)))
+    return f"{names.index(washout) + 1:0{width}d}_{washout}"
+
+
+def phase_lane_path() -> str:
+    """State lane of the flight phases (sorted first among the lanes)."""
+    return "/lanes/0_phase"
+
+
+def washout_lane_path(data: RecordingData, washout: str) -> str:
+    """State lane of the limits ``washout`` is held at (joined by "+"), ordered as the washouts."""
+    return f"/lanes/{_lane_name(data, washout)}"
+
+
+def limit_lane_path(data: RecordingData, washout: str) -> str:
+    """State lanes of one washout's limits: one lane (instance) per limit kind it reaches, in data order."""
+    return f"/limits/{_lane_name(data, washout)}"
 
 
 def sources(data: RecordingData) -> list[str]:
@@ -341,7 +367,11 @@ def _dof_columns(data: RecordingData) -> tuple[list[np.ndarray], list[np.ndarray
 
 
 def _send_motion(
-    rec: rr.RecordingStream, data: RecordingData, time: rr.TimeColumn, perceived: list[np.ndarray], raw: list[np.ndarray]
+    rec: rr.RecordingStream,
+    data: RecordingData,
+    time: rr.TimeColumn,
+    perceived: list[np.ndarray],
+    raw: list[np.ndarray],
 ) -> None:
     names = sources(data)
     colors = source_colors(list(data.washouts))
@@ -374,7 +404,9 @@ def _usage(data: RecordingData) -> dict[str, np.ndarray]:
     return out
 
 
-def _send_platforms(rec: rr.RecordingStream, data: RecordingData, time: rr.TimeColumn, usage: dict[str, np.ndarray]) -> None:
+def _send_platforms(
+    rec: rr.RecordingStream, data: RecordingData, time: rr.TimeColumn, usage: dict[str, np.ndarray]
+) -> None:
     t_s = np.asarray(data.t_s, dtype=np.float64)
     washouts = list(data.washouts)
     colors = [series_color(w, washouts) for w in washouts]
@@ -382,8 +414,7 @@ def _send_platforms(rec: rr.RecordingStream, data: RecordingData, time: rr.TimeC
         limit = data.envelope.axes(fname)
         axes = _axis_names(q)
         uniform = bool(np.all(limit == limit[0]))
-        text = f"{limit[0]:g}" if uniform else "/".join(f"{v:g}" for v in limit)
-        _limit_line(rec, f"/envelope/{q}/limit", t_s, [1.0], [f"limit (+-{text} {unit})"])
+        _limit_line(rec, f"/envelope/{q}/limit", t_s, [1.0], [f"limit (+-{_limit_text(limit)} {unit})"])
         _series(rec, envelope_usage_path(q), time, usage[q], washouts, colors, [WASHOUT_WIDTH] * len(washouts), "Max")
         for w in washouts:
             values = np.asarray(getattr(data.platforms[w], fname), dtype=np.float64)
@@ -409,11 +440,17 @@ def detail_samples(values: np.ndarray, tolerance: np.ndarray, max_stride: int = 
         if idx.size < 2:
             break
         ok = all(
-            np.max(np.abs(np.interp(k, idx, values[idx, j]) - values[:, j])) <= tolerance[j] for j in range(values.shape[1])
+            np.max(np.abs(np.interp(k, idx, values[idx, j]) - values[:, j])) <= tolerance[j]
+            for j in range(values.shape[1])
         )
         if ok:
             return idx
     return np.arange(n)
+
+
+def _limit_text(limit: np.ndarray) -> str:
+    """"2" for one limit on all axes, "1.5/1.5/1" for per-axis limits."""
+    return f"{limit[0]:.3g}" if bool(np.all(limit == limit[0])) else "/".join(f"{v:.3g}" for v in limit)
 
 
 def _runs(flags: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -444,27 +481,35 @@ def _send_lanes(rec: rr.RecordingStream, data: RecordingData) -> None:
         if data.phases[-1][2] < t_s[-1]:
             idx = np.append(idx, np.searchsorted(t_s, data.phases[-1][2] - 0.5e-9))
             names.append("")
-        _send_states(rec, "/lanes/phase", t_s, names, np.minimum(idx, n - 1))
+        _send_states(rec, phase_lane_path(), t_s, names, np.minimum(idx, n - 1))
     onsets: list[tuple[float, str]] = []
     for w in data.washouts:
         kinds = [(k, np.asarray(v, dtype=bool)) for k, v in data.platforms[w].saturated.items() if np.any(v)]
         code = np.zeros(n, dtype=np.int64)
+        dt = float(t_s[1] - t_s[0]) if n > 1 else 0.0
         for j, (kind, flags) in enumerate(kinds):
             code |= flags.astype(np.int64) << j
             starts, ends = _runs(flags)
-            change = np.sort(np.concatenate([starts, ends[ends + 1 < n] + 1]))
-            states = [kind if flags[i] else "" for i in change]
-            _send_states(rec, f"/limits/{w}/{kind}", t_s, states, change)
             onsets.extend(
-                (float(t_s[s]), f"{w}: {kind} limit reached for {t_s[e] - t_s[s] + (t_s[1] - t_s[0] if n > 1 else 0):.3f} s")
+                (float(t_s[s]), f"{w}: {kind} limit reached for {t_s[e] - t_s[s] + dt:.3f} s")
                 for s, e in zip(starts, ends, strict=True)
+            )
+        change = np.flatnonzero(np.diff(code, prepend=0))
+        if kinds:  # one entity per washout, one lane (instance) per kind reached, in a fixed order
+            rows = [[k if code[i] >> j & 1 else "" for j, (k, _) in enumerate(kinds)] for i in change]
+            states = rr.StateChange.columns(state=[x for row in rows for x in row])
+            rec.send_columns(
+                limit_lane_path(data, w),
+                indexes=[_time_column(t_s[change])],
+                columns=states.partition([len(kinds)] * len(rows)),
+                strict=True,
             )
         change = np.flatnonzero(np.diff(code, prepend=0))
         if change.size:
             states = ["+".join(k for j, (k, _) in enumerate(kinds) if code[i] >> j & 1) for i in change]
-            _send_states(rec, f"/lanes/{w}", t_s, states, change)
-        else:  # a lane that says "never held at a limit"
-            _send_states(rec, f"/lanes/{w}", t_s, [""], np.array([0]))
+            _send_states(rec, washout_lane_path(data, w), t_s, states, change)
+        else:  # an empty lane: never held at a limit
+            _send_states(rec, washout_lane_path(data, w), t_s, [""], np.array([0]))
     if onsets:
         onsets.sort(key=lambda item: item[0])
         rec.send_columns(
@@ -518,12 +563,14 @@ def _layout(data: RecordingData, perceived: list[np.ndarray], raw: list[np.ndarr
         dofs=tuple((dof, unit) for dof, _, _, unit in DOFS),
         t_end_s=float(data.t_s[-1]),
         perceived_ranges=tuple(
-            _span([p], (c - th, c + th)) for p, (c, th) in zip(perceived, _threshold_lines(data.thresholds), strict=True)
+            _span([p], (c - th, c + th))
+            for p, (c, th) in zip(perceived, _threshold_lines(data.thresholds), strict=True)
         ),
         raw_ranges=tuple(_span([r]) for r in raw),
         limit_lanes=tuple(_limit_lanes(data)),
         camera=scene3d.camera(offsets, data.envelope.sphere_diameter_m),
         envelope_quantities=tuple((q, unit) for q, _, unit in ENVELOPE_QUANTITIES),
+        limits_text=tuple(f"+-{_limit_text(data.envelope.axes(f))} {unit}" for _, f, unit in ENVELOPE_QUANTITIES),
     )
 
 

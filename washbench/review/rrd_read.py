@@ -11,7 +11,14 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.compute as pc
 
-__all__ = ["read_blueprint_components", "read_component", "read_properties", "read_scalar_series", "read_text_documents"]
+__all__ = [
+    "read_blueprint_components",
+    "read_component",
+    "read_properties",
+    "read_scalar_series",
+    "read_static",
+    "read_text_documents",
+]
 
 TIMELINE = "time"
 

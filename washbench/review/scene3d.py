@@ -53,7 +53,7 @@ def relative_to_initial_heading(q_wxyz: np.ndarray) -> np.ndarray:
 
 def scene_stride(dt_s: float) -> int:
     """Send every k-th pose so that the 3D rate is at most SCENE_RATE_HZ."""
-    return max(1, int(math.floor(1.0 / (dt_s * SCENE_RATE_HZ) + 1e-9)))
+    return max(1, math.floor(1.0 / (dt_s * SCENE_RATE_HZ) + 1e-9))
 
 
 def object_offsets(n_washouts: int, travel_m: np.ndarray, diameter_m: float) -> np.ndarray:
@@ -70,7 +70,7 @@ def camera(
     """Eye and target (NED, m): behind (south of) the row of objects and above it, looking north at its middle."""
     width = float(offsets[-1, 1] - offsets[0, 1]) + 2.0 * diameter_m
     centre = 0.5 * float(offsets[0, 1] + offsets[-1, 1])
-    eye = (-0.55 * width, centre, -0.3 * width)
+    eye = (-0.46 * width, centre, -0.24 * width)
     return eye, (0.0, centre, 0.0)
 
 
@@ -86,7 +86,7 @@ def _shape(size: float) -> list[list[list[float]]]:
     ]
 
 
-def _log_object(rec: rr.RecordingStream, path: str, size: float, color: tuple[int, int, int], label: str) -> None:
+def _log_object(rec: rr.RecordingStream, path: str, size: float, color: tuple[int, int, int]) -> None:
     rec.log(
         f"{path}/shape",
         rr.LineStrips3D(_shape(size), colors=[color], radii=[0.035 * size]),
@@ -99,8 +99,6 @@ def _log_object(rec: rr.RecordingStream, path: str, size: float, color: tuple[in
             half_sizes=[[0.75 * size, 0.55 * size, 0.02 * size]],
             colors=[(*color, 110)],
             fill_mode="Solid",
-            labels=[label],
-            show_labels=True,
         ),
         static=True,
         strict=True,
@@ -134,7 +132,20 @@ def send_scene(
         columns=rr.Transform3D.columns(quaternion=quat_wxyz_to_xyzw(q_ac)),
         strict=True,
     )
-    _log_object(rec, "/world/aircraft/body", half, AIRCRAFT_COLOR, "aircraft")
+    _log_object(rec, "/world/aircraft/body", half, AIRCRAFT_COLOR)
+    # one label per object, under it (z down), where it hides no shape
+    rec.log(
+        "/world/labels",
+        rr.Points3D(
+            offsets + np.array([0.0, 0.0, half + 0.5]),
+            labels=["aircraft", *washouts],
+            colors=[AIRCRAFT_COLOR, *[series_color(w, washouts) for w in washouts]],
+            radii=[0.05],
+            show_labels=True,
+        ),
+        static=True,
+        strict=True,
+    )
     for i, w in enumerate(washouts):
         color = series_color(w, washouts)
         base = f"/world/atlas/{w}"
@@ -158,4 +169,4 @@ def send_scene(
             static=True,
             strict=True,
         )
-        _log_object(rec, f"{base}/cockpit", 0.8 * half, color, w)
+        _log_object(rec, f"{base}/cockpit", 0.8 * half, color)
