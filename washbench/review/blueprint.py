@@ -99,21 +99,17 @@ def _whole_manoeuvre(t_end_s: float) -> rrb.TimeAxis:
     return rrb.TimeAxis(
         link="Independent",
         view_range=rrb.TimeRange(
-            start=rrb.TimeRangeBoundary.absolute(seconds=0.0),
-            end=rrb.TimeRangeBoundary.absolute(seconds=float(t_end_s)),
+            start=rrb.TimeRangeBoundary.absolute(nanos=0),
+            end=rrb.TimeRangeBoundary.absolute(nanos=round(t_end_s * 1e9)),  # as the time column rounds
         ),
     )
 
 
 def _all_data() -> rrb.VisibleTimeRange:
-    return rrb.VisibleTimeRange(
-        "time", start=rrb.TimeRangeBoundary.infinite(), end=rrb.TimeRangeBoundary.infinite()
-    )
+    return rrb.VisibleTimeRange("time", start=rrb.TimeRangeBoundary.infinite(), end=rrb.TimeRangeBoundary.infinite())
 
 
-def _stack(
-    layout: Layout, prefix: str, ranges: Sequence[tuple[float, float]], title: str
-) -> list[rrb.TimeSeriesView]:
+def _stack(layout: Layout, prefix: str, ranges: Sequence[tuple[float, float]], title: str) -> list[rrb.TimeSeriesView]:
     """Six stacked panels (one per DOF) without legends, y ranges fixed to hold all the data and the thresholds."""
     views = []
     for (dof, unit), (lo, hi) in zip(layout.dofs, ranges, strict=True):

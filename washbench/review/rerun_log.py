@@ -449,7 +449,7 @@ def detail_samples(values: np.ndarray, tolerance: np.ndarray, max_stride: int = 
 
 
 def _limit_text(limit: np.ndarray) -> str:
-    """"2" for one limit on all axes, "1.5/1.5/1" for per-axis limits."""
+    """ "2" for one limit on all axes, "1.5/1.5/1" for per-axis limits."""
     return f"{limit[0]:.3g}" if bool(np.all(limit == limit[0])) else "/".join(f"{v:.3g}" for v in limit)
 
 

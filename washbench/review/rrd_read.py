@@ -120,21 +120,20 @@ def read_properties(path: Path) -> dict[str, str]:
     return out
 
 
-def read_blueprint_components(path: Path) -> list[tuple[str, dict[str, list[object]]]]:
-    """The stored blueprint: one (entity path, {component: last value}) per blueprint entity that has data."""
+def read_blueprint_components(path: Path) -> dict[str, dict[str, list[object]]]:
+    """The stored blueprint: entity path -> {component: its last value (a list of instances)}."""
     from rerun.chunk import RrdReader
 
     reader = RrdReader(str(path))
-    out: list[tuple[str, dict[str, list[object]]]] = []
+    out: dict[str, dict[str, list[object]]] = {}
     for blueprint in reader.blueprints():
         for chunk in reader.stream(store=blueprint):
             batch = chunk.to_record_batch()
-            comps = {}
             for name in batch.schema.names:
                 if ":" in name:
                     rows = [r for r in batch.column(name).to_pylist() if r is not None]
                     if rows:
-                        comps[name] = rows[-1] if isinstance(rows[-1], list) else [rows[-1]]
-            if comps:
-                out.append((chunk.entity_path, comps))
+                        out.setdefault(chunk.entity_path, {})[name] = (
+                            rows[-1] if isinstance(rows[-1], list) else [rows[-1]]
+                        )
     return out

@@ -64,9 +64,7 @@ def object_offsets(n_washouts: int, travel_m: np.ndarray, diameter_m: float) -> 
     return offsets
 
 
-def camera(
-    offsets: np.ndarray, diameter_m: float
-) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+def camera(offsets: np.ndarray, diameter_m: float) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
     """Eye and target (NED, m): behind (south of) the row of objects and above it, looking north at its middle."""
     width = float(offsets[-1, 1] - offsets[0, 1]) + 2.0 * diameter_m
     centre = 0.5 * float(offsets[0, 1] + offsets[-1, 1])
