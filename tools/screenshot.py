@@ -151,6 +151,8 @@ def screenshot(rrd: Path, out: Path, *, tab: str | None, at_s: float | None, the
             timeline = state.recordings[0].timelines[0]
             t_s = at_s if at_s is not None else 0.5 * (timeline.start + timeline.end) * 1e-9
             client.set_time("time", duration=float(t_s), play_state="paused")
+            if shutil.which("xdotool"):  # the pointer starts mid-screen, where it would raise a tooltip
+                subprocess.run(["xdotool", "mousemove", "0", "0"], env=env, check=False, capture_output=True)
             time.sleep(4.0)  # let the software renderer draw a few frames
             out.parent.mkdir(parents=True, exist_ok=True)
             client.save_screenshot(str(out.resolve()))

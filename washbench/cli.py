@@ -65,8 +65,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
     p.add_argument("--quiet", action="store_true", help="no progress display")
 
-    p = sub.add_parser("replay", help="open a recording in the rerun viewer")
-    p.add_argument("recording", type=Path, help=".rrd file written by washbench run or suite")
+    p = sub.add_parser("replay", help="open a recording (or compare two) in the rerun viewer")
+    p.add_argument(
+        "recording", type=Path, nargs="+", help=".rrd file(s) from washbench run or suite: one, or two to compare"
+    )
     p.add_argument("--web", action="store_true", help="always use the web viewer")
     return parser
 
