@@ -152,7 +152,7 @@ def build_blueprint(layout: Layout) -> rrb.Blueprint:
             time_ranges=_all_data(),
         ),
         rrb.TextDocumentView(origin="/metrics", name="Metrics"),
-        row_shares=[2.2, 1.0 + 0.15 * len(layout.washouts), 3],
+        row_shares=[2.0, 1.1 + 0.2 * len(layout.washouts), 2.4],
     )
     perceived = rrb.Vertical(
         _lanes(layout, "/lanes", "Phases; limits reached"),

@@ -68,7 +68,7 @@ def camera(offsets: np.ndarray, diameter_m: float) -> tuple[tuple[float, float, 
     """Eye and target (NED, m): behind (south of) the row of objects and above it, looking north at its middle."""
     width = float(offsets[-1, 1] - offsets[0, 1]) + 2.0 * diameter_m
     centre = 0.5 * float(offsets[0, 1] + offsets[-1, 1])
-    eye = (-0.46 * width, centre, -0.24 * width)
+    eye = (-0.52 * width, centre, -0.27 * width)
     return eye, (0.0, centre, 0.0)
 
 
