@@ -52,7 +52,7 @@ def test_different_time_axes_are_refused(pair, tmp_path):
     a, _, _ = pair
     other = tmp_path / "short.rrd"
     write_recording(other, make_data(n=120))
-    with pytest.raises(WashbenchError, match="time axis .* differs"):
+    with pytest.raises(WashbenchError, match=r"time axis .* differs"):
         write_comparison(a, other, tmp_path / "x.rrd")
     assert not (tmp_path / "x.rrd").exists()
 

@@ -5,8 +5,8 @@
 Starts a private X server (Xvfb, first free display) and the rerun viewer bundled with rerun-sdk on it (WGPU_BACKEND
 vulkan, a throw-away HOME so no user settings leak in, the theme written into that HOME's viewer settings), waits until
 the recording is loaded, selects the tab whose name contains NAME (default: the first), puts the time cursor at S
-seconds (default: the middle of the recording), saves the screenshot and stops both processes. The picture is twice
-the window size (the viewer renders at scale 2).
+seconds (default: the middle of the recording), saves the screenshot (the window size in pixels) and stops both
+processes.
 
 Needs the Debian packages ``xvfb mesa-vulkan-drivers libvulkan1 libegl1 libgl1-mesa-dri`` (see
 docs/review.md); says which are missing and exits with status 2 when they are not there.
