@@ -61,7 +61,7 @@ def test_cli_errors_are_one_line_before_any_viewer_starts(pair, tmp_path):
     a, b, _ = pair
     other = tmp_path / "short.rrd"
     write_recording(other, make_data(n=120))
-    for args in ([a, other], [a, b, a], [a, tmp_path / "missing.rrd"]):
+    for args in ([a, other], [a, b, a]):  # a missing or broken file: see test_replay.py
         proc = subprocess.run(
             [sys.executable, "-m", "washbench", "replay", "--web", *map(str, args)],
             capture_output=True, text=True, timeout=120, check=False,
