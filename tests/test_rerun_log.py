@@ -331,6 +331,7 @@ def test_blueprint_stacks_the_perceived_panels_on_the_whole_manoeuvre(written):
     by_name = {v["ViewBlueprint:display_name"][0]: (vid, v) for vid, v in views.items()}
     t_end_ns = round(data.t_s[-1] * 1e9)
     perceived = []
+    series = read_scalar_series(path)
     for dof, _, _, unit in DOFS:
         vid, v = by_name[f"perceived {dof} [{unit}]"]
         perceived.append(vid)
@@ -339,7 +340,7 @@ def test_blueprint_stacks_the_perceived_panels_on_the_whole_manoeuvre(written):
         assert v["VisibleTimeRanges:ranges"][0]["range"] == {"start": None, "end": None}  # all data queried
         assert v["PlotLegend:visible"] == [False]  # the one legend has its own panel
         lo, hi = v["ScalarAxis:range"][0]
-        m = read_scalar_series(path)[perceived_path(dof)][1]
+        m = series[perceived_path(dof)][1]
         assert lo < m.min() and hi > m.max()  # every trace inside the fixed range
     # the lanes above, then the six panels, stacked in one container (a tab named "Perceived")
     stacks = [c for c in _containers(path).values() if c.get("ContainerBlueprint:display_name") == ["Perceived"]]

@@ -182,6 +182,7 @@ def replay_command(paths: Path | list[Path], web: bool) -> int:
     with tempfile.TemporaryDirectory(prefix="washbench-compare-") as tmp:
         out = Path(tmp) / "comparison.rrd"
         write_comparison(files[0], files[1], out)
+        print(f"washbench: comparing {files[0]} with {files[1]}", flush=True)
         return _replay(out, web)
 
 
