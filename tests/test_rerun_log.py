@@ -224,10 +224,13 @@ def test_saturation_onset_events(written):
             expected_onsets += [(data.t_s[i], f"{w}: {kind} limit") for i in rising]
     t_ev, text = read_component(path, "TextLog:text")["/events/saturation"]
     assert len(text) == len(expected_onsets)
-    got = sorted((round(float(tt), 6), s.split(" reached")[0]) for tt, s in zip(t_ev, text, strict=True))
+    got = sorted(
+        (round(float(tt), 6), s.split("  ", 1)[1].split(" reached")[0]) for tt, s in zip(t_ev, text, strict=True)
+    )
+    assert all(s.startswith(f"{tt:.2f} s  ") for tt, s in zip(t_ev, text, strict=True))
     assert got == sorted((round(float(tt), 6), s) for tt, s in expected_onsets)
-    assert "small-angle: pos limit reached for 0.167 s" in text  # 20 samples at 120 Hz
-    assert "small-angle: rate limit reached for 0.008 s" in text  # 1 sample
+    assert "1.50 s  small-angle: pos limit reached for 0.167 s" in text  # 20 samples at 120 Hz, from k = 180
+    assert "0.04 s  small-angle: rate limit reached for 0.008 s" in text  # 1 sample, k = 5
     _, levels = read_component(path, "TextLog:level")["/events/saturation"]
     assert set(levels) == {"WARN"}
 
@@ -236,7 +239,7 @@ def test_phases_as_a_lane_and_as_events(written):
     path, data = written
     t, text = read_component(path, "TextLog:text")["/events/phases"]
     np.testing.assert_allclose(t, [p[1] for p in data.phases], atol=1e-9)
-    assert [s.split()[1] for s in text] == ["entry", "hold", "exit"]
+    assert [s.split()[3] for s in text] == ["entry", "hold", "exit"]
     t_ch, states = read_component(path, "StateChange:state")[phase_lane_path()]
     np.testing.assert_allclose(t_ch, [p[1] for p in data.phases], atol=1e-9)
     assert list(states) == ["entry", "hold", "exit"]

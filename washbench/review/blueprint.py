@@ -152,7 +152,7 @@ def build_blueprint(layout: Layout) -> rrb.Blueprint:
             time_ranges=_all_data(),
         ),
         rrb.TextDocumentView(origin="/metrics", name="Metrics"),
-        row_shares=[2.0, 1.1 + 0.2 * len(layout.washouts), 2.4],
+        row_shares=[2.0, 1.3 + 0.25 * len(layout.washouts), 2.4],
     )
     perceived = rrb.Vertical(
         _lanes(layout, "/lanes", "Phases; limits reached"),
@@ -202,7 +202,19 @@ def build_blueprint(layout: Layout) -> rrb.Blueprint:
         )
         for w in layout.washouts
     ]
-    events = rrb.TextLogView(origin="/events", name="Phases and limit events")
+    enc = rrb.encodings
+    events = rrb.TextLogView(
+        origin="/events",
+        name="Phases and limit events",
+        columns=rrb.archetypes.TextLogColumns(
+            timeline_columns=[enc.TimelineColumn("time")],
+            text_log_columns=[
+                enc.TextLogColumn("LogLevel"),
+                enc.TextLogColumn("Body"),
+                enc.TextLogColumn("EntityPath", visible=False),
+            ],
+        ),
+    )
     tabs = rrb.Tabs(perceived, raw, envelope, *per_washout, events, active_tab=0)
     return rrb.Blueprint(
         rrb.Horizontal(tabs, side, column_shares=[3, 1.4]),

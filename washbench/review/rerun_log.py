@@ -17,7 +17,8 @@ the nanosecond):
   i = 1, 2, ... in washout order, as the viewer sorts lanes by name): state lanes; ``/limits/<i>_<washout>/<kind>``:
   one entity per washout with one lane (instance) per limit kind it ever reaches;
 - ``/world/...``: the 3D scene (:mod:`washbench.review.scene3d`);
-- ``/events/phases`` and ``/events/saturation``: text log entries at phase starts and limit onsets;
+- ``/events/phases`` and ``/events/saturation``: text log entries at phase starts and limit onsets, each text
+  starting with its time (the viewer's time column is narrow);
 - ``/metrics``: the metric table as a Markdown document; the recording properties ``provenance`` (strings).
 
 Precision: every scalar is stored as float64, bit-equal to the traces it came from (angular rates converted to deg/s
@@ -491,7 +492,7 @@ def _send_lanes(rec: rr.RecordingStream, data: RecordingData) -> None:
             code |= flags.astype(np.int64) << j
             starts, ends = _runs(flags)
             onsets.extend(
-                (float(t_s[s]), f"{w}: {kind} limit reached for {t_s[e] - t_s[s] + dt:.3f} s")
+                (float(t_s[s]), f"{t_s[s]:.2f} s  {w}: {kind} limit reached for {t_s[e] - t_s[s] + dt:.3f} s")
                 for s, e in zip(starts, ends, strict=True)
             )
         change = np.flatnonzero(np.diff(code, prepend=0))
@@ -529,7 +530,7 @@ def _send_text(rec: rr.RecordingStream, data: RecordingData) -> None:
             "/events/phases",
             indexes=[_time_column(np.array([t0 for _, t0, _ in data.phases], dtype=np.float64))],
             columns=rr.TextLog.columns(
-                text=[f"phase {name} ({t0:.2f}-{t1:.2f} s)" for name, t0, t1 in data.phases],
+                text=[f"{t0:.2f} s  phase {name} ({t0:.2f}-{t1:.2f} s)" for name, t0, t1 in data.phases],
                 level=["INFO"] * len(data.phases),
             ),
             strict=True,
