@@ -155,7 +155,14 @@ def screenshot(rrd: Path, out: Path, *, tab: str | None, at_s: float | None, the
                 subprocess.run(["xdotool", "mousemove", "0", "0"], env=env, check=False, capture_output=True)
             time.sleep(4.0)  # let the software renderer draw a few frames
             out.parent.mkdir(parents=True, exist_ok=True)
-            client.save_screenshot(str(out.resolve()))
+            for attempt in range(3):  # a loaded machine's software renderer can miss the viewer's deadline
+                try:
+                    client.save_screenshot(str(out.resolve()))
+                    break
+                except TimeoutError:
+                    if attempt == 2:
+                        raise RuntimeError("the viewer sent no screenshot (timed out three times)") from None
+                    time.sleep(5.0)
             for _ in range(40):
                 if out.exists() and out.stat().st_size > 0:
                     break
