@@ -267,3 +267,13 @@ def test_time_beyond_the_threshold_counts_the_felt_samples(run_dir: Path) -> Non
     # rolling into a 25 deg bank is felt (Zacharias roll threshold 3.0 deg/s), for less than the manoeuvre
     assert values[3] == pytest.approx(float(np.count_nonzero(np.abs(roll) > 3.0)) / 120.0, rel=5e-3)
     assert 0.0 < values[3] < roll.size / 120.0
+
+
+def test_recording_properties_hold_the_provenance(run_dir: Path, inputs: dict[str, Path]) -> None:
+    from washbench.review.rerun_log import read_properties
+
+    props = read_properties(run_dir / "recording.rrd")
+    doc = json.loads((run_dir / "run.json").read_text())
+    assert props["params.sha256"] == sha256(inputs["params"]) and props["params.name"] == "CW1-report-test"
+    assert props["platform.sha256"] == sha256(inputs["platform"]) and props["turbulence.seed"] == "7"
+    assert props["software.jsbsim"] == "1.3.3" and props["created_utc"] == doc["created_utc"]

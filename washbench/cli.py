@@ -160,8 +160,10 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("report", help="write report.md and its figures again from existing results (no flying)")
     p.add_argument("results", type=Path, help="a result folder (washbench run / cue) or a suite folder")
 
-    p = sub.add_parser("replay", help="open a recording in the rerun viewer")
-    p.add_argument("recording", type=Path, help=".rrd file written by washbench run or suite")
+    p = sub.add_parser("replay", help="open a recording (or compare two) in the rerun viewer")
+    p.add_argument(
+        "recording", type=Path, nargs="+", help=".rrd file(s) from washbench run or suite: one, or two to compare"
+    )
     p.add_argument("--web", action="store_true", help="always use the web viewer")
     return parser
 

@@ -352,7 +352,7 @@ def write_outputs(
     recording.rrd (unless ``opts.recording`` is False). Every file is written under a temporary name and
     all are renamed into place together, then ranking.csv and report.md are written (atomically) last, so
     a failure leaves no half-written file."""
-    from washbench.io.provenance import parquet_metadata, utc_now
+    from washbench.io.provenance import flat_strings, parquet_metadata, utc_now
     from washbench.runs.pipeline import write_run_json, write_run_recording
     from washbench.runs.suite import write_run_review
 
@@ -386,7 +386,8 @@ def write_outputs(
                 if opts.recording:
                     title = f"{summary.aircraft} / {summary.manoeuvre}"
                     q = recorded_attitude(seg.motion)
-                    write_run_recording(tmp[RECORDING_FILE], title, seg.motion, result, limits, q, [])
+                    props = flat_strings(provenance, created) if provenance else None
+                    write_run_recording(tmp[RECORDING_FILE], title, seg.motion, result, limits, q, [], props)
                 summaries.append(summary)
         for summary in summaries:  # last, as a suite's report: each written atomically once the rest is in place
             if not opts.recording:  # a recording of an earlier run would not show these results

@@ -42,7 +42,7 @@ from washbench.analysis.metrics import MetricRow
 from washbench.analysis.ranking import DOFS, perceived_motion
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
-from washbench.io.provenance import build_provenance, utc_now
+from washbench.io.provenance import build_provenance, flat_strings, utc_now
 
 if TYPE_CHECKING:
     from washbench.io.results import Motion
@@ -84,21 +84,10 @@ def aircraft_attitude(phi_deg: np.ndarray, theta_deg: np.ndarray, psi_deg: np.nd
 
 
 def metrics_markdown(title: str, rows: list[MetricRow]) -> str:
-    """The metric table of one run as Markdown (for the recording and the report)."""
-    lines = [
-        f"# {title}",
-        "",
-        "Aircraft pilot's perceived motion vs each simulator pilot's. NPC: 1 is perfect, larger is worse,",
-        "empty where a signal is flat. Errors in m/s^2 (integral m/s^2*s) for surge, sway, heave and deg/s",
-        "(integral deg) for roll, pitch, yaw.",
-        "",
-        "| washout | DOF | NPC | integral error | max error |",
-        "|---|---|---|---|---|",
-    ]
-    for r in rows:
-        npc = "" if math.isnan(r.npc) else f"{r.npc:.4f}"
-        lines.append(f"| {r.washout} | {r.dof} | {npc} | {r.integral_error:.4g} | {r.max_error:.4g} |")
-    return "\n".join(lines) + "\n"
+    """The metric table of one run as Markdown, DOF by washout (for the recording)."""
+    from washbench.review.metrics_table import metrics_table_markdown
+
+    return metrics_table_markdown(title, rows)
 
 
 def _publish(partial: Path, final: Path) -> None:
@@ -265,7 +254,8 @@ def write_cued_folder(
     result = analyse(motion, traces, filter_start=filter_start)
     write_results(folder, result, provenance)
     title = f"{summary.aircraft} / {summary.manoeuvre}"
-    write_run_recording(folder / "recording.rrd", title, motion, result, limits, aircraft_q, phases)
+    props = flat_strings(provenance, str((extra or {}).get("created_utc") or "")) if provenance else None
+    write_run_recording(folder / "recording.rrd", title, motion, result, limits, aircraft_q, phases, props)
     ac = result.perceived["aircraft"]
     summary = dataclasses.replace(
         summary,
@@ -383,10 +373,12 @@ def write_run_recording(
     limits: PlatformLimits,
     aircraft_q: np.ndarray,
     phases: list[tuple[str, float, float]],
+    properties: dict[str, str] | None = None,
 ) -> None:
     """The recording of one result folder (``run`` and ``cue`` alike): the one call of the recording writer.
 
-    ``aircraft_q`` (N, 4) the aircraft's attitude, body -> NED, scalar first; ``phases`` (name, start, end) [s].
+    ``aircraft_q`` (N, 4) the aircraft's attitude, body -> NED, scalar first; ``phases`` (name, start, end) [s];
+    ``properties``: the provenance as flat strings (:func:`washbench.io.provenance.flat_strings`).
     """
     from washbench.review.rerun_log import MotionSeries, PlatformSeries, RecordingData, write_recording
 
@@ -421,7 +413,7 @@ def write_run_recording(
         phases=[(p[0], float(p[1]), float(p[2])) for p in phases],
         metrics_markdown=metrics_markdown(title, list(result.metrics)),
     )
-    write_recording(path, data)
+    write_recording(path, data, properties)
 
 
 def platform_envelope(limits: PlatformLimits) -> PlatformEnvelope:
