@@ -22,7 +22,7 @@ from washbench.io.paths import DATA_DIR
 from washbench.io.provenance import PARQUET_KEY
 from washbench.review.figures import minmax_decimate
 from washbench.review.numbers import sig
-from washbench.review.palette import WASHOUT_COLORS, washout_colors
+from washbench.review.palette import AIRCRAFT_COLOR, WASHOUT_COLORS, washout_colors
 from washbench.review.report import write_result_report
 
 MANOEUVRE = """\
@@ -223,11 +223,16 @@ def test_report_of_a_missing_or_foreign_folder_is_one_line(tmp_path: Path) -> No
         assert len(proc.stderr.strip().splitlines()) == 1, proc.stderr
 
 
-def test_washout_colours_are_fixed_and_distinct() -> None:
-    colors = washout_colors(["my-a", "large-angle", "my-b", "small-angle", "unrestricted"])
+def test_washout_colours_are_fixed_distinct_and_the_recordings() -> None:
+    from washbench.review import blueprint
+
+    names = ["my-a", "large-angle", "my-b", "small-angle", "unrestricted"]
+    colors = washout_colors(names)
     for name, rgb in WASHOUT_COLORS.items():
         assert colors[name] == rgb
     assert len(set(colors.values())) == len(colors)
+    assert [blueprint.series_color(w, names) for w in names] == [colors[w] for w in names]
+    assert blueprint.series_color("aircraft") == AIRCRAFT_COLOR
 
 
 @pytest.mark.parametrize("x", [5.058e-05, 83.88, 0.99951, 9.996, -12345.0, 1.0, 0.1, 123.4, -0.000123456])
