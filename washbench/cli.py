@@ -65,6 +65,26 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
     p.add_argument("--quiet", action="store_true", help="no progress display")
 
+    p = sub.add_parser("omct", help="Objective Motion Cueing Test: gain and phase of each washout, Bode plots")
+    p.add_argument("--out", type=Path, required=True, help="output folder (omct.csv, bode_<test>.png, report.md)")
+    p.add_argument("--washout", action="append", metavar="NAME", help="washout to test, repeatable (default: all)")
+    p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
+    p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
+    p.add_argument("--boundaries", type=Path, help="gain/phase boundaries YAML, drawn and checked (README)")
+    p.add_argument("--rate-hz", type=float, default=120.0, help="washout sample rate (default 120)")
+
+    from washbench.analysis.signals import AXES, KINDS
+
+    p = sub.add_parser("signal", help="write a test signal on one axis as a washbench cue input")
+    p.add_argument("kind", choices=KINDS, help="signal shape")
+    p.add_argument("--axis", required=True, choices=AXES, help="specific force or rotation axis (body)")
+    p.add_argument("--amplitude", type=float, required=True, help="m/s^2 (f_x, f_y, f_z) or deg/s (rotations)")
+    p.add_argument("--frequency-hz", type=float, help="frequency (every kind but step; see README)")
+    p.add_argument("--duration-s", type=float, default=20.0, help="length (default 20 s)")
+    p.add_argument("--rate-hz", type=float, default=120.0, help="sample rate (default 120 Hz)")
+    p.add_argument("--start-s", type=float, default=1.0, help="onset of step, pulse, doublet, chirp (default 1 s)")
+    p.add_argument("--out", type=Path, required=True, help="output file, .csv or .parquet")
+
     p = sub.add_parser("replay", help="open a recording in the rerun viewer")
     p.add_argument("recording", type=Path, help=".rrd file written by washbench run or suite")
     p.add_argument("--web", action="store_true", help="always use the web viewer")
@@ -105,6 +125,24 @@ def _dispatch(args: argparse.Namespace) -> int:
             params_path=args.params,
             platform_path=args.platform,
             progress=not args.quiet,
+        )
+    if args.command == "omct":
+        from washbench.runs.omct import run_omct
+
+        run_omct(args.out, args.washout, args.params, args.platform, args.boundaries, rate_hz=args.rate_hz)
+        return 0
+    if args.command == "signal":
+        from washbench.runs.omct import signal_command
+
+        return signal_command(
+            args.kind,
+            args.axis,
+            args.amplitude,
+            args.frequency_hz,
+            args.duration_s,
+            args.rate_hz,
+            args.start_s,
+            args.out,
         )
     if args.command == "replay":
         from washbench.review.replay import replay_command

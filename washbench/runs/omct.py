@@ -1,0 +1,431 @@
+"""``washbench omct``: the Objective Motion Cueing Test of each washout; omct.csv, Bode plots, report.md.
+
+A list of :class:`WashoutEntry` (name, kind, parameters) drives it, so a built-in washout and a parameter
+variant go through the same code. For every test and frequency the input is generated once
+(:func:`washbench.analysis.omct.input_spec`, the same sine ``washbench signal`` writes) and run through
+``washbench.cueing.cue_trace`` -- the washouts that share a parameter set in ONE call, as the compiled bank
+runs several washouts on the same input side by side. The analysis is :mod:`washbench.analysis.omct`.
+
+Perceived motion (the issue's "beyond the standard"): the vestibular models are linear, so at the test
+frequency the perceived response is the model's own discrete frequency response at the run's step
+(:func:`washbench.analysis.omct.discrete_frequency_response` of the discretised sections that
+``washbench cue`` applies) times the measured head response; the aircraft pilot's likewise, from the
+aircraft's own motion. This is the periodic steady state of those filters without the canal's 30 s
+adaptation transient to wait for (checked against filtering a long sine in the tests).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from washbench.analysis import omct
+from washbench.analysis.omct_boundaries import BoundaryFile
+from washbench.analysis.signals import generate
+from washbench.errors import WashbenchError, located
+from washbench.io.atomic import write_text_atomic
+from washbench.io.results import csv_number
+from washbench.io.yamlio import load_yaml_model
+from washbench.perception.vestibular import VestibularModel, VestibularParams
+
+CSV_FILE = "omct.csv"
+REPORT_FILE = "report.md"
+CSV_COLUMNS: tuple[str, ...] = (
+    "washout", "test", "input", "output", "frequency_radps", "amplitude", "amplitude_unit", "gain", "phase_deg",
+    "linear", "distortion", "saturated", "gain_inside", "phase_inside",
+    "perceived_gain", "perceived_phase_deg", "aircraft_perceived_gain", "aircraft_perceived_phase_deg",
+)  # fmt: skip
+
+
+@dataclass(frozen=True)
+class WashoutEntry:
+    """One washout to test: its label, its kind (a name of ``WASHOUT_NAMES``) and its parameter set."""
+
+    name: str
+    kind: str
+    params: object  # washbench.cueing.WashoutParams
+
+
+@dataclass(frozen=True)
+class OmctPoint:
+    """One test of one washout at one frequency. Phases in degrees, continuous along frequency.
+
+    ``saturated``: limit kinds that bound during the run; ``gain_inside``/``phase_inside``: None where no
+    boundary covers the point; ``*_phase_deg``: NaN where the gain is 0 (the aircraft pilot of a tilt test).
+    """
+
+    washout: str
+    test: str
+    input: str
+    output: str
+    frequency_radps: float
+    amplitude: float
+    amplitude_unit: str
+    gain: float
+    phase_deg: float
+    linear: bool
+    distortion: float
+    saturated: tuple[str, ...]
+    gain_inside: bool | None
+    phase_inside: bool | None
+    perceived_gain: float
+    perceived_phase_deg: float
+    aircraft_perceived_gain: float
+    aircraft_perceived_phase_deg: float
+
+
+@dataclass(frozen=True)
+class OmctSettings:
+    """How the runs were made: sample rate [Hz], settle time [s] and the vestibular parameters."""
+
+    rate_hz: float
+    settle_s: float
+    slowest_decay_radps: float
+
+
+def _phase(h: complex) -> float:
+    return math.degrees(math.atan2(h.imag, h.real)) if h != 0 else math.nan
+
+
+def slowest_decay(entries: Sequence[WashoutEntry]) -> float:
+    """The slowest linearised decay rate [1/s] over the washouts (one settle time for all, same input)."""
+    rates = []
+    for e in entries:
+        p = e.params
+        rot = p.rotational.highpass_wn_radps  # type: ignore[attr-defined]
+        rates.append(
+            omct.slowest_decay_radps(
+                e.kind,
+                p.tilt.gain_per_s,  # type: ignore[attr-defined]
+                (rot.roll, rot.pitch, rot.yaw),
+                p.translational_highpass_wn_radps.xyz,  # type: ignore[attr-defined]
+                p.tilt.lowpass_wn_radps.xyz,  # type: ignore[attr-defined]
+                p.head.derivative_wn_radps,  # type: ignore[attr-defined]
+            )
+        )
+    return min(rates)
+
+
+def _groups(entries: Sequence[WashoutEntry]) -> list[tuple[object, list[WashoutEntry]]]:
+    """Entries that share a parameter set and have distinct kinds, so one cue_trace call runs them together."""
+    groups: list[tuple[object, list[WashoutEntry]]] = []
+    for e in entries:
+        for params, members in groups:
+            if params == e.params and all(m.kind != e.kind for m in members):
+                members.append(e)
+                break
+        else:
+            groups.append((e.params, [e]))
+    return groups
+
+
+def measure(
+    entries: Sequence[WashoutEntry],
+    limits: object,
+    rate_hz: float = 120.0,
+    tests: Sequence[omct.OmctTest] = omct.TESTS,
+    frequencies_radps: Sequence[float] = omct.FREQUENCIES_RADPS,
+    boundaries: dict[str, omct.Bounds] | None = None,
+    vestibular: VestibularParams | None = None,
+) -> tuple[list[OmctPoint], OmctSettings]:
+    """Run every test at every frequency for every washout; points ordered washout, test, frequency."""
+    from washbench.cueing import cue_trace
+
+    if not entries:
+        raise WashbenchError("no washout selected")
+    if not (math.isfinite(rate_hz) and rate_hz > 0.0):
+        raise WashbenchError(f"--rate-hz must be a positive number, got {rate_hz!r}")
+    top = max(frequencies_radps)
+    if top >= math.pi * rate_hz:
+        raise WashbenchError(f"--rate-hz {rate_hz}: {top:.4g} rad/s is at or above the Nyquist frequency")
+    dt = 1.0 / rate_hz
+    sigma = slowest_decay(entries)
+    model = VestibularModel(dt, vestibular)
+    raw: dict[tuple[str, str], list[tuple[float, float, str, complex, float, tuple[str, ...], complex]]] = {}
+    for test in tests:
+        for w in frequencies_radps:
+            tm = omct.timing(w, sigma)
+            spec = omct.input_spec(test, w, rate_hz, tm.duration_s)
+            sig = generate(spec)
+            ref = omct.reference_fit(test, sig.f_mps2, sig.omega_radps, dt, w, tm.periods)
+            aircraft = omct.response(test, ref, sig.f_mps2, sig.omega_radps, dt, w, tm.periods, _g(entries[0]))
+            for params, members in _groups(entries):
+                traces = cue_trace(sig.f_mps2, sig.omega_radps, dt, [m.kind for m in members], params, limits)
+                for m in members:
+                    tr = traces[m.kind]
+                    r = omct.response(test, ref, tr.head_f_mps2, tr.head_omega_radps, dt, w, tm.periods, _g(m))
+                    sat = omct.saturated_kinds(tr.saturation_counts)
+                    raw.setdefault((m.name, test.name), []).append(
+                        (w, spec.amplitude, omct.amplitude(test.input_axis, w)[1], r.h, r.distortion, sat, aircraft.h)
+                    )
+    points: list[OmctPoint] = []
+    for e in entries:
+        for test in tests:
+            points += _points(e.name, test, raw[(e.name, test.name)], model, dt, (boundaries or {}).get(test.name))
+    return points, OmctSettings(rate_hz=rate_hz, settle_s=omct.timing(1.0, sigma).settle_s, slowest_decay_radps=sigma)
+
+
+def _g(entry: WashoutEntry) -> float:
+    return float(entry.params.gravity_mps2)  # type: ignore[attr-defined]
+
+
+def _points(
+    washout: str,
+    test: omct.OmctTest,
+    rows: list[tuple[float, float, str, complex, float, tuple[str, ...], complex]],
+    model: VestibularModel,
+    dt: float,
+    bounds: omct.Bounds | None,
+) -> list[OmctPoint]:
+    """One washout's points of one test, phases unwrapped along frequency, boundaries checked."""
+    vest = model.canals if test.output_kind == "omega" else model.otolith
+    rows = sorted(rows, key=lambda r: r[0])
+    v = [omct.discrete_frequency_response(vest.b, vest.phi, r[0], dt) for r in rows]
+    phase = omct.unwrap_phase_deg([_phase(r[3]) for r in rows])
+    p_phase = omct.unwrap_phase_deg([_phase(vi * r[3]) for vi, r in zip(v, rows, strict=True)])
+    a_phase = omct.unwrap_phase_deg([_phase(vi * r[6]) for vi, r in zip(v, rows, strict=True)])
+    out = []
+    for i, (w, amp, unit, h, dist, sat, h_ac) in enumerate(rows):
+        gain_in, phase_in = omct.check_bounds(bounds, w, abs(h), phase[i])
+        out.append(
+            OmctPoint(
+                washout=washout,
+                test=test.name,
+                input=test.input_axis,
+                output=test.output_axis,
+                frequency_radps=w,
+                amplitude=amp,
+                amplitude_unit=unit,
+                gain=abs(h),
+                phase_deg=phase[i],
+                linear=omct.is_linear(dist, sat),
+                distortion=dist,
+                saturated=sat,
+                gain_inside=gain_in,
+                phase_inside=phase_in,
+                perceived_gain=abs(v[i] * h),
+                perceived_phase_deg=p_phase[i],
+                aircraft_perceived_gain=abs(v[i] * h_ac),
+                aircraft_perceived_phase_deg=a_phase[i],
+            )
+        )
+    return out
+
+
+# ---------------------------------------------------------------- files
+
+
+def _flag(x: bool | None) -> str:
+    return "" if x is None else ("true" if x else "false")
+
+
+def csv_text(points: Sequence[OmctPoint]) -> str:
+    """omct.csv: one row per point, numbers in full precision (repr), NaN/None as empty fields."""
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(CSV_COLUMNS)
+    for p in points:
+        w.writerow(
+            [
+                p.washout, p.test, p.input, p.output, csv_number(p.frequency_radps), csv_number(p.amplitude),
+                p.amplitude_unit, csv_number(p.gain), csv_number(p.phase_deg), _flag(p.linear),
+                csv_number(p.distortion), ";".join(p.saturated), _flag(p.gain_inside), _flag(p.phase_inside),
+                csv_number(p.perceived_gain), csv_number(p.perceived_phase_deg),
+                csv_number(p.aircraft_perceived_gain), csv_number(p.aircraft_perceived_phase_deg),
+            ]
+        )  # fmt: skip
+    return buf.getvalue()
+
+
+def load_boundaries(path: str | Path) -> BoundaryFile:
+    """Read and check a boundary file; WashbenchError ``file:line: field: problem`` on bad input."""
+    return load_yaml_model(Path(path), BoundaryFile)
+
+
+def report_text(
+    points: Sequence[OmctPoint],
+    settings: OmctSettings,
+    washouts: Sequence[WashoutEntry],
+    boundary: BoundaryFile | None,
+    plots: dict[str, str],
+) -> str:
+    """report.md: how the test was run, non-linear and out-of-bounds points, gain and phase per test."""
+    from washbench.analysis.omct import MAX_DISTORTION, MIN_WINDOW_S, SETTLE_TIME_CONSTANTS, TESTS
+
+    names = [e.name for e in washouts]
+    lines = [
+        "# Objective Motion Cueing Test",
+        "",
+        f"Washouts: {', '.join(f'{e.name} ({e.kind})' for e in washouts)}. Sample rate {settings.rate_hz:g} Hz.",
+        "",
+        "Output: the simulator's motion at the pilot's head (specific force and angular velocity from the "
+        "platform kinematics), not the vestibular estimators. Gains are dimensionless; for `f_x_to_pitch` and "
+        "`f_y_to_roll` the output is the attitude as the specific force it tilts into the pilot (g theta, "
+        "-g phi), so a perfect static tilt coordination has gain 1.",
+        "",
+        f"Each run waits {settings.settle_s:.3g} s ({SETTLE_TIME_CONSTANTS:g} time constants of the slowest "
+        f"linearised decay, {settings.slowest_decay_radps:.3g} 1/s: a transient falls to "
+        f"{math.exp(-SETTLE_TIME_CONSTANTS):.1e} of its start), then takes the Fourier coefficient at the input "
+        f"frequency over whole periods lasting at least {MIN_WINDOW_S:g} s. A point is linear when no platform, "
+        f"tilt-rate or rotational-saturation limit bound during its run and the output's residual after the "
+        f"fundamental is at most {MAX_DISTORTION:.0%} of the input.",
+        "",
+        "Amplitudes are chosen here (not ICAO 9625's): 0.5 m/s^2 for the translational tests; for the "
+        "rotational tests an attitude of min(2 deg, 50 deg/s^2 / w^2), given as its angular-velocity amplitude "
+        "(column `amplitude`, deg/s).",
+        "",
+    ]
+    if boundary is not None:
+        lines += [f"Boundaries: {boundary.name} (source: {boundary.source}).", ""]
+    else:
+        lines += ["Boundaries: none given (`--boundaries FILE`).", ""]
+    bad = [p for p in points if not p.linear]
+    lines += ["## Linearity", ""]
+    if bad:
+        lines += [f"{len(bad)} of {len(points)} points are NOT linear:", ""]
+        lines += [
+            "| washout | test | frequency (rad/s) | amplitude | limits bound | distortion |",
+            "|---|---|---|---|---|---|",
+        ]
+        for p in bad:
+            lines.append(
+                f"| {p.washout} | {p.test} | {p.frequency_radps:.3g} | {p.amplitude:.3g} {p.amplitude_unit} | "
+                f"{', '.join(p.saturated) or '-'} | {p.distortion:.2e} |"
+            )
+        lines.append("")
+    else:
+        worst = max(points, key=lambda p: p.distortion)
+        lines += [
+            f"All {len(points)} points are linear (largest distortion {worst.distortion:.1e}, "
+            f"{worst.washout} {worst.test} at {worst.frequency_radps:.3g} rad/s).",
+            "",
+        ]
+    if boundary is not None:
+        out = [p for p in points if p.gain_inside is False or p.phase_inside is False]
+        checked = [p for p in points if p.gain_inside is not None or p.phase_inside is not None]
+        lines += ["## Boundaries", "", f"{len(checked)} points checked, {len(out)} outside.", ""]
+        for name in names:
+            n_out = sum(1 for p in out if p.washout == name)
+            n_chk = sum(1 for p in checked if p.washout == name)
+            lines.append(f"- {name}: {n_chk - n_out} of {n_chk} inside")
+        lines.append("")
+    lines += ["## Gain and phase per test", ""]
+    by = {(p.washout, p.test): [] for p in points}  # type: dict[tuple[str, str], list[OmctPoint]]
+    for p in points:
+        by[(p.washout, p.test)].append(p)
+    freqs = sorted({p.frequency_radps for p in points})
+    for test in TESTS:
+        if not any((n, test.name) in by for n in names):
+            continue
+        lines += [f"### {test.name} ({test.input_axis} -> {test.output_axis})", ""]
+        if test.name in plots:
+            lines += [f"![{test.name}]({plots[test.name]})", ""]
+        head = "| w (rad/s) | " + " | ".join(f"{n} gain | {n} phase (deg)" for n in names) + " |"
+        lines += [head, "|---|" + "---|---|" * len(names)]
+        for w in freqs:
+            cells = []
+            for n in names:
+                pts = [p for p in by.get((n, test.name), []) if p.frequency_radps == w]
+                if pts:
+                    p = pts[0]
+                    mark = "" if p.linear else " (non-linear)"
+                    if p.gain_inside is False or p.phase_inside is False:
+                        mark += " (outside)"
+                    cells.append(f"{p.gain:.4g}{mark} | {p.phase_deg:.1f}")
+                else:
+                    cells.append(" | ")
+            lines.append(f"| {w:.4g} | " + " | ".join(cells) + " |")
+        lines.append("")
+    return "\n".join(lines) + "\n"
+
+
+def run_omct(
+    out_dir: Path,
+    washouts: Sequence[str] | None = None,
+    params_path: Path | None = None,
+    platform_path: Path | None = None,
+    boundaries_path: Path | None = None,
+    rate_hz: float = 120.0,
+    plots: bool = True,
+) -> list[OmctPoint]:
+    """The ``washbench omct`` command: built-in washouts (default all three) with one parameter set.
+
+    Writes ``omct.csv``, ``bode_<test>.png`` (with ``plots``) and ``report.md`` into ``out_dir``; bad input
+    raises WashbenchError before anything is written.
+    """
+    from washbench.cueing import load_washout_params
+    from washbench.platform import load_platform_limits
+    from washbench.runs.cue import check_washout_names
+
+    names = check_washout_names(washouts)
+    params = load_washout_params(params_path)
+    limits = load_platform_limits(platform_path)
+    boundary = load_boundaries(boundaries_path) if boundaries_path is not None else None
+    entries = [WashoutEntry(name=n, kind=n, params=params) for n in names]
+    return run_entries(out_dir, entries, limits, boundary, rate_hz=rate_hz, plots=plots)
+
+
+def run_entries(
+    out_dir: Path,
+    entries: Sequence[WashoutEntry],
+    limits: object,
+    boundary: BoundaryFile | None,
+    rate_hz: float = 120.0,
+    plots: bool = True,
+) -> list[OmctPoint]:
+    """Measure ``entries`` and write the results (the part of :func:`run_omct` a variant list can call)."""
+    out_dir = Path(out_dir)
+    if out_dir.exists() and not out_dir.is_dir():
+        raise WashbenchError(located(out_dir, "output path exists and is not a folder"))
+    points, settings = measure(entries, limits, rate_hz=rate_hz, boundaries=boundary.bounds() if boundary else None)
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+        files: dict[str, str] = {}
+        if plots:
+            from washbench.review.bode import write_bode_plots
+
+            files = write_bode_plots(out_dir, points, boundary.bounds() if boundary else {}, [e.name for e in entries])
+        write_text_atomic(out_dir / CSV_FILE, csv_text(points))
+        write_text_atomic(out_dir / REPORT_FILE, report_text(points, settings, entries, boundary, files))
+    except OSError as exc:
+        raise WashbenchError(located(out_dir, f"cannot write results: {exc.strerror or exc}")) from None
+    n_bad = sum(1 for p in points if not p.linear)
+    print(
+        f"OMCT: {len(entries)} washouts x {len({p.test for p in points})} tests x "
+        f"{len({p.frequency_radps for p in points})} frequencies at {settings.rate_hz:g} Hz; "
+        f"{n_bad} non-linear points"
+    )
+    if boundary is not None:
+        n_out = sum(1 for p in points if p.gain_inside is False or p.phase_inside is False)
+        print(f"  boundaries {boundary.name}: {n_out} points outside")
+    print(f"wrote {out_dir / CSV_FILE}, {out_dir / REPORT_FILE}" + (f" and {len(files)} Bode plots" if files else ""))
+    return points
+
+
+def signal_command(
+    kind: str,
+    axis: str,
+    amplitude: float,
+    frequency_hz: float | None,
+    duration_s: float,
+    rate_hz: float,
+    start_s: float,
+    out: Path,
+) -> int:
+    """The ``washbench signal`` command: generate a test signal and write it as a ``washbench cue`` input."""
+    from washbench.analysis.signals import SignalSpec, amplitude_unit
+    from washbench.io.motion_file import write_motion
+
+    spec = SignalSpec(kind, axis, amplitude, frequency_hz, duration_s, rate_hz, start_s)
+    sig = generate(spec)
+    write_motion(out, sig.t_s, sig.f_mps2, sig.omega_radps)
+    freq = "" if frequency_hz is None or kind == "step" else f" at {frequency_hz:g} Hz"
+    print(
+        f"wrote {out}: {kind} on {axis}, amplitude {amplitude:g} {amplitude_unit(axis)}{freq}, "
+        f"{sig.t_s.shape[0]} samples at {rate_hz:g} Hz"
+    )
+    return 0
