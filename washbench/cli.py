@@ -72,6 +72,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
     p.add_argument("--boundaries", type=Path, help="gain/phase boundaries YAML, drawn and checked (README)")
     p.add_argument("--rate-hz", type=float, default=120.0, help="washout sample rate (default 120)")
+    p.add_argument("--amplitude-scale", type=float, default=1.0, help="multiply every input amplitude (default 1)")
 
     from washbench.analysis.signals import AXES, KINDS
 
@@ -129,7 +130,15 @@ def _dispatch(args: argparse.Namespace) -> int:
     if args.command == "omct":
         from washbench.runs.omct import run_omct
 
-        run_omct(args.out, args.washout, args.params, args.platform, args.boundaries, rate_hz=args.rate_hz)
+        run_omct(
+            args.out,
+            args.washout,
+            args.params,
+            args.platform,
+            args.boundaries,
+            rate_hz=args.rate_hz,
+            amplitude_scale=args.amplitude_scale,
+        )
         return 0
     if args.command == "signal":
         from washbench.runs.omct import signal_command

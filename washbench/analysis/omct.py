@@ -154,13 +154,16 @@ def timing(w_radps: float, slowest_decay: float) -> Timing:
     return Timing(settle_s=settle, periods=periods, duration_s=settle + periods * period)
 
 
-def input_spec(test: OmctTest, w_radps: float, rate_hz: float, duration_s: float) -> SignalSpec:
-    """The test's input, a ``sine`` of :mod:`washbench.analysis.signals` (what ``washbench signal`` writes)."""
+def input_spec(test: OmctTest, w_radps: float, rate_hz: float, duration_s: float, scale: float = 1.0) -> SignalSpec:
+    """The test's input, a ``sine`` of :mod:`washbench.analysis.signals` (what ``washbench signal`` writes).
+
+    ``scale`` multiplies the amplitude of :func:`amplitude` (to probe the end of the linear range).
+    """
     amp, _ = amplitude(test.input_axis, w_radps)
     return SignalSpec(
         kind="sine",
         axis=test.input_axis,
-        amplitude=amp,
+        amplitude=amp * scale,
         frequency_hz=w_radps / (2.0 * math.pi),
         duration_s=duration_s,
         rate_hz=rate_hz,

@@ -25,7 +25,7 @@ from pathlib import Path
 
 from washbench.analysis import omct
 from washbench.analysis.omct_boundaries import BoundaryFile
-from washbench.analysis.signals import generate
+from washbench.analysis.signals import amplitude_unit, generate
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
 from washbench.io.results import csv_number
@@ -80,11 +80,12 @@ class OmctPoint:
 
 @dataclass(frozen=True)
 class OmctSettings:
-    """How the runs were made: sample rate [Hz], settle time [s] and the vestibular parameters."""
+    """How the runs were made: sample rate [Hz], settle time [s], slowest decay [1/s], amplitude scale."""
 
     rate_hz: float
     settle_s: float
     slowest_decay_radps: float
+    amplitude_scale: float = 1.0
 
 
 def _phase(h: complex) -> float:
@@ -131,14 +132,21 @@ def measure(
     frequencies_radps: Sequence[float] = omct.FREQUENCIES_RADPS,
     boundaries: dict[str, omct.Bounds] | None = None,
     vestibular: VestibularParams | None = None,
+    amplitude_scale: float = 1.0,
 ) -> tuple[list[OmctPoint], OmctSettings]:
-    """Run every test at every frequency for every washout; points ordered washout, test, frequency."""
+    """Run every test at every frequency for every washout; points ordered washout, test, frequency.
+
+    ``amplitude_scale`` multiplies every input amplitude (1: the amplitudes of :func:`omct.amplitude`), to
+    probe where a washout stops being linear.
+    """
     from washbench.cueing import cue_trace
 
     if not entries:
         raise WashbenchError("no washout selected")
     if not (math.isfinite(rate_hz) and rate_hz > 0.0):
         raise WashbenchError(f"--rate-hz must be a positive number, got {rate_hz!r}")
+    if not (math.isfinite(amplitude_scale) and amplitude_scale > 0.0):
+        raise WashbenchError(f"--amplitude-scale must be a positive number, got {amplitude_scale!r}")
     top = max(frequencies_radps)
     if top >= math.pi * rate_hz:
         raise WashbenchError(f"--rate-hz {rate_hz}: {top:.4g} rad/s is at or above the Nyquist frequency")
@@ -149,7 +157,7 @@ def measure(
     for test in tests:
         for w in frequencies_radps:
             tm = omct.timing(w, sigma)
-            spec = omct.input_spec(test, w, rate_hz, tm.duration_s)
+            spec = omct.input_spec(test, w, rate_hz, tm.duration_s, amplitude_scale)
             sig = generate(spec)
             ref = omct.reference_fit(test, sig.f_mps2, sig.omega_radps, dt, w, tm.periods)
             aircraft = omct.response(test, ref, sig.f_mps2, sig.omega_radps, dt, w, tm.periods, _g(entries[0]))
@@ -160,13 +168,14 @@ def measure(
                     r = omct.response(test, ref, tr.head_f_mps2, tr.head_omega_radps, dt, w, tm.periods, _g(m))
                     sat = omct.saturated_kinds(tr.saturation_counts)
                     raw.setdefault((m.name, test.name), []).append(
-                        (w, spec.amplitude, omct.amplitude(test.input_axis, w)[1], r.h, r.distortion, sat, aircraft.h)
+                        (w, spec.amplitude, amplitude_unit(test.input_axis), r.h, r.distortion, sat, aircraft.h)
                     )
     points: list[OmctPoint] = []
     for e in entries:
         for test in tests:
             points += _points(e.name, test, raw[(e.name, test.name)], model, dt, (boundaries or {}).get(test.name))
-    return points, OmctSettings(rate_hz=rate_hz, settle_s=omct.timing(1.0, sigma).settle_s, slowest_decay_radps=sigma)
+    settle = omct.timing(1.0, sigma).settle_s
+    return points, OmctSettings(rate_hz, settle, sigma, amplitude_scale)
 
 
 def _g(entry: WashoutEntry) -> float:
@@ -276,7 +285,12 @@ def report_text(
         "",
         "Amplitudes are chosen here (not ICAO 9625's): 0.5 m/s^2 for the translational tests; for the "
         "rotational tests an attitude of min(2 deg, 50 deg/s^2 / w^2), given as its angular-velocity amplitude "
-        "(column `amplitude`, deg/s).",
+        "(column `amplitude`, deg/s)."
+        + (
+            f" Here scaled by {settings.amplitude_scale:g} (`--amplitude-scale`)."
+            if settings.amplitude_scale != 1
+            else ""
+        ),
         "",
     ]
     if boundary is not None:
@@ -350,6 +364,7 @@ def run_omct(
     platform_path: Path | None = None,
     boundaries_path: Path | None = None,
     rate_hz: float = 120.0,
+    amplitude_scale: float = 1.0,
     plots: bool = True,
 ) -> list[OmctPoint]:
     """The ``washbench omct`` command: built-in washouts (default all three) with one parameter set.
@@ -366,7 +381,9 @@ def run_omct(
     limits = load_platform_limits(platform_path)
     boundary = load_boundaries(boundaries_path) if boundaries_path is not None else None
     entries = [WashoutEntry(name=n, kind=n, params=params) for n in names]
-    return run_entries(out_dir, entries, limits, boundary, rate_hz=rate_hz, plots=plots)
+    return run_entries(
+        out_dir, entries, limits, boundary, rate_hz=rate_hz, amplitude_scale=amplitude_scale, plots=plots
+    )
 
 
 def run_entries(
@@ -375,13 +392,15 @@ def run_entries(
     limits: object,
     boundary: BoundaryFile | None,
     rate_hz: float = 120.0,
+    amplitude_scale: float = 1.0,
     plots: bool = True,
 ) -> list[OmctPoint]:
     """Measure ``entries`` and write the results (the part of :func:`run_omct` a variant list can call)."""
     out_dir = Path(out_dir)
     if out_dir.exists() and not out_dir.is_dir():
         raise WashbenchError(located(out_dir, "output path exists and is not a folder"))
-    points, settings = measure(entries, limits, rate_hz=rate_hz, boundaries=boundary.bounds() if boundary else None)
+    bounds = boundary.bounds() if boundary else None
+    points, settings = measure(entries, limits, rate_hz=rate_hz, boundaries=bounds, amplitude_scale=amplitude_scale)
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
         files: dict[str, str] = {}
