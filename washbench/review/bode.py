@@ -19,6 +19,7 @@ from washbench.analysis.omct import TESTS, Bounds, bounds_at
 from washbench.io.atomic import atomic_path
 
 _COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown", "tab:pink", "tab:olive")
+_STYLES = (("-", "o"), ("--", "s"), (":", "^"), ("-.", "D"))  # washouts that coincide stay visible
 
 
 def _pyplot() -> Any:
@@ -42,13 +43,14 @@ def _boundary_lines(ax_gain: Any, ax_phase: Any, b: Bounds) -> None:
 
 
 def _series(
-    ax_gain: Any, ax_phase: Any, w: np.ndarray, g: np.ndarray, ph: np.ndarray, lin: np.ndarray, **kw: Any
+    ax_gain: Any, ax_phase: Any, w: np.ndarray, g: np.ndarray, ph: np.ndarray, lin: np.ndarray, i: int, **kw: Any
 ) -> None:
-    ax_gain.plot(w, g, "-", **kw)
-    ax_phase.plot(w, ph, "-", **kw)
+    line, marker = _STYLES[i % len(_STYLES)]
+    ax_gain.plot(w, g, line, **kw)
+    ax_phase.plot(w, ph, line, **kw)
     kw.pop("label", None)
-    ax_gain.plot(w[lin], g[lin], "o", ms=4, **kw)
-    ax_phase.plot(w[lin], ph[lin], "o", ms=4, **kw)
+    ax_gain.plot(w[lin], g[lin], marker, ms=4, fillstyle="none", **kw)
+    ax_phase.plot(w[lin], ph[lin], marker, ms=4, fillstyle="none", **kw)
     ax_gain.plot(w[~lin], g[~lin], "x", ms=7, mew=2, **kw)
     ax_phase.plot(w[~lin], ph[~lin], "x", ms=7, mew=2, **kw)
 
@@ -75,10 +77,10 @@ def write_bode_plots(
             w = np.array([p.frequency_radps for p in mine])
             lin = np.array([p.linear for p in mine])
             colour = _COLOURS[i % len(_COLOURS)]
-            _series(ag, aph, w, np.array([p.gain for p in mine]), np.array([p.phase_deg for p in mine]), lin,
+            _series(ag, aph, w, np.array([p.gain for p in mine]), np.array([p.phase_deg for p in mine]), lin, i,
                     color=colour, label=name)  # fmt: skip
             _series(apg, app, w, np.array([p.perceived_gain for p in mine]),
-                    np.array([p.perceived_phase_deg for p in mine]), lin, color=colour, label=name)  # fmt: skip
+                    np.array([p.perceived_phase_deg for p in mine]), lin, i, color=colour, label=name)  # fmt: skip
             if not aircraft_drawn:
                 ga = np.array([p.aircraft_perceived_gain for p in mine])
                 pa = np.array([p.aircraft_perceived_phase_deg for p in mine])
