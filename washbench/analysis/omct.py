@@ -146,10 +146,15 @@ class Timing:
     duration_s: float
 
 
+def settle_time_s(slowest_decay: float) -> float:
+    """SETTLE_TIME_CONSTANTS time constants of the slowest decay [1/s]: the wait before the analysis [s]."""
+    return SETTLE_TIME_CONSTANTS / slowest_decay
+
+
 def timing(w_radps: float, slowest_decay: float) -> Timing:
-    """Settle for SETTLE_TIME_CONSTANTS / slowest_decay, then whole periods lasting at least MIN_WINDOW_S."""
+    """Settle for :func:`settle_time_s`, then whole periods lasting at least MIN_WINDOW_S."""
     period = 2.0 * math.pi / w_radps
-    settle = SETTLE_TIME_CONSTANTS / slowest_decay
+    settle = settle_time_s(slowest_decay)
     periods = max(1, math.ceil(MIN_WINDOW_S / period))
     return Timing(settle_s=settle, periods=periods, duration_s=settle + periods * period)
 

@@ -174,8 +174,7 @@ def measure(
     for e in entries:
         for test in tests:
             points += _points(e.name, test, raw[(e.name, test.name)], model, dt, (boundaries or {}).get(test.name))
-    settle = omct.timing(1.0, sigma).settle_s
-    return points, OmctSettings(rate_hz, settle, sigma, amplitude_scale)
+    return points, OmctSettings(rate_hz, omct.settle_time_s(sigma), sigma, amplitude_scale)
 
 
 def _g(entry: WashoutEntry) -> float:
