@@ -345,3 +345,16 @@ def test_omct_bad_input(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> N
     assert main(["omct", "--out", str(out), "--amplitude-scale", "-1"]) == 2
     assert "--amplitude-scale" in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_entries_with_their_own_parameters() -> None:
+    """A (name, kind, params) list drives the OMCT: a variant with yaw wn 1 rad/s gives s/(s + 1)."""
+    rot = PARAMS.rotational.highpass_wn_radps.model_copy(update={"yaw": 1.0})
+    fast = PARAMS.model_copy(update={"rotational": PARAMS.rotational.model_copy(update={"highpass_wn_radps": rot})})
+    entries = [WashoutEntry("large-angle", "large-angle", PARAMS), WashoutEntry("fast-yaw", "large-angle", fast)]
+    points, _ = measure(entries, LIMITS, tests=[TESTS_BY_NAME["yaw_to_yaw"]], frequencies_radps=[0.1, 1.0, 10.0])
+    for p in points:
+        wn = 1.0 if p.washout == "fast-yaw" else 0.5
+        ref = _fr([1, 0], [1, wn], p.frequency_radps)
+        assert abs(_h(p.gain, p.phase_deg) / ref - 1) <= tolerance(p.frequency_radps, RATE_HZ)
+    assert {p.washout for p in points} == {"large-angle", "fast-yaw"}

@@ -292,6 +292,17 @@ def report_text(
         ),
         "",
     ]
+    freqs = sorted({p.frequency_radps for p in points})
+    scale = settings.amplitude_scale
+    lines += [
+        "| w (rad/s) | translational (m/s^2) | rotational rate (deg/s) | rotational attitude (deg) |",
+        "|---|---|---|---|",
+    ]
+    for w in freqs:
+        f_amp = omct.amplitude("f_x", w)[0] * scale
+        r_amp = omct.amplitude("pitch", w)[0] * scale
+        lines.append(f"| {w:.4g} | {f_amp:.3g} | {r_amp:.4g} | {r_amp / w:.4g} |")
+    lines.append("")
     if boundary is not None:
         lines += [f"Boundaries: {boundary.name} (source: {boundary.source}).", ""]
     else:
@@ -330,7 +341,6 @@ def report_text(
     by = {(p.washout, p.test): [] for p in points}  # type: dict[tuple[str, str], list[OmctPoint]]
     for p in points:
         by[(p.washout, p.test)].append(p)
-    freqs = sorted({p.frequency_radps for p in points})
     for test in TESTS:
         if not any((n, test.name) in by for n in names):
             continue
