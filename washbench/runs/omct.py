@@ -26,11 +26,13 @@ from pathlib import Path
 from washbench.analysis import omct
 from washbench.analysis.omct_boundaries import BoundaryFile
 from washbench.analysis.signals import amplitude_unit, generate
+from washbench.cueing.params import WashoutParams
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
 from washbench.io.results import csv_number
 from washbench.io.yamlio import load_yaml_model
 from washbench.perception.vestibular import VestibularModel, VestibularParams
+from washbench.platform.limits import PlatformLimits
 
 CSV_FILE = "omct.csv"
 REPORT_FILE = "report.md"
@@ -47,7 +49,7 @@ class WashoutEntry:
 
     name: str
     kind: str
-    params: object  # washbench.cueing.WashoutParams
+    params: WashoutParams
 
 
 @dataclass(frozen=True)
@@ -97,23 +99,23 @@ def slowest_decay(entries: Sequence[WashoutEntry]) -> float:
     rates = []
     for e in entries:
         p = e.params
-        rot = p.rotational.highpass_wn_radps  # type: ignore[attr-defined]
+        rot = p.rotational.highpass_wn_radps
         rates.append(
             omct.slowest_decay_radps(
                 e.kind,
-                p.tilt.gain_per_s,  # type: ignore[attr-defined]
+                p.tilt.gain_per_s,
                 (rot.roll, rot.pitch, rot.yaw),
-                p.translational_highpass_wn_radps.xyz,  # type: ignore[attr-defined]
-                p.tilt.lowpass_wn_radps.xyz,  # type: ignore[attr-defined]
-                p.head.derivative_wn_radps,  # type: ignore[attr-defined]
+                p.translational_highpass_wn_radps.xyz,
+                p.tilt.lowpass_wn_radps.xyz,
+                p.head.derivative_wn_radps,
             )
         )
     return min(rates)
 
 
-def _groups(entries: Sequence[WashoutEntry]) -> list[tuple[object, list[WashoutEntry]]]:
+def _groups(entries: Sequence[WashoutEntry]) -> list[tuple[WashoutParams, list[WashoutEntry]]]:
     """Entries that share a parameter set and have distinct kinds, so one cue_trace call runs them together."""
-    groups: list[tuple[object, list[WashoutEntry]]] = []
+    groups: list[tuple[WashoutParams, list[WashoutEntry]]] = []
     for e in entries:
         for params, members in groups:
             if params == e.params and all(m.kind != e.kind for m in members):
@@ -126,7 +128,7 @@ def _groups(entries: Sequence[WashoutEntry]) -> list[tuple[object, list[WashoutE
 
 def measure(
     entries: Sequence[WashoutEntry],
-    limits: object,
+    limits: PlatformLimits,
     rate_hz: float = 120.0,
     tests: Sequence[omct.OmctTest] = omct.TESTS,
     frequencies_radps: Sequence[float] = omct.FREQUENCIES_RADPS,
@@ -178,7 +180,7 @@ def measure(
 
 
 def _g(entry: WashoutEntry) -> float:
-    return float(entry.params.gravity_mps2)  # type: ignore[attr-defined]
+    return float(entry.params.gravity_mps2)
 
 
 def _points(
@@ -398,7 +400,7 @@ def run_omct(
 def run_entries(
     out_dir: Path,
     entries: Sequence[WashoutEntry],
-    limits: object,
+    limits: PlatformLimits,
     boundary: BoundaryFile | None,
     rate_hz: float = 120.0,
     amplitude_scale: float = 1.0,
