@@ -29,6 +29,7 @@ import os
 import shutil
 import sys
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -121,6 +122,7 @@ def run_manoeuvre(
     params_path: Path | None = None,
     platform_path: Path | None = None,
     progress: bool = False,
+    aircraft_dirs: Sequence[Path] = (),
 ) -> RunSummary:
     """Fly one manoeuvre with the washouts in lockstep and write its results folder.
 
@@ -135,7 +137,7 @@ def run_manoeuvre(
     from washbench.platform import load_platform_limits
     from washbench.runs.cue import analyse, write_results
 
-    manoeuvre = load_manoeuvre(manoeuvre_path)
+    manoeuvre = load_manoeuvre(manoeuvre_path, aircraft_dirs)
     params = load_washout_params(params_path)
     limits = load_platform_limits(platform_path)
     washouts = tuple(WASHOUT_NAMES)
@@ -282,6 +284,7 @@ def run_command(
     params_path: Path | None = None,
     platform_path: Path | None = None,
     progress: bool = True,
+    aircraft_dirs: Sequence[Path] = (),
 ) -> int:
     """CLI entry of ``washbench run``: 0 if the flight ran and passed its checks, else 1."""
     start = time.perf_counter()
@@ -291,6 +294,7 @@ def run_command(
         params_path=params_path,
         platform_path=platform_path,
         progress=progress and sys.stderr.isatty(),
+        aircraft_dirs=aircraft_dirs,
     )
     state = "ok" if s.ok else f"FAILED ({s.reason})"
     print(
