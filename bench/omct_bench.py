@@ -18,8 +18,9 @@ import jsbsim
 import numpy as np
 
 from washbench.cueing import WASHOUT_NAMES, cue_trace, load_washout_params
+from washbench.cueing.variants import Washout
 from washbench.platform import load_platform_limits
-from washbench.runs.omct import WashoutEntry, measure
+from washbench.runs.omct import measure
 
 DT_S = 1.0 / 120.0
 
@@ -44,7 +45,7 @@ def fdm_step_s(n: int = 20000) -> float:
 
 def main() -> None:
     params, limits = load_washout_params(), load_platform_limits()
-    entries = [WashoutEntry(n, n, params) for n in WASHOUT_NAMES]
+    entries = [Washout(n, n, params) for n in WASHOUT_NAMES]
     measure(entries, limits, tests=[], frequencies_radps=[1.0])  # imports, numba cache
     t0 = time.perf_counter()
     points, settings = measure(entries, limits)

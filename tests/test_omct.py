@@ -38,11 +38,12 @@ from scipy import signal
 from washbench.analysis import omct
 from washbench.analysis.omct import FREQUENCIES_RADPS, TEST_NAMES, TESTS_BY_NAME
 from washbench.cli import main
-from washbench.cueing import WASHOUT_NAMES, load_washout_params
+from washbench.cueing import WASHOUT_NAMES, WashoutParams, load_washout_params
+from washbench.cueing.variants import Washout
 from washbench.io.results import read_traces
 from washbench.perception.vestibular import VestibularModel
 from washbench.platform import load_platform_limits
-from washbench.runs.omct import CSV_COLUMNS, WashoutEntry, csv_text, measure, report_text, slowest_decay
+from washbench.runs.omct import CSV_COLUMNS, csv_text, measure, report_text, slowest_decay
 
 PARAMS = load_washout_params()
 LIMITS = load_platform_limits()
@@ -50,19 +51,31 @@ G = PARAMS.gravity_mps2
 K = PARAMS.tilt.gain_per_s
 RATE_HZ = 120.0
 EXAMPLE_BOUNDARIES = Path(__file__).resolve().parent.parent / "docs" / "omct-boundaries-example.yaml"
+# a variant on the command line: other surge high-pass and yaw high-pass break frequencies
+VARIANT = "la_fast=large-angle,translational_highpass_wn_radps.x=2.5,rotational.highpass_wn_radps.yaw=1.0"
+VARIANT_PARAMS = PARAMS.model_copy(
+    update={
+        "translational_highpass_wn_radps": PARAMS.translational_highpass_wn_radps.model_copy(update={"x": 2.5}),
+        "rotational": PARAMS.rotational.model_copy(
+            update={"highpass_wn_radps": PARAMS.rotational.highpass_wn_radps.model_copy(update={"yaw": 1.0})}
+        ),
+    }
+)
+KIND = {**{n: n for n in WASHOUT_NAMES}, "la_fast": "large-angle"}
+PARAMS_OF = {**{n: PARAMS for n in WASHOUT_NAMES}, "la_fast": VARIANT_PARAMS}
 
 
 def _fr(num: list[float], den: list[float], w: float) -> complex:
     return complex(signal.freqs(num, den, worN=[w])[1][0])
 
 
-def reference(washout: str, test: str, w: float) -> complex:
-    """The closed-form linearised response of ``washout`` in ``test`` at ``w`` rad/s (module docstring)."""
+def reference(washout: str, test: str, w: float, params: WashoutParams = PARAMS) -> complex:
+    """The closed-form linearised response of a ``washout`` kind in ``test`` at ``w`` rad/s (module docstring)."""
     s = 1j * w
-    lp_wn = PARAMS.tilt.lowpass_wn_radps
-    hp_wn = PARAMS.translational_highpass_wn_radps
-    rot_wn = PARAMS.rotational.highpass_wn_radps
-    w2 = PARAMS.head.derivative_wn_radps
+    lp_wn = params.tilt.lowpass_wn_radps
+    hp_wn = params.translational_highpass_wn_radps
+    rot_wn = params.rotational.highpass_wn_radps
+    w2 = params.head.derivative_wn_radps
 
     def lp(wn: float) -> complex:  # Eq. 3
         return _fr([4 * wn * wn], [1, 4 * wn, 4 * wn * wn], w)
@@ -115,9 +128,10 @@ def _float(x: str) -> float:
 
 @pytest.fixture(scope="module")
 def omct_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[dict[str, str]]]:
-    """One real ``washbench omct`` run: three washouts, ten tests, twelve frequencies, example boundaries."""
+    """One real ``washbench omct`` run: three washouts and a variant, ten tests, twelve frequencies, boundaries."""
     out = tmp_path_factory.mktemp("omct")
-    assert main(["omct", "--out", str(out), "--boundaries", str(EXAMPLE_BOUNDARIES)]) == 0
+    args = ["omct", "--out", str(out), "--boundaries", str(EXAMPLE_BOUNDARIES), "--variant", VARIANT]
+    assert main([*args, *(a for n in WASHOUT_NAMES for a in ("--washout", n))]) == 0
     with open(out / "omct.csv", newline="", encoding="utf-8") as fh:
         reader = csv.DictReader(fh)
         assert tuple(reader.fieldnames or ()) == CSV_COLUMNS
@@ -127,12 +141,12 @@ def omct_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[dict[
 
 def test_omct_files(omct_run: tuple[Path, list[dict[str, str]]]) -> None:
     out, rows = omct_run
-    assert len(rows) == 3 * 10 * 12
+    assert len(rows) == 4 * 10 * 12
     for name in TEST_NAMES:
         png = out / f"bode_{name}.png"
         assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     report = (out / "report.md").read_text()
-    assert "All 360 points are linear" in report
+    assert "All 480 points are linear" in report and "la_fast (large-angle)" in report
     assert "illustrative example (not ICAO 9625)" in report
     for row in rows:
         assert row["amplitude_unit"] == ("deg/s" if row["input"] in ("roll", "pitch", "yaw") else "m/s^2")
@@ -140,26 +154,26 @@ def test_omct_files(omct_run: tuple[Path, list[dict[str, str]]]) -> None:
 
 
 def test_gain_and_phase_equal_the_closed_form(omct_run: tuple[Path, list[dict[str, str]]]) -> None:
-    """All ten tests, all twelve frequencies, the three washouts: within the discretisation tolerance."""
+    """All ten tests, all twelve frequencies, the three washouts and the variant: within the tolerance."""
     _, rows = omct_run
     seen = set()
     worst = 0.0
     for row in rows:
         w = float(row["frequency_radps"])
         h = _h(float(row["gain"]), float(row["phase_deg"]))
-        ref = reference(row["washout"], row["test"], w)
+        ref = reference(KIND[row["washout"]], row["test"], w, PARAMS_OF[row["washout"]])
         err = abs(h / ref - 1.0)
         assert err <= tolerance(w, RATE_HZ), (row["washout"], row["test"], w, h, ref, err)
         worst = max(worst, err / tolerance(w, RATE_HZ))
         seen.add((row["washout"], row["test"], w))
-    assert len(seen) == 360
+    assert len(seen) == 480
     assert {float(r["frequency_radps"]) for r in rows} == set(FREQUENCIES_RADPS)
     assert worst > 0.3  # the bound is not loose by orders of magnitude
 
 
 def test_discretisation_error_falls_with_the_step() -> None:
     """At 1 kHz the worst mismatch at the top frequency is several times smaller than at 120 Hz."""
-    entries = [WashoutEntry(n, n, PARAMS) for n in WASHOUT_NAMES]
+    entries = [Washout(n, n, PARAMS) for n in WASHOUT_NAMES]
     w = FREQUENCIES_RADPS[-1]
     errs = {}
     for rate in (RATE_HZ, 1000.0):
@@ -178,7 +192,7 @@ def test_omct_equals_cue_traces_of_a_signal_sine(omct_run: tuple[Path, list[dict
     for test_name in ("pitch_to_f_x", "f_y_to_roll"):
         test = TESTS_BY_NAME[test_name]
         amp, _ = omct.amplitude(test.input_axis, w)
-        tm = omct.timing(w, slowest_decay([WashoutEntry(n, n, PARAMS) for n in WASHOUT_NAMES]))
+        tm = omct.timing(w, slowest_decay([Washout(n, n, PARAMS) for n in WASHOUT_NAMES]))
         sig_file = tmp_path / f"{test_name}.csv"
         args = ["signal", "sine", "--axis", test.input_axis, "--amplitude", repr(amp)]
         args += ["--frequency-hz", repr(w / (2 * math.pi)), "--duration-s", repr(tm.duration_s), "--out", str(sig_file)]
@@ -205,7 +219,7 @@ def test_omct_equals_cue_traces_of_a_signal_sine(omct_run: tuple[Path, list[dict
 
 def test_too_large_amplitude_is_flagged_non_linear() -> None:
     """Ten times the translational amplitude (5 m/s^2) at 1 rad/s drives the tilt into its 3 deg/s limit."""
-    entries = [WashoutEntry(n, n, PARAMS) for n in WASHOUT_NAMES]
+    entries = [Washout(n, n, PARAMS) for n in WASHOUT_NAMES]
     tests = [TESTS_BY_NAME["f_x_to_f_x"]]
     w = [FREQUENCIES_RADPS[5]]
     small, _ = measure(entries, LIMITS, tests=tests, frequencies_radps=w)
@@ -328,7 +342,7 @@ def test_fourier_coefficient_whole_periods_not_on_a_sample() -> None:
 
 
 def test_omct_is_deterministic() -> None:
-    entries = [WashoutEntry("large-angle", "large-angle", PARAMS), WashoutEntry("tuned", "large-angle", PARAMS)]
+    entries = [Washout("large-angle", "large-angle", PARAMS), Washout("tuned", "large-angle", PARAMS)]
     a, _ = measure(entries, LIMITS, tests=[TESTS_BY_NAME["roll_to_f_y"]], frequencies_radps=[0.631, 6.31])
     b, _ = measure(entries, LIMITS, tests=[TESTS_BY_NAME["roll_to_f_y"]], frequencies_radps=[0.631, 6.31])
     assert csv_text(a) == csv_text(b)
@@ -340,6 +354,8 @@ def test_omct_bad_input(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> N
     out = tmp_path / "out"
     assert main(["omct", "--out", str(out), "--washout", "big-angle"]) == 2
     assert "unknown washout 'big-angle'" in capsys.readouterr().err
+    assert main(["omct", "--out", str(out), "--variant", "v=large-angle,tilt.gain_per_sec=1"]) == 2
+    assert "gain_per_sec" in capsys.readouterr().err
     assert main(["omct", "--out", str(out), "--rate-hz", "4"]) == 2
     assert "Nyquist" in capsys.readouterr().err
     assert main(["omct", "--out", str(out), "--amplitude-scale", "-1"]) == 2
@@ -351,7 +367,7 @@ def test_entries_with_their_own_parameters() -> None:
     """A (name, kind, params) list drives the OMCT: a variant with yaw wn 1 rad/s gives s/(s + 1)."""
     rot = PARAMS.rotational.highpass_wn_radps.model_copy(update={"yaw": 1.0})
     fast = PARAMS.model_copy(update={"rotational": PARAMS.rotational.model_copy(update={"highpass_wn_radps": rot})})
-    entries = [WashoutEntry("large-angle", "large-angle", PARAMS), WashoutEntry("fast-yaw", "large-angle", fast)]
+    entries = [Washout("large-angle", "large-angle", PARAMS), Washout("fast-yaw", "large-angle", fast)]
     points, _ = measure(entries, LIMITS, tests=[TESTS_BY_NAME["yaw_to_yaw"]], frequencies_radps=[0.1, 1.0, 10.0])
     for p in points:
         wn = 1.0 if p.washout == "fast-yaw" else 0.5

@@ -1,10 +1,10 @@
 """``washbench omct``: the Objective Motion Cueing Test of each washout; omct.csv, Bode plots, report.md.
 
-A list of :class:`WashoutEntry` (name, kind, parameters) drives it, so a built-in washout and a parameter
-variant go through the same code. For every test and frequency the input is generated once
-(:func:`washbench.analysis.omct.input_spec`, the same sine ``washbench signal`` writes) and run through
-``washbench.cueing.cue_trace`` -- the washouts that share a parameter set in ONE call, as the compiled bank
-runs several washouts on the same input side by side. The analysis is :mod:`washbench.analysis.omct`.
+A list of :class:`washbench.cueing.variants.Washout` (name, kind, parameters) drives it, so a built-in washout
+and a variant (``--variant``, a ``variants:`` section of ``--params``) go through the same code. For every test
+and frequency the input is generated once (:func:`washbench.analysis.omct.input_spec`, the same sine
+``washbench signal`` writes) and all washouts run on it in ONE ``washbench.cueing.cue_trace`` call, side by side
+as the compiled bank runs them. The analysis is :mod:`washbench.analysis.omct`.
 
 Perceived motion (the issue's "beyond the standard"): the vestibular models are linear, so at the test
 frequency the perceived response is the model's own discrete frequency response at the run's step
@@ -26,7 +26,7 @@ from pathlib import Path
 from washbench.analysis import omct
 from washbench.analysis.omct_boundaries import BoundaryFile
 from washbench.analysis.signals import amplitude_unit, generate
-from washbench.cueing.params import WashoutParams
+from washbench.cueing.variants import Washout
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
 from washbench.io.results import csv_number
@@ -41,15 +41,6 @@ CSV_COLUMNS: tuple[str, ...] = (
     "linear", "distortion", "saturated", "gain_inside", "phase_inside",
     "perceived_gain", "perceived_phase_deg", "aircraft_perceived_gain", "aircraft_perceived_phase_deg",
 )  # fmt: skip
-
-
-@dataclass(frozen=True)
-class WashoutEntry:
-    """One washout to test: its label, its kind (a name of ``WASHOUT_NAMES``) and its parameter set."""
-
-    name: str
-    kind: str
-    params: WashoutParams
 
 
 @dataclass(frozen=True)
@@ -94,7 +85,7 @@ def _phase(h: complex) -> float:
     return math.degrees(math.atan2(h.imag, h.real)) if h != 0 else math.nan
 
 
-def slowest_decay(entries: Sequence[WashoutEntry]) -> float:
+def slowest_decay(entries: Sequence[Washout]) -> float:
     """The slowest linearised decay rate [1/s] over the washouts (one settle time for all, same input)."""
     rates = []
     for e in entries:
@@ -113,21 +104,8 @@ def slowest_decay(entries: Sequence[WashoutEntry]) -> float:
     return min(rates)
 
 
-def _groups(entries: Sequence[WashoutEntry]) -> list[tuple[WashoutParams, list[WashoutEntry]]]:
-    """Entries that share a parameter set and have distinct kinds, so one cue_trace call runs them together."""
-    groups: list[tuple[WashoutParams, list[WashoutEntry]]] = []
-    for e in entries:
-        for params, members in groups:
-            if params == e.params and all(m.kind != e.kind for m in members):
-                members.append(e)
-                break
-        else:
-            groups.append((e.params, [e]))
-    return groups
-
-
 def measure(
-    entries: Sequence[WashoutEntry],
+    entries: Sequence[Washout],
     limits: PlatformLimits,
     rate_hz: float = 120.0,
     tests: Sequence[omct.OmctTest] = omct.TESTS,
@@ -163,15 +141,14 @@ def measure(
             sig = generate(spec)
             ref = omct.reference_fit(test, sig.f_mps2, sig.omega_radps, dt, w, tm.periods)
             aircraft = omct.response(test, ref, sig.f_mps2, sig.omega_radps, dt, w, tm.periods, _g(entries[0]))
-            for params, members in _groups(entries):
-                traces = cue_trace(sig.f_mps2, sig.omega_radps, dt, [m.kind for m in members], params, limits)
-                for m in members:
-                    tr = traces[m.kind]
-                    r = omct.response(test, ref, tr.head_f_mps2, tr.head_omega_radps, dt, w, tm.periods, _g(m))
-                    sat = omct.saturated_kinds(tr.saturation_counts)
-                    raw.setdefault((m.name, test.name), []).append(
-                        (w, spec.amplitude, amplitude_unit(test.input_axis), r.h, r.distortion, sat, aircraft.h)
-                    )
+            traces = cue_trace(sig.f_mps2, sig.omega_radps, dt, entries, None, limits)
+            for m in entries:
+                tr = traces[m.name]
+                r = omct.response(test, ref, tr.head_f_mps2, tr.head_omega_radps, dt, w, tm.periods, _g(m))
+                sat = omct.saturated_kinds(tr.saturation_counts)
+                raw.setdefault((m.name, test.name), []).append(
+                    (w, spec.amplitude, amplitude_unit(test.input_axis), r.h, r.distortion, sat, aircraft.h)
+                )
     points: list[OmctPoint] = []
     for e in entries:
         for test in tests:
@@ -179,7 +156,7 @@ def measure(
     return points, OmctSettings(rate_hz, omct.settle_time_s(sigma), sigma, amplitude_scale)
 
 
-def _g(entry: WashoutEntry) -> float:
+def _g(entry: Washout) -> float:
     return float(entry.params.gravity_mps2)
 
 
@@ -259,7 +236,7 @@ def load_boundaries(path: str | Path) -> BoundaryFile:
 def report_text(
     points: Sequence[OmctPoint],
     settings: OmctSettings,
-    washouts: Sequence[WashoutEntry],
+    washouts: Sequence[Washout],
     boundary: BoundaryFile | None,
     plots: dict[str, str],
 ) -> str:
@@ -377,21 +354,20 @@ def run_omct(
     rate_hz: float = 120.0,
     amplitude_scale: float = 1.0,
     plots: bool = True,
+    variants: Sequence[str] = (),
 ) -> list[OmctPoint]:
-    """The ``washbench omct`` command: built-in washouts (default all three) with one parameter set.
+    """The ``washbench omct`` command: the washouts of ``--washout``, ``--variant`` and ``--params``.
 
-    Writes ``omct.csv``, ``bode_<test>.png`` (with ``plots``) and ``report.md`` into ``out_dir``; bad input
-    raises WashbenchError before anything is written.
+    (:func:`washbench.cueing.variants.select_washouts`: by default the three built-in washouts.) Writes
+    ``omct.csv``, ``bode_<test>.png`` (with ``plots``) and ``report.md`` into ``out_dir``; bad input raises
+    WashbenchError before anything is written.
     """
-    from washbench.cueing import load_washout_params
+    from washbench.cueing.variants import select_washouts
     from washbench.platform import load_platform_limits
-    from washbench.runs.cue import check_washout_names
 
-    names = check_washout_names(washouts)
-    params = load_washout_params(params_path)
+    entries = select_washouts(washouts, variants, params_path)
     limits = load_platform_limits(platform_path)
     boundary = load_boundaries(boundaries_path) if boundaries_path is not None else None
-    entries = [WashoutEntry(name=n, kind=n, params=params) for n in names]
     return run_entries(
         out_dir, entries, limits, boundary, rate_hz=rate_hz, amplitude_scale=amplitude_scale, plots=plots
     )
@@ -399,7 +375,7 @@ def run_omct(
 
 def run_entries(
     out_dir: Path,
-    entries: Sequence[WashoutEntry],
+    entries: Sequence[Washout],
     limits: PlatformLimits,
     boundary: BoundaryFile | None,
     rate_hz: float = 120.0,
