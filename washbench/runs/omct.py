@@ -401,7 +401,7 @@ def run_entries(
         raise WashbenchError(located(out_dir, f"cannot write results: {exc.strerror or exc}")) from None
     n_bad = sum(1 for p in points if not p.linear)
     print(
-        f"OMCT: {len(entries)} washouts x {len({p.test for p in points})} tests x "
+        f"OMCT: {len(entries)} washout{'s' if len(entries) != 1 else ''} x {len({p.test for p in points})} tests x "
         f"{len({p.frequency_radps for p in points})} frequencies at {settings.rate_hz:g} Hz; "
         f"{n_bad} non-linear points"
     )
