@@ -3,7 +3,8 @@
 Left column: the simulator's motion at the pilot's head (gain on a log axis, absolute, as the OMCT literature
 plots it; phase in degrees), with the boundaries if given (dashed, the band between them shaded). Right
 column: what the pilot perceives through the vestibular models, each simulator pilot against the aircraft
-pilot (black, dashed) for the same input. Non-linear points are drawn as crosses. matplotlib is imported
+pilot (black, dashed) for the same input. Non-linear points are drawn as crosses, points outside the
+boundaries get a red ring. matplotlib is imported
 lazily with the Agg backend (no display needed).
 """
 
@@ -81,6 +82,11 @@ def write_bode_plots(
                     color=colour, label=name)  # fmt: skip
             _series(apg, app, w, np.array([p.perceived_gain for p in mine]),
                     np.array([p.perceived_phase_deg for p in mine]), lin, i, color=colour, label=name)  # fmt: skip
+            for p in mine:  # outside the boundaries: a red ring
+                if p.gain_inside is False:
+                    ag.plot(p.frequency_radps, p.gain, "o", ms=11, mfc="none", mec="red", mew=1.5)
+                if p.phase_inside is False:
+                    aph.plot(p.frequency_radps, p.phase_deg, "o", ms=11, mfc="none", mec="red", mew=1.5)
             if not aircraft_drawn:
                 ga = np.array([p.aircraft_perceived_gain for p in mine])
                 pa = np.array([p.aircraft_perceived_phase_deg for p in mine])
@@ -104,7 +110,7 @@ def write_bode_plots(
         apg.set_title("perceived (vestibular models)")
         ag.legend(fontsize=8, loc="best")
         apg.legend(fontsize=8, loc="best")
-        fig.suptitle(f"OMCT {test.name}  (x: non-linear point)", fontsize=11)
+        fig.suptitle(f"OMCT {test.name}  (x: non-linear point; red ring: outside the boundaries)", fontsize=11)
         fig.tight_layout()
         name = f"bode_{test.name}.png"
         with atomic_path(Path(out_dir) / name) as tmp:
