@@ -109,11 +109,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--rate-hz", type=float, default=120.0, help="washout sample rate (default 120)")
     p.add_argument("--amplitude-scale", type=float, default=1.0, help="multiply every input amplitude (default 1)")
 
-    from washbench.analysis.signals import AXES, KINDS
-
     p = sub.add_parser("signal", help="write a test signal on one axis as a washbench cue input")
-    p.add_argument("kind", choices=KINDS, help="signal shape")
-    p.add_argument("--axis", required=True, choices=AXES, help="specific force or rotation axis (body)")
+    p.add_argument("kind", help="signal shape: sine, step, pulse, doublet, chirp, multisine")
+    p.add_argument("--axis", required=True, help="body axis: f_x, f_y, f_z (specific force), roll, pitch, yaw")
     p.add_argument("--amplitude", type=float, required=True, help="m/s^2 (f_x, f_y, f_z) or deg/s (rotations)")
     p.add_argument("--frequency-hz", type=float, help="frequency (every kind but step; see README)")
     p.add_argument("--duration-s", type=float, default=20.0, help="length (default 20 s)")
