@@ -53,6 +53,12 @@ def report_text(
         ),
         "",
     ]
+    lines += [
+        "Perceived (right-hand plots, `perceived_*` columns): the same responses through the vestibular models "
+        "(otolith for specific force, canals for rotation), for each simulator pilot and for the aircraft pilot "
+        "given the same input; in `f_x_to_pitch` and `f_y_to_roll` the aircraft does not rotate (gain 0).",
+        "",
+    ]
     freqs = sorted({p.frequency_radps for p in points})
     scale = settings.amplitude_scale
     lines += [
