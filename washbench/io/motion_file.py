@@ -17,7 +17,9 @@ import pyarrow.parquet as pq
 
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import atomic_path, write_text_atomic
-from washbench.io.results import INPUT_COLUMNS, SUFFIXES
+from washbench.io.results import INPUT_COLUMNS
+
+SUFFIXES = {".csv": "csv", ".parquet": "parquet", ".pq": "parquet"}  # what this writer writes
 
 
 def write_motion(path: str | Path, t_s: np.ndarray, f_mps2: np.ndarray, omega_radps: np.ndarray) -> Path:
