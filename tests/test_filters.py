@@ -109,7 +109,7 @@ def test_cutoffs_match_paper_text():
 
 
 @pytest.mark.parametrize("dt", [1 / 50, 1 / 120, 1 / 1000])
-@pytest.mark.parametrize("name,tf", CASES + [("identity", filters.rotational_highpass(0.0))])
+@pytest.mark.parametrize("name,tf", [*CASES, ("identity", filters.rotational_highpass(0.0))])
 def test_discretise_equals_scipy_bilinear_bit_for_bit(name: str, tf, dt: float) -> None:
     # the numpy Tustin transform replaces scipy.signal (import time); it must give the same coefficients
     num, den = tf

@@ -56,6 +56,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
     p.add_argument("--quiet", action="store_true", help="no progress display")
+    p.add_argument("--no-recording", action="store_true", help="do not write recording.rrd (smaller, faster)")
 
     p = sub.add_parser("suite", help="run many manoeuvres in parallel and compare the washouts")
     p.add_argument("inputs", type=Path, nargs="*", help="manoeuvre files or folders (default: bundled manoeuvres/)")
@@ -64,6 +65,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
     p.add_argument("--quiet", action="store_true", help="no progress display")
+    p.add_argument("--no-recording", action="store_true", help="do not write the recording.rrd files")
 
     p = sub.add_parser("replay", help="open a recording in the rerun viewer")
     p.add_argument("recording", type=Path, help=".rrd file written by washbench run or suite")
@@ -93,7 +95,12 @@ def _dispatch(args: argparse.Namespace) -> int:
         from washbench.runs.pipeline import run_command
 
         return run_command(
-            args.manoeuvre, args.out, params_path=args.params, platform_path=args.platform, progress=not args.quiet
+            args.manoeuvre,
+            args.out,
+            params_path=args.params,
+            platform_path=args.platform,
+            progress=not args.quiet,
+            recording=not args.no_recording,
         )
     if args.command == "suite":
         from washbench.runs.suite import suite_command
@@ -105,6 +112,7 @@ def _dispatch(args: argparse.Namespace) -> int:
             params_path=args.params,
             platform_path=args.platform,
             progress=not args.quiet,
+            recording=not args.no_recording,
         )
     if args.command == "replay":
         from washbench.review.replay import replay_command

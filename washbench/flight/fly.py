@@ -193,8 +193,10 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
     nz_last = 1.0  # load factor of the last sample (before the first step: level flight or at rest)
     fy_last = 0.0  # and its lateral specific force, m/s^2
     k = 0
-    wall0 = time.monotonic()
-    next_report = wall0 + 0.5
+    # progress: overwritten in place on a terminal; otherwise (a log file, CI) one line every 5 s
+    tty = progress and sys.stderr.isatty()
+    report_every_s = 0.5 if tty else 5.0
+    next_report = time.monotonic() + report_every_s
     nphases = len(m.phases)
 
     while True:
@@ -282,8 +284,8 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
                 flapc_w.set_double_value(pilot.flaps_cmd)
                 lbrk_w.set_double_value(pilot.brakes)
                 rbrk_w.set_double_value(pilot.brakes)
-                if progress:
-                    _progress(m.name, iphase, nphases, phase.name, t)
+                if tty:
+                    _progress(m.name, iphase, nphases, phase.name, t, tty)
 
         if not final:
             pilot.step(phi, theta, psi, p, q, r, beta, vc, vg, trk, hdot, h, agl, x_rw * 3.2808399,
@@ -318,12 +320,12 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
                 break
         k += 1
         if progress and k % 600 == 0 and time.monotonic() > next_report:
-            next_report = time.monotonic() + 0.5
-            _progress(m.name, iphase, nphases, m.phases[iphase].name, t)
+            next_report = time.monotonic() + report_every_s
+            _progress(m.name, iphase, nphases, m.phases[iphase].name, t, tty)
 
     if reason and 0 <= iphase < nphases:  # the phase the flight stopped in, up to the last recorded sample
         phases_out.append((m.phases[iphase].name, phase_k0 * dt, max(len(rows) // ncol - 1, 0) * dt))
-    if progress:
+    if tty:
         sys.stderr.write("\r\033[K")
         sys.stderr.flush()
 
@@ -342,8 +344,9 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
     return FlightResult(m.name, m.aircraft, dt, columns, phases_out, checks, status, reason, events)
 
 
-def _progress(name: str, iphase: int, nphases: int, phase: str, t: float) -> None:
-    sys.stderr.write(f"\r\033[K{name}: phase {iphase + 1}/{nphases} '{phase}', t = {t:6.1f} s")
+def _progress(name: str, iphase: int, nphases: int, phase: str, t: float, tty: bool) -> None:
+    line = f"{name}: phase {iphase + 1}/{nphases} '{phase}', t = {t:6.1f} s"
+    sys.stderr.write(f"\r\033[K{line}" if tty else f"{line}\n")
     sys.stderr.flush()
 
 
@@ -388,9 +391,8 @@ def write_flight(out_dir: str | Path, result: FlightResult, source: str = "") ->
 def fly_command(manoeuvre_path: Path, out_dir: Path, progress: bool = True) -> int:
     """``washbench fly FILE --out DIR``: 0 if flown with every check passing, else 1."""
     m = load_manoeuvre(manoeuvre_path)
-    show = progress and sys.stderr.isatty()
     wall = time.monotonic()
-    result = fly(m, progress=show)
+    result = fly(m, progress=progress)
     wall = time.monotonic() - wall
     write_flight(out_dir, result, str(manoeuvre_path))
     passed = sum(1 for c in result.checks if c[3])

@@ -132,8 +132,11 @@ def run_manoeuvre(
     params_path: Path | None = None,
     platform_path: Path | None = None,
     progress: bool = False,
+    recording: bool = True,
 ) -> RunSummary:
     """Fly one manoeuvre with the washouts in lockstep and write its results folder.
+
+    ``recording=False`` skips ``recording.rrd`` (and the import of rerun): every other file is written.
 
     Raises WashbenchError for a bad manoeuvre, parameter or platform file (nothing written).
     A flight that crashes or fails a check still writes its results (what was flown), with
@@ -180,8 +183,9 @@ def run_manoeuvre(
         traces = {w: WashoutTrace.from_rows(block[:, i, :]) for i, w in enumerate(washouts)}
         result = analyse(motion, traces)
         write_results(partial, result)
-        title = f"{manoeuvre.aircraft} / {manoeuvre.name}"
-        _write_recording(partial / "recording.rrd", title, motion, flight, result, limits)
+        if recording:
+            title = f"{manoeuvre.aircraft} / {manoeuvre.name}"
+            _write_recording(partial / "recording.rrd", title, motion, flight, result, limits)
         felt = perceived_motion(
             result.perceived["aircraft"].f_mps2, result.perceived["aircraft"].omega_radps, motion.dt_s
         )
@@ -293,6 +297,7 @@ def run_command(
     params_path: Path | None = None,
     platform_path: Path | None = None,
     progress: bool = True,
+    recording: bool = True,
 ) -> int:
     """CLI entry of ``washbench run``: 0 if the flight ran and passed its checks, else 1."""
     start = time.perf_counter()
@@ -301,7 +306,8 @@ def run_command(
         out_root,
         params_path=params_path,
         platform_path=platform_path,
-        progress=progress and sys.stderr.isatty(),
+        progress=progress,
+        recording=recording,
     )
     state = "ok" if s.ok else f"FAILED ({s.reason})"
     print(

@@ -74,7 +74,9 @@ def find_manoeuvres(inputs: Sequence[Path]) -> list[Path]:
     return unique
 
 
-def _run_one(path: str, out_dir: str, params_path: str | None, platform_path: str | None) -> Outcome:
+def _run_one(
+    path: str, out_dir: str, params_path: str | None, platform_path: str | None, recording: bool = True
+) -> Outcome:
     """Worker: run one manoeuvre; never raises (failures come back as an Outcome)."""
     from washbench.runs.pipeline import run_manoeuvre
 
@@ -85,6 +87,7 @@ def _run_one(path: str, out_dir: str, params_path: str | None, platform_path: st
             Path(out_dir),
             params_path=Path(params_path) if params_path else None,
             platform_path=Path(platform_path) if platform_path else None,
+            recording=recording,
         )
     except WashbenchError as exc:
         summary = RunSummary(ok=False, reason=str(exc))
@@ -103,12 +106,22 @@ def run_suite(
     params_path: Path | None = None,
     platform_path: Path | None = None,
     progress: bool = True,
+    recording: bool = True,
 ) -> list[Outcome]:
-    """Run every file in parallel processes; return the outcomes in the order of ``files``."""
+    """Run every file in parallel processes; return the outcomes in the order of ``files``.
+
+    ``recording=False``: no ``recording.rrd`` in the run folders (the report then links none).
+    """
     jobs = max(1, min(jobs or os.cpu_count() or 1, len(files)))
     out_dir.mkdir(parents=True, exist_ok=True)
     args = [
-        (str(f), str(out_dir), str(params_path) if params_path else None, str(platform_path) if platform_path else None)
+        (
+            str(f),
+            str(out_dir),
+            str(params_path) if params_path else None,
+            str(platform_path) if platform_path else None,
+            recording,
+        )
         for f in files
     ]
     outcomes: dict[str, Outcome] = {}
@@ -261,7 +274,8 @@ def report_markdown(outcomes: Sequence[Outcome], rankings: dict[tuple[str, str],
         lines += ["", f"## {o.run.aircraft} / {o.run.manoeuvre}", ""]
         if o.run.run_dir:
             rel = os.path.relpath(o.run.run_dir, out_dir)
-            lines.append(f"Results in `{rel}/`; replay with `washbench replay {rel}/recording.rrd`.")
+            replay = f"; replay with `washbench replay {rel}/recording.rrd`"
+            lines.append(f"Results in `{rel}/`{replay if (o.run.run_dir / 'recording.rrd').exists() else ''}.")
             lines.append("")
         sat = ", ".join(
             f"{w}: " + (", ".join(f"{k} {n}" for k, n in kinds.items() if n) or "none")
@@ -310,6 +324,7 @@ def suite_command(
     params_path: Path | None = None,
     platform_path: Path | None = None,
     progress: bool = True,
+    recording: bool = True,
 ) -> int:
     """CLI entry: run the suite, write its results, print where they are; 0 if all succeeded, else 1."""
     if jobs is not None and jobs < 1:
@@ -323,7 +338,13 @@ def suite_command(
     load_platform_limits(platform_path)
     start = time.perf_counter()
     outcomes = run_suite(
-        files, out_dir, jobs=jobs, params_path=params_path, platform_path=platform_path, progress=progress
+        files,
+        out_dir,
+        jobs=jobs,
+        params_path=params_path,
+        platform_path=platform_path,
+        progress=progress,
+        recording=recording,
     )
     write_suite_results(outcomes, out_dir)
     n_ok = sum(o.run.ok for o in outcomes)
