@@ -25,7 +25,7 @@ from washbench.flight.checks import evaluate
 from washbench.flight.columns import COLUMN_NAMES
 from washbench.flight.fdm import make_fdm
 from washbench.flight.manoeuvre import Manoeuvre, Until, load_manoeuvre, pilot_profile_path
-from washbench.flight.monitor import Monitor
+from washbench.flight.monitor import ALPHA_MAX_RAD, BIG, Monitor
 from washbench.flight.pilot import Pilot
 from washbench.flight.profile import load_profile
 from washbench.io.atomic import atomic_path, write_text_atomic
@@ -141,6 +141,12 @@ def _end_reached(u: Until, t_phase: float, turned: float, rolled: float, pitched
     )
 
 
+def _duration_only(u: Until) -> float | None:
+    """``duration_s - 1e-9`` (the threshold :func:`_end_reached` uses) if the phase ends only by its duration."""
+    others = u.model_dump(exclude={"duration_s", "timeout_s"}, exclude_none=True)
+    return u.duration_s - 1e-9 if u.duration_s is not None and not others else None
+
+
 def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool = False) -> FlightResult:
     """Fly ``manoeuvre`` to its end (or to a crash) and return the recording and check results.
 
@@ -176,6 +182,10 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
     alpha_stall_deg = profile.limits.alpha_stall_deg
 
     rows = array("d")
+    rows_extend = rows.extend
+    run = fdm.run
+    nz_max, nz_min = monitor.nz_max, monitor.nz_min
+    vne, h_collapsed = monitor.vne, monitor.h_collapsed
     ncol = len(COLUMN_NAMES)
     phases_out: list[tuple[str, float, float]] = []
     events: dict[str, list[float]] = {"touchdown_times_s": [], "touchdown_sinks_fps": [], "liftoff_times_s": []}
@@ -183,6 +193,7 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
     iphase = -1
     phase_k0 = 0
     u: Until | None = None
+    end_s: float | None = None
     psi_prev = p_prev = q_prev = 0.0
     turned = 0.0
     rolled = pitched = 0.0  # integrals of the body rates p and q over the phase, rad (trapezoidal rule)
@@ -218,7 +229,12 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
         for g in struct_gets:
             sw += g()
 
-        problem = monitor.state(phi + theta + p + q + r + vc + h + agl + alpha, vc, alpha, agl, wow, sw)
+        total = phi + theta + p + q + r + vc + h + agl + alpha
+        # the monitor's state checks, inlined (hot path); it is asked for the cause only when one fails
+        problem = None
+        if (not -BIG < total < BIG or sw > 0.0 or vc > vne or agl < h_collapsed
+                or (not wow and (alpha > ALPHA_MAX_RAD or alpha < -ALPHA_MAX_RAD))):  # fmt: skip
+            problem = monitor.state(total, vc, alpha, agl, wow, sw)
         # events at this sample
         if wow and not was_wow:
             sink = -hdot
@@ -258,8 +274,10 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
         advance = iphase < 0
         if u is not None:
             t_phase = (k - phase_k0) * dt
-            if _end_reached(u, t_phase, abs(turned) * R2D, abs(rolled) * R2D, abs(pitched) * R2D, vc, h, agl,
-                            phi * R2D, theta * R2D, alpha * R2D, phase_events):  # fmt: skip
+            if end_s is not None:  # a phase that ends only after a duration (most): no call needed
+                advance = t_phase >= end_s
+            elif _end_reached(u, t_phase, abs(turned) * R2D, abs(rolled) * R2D, abs(pitched) * R2D, vc, h, agl,
+                              phi * R2D, theta * R2D, alpha * R2D, phase_events):  # fmt: skip
                 advance = True
             elif u.duration_s is None and t_phase >= u.timeout_s:
                 reason = (
@@ -277,6 +295,7 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
             else:
                 phase = m.phases[iphase]
                 u = phase.until
+                end_s = _duration_only(u)
                 phase_k0 = k
                 turned = rolled = pitched = 0.0
                 phase_events = set()
@@ -297,27 +316,22 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
             thr_set(pilot.throttle)
             if k % mix_every == 0:
                 mix_w.set_double_value(float(np.interp(h, mix_h_ft, mix_norm)))
-        fdm.run()
-        fx = ax_get() * FT_S2_TO_M_S2
-        fy = ay_get() * FT_S2_TO_M_S2
-        fz = az_get() * FT_S2_TO_M_S2
+        run()
+        ax, ay, az = ax_get(), ay_get(), az_get()
         nz = nz_get()
         nz_last = nz
-        fy_last = fy
-        rows.extend((t, fx, fy, fz, p * R2D, q * R2D, r * R2D, phi * R2D, theta * R2D, psi * R2D % 360.0,
-                     alpha * R2D, beta * R2D, vc, vg * FPS_TO_KT, h, agl, hdot * 60.0, north, east, lat * R2D,
-                     lon * R2D, x_rw, y_rw, nz, pilot.aileron, pilot.elevator, pilot.rudder, pilot.throttle,
-                     flap_get(), pilot.brakes, rpm_get(), 1.0 if wow else 0.0, float(iphase if not final
-                                                                                      else nphases - 1)))  # fmt: skip
+        fy_last = ay * FT_S2_TO_M_S2
+        # raw values in JSBSim's units; converted column by column after the loop (same bits, fewer operations)
+        rows_extend((k, ax, ay, az, p, q, r, phi, theta, psi, alpha, beta, vc, vg, h, agl, hdot, north, east, lat,
+                     lon, x_rw, y_rw, nz, pilot.aileron, pilot.elevator, pilot.rudder, pilot.throttle, flap_get(),
+                     pilot.brakes, rpm_get(), wow, iphase if not final else nphases - 1))  # fmt: skip
         if step_hook is not None:
-            step_hook(k, np.array((fx, fy, fz)), np.array((p, q, r)))
+            step_hook(k, np.array((ax * FT_S2_TO_M_S2, fy_last, az * FT_S2_TO_M_S2)), np.array((p, q, r)))
         if final:
             break
-        if not wow:
-            problem = monitor.load_factor(nz)
-            if problem:
-                reason = f"t={t:.2f} s: {problem}"
-                break
+        if not wow and (nz > nz_max or nz < nz_min):
+            reason = f"t={t:.2f} s: {monitor.load_factor(nz)}"
+            break
         k += 1
         if progress and k % 600 == 0 and time.monotonic() > next_report:
             next_report = time.monotonic() + report_every_s
@@ -329,10 +343,7 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
         sys.stderr.write("\r\033[K")
         sys.stderr.flush()
 
-    data = np.frombuffer(rows, dtype=np.float64).reshape(-1, ncol) if rows else np.zeros((0, ncol))
-    columns = {name: np.ascontiguousarray(data[:, i]) for i, name in enumerate(COLUMN_NAMES)}
-    columns["wow"] = columns["wow"].astype(np.int8)
-    columns["phase"] = columns["phase"].astype(np.int16)
+    columns = _columns(np.frombuffer(rows, dtype=np.float64).reshape(-1, ncol), dt)
     results = evaluate(list(m.checks), columns, phases_out, events, dt) if not reason else []
     checks = [(c.name, c.measured, c.limit, c.passed) for c in results]
     status = "ok"
@@ -342,6 +353,28 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
         status = "failed"
         reason = "checks failed: " + ", ".join(c.name for c in results if not c.passed)
     return FlightResult(m.name, m.aircraft, dt, columns, phases_out, checks, status, reason, events)
+
+
+#: Factor from the raw value recorded per step to each flight.parquet column (None: taken as it is).
+_SCALE: dict[str, float | None] = {name: None for name in COLUMN_NAMES} | {
+    "f_x_mps2": FT_S2_TO_M_S2, "f_y_mps2": FT_S2_TO_M_S2, "f_z_mps2": FT_S2_TO_M_S2,
+    "omega_x_degps": R2D, "omega_y_degps": R2D, "omega_z_degps": R2D, "phi_deg": R2D, "theta_deg": R2D,
+    "psi_deg": R2D, "alpha_deg": R2D, "beta_deg": R2D, "gs_kts": FPS_TO_KT, "climb_fpm": 60.0, "lat_deg": R2D,
+    "lon_deg": R2D,
+}  # fmt: skip
+
+
+def _columns(raw: np.ndarray, dt: float) -> dict[str, np.ndarray]:
+    """flight.parquet's columns from the raw rows of the loop (step counter, JSBSim units, radians)."""
+    columns: dict[str, np.ndarray] = {}
+    for i, name in enumerate(COLUMN_NAMES):
+        scale = _SCALE[name]
+        columns[name] = raw[:, i] * scale if scale is not None else np.ascontiguousarray(raw[:, i])
+    columns["t_s"] = columns["t_s"] * dt  # t = k * dt, as in the loop
+    columns["psi_deg"] = columns["psi_deg"] % 360.0
+    columns["wow"] = columns["wow"].astype(np.int8)
+    columns["phase"] = columns["phase"].astype(np.int16)
+    return columns
 
 
 def _progress(name: str, iphase: int, nphases: int, phase: str, t: float, tty: bool) -> None:

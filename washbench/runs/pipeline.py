@@ -1,8 +1,10 @@
 """``washbench run``: fly a manoeuvre with the three washouts in lockstep, then perceive, measure, record.
 
 At every JSBSim step the scripted pilot's flight gives one sample of pilot-head motion; the
-sample goes straight through the three washouts and the kinematic Atlas model
-(:class:`washbench.cueing.CueingBank`, the streaming form), as a real simulator would run them.
+samples go through the three washouts and the kinematic Atlas model while the flight goes on,
+a block of ``LOCKSTEP_BLOCK`` samples (1 s at 120 Hz) at a time
+(:meth:`washbench.cueing.CueingBank.steps`: the same compiled step as the per-sample streaming
+form, bit for bit, without a Python call per sample).
 After the flight the vestibular models, the metrics and the tables are the same code as
 ``washbench cue`` (:func:`washbench.runs.cue.analyse`), on the flight as written to
 ``flight.parquet`` and read back, so ``washbench fly`` then ``washbench cue`` gives the same
@@ -41,11 +43,16 @@ from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
 
 if TYPE_CHECKING:
+    from washbench.cueing import CueingBank
     from washbench.flight.fly import FlightResult
     from washbench.io.results import Motion
     from washbench.platform import PlatformLimits
     from washbench.review.rerun_log import PlatformEnvelope
     from washbench.runs.cue import CueResult
+
+#: Samples the washouts take at a time during the flight (1 s at 120 Hz): the same compiled step as one
+#: sample at a time, bit for bit, with one call per block instead of one per sample.
+LOCKSTEP_BLOCK = 120
 
 RUN_FILES = ("flight.json", "flight.parquet", "traces.parquet", "metrics.csv", "recording.rrd", "run.json")
 
@@ -125,6 +132,42 @@ def _publish(partial: Path, final: Path) -> None:
     shutil.rmtree(old, ignore_errors=True)
 
 
+class Lockstep:
+    """The flight's step hook that feeds the washouts as the flight goes, ``LOCKSTEP_BLOCK`` samples at a time.
+
+    ``finish()`` runs the last partial block and returns every output row, (washouts, N, fields).
+    """
+
+    def __init__(self, bank: CueingBank) -> None:
+        self.bank = bank
+        self.blocks: list[np.ndarray] = []  # (washouts, samples, fields) per block
+        self.f = np.empty((LOCKSTEP_BLOCK, 3))
+        self.w = np.empty((LOCKSTEP_BLOCK, 3))
+        self.filled = 0
+
+    def __call__(self, k: int, f_mps2: np.ndarray, omega_radps: np.ndarray) -> None:
+        i = self.filled
+        self.f[i] = f_mps2
+        self.w[i] = omega_radps
+        self.filled = i + 1
+        if i + 1 == LOCKSTEP_BLOCK:
+            self._flush()
+
+    def _flush(self) -> None:
+        # The washouts see the angular velocity exactly as flight.parquet stores it (deg/s) and
+        # washbench cue reads it back (np.radians), so both paths give the same bits.
+        n = self.filled
+        self.blocks.append(self.bank.steps(self.f[:n], np.radians(np.degrees(self.w[:n]))))
+        self.filled = 0
+
+    def finish(self) -> np.ndarray:
+        if self.filled:
+            self._flush()
+        if not self.blocks:
+            return np.zeros((len(self.bank.washouts), 0, len(self.bank.FIELDS)))
+        return np.concatenate(self.blocks, axis=1)
+
+
 def run_manoeuvre(
     manoeuvre_path: Path,
     out_root: Path,
@@ -154,21 +197,13 @@ def run_manoeuvre(
     limits = load_platform_limits(platform_path)
     washouts = tuple(WASHOUT_NAMES)
     bank = CueingBank(washouts, params, limits, manoeuvre.dt_s)
-    rows: list[np.ndarray] = []
-    step = bank.step
-    omega_deg = np.empty(3)
-
-    def lockstep(k: int, f_mps2: np.ndarray, omega_radps: np.ndarray) -> None:
-        # The washouts see the angular velocity exactly as flight.parquet stores it (deg/s) and
-        # washbench cue reads it back (np.radians), so both paths give the same bits.
-        np.degrees(omega_radps, out=omega_deg)
-        rows.append(step(f_mps2, np.radians(omega_deg)).copy())
-
+    lockstep = Lockstep(bank)
     start = time.perf_counter()
     flight = fly(manoeuvre, step_hook=lockstep, progress=progress)
+    block = lockstep.finish()  # (washouts, N, fields)
     n = len(flight.t_s)
-    if len(rows) != n:
-        raise RuntimeError(f"washouts ran {len(rows)} steps for {n} recorded samples")
+    if block.shape[1] != n:
+        raise RuntimeError(f"washouts ran {block.shape[1]} steps for {n} recorded samples")
 
     final = Path(out_root) / manoeuvre.aircraft / manoeuvre.name
     partial = final.with_name(f".{final.name}.partial-{os.getpid()}")
@@ -179,8 +214,7 @@ def run_manoeuvre(
         if n < 2:
             raise WashbenchError(located(manoeuvre_path, f"the flight recorded {n} sample(s): nothing to cue"))
         motion = read_motion(partial / "flight.parquet")
-        block = np.stack(rows)  # (N, washouts, fields)
-        traces = {w: WashoutTrace.from_rows(block[:, i, :]) for i, w in enumerate(washouts)}
+        traces = {w: WashoutTrace.from_rows(block[i]) for i, w in enumerate(washouts)}
         result = analyse(motion, traces)
         write_results(partial, result)
         if recording:
