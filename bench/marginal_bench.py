@@ -64,7 +64,7 @@ def time_fly(path: Path, washouts: bool) -> tuple[float, int]:
     if washouts:
         hook = Lockstep(CueingBank(WASHOUT_NAMES, load_washout_params(), load_platform_limits(), m.dt_s))
     t0 = time.process_time()
-    result = fly(m, step_hook=hook)
+    result = fly(m, block_hook=hook)
     if hook is not None:
         hook.finish()
     wall = time.process_time() - t0

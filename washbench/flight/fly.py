@@ -35,6 +35,7 @@ R2D = 180.0 / math.pi
 FPS_TO_KT = 3600.0 * 0.3048 / 1852.0
 
 StepHook = Callable[[int, np.ndarray, np.ndarray], None]
+BlockHook = Callable[[int, np.ndarray, np.ndarray], None]
 
 #: Properties read every step (verified to exist at start-up: JSBSim ignores typos silently).
 STATE_PROPERTIES = (
@@ -147,12 +148,15 @@ def _duration_only(u: Until) -> float | None:
     return u.duration_s - 1e-9 if u.duration_s is not None and not others else None
 
 
-def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool = False) -> FlightResult:
+def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool = False,
+        block_hook: BlockHook | None = None, block_size: int = 120) -> FlightResult:  # fmt: skip
     """Fly ``manoeuvre`` to its end (or to a crash) and return the recording and check results.
 
     ``step_hook(k, f_mps2, omega_radps)`` is called once per recorded sample, in order, as soon
     as the sample is final (specific force at the eyepoint in m/s^2 and body rates in rad/s,
-    body axes x forward, y right, z down).
+    body axes x forward, y right, z down). ``block_hook(k0, f_mps2, omega_radps)`` gets the same
+    samples ``block_size`` at a time as (M, 3) arrays (samples ``k0 .. k0 + M - 1``; the last block
+    may be shorter), without a Python call per sample.
     """
     m = manoeuvre
     profile = load_profile(pilot_profile_path(m.aircraft))
@@ -204,6 +208,7 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
     nz_last = 1.0  # load factor of the last sample (before the first step: level flight or at rest)
     fy_last = 0.0  # and its lateral specific force, m/s^2
     k = 0
+    k_sent = 0  # samples handed to block_hook so far
     # progress: overwritten in place on a terminal; otherwise (a log file, CI) one line every 5 s
     tty = progress and sys.stderr.isatty()
     report_every_s = 0.5 if tty else 5.0
@@ -327,6 +332,8 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
                      pilot.brakes, rpm_get(), wow, iphase if not final else nphases - 1))  # fmt: skip
         if step_hook is not None:
             step_hook(k, np.array((ax * FT_S2_TO_M_S2, fy_last, az * FT_S2_TO_M_S2)), np.array((p, q, r)))
+        if block_hook is not None and k + 1 - k_sent == block_size:
+            k_sent = _send_block(block_hook, rows, k_sent, ncol)
         if final:
             break
         if not wow and (nz > nz_max or nz < nz_min):
@@ -337,6 +344,8 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
             next_report = time.monotonic() + report_every_s
             _progress(m.name, iphase, nphases, m.phases[iphase].name, t, tty)
 
+    if block_hook is not None and len(rows) // ncol > k_sent:
+        _send_block(block_hook, rows, k_sent, ncol)
     if reason and 0 <= iphase < nphases:  # the phase the flight stopped in, up to the last recorded sample
         phases_out.append((m.phases[iphase].name, phase_k0 * dt, max(len(rows) // ncol - 1, 0) * dt))
     if tty:
@@ -353,6 +362,14 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
         status = "failed"
         reason = "checks failed: " + ", ".join(c.name for c in results if not c.passed)
     return FlightResult(m.name, m.aircraft, dt, columns, phases_out, checks, status, reason, events)
+
+
+def _send_block(hook: BlockHook, rows: array, k0: int, ncol: int) -> int:
+    """Give ``hook`` the recorded samples from ``k0`` on (f in m/s^2, omega in rad/s); return the new count."""
+    with memoryview(rows) as view:
+        raw = np.frombuffer(view[k0 * ncol :], dtype=np.float64).reshape(-1, ncol).copy()
+    hook(k0, raw[:, 1:4] * FT_S2_TO_M_S2, raw[:, 4:7])
+    return k0 + raw.shape[0]
 
 
 #: Factor from the raw value recorded per step to each flight.parquet column (None: taken as it is).

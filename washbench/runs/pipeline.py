@@ -133,36 +133,25 @@ def _publish(partial: Path, final: Path) -> None:
 
 
 class Lockstep:
-    """The flight's step hook that feeds the washouts as the flight goes, ``LOCKSTEP_BLOCK`` samples at a time.
+    """The flight's block hook (:func:`washbench.flight.fly.fly`): feeds the washouts as the flight goes.
 
-    ``finish()`` runs the last partial block and returns every output row, (washouts, N, fields).
+    ``finish()`` returns every output row, (washouts, N, fields).
     """
 
     def __init__(self, bank: CueingBank) -> None:
         self.bank = bank
         self.blocks: list[np.ndarray] = []  # (washouts, samples, fields) per block
-        self.f = np.empty((LOCKSTEP_BLOCK, 3))
-        self.w = np.empty((LOCKSTEP_BLOCK, 3))
-        self.filled = 0
+        self.done = 0
 
-    def __call__(self, k: int, f_mps2: np.ndarray, omega_radps: np.ndarray) -> None:
-        i = self.filled
-        self.f[i] = f_mps2
-        self.w[i] = omega_radps
-        self.filled = i + 1
-        if i + 1 == LOCKSTEP_BLOCK:
-            self._flush()
-
-    def _flush(self) -> None:
+    def __call__(self, k0: int, f_mps2: np.ndarray, omega_radps: np.ndarray) -> None:
+        if k0 != self.done:
+            raise RuntimeError(f"lockstep: block starts at sample {k0}, expected {self.done}")
         # The washouts see the angular velocity exactly as flight.parquet stores it (deg/s) and
         # washbench cue reads it back (np.radians), so both paths give the same bits.
-        n = self.filled
-        self.blocks.append(self.bank.steps(self.f[:n], np.radians(np.degrees(self.w[:n]))))
-        self.filled = 0
+        self.blocks.append(self.bank.steps(f_mps2, np.radians(np.degrees(omega_radps))))
+        self.done += f_mps2.shape[0]
 
     def finish(self) -> np.ndarray:
-        if self.filled:
-            self._flush()
         if not self.blocks:
             return np.zeros((len(self.bank.washouts), 0, len(self.bank.FIELDS)))
         return np.concatenate(self.blocks, axis=1)
@@ -199,7 +188,7 @@ def run_manoeuvre(
     bank = CueingBank(washouts, params, limits, manoeuvre.dt_s)
     lockstep = Lockstep(bank)
     start = time.perf_counter()
-    flight = fly(manoeuvre, step_hook=lockstep, progress=progress)
+    flight = fly(manoeuvre, block_hook=lockstep, block_size=LOCKSTEP_BLOCK, progress=progress)
     block = lockstep.finish()  # (washouts, N, fields)
     n = len(flight.t_s)
     if block.shape[1] != n:
