@@ -424,7 +424,8 @@ def flight_summary(result: FlightResult, source: str = "") -> dict[str, object]:
 def write_flight(out_dir: str | Path, result: FlightResult, source: str = "") -> None:
     """Write ``out_dir/flight.parquet`` and ``out_dir/flight.json`` atomically."""
     import pyarrow as pa
-    import pyarrow.parquet as pq
+
+    from washbench.io.results import write_parquet
 
     out = Path(out_dir)
     try:
@@ -434,7 +435,7 @@ def write_flight(out_dir: str | Path, result: FlightResult, source: str = "") ->
     table = pa.table({name: result.columns[name] for name in COLUMN_NAMES})
     table = table.replace_schema_metadata({"washbench.manoeuvre": result.name, "washbench.aircraft": result.aircraft})
     with atomic_path(out / "flight.parquet") as tmp:
-        pq.write_table(table, tmp)
+        write_parquet(tmp, table)
     write_text_atomic(out / "flight.json", json.dumps(flight_summary(result, source), indent=2) + "\n")
 
 
