@@ -60,7 +60,9 @@ def pearson(x: np.ndarray, y: np.ndarray) -> float:
         return math.nan
     dx = x - x.mean()
     dy = y - y.mean()
-    pc = float(np.dot(dx, dy) / (math.sqrt(float(np.dot(dx, dx))) * math.sqrt(float(np.dot(dy, dy)))))
+    # np.sum of products, not np.dot: OpenBLAS's dot threads large vectors, which costs milliseconds per call on a
+    # busy machine (100x the sum) and makes the last bits depend on the thread count; numpy's pairwise sum does not.
+    pc = float(np.sum(dx * dy) / (math.sqrt(float(np.sum(dx * dx))) * math.sqrt(float(np.sum(dy * dy)))))
     return min(1.0, max(-1.0, pc))
 
 
