@@ -417,6 +417,13 @@ def write_parquet(path: str | Path, arrow: pa.Table) -> None:
     pq.write_table(arrow, path, compression="zstd", use_dictionary=others, use_byte_stream_split=floats)
 
 
+def parquet_writer(path: str | Path, schema: pa.Schema) -> pq.ParquetWriter:
+    """A writer for tables written a row group at a time, with :func:`write_parquet`'s settings."""
+    floats = [f.name for f in schema if pa.types.is_floating(f.type)]
+    others = [f.name for f in schema if not pa.types.is_floating(f.type)]
+    return pq.ParquetWriter(path, schema, compression="zstd", use_dictionary=others, use_byte_stream_split=floats)
+
+
 def write_traces(path: str | Path, table: Mapping[str, np.ndarray]) -> None:
     """Write the traces table (column name -> 1-D array, all the same length) to Parquet, atomically."""
     arrow = pa.table({name: pa.array(np.asarray(col)) for name, col in table.items()})

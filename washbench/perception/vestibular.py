@@ -263,6 +263,31 @@ class VestibularModel:
         return Perceived(f_mps2=f_hat, omega_radps=w_hat)
 
 
+class PerceptionStream:
+    """One pilot's vestibular models fed chunk by chunk: the same bits as :meth:`VestibularModel.perceive` whole.
+
+    The filters start in the steady state of the first sample of the first chunk.
+    """
+
+    def __init__(self, model: VestibularModel) -> None:
+        self.model = model
+        self._state: tuple[np.ndarray, np.ndarray] | None = None
+
+    def perceive(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> Perceived:
+        """Perceived motion for the next samples (N, 3) each."""
+        f = _check_n3(f_mps2, "f_mps2")
+        w = _check_n3(omega_radps, "omega_radps")
+        m = self.model
+        if self._state is None:
+            self._state = (m.otolith.start(f[0]), m.canals.start(w[0]))
+        f_hat = m.otolith.run(f, self._state[0])
+        w_hat = m.canals.run(w, self._state[1])
+        th = m.params.thresholds
+        if th is not None:
+            f_hat, w_hat = apply_deadband(f_hat, w_hat, th)
+        return Perceived(f_mps2=f_hat, omega_radps=w_hat)
+
+
 def _check_n3(a: np.ndarray, name: str) -> np.ndarray:
     a = np.asarray(a, dtype=np.float64)
     if a.ndim != 2 or a.shape[1] != 3 or a.shape[0] == 0:

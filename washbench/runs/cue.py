@@ -12,12 +12,15 @@ the post-processing:
 from __future__ import annotations
 
 import math
+import sys
+import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
 import numpy as np
+import pyarrow as pa
 
 from washbench.analysis.metrics import MetricRow, dof_metrics
 from washbench.errors import WashbenchError, located
@@ -98,7 +101,7 @@ _TRACE_FIELDS = {
 }
 
 
-def _checked_trace(name: str, trace: TraceLike, n: int) -> dict[str, np.ndarray]:
+def _checked_trace(name: str, trace: TraceLike, n: int, first: int = 0) -> dict[str, np.ndarray]:
     """The trace's arrays as float64, checked for shape and finiteness (a non-finite value is an error)."""
     out = {}
     for attr, width in _TRACE_FIELDS.items():
@@ -107,7 +110,7 @@ def _checked_trace(name: str, trace: TraceLike, n: int) -> dict[str, np.ndarray]
             raise ValueError(f"washout {name!r}: {attr} has shape {a.shape}, expected ({n}, {width})")
         bad = ~np.isfinite(a)
         if bad.any():
-            row = int(np.argmax(bad.any(axis=1)))
+            row = first + int(np.argmax(bad.any(axis=1)))
             raise WashbenchError(f"washout {name!r} produced a non-finite {attr} at sample {row} (t index {row})")
         out[attr] = a
     return out
@@ -121,19 +124,42 @@ def analyse(motion: Motion, traces: Mapping[str, TraceLike], vestibular: Vestibu
     """
     model = VestibularModel(motion.dt_s, vestibular)
     n = motion.n
+    arrays = {name: _checked_trace(name, trace, n) for name, trace in traces.items()}
     perceived: dict[str, Perceived] = {AIRCRAFT: model.perceive(motion.f_mps2, motion.omega_radps)}
-    table: dict[str, np.ndarray] = {TIME_COLUMN: motion.t_s}
-    _put(table, f_columns(AIRCRAFT), motion.f_mps2)
-    _put(table, omega_columns(AIRCRAFT), motion.omega_degps_out())
+    for name, arr in arrays.items():
+        perceived[name] = model.perceive(arr["head_f_mps2"], arr["head_omega_radps"])
+    table = _table(motion.t_s, motion.f_mps2, motion.omega_degps_out(), motion.extra, traces, arrays, perceived)
+    return CueResult(motion=motion, traces=dict(traces), perceived=perceived, metrics=_metrics(perceived, motion.dt_s),
+                     table=table)  # fmt: skip
+
+
+def _metrics(perceived: Mapping[str, Perceived], dt_s: float) -> list[MetricRow]:
+    ac = perceived[AIRCRAFT]
+    rows: list[MetricRow] = []
+    for name, p in perceived.items():
+        if name != AIRCRAFT:
+            rows += dof_metrics(name, ac.f_mps2, ac.omega_radps, p.f_mps2, p.omega_radps, dt_s)
+    return rows
+
+
+def _table(
+    t_s: np.ndarray,
+    f_mps2: np.ndarray,
+    omega_degps: np.ndarray,
+    extra: Mapping[str, np.ndarray],
+    traces: Mapping[str, TraceLike],
+    arrays: Mapping[str, dict[str, np.ndarray]],
+    perceived: Mapping[str, Perceived],
+) -> dict[str, np.ndarray]:
+    """The traces.parquet columns, in order, for the given rows (a whole trace or a chunk of one)."""
+    n = t_s.shape[0]
+    table: dict[str, np.ndarray] = {TIME_COLUMN: t_s}
+    _put(table, f_columns(AIRCRAFT), f_mps2)
+    _put(table, omega_columns(AIRCRAFT), omega_degps)
     _put(table, perceived_f_columns(AIRCRAFT), perceived[AIRCRAFT].f_mps2)
     _put(table, perceived_omega_columns(AIRCRAFT), perceived[AIRCRAFT].omega_radps * _DEG)
-    rows: list[MetricRow] = []
-    ac = perceived[AIRCRAFT]
     for name, trace in traces.items():
-        arr = _checked_trace(name, trace, n)
-        p = model.perceive(arr["head_f_mps2"], arr["head_omega_radps"])
-        perceived[name] = p
-        rows += dof_metrics(name, ac.f_mps2, ac.omega_radps, p.f_mps2, p.omega_radps, motion.dt_s)
+        arr, p = arrays[name], perceived[name]
         _put(table, f_columns(name), arr["head_f_mps2"])
         _put(table, omega_columns(name), arr["head_omega_radps"] * _DEG)
         _put(table, perceived_f_columns(name), p.f_mps2)
@@ -151,11 +177,11 @@ def analyse(motion: Motion, traces: Mapping[str, TraceLike], vestibular: Vestibu
             if flags.shape != (n,):
                 raise ValueError(f"washout {name!r}: saturated[{kind!r}] has shape {flags.shape}, expected ({n},)")
             table[sat_column(name, kind)] = flags.astype(np.int8)
-    for col, values in motion.extra.items():
+    for col, values in extra.items():
         if col in table:
             raise WashbenchError(f"input column {col!r} clashes with a result column of the same name")
         table[col] = values
-    return CueResult(motion=motion, traces=dict(traces), perceived=perceived, metrics=rows, table=table)
+    return table
 
 
 def _put(table: dict[str, np.ndarray], names: Sequence[str], values: np.ndarray) -> None:
@@ -204,6 +230,108 @@ def write_results(out_dir: Path, result: CueResult) -> tuple[Path, Path]:
     return traces_path, metrics_path
 
 
+#: Rows ``washbench cue`` works on at a time: memory beyond the input and the perceived signals is bounded by
+#: about 2 KB a row of this (65 MB), whatever the length of the recording.
+CHUNK_ROWS = 32768
+
+
+def cue_to_files(
+    motion: Motion,
+    washouts: Sequence[str],
+    params: Any,
+    limits: Any,
+    out_dir: Path,
+    *,
+    vestibular: VestibularParams | None = None,
+    chunk_rows: int = CHUNK_ROWS,
+    progress: bool = False,
+) -> tuple[list[MetricRow], dict[str, dict[str, int]], tuple[Path, Path]]:
+    """:func:`cue_motion` then :func:`write_results`, ``chunk_rows`` samples at a time; the same files, bit for bit
+    in content (only the Parquet row groups differ).
+
+    Held whole are only the input and each pilot's perceived motion (48 bytes a row per pilot, for the metrics);
+    the washout traces and the table exist one chunk at a time. Returns the metric rows, the saturation counts per
+    washout and the two paths written. ``progress``: a line on stderr every 5 s (in place on a terminal).
+    """
+    from washbench.cueing import CueingBank, WashoutTrace, check_washouts
+    from washbench.io.results import parquet_writer
+    from washbench.perception.vestibular import PerceptionStream
+
+    names = check_washouts(washouts)
+    if chunk_rows < 1:
+        raise ValueError(f"chunk_rows must be at least 1, got {chunk_rows}")
+    n = motion.n
+    bank = CueingBank(names, params, limits, motion.dt_s)
+    model = VestibularModel(motion.dt_s, vestibular)
+    streams = {p: PerceptionStream(model) for p in (AIRCRAFT, *names)}
+    felt = {p: (np.empty((n, 3)), np.empty((n, 3))) for p in streams}
+    omega_deg = motion.omega_degps_out()
+    out_dir = Path(out_dir)
+    traces_path, metrics_path = out_dir / TRACES_FILE, out_dir / METRICS_FILE
+    if out_dir.exists() and not out_dir.is_dir():
+        raise WashbenchError(located(out_dir, "output path exists and is not a folder"))
+    reporter = _Progress(n) if progress else None
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+        with atomic_path(traces_path) as tmp_traces, atomic_path(metrics_path) as tmp_metrics:
+            writer = None
+            try:
+                for a in range(0, n, chunk_rows):
+                    b = min(n, a + chunk_rows)
+                    block = bank.steps(motion.f_mps2[a:b], motion.omega_radps[a:b])
+                    traces = {w: WashoutTrace.from_rows(block[i]) for i, w in enumerate(names)}
+                    arrays = {w: _checked_trace(w, traces[w], b - a, a) for w in names}
+                    perceived = {AIRCRAFT: streams[AIRCRAFT].perceive(motion.f_mps2[a:b], motion.omega_radps[a:b])}
+                    for w in names:
+                        perceived[w] = streams[w].perceive(arrays[w]["head_f_mps2"], arrays[w]["head_omega_radps"])
+                    for p, per in perceived.items():
+                        felt[p][0][a:b] = per.f_mps2
+                        felt[p][1][a:b] = per.omega_radps
+                    extra = {c: v[a:b] for c, v in motion.extra.items()}
+                    table = _table(motion.t_s[a:b], motion.f_mps2[a:b], omega_deg[a:b], extra, traces, arrays,
+                                   perceived)  # fmt: skip
+                    arrow = pa.table({c: pa.array(np.asarray(v)) for c, v in table.items()})
+                    if writer is None:
+                        writer = parquet_writer(tmp_traces, arrow.schema)
+                    writer.write_table(arrow)
+                    if reporter is not None:
+                        reporter.update(b)
+            finally:
+                if writer is not None:
+                    writer.close()
+                if reporter is not None:
+                    reporter.close()
+            rows = _metrics({p: Perceived(f_mps2=f, omega_radps=w) for p, (f, w) in felt.items()}, motion.dt_s)
+            write_metrics_csv(tmp_metrics, rows)
+    except OSError as exc:
+        raise WashbenchError(located(out_dir, f"cannot write results: {exc.strerror or exc}")) from None
+    return rows, bank.saturation_counts(), (traces_path, metrics_path)
+
+
+class _Progress:
+    """``cue: 45% (97,000 of 216,000 rows)`` on stderr: in place on a terminal, else a line every 5 s."""
+
+    def __init__(self, total: int) -> None:
+        self.total = total
+        self.tty = sys.stderr.isatty()
+        self.every = 0.5 if self.tty else 5.0
+        self.next = time.monotonic() + self.every
+
+    def update(self, done: int) -> None:
+        now = time.monotonic()
+        if now < self.next or done >= self.total:
+            return
+        self.next = now + self.every
+        line = f"cue: {100 * done // self.total}% ({done:,} of {self.total:,} rows)"
+        sys.stderr.write(f"\r\033[K{line}" if self.tty else f"{line}\n")
+        sys.stderr.flush()
+
+    def close(self) -> None:
+        if self.tty:
+            sys.stderr.write("\r\033[K")
+            sys.stderr.flush()
+
+
 def run_cue(
     input_path: Path,
     out_dir: Path,
@@ -222,14 +350,13 @@ def run_cue(
     params = load_washout_params(params_path)
     limits = load_platform_limits(platform_path)
     motion = read_motion(input_path)
-    result = cue_motion(motion, names, params, limits)
-    traces_path, metrics_path = write_results(out_dir, result)
+    _, saturations, (traces_path, metrics_path) = cue_to_files(motion, names, params, limits, out_dir, progress=True)
     print(
         f"{input_path}: {motion.n} rows, {motion.duration_s:.3f} s at dt = {motion.dt_s:.6g} s "
         f"({1.0 / motion.dt_s:.6g} Hz)"
     )
     for name in names:
-        counts = result.traces[name].saturation_counts
+        counts = saturations[name]
         sat = ", ".join(f"{k} {v}" for k, v in counts.items() if v) or "none"
         print(f"  {name}: saturated samples: {sat}")
     print(f"wrote {traces_path} and {metrics_path}")
