@@ -8,8 +8,10 @@ command's flight (0 for ``validate`` and ``cue``): what any JSBSim-based tool pa
     .venv/bin/python bench/startup_bench.py [--repeat 5]
 
 Commands: ``washbench validate`` (one bundled file), ``washbench cue`` on a 2 s 120 Hz CSV,
-``washbench run`` and ``washbench run --no-recording`` on a 2 s level flight (c172p, trimmed), and
-the imports each pulls in (``python -X importtime``, the slowest top-level packages).
+``washbench run`` and ``washbench run --no-recording`` on a 2 s level flight (c172p, trimmed), one
+``washbench run`` of the bundled c172 takeoff (10,668 steps), and the imports each pulls in
+(``python -X importtime``, the slowest top-level packages). Wall and CPU time are both printed: on a
+shared machine the CPU time is the steadier figure.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import resource
 import subprocess
 import sys
 import tempfile
@@ -52,16 +55,19 @@ for _ in range(int(sys.argv[1])):
 """
 
 
-def wall(cmd: list[str], repeat: int, cwd: Path) -> float:
-    """Minimum wall time of ``cmd`` over ``repeat`` runs (output discarded; a failure stops the bench)."""
-    best = float("inf")
+def wall(cmd: list[str], repeat: int, cwd: Path) -> tuple[float, float]:
+    """Minimum wall time and minimum CPU time (user + system) of ``cmd`` over ``repeat`` runs."""
+    best, best_cpu = float("inf"), float("inf")
     for _ in range(repeat):
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
         t0 = time.perf_counter()
         done = subprocess.run(cmd, cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
         best = min(best, time.perf_counter() - t0)
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        best_cpu = min(best_cpu, after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime)
         if done.returncode not in (0, 1):
             raise SystemExit(f"{' '.join(cmd)} failed ({done.returncode}): {done.stderr.strip()}")
-    return best
+    return best, best_cpu
 
 
 def top_imports(args: list[str], cwd: Path, n: int = 6) -> str:
@@ -99,25 +105,29 @@ def main() -> None:
             t = k / 120.0
             lines.append(f"{t!r},{math.sin(t)!r},0.0,-9.80665,{math.cos(t)!r},0.0,0.0")
         (tmp / "short.csv").write_text("\n".join(lines) + "\n")
-        validate_file = str(HERE.parent / "washbench" / "data" / "manoeuvres" / "c172" / "takeoff.yaml")
+        takeoff = str(HERE.parent / "washbench" / "data" / "manoeuvres" / "c172" / "takeoff.yaml")
+        validate_file = takeoff
         cases = [
             ("validate", ["validate", validate_file], 0),
             ("cue, 2 s at 120 Hz", ["cue", "short.csv", "--out", "cue_out"], 0),
             ("run, 2 s flight", ["run", "short.yaml", "--out", "run_out", "--quiet"], 240),
             ("run --no-recording, 2 s", ["run", "short.yaml", "--out", "run_out2", "--quiet", "--no-recording"], 240),
+            ("run, c172 takeoff (89 s)", ["run", takeoff, "--out", "run_out3", "--quiet"], 10668),
         ]
         # compile or load the numba cache once, so the first timed run is not the one that compiles
         subprocess.run([*exe, "cue", "short.csv", "--out", "warm"], cwd=tmp, stdout=subprocess.DEVNULL, check=True)
-        bare = {steps: wall([sys.executable, "bare.py", str(steps)], args.repeat, tmp) for steps in (0, 240)}
-        print(f"bare JSBSim process (import, load c172p, run_ic): {bare[0]:.3f} s; with 240 steps {bare[240]:.3f} s")
-        print(f"(minimum of {args.repeat} runs each; JSBSIM_DEBUG={env_ok!r})")
-        print(f"{'command':28s} {'wall s':>8s} {'x bare':>7s}   slowest imports (cumulative s)")
+        bare = {steps: wall([sys.executable, "bare.py", str(steps)], args.repeat, tmp) for steps in (0, 240, 10668)}
+        print("bare JSBSim process (import, load c172p, run_ic, N steps), wall / CPU s: "
+              + ", ".join(f"N={n}: {w:.3f} / {c:.3f}" for n, (w, c) in bare.items()))  # fmt: skip
+        print(f"(minimum of {args.repeat} runs each; CPU = user + system of the process; JSBSIM_DEBUG={env_ok!r})")
+        print(f"{'command':28s} {'wall s':>7s} {'x bare':>6s} {'CPU s':>7s} {'x bare':>6s}   slowest imports (s)")
         for label, cmd, steps in cases:
             if "--no-recording" in cmd and "--no-recording" not in _help(exe, tmp):
                 print(f"{label:28s} {'n/a':>8s}   (this version has no --no-recording)")
                 continue
-            w = wall([*exe, *cmd], args.repeat, tmp)
-            print(f"{label:28s} {w:8.3f} {w / bare[steps]:7.2f}   {top_imports(cmd, tmp)}")
+            w, c = wall([*exe, *cmd], args.repeat, tmp)
+            bw, bc = bare[steps]
+            print(f"{label:28s} {w:7.3f} {w / bw:6.2f} {c:7.3f} {c / bc:6.2f}   {top_imports(cmd, tmp)}")
 
 
 def _help(exe: list[str], cwd: Path) -> str:
