@@ -22,6 +22,10 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from washbench.cueing.numbastart import prepare
+
+prepare()
+
 NCOEF = 9
 
 TransferFunction = tuple[list[float], list[float]]

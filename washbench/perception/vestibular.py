@@ -37,8 +37,11 @@ import numpy as np
 from numba import njit
 from pydantic import Field
 
+from washbench.cueing.numbastart import prepare
 from washbench.io.yamlio import StrictModel
 from washbench.perception.thresholds import Thresholds, apply_deadband
+
+prepare()
 
 
 class OtolithParams(StrictModel):
