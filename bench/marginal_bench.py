@@ -26,7 +26,7 @@ import numpy as np
 from washbench.cueing import WASHOUT_NAMES, CueingBank, load_washout_params
 from washbench.flight.fdm import make_fdm
 from washbench.flight.fly import fly
-from washbench.flight.manoeuvre import load_manoeuvre, pilot_profile_path
+from washbench.flight.manoeuvre import load_manoeuvre
 from washbench.flight.profile import load_profile
 from washbench.platform import load_platform_limits
 from washbench.runs.pipeline import Lockstep
@@ -76,7 +76,7 @@ def time_fly(path: Path, washouts: bool) -> tuple[float, int]:
 def time_bare(path: Path, steps: int) -> float:
     """Wall time of ``steps`` bare ``fdm.run()`` calls from the manoeuvre's start (set-up not timed)."""
     m = load_manoeuvre(path)
-    fdm, _ = make_fdm(m, load_profile(pilot_profile_path(m.aircraft)))
+    fdm, _ = make_fdm(m, load_profile(m.aircraft_files.profile))
     run = fdm.run
     t0 = time.process_time()
     for _ in range(steps):

@@ -65,4 +65,4 @@ def test_commands_import_only_what_they_need(tmp_path) -> None:
     assert imported_by(["cue", str(tmp_path / "in.csv"), "--out", str(tmp_path / "cue")]) == set()
     no_rec = ["run", str(tmp_path / "m.yaml"), "--out", str(tmp_path / "r1"), "--quiet", "--no-recording"]
     assert imported_by(no_rec) == set()
-    assert imported_by(["run", str(tmp_path / "m.yaml"), "--out", str(tmp_path / "r2"), "--quiet"]) == {"rerun"}  # rerun's submodules
+    assert imported_by(["run", str(tmp_path / "m.yaml"), "--out", str(tmp_path / "r2"), "--quiet"]) == {"rerun"}

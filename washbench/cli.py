@@ -25,6 +25,7 @@ class _Parser(argparse.ArgumentParser):
 def build_parser() -> argparse.ArgumentParser:
     """The full command-line interface."""
     parser = _Parser(prog="washbench", description=__doc__.splitlines()[0] if __doc__ else None)
+    parser.add_argument("--version", action="version", version=_version_line())
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
     p = sub.add_parser("cue", help="run washouts, Atlas model, vestibular models and metrics on a recorded trace")
@@ -40,32 +41,44 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
 
     p = sub.add_parser("fly", help="fly a manoeuvre file with JSBSim and the scripted pilot")
-    p.add_argument("manoeuvre", type=Path, help="manoeuvre YAML file")
+    p.add_argument("manoeuvre", type=Path, help="manoeuvre YAML file, or a bundled one by name (c172/takeoff)")
     p.add_argument("--out", type=Path, required=True, help="output folder (flight.parquet, flight.json)")
+    _aircraft_dir_option(p)
     p.add_argument("--quiet", action="store_true", help="no progress display")
 
     p = sub.add_parser("validate", help="check manoeuvre files without flying them")
     p.add_argument("manoeuvres", type=Path, nargs="+", help="manoeuvre YAML files")
+    _aircraft_dir_option(p)
 
     p = sub.add_parser("schema", help="print the manoeuvre file JSON Schema")
     p.add_argument("--out", type=Path, help="write to this file instead of standard output")
 
     p = sub.add_parser("run", help="fly a manoeuvre with the washouts in lockstep; write traces, metrics, recording")
-    p.add_argument("manoeuvre", type=Path, help="manoeuvre YAML file")
+    p.add_argument("manoeuvre", type=Path, help="manoeuvre YAML file, or a bundled one by name (c172/takeoff)")
     p.add_argument("--out", type=Path, required=True, help="results folder; writes OUT/<aircraft>/<manoeuvre>/")
+    _aircraft_dir_option(p)
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
     p.add_argument("--quiet", action="store_true", help="no progress display")
     p.add_argument("--no-recording", action="store_true", help="do not write recording.rrd (smaller, faster)")
 
     p = sub.add_parser("suite", help="run many manoeuvres in parallel and compare the washouts")
-    p.add_argument("inputs", type=Path, nargs="*", help="manoeuvre files or folders (default: bundled manoeuvres/)")
+    p.add_argument(
+        "inputs",
+        type=Path,
+        nargs="*",
+        help="manoeuvre files or folders, or bundled ones by name (c172, columbia400/takeoff); default: all bundled",
+    )
     p.add_argument("--out", type=Path, required=True, help="results folder")
+    _aircraft_dir_option(p)
     p.add_argument("--jobs", type=int, help="parallel processes (default: number of cores)")
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
     p.add_argument("--quiet", action="store_true", help="no progress display")
     p.add_argument("--no-recording", action="store_true", help="do not write the recording.rrd files")
+
+    p = sub.add_parser("examples", help="copy the bundled manoeuvres and pilot profiles into a folder to edit")
+    p.add_argument("folder", type=Path, help="destination (created; existing files are never overwritten)")
 
     p = sub.add_parser("replay", help="open a recording in the rerun viewer")
     p.add_argument("recording", type=Path, help=".rrd file written by washbench run or suite")
@@ -73,7 +86,44 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _aircraft_dir_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--aircraft-dir",
+        type=Path,
+        action="append",
+        default=[],
+        metavar="DIR",
+        help="folder of aircraft (<DIR>/<name>/<name>.xml, <DIR>/<name>/pilot.yaml), searched first; repeatable",
+    )
+
+
+def _version_line() -> str:
+    """``washbench X (JSBSim Y, rerun-sdk Z, Python W)`` from the installed distributions (no heavy imports)."""
+    import platform
+    from importlib.metadata import PackageNotFoundError, version
+
+    from washbench import __version__
+
+    def dist(name: str) -> str:
+        try:
+            return version(name)
+        except PackageNotFoundError:
+            return "not installed"
+
+    return (
+        f"washbench {__version__} (JSBSim {dist('jsbsim')}, rerun-sdk {dist('rerun-sdk')}, "
+        f"numpy {dist('numpy')}, Python {platform.python_version()})"
+    )
+
+
 def _dispatch(args: argparse.Namespace) -> int:
+    if hasattr(args, "manoeuvre") or hasattr(args, "manoeuvres"):
+        from washbench.io.paths import resolve_manoeuvre  # a bundled name such as c172/takeoff
+
+        if hasattr(args, "manoeuvre"):
+            args.manoeuvre = resolve_manoeuvre(args.manoeuvre)
+        else:
+            args.manoeuvres = [resolve_manoeuvre(m) for m in args.manoeuvres]
     if args.command == "cue":
         from washbench.runs.cue import run_cue
 
@@ -82,11 +132,11 @@ def _dispatch(args: argparse.Namespace) -> int:
     if args.command == "fly":
         from washbench.flight.fly import fly_command
 
-        return fly_command(args.manoeuvre, args.out, progress=not args.quiet)
+        return fly_command(args.manoeuvre, args.out, progress=not args.quiet, aircraft_dirs=args.aircraft_dir)
     if args.command == "validate":
         from washbench.flight.manoeuvre import validate_command
 
-        return validate_command(args.manoeuvres)
+        return validate_command(args.manoeuvres, aircraft_dirs=args.aircraft_dir)
     if args.command == "schema":
         from washbench.flight.manoeuvre import schema_command
 
@@ -101,6 +151,7 @@ def _dispatch(args: argparse.Namespace) -> int:
             platform_path=args.platform,
             progress=not args.quiet,
             recording=not args.no_recording,
+            aircraft_dirs=args.aircraft_dir,
         )
     if args.command == "suite":
         from washbench.runs.suite import suite_command
@@ -113,7 +164,12 @@ def _dispatch(args: argparse.Namespace) -> int:
             platform_path=args.platform,
             progress=not args.quiet,
             recording=not args.no_recording,
+            aircraft_dirs=args.aircraft_dir,
         )
+    if args.command == "examples":
+        from washbench.io.examples import copy_examples
+
+        return copy_examples(args.folder)
     if args.command == "replay":
         from washbench.review.replay import replay_command
 

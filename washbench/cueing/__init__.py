@@ -20,7 +20,10 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
+from washbench.cueing.jitcache import configure_cache
 from washbench.cueing.params import WASHOUT_NAMES, WashoutParams, check_washouts, load_washout_params
+
+configure_cache()  # before any jitted module is imported (numba reads its cache folder at decoration)
 
 if TYPE_CHECKING:
     from washbench.cueing.bank import CueingBank, WashoutTrace, cue_trace

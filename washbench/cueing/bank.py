@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from washbench.cueing import filters
+from washbench.cueing.jitcache import announce_compile
 from washbench.cueing.kernel import (
     C_ALPHA,
     C_AMAX,
@@ -191,6 +192,7 @@ def _warm_up() -> None:
     """
     if bank_step.signatures:
         return
+    announce_compile(bank_step)
     cfg = np.zeros((0, NCFG))
     bank_step(
         np.zeros(3),
@@ -292,5 +294,6 @@ def cue_trace(
     state = np.zeros((len(names), NSTATE))
     counts = np.zeros((len(names), len(SAT_KINDS)), dtype=np.int64)
     out = np.zeros((len(names), f.shape[0], NFIELDS))
+    announce_compile(bank_trace)
     bank_trace(f, w, cfg, coef, state, counts, out)
     return {name: WashoutTrace.from_rows(out[i]) for i, name in enumerate(names)}

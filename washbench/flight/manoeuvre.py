@@ -19,13 +19,13 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Annotated, Any, Literal, get_args
 
-from pydantic import Field
+from pydantic import Field, PrivateAttr
 
 from washbench.errors import WashbenchError, located
 from washbench.flight.columns import COLUMN_NAMES, RUNWAY_COLUMNS
 from washbench.flight.profile import PilotProfile, load_profile
 from washbench.io.atomic import write_text_atomic
-from washbench.io.paths import AIRCRAFT_DIR, DATA_DIR
+from washbench.io.paths import AircraftFiles, find_aircraft, find_aircraft_files, find_profile
 from washbench.io.yamlio import Loc, StrictModel, format_field_path, line_of, read_yaml, validate_data
 
 Positive = Annotated[float, Field(gt=0)]
@@ -225,6 +225,7 @@ class Manoeuvre(StrictModel):
     name: Annotated[str, Field(min_length=1)]
     description: str = ""
     aircraft: Annotated[str, Field(min_length=1)]
+    pilot_profile: str | None = None  # path of the pilot profile YAML, relative to this file (default: searched)
     rate_hz: Annotated[int, Field(ge=30, le=1000)] = 120
     runway: Runway | None = None
     start: Start
@@ -232,39 +233,44 @@ class Manoeuvre(StrictModel):
     phases: Annotated[list[Phase], Field(min_length=1)]
     checks: list[Check] = Field(default_factory=list)
 
+    _files: AircraftFiles | None = PrivateAttr(default=None)
+    _source: Path | None = PrivateAttr(default=None)
+
     @property
     def dt_s(self) -> float:
         """The flight dynamics time step, s."""
         return 1.0 / self.rate_hz
 
+    @property
+    def source(self) -> Path | None:
+        """The file this manoeuvre was loaded from (None when built in Python)."""
+        return self._source
+
+    @property
+    def aircraft_files(self) -> AircraftFiles:
+        """Where the aircraft model and the pilot profile are (found when the file was loaded).
+
+        For a manoeuvre built in Python, searched now without a manoeuvre file or ``--aircraft-dir``.
+        """
+        if self._files is None:
+            self._files = find_aircraft_files(self.aircraft, self._source, (), self.pilot_profile)
+        return self._files
+
 
 # --- aircraft lookup ---------------------------------------------------------------------------
 
 
-def jsbsim_root() -> Path:
-    """The folder of the installed jsbsim package (its ``aircraft/``, ``engine/``, ``systems/``).
-
-    Found without importing jsbsim's compiled module (0.1 s that ``washbench validate`` does not need).
-    """
-    import importlib.util
-
-    spec = importlib.util.find_spec("jsbsim")
-    if spec is None or spec.origin is None:
-        raise WashbenchError("the jsbsim package is not installed")
-    return Path(spec.origin).resolve().parent
+def aircraft_path(name: str, manoeuvre_file: Path | None = None, aircraft_dirs: Sequence[Path] = ()) -> Path | None:
+    """The folder holding ``<name>/<name>.xml`` along the search path (washbench.io.paths), or None."""
+    try:
+        return find_aircraft(name, manoeuvre_file, aircraft_dirs)
+    except WashbenchError:
+        return None
 
 
-def aircraft_path(name: str) -> Path | None:
-    """The folder holding ``<name>/<name>.xml``: the project's ``aircraft/`` first, then jsbsim's."""
-    for root in (AIRCRAFT_DIR, jsbsim_root() / "aircraft"):
-        if (root / name / f"{name}.xml").is_file():
-            return root
-    return None
-
-
-def pilot_profile_path(aircraft: str) -> Path:
-    """Where the scripted pilot's profile for ``aircraft`` lives."""
-    return DATA_DIR / f"pilot_{aircraft}.yaml"
+def pilot_profile_path(aircraft: str, manoeuvre_file: Path | None = None, aircraft_dirs: Sequence[Path] = ()) -> Path:
+    """The scripted pilot's profile for ``aircraft`` along the search path (WashbenchError if there is none)."""
+    return find_profile(aircraft, manoeuvre_file, aircraft_dirs)
 
 
 # --- semantic checks ---------------------------------------------------------------------------
@@ -285,17 +291,16 @@ def _set_fields(model: StrictModel, names: Sequence[str]) -> list[str]:
     return [n for n in names if getattr(model, n) is not None and getattr(model, n) is not False]
 
 
-def _check_semantics(m: Manoeuvre, where: _Where) -> None:
+def _check_semantics(m: Manoeuvre, where: _Where, aircraft_dirs: Sequence[Path] = ()) -> None:
     """Checks a schema cannot express; raise one-line WashbenchError on the first problem."""
-    if aircraft_path(m.aircraft) is None:
-        raise where.error(
-            ("aircraft",),
-            f"unknown aircraft '{m.aircraft}' (neither in the project's aircraft/ folder nor bundled with JSBSim)",
-        )
-    profile_file = pilot_profile_path(m.aircraft)
-    if not profile_file.is_file():
-        raise where.error(("aircraft",), f"no scripted-pilot profile for '{m.aircraft}' (expected {profile_file})")
-    profile = load_profile(profile_file)
+    try:
+        files = find_aircraft_files(m.aircraft, where.path, aircraft_dirs, m.pilot_profile)
+    except WashbenchError as exc:
+        field = "pilot_profile" if str(exc).startswith("pilot_profile:") else "aircraft"
+        raise where.error((field,), str(exc).removeprefix("pilot_profile: ")) from None
+    m._files = files
+    m._source = where.path
+    profile = load_profile(files.profile)
 
     starts = _set_fields(m.start, ("air", "runway"))
     if len(starts) != 1:
@@ -437,21 +442,25 @@ def _never_reason(
 # --- public API ----------------------------------------------------------------------------------
 
 
-def load_manoeuvre(path: str | Path) -> Manoeuvre:
-    """Read, validate and semantically check a manoeuvre file; raise a one-line WashbenchError."""
+def load_manoeuvre(path: str | Path, aircraft_dirs: Sequence[Path] = ()) -> Manoeuvre:
+    """Read, validate and semantically check a manoeuvre file; raise a one-line WashbenchError.
+
+    The aircraft and its pilot profile are found along the search path of :mod:`washbench.io.paths`
+    (``aircraft_dirs`` are the ``--aircraft-dir`` folders) and kept in :attr:`Manoeuvre.aircraft_files`.
+    """
     path = Path(path)
     data, lines = read_yaml(path)
     m = validate_data(path, data, lines, Manoeuvre)
-    _check_semantics(m, _Where(path, lines))
+    _check_semantics(m, _Where(path, lines), aircraft_dirs)
     return m
 
 
-def validate_command(paths: Sequence[Path]) -> int:
+def validate_command(paths: Sequence[Path], aircraft_dirs: Sequence[Path] = ()) -> int:
     """``washbench validate FILE...``: print ``FILE: OK`` or the error line per file; 2 if any is bad."""
     bad = 0
     for path in paths:
         try:
-            load_manoeuvre(path)
+            load_manoeuvre(path, aircraft_dirs)
         except WashbenchError as exc:
             print(f"washbench: error: {exc}", file=sys.stderr)
             bad += 1

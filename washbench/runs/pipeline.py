@@ -31,6 +31,7 @@ import os
 import shutil
 import sys
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -165,6 +166,7 @@ def run_manoeuvre(
     platform_path: Path | None = None,
     progress: bool = False,
     recording: bool = True,
+    aircraft_dirs: Sequence[Path] = (),
 ) -> RunSummary:
     """Fly one manoeuvre with the washouts in lockstep and write its results folder.
 
@@ -181,7 +183,7 @@ def run_manoeuvre(
     from washbench.platform import load_platform_limits
     from washbench.runs.cue import analyse, write_results
 
-    manoeuvre = load_manoeuvre(manoeuvre_path)
+    manoeuvre = load_manoeuvre(manoeuvre_path, aircraft_dirs)
     params = load_washout_params(params_path)
     limits = load_platform_limits(platform_path)
     washouts = tuple(WASHOUT_NAMES)
@@ -321,6 +323,7 @@ def run_command(
     platform_path: Path | None = None,
     progress: bool = True,
     recording: bool = True,
+    aircraft_dirs: Sequence[Path] = (),
 ) -> int:
     """CLI entry of ``washbench run``: 0 if the flight ran and passed its checks, else 1."""
     start = time.perf_counter()
@@ -331,6 +334,7 @@ def run_command(
         platform_path=platform_path,
         progress=progress,
         recording=recording,
+        aircraft_dirs=aircraft_dirs,
     )
     state = "ok" if s.ok else f"FAILED ({s.reason})"
     print(

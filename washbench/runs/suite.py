@@ -25,7 +25,7 @@ import os
 import sys
 import time
 import traceback
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
@@ -42,7 +42,7 @@ from washbench.analysis.ranking import (
 from washbench.cueing.params import WASHOUT_NAMES
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
-from washbench.io.paths import MANOEUVRES_DIR
+from washbench.io.paths import MANOEUVRES_DIR, bundled_names, resolve_manoeuvre
 from washbench.io.results import csv_number
 from washbench.runs.pipeline import RunSummary
 
@@ -61,13 +61,15 @@ def find_manoeuvres(inputs: Sequence[Path]) -> list[Path]:
     if not inputs:
         inputs = [MANOEUVRES_DIR]
     found: list[Path] = []
-    for item in inputs:
+    for item in map(resolve_manoeuvre, inputs):
         if item.is_dir():
             found.extend(sorted(p for p in item.rglob("*.yaml") if p.is_file()))
         elif item.is_file():
             found.append(item)
         else:
-            raise WashbenchError(located(item, "no such file or folder"))
+            raise WashbenchError(
+                located(item, f"no such file or folder, nor a bundled manoeuvre ({', '.join(bundled_names())})")
+            )
     unique = list(dict.fromkeys(p.resolve() for p in found))
     if not unique:
         raise WashbenchError(located(inputs[0], "no manoeuvre files (*.yaml) found"))
@@ -75,7 +77,12 @@ def find_manoeuvres(inputs: Sequence[Path]) -> list[Path]:
 
 
 def _run_one(
-    path: str, out_dir: str, params_path: str | None, platform_path: str | None, recording: bool = True
+    path: str,
+    out_dir: str,
+    params_path: str | None,
+    platform_path: str | None,
+    aircraft_dirs: tuple[str, ...] = (),
+    recording: bool = True,
 ) -> Outcome:
     """Worker: run one manoeuvre; never raises (failures come back as an Outcome)."""
     from washbench.runs.pipeline import run_manoeuvre
@@ -88,6 +95,7 @@ def _run_one(
             params_path=Path(params_path) if params_path else None,
             platform_path=Path(platform_path) if platform_path else None,
             recording=recording,
+            aircraft_dirs=[Path(d) for d in aircraft_dirs],
         )
     except WashbenchError as exc:
         summary = RunSummary(ok=False, reason=str(exc))
@@ -96,6 +104,25 @@ def _run_one(
         where = tb[-3].strip() if len(tb) >= 3 else ""
         summary = RunSummary(ok=False, reason=f"internal error: {type(exc).__name__}: {exc} ({where})")
     return Outcome(path=path, wall_s=time.perf_counter() - start, run=summary)
+
+
+def _preload() -> None:
+    """Worker initializer where there is no forkserver: load the heavy modules once per worker."""
+    import washbench.runs.preload  # noqa: F401
+
+
+def pool_context() -> tuple[multiprocessing.context.BaseContext, Callable[[], None] | None]:
+    """The process pool's start method and worker initializer.
+
+    ``forkserver`` (Linux, macOS) where it exists: workers fork from a server that has already imported the heavy
+    modules (JSBSim, the numba kernels, rerun, pyarrow), so each starts in milliseconds. Elsewhere (Windows)
+    ``spawn``, with every worker importing them once at its start.
+    """
+    if "forkserver" in multiprocessing.get_all_start_methods():
+        ctx = multiprocessing.get_context("forkserver")
+        ctx.set_forkserver_preload(["washbench.runs.preload"])
+        return ctx, None
+    return multiprocessing.get_context("spawn"), _preload
 
 
 def run_suite(
@@ -107,6 +134,7 @@ def run_suite(
     platform_path: Path | None = None,
     progress: bool = True,
     recording: bool = True,
+    aircraft_dirs: Sequence[Path] = (),
 ) -> list[Outcome]:
     """Run every file in parallel processes; return the outcomes in the order of ``files``.
 
@@ -114,16 +142,10 @@ def run_suite(
     """
     jobs = max(1, min(jobs or os.cpu_count() or 1, len(files)))
     out_dir.mkdir(parents=True, exist_ok=True)
-    args = [
-        (
-            str(f),
-            str(out_dir),
-            str(params_path) if params_path else None,
-            str(platform_path) if platform_path else None,
-            recording,
-        )
-        for f in files
-    ]
+    dirs = tuple(str(d) for d in aircraft_dirs)
+    params = str(params_path) if params_path else None
+    platform = str(platform_path) if platform_path else None
+    args = [(str(f), str(out_dir), params, platform, dirs, recording) for f in files]
     outcomes: dict[str, Outcome] = {}
     start = time.perf_counter()
     if progress:
@@ -136,11 +158,8 @@ def run_suite(
         for a in args:
             outcomes[a[0]] = _report(_run_one(*a), len(outcomes) + 1, len(files), start, progress)
     else:
-        ctx = multiprocessing.get_context("forkserver")
-        # Workers fork from a server that has already imported the heavy modules (JSBSim, numba
-        # kernels, rerun, pyarrow), so each worker starts in milliseconds instead of seconds.
-        ctx.set_forkserver_preload(["washbench.runs.preload"])
-        with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as pool:
+        ctx, initializer = pool_context()
+        with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=initializer) as pool:
             futures = [pool.submit(_run_one, *a) for a in args]
             for fut in as_completed(futures):
                 outcome = fut.result()
@@ -325,6 +344,7 @@ def suite_command(
     platform_path: Path | None = None,
     progress: bool = True,
     recording: bool = True,
+    aircraft_dirs: Sequence[Path] = (),
 ) -> int:
     """CLI entry: run the suite, write its results, print where they are; 0 if all succeeded, else 1."""
     if jobs is not None and jobs < 1:
@@ -345,6 +365,7 @@ def suite_command(
         platform_path=platform_path,
         progress=progress,
         recording=recording,
+        aircraft_dirs=aircraft_dirs,
     )
     write_suite_results(outcomes, out_dir)
     n_ok = sum(o.run.ok for o in outcomes)
