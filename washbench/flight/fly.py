@@ -209,7 +209,7 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
     fy_last = 0.0  # and its lateral specific force, m/s^2
     k = 0
     k_sent = 0  # samples handed to block_hook so far
-    # progress: overwritten in place on a terminal; otherwise (a log file, CI) one line every 5 s
+    # progress: overwritten in place on a terminal; otherwise (a log file, CI) a line per phase and every 5 s
     tty = progress and sys.stderr.isatty()
     report_every_s = 0.5 if tty else 5.0
     next_report = time.monotonic() + report_every_s
@@ -308,7 +308,7 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
                 flapc_w.set_double_value(pilot.flaps_cmd)
                 lbrk_w.set_double_value(pilot.brakes)
                 rbrk_w.set_double_value(pilot.brakes)
-                if tty:
+                if progress:  # a line at each phase start (in place on a terminal)
                     _progress(m.name, iphase, nphases, phase.name, t, tty)
 
         if not final:
