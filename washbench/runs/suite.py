@@ -111,16 +111,16 @@ def _preload() -> None:
     import washbench.runs.preload  # noqa: F401
 
 
-def pool_context() -> tuple[multiprocessing.context.BaseContext, Callable[[], None] | None]:
+def pool_context(recording: bool = True) -> tuple[multiprocessing.context.BaseContext, Callable[[], None] | None]:
     """The process pool's start method and worker initializer.
 
     ``forkserver`` (Linux, macOS) where it exists: workers fork from a server that has already imported the heavy
-    modules (JSBSim, the numba kernels, rerun, pyarrow), so each starts in milliseconds. Elsewhere (Windows)
-    ``spawn``, with every worker importing them once at its start.
+    modules (JSBSim, the numba kernels, pyarrow, and rerun unless ``recording`` is False), so each starts in
+    milliseconds. Elsewhere (Windows) ``spawn``, with every worker importing them once at its start.
     """
     if "forkserver" in multiprocessing.get_all_start_methods():
         ctx = multiprocessing.get_context("forkserver")
-        ctx.set_forkserver_preload(["washbench.runs.preload"])
+        ctx.set_forkserver_preload(["washbench.runs.preload", *(["rerun"] if recording else [])])
         return ctx, None
     return multiprocessing.get_context("spawn"), _preload
 
@@ -158,7 +158,7 @@ def run_suite(
         for a in args:
             outcomes[a[0]] = _report(_run_one(*a), len(outcomes) + 1, len(files), start, progress)
     else:
-        ctx, initializer = pool_context()
+        ctx, initializer = pool_context(recording)
         with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=initializer) as pool:
             futures = [pool.submit(_run_one, *a) for a in args]
             for fut in as_completed(futures):
