@@ -11,8 +11,35 @@ import argparse
 import sys
 from pathlib import Path
 
-from washbench.cueing.params import WASHOUT_NAMES
+from washbench.cueing.params import WASHOUT_KINDS
 from washbench.errors import WashbenchError
+
+_VARIANT_HELP = "add a washout NAME of KIND with dotted-key overrides of the parameter file, repeatable"
+
+
+def _washout_options(p: argparse.ArgumentParser, variants: bool = True) -> None:
+    """--washout (built-in washouts) and --variant (named variants), shared by cue, run, suite (and omct)."""
+    p.add_argument(
+        "--washout",
+        action="append",
+        metavar="NAME",
+        help=f"built-in washout to run, repeatable: {', '.join(WASHOUT_KINDS)} (default: all three, or none with "
+        "a variant)",
+    )
+    if variants:
+        p.add_argument("--variant", action="append", default=[], metavar="NAME=KIND[,KEY=VALUE...]", help=_VARIANT_HELP)
+
+
+def _study_options(p: argparse.ArgumentParser) -> None:
+    """What sweep and tune share."""
+    p.add_argument("--params", type=Path, help="base washout parameter YAML (default: bundled CW1)")
+    p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
+    p.add_argument("--from", dest="from_dir", type=Path, metavar="RESULTS_DIR",
+                   help="read RESULTS_DIR/<aircraft>/<manoeuvre>/flight.parquet instead of flying")
+    p.add_argument("--jobs", type=int, help="parallel processes for the flights (default: number of cores)")
+    p.add_argument("--dask", metavar="ADDRESS", help="send the work to this Dask scheduler (washbench[cluster])")
+    p.add_argument("--quiet", action="store_true", help="no progress display")
+    _aircraft_dir_option(p)
 
 
 class _Parser(argparse.ArgumentParser):
@@ -31,12 +58,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("cue", help="run washouts, Atlas model, vestibular models and metrics on a recorded trace")
     p.add_argument("input", type=Path, help="CSV or Parquet: t_s, f_{x,y,z}_mps2, omega_{x,y,z}_degps (body axes)")
     p.add_argument("--out", type=Path, required=True, help="output folder (traces.parquet, metrics.csv)")
-    p.add_argument(
-        "--washout",
-        action="append",
-        metavar="NAME",
-        help=f"washout to run, repeatable: {', '.join(WASHOUT_NAMES)} (default: all three)",
-    )
+    _washout_options(p)
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
 
@@ -56,6 +78,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("run", help="fly a manoeuvre with the washouts in lockstep; write traces, metrics, recording")
     p.add_argument("manoeuvre", type=Path, help="manoeuvre YAML file, or a bundled one by name (c172/takeoff)")
     p.add_argument("--out", type=Path, required=True, help="results folder; writes OUT/<aircraft>/<manoeuvre>/")
+    _washout_options(p)
     _aircraft_dir_option(p)
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
@@ -72,11 +95,33 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", type=Path, required=True, help="results folder")
     _aircraft_dir_option(p)
     p.add_argument("--jobs", type=int, help="parallel processes (default: number of cores)")
+    _washout_options(p)
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
+    p.add_argument("--dask", metavar="ADDRESS", help="run on this Dask scheduler instead of local processes")
     p.add_argument("--quiet", action="store_true", help="no progress display")
     p.add_argument("--no-recording", action="store_true", help="do not write the recording.rrd files")
 
+    p = sub.add_parser("sweep", help="a grid of washout parameters on recorded flights: scores and metrics per point")
+    p.add_argument("manoeuvres", type=Path, nargs="+", help="manoeuvre files or folders")
+    p.add_argument("--washout", action="append", metavar="KIND", help="washout kind, repeatable (default: all three)")
+    p.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=V1,V2,...",
+                   help="a parameter-file key and its values, repeatable (the grid is every combination)")
+    p.add_argument("--out", type=Path, required=True, help="output folder (sweep.csv, sweep_metrics.csv, sweep.png)")
+    _study_options(p)
+
+    p = sub.add_parser("tune", help="tune washout parameters on training manoeuvres (differential evolution)")
+    p.add_argument("manoeuvres", type=Path, nargs="+", help="training manoeuvre files or folders")
+    p.add_argument("--washout", required=True, metavar="KIND", help=f"washout kind: {', '.join(WASHOUT_KINDS)}")
+    p.add_argument("--tune", dest="tunes", action="append", default=[], metavar="KEY=LOW:HIGH",
+                   help="a parameter-file key and its search interval, repeatable")
+    p.add_argument("--test", type=Path, nargs="+", default=[], metavar="MANOEUVRE", help="test manoeuvres")
+    p.add_argument("--budget", type=int, default=200, help="evaluations at most (default 200)")
+    p.add_argument("--seed", type=int, default=0, help="random seed (default 0): same seed, same result")
+    p.add_argument("--saturation-weight", type=float, default=1.0,
+                   help="penalty per unit fraction of time at a platform limit (default 1)")
+    p.add_argument("--out", type=Path, required=True, help="output folder (tuned.yaml, tune.csv, report.md)")
+    _study_options(p)
     p = sub.add_parser("examples", help="copy the bundled manoeuvres and pilot profiles into a folder to edit")
     p.add_argument("folder", type=Path, help="destination (created; existing files are never overwritten)")
 
@@ -127,7 +172,14 @@ def _dispatch(args: argparse.Namespace) -> int:
     if args.command == "cue":
         from washbench.runs.cue import run_cue
 
-        run_cue(args.input, args.out, washouts=args.washout, params_path=args.params, platform_path=args.platform)
+        run_cue(
+            args.input,
+            args.out,
+            washouts=args.washout,
+            params_path=args.params,
+            platform_path=args.platform,
+            variants=args.variant,
+        )
         return 0
     if args.command == "fly":
         from washbench.flight.fly import fly_command
@@ -151,6 +203,8 @@ def _dispatch(args: argparse.Namespace) -> int:
             platform_path=args.platform,
             progress=not args.quiet,
             recording=not args.no_recording,
+            washouts=args.washout,
+            variants=args.variant,
             aircraft_dirs=args.aircraft_dir,
         )
     if args.command == "suite":
@@ -165,7 +219,12 @@ def _dispatch(args: argparse.Namespace) -> int:
             progress=not args.quiet,
             recording=not args.no_recording,
             aircraft_dirs=args.aircraft_dir,
+            washouts=args.washout,
+            variants=args.variant,
+            dask=args.dask,
         )
+    if args.command in ("sweep", "tune"):
+        return _study(args)
     if args.command == "examples":
         from washbench.io.examples import copy_examples
 
@@ -175,6 +234,35 @@ def _dispatch(args: argparse.Namespace) -> int:
 
         return replay_command(args.recording, web=args.web)
     raise AssertionError(f"unhandled command {args.command}")  # unreachable: argparse restricts choices
+
+
+def _study(args: argparse.Namespace) -> int:
+    common = dict(
+        params_path=args.params,
+        platform_path=args.platform,
+        from_dir=args.from_dir,
+        jobs=args.jobs,
+        dask=args.dask,
+        progress=not args.quiet,
+        aircraft_dirs=args.aircraft_dir,
+    )
+    if args.command == "sweep":
+        from washbench.runs.sweep import sweep_command
+
+        return sweep_command(args.manoeuvres, args.out, washouts=args.washout, sets=args.sets, **common)
+    from washbench.runs.tune import tune_command
+
+    return tune_command(
+        args.manoeuvres,
+        args.out,
+        washout=args.washout,
+        tunes=args.tunes,
+        test=args.test,
+        budget=args.budget,
+        seed=args.seed,
+        saturation_weight=args.saturation_weight,
+        **common,
+    )
 
 
 def main(argv: list[str] | None = None) -> int:

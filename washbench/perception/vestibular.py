@@ -34,14 +34,10 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 from pydantic import Field
 
-from washbench.cueing.numbastart import prepare
 from washbench.io.yamlio import StrictModel
 from washbench.perception.thresholds import Thresholds, apply_deadband
-
-prepare()
 
 
 class OtolithParams(StrictModel):
@@ -152,6 +148,11 @@ class DiscreteModel:
     b: tuple[tuple[float, float], ...]  # per section: (coefficient of u[k], coefficient of u[k-1])
     phi: tuple[float, ...]
     dc_gain: float
+    steady: tuple[float, ...] = ()  # per section: its state for a unit constant input (its DC gain, -r/p)
+
+    def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The sections as the compiled core wants them: b (S, 2), phi (S,), steady (S,), float64."""
+        return np.array(self.b, dtype=np.float64), np.array(self.phi), np.array(self.steady)
 
     @classmethod
     def from_partial_fractions(cls, pf: PartialFractions, dt_s: float) -> DiscreteModel:
@@ -163,66 +164,40 @@ class DiscreteModel:
             g0, g1 = _foh_weights(a * dt_s)
             b.append((r * dt_s * g1, r * dt_s * g0))
             phi.append(math.exp(-a * dt_s))
-        dc = sum(-r / p for r, p in zip(pf.residues, pf.poles, strict=True))
-        return cls(dt_s=dt_s, b=tuple(b), phi=tuple(phi), dc_gain=dc)
+        steady = tuple(-r / p for r, p in zip(pf.residues, pf.poles, strict=True))
+        return cls(dt_s=dt_s, b=tuple(b), phi=tuple(phi), dc_gain=sum(steady), steady=steady)
 
-    def start(self, u0: np.ndarray) -> np.ndarray:
-        """Filter state (sections, m) at rest in the steady state of the first sample ``u0`` (m,).
+    def start(self, u0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """State for :meth:`run`: the section states (sections, m) at rest in the steady state of the first
+        sample ``u0`` (m,), and the previous input (``u0``)."""
+        u0 = np.array(u0, dtype=np.float64).reshape(-1)
+        return np.array(self.steady)[:, None] * u0[None, :], u0
 
-        Per section the state of ``scipy.signal.lfilter``'s transposed direct form II with
-        ``lfilter_zi``, so :meth:`run` reproduces ``lfilter`` bit for bit.
-        """
-        u0 = np.asarray(u0, dtype=np.float64).reshape(-1)
-        zi = np.empty(len(self.phi))
-        for i, ((b1, b0), phi) in enumerate(zip(self.b, self.phi, strict=True)):
-            # lfilter_zi of b = [b1, b0], a = [1, -phi]: (1 - phi) z = b0 + phi b1
-            zi[i] = np.linalg.solve(np.array([[1.0 + -phi]]), np.array([b0 - -phi * b1]))[0]
-        return zi[:, None] * u0[None, :]
-
-    def run(self, u: np.ndarray, state: np.ndarray) -> np.ndarray:
+    def run(self, u: np.ndarray, state: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
         """Filter the next samples ``u`` (N, m), advancing ``state`` (from :meth:`start`) in place.
 
-        Feeding a trace in chunks gives the same bits as feeding it whole.
+        The same compiled step as :meth:`apply`: feeding a trace in chunks gives the same bits as feeding it whole.
         """
-        u = np.ascontiguousarray(u, dtype=np.float64)
-        y = np.empty_like(u)
-        b1 = np.array([b[0] for b in self.b])
-        b0 = np.array([b[1] for b in self.b])
-        _run_sections(u, b1, b0, np.array(self.phi), state, y)
-        return y
+        from washbench.perception.sections import sections_run
+
+        b, phi, _ = self.arrays()
+        x, u_prev = state
+        return sections_run(b, phi, x, u_prev, np.ascontiguousarray(u, dtype=np.float64))
 
     def apply(self, u: np.ndarray) -> np.ndarray:
         """Filter ``u`` (N,) or (N, m) along axis 0, starting in the steady state of ``u[0]``.
 
-        Returns float64 of the same shape; equal bit for bit to summing ``scipy.signal.lfilter`` of each
-        section with ``zi = lfilter_zi * u[0]`` (one compiled loop instead of one pass per section).
+        Returns float64 of the same shape. One compiled pass per column (:mod:`washbench.perception.sections`),
+        the same step the studies' evaluation kernel takes per sample.
         """
+        from washbench.perception.sections import sections_apply
+
         u = np.asarray(u, dtype=np.float64)
         if u.ndim not in (1, 2) or u.shape[0] == 0:
             raise ValueError(f"expected a non-empty (N,) or (N, m) array, got shape {u.shape}")
-        u2 = u.reshape(u.shape[0], -1)
-        return self.run(u2, self.start(u2[0])).reshape(u.shape)
-
-
-@njit(cache=True)
-def _run_sections(u: np.ndarray, b1: np.ndarray, b0: np.ndarray, phi: np.ndarray, z: np.ndarray,
-                  y: np.ndarray) -> None:  # fmt: skip
-    """Parallel first-order sections over u (N, m): y = sum_i y_i, y_i = b1_i u + z_i, z_i <- b0_i u + phi_i y_i.
-
-    The operations and their order are those of ``scipy.signal.lfilter`` (a = [1, -phi]) summed section by
-    section, so the result is the same to the last bit.
-    """
-    n, m = u.shape
-    ns = b1.shape[0]
-    for k in range(n):
-        for j in range(m):
-            x = u[k, j]
-            acc = 0.0
-            for i in range(ns):
-                yi = z[i, j] + b1[i] * x
-                z[i, j] = x * b0[i] - yi * -phi[i]
-                acc += yi
-            y[k, j] = acc
+        b, phi, steady = self.arrays()
+        y = sections_apply(b, phi, steady, u if u.ndim == 2 else u.reshape(-1, 1))
+        return y.reshape(u.shape)
 
 
 def otolith_model(p: OtolithParams, dt_s: float) -> DiscreteModel:

@@ -192,12 +192,13 @@ def _put(table: dict[str, np.ndarray], names: Sequence[str], values: np.ndarray)
 
 def cue_motion(
     motion: Motion,
-    washouts: Sequence[str],
+    washouts: Sequence[Any],
     params: Any,
     limits: Any,
     vestibular: VestibularParams | None = None,
 ) -> CueResult:
-    """Run the named washouts and the Atlas model over ``motion`` (``cueing.cue_trace``), then :func:`analyse`."""
+    """Run the washouts (names with ``params``, or Washout variants) and the Atlas model over ``motion``
+    (``cueing.cue_trace``, one compiled call), then :func:`analyse`."""
     from washbench.cueing import cue_trace
 
     traces = cue_trace(motion.f_mps2, motion.omega_radps, motion.dt_s, washouts, params, limits)
@@ -253,15 +254,15 @@ def cue_to_files(
     the washout traces and the table exist one chunk at a time. Returns the metric rows, the saturation counts per
     washout and the two paths written. ``progress``: a line on stderr every 5 s (in place on a terminal).
     """
-    from washbench.cueing import CueingBank, WashoutTrace, check_washouts
+    from washbench.cueing import CueingBank, WashoutTrace
     from washbench.io.results import parquet_writer
     from washbench.perception.vestibular import PerceptionStream
 
-    names = check_washouts(washouts)
     if chunk_rows < 1:
         raise ValueError(f"chunk_rows must be at least 1, got {chunk_rows}")
     n = motion.n
-    bank = CueingBank(names, params, limits, motion.dt_s)
+    bank = CueingBank(washouts, params, limits, motion.dt_s)  # names with ``params``, or Washout variants
+    names = bank.washouts
     model = VestibularModel(motion.dt_s, vestibular)
     streams = {p: PerceptionStream(model) for p in (AIRCRAFT, *names)}
     felt = {p: (np.empty((n, 3)), np.empty((n, 3))) for p in streams}
@@ -338,19 +339,22 @@ def run_cue(
     washouts: Sequence[str] | None = None,
     params_path: Path | None = None,
     platform_path: Path | None = None,
+    variants: Sequence[str] = (),
 ) -> None:
     """The ``washbench cue`` command: read ``input_path``, cue it, write results into ``out_dir``.
 
+    ``washouts``, ``variants`` and ``params_path`` select the washouts
+    (:func:`washbench.cueing.variants.select_washouts`).
     Raises WashbenchError (one line) for bad names, parameter files or input; writes nothing then.
     """
-    from washbench.cueing import load_washout_params
+    from washbench.cueing.variants import select_washouts
     from washbench.platform import load_platform_limits
 
-    names = check_washout_names(washouts)
-    params = load_washout_params(params_path)
+    specs = select_washouts(washouts, variants, params_path)
+    names = [w.name for w in specs]
     limits = load_platform_limits(platform_path)
     motion = read_motion(input_path)
-    _, saturations, (traces_path, metrics_path) = cue_to_files(motion, names, params, limits, out_dir, progress=True)
+    _, saturations, (traces_path, metrics_path) = cue_to_files(motion, specs, None, limits, out_dir, progress=True)
     print(
         f"{input_path}: {motion.n} rows, {motion.duration_s:.3f} s at dt = {motion.dt_s:.6g} s "
         f"({1.0 / motion.dt_s:.6g} Hz)"

@@ -38,8 +38,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from washbench.analysis.metrics import MetricRow, integral_abs_error
-from washbench.analysis.ranking import DOFS
+from washbench.analysis.metrics import MetricRow
+from washbench.analysis.ranking import DOFS, perceived_motion
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
 
@@ -77,15 +77,6 @@ class RunSummary:
     metrics: list[MetricRow] = field(default_factory=list)
     motion: dict[str, float] = field(default_factory=dict)  # DOF -> aircraft pilot's perceived motion
     saturations: dict[str, dict[str, int]] = field(default_factory=dict)
-
-
-def perceived_motion(perceived_f_mps2: np.ndarray, perceived_omega_radps: np.ndarray, dt_s: float) -> dict[str, float]:
-    """How much the aircraft pilot felt per DOF: integral of |perceived(t) - perceived(0)| dt.
-
-    Surge, sway, heave in m/s^2*s; roll, pitch, yaw in deg (the units of metrics.csv).
-    """
-    columns = np.column_stack([perceived_f_mps2, np.degrees(perceived_omega_radps)])
-    return {dof: integral_abs_error(x, np.full_like(x, x[0]), dt_s) for dof, x in zip(DOFS, columns.T, strict=True)}
 
 
 def aircraft_attitude(phi_deg: np.ndarray, theta_deg: np.ndarray, psi_deg: np.ndarray) -> np.ndarray:
@@ -166,17 +157,22 @@ def run_manoeuvre(
     platform_path: Path | None = None,
     progress: bool = False,
     recording: bool = True,
+    washouts: Sequence[str] | None = None,
+    variants: Sequence[str] = (),
     aircraft_dirs: Sequence[Path] = (),
 ) -> RunSummary:
     """Fly one manoeuvre with the washouts in lockstep and write its results folder.
 
+    ``washouts`` (built-in names), ``variants`` (``--variant`` texts) and the parameter file's ``variants:``
+    select the washouts (:func:`washbench.cueing.variants.select_washouts`; default the three built-in ones).
     ``recording=False`` skips ``recording.rrd`` (and the import of rerun): every other file is written.
 
     Raises WashbenchError for a bad manoeuvre, parameter or platform file (nothing written).
     A flight that crashes or fails a check still writes its results (what was flown), with
     ``ok`` False and the reason.
     """
-    from washbench.cueing import WASHOUT_NAMES, CueingBank, WashoutTrace, load_washout_params
+    from washbench.cueing import CueingBank, WashoutTrace
+    from washbench.cueing.variants import select_washouts
     from washbench.flight.fly import fly, write_flight
     from washbench.flight.manoeuvre import load_manoeuvre
     from washbench.io.results import read_motion
@@ -184,10 +180,10 @@ def run_manoeuvre(
     from washbench.runs.cue import analyse, write_results
 
     manoeuvre = load_manoeuvre(manoeuvre_path, aircraft_dirs)
-    params = load_washout_params(params_path)
+    specs = select_washouts(washouts, variants, params_path)
     limits = load_platform_limits(platform_path)
-    washouts = tuple(WASHOUT_NAMES)
-    bank = CueingBank(washouts, params, limits, manoeuvre.dt_s)
+    bank = CueingBank(specs, None, limits, manoeuvre.dt_s)
+    washouts = bank.washouts
     lockstep = Lockstep(bank)
     start = time.perf_counter()
     flight = fly(manoeuvre, block_hook=lockstep, block_size=LOCKSTEP_BLOCK, progress=progress)
@@ -323,6 +319,8 @@ def run_command(
     platform_path: Path | None = None,
     progress: bool = True,
     recording: bool = True,
+    washouts: Sequence[str] | None = None,
+    variants: Sequence[str] = (),
     aircraft_dirs: Sequence[Path] = (),
 ) -> int:
     """CLI entry of ``washbench run``: 0 if the flight ran and passed its checks, else 1."""
@@ -334,6 +332,8 @@ def run_command(
         platform_path=platform_path,
         progress=progress,
         recording=recording,
+        washouts=washouts,
+        variants=variants,
         aircraft_dirs=aircraft_dirs,
     )
     state = "ok" if s.ok else f"FAILED ({s.reason})"

@@ -6,9 +6,9 @@ that fails (bad file, crash, divergence, failed check, or an unexpected error) i
 reason; the others still complete and are kept. Then the suite writes, each file atomically:
 
 - ``OUT/metrics.csv``: ``aircraft,manoeuvre,washout,dof,npc,integral_error,max_error``
-- ``OUT/comparison.csv``: every metric per washout and DOF with its difference from small-angle
-  (positive = better than small-angle), like the paper's Table 4
-- ``OUT/ranking.csv``: the three washouts ranked per manoeuvre by the rule of
+- ``OUT/comparison.csv``: every metric per washout and DOF with its difference from the reference washout
+  (small-angle when it runs, otherwise the first listed; positive = better), like the paper's Table 4
+- ``OUT/ranking.csv``: the washouts (built-in or variants) ranked per manoeuvre by the rule of
   :mod:`washbench.analysis.ranking`
 - ``OUT/report.md``: all of it, with links to each recording, written last.
 
@@ -33,13 +33,12 @@ from pathlib import Path
 from washbench.analysis.ranking import (
     DOFS,
     METRICS,
-    REFERENCE_WASHOUT,
     RankRow,
     compare,
     rank,
+    reference_washout,
     wins,
 )
-from washbench.cueing.params import WASHOUT_NAMES
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
 from washbench.io.paths import MANOEUVRES_DIR, bundled_names, resolve_manoeuvre
@@ -81,6 +80,8 @@ def _run_one(
     out_dir: str,
     params_path: str | None,
     platform_path: str | None,
+    washouts: tuple[str, ...] | None = None,
+    variants: tuple[str, ...] = (),
     aircraft_dirs: tuple[str, ...] = (),
     recording: bool = True,
 ) -> Outcome:
@@ -95,6 +96,8 @@ def _run_one(
             params_path=Path(params_path) if params_path else None,
             platform_path=Path(platform_path) if platform_path else None,
             recording=recording,
+            washouts=washouts,
+            variants=variants,
             aircraft_dirs=[Path(d) for d in aircraft_dirs],
         )
     except WashbenchError as exc:
@@ -133,10 +136,13 @@ def run_suite(
     params_path: Path | None = None,
     platform_path: Path | None = None,
     progress: bool = True,
-    recording: bool = True,
+    washouts: Sequence[str] | None = None,
+    variants: Sequence[str] = (),
+    dask: str | None = None,
     aircraft_dirs: Sequence[Path] = (),
+    recording: bool = True,
 ) -> list[Outcome]:
-    """Run every file in parallel processes; return the outcomes in the order of ``files``.
+    """Run every file in parallel processes (or on the Dask cluster at ``dask``); outcomes in the order of ``files``.
 
     ``recording=False``: no ``recording.rrd`` in the run folders (the report then links none).
     """
@@ -145,7 +151,8 @@ def run_suite(
     dirs = tuple(str(d) for d in aircraft_dirs)
     params = str(params_path) if params_path else None
     platform = str(platform_path) if platform_path else None
-    args = [(str(f), str(out_dir), params, platform, dirs, recording) for f in files]
+    chosen = tuple(washouts) if washouts else None
+    args = [(str(f), str(out_dir), params, platform, chosen, tuple(variants), dirs, recording) for f in files]
     outcomes: dict[str, Outcome] = {}
     start = time.perf_counter()
     if progress:
@@ -154,7 +161,12 @@ def run_suite(
             "suite: loading JSBSim, rerun and the washout kernel (compiled once after install: a few seconds)",
             file=sys.stderr,
         )
-    if jobs == 1:
+    if dask:
+        from washbench.runs.cluster import dask_map
+
+        for outcome in dask_map(dask, _run_one, args):
+            outcomes[outcome.path] = _report(outcome, len(outcomes) + 1, len(files), start, progress)
+    elif jobs == 1:
         for a in args:
             outcomes[a[0]] = _report(_run_one(*a), len(outcomes) + 1, len(files), start, progress)
     else:
@@ -216,13 +228,15 @@ def metrics_table(outcomes: Sequence[Outcome]) -> str:
 
 
 def comparison_table(outcomes: Sequence[Outcome]) -> str:
-    """``comparison.csv``: each metric per washout and DOF and its improvement over small-angle."""
+    """``comparison.csv``: each metric per washout and DOF and its improvement over the reference washout
+    (small-angle when it runs, otherwise the first listed: ``<washout>_better_by`` = reference - washout)."""
     washouts = _washouts(outcomes)
-    others = [w for w in washouts if w != REFERENCE_WASHOUT]
+    reference = reference_washout(washouts)
+    others = [w for w in washouts if w != reference]
     header = ["aircraft", "manoeuvre", "dof", "metric", *washouts, *[f"{w}_better_by" for w in others]]
     rows = [header]
     for o in _runs_with_metrics(outcomes):
-        for c in compare(o.run.metrics):
+        for c in compare(o.run.metrics, reference):
             rows.append(
                 [o.run.aircraft, o.run.manoeuvre, c.dof, c.metric]
                 + [csv_number(c.values.get(w, math.nan)) for w in washouts]
@@ -241,13 +255,15 @@ def ranking_table(rankings: dict[tuple[str, str], list[RankRow]]) -> str:
 
 
 def _washouts(outcomes: Sequence[Outcome]) -> list[str]:
-    seen = {m.washout for o in outcomes for m in o.run.metrics}
-    return [w for w in WASHOUT_NAMES if w in seen] + sorted(seen - set(WASHOUT_NAMES))
+    """Every washout of the suite in the order the configuration listed them."""
+    return list(dict.fromkeys(m.washout for o in outcomes for m in o.run.metrics))
 
 
 def report_markdown(outcomes: Sequence[Outcome], rankings: dict[tuple[str, str], list[RankRow]], out_dir: Path) -> str:
     """``report.md``: status, ranking, Table-4 comparison and metrics of every manoeuvre."""
     ok = [o for o in outcomes if o.run.ok]
+    washouts = _washouts(outcomes)
+    reference = reference_washout(washouts)
     lines = [
         "# washbench suite report",
         "",
@@ -256,15 +272,15 @@ def report_markdown(outcomes: Sequence[Outcome], rankings: dict[tuple[str, str],
         "Metrics compare the aircraft pilot's perceived motion with each simulator pilot's: NPC is the",
         "normalized Pearson correlation (1 is perfect, larger is worse, empty where a signal is flat),",
         "integral and maximum of |error| in m/s^2 (integral m/s^2*s) for surge, sway, heave and deg/s",
-        "(integral deg) for roll, pitch, yaw. In the comparison, `better by` is small-angle minus the",
-        "washout: positive means better than small-angle. The score (lower is better) is the weighted",
+        f"(integral deg) for roll, pitch, yaw. In the comparison, `better by` is {reference} minus the",
+        f"washout: positive means better than {reference}. The score (lower is better) is the weighted",
         "relative integral error of `washbench/analysis/ranking.py`: each DOF's error over the aircraft pilot's own",
         "perceived motion in it, DOFs weighted by how much was felt there (half the weight to specific",
         "force, half to rotation); a DOF the pilot did not feel weighs nothing.",
         "",
         "## Summary",
         "",
-        "| aircraft | manoeuvre | status | checks | best washout | scores (small / large / unrestricted) | recording |",
+        f"| aircraft | manoeuvre | status | checks | best washout | scores ({' / '.join(washouts)}) | recording |",
         "|---|---|---|---|---|---|---|",
     ]
     for o in outcomes:
@@ -272,7 +288,7 @@ def report_markdown(outcomes: Sequence[Outcome], rankings: dict[tuple[str, str],
         ranking = rankings.get(key, [])
         best = ranking[0].washout if ranking else ""
         by_name = {r.washout: r.score for r in ranking}
-        scores = " / ".join(f"{by_name[w]:.3f}" if w in by_name else "-" for w in WASHOUT_NAMES)
+        scores = " / ".join(f"{by_name[w]:.3f}" if w in by_name else "-" for w in washouts)
         status = "ok" if o.run.ok else "FAILED"
         rec = ""
         if o.run.run_dir and (o.run.run_dir / "recording.rrd").exists():
@@ -308,10 +324,11 @@ def report_markdown(outcomes: Sequence[Outcome], rankings: dict[tuple[str, str],
 
 def _comparison_md(o: Outcome) -> list[str]:
     washouts = _washouts([o])
-    others = [w for w in washouts if w != REFERENCE_WASHOUT]
+    reference = reference_washout(washouts)
+    others = [w for w in washouts if w != reference]
     head = "| DOF | metric | " + " | ".join(washouts) + " | " + " | ".join(f"{w} better by" for w in others) + " |"
     lines = [head, "|" + "---|" * (2 + len(washouts) + len(others))]
-    for c in compare(o.run.metrics):
+    for c in compare(o.run.metrics, reference):
         vals = " | ".join(_md_num(c.values.get(w, math.nan)) for w in washouts)
         diffs = " | ".join(_md_num(c.better_than_reference.get(w, math.nan), signed=True) for w in others)
         lines.append(f"| {c.dof} | {c.metric} | {vals} | {diffs} |")
@@ -344,17 +361,20 @@ def suite_command(
     platform_path: Path | None = None,
     progress: bool = True,
     recording: bool = True,
+    washouts: Sequence[str] | None = None,
+    variants: Sequence[str] = (),
+    dask: str | None = None,
     aircraft_dirs: Sequence[Path] = (),
 ) -> int:
     """CLI entry: run the suite, write its results, print where they are; 0 if all succeeded, else 1."""
     if jobs is not None and jobs < 1:
         raise WashbenchError(f"--jobs: expected a whole number of at least 1, got {jobs}")
     files = find_manoeuvres(inputs)
-    # Fail fast on a bad parameter or platform file: every run would fail the same way.
-    from washbench.cueing import load_washout_params
+    # Fail fast on a bad parameter, variant or platform file: every run would fail the same way.
+    from washbench.cueing.variants import select_washouts
     from washbench.platform import load_platform_limits
 
-    load_washout_params(params_path)
+    select_washouts(washouts, variants, params_path)
     load_platform_limits(platform_path)
     start = time.perf_counter()
     outcomes = run_suite(
@@ -365,6 +385,9 @@ def suite_command(
         platform_path=platform_path,
         progress=progress,
         recording=recording,
+        washouts=washouts,
+        variants=variants,
+        dask=dask,
         aircraft_dirs=aircraft_dirs,
     )
     write_suite_results(outcomes, out_dir)
