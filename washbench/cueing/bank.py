@@ -69,6 +69,7 @@ from washbench.cueing.kernel import (
     O_VEL,
     O_WHEEL,
     SAT_KINDS,
+    bank_block,
     bank_step,
     bank_trace,
 )
@@ -241,10 +242,6 @@ def _warm_up() -> None:
         np.zeros((0, NFIELDS)),
     )
     bank_step.disable_compile()
-    if not bank_trace.signatures:  # the block form (CueingBank.steps, cue_trace): load it too, once
-        z = np.zeros((0, 3))
-        bank_trace(z, z, cfg, np.zeros((0, NFILT, filters.NCOEF)), np.zeros((0, NSTATE)),
-                   np.zeros((0, len(SAT_KINDS)), dtype=np.int64), np.zeros((0, NFIELDS, 0)))  # fmt: skip
 
 
 class CueingBank:
@@ -299,11 +296,11 @@ class CueingBank:
             raise ValueError(f"f and omega must both be (M, 3), got {f.shape} and {w.shape}")
         if not (np.isfinite(f).all() and np.isfinite(w).all()):
             raise ValueError("cueing input: non-finite specific force or angular velocity")
-        out = np.empty((len(self.washouts), NFIELDS, f.shape[0]))  # bank_trace writes field-major
-        bank_trace(f, w, self._cfg, self._coef, self._state, self._counts, out)
+        out = np.empty((len(self.washouts), f.shape[0], NFIELDS))
+        bank_block(f, w, self._cfg, self._coef, self._state, self._counts, out)
         if f.shape[0]:
-            self._out[:] = out[:, :, -1]
-        return out.transpose(0, 2, 1)
+            self._out[:] = out[:, -1]
+        return out
 
     def saturation_counts(self) -> dict[str, dict[str, int]]:
         """washout -> limit kind -> number of steps at that limit so far."""
