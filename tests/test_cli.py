@@ -62,7 +62,7 @@ def test_commands_import_only_what_they_need(tmp_path) -> None:
     lines += [f"{k / 120.0!r},0.1,0.0,-9.80665,1.0,0.0,0.0" for k in range(60)]
     (tmp_path / "in.csv").write_text("\n".join(lines) + "\n")
     assert imported_by(["validate", str(tmp_path / "m.yaml")]) == set()
-    assert imported_by(["cue", str(tmp_path / "in.csv"), "--out", str(tmp_path / "cue")]) == set()
+    assert imported_by(["cue", str(tmp_path / "in.csv"), "--out", str(tmp_path / "cue"), "--no-recording"]) == set()
     no_rec = ["run", str(tmp_path / "m.yaml"), "--out", str(tmp_path / "r1"), "--quiet", "--no-recording"]
     assert imported_by(no_rec) == set()
     assert imported_by(["run", str(tmp_path / "m.yaml"), "--out", str(tmp_path / "r2"), "--quiet"]) == {"rerun"}

@@ -68,8 +68,15 @@ def test_cue_writes_traces_and_metrics(kind: str, inputs: dict[str, Path], tmp_p
     out = tmp_path / "new" / "results"  # created if missing
     res = cue(inputs[kind], "--out", out)
     assert res.returncode == 0, res.stderr
-    assert "2401 rows" in res.stdout and str(out / "traces.parquet") in res.stdout
-    assert sorted(p.name for p in out.iterdir()) == ["metrics.csv", "traces.parquet"]
+    assert "2401 rows" in res.stdout and f"wrote {out}" in res.stdout
+    assert sorted(p.name for p in out.iterdir()) == [
+        "metrics.csv",
+        "ranking.csv",
+        "recording.rrd",
+        "report.md",
+        "run.json",
+        "traces.parquet",
+    ]
 
     rows = read_metrics_csv(out / "metrics.csv")
     assert len(rows) == 18
@@ -156,7 +163,7 @@ def bad_cases(d: Path) -> dict[str, tuple[list[str | Path], str]]:
         "inf": ([variant("f.csv", omega_y_degps=(9, math.inf))], "f.csv:11: omega_y_degps: value is infinite"),
         "empty": ([empty], "empty.csv: the file is empty"),
         "unreadable": ([junk], "junk.parquet: not a readable Parquet file"),
-        "extension": ([d / "trace.txt"], "trace.txt: unknown file type '.txt'"),
+        "extension": ([d / "trace.dat"], "trace.dat: unknown file type '.dat'"),
         "washout": ([d / "ok.csv", "--washout", "big-angle"], "unknown washout 'big-angle' (valid: small-angle"),
         "params": ([d / "ok.csv", "--params", params], f"params.yaml:{params_line}: surge_gain: unknown key"),
     }
@@ -166,7 +173,7 @@ def test_bad_inputs_one_line_exit_2_nothing_written(tmp_path: Path) -> None:
     d = tmp_path / "in"
     d.mkdir()
     write_csv(d / "ok.csv", synthetic())
-    (d / "trace.txt").write_text("t_s\n0\n")
+    (d / "trace.dat").write_text("t_s\n0\n")
     cases = bad_cases(d)
     # a results folder holding an earlier metrics.csv: a failing run must not touch it
     out = tmp_path / "out"
@@ -202,30 +209,3 @@ def test_library_reads_what_the_cli_reads(inputs: dict[str, Path]) -> None:
     a, b = read_motion(inputs["csv"]), read_motion(inputs["parquet"])
     assert a.dt_s == b.dt_s
     assert np.array_equal(a.f_mps2, b.f_mps2) and np.array_equal(a.omega_radps, b.omega_radps)
-
-
-@pytest.mark.parametrize("chunk_rows", [7, 1000])
-def test_chunked_cue_writes_the_same_content_as_the_whole_trace(tmp_path: Path, chunk_rows: int) -> None:
-    # washbench cue works chunk by chunk (bounded memory); the whole-trace path is the reference
-    from washbench.cueing import load_washout_params
-    from washbench.platform import load_platform_limits
-    from washbench.runs.cue import cue_motion, cue_to_files, write_results
-
-    cols = synthetic()
-    cols["f_y_mps2"] = 3.0 * np.sin(cols["t_s"])  # enough motion to saturate the platform somewhere
-    cols["omega_z_degps"] = 40.0 * np.sin(0.3 * cols["t_s"])
-    motion = read_motion(write_csv(tmp_path / "in.csv", cols))
-    params, limits = load_washout_params(), load_platform_limits()
-    whole = cue_motion(motion, WASHOUT_NAMES, params, limits)
-    write_results(tmp_path / "whole", whole)
-    rows, saturations, _ = cue_to_files(motion, WASHOUT_NAMES, params, limits, tmp_path / "chunked",
-                                        chunk_rows=chunk_rows)  # fmt: skip
-    assert (tmp_path / "chunked" / "metrics.csv").read_bytes() == (tmp_path / "whole" / "metrics.csv").read_bytes()
-    assert rows == whole.metrics
-    assert saturations == {w: dict(whole.traces[w].saturation_counts) for w in WASHOUT_NAMES}
-    assert any(v for s in saturations.values() for v in s.values())
-    a, b = pq.read_table(tmp_path / "chunked" / "traces.parquet"), pq.read_table(tmp_path / "whole" / "traces.parquet")
-    assert a.schema.equals(b.schema) and a.num_rows == b.num_rows == motion.n
-    for name in a.column_names:
-        assert np.array_equal(a.column(name).to_numpy(), b.column(name).to_numpy()), name
-    assert pq.ParquetFile(tmp_path / "chunked" / "traces.parquet").num_row_groups == -(-motion.n // chunk_rows)

@@ -25,7 +25,8 @@ from washbench.flight.checks import evaluate
 from washbench.flight.columns import COLUMN_NAMES
 from washbench.flight.fdm import make_fdm
 from washbench.flight.manoeuvre import Manoeuvre, Until, load_manoeuvre
-from washbench.flight.monitor import ALPHA_MAX_RAD, BIG, Monitor
+from washbench.flight.monitor import BIG, Monitor
+from washbench.flight.openloop import OpenLoop
 from washbench.flight.pilot import Pilot
 from washbench.flight.profile import load_profile
 from washbench.io.atomic import atomic_path, write_text_atomic
@@ -90,6 +91,7 @@ class FlightResult:
     status: str  # "ok" or "failed"
     reason: str = ""
     events: dict[str, list[float]] = field(default_factory=dict)
+    probes: dict[str, np.ndarray] = field(default_factory=dict)  # fly(probes=...): JSBSim properties after each step
 
     @property
     def ok(self) -> bool:
@@ -148,8 +150,14 @@ def _duration_only(u: Until) -> float | None:
     return u.duration_s - 1e-9 if u.duration_s is not None and not others else None
 
 
-def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool = False,
-        block_hook: BlockHook | None = None, block_size: int = 120) -> FlightResult:  # fmt: skip
+def fly(
+    manoeuvre: Manoeuvre,
+    step_hook: StepHook | None = None,
+    progress: bool = False,
+    probes: Sequence[str] = (),
+    block_hook: BlockHook | None = None,
+    block_size: int = 120,
+) -> FlightResult:
     """Fly ``manoeuvre`` to its end (or to a crash) and return the recording and check results.
 
     ``step_hook(k, f_mps2, omega_radps)`` is called once per recorded sample, in order, as soon
@@ -157,6 +165,9 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
     body axes x forward, y right, z down). ``block_hook(k0, f_mps2, omega_radps)`` gets the same
     samples ``block_size`` at a time as (M, 3) arrays (samples ``k0 .. k0 + M - 1``; the last block
     may be shorter), without a Python call per sample.
+    ``probes`` names JSBSim properties read after each
+    step (sample ``k``: the value the step from ``k`` produced, e.g. a surface position), returned
+    in ``FlightResult.probes``.
     """
     m = manoeuvre
     profile = load_profile(m.aircraft_files.profile)
@@ -173,7 +184,10 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
 
     pilot = Pilot(profile, m.runway, dt)
     pilot.set_controls(ail_w.get_double_value(), elev_w.get_double_value(), rud_w.get_double_value())
-    monitor = Monitor(profile)
+    monitor = Monitor.for_profile(profile)
+    openloop = OpenLoop(fdm, profile, pilot)
+    probe_gets = [n.get_double_value for n in _nodes(fdm, tuple(probes))]
+    probe_rows: list[list[float]] = [[] for _ in probe_gets]
     frame = setup.frame
     lat0, lon0, mlat, mlon = frame.lat0, frame.lon0, frame.m_per_rad_lat, frame.m_per_rad_lon
     has_runway = setup.threshold_ne_m is not None
@@ -189,7 +203,7 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
     rows_extend = rows.extend
     run = fdm.run
     nz_max, nz_min = monitor.nz_max, monitor.nz_min
-    vne, h_collapsed = monitor.vne, monitor.h_collapsed
+    vne, h_collapsed, alpha_max = monitor.vne, monitor.h_collapsed, monitor.alpha_max
     ncol = len(COLUMN_NAMES)
     phases_out: list[tuple[str, float, float]] = []
     events: dict[str, list[float]] = {"touchdown_times_s": [], "touchdown_sinks_fps": [], "liftoff_times_s": []}
@@ -238,7 +252,7 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
         # the monitor's state checks, inlined (hot path); it is asked for the cause only when one fails
         problem = None
         if (not -BIG < total < BIG or sw > 0.0 or vc > vne or agl < h_collapsed
-                or (not wow and (alpha > ALPHA_MAX_RAD or alpha < -ALPHA_MAX_RAD))):  # fmt: skip
+                or (not wow and (alpha > alpha_max or alpha < -alpha_max))):  # fmt: skip
             problem = monitor.state(total, vc, alpha, agl, wow, sw)
         # events at this sample
         if wow and not was_wow:
@@ -305,31 +319,38 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
                 turned = rolled = pitched = 0.0
                 phase_events = set()
                 pilot.begin_phase(phase.hold, theta, thr_w.get_double_value(), flap_get())
+                openloop.begin_phase(phase.inputs)
                 flapc_w.set_double_value(pilot.flaps_cmd)
                 lbrk_w.set_double_value(pilot.brakes)
                 rbrk_w.set_double_value(pilot.brakes)
                 if progress:  # a line at each phase start (in place on a terminal)
                     _progress(m.name, iphase, nphases, phase.name, t, tty)
 
+        ail, elev, rud, thr = pilot.aileron, pilot.elevator, pilot.rudder, pilot.throttle
         if not final:
             pilot.step(phi, theta, psi, p, q, r, beta, vc, vg, trk, hdot, h, agl, x_rw * 3.2808399,
                        y_rw * 3.2808399, wow, nz_last, alpha, vt_get(), fy_last)  # fmt: skip
-            ail_set(pilot.aileron)
-            elev_set(pilot.elevator)
-            rud_set(pilot.rudder)
+            ail, elev, rud, thr = pilot.aileron, pilot.elevator, pilot.rudder, pilot.throttle
+            if openloop.active:  # the phase's open-loop inputs, on top of or instead of the pilot's commands
+                ail, elev, rud, thr = openloop.apply((k - phase_k0) * dt, ail, elev, rud, thr)
+            ail_set(ail)
+            elev_set(elev)
+            rud_set(rud)
             steer_set(pilot.steer)
-            thr_set(pilot.throttle)
+            thr_set(thr)
             if k % mix_every == 0:
                 mix_w.set_double_value(float(np.interp(h, mix_h_ft, mix_norm)))
         run()
+        for get, out in zip(probe_gets, probe_rows, strict=True):
+            out.append(get())
         ax, ay, az = ax_get(), ay_get(), az_get()
         nz = nz_get()
         nz_last = nz
         fy_last = ay * FT_S2_TO_M_S2
         # raw values in JSBSim's units; converted column by column after the loop (same bits, fewer operations)
         rows_extend((k, ax, ay, az, p, q, r, phi, theta, psi, alpha, beta, vc, vg, h, agl, hdot, north, east, lat,
-                     lon, x_rw, y_rw, nz, pilot.aileron, pilot.elevator, pilot.rudder, pilot.throttle, flap_get(),
-                     pilot.brakes, rpm_get(), wow, iphase if not final else nphases - 1))  # fmt: skip
+                     lon, x_rw, y_rw, nz, ail, elev, rud, thr, flap_get(), pilot.brakes, rpm_get(), wow,
+                     iphase if not final else nphases - 1))  # fmt: skip
         if step_hook is not None:
             step_hook(k, np.array((ax * FT_S2_TO_M_S2, fy_last, az * FT_S2_TO_M_S2)), np.array((p, q, r)))
         if block_hook is not None and k + 1 - k_sent == block_size:
@@ -361,7 +382,8 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
     elif not all(c.passed for c in results):
         status = "failed"
         reason = "checks failed: " + ", ".join(c.name for c in results if not c.passed)
-    return FlightResult(m.name, m.aircraft, dt, columns, phases_out, checks, status, reason, events)
+    probed = {name: np.array(v) for name, v in zip(probes, probe_rows, strict=True)}
+    return FlightResult(m.name, m.aircraft, dt, columns, phases_out, checks, status, reason, events, probed)
 
 
 def _send_block(hook: BlockHook, rows: array, k0: int, ncol: int) -> int:

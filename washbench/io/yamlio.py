@@ -34,7 +34,7 @@ Loc = tuple[str | int, ...]
 class StrictModel(BaseModel):
     """Base for models read from YAML: unknown keys rejected, strict types, frozen."""
 
-    model_config = ConfigDict(extra="forbid", strict=True, frozen=True)
+    model_config = ConfigDict(extra="forbid", strict=True, frozen=True, use_attribute_docstrings=True)
 
 
 class _UniqueKeyLoader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):  # type: ignore[misc]

@@ -1,10 +1,8 @@
 """``washbench run``: fly a manoeuvre with the three washouts in lockstep, then perceive, measure, record.
 
 At every JSBSim step the scripted pilot's flight gives one sample of pilot-head motion; the
-samples go through the three washouts and the kinematic Atlas model while the flight goes on,
-a block of ``LOCKSTEP_BLOCK`` samples (1 s at 120 Hz) at a time
-(:meth:`washbench.cueing.CueingBank.steps`: the same compiled step as the per-sample streaming
-form, bit for bit, without a Python call per sample).
+sample goes straight through the three washouts and the kinematic Atlas model
+(:class:`washbench.cueing.CueingBank`, the streaming form), as a real simulator would run them.
 After the flight the vestibular models, the metrics and the tables are the same code as
 ``washbench cue`` (:func:`washbench.runs.cue.analyse`), on the flight as written to
 ``flight.parquet`` and read back, so ``washbench fly`` then ``washbench cue`` gives the same
@@ -25,6 +23,7 @@ an interrupted run never leaves a half-written folder that looks complete)::
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import json
 import math
 import os
@@ -34,9 +33,10 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from washbench.analysis.metrics import MetricRow
 from washbench.analysis.ranking import DOFS, perceived_motion
@@ -44,16 +44,10 @@ from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
 
 if TYPE_CHECKING:
-    from washbench.cueing import CueingBank
-    from washbench.flight.fly import FlightResult
     from washbench.io.results import Motion
     from washbench.platform import PlatformLimits
     from washbench.review.rerun_log import PlatformEnvelope
     from washbench.runs.cue import CueResult
-
-#: Samples the washouts take at a time during the flight (1 s at 120 Hz): the same compiled step as one
-#: sample at a time, bit for bit, with one call per block instead of one per sample.
-LOCKSTEP_BLOCK = 120
 
 RUN_FILES = ("flight.json", "flight.parquet", "traces.parquet", "metrics.csv", "recording.rrd", "run.json")
 
@@ -80,21 +74,9 @@ class RunSummary:
 
 
 def aircraft_attitude(phi_deg: np.ndarray, theta_deg: np.ndarray, psi_deg: np.ndarray) -> np.ndarray:
-    """Body->NED quaternions (N, 4), scalar first, from ZYX Euler angles in degrees: q = q_z(psi) q_y(theta) q_x(phi).
-
-    Closed form (what ``scipy.spatial.transform.Rotation.from_euler("ZYX", ...)`` gives, without its import).
-    """
-    h = 0.5 * np.radians(np.column_stack([phi_deg, theta_deg, psi_deg]))
-    c, s = np.cos(h), np.sin(h)
-    cf, ct, cp, sf, st, sp = c[:, 0], c[:, 1], c[:, 2], s[:, 0], s[:, 1], s[:, 2]
-    return np.column_stack(
-        [
-            cf * ct * cp + sf * st * sp,
-            sf * ct * cp - cf * st * sp,
-            cf * st * cp + sf * ct * sp,
-            cf * ct * sp - sf * st * cp,
-        ]
-    )
+    """Body->NED quaternions (N, 4), scalar first, from ZYX Euler angles in degrees."""
+    angles = np.column_stack([psi_deg, theta_deg, phi_deg])
+    return Rotation.from_euler("ZYX", angles, degrees=True).as_quat(scalar_first=True)
 
 
 def metrics_markdown(title: str, rows: list[MetricRow]) -> str:
@@ -124,31 +106,6 @@ def _publish(partial: Path, final: Path) -> None:
     shutil.rmtree(old, ignore_errors=True)
 
 
-class Lockstep:
-    """The flight's block hook (:func:`washbench.flight.fly.fly`): feeds the washouts as the flight goes.
-
-    ``finish()`` returns every output row, (washouts, N, fields).
-    """
-
-    def __init__(self, bank: CueingBank) -> None:
-        self.bank = bank
-        self.blocks: list[np.ndarray] = []  # (washouts, samples, fields) per block
-        self.done = 0
-
-    def __call__(self, k0: int, f_mps2: np.ndarray, omega_radps: np.ndarray) -> None:
-        if k0 != self.done:
-            raise RuntimeError(f"lockstep: block starts at sample {k0}, expected {self.done}")
-        # The washouts see the angular velocity exactly as flight.parquet stores it (deg/s) and
-        # washbench cue reads it back (np.radians), so both paths give the same bits.
-        self.blocks.append(self.bank.steps(f_mps2, np.radians(np.degrees(omega_radps))))
-        self.done += f_mps2.shape[0]
-
-    def finish(self) -> np.ndarray:
-        if not self.blocks:
-            return np.zeros((len(self.bank.washouts), 0, len(self.bank.FIELDS)))
-        return np.concatenate(self.blocks, axis=1)
-
-
 def run_manoeuvre(
     manoeuvre_path: Path,
     out_root: Path,
@@ -156,41 +113,39 @@ def run_manoeuvre(
     params_path: Path | None = None,
     platform_path: Path | None = None,
     progress: bool = False,
-    recording: bool = True,
     washouts: Sequence[str] | None = None,
     variants: Sequence[str] = (),
+    filter_start: str = "steady",
     aircraft_dirs: Sequence[Path] = (),
+    recording: bool = True,
 ) -> RunSummary:
     """Fly one manoeuvre with the washouts in lockstep and write its results folder.
 
+    ``recording=False`` skips ``recording.rrd`` (and the import of rerun): every other file is written.
+
     ``washouts`` (built-in names), ``variants`` (``--variant`` texts) and the parameter file's ``variants:``
     select the washouts (:func:`washbench.cueing.variants.select_washouts`; default the three built-in ones).
-    ``recording=False`` skips ``recording.rrd`` (and the import of rerun): every other file is written.
+    ``filter_start``: the washouts' and vestibular models' start state (``steady`` or ``rest``).
 
     Raises WashbenchError for a bad manoeuvre, parameter or platform file (nothing written).
     A flight that crashes or fails a check still writes its results (what was flown), with
     ``ok`` False and the reason.
     """
-    from washbench.cueing import CueingBank, WashoutTrace
     from washbench.cueing.variants import select_washouts
     from washbench.flight.fly import fly, write_flight
     from washbench.flight.manoeuvre import load_manoeuvre
-    from washbench.io.results import read_motion
     from washbench.platform import load_platform_limits
-    from washbench.runs.cue import analyse, write_results
 
     manoeuvre = load_manoeuvre(manoeuvre_path, aircraft_dirs)
     specs = select_washouts(washouts, variants, params_path)
     limits = load_platform_limits(platform_path)
-    bank = CueingBank(specs, None, limits, manoeuvre.dt_s)
-    washouts = bank.washouts
-    lockstep = Lockstep(bank)
+    washouts = tuple(w.name for w in specs)
+    rows, lockstep = lockstep_blocks(specs, limits, manoeuvre.dt_s, filter_start)
     start = time.perf_counter()
     flight = fly(manoeuvre, block_hook=lockstep, block_size=LOCKSTEP_BLOCK, progress=progress)
-    block = lockstep.finish()  # (washouts, N, fields)
     n = len(flight.t_s)
-    if block.shape[1] != n:
-        raise RuntimeError(f"washouts ran {block.shape[1]} steps for {n} recorded samples")
+    if len(rows) != n:
+        raise RuntimeError(f"washouts ran {len(rows)} steps for {n} recorded samples")
 
     final = Path(out_root) / manoeuvre.aircraft / manoeuvre.name
     partial = final.with_name(f".{final.name}.partial-{os.getpid()}")
@@ -200,16 +155,7 @@ def run_manoeuvre(
         write_flight(partial, flight, str(manoeuvre_path))
         if n < 2:
             raise WashbenchError(located(manoeuvre_path, f"the flight recorded {n} sample(s): nothing to cue"))
-        motion = read_motion(partial / "flight.parquet")
-        traces = {w: WashoutTrace.from_rows(block[i]) for i, w in enumerate(washouts)}
-        result = analyse(motion, traces)
-        write_results(partial, result)
-        if recording:
-            title = f"{manoeuvre.aircraft} / {manoeuvre.name}"
-            _write_recording(partial / "recording.rrd", title, motion, flight, result, limits)
-        felt = perceived_motion(
-            result.perceived["aircraft"].f_mps2, result.perceived["aircraft"].omega_radps, motion.dt_s
-        )
+        cols = flight.columns
         # the flight is "failed" when the monitor stopped it or a check failed, with the reason
         summary = RunSummary(
             ok=flight.ok,
@@ -217,15 +163,12 @@ def run_manoeuvre(
             aircraft=manoeuvre.aircraft,
             manoeuvre=manoeuvre.name,
             run_dir=final,
-            steps=n,
-            dt_s=motion.dt_s,
             checks_passed=sum(1 for c in flight.checks if c[3]),
             checks_total=len(flight.checks),
-            metrics=list(result.metrics),
-            motion=felt,
-            saturations={w: dict(traces[w].saturation_counts) for w in washouts},
         )
-        _write_run_json(partial / "run.json", summary, time.perf_counter() - start)
+        ac_q = aircraft_attitude(cols["phi_deg"], cols["theta_deg"], cols["psi_deg"])
+        summary = write_cued_folder(partial, summary, rows, washouts, limits, ac_q, flight.phases, start, filter_start,
+                                    recording=recording)
         _publish(partial, final)
     finally:
         with contextlib.suppress(FileNotFoundError):
@@ -233,8 +176,177 @@ def run_manoeuvre(
     return summary
 
 
-def _write_run_json(path: Path, s: RunSummary, wall_s: float) -> None:
-    doc = {
+def check_max_time(max_time_s: float | None) -> None:
+    """``--max-time-s``: None or a positive, finite number of seconds (WashbenchError otherwise)."""
+    if max_time_s is not None and not (math.isfinite(max_time_s) and max_time_s > 0.0):
+        raise WashbenchError(f"--max-time-s: expected a positive number of seconds, got {max_time_s:g}")
+
+
+def lockstep_washouts(
+    specs: Sequence[Any], limits: Any, dt_s: float, filter_start: str = "steady"
+) -> tuple[list[np.ndarray], Any]:
+    """A washout bank (selected :class:`washbench.cueing.variants.Washout` s) run in lockstep with a flight:
+    (the rows it fills, the flight's step hook)."""
+    from washbench.cueing import CueingBank
+
+    bank = CueingBank(specs, None, limits, dt_s, filter_start)
+    rows: list[np.ndarray] = []
+    step = bank.step
+    omega_deg = np.empty(3)
+
+    def lockstep(k: int, f_mps2: np.ndarray, omega_radps: np.ndarray) -> None:
+        # The washouts see the angular velocity exactly as flight.parquet stores it (deg/s) and
+        # washbench cue reads it back (np.radians), so both paths give the same bits.
+        np.degrees(omega_radps, out=omega_deg)
+        rows.append(step(f_mps2, np.radians(omega_deg)).copy())
+
+    return rows, lockstep
+
+
+#: Samples the washouts take at a time during a flight (1 s at 120 Hz): the same compiled step as one
+#: sample at a time, bit for bit, with one call per block instead of one per sample.
+LOCKSTEP_BLOCK = 120
+
+
+def lockstep_blocks(
+    specs: Sequence[Any], limits: Any, dt_s: float, filter_start: str = "steady"
+) -> tuple[list[np.ndarray], Any]:
+    """:func:`lockstep_washouts` for ``fly``'s block hook: the washouts take the flight's samples a block at a
+    time (``CueingBank.steps``, one compiled call per block); ``rows`` gets one (washouts, fields) row per sample."""
+    from washbench.cueing import CueingBank
+
+    bank = CueingBank(specs, None, limits, dt_s, filter_start)
+    rows: list[np.ndarray] = []
+
+    def lockstep(k0: int, f_mps2: np.ndarray, omega_radps: np.ndarray) -> None:
+        if k0 != len(rows):
+            raise RuntimeError(f"lockstep: block starts at sample {k0}, expected {len(rows)}")
+        # The washouts see the angular velocity exactly as flight.parquet stores it (deg/s) and
+        # washbench cue reads it back (np.radians), so both paths give the same bits.
+        rows.extend(bank.steps(f_mps2, np.radians(np.degrees(omega_radps))).transpose(1, 0, 2))
+
+    return rows, lockstep
+
+
+def write_cued_folder(
+    folder: Path,
+    summary: RunSummary,
+    rows: list[np.ndarray],
+    washouts: tuple[str, ...],
+    limits: Any,
+    aircraft_q: np.ndarray,
+    phases: list[tuple[str, float, float]],
+    start: float,
+    filter_start: str = "steady",
+    extra: dict[str, object] | None = None,
+    recording: bool = True,
+) -> RunSummary:
+    """Everything after the flight, into ``folder`` (which already holds ``flight.parquet``): perception and
+    metrics on the flight read back (as ``washbench cue`` reads it), traces.parquet, metrics.csv, recording.rrd,
+    run.json, ranking.csv and report.md. Returns ``summary`` completed with the steps, metrics and saturations."""
+    from washbench.cueing import WashoutTrace
+    from washbench.io.results import read_motion
+    from washbench.runs.cue import analyse, write_results
+    from washbench.runs.suite import write_run_review
+
+    motion = read_motion(folder / "flight.parquet")
+    block = np.stack(rows)  # (N, washouts, fields)
+    traces = {w: WashoutTrace.from_rows(block[:, i, :]) for i, w in enumerate(washouts)}
+    result = analyse(motion, traces, filter_start=filter_start)
+    write_results(folder, result)
+    if recording:
+        title = f"{summary.aircraft} / {summary.manoeuvre}"
+        write_run_recording(folder / "recording.rrd", title, motion, result, limits, aircraft_q, phases)
+    ac = result.perceived["aircraft"]
+    summary = dataclasses.replace(
+        summary,
+        steps=motion.n,
+        dt_s=motion.dt_s,
+        metrics=list(result.metrics),
+        motion=perceived_motion(ac.f_mps2, ac.omega_radps, motion.dt_s),
+        saturations={w: dict(traces[w].saturation_counts) for w in washouts},
+    )
+    write_run_json(folder / "run.json", summary, time.perf_counter() - start, extra)
+    write_run_review(folder, dataclasses.replace(summary, run_dir=folder))
+    return summary
+
+
+def run_script(
+    script_path: Path,
+    out_root: Path,
+    *,
+    params_path: Path | None = None,
+    platform_path: Path | None = None,
+    max_time_s: float | None = None,
+    filter_start: str = "steady",
+    aircraft_dirs: Sequence[Path] = (),
+    washouts: Sequence[str] | None = None,
+    variants: Sequence[str] = (),
+    recording: bool = True,
+) -> list[RunSummary]:
+    """Fly a JSBSim script (:mod:`washbench.flight.scripts`) with the washouts in lockstep, one result per run.
+
+    Writes ``OUT/<aircraft>/<script>/`` (one run) or ``OUT/<aircraft>/<script>/<run_i>/`` (a script that
+    resets), published as one folder. A crash still writes what was flown, with ``ok`` False and the reason.
+    """
+    from washbench.cueing.bank import check_filter_start
+    from washbench.cueing.variants import select_washouts
+    from washbench.flight.scripts import fly_script, load_script_info, write_script_flight
+    from washbench.platform import load_platform_limits
+
+    info = load_script_info(script_path, aircraft_dirs)
+    check_filter_start(filter_start)
+    check_max_time(max_time_s)
+    specs = select_washouts(washouts, variants, params_path)
+    limits = load_platform_limits(platform_path)
+    names = tuple(w.name for w in specs)
+    banks: list[list[np.ndarray]] = []
+
+    def segment_hook(i: int, dt_s: float) -> Any:
+        rows, hook = lockstep_washouts(specs, limits, dt_s, filter_start)
+        banks.append(rows)
+        return hook
+
+    start = time.perf_counter()
+    flight = fly_script(script_path, max_time_s=max_time_s, segment_hook=segment_hook, aircraft_dirs=aircraft_dirs)
+    final = Path(out_root) / info.aircraft / info.name
+    partial = final.with_name(f".{final.name}.partial-{os.getpid()}")
+    shutil.rmtree(partial, ignore_errors=True)
+    partial.mkdir(parents=True)
+    several = len(flight.segments) > 1
+    summaries = []
+    try:
+        for seg, rows in zip(flight.segments, banks, strict=True):
+            folder = partial / seg.name if several else partial
+            folder.mkdir(exist_ok=True)
+            write_script_flight(folder, flight, seg)
+            summary = RunSummary(
+                ok=seg.ok,
+                reason=seg.reason,
+                aircraft=info.aircraft,
+                manoeuvre=f"{info.name}/{seg.name}" if several else info.name,
+                run_dir=final / seg.name if several else final,
+            )
+            if seg.n < 2:
+                summaries.append(dataclasses.replace(summary, ok=False, reason=seg.reason or "nothing recorded"))
+                continue
+            cols = seg.columns
+            ac_q = aircraft_attitude(cols["phi_deg"], cols["theta_deg"], cols["psi_deg"])
+            extra = {"script": str(info.path), "segment": seg.name, "stopped_by_time_limit": flight.stopped_by_limit}
+            summaries.append(
+                write_cued_folder(folder, summary, rows, names, limits, ac_q, [], start, filter_start, extra,
+                                  recording=recording)
+            )
+        _publish(partial, final)
+    finally:
+        with contextlib.suppress(FileNotFoundError):
+            shutil.rmtree(partial)
+    return summaries
+
+
+def write_run_json(path: Path, s: RunSummary, wall_s: float, extra: dict[str, object] | None = None) -> None:
+    """``run.json``: the summary of one result folder (``extra``: more keys, e.g. what ``cue`` read)."""
+    doc: dict[str, object] = {
         "aircraft": s.aircraft,
         "manoeuvre": s.manoeuvre,
         "ok": s.ok,
@@ -249,16 +361,25 @@ def _write_run_json(path: Path, s: RunSummary, wall_s: float) -> None:
         },
         "saturations": s.saturations,
     }
+    doc |= extra or {}
     write_text_atomic(path, json.dumps(doc, indent=2) + "\n")
 
 
-def _write_recording(
-    path: Path, title: str, motion: Motion, flight: FlightResult, result: CueResult, limits: PlatformLimits
+def write_run_recording(
+    path: Path,
+    title: str,
+    motion: Motion,
+    result: CueResult,
+    limits: PlatformLimits,
+    aircraft_q: np.ndarray,
+    phases: list[tuple[str, float, float]],
 ) -> None:
+    """The recording of one result folder (``run`` and ``cue`` alike): the one call of the recording writer.
+
+    ``aircraft_q`` (N, 4) the aircraft's attitude, body -> NED, scalar first; ``phases`` (name, start, end) [s].
+    """
     from washbench.review.rerun_log import MotionSeries, PlatformSeries, RecordingData, write_recording
 
-    cols = flight.columns
-    ac_q = aircraft_attitude(cols["phi_deg"], cols["theta_deg"], cols["psi_deg"])
     ac = result.perceived["aircraft"]
     washouts: dict[str, MotionSeries] = {}
     platforms: dict[str, PlatformSeries] = {}
@@ -282,12 +403,12 @@ def _write_recording(
             omega_radps=motion.omega_radps,
             perceived_f_mps2=ac.f_mps2,
             perceived_omega_radps=ac.omega_radps,
-            q=ac_q,
+            q=aircraft_q,
         ),
         washouts=washouts,
         platforms=platforms,
         envelope=platform_envelope(limits),
-        phases=[(p[0], float(p[1]), float(p[2])) for p in flight.phases],
+        phases=[(p[0], float(p[1]), float(p[2])) for p in phases],
         metrics_markdown=metrics_markdown(title, list(result.metrics)),
     )
     write_recording(path, data)
@@ -318,30 +439,59 @@ def run_command(
     params_path: Path | None = None,
     platform_path: Path | None = None,
     progress: bool = True,
-    recording: bool = True,
+    max_time_s: float | None = None,
+    filter_start: str = "steady",
     washouts: Sequence[str] | None = None,
     variants: Sequence[str] = (),
     aircraft_dirs: Sequence[Path] = (),
+    recording: bool = True,
 ) -> int:
-    """CLI entry of ``washbench run``: 0 if the flight ran and passed its checks, else 1."""
+    """CLI entry of ``washbench run`` (a YAML manoeuvre or a JSBSim script): 0 if every run was ok, else 1."""
+    from washbench.cueing.bank import check_filter_start
+    from washbench.flight.scripts import is_script
+
+    check_filter_start(filter_start)
+    check_max_time(max_time_s)
     start = time.perf_counter()
-    s = run_manoeuvre(
-        manoeuvre_path,
-        out_root,
-        params_path=params_path,
-        platform_path=platform_path,
-        progress=progress,
-        recording=recording,
-        washouts=washouts,
-        variants=variants,
-        aircraft_dirs=aircraft_dirs,
-    )
-    state = "ok" if s.ok else f"FAILED ({s.reason})"
-    print(
-        f"{s.aircraft}/{s.manoeuvre}: {state}; checks {s.checks_passed}/{s.checks_total}; "
-        f"{s.steps * s.dt_s:.1f} s flown in {time.perf_counter() - start:.1f} s; results in {s.run_dir}"
-    )
-    for w, kinds in s.saturations.items():
-        sat = ", ".join(f"{k} {v}" for k, v in kinds.items() if v) or "none"
-        print(f"  {w}: platform saturations (steps): {sat}", file=sys.stdout)
-    return 0 if s.ok else 1
+    if is_script(manoeuvre_path):
+        runs = run_script(
+            manoeuvre_path,
+            out_root,
+            params_path=params_path,
+            platform_path=platform_path,
+            max_time_s=max_time_s,
+            filter_start=filter_start,
+            aircraft_dirs=aircraft_dirs,
+            washouts=washouts,
+            variants=variants,
+            recording=recording,
+        )
+    else:
+        if max_time_s is not None:
+            raise WashbenchError("--max-time-s applies to JSBSim scripts only (a manoeuvre's phases set its length)")
+        runs = [
+            run_manoeuvre(
+                manoeuvre_path,
+                out_root,
+                params_path=params_path,
+                platform_path=platform_path,
+                progress=progress,
+                filter_start=filter_start,
+                aircraft_dirs=aircraft_dirs,
+                washouts=washouts,
+                variants=variants,
+                recording=recording,
+            )
+        ]
+    wall = time.perf_counter() - start
+    for s in runs:
+        state = "ok" if s.ok else f"FAILED ({s.reason})"
+        checks = f"; checks {s.checks_passed}/{s.checks_total}" if s.checks_total else ""
+        print(
+            f"{s.aircraft}/{s.manoeuvre}: {state}{checks}; {s.steps * s.dt_s:.1f} s flown in {wall:.1f} s; "
+            f"results in {s.run_dir}"
+        )
+        for w, kinds in s.saturations.items():
+            sat = ", ".join(f"{k} {v}" for k, v in kinds.items() if v) or "none"
+            print(f"  {w}: platform saturations (steps): {sat}", file=sys.stdout)
+    return 0 if all(s.ok for s in runs) else 1

@@ -55,23 +55,39 @@ class Outcome:
     run: RunSummary
 
 
-def find_manoeuvres(inputs: Sequence[Path]) -> list[Path]:
-    """Manoeuvre files from files and folders (folders are searched recursively for ``*.yaml``)."""
-    if not inputs:
+def _is_runscript(path: Path) -> bool:
+    """True for an XML file whose root element is a JSBSim ``<runscript>`` (cheap: reads the first element)."""
+    import xml.etree.ElementTree as ET
+
+    try:
+        for _, elem in ET.iterparse(path, events=("start",)):
+            return elem.tag == "runscript"
+    except (ET.ParseError, OSError):
+        return False
+    return False
+
+
+def find_manoeuvres(inputs: Sequence[Path], scripts: Sequence[Path] = ()) -> list[Path]:
+    """Manoeuvre files and JSBSim scripts from files and folders (folders are searched recursively for
+    ``*.yaml`` manoeuvres and ``*.xml`` JSBSim scripts), then ``scripts``; no inputs at all: the bundled
+    manoeuvres."""
+    if not inputs and not scripts:
         inputs = [MANOEUVRES_DIR]
     found: list[Path] = []
     for item in map(resolve_manoeuvre, inputs):
         if item.is_dir():
             found.extend(sorted(p for p in item.rglob("*.yaml") if p.is_file()))
+            found.extend(sorted(p for p in item.rglob("*.xml") if p.is_file() and _is_runscript(p)))
         elif item.is_file():
             found.append(item)
         else:
             raise WashbenchError(
                 located(item, f"no such file or folder, nor a bundled manoeuvre ({', '.join(bundled_names())})")
             )
+    found.extend(scripts)
     unique = list(dict.fromkeys(p.resolve() for p in found))
     if not unique:
-        raise WashbenchError(located(inputs[0], "no manoeuvre files (*.yaml) found"))
+        raise WashbenchError(located(inputs[0], "no manoeuvre files (*.yaml) or JSBSim scripts (*.xml) found"))
     return unique
 
 
@@ -83,30 +99,33 @@ def _run_one(
     washouts: tuple[str, ...] | None = None,
     variants: tuple[str, ...] = (),
     aircraft_dirs: tuple[str, ...] = (),
+    max_time_s: float | None = None,
     recording: bool = True,
-) -> Outcome:
-    """Worker: run one manoeuvre; never raises (failures come back as an Outcome)."""
-    from washbench.runs.pipeline import run_manoeuvre
+) -> list[Outcome]:
+    """Worker: run one manoeuvre or JSBSim script (one outcome per run segment); never raises (failures
+    come back as an Outcome)."""
+    from washbench.flight.scripts import is_script
+    from washbench.runs.pipeline import run_manoeuvre, run_script
 
     start = time.perf_counter()
+    params = Path(params_path) if params_path else None
+    platform = Path(platform_path) if platform_path else None
     try:
-        summary = run_manoeuvre(
-            Path(path),
-            Path(out_dir),
-            params_path=Path(params_path) if params_path else None,
-            platform_path=Path(platform_path) if platform_path else None,
-            recording=recording,
-            washouts=washouts,
-            variants=variants,
-            aircraft_dirs=[Path(d) for d in aircraft_dirs],
-        )
+        dirs = [Path(d) for d in aircraft_dirs]
+        common = {"params_path": params, "platform_path": platform, "aircraft_dirs": dirs}
+        common |= {"washouts": washouts, "variants": variants, "recording": recording}
+        if is_script(Path(path)):
+            runs = run_script(Path(path), Path(out_dir), max_time_s=max_time_s, **common)
+        else:
+            runs = [run_manoeuvre(Path(path), Path(out_dir), **common)]
     except WashbenchError as exc:
-        summary = RunSummary(ok=False, reason=str(exc))
+        runs = [RunSummary(ok=False, reason=str(exc))]
     except Exception as exc:  # an unexpected bug in one run must not take the suite down
         tb = traceback.format_exc(limit=-3).strip().splitlines()
         where = tb[-3].strip() if len(tb) >= 3 else ""
-        summary = RunSummary(ok=False, reason=f"internal error: {type(exc).__name__}: {exc} ({where})")
-    return Outcome(path=path, wall_s=time.perf_counter() - start, run=summary)
+        runs = [RunSummary(ok=False, reason=f"internal error: {type(exc).__name__}: {exc} ({where})")]
+    wall = time.perf_counter() - start
+    return [Outcome(path=path, wall_s=wall / len(runs), run=r) for r in runs]
 
 
 def _preload() -> None:
@@ -118,8 +137,8 @@ def pool_context(recording: bool = True) -> tuple[multiprocessing.context.BaseCo
     """The process pool's start method and worker initializer.
 
     ``forkserver`` (Linux, macOS) where it exists: workers fork from a server that has already imported the heavy
-    modules (JSBSim, the numba kernels, pyarrow, and rerun unless ``recording`` is False), so each starts in
-    milliseconds. Elsewhere (Windows) ``spawn``, with every worker importing them once at its start.
+    modules (JSBSim, the numba kernels, rerun, pyarrow), so each starts in milliseconds. Elsewhere (Windows)
+    ``spawn``, with every worker importing them once at its start.
     """
     if "forkserver" in multiprocessing.get_all_start_methods():
         ctx = multiprocessing.get_context("forkserver")
@@ -140,20 +159,21 @@ def run_suite(
     variants: Sequence[str] = (),
     dask: str | None = None,
     aircraft_dirs: Sequence[Path] = (),
+    max_time_s: float | None = None,
     recording: bool = True,
 ) -> list[Outcome]:
-    """Run every file in parallel processes (or on the Dask cluster at ``dask``); outcomes in the order of ``files``.
-
-    ``recording=False``: no ``recording.rrd`` in the run folders (the report then links none).
-    """
+    """Run every file in parallel processes (or on the Dask cluster at ``dask``); outcomes in the order of ``files``
+    (a JSBSim script that resets gives one outcome per run segment, in order). ``recording=False``: no
+    ``recording.rrd`` in the run folders (the report then links none)."""
     jobs = max(1, min(jobs or os.cpu_count() or 1, len(files)))
     out_dir.mkdir(parents=True, exist_ok=True)
     dirs = tuple(str(d) for d in aircraft_dirs)
     params = str(params_path) if params_path else None
     platform = str(platform_path) if platform_path else None
     chosen = tuple(washouts) if washouts else None
-    args = [(str(f), str(out_dir), params, platform, chosen, tuple(variants), dirs, recording) for f in files]
-    outcomes: dict[str, Outcome] = {}
+    args = [(str(f), str(out_dir), params, platform, chosen, tuple(variants), dirs, max_time_s, recording)
+            for f in files]
+    outcomes: dict[str, list[Outcome]] = {}
     start = time.perf_counter()
     if progress:
         print(
@@ -164,8 +184,8 @@ def run_suite(
     if dask:
         from washbench.runs.cluster import dask_map
 
-        for outcome in dask_map(dask, _run_one, args):
-            outcomes[outcome.path] = _report(outcome, len(outcomes) + 1, len(files), start, progress)
+        for runs in dask_map(dask, _run_one, args):
+            outcomes[runs[0].path] = _report(runs, len(outcomes) + 1, len(files), start, progress)
     elif jobs == 1:
         for a in args:
             outcomes[a[0]] = _report(_run_one(*a), len(outcomes) + 1, len(files), start, progress)
@@ -174,12 +194,18 @@ def run_suite(
         with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=initializer) as pool:
             futures = [pool.submit(_run_one, *a) for a in args]
             for fut in as_completed(futures):
-                outcome = fut.result()
-                outcomes[outcome.path] = _report(outcome, len(outcomes) + 1, len(files), start, progress)
-    return [outcomes[a[0]] for a in args]
+                runs = fut.result()
+                outcomes[runs[0].path] = _report(runs, len(outcomes) + 1, len(files), start, progress)
+    return [o for a in args for o in outcomes[a[0]]]
 
 
-def _report(outcome: Outcome, done: int, total: int, start: float, progress: bool) -> Outcome:
+def _report(runs: list[Outcome], done: int, total: int, start: float, progress: bool) -> list[Outcome]:
+    for outcome in runs:
+        _report_one(outcome, done, total, start, progress)
+    return runs
+
+
+def _report_one(outcome: Outcome, done: int, total: int, start: float, progress: bool) -> None:
     if progress:
         name = f"{outcome.run.aircraft}/{outcome.run.manoeuvre}" if outcome.run.aircraft else _short(outcome.path)
         state = "ok  " if outcome.run.ok else "FAIL"
@@ -188,7 +214,6 @@ def _report(outcome: Outcome, done: int, total: int, start: float, progress: boo
         if not outcome.run.ok:
             line += f"\n        {outcome.run.reason}"
         print(f"{line}   (elapsed {time.perf_counter() - start:.0f} s)", file=sys.stderr, flush=True)
-    return outcome
 
 
 def _short(path: str) -> str:
@@ -259,13 +284,18 @@ def _washouts(outcomes: Sequence[Outcome]) -> list[str]:
     return list(dict.fromkeys(m.washout for o in outcomes for m in o.run.metrics))
 
 
-def report_markdown(outcomes: Sequence[Outcome], rankings: dict[tuple[str, str], list[RankRow]], out_dir: Path) -> str:
+def report_markdown(
+    outcomes: Sequence[Outcome],
+    rankings: dict[tuple[str, str], list[RankRow]],
+    out_dir: Path,
+    title: str = "washbench suite report",
+) -> str:
     """``report.md``: status, ranking, Table-4 comparison and metrics of every manoeuvre."""
     ok = [o for o in outcomes if o.run.ok]
     washouts = _washouts(outcomes)
     reference = reference_washout(washouts)
     lines = [
-        "# washbench suite report",
+        f"# {title}",
         "",
         f"{len(ok)} of {len(outcomes)} manoeuvres ran and passed their checks.",
         "",
@@ -352,6 +382,19 @@ def write_suite_results(outcomes: Sequence[Outcome], out_dir: Path) -> None:
     write_text_atomic(out_dir / "report.md", report_markdown(outcomes, rankings, out_dir))
 
 
+def write_run_review(run_dir: Path, summary: RunSummary, source: str = "") -> None:
+    """``ranking.csv`` and ``report.md`` of one result folder (the same tables as a suite's, for one run).
+
+    The one call site for a result folder's report (``washbench cue`` uses it; the report of the review
+    issue replaces its body).
+    """
+    rankings = {(summary.aircraft, summary.manoeuvre): rank(summary.metrics, summary.motion)} if summary.metrics else {}
+    outcome = Outcome(path=source or str(run_dir), wall_s=0.0, run=summary)
+    write_text_atomic(run_dir / "ranking.csv", ranking_table(rankings))
+    title = f"washbench report: {summary.aircraft} / {summary.manoeuvre}" if summary.aircraft else "washbench report"
+    write_text_atomic(run_dir / "report.md", report_markdown([outcome], rankings, run_dir, title=title))
+
+
 def suite_command(
     inputs: Sequence[Path],
     out_dir: Path,
@@ -360,16 +403,26 @@ def suite_command(
     params_path: Path | None = None,
     platform_path: Path | None = None,
     progress: bool = True,
-    recording: bool = True,
     washouts: Sequence[str] | None = None,
     variants: Sequence[str] = (),
     dask: str | None = None,
     aircraft_dirs: Sequence[Path] = (),
+    jsbsim_scripts: Sequence[str] = (),
+    max_time_s: float | None = None,
+    recording: bool = True,
 ) -> int:
-    """CLI entry: run the suite, write its results, print where they are; 0 if all succeeded, else 1."""
+    """CLI entry: run the suite, write its results, print where they are; 0 if all succeeded, else 1.
+
+    ``jsbsim_scripts``: names of scripts shipped with JSBSim (``c1723``) run besides ``inputs``.
+    """
+    from washbench.flight.scripts import bundled_script
+
     if jobs is not None and jobs < 1:
         raise WashbenchError(f"--jobs: expected a whole number of at least 1, got {jobs}")
-    files = find_manoeuvres(inputs)
+    from washbench.runs.pipeline import check_max_time
+
+    check_max_time(max_time_s)
+    files = find_manoeuvres(inputs, [bundled_script(n) for n in jsbsim_scripts])
     # Fail fast on a bad parameter, variant or platform file: every run would fail the same way.
     from washbench.cueing.variants import select_washouts
     from washbench.platform import load_platform_limits
@@ -384,17 +437,17 @@ def suite_command(
         params_path=params_path,
         platform_path=platform_path,
         progress=progress,
-        recording=recording,
         washouts=washouts,
         variants=variants,
         dask=dask,
         aircraft_dirs=aircraft_dirs,
+        max_time_s=max_time_s,
+        recording=recording,
     )
     write_suite_results(outcomes, out_dir)
     n_ok = sum(o.run.ok for o in outcomes)
     print(
-        f"suite: {n_ok}/{len(outcomes)} manoeuvres ok in {time.perf_counter() - start:.1f} s; "
-        f"report: {out_dir / 'report.md'}"
+        f"suite: {n_ok}/{len(outcomes)} runs ok in {time.perf_counter() - start:.1f} s; report: {out_dir / 'report.md'}"
     )
     return 0 if n_ok == len(outcomes) else 1
 
