@@ -36,7 +36,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from washbench.analysis.metrics import MetricRow
 from washbench.analysis.ranking import DOFS, perceived_motion
@@ -74,9 +73,21 @@ class RunSummary:
 
 
 def aircraft_attitude(phi_deg: np.ndarray, theta_deg: np.ndarray, psi_deg: np.ndarray) -> np.ndarray:
-    """Body->NED quaternions (N, 4), scalar first, from ZYX Euler angles in degrees."""
-    angles = np.column_stack([psi_deg, theta_deg, phi_deg])
-    return Rotation.from_euler("ZYX", angles, degrees=True).as_quat(scalar_first=True)
+    """Body->NED quaternions (N, 4), scalar first, from ZYX Euler angles in degrees: q = q_z(psi) q_y(theta) q_x(phi).
+
+    Closed form (what ``scipy.spatial.transform.Rotation.from_euler("ZYX", ...)`` gives, without its import).
+    """
+    h = 0.5 * np.radians(np.column_stack([phi_deg, theta_deg, psi_deg]))
+    c, s = np.cos(h), np.sin(h)
+    cf, ct, cp, sf, st, sp = c[:, 0], c[:, 1], c[:, 2], s[:, 0], s[:, 1], s[:, 2]
+    return np.column_stack(
+        [
+            cf * ct * cp + sf * st * sp,
+            sf * ct * cp - cf * st * sp,
+            cf * st * cp + sf * ct * sp,
+            cf * ct * sp - sf * st * cp,
+        ]
+    )
 
 
 def metrics_markdown(title: str, rows: list[MetricRow]) -> str:
