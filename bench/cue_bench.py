@@ -7,12 +7,19 @@ Baselines measured in the same run, printed as ratios:
 * reading the input: ``read_motion`` (with validation) against a bare ``pyarrow.csv.read_csv`` of the same file;
 * vestibular models: one pilot's otolith + canal models (discretised parallel first-order sections,
   ``lfilter`` over axis 0) against ``scipy.signal.lsim`` of the continuous transfer functions on the same 6 axes;
-* whole command: read + cue_trace + analyse + write against the bare CSV read.
+* whole command: read + cue_trace + analyse + write against the bare CSV read;
+* the ``washbench cue`` command itself (its own process, start-up included) against bare JSBSim ``fdm.run()``
+  for as many steps as the input has rows (c172p in the air, this process), both as CPU time (on a shared
+  machine wall time counts other processes), minimum of ``--repeat`` runs; the aim is at most 1.5x.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
+import resource
+import subprocess
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -56,9 +63,39 @@ def best_of(fn, repeat: int = 3) -> float:
     return min(times)
 
 
+def command_cpu_s(src: Path, out: Path) -> float:
+    """CPU time (user + system) of one ``washbench cue`` process on ``src``."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    subprocess.run([sys.executable, "-m", "washbench", "cue", str(src), "--out", str(out)], check=True,
+                   stdout=subprocess.DEVNULL)  # fmt: skip
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+
+
+def bare_jsbsim_cpu_s(steps: int) -> float:
+    """CPU time of ``steps`` bare ``fdm.run()`` calls (c172p in the air at 120 Hz, set-up not counted)."""
+    os.environ["JSBSIM_DEBUG"] = "0"
+    import jsbsim
+
+    fdm = jsbsim.FGFDMExec(jsbsim.get_default_root_dir())
+    fdm.load_model("c172p")
+    fdm.set_dt(DT_S)
+    fdm["ic/h-sl-ft"] = 4000.0
+    fdm["ic/vc-kts"] = 100.0
+    fdm.run_ic()
+    fdm["propulsion/set-running"] = -1
+    fdm["fcs/throttle-cmd-norm"] = 0.7
+    run = fdm.run
+    t0 = time.process_time()
+    for _ in range(steps):
+        run()
+    return time.process_time() - t0
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--minutes", type=float, default=30.0)
+    ap.add_argument("--repeat", type=int, default=3, help="runs of the command and of bare JSBSim (minimum)")
     args = ap.parse_args()
     n = round(args.minutes * 60 / DT_S)
     params, limits = load_washout_params(None), load_platform_limits(None)
@@ -86,6 +123,8 @@ def main() -> None:
                 scipy.signal.lsim(can, motion.omega_radps[:, i], t)
 
         t_lsim = best_of(lsim_all, 1)
+        cmd = min(command_cpu_s(src, Path(tmp) / "cmd") for _ in range(args.repeat))
+        bare = min(bare_jsbsim_cpu_s(n) for _ in range(args.repeat))
 
     total = t_read + t_cue + t_analyse + t_write
     print(f"{n} rows ({args.minutes:g} min at 120 Hz), 3 washouts")
@@ -97,6 +136,8 @@ def main() -> None:
     print(f"  total                        {total:7.3f} s   {total / t_bare:6.2f} x baseline")
     print(f"  vestibular, one pilot        {t_vest:7.3f} s   (baseline: scipy.signal.lsim {t_lsim:.3f} s,", end=" ")
     print(f"{t_lsim / t_vest:.1f}x slower)")
+    print(f"washbench cue command, CPU s   {cmd:7.3f} s   {cmd / bare:6.2f} x bare JSBSim for {n} steps "
+          f"({bare:.3f} s CPU; aim <= 1.5x)")  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -40,6 +40,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("inputs", nargs="*", type=Path)
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
+    parser.add_argument("--no-recording", action="store_true", help="run the suite without recording.rrd files")
     args = parser.parse_args()
 
     from washbench.runs.suite import find_manoeuvres, run_suite, write_suite_results
@@ -47,7 +48,7 @@ def main() -> None:
     files = find_manoeuvres(args.inputs)
     with tempfile.TemporaryDirectory() as tmp:
         start = time.perf_counter()
-        outcomes = run_suite(files, Path(tmp), jobs=args.jobs, progress=False)
+        outcomes = run_suite(files, Path(tmp), jobs=args.jobs, progress=False, recording=not args.no_recording)
         write_suite_results(outcomes, Path(tmp))
         suite_s = time.perf_counter() - start
     failed = [o for o in outcomes if not o.run.ok]

@@ -20,3 +20,49 @@ def test_unknown_subcommand_is_one_line_exit_2() -> None:
     assert out.returncode == 2
     assert "Traceback" not in out.stderr
     assert len(out.stderr.strip().splitlines()) == 1
+
+
+SHORT_FLIGHT = """\
+name: short
+aircraft: c172p
+start:
+  air: {altitude_ft: 4000, airspeed_kts: 95, heading_deg: 90}
+phases:
+  - name: level
+    hold: {wings_level: true, altitude_ft: 4000, airspeed_kts: 95}
+    until: {duration_s: 1}
+checks:
+  - {name: altitude held, signal: altitude_ft, stat: max_deviation, max: 60}
+"""
+
+HEAVY = ("scipy.linalg", "scipy.signal", "scipy.stats", "scipy.spatial", "rerun.", "rerun_sdk")
+
+
+def imported_by(args: list[str]) -> set[str]:
+    """The heavy packages a washbench command imports (it runs in a fresh interpreter)."""
+    code = (
+        "import sys, contextlib, io\n"
+        "from washbench.cli import main\n"
+        "with contextlib.redirect_stdout(io.StringIO()):\n"
+        f"    status = main({args!r})\n"
+        f"print(status, *sorted({{'.'.join(m.split('.')[:2 if m.startswith('scipy.') else 1])"
+        f" for m in sys.modules if m.startswith({HEAVY!r}) or m == 'rerun'}}))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    status, *names = out.stdout.split()
+    assert status == "0", out.stdout
+    return set(names)
+
+
+def test_commands_import_only_what_they_need(tmp_path) -> None:
+    # start-up cost: scipy.signal/stats (about 0.7 s), scipy.linalg (0.3 s, numba's BLAS probe) and rerun (0.4 s)
+    (tmp_path / "m.yaml").write_text(SHORT_FLIGHT)
+    lines = ["t_s,f_x_mps2,f_y_mps2,f_z_mps2,omega_x_degps,omega_y_degps,omega_z_degps"]
+    lines += [f"{k / 120.0!r},0.1,0.0,-9.80665,1.0,0.0,0.0" for k in range(60)]
+    (tmp_path / "in.csv").write_text("\n".join(lines) + "\n")
+    assert imported_by(["validate", str(tmp_path / "m.yaml")]) == set()
+    assert imported_by(["cue", str(tmp_path / "in.csv"), "--out", str(tmp_path / "cue"), "--no-recording"]) == set()
+    no_rec = ["run", str(tmp_path / "m.yaml"), "--out", str(tmp_path / "r1"), "--quiet", "--no-recording"]
+    assert imported_by(no_rec) == set()
+    assert imported_by(["run", str(tmp_path / "m.yaml"), "--out", str(tmp_path / "r2"), "--quiet"]) == {"rerun"}

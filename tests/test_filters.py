@@ -106,3 +106,20 @@ def test_cutoffs_match_paper_text():
     for tf, f_hz in ((filters.tilt_lowpass(1.5), 0.307), (filters.translational_highpass(1.5), 0.371)):
         h = discrete_freqresp(discretise(tf, DT), np.array([2 * np.pi * f_hz]), DT)
         assert abs(h[0]) == pytest.approx(1 / np.sqrt(2), abs=0.01)
+
+
+@pytest.mark.parametrize("dt", [1 / 50, 1 / 120, 1 / 1000])
+@pytest.mark.parametrize("name,tf", [*CASES, ("identity", filters.rotational_highpass(0.0))])
+def test_discretise_equals_scipy_bilinear_bit_for_bit(name: str, tf, dt: float) -> None:
+    # the numpy Tustin transform replaces scipy.signal (import time); it must give the same coefficients
+    num, den = tf
+    expected = np.zeros(filters.NCOEF)
+    if len(den) == 1:
+        expected[8] = num[-1] / den[0]
+    else:
+        ad, bd, cd, dd, _ = signal.cont2discrete(signal.tf2ss(num, den), dt, method="bilinear")
+        n = ad.shape[0]
+        a2 = np.zeros((2, 2))
+        a2[:n, :n] = ad
+        expected[:4], expected[4 : 4 + n], expected[6 : 6 + n], expected[8] = a2.ravel(), bd[:, 0], cd[0], dd[0, 0]
+    np.testing.assert_array_equal(discretise(tf, dt), expected)

@@ -160,8 +160,18 @@ def test_wind_start_keeps_airspeed_and_tracks_the_runway(flights: dict[str, Flig
 def test_step_hook_sees_every_final_sample_in_order(tmp_path: Path) -> None:
     path = write(tmp_path, "turb.yaml", TURBULENT.replace("SEED", "3"))
     seen: list[tuple[int, np.ndarray, np.ndarray]] = []
-    result = fly(load_manoeuvre(path), step_hook=lambda k, f, w: seen.append((k, f.copy(), w.copy())))
+    blocks: list[tuple[int, np.ndarray, np.ndarray]] = []
+    result = fly(
+        load_manoeuvre(path),
+        step_hook=lambda k, f, w: seen.append((k, f.copy(), w.copy())),
+        block_hook=lambda k0, f, w: blocks.append((k0, f, w)),
+        block_size=50,
+    )
     assert [k for k, _, _ in seen] == list(range(len(result.t_s)))
+    # the block hook: the same samples, 50 at a time (the last block shorter), same bits
+    assert [k0 for k0, _, _ in blocks] == list(range(0, len(result.t_s), 50))
+    np.testing.assert_array_equal(np.concatenate([b[1] for b in blocks]), np.array([s[1] for s in seen]))
+    np.testing.assert_array_equal(np.concatenate([b[2] for b in blocks]), np.array([s[2] for s in seen]))
     f = np.array([s[1] for s in seen])
     w = np.array([s[2] for s in seen])
     c = result.columns
@@ -244,7 +254,9 @@ def test_fly_cli_writes_files_and_prints_one_summary_line(tmp_path: Path) -> Non
     lines = proc.stdout.strip().splitlines()
     n_checks = len(load_manoeuvre(C172 / "coordinated_turn.yaml").checks)
     assert len(lines) == 1 and lines[0].startswith(f"coordinated_turn (c172p): ok, {n_checks}/{n_checks} checks passed")
-    assert proc.stderr == ""  # no progress display when stderr is not a terminal
+    # not a terminal: progress, if the flight takes more than 5 s of wall time, is plain lines without escapes
+    assert "\033" not in proc.stderr and "\r" not in proc.stderr
+    assert all(line.startswith("coordinated_turn: phase ") for line in proc.stderr.splitlines())
     assert (out_dir / "flight.parquet").is_file() and (out_dir / "flight.json").is_file()
 
 

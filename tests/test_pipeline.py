@@ -136,3 +136,14 @@ def test_run_summary_is_consistent(run_dir: Path) -> None:
     n = pq.read_metadata(run_dir / "traces.parquet").num_rows
     assert summary["steps"] == n
     assert set(summary["perceived_motion"]) == set(DOF_COLUMNS)
+
+
+def test_aircraft_attitude_matches_scipy_rotation() -> None:
+    from scipy.spatial.transform import Rotation
+
+    from washbench.runs.pipeline import aircraft_attitude
+
+    rng = np.random.default_rng(0)
+    phi, theta, psi = rng.uniform(-180, 180, 500), rng.uniform(-90, 90, 500), rng.uniform(0, 360, 500)
+    expected = Rotation.from_euler("ZYX", np.column_stack([psi, theta, phi]), degrees=True).as_quat(scalar_first=True)
+    np.testing.assert_allclose(aircraft_attitude(phi, theta, psi), expected, atol=1e-15)

@@ -115,11 +115,18 @@ def test_ranking_and_comparison_tables(first: tuple[Path, subprocess.CompletedPr
 def test_same_suite_twice_gives_identical_metrics(
     inputs: Path, first: tuple[Path, subprocess.CompletedProcess[str]], tmp_path: Path
 ) -> None:
+    # the second time in one process and without recordings: the same numbers, and no .rrd anywhere
     out, _ = first
-    again = suite(inputs, "--out", tmp_path, "--jobs", "1", "--quiet")
+    again = suite(inputs, "--out", tmp_path, "--jobs", "1", "--quiet", "--no-recording")
     assert again.returncode == 1
     for name in ("metrics.csv", "comparison.csv", "ranking.csv"):
         assert (tmp_path / name).read_bytes() == (out / name).read_bytes(), name
+    for name in ("coordinated_turn", "stall_recovery"):
+        run = tmp_path / "c172p" / name
+        recorded = {p.name for p in (out / "c172p" / name).iterdir()}
+        assert "recording.rrd" in recorded and {p.name for p in run.iterdir()} == recorded - {"recording.rrd"}
+        assert (run / "traces.parquet").read_bytes() == (out / "c172p" / name / "traces.parquet").read_bytes()
+    assert "recording.rrd" not in (tmp_path / "report.md").read_text()
 
 
 def test_bad_arguments_are_one_line(tmp_path: Path) -> None:

@@ -174,6 +174,15 @@ def test_streaming_and_whole_trace_identical_bit_for_bit():
             np.testing.assert_array_equal(getattr(streamed, field), getattr(whole, field), err_msg=field)
         np.testing.assert_array_equal(streamed.wheel_radps, whole.wheel_radps)
         assert streamed.saturation_counts == whole.saturation_counts == bank.saturation_counts()[name]
+    # blocks of samples (CueingBank.steps, what washbench run uses), mixed with single steps: the same bits
+    blocked = CueingBank(WASHOUT_NAMES, PARAMS, LIMITS, DT)
+    parts = [blocked.steps(f[:1000], w[:1000]), blocked.step(f[1000], w[1000])[:, None].copy()]
+    parts.append(blocked.steps(f[1001:1001], w[1001:1001]))
+    parts.append(blocked.steps(f[1001:], w[1001:]))
+    np.testing.assert_array_equal(np.concatenate(parts, axis=1), rows)
+    assert blocked.saturation_counts() == bank.saturation_counts()
+    with pytest.raises(ValueError, match="non-finite"):
+        blocked.steps(np.full((2, 3), np.nan), np.zeros((2, 3)))
 
 
 def test_step_accepts_lists_and_reuses_its_output():

@@ -98,6 +98,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
     p.add_argument("--quiet", action="store_true", help="no progress display")
+    p.add_argument("--no-recording", action="store_true", help="do not write recording.rrd (smaller, faster)")
 
     p = sub.add_parser("suite", help="run many manoeuvres in parallel and compare the washouts")
     p.add_argument(
@@ -117,6 +118,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
     p.add_argument("--dask", metavar="ADDRESS", help="run on this Dask scheduler instead of local processes")
     p.add_argument("--quiet", action="store_true", help="no progress display")
+    p.add_argument("--no-recording", action="store_true", help="do not write the recording.rrd files")
 
     p = sub.add_parser("omct", help="Objective Motion Cueing Test: gain and phase of each washout, Bode plots")
     p.add_argument("--out", type=Path, required=True, help="output folder (omct.csv, bode_<test>.png, report.md)")
@@ -296,6 +298,7 @@ def _dispatch(args: argparse.Namespace) -> int:
             params_path=args.params,
             platform_path=args.platform,
             progress=not args.quiet,
+            recording=not args.no_recording,
             max_time_s=args.max_time_s,
             filter_start=args.filter_start,
             washouts=args.washout,
@@ -312,6 +315,7 @@ def _dispatch(args: argparse.Namespace) -> int:
             params_path=args.params,
             platform_path=args.platform,
             progress=not args.quiet,
+            recording=not args.no_recording,
             jsbsim_scripts=args.jsbsim_scripts,
             max_time_s=args.max_time_s,
             aircraft_dirs=args.aircraft_dir,

@@ -2,8 +2,10 @@
 
 Each filter is single-input single-output and at most second order. Its continuous transfer function
 (numerator, denominator in powers of s, s in rad/s) is discretised ONCE at set-up with the bilinear
-(Tustin) transform of ``scipy.signal.cont2discrete`` into a discrete state space (A, B, C, D), padded
-to two states and packed into 9 floats ``[A00, A01, A10, A11, B0, B1, C0, C1, D]``. The compiled step
+(Tustin) transform into a discrete state space (A, B, C, D) (the controllable canonical form and the
+formulas of ``scipy.signal.tf2ss`` and ``cont2discrete(method="bilinear")``, written in numpy so that no
+command pays the second it takes to import ``scipy.signal``), padded to two states and packed into 9
+floats ``[A00, A01, A10, A11, B0, B1, C0, C1, D]``. The compiled step
 is then ``y = C x + D u; x <- A x + B u``. A filter starts in the steady state of its first input
 sample (:func:`filt_init`), so a constant input gives no transient.
 
@@ -21,7 +23,10 @@ import functools
 
 import numpy as np
 from numba import njit
-from scipy import signal
+
+from washbench.cueing.numbastart import prepare
+
+prepare()
 
 NCOEF = 9
 
@@ -65,11 +70,16 @@ def _discretise(num: tuple[float, ...], den: tuple[float, ...], dt_s: float) -> 
     if len(den) == 1:  # static gain
         coef[8] = num[-1] / den[0]
         return coef
-    a, b, c, d = signal.tf2ss(num, den)
-    ad, bd, cd, dd, _ = signal.cont2discrete((a, b, c, d), dt_s, method="bilinear")
-    n = ad.shape[0]
+    n = len(den) - 1
     if n > 2:
         raise ValueError(f"filter order {n} > 2 is not supported")
+    a, b, c, d = _tf2ss(num, den)
+    # bilinear transform (generalised bilinear with alpha = 1/2), as scipy.signal.cont2discrete does it
+    ima = np.eye(n) - 0.5 * dt_s * a
+    ad = np.linalg.solve(ima, np.eye(n) + 0.5 * dt_s * a)
+    bd = np.linalg.solve(ima, dt_s * b)
+    cd = np.linalg.solve(ima.T, c.T).T
+    dd = d + 0.5 * (c @ bd)
     a2 = np.zeros((2, 2))
     a2[:n, :n] = ad
     coef[0:4] = a2.ravel()
@@ -77,6 +87,23 @@ def _discretise(num: tuple[float, ...], den: tuple[float, ...], dt_s: float) -> 
     coef[6 : 6 + n] = cd[0, :]
     coef[8] = dd[0, 0]
     return coef
+
+
+def _tf2ss(num: list[float], den: list[float]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Controllable canonical state space of a proper SISO ``num(s) / den(s)`` (scipy.signal.tf2ss's form)."""
+    den_a = np.asarray(den, dtype=np.float64)
+    num_a = np.asarray(num, dtype=np.float64)
+    n = len(den_a) - 1
+    num_a = np.concatenate([np.zeros(n + 1 - len(num_a)), num_a]) / den_a[0]
+    den_a = den_a / den_a[0]
+    d = np.array([[num_a[0]]])
+    a = np.zeros((n, n))
+    a[0, :] = -den_a[1:]
+    a[1:, :-1] += np.eye(n - 1)
+    b = np.zeros((n, 1))
+    b[0, 0] = 1.0
+    c = (num_a[1:] - num_a[0] * den_a[1:]).reshape(1, n)
+    return a, b, c, d
 
 
 @njit(cache=True)

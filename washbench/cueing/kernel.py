@@ -362,6 +362,17 @@ def bank_trace(f, om, cfg, coef, state, counts, out):
                 out[i, j, k] = row[j]
 
 
+@njit(cache=True)
+def bank_block(f, om, cfg, coef, state, counts, out):
+    """Block form for a flight in progress (:meth:`CueingBank.steps`): f, om (M, 3) checked finite; out
+    (n_washouts, M, NFIELDS). Serial: a short block does not pay for threads (nor starts OpenMP in a process
+    that may fork); the same per-washout step as bank_step, sample by sample.
+    """
+    for k in range(f.shape[0]):
+        for i in range(cfg.shape[0]):
+            step_one(f[k], om[k], cfg[i], coef[i], state[i], counts[i], out[i, k])
+
+
 _HERE = Path(__file__).resolve().parent
 drop_stale_cache(
     __file__,
@@ -378,6 +389,7 @@ __all__ = [
     "NFILT",
     "NSTATE",
     "SAT_KINDS",
+    "bank_block",
     "bank_step",
     "bank_trace",
     "step_one",

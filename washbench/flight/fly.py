@@ -25,7 +25,7 @@ from washbench.flight.checks import evaluate
 from washbench.flight.columns import COLUMN_NAMES
 from washbench.flight.fdm import make_fdm
 from washbench.flight.manoeuvre import Manoeuvre, Until, load_manoeuvre
-from washbench.flight.monitor import Monitor
+from washbench.flight.monitor import BIG, Monitor
 from washbench.flight.openloop import OpenLoop
 from washbench.flight.pilot import Pilot
 from washbench.flight.profile import load_profile
@@ -37,6 +37,7 @@ R2D = 180.0 / math.pi
 FPS_TO_KT = 3600.0 * 0.3048 / 1852.0
 
 StepHook = Callable[[int, np.ndarray, np.ndarray], None]
+BlockHook = Callable[[int, np.ndarray, np.ndarray], None]
 
 #: Properties read every step (verified to exist at start-up: JSBSim ignores typos silently).
 STATE_PROPERTIES = (
@@ -144,14 +145,28 @@ def _end_reached(u: Until, t_phase: float, turned: float, rolled: float, pitched
     )
 
 
+def _duration_only(u: Until) -> float | None:
+    """``duration_s - 1e-9`` (the threshold :func:`_end_reached` uses) if the phase ends only by its duration."""
+    others = u.model_dump(exclude={"duration_s", "timeout_s"}, exclude_none=True)
+    return u.duration_s - 1e-9 if u.duration_s is not None and not others else None
+
+
 def fly(
-    manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool = False, probes: Sequence[str] = ()
+    manoeuvre: Manoeuvre,
+    step_hook: StepHook | None = None,
+    progress: bool = False,
+    probes: Sequence[str] = (),
+    block_hook: BlockHook | None = None,
+    block_size: int = 120,
 ) -> FlightResult:
     """Fly ``manoeuvre`` to its end (or to a crash) and return the recording and check results.
 
     ``step_hook(k, f_mps2, omega_radps)`` is called once per recorded sample, in order, as soon
     as the sample is final (specific force at the eyepoint in m/s^2 and body rates in rad/s,
-    body axes x forward, y right, z down). ``probes`` names JSBSim properties read after each
+    body axes x forward, y right, z down). ``block_hook(k0, f_mps2, omega_radps)`` gets the same
+    samples ``block_size`` at a time as (M, 3) arrays (samples ``k0 .. k0 + M - 1``; the last block
+    may be shorter), without a Python call per sample.
+    ``probes`` names JSBSim properties read after each
     step (sample ``k``: the value the step from ``k`` produced, e.g. a surface position), returned
     in ``FlightResult.probes``.
     """
@@ -186,6 +201,10 @@ def fly(
     alpha_stall_deg = profile.limits.alpha_stall_deg
 
     rows = array("d")
+    rows_extend = rows.extend
+    run = fdm.run
+    nz_max, nz_min = monitor.nz_max, monitor.nz_min
+    vne, h_collapsed, alpha_max = monitor.vne, monitor.h_collapsed, monitor.alpha_max
     ncol = len(COLUMN_NAMES)
     phases_out: list[tuple[str, float, float]] = []
     events: dict[str, list[float]] = {"touchdown_times_s": [], "touchdown_sinks_fps": [], "liftoff_times_s": []}
@@ -193,6 +212,7 @@ def fly(
     iphase = -1
     phase_k0 = 0
     u: Until | None = None
+    end_s: float | None = None
     psi_prev = p_prev = q_prev = 0.0
     turned = 0.0
     rolled = pitched = 0.0  # integrals of the body rates p and q over the phase, rad (trapezoidal rule)
@@ -203,8 +223,11 @@ def fly(
     nz_last = 1.0  # load factor of the last sample (before the first step: level flight or at rest)
     fy_last = 0.0  # and its lateral specific force, m/s^2
     k = 0
-    wall0 = time.monotonic()
-    next_report = wall0 + 0.5
+    k_sent = 0  # samples handed to block_hook so far
+    # progress: overwritten in place on a terminal; otherwise (a log file, CI) a line per phase and every 5 s
+    tty = progress and sys.stderr.isatty()
+    report_every_s = 0.5 if tty else 5.0
+    next_report = time.monotonic() + report_every_s
     nphases = len(m.phases)
 
     while True:
@@ -226,7 +249,12 @@ def fly(
         for g in struct_gets:
             sw += g()
 
-        problem = monitor.state(phi + theta + p + q + r + vc + h + agl + alpha, vc, alpha, agl, wow, sw)
+        total = phi + theta + p + q + r + vc + h + agl + alpha
+        # the monitor's state checks, inlined (hot path); it is asked for the cause only when one fails
+        problem = None
+        if (not -BIG < total < BIG or sw > 0.0 or vc > vne or agl < h_collapsed
+                or (not wow and (alpha > alpha_max or alpha < -alpha_max))):  # fmt: skip
+            problem = monitor.state(total, vc, alpha, agl, wow, sw)
         # events at this sample
         if wow and not was_wow:
             sink = -hdot
@@ -266,8 +294,10 @@ def fly(
         advance = iphase < 0
         if u is not None:
             t_phase = (k - phase_k0) * dt
-            if _end_reached(u, t_phase, abs(turned) * R2D, abs(rolled) * R2D, abs(pitched) * R2D, vc, h, agl,
-                            phi * R2D, theta * R2D, alpha * R2D, phase_events):  # fmt: skip
+            if end_s is not None:  # a phase that ends only after a duration (most): no call needed
+                advance = t_phase >= end_s
+            elif _end_reached(u, t_phase, abs(turned) * R2D, abs(rolled) * R2D, abs(pitched) * R2D, vc, h, agl,
+                              phi * R2D, theta * R2D, alpha * R2D, phase_events):  # fmt: skip
                 advance = True
             elif u.duration_s is None and t_phase >= u.timeout_s:
                 reason = (
@@ -285,6 +315,7 @@ def fly(
             else:
                 phase = m.phases[iphase]
                 u = phase.until
+                end_s = _duration_only(u)
                 phase_k0 = k
                 turned = rolled = pitched = 0.0
                 phase_events = set()
@@ -293,8 +324,8 @@ def fly(
                 flapc_w.set_double_value(pilot.flaps_cmd)
                 lbrk_w.set_double_value(pilot.brakes)
                 rbrk_w.set_double_value(pilot.brakes)
-                if progress:
-                    _progress(m.name, iphase, nphases, phase.name, t)
+                if progress:  # a line at each phase start (in place on a terminal)
+                    _progress(m.name, iphase, nphases, phase.name, t, tty)
 
         ail, elev, rud, thr = pilot.aileron, pilot.elevator, pilot.rudder, pilot.throttle
         if not final:
@@ -310,44 +341,40 @@ def fly(
             thr_set(thr)
             if k % mix_every == 0:
                 mix_w.set_double_value(float(np.interp(h, mix_h_ft, mix_norm)))
-        fdm.run()
+        run()
         for get, out in zip(probe_gets, probe_rows, strict=True):
             out.append(get())
-        fx = ax_get() * FT_S2_TO_M_S2
-        fy = ay_get() * FT_S2_TO_M_S2
-        fz = az_get() * FT_S2_TO_M_S2
+        ax, ay, az = ax_get(), ay_get(), az_get()
         nz = nz_get()
         nz_last = nz
-        fy_last = fy
-        rows.extend((t, fx, fy, fz, p * R2D, q * R2D, r * R2D, phi * R2D, theta * R2D, psi * R2D % 360.0,
-                     alpha * R2D, beta * R2D, vc, vg * FPS_TO_KT, h, agl, hdot * 60.0, north, east, lat * R2D,
-                     lon * R2D, x_rw, y_rw, nz, ail, elev, rud, thr,
-                     flap_get(), pilot.brakes, rpm_get(), 1.0 if wow else 0.0, float(iphase if not final
-                                                                                      else nphases - 1)))  # fmt: skip
+        fy_last = ay * FT_S2_TO_M_S2
+        # raw values in JSBSim's units; converted column by column after the loop (same bits, fewer operations)
+        rows_extend((k, ax, ay, az, p, q, r, phi, theta, psi, alpha, beta, vc, vg, h, agl, hdot, north, east, lat,
+                     lon, x_rw, y_rw, nz, ail, elev, rud, thr, flap_get(), pilot.brakes, rpm_get(), wow,
+                     iphase if not final else nphases - 1))  # fmt: skip
         if step_hook is not None:
-            step_hook(k, np.array((fx, fy, fz)), np.array((p, q, r)))
+            step_hook(k, np.array((ax * FT_S2_TO_M_S2, fy_last, az * FT_S2_TO_M_S2)), np.array((p, q, r)))
+        if block_hook is not None and k + 1 - k_sent == block_size:
+            k_sent = _send_block(block_hook, rows, k_sent, ncol)
         if final:
             break
-        if not wow:
-            problem = monitor.load_factor(nz)
-            if problem:
-                reason = f"t={t:.2f} s: {problem}"
-                break
+        if not wow and (nz > nz_max or nz < nz_min):
+            reason = f"t={t:.2f} s: {monitor.load_factor(nz)}"
+            break
         k += 1
         if progress and k % 600 == 0 and time.monotonic() > next_report:
-            next_report = time.monotonic() + 0.5
-            _progress(m.name, iphase, nphases, m.phases[iphase].name, t)
+            next_report = time.monotonic() + report_every_s
+            _progress(m.name, iphase, nphases, m.phases[iphase].name, t, tty)
 
+    if block_hook is not None and len(rows) // ncol > k_sent:
+        _send_block(block_hook, rows, k_sent, ncol)
     if reason and 0 <= iphase < nphases:  # the phase the flight stopped in, up to the last recorded sample
         phases_out.append((m.phases[iphase].name, phase_k0 * dt, max(len(rows) // ncol - 1, 0) * dt))
-    if progress:
+    if tty:
         sys.stderr.write("\r\033[K")
         sys.stderr.flush()
 
-    data = np.frombuffer(rows, dtype=np.float64).reshape(-1, ncol) if rows else np.zeros((0, ncol))
-    columns = {name: np.ascontiguousarray(data[:, i]) for i, name in enumerate(COLUMN_NAMES)}
-    columns["wow"] = columns["wow"].astype(np.int8)
-    columns["phase"] = columns["phase"].astype(np.int16)
+    columns = _columns(np.frombuffer(rows, dtype=np.float64).reshape(-1, ncol), dt)
     results = evaluate(list(m.checks), columns, phases_out, events, dt) if not reason else []
     checks = [(c.name, c.measured, c.limit, c.passed) for c in results]
     status = "ok"
@@ -360,8 +387,39 @@ def fly(
     return FlightResult(m.name, m.aircraft, dt, columns, phases_out, checks, status, reason, events, probed)
 
 
-def _progress(name: str, iphase: int, nphases: int, phase: str, t: float) -> None:
-    sys.stderr.write(f"\r\033[K{name}: phase {iphase + 1}/{nphases} '{phase}', t = {t:6.1f} s")
+def _send_block(hook: BlockHook, rows: array, k0: int, ncol: int) -> int:
+    """Give ``hook`` the recorded samples from ``k0`` on (f in m/s^2, omega in rad/s); return the new count."""
+    with memoryview(rows) as view:
+        raw = np.frombuffer(view[k0 * ncol :], dtype=np.float64).reshape(-1, ncol).copy()
+    hook(k0, raw[:, 1:4] * FT_S2_TO_M_S2, raw[:, 4:7])
+    return k0 + raw.shape[0]
+
+
+#: Factor from the raw value recorded per step to each flight.parquet column (None: taken as it is).
+_SCALE: dict[str, float | None] = {name: None for name in COLUMN_NAMES} | {
+    "f_x_mps2": FT_S2_TO_M_S2, "f_y_mps2": FT_S2_TO_M_S2, "f_z_mps2": FT_S2_TO_M_S2,
+    "omega_x_degps": R2D, "omega_y_degps": R2D, "omega_z_degps": R2D, "phi_deg": R2D, "theta_deg": R2D,
+    "psi_deg": R2D, "alpha_deg": R2D, "beta_deg": R2D, "gs_kts": FPS_TO_KT, "climb_fpm": 60.0, "lat_deg": R2D,
+    "lon_deg": R2D,
+}  # fmt: skip
+
+
+def _columns(raw: np.ndarray, dt: float) -> dict[str, np.ndarray]:
+    """flight.parquet's columns from the raw rows of the loop (step counter, JSBSim units, radians)."""
+    columns: dict[str, np.ndarray] = {}
+    for i, name in enumerate(COLUMN_NAMES):
+        scale = _SCALE[name]
+        columns[name] = raw[:, i] * scale if scale is not None else np.ascontiguousarray(raw[:, i])
+    columns["t_s"] = columns["t_s"] * dt  # t = k * dt, as in the loop
+    columns["psi_deg"] = columns["psi_deg"] % 360.0
+    columns["wow"] = columns["wow"].astype(np.int8)
+    columns["phase"] = columns["phase"].astype(np.int16)
+    return columns
+
+
+def _progress(name: str, iphase: int, nphases: int, phase: str, t: float, tty: bool) -> None:
+    line = f"{name}: phase {iphase + 1}/{nphases} '{phase}', t = {t:6.1f} s"
+    sys.stderr.write(f"\r\033[K{line}" if tty else f"{line}\n")
     sys.stderr.flush()
 
 
@@ -394,7 +452,8 @@ def write_flight(
     ``provenance`` (:mod:`washbench.io.provenance`, no date) goes into the Parquet metadata and flight.json.
     """
     import pyarrow as pa
-    import pyarrow.parquet as pq
+
+    from washbench.io.results import write_parquet
 
     out = Path(out_dir)
     try:
@@ -407,7 +466,7 @@ def write_flight(
         meta.update(parquet_metadata(provenance))
     table = table.replace_schema_metadata(meta)
     with atomic_path(out / "flight.parquet") as tmp:
-        pq.write_table(table, tmp)
+        write_parquet(tmp, table)
     summary = flight_summary(result, source)
     if provenance:
         summary["provenance"] = dict(provenance)
@@ -417,9 +476,8 @@ def write_flight(
 def fly_command(manoeuvre_path: Path, out_dir: Path, progress: bool = True, aircraft_dirs: Sequence[Path] = ()) -> int:
     """``washbench fly FILE --out DIR``: 0 if flown with every check passing, else 1."""
     m = load_manoeuvre(manoeuvre_path, aircraft_dirs)
-    show = progress and sys.stderr.isatty()
     wall = time.monotonic()
-    result = fly(m, progress=show)
+    result = fly(m, progress=progress)
     wall = time.monotonic() - wall
     prov = build_provenance(
         manoeuvre_path=manoeuvre_path, turbulence=m.environment.turbulence, aircraft_files=m.aircraft_files

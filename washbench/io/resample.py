@@ -22,7 +22,6 @@ import itertools
 import math
 
 import numpy as np
-import scipy.signal
 
 from washbench.errors import WashbenchError, located
 from washbench.io.readers import Samples
@@ -159,6 +158,8 @@ def antialias(x: np.ndarray, rate_hz: float, fs_hz: float) -> np.ndarray:
     """Zero-phase Butterworth low-pass (order :data:`ANTIALIAS_ORDER`, forward and backward) at
     ``ANTIALIAS_FRACTION * rate_hz`` of ``x`` (N,) or (N, m) sampled uniformly at ``fs_hz``."""
     cutoff = ANTIALIAS_FRACTION * rate_hz
+    import scipy.signal  # here, not at the top: a second of start-up that only --resample needs
+
     sos = scipy.signal.butter(ANTIALIAS_ORDER, cutoff, fs=fs_hz, output="sos")
     padlen = min(3 * (2 * len(sos) + 1), x.shape[0] - 1)
     return scipy.signal.sosfiltfilt(sos, x, axis=0, padlen=padlen)

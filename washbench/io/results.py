@@ -222,6 +222,24 @@ def read_motion(path: str | Path) -> Motion:
 # --------------------------------------------------------------------------- writers and readers
 
 
+def write_parquet(path: str | Path, arrow: pa.Table) -> None:
+    """Write a table to Parquet the one way every washbench trace file is written (not atomic by itself).
+
+    zstd throughout; floats byte-stream-split (about 2/3 of the size of dictionary + zstd, and 4x faster),
+    other columns dictionary-encoded.
+    """
+    floats = [f.name for f in arrow.schema if pa.types.is_floating(f.type)]
+    others = [name for name in arrow.column_names if name not in set(floats)]
+    pq.write_table(arrow, path, compression="zstd", use_dictionary=others, use_byte_stream_split=floats)
+
+
+def parquet_writer(path: str | Path, schema: pa.Schema) -> pq.ParquetWriter:
+    """A writer for tables written a row group at a time, with :func:`write_parquet`'s settings."""
+    floats = [f.name for f in schema if pa.types.is_floating(f.type)]
+    others = [f.name for f in schema if not pa.types.is_floating(f.type)]
+    return pq.ParquetWriter(path, schema, compression="zstd", use_dictionary=others, use_byte_stream_split=floats)
+
+
 def write_traces(
     path: str | Path, table: Mapping[str, np.ndarray], metadata: Mapping[bytes, bytes] | None = None
 ) -> None:
@@ -232,11 +250,8 @@ def write_traces(
     arrow = pa.table({name: pa.array(np.asarray(col)) for name, col in table.items()})
     if metadata:
         arrow = arrow.replace_schema_metadata(dict(metadata))
-    floats = [f.name for f in arrow.schema if pa.types.is_floating(f.type)]
-    others = [name for name in arrow.column_names if name not in set(floats)]
     with atomic_path(path) as tmp:
-        # byte-stream-split + zstd for floats: about 2/3 of the size and 4x faster than dictionary + zstd
-        pq.write_table(arrow, tmp, compression="zstd", use_dictionary=others, use_byte_stream_split=floats)
+        write_parquet(tmp, arrow)
 
 
 def read_traces(path: str | Path) -> dict[str, np.ndarray]:

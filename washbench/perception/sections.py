@@ -14,6 +14,9 @@ import numpy as np
 from numba import njit, prange
 
 import washbench.cueing.jitcache  # noqa: F401  (numba's cache folder is set before anything here is compiled)
+from washbench.cueing.numbastart import prepare
+
+prepare()
 
 
 @njit(cache=True, inline="always")
@@ -49,6 +52,29 @@ def sections_apply(b, phi, steady, u):
             yt[j, k] = sections_step(b, phi, x, u_prev, u[k, j])
             u_prev = u[k, j]
     return yt.T
+
+
+@njit(cache=True)
+def sections_run(b, phi, x, u_prev, u):
+    """Filter the next samples ``u`` (N, m) from the section states ``x`` (S, m) and previous inputs ``u_prev``
+    (m,), both advanced in place (chunk by chunk: :class:`washbench.perception.vestibular.PerceptionStream`).
+
+    The same step as :func:`sections_apply`, so a trace fed in chunks gives the bits it gives whole.
+    """
+    n, m = u.shape
+    y = np.empty((n, m))
+    xs = np.empty(phi.shape[0])
+    for j in range(m):
+        for i in range(xs.shape[0]):
+            xs[i] = x[i, j]
+        up = u_prev[j]
+        for k in range(n):
+            y[k, j] = sections_step(b, phi, xs, up, u[k, j])
+            up = u[k, j]
+        for i in range(xs.shape[0]):
+            x[i, j] = xs[i]
+        u_prev[j] = up
+    return y
 
 
 @njit(cache=True, parallel=True)

@@ -171,6 +171,23 @@ class DiscreteModel:
         steady = tuple(-r / p for r, p in zip(pf.residues, pf.poles, strict=True))
         return cls(dt_s=dt_s, b=tuple(b), phi=tuple(phi), dc_gain=sum(steady), steady=steady)
 
+    def start(self, u0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """State for :meth:`run`: the section states (sections, m) at rest in the steady state of the first
+        sample ``u0`` (m,), and the previous input (``u0``)."""
+        u0 = np.array(u0, dtype=np.float64).reshape(-1)
+        return np.array(self.steady)[:, None] * u0[None, :], u0
+
+    def run(self, u: np.ndarray, state: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
+        """Filter the next samples ``u`` (N, m), advancing ``state`` (from :meth:`start`) in place.
+
+        The same compiled step as :meth:`apply`: feeding a trace in chunks gives the same bits as feeding it whole.
+        """
+        from washbench.perception.sections import sections_run
+
+        b, phi, _ = self.arrays()
+        x, u_prev = state
+        return sections_run(b, phi, x, u_prev, np.ascontiguousarray(u, dtype=np.float64))
+
     def apply(self, u: np.ndarray, start: np.ndarray | None = None) -> np.ndarray:
         """Filter ``u`` (N,) or (N, m) along axis 0, starting in the steady state of ``start`` (default ``u[0]``).
 
@@ -241,6 +258,31 @@ class VestibularModel:
         f_hat = self.otolith.apply(f, np.array(REST_F_MPS2) if rest else None)
         w_hat = self.canals.apply(w, np.zeros(3) if rest else None)
         th = self.params.thresholds
+        if th is not None:
+            f_hat, w_hat = apply_deadband(f_hat, w_hat, th)
+        return Perceived(f_mps2=f_hat, omega_radps=w_hat)
+
+
+class PerceptionStream:
+    """One pilot's vestibular models fed chunk by chunk: the same bits as :meth:`VestibularModel.perceive` whole.
+
+    The filters start in the steady state of the first sample of the first chunk.
+    """
+
+    def __init__(self, model: VestibularModel) -> None:
+        self.model = model
+        self._state: tuple[np.ndarray, np.ndarray] | None = None
+
+    def perceive(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> Perceived:
+        """Perceived motion for the next samples (N, 3) each."""
+        f = _check_n3(f_mps2, "f_mps2")
+        w = _check_n3(omega_radps, "omega_radps")
+        m = self.model
+        if self._state is None:
+            self._state = (m.otolith.start(f[0]), m.canals.start(w[0]))
+        f_hat = m.otolith.run(f, self._state[0])
+        w_hat = m.canals.run(w, self._state[1])
+        th = m.params.thresholds
         if th is not None:
             f_hat, w_hat = apply_deadband(f_hat, w_hat, th)
         return Perceived(f_mps2=f_hat, omega_radps=w_hat)

@@ -36,7 +36,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from washbench.analysis.metrics import MetricRow
 from washbench.analysis.ranking import DOFS, perceived_motion
@@ -78,9 +77,21 @@ class RunSummary:
 
 
 def aircraft_attitude(phi_deg: np.ndarray, theta_deg: np.ndarray, psi_deg: np.ndarray) -> np.ndarray:
-    """Body->NED quaternions (N, 4), scalar first, from ZYX Euler angles in degrees."""
-    angles = np.column_stack([psi_deg, theta_deg, phi_deg])
-    return Rotation.from_euler("ZYX", angles, degrees=True).as_quat(scalar_first=True)
+    """Body->NED quaternions (N, 4), scalar first, from ZYX Euler angles in degrees: q = q_z(psi) q_y(theta) q_x(phi).
+
+    Closed form (what ``scipy.spatial.transform.Rotation.from_euler("ZYX", ...)`` gives, without its import).
+    """
+    h = 0.5 * np.radians(np.column_stack([phi_deg, theta_deg, psi_deg]))
+    c, s = np.cos(h), np.sin(h)
+    cf, ct, cp, sf, st, sp = c[:, 0], c[:, 1], c[:, 2], s[:, 0], s[:, 1], s[:, 2]
+    return np.column_stack(
+        [
+            cf * ct * cp + sf * st * sp,
+            sf * ct * cp - cf * st * sp,
+            cf * st * cp + sf * ct * sp,
+            cf * ct * sp - sf * st * cp,
+        ]
+    )
 
 
 def metrics_markdown(title: str, rows: list[MetricRow]) -> str:
@@ -110,8 +121,11 @@ def run_manoeuvre(
     variants: Sequence[str] = (),
     filter_start: str = "steady",
     aircraft_dirs: Sequence[Path] = (),
+    recording: bool = True,
 ) -> RunSummary:
     """Fly one manoeuvre with the washouts in lockstep and write its results folder.
+
+    ``recording=False`` skips ``recording.rrd`` (and the import of rerun): every other file is written.
 
     ``washouts`` (built-in names), ``variants`` (``--variant`` texts) and the parameter file's ``variants:``
     select the washouts (:func:`washbench.cueing.variants.select_washouts`; default the three built-in ones).
@@ -134,10 +148,10 @@ def run_manoeuvre(
     flight_prov = build_provenance(manoeuvre_path=manoeuvre_path, turbulence=turbulence, aircraft_files=ac_files)
     prov = run_provenance(params_path, platform_path, specs, limits, manoeuvre_path, turbulence, ac_files)
     washouts = tuple(w.name for w in specs)
-    rows, lockstep = lockstep_washouts(specs, limits, manoeuvre.dt_s, filter_start)
+    rows, lockstep = lockstep_blocks(specs, limits, manoeuvre.dt_s, filter_start)
     start = time.perf_counter()
     created = utc_now()
-    flight = fly(manoeuvre, step_hook=lockstep, progress=progress)
+    flight = fly(manoeuvre, block_hook=lockstep, block_size=LOCKSTEP_BLOCK, progress=progress)
     n = len(flight.t_s)
     if len(rows) != n:
         raise RuntimeError(f"washouts ran {len(rows)} steps for {n} recorded samples")
@@ -164,8 +178,9 @@ def run_manoeuvre(
         ac_q = aircraft_attitude(cols["phi_deg"], cols["theta_deg"], cols["psi_deg"])
         extra = {"created_utc": created, "provenance": prov}
         summary = write_cued_folder(
-            partial, summary, rows, washouts, limits, ac_q, flight.phases, start, filter_start, extra, prov
-        )
+            partial, summary, rows, washouts, limits, ac_q, flight.phases, start, filter_start, extra, prov,
+            recording=recording,
+        )  # fmt: skip
         _publish(partial, final)
     finally:
         with contextlib.suppress(FileNotFoundError):
@@ -226,6 +241,31 @@ def lockstep_washouts(
     return rows, lockstep
 
 
+#: Samples the washouts take at a time during a flight (1 s at 120 Hz): the same compiled step as one
+#: sample at a time, bit for bit, with one call per block instead of one per sample.
+LOCKSTEP_BLOCK = 120
+
+
+def lockstep_blocks(
+    specs: Sequence[Any], limits: Any, dt_s: float, filter_start: str = "steady"
+) -> tuple[list[np.ndarray], Any]:
+    """:func:`lockstep_washouts` for ``fly``'s block hook: the washouts take the flight's samples a block at a
+    time (``CueingBank.steps``, one compiled call per block); ``rows`` gets one (washouts, fields) row per sample."""
+    from washbench.cueing import CueingBank
+
+    bank = CueingBank(specs, None, limits, dt_s, filter_start)
+    rows: list[np.ndarray] = []
+
+    def lockstep(k0: int, f_mps2: np.ndarray, omega_radps: np.ndarray) -> None:
+        if k0 != len(rows):
+            raise RuntimeError(f"lockstep: block starts at sample {k0}, expected {len(rows)}")
+        # The washouts see the angular velocity exactly as flight.parquet stores it (deg/s) and
+        # washbench cue reads it back (np.radians), so both paths give the same bits.
+        rows.extend(bank.steps(f_mps2, np.radians(np.degrees(omega_radps))).transpose(1, 0, 2))
+
+    return rows, lockstep
+
+
 def write_cued_folder(
     folder: Path,
     summary: RunSummary,
@@ -238,6 +278,7 @@ def write_cued_folder(
     filter_start: str = "steady",
     extra: dict[str, object] | None = None,
     provenance: dict[str, Any] | None = None,
+    recording: bool = True,
 ) -> RunSummary:
     """Everything after the flight, into ``folder`` (which already holds ``flight.parquet``): perception and
     metrics on the flight read back (as ``washbench cue`` reads it), traces.parquet, metrics.csv, recording.rrd,
@@ -253,9 +294,10 @@ def write_cued_folder(
     traces = {w: WashoutTrace.from_rows(block[:, i, :]) for i, w in enumerate(washouts)}
     result = analyse(motion, traces, filter_start=filter_start)
     write_results(folder, result, provenance)
-    title = f"{summary.aircraft} / {summary.manoeuvre}"
-    props = flat_strings(provenance, str((extra or {}).get("created_utc") or "")) if provenance else None
-    write_run_recording(folder / "recording.rrd", title, motion, result, limits, aircraft_q, phases, props)
+    if recording:
+        title = f"{summary.aircraft} / {summary.manoeuvre}"
+        props = flat_strings(provenance, str((extra or {}).get("created_utc") or "")) if provenance else None
+        write_run_recording(folder / "recording.rrd", title, motion, result, limits, aircraft_q, phases, props)
     ac = result.perceived["aircraft"]
     summary = dataclasses.replace(
         summary,
@@ -281,6 +323,7 @@ def run_script(
     aircraft_dirs: Sequence[Path] = (),
     washouts: Sequence[str] | None = None,
     variants: Sequence[str] = (),
+    recording: bool = True,
 ) -> list[RunSummary]:
     """Fly a JSBSim script (:mod:`washbench.flight.scripts`) with the washouts in lockstep, one result per run.
 
@@ -335,7 +378,8 @@ def run_script(
             extra = {"script": str(info.path), "segment": seg.name, "stopped_by_time_limit": flight.stopped_by_limit}
             extra |= {"created_utc": created, "provenance": prov}
             summaries.append(
-                write_cued_folder(folder, summary, rows, names, limits, ac_q, [], start, filter_start, extra, prov)
+                write_cued_folder(folder, summary, rows, names, limits, ac_q, [], start, filter_start, extra, prov,
+                                  recording=recording)
             )
         _publish(partial, final)
     finally:
@@ -446,6 +490,7 @@ def run_command(
     washouts: Sequence[str] | None = None,
     variants: Sequence[str] = (),
     aircraft_dirs: Sequence[Path] = (),
+    recording: bool = True,
 ) -> int:
     """CLI entry of ``washbench run`` (a YAML manoeuvre or a JSBSim script): 0 if every run was ok, else 1."""
     from washbench.cueing.bank import check_filter_start
@@ -466,6 +511,7 @@ def run_command(
             aircraft_dirs=aircraft_dirs,
             washouts=washouts,
             variants=variants,
+            recording=recording,
         )
     else:
         if max_time_s is not None:
@@ -476,11 +522,12 @@ def run_command(
                 out_root,
                 params_path=params_path,
                 platform_path=platform_path,
-                progress=progress and sys.stderr.isatty(),
+                progress=progress,
                 filter_start=filter_start,
                 aircraft_dirs=aircraft_dirs,
                 washouts=washouts,
                 variants=variants,
+                recording=recording,
             )
         ]
     wall = time.perf_counter() - start

@@ -101,6 +101,7 @@ def _run_one(
     variants: tuple[str, ...] = (),
     aircraft_dirs: tuple[str, ...] = (),
     max_time_s: float | None = None,
+    recording: bool = True,
 ) -> list[Outcome]:
     """Worker: run one manoeuvre or JSBSim script (one outcome per run segment); never raises (failures
     come back as an Outcome)."""
@@ -113,7 +114,7 @@ def _run_one(
     try:
         dirs = [Path(d) for d in aircraft_dirs]
         common = {"params_path": params, "platform_path": platform, "aircraft_dirs": dirs}
-        common |= {"washouts": washouts, "variants": variants}
+        common |= {"washouts": washouts, "variants": variants, "recording": recording}
         if is_script(Path(path)):
             runs = run_script(Path(path), Path(out_dir), max_time_s=max_time_s, **common)
         else:
@@ -133,7 +134,7 @@ def _preload() -> None:
     import washbench.runs.preload  # noqa: F401
 
 
-def pool_context() -> tuple[multiprocessing.context.BaseContext, Callable[[], None] | None]:
+def pool_context(recording: bool = True) -> tuple[multiprocessing.context.BaseContext, Callable[[], None] | None]:
     """The process pool's start method and worker initializer.
 
     ``forkserver`` (Linux, macOS) where it exists: workers fork from a server that has already imported the heavy
@@ -142,7 +143,7 @@ def pool_context() -> tuple[multiprocessing.context.BaseContext, Callable[[], No
     """
     if "forkserver" in multiprocessing.get_all_start_methods():
         ctx = multiprocessing.get_context("forkserver")
-        ctx.set_forkserver_preload(["washbench.runs.preload"])
+        ctx.set_forkserver_preload(["washbench.runs.preload", *(["rerun"] if recording else [])])
         return ctx, None
     return multiprocessing.get_context("spawn"), _preload
 
@@ -160,16 +161,19 @@ def run_suite(
     dask: str | None = None,
     aircraft_dirs: Sequence[Path] = (),
     max_time_s: float | None = None,
+    recording: bool = True,
 ) -> list[Outcome]:
     """Run every file in parallel processes (or on the Dask cluster at ``dask``); outcomes in the order of ``files``
-    (a JSBSim script that resets gives one outcome per run segment, in order)."""
+    (a JSBSim script that resets gives one outcome per run segment, in order). ``recording=False``: no
+    ``recording.rrd`` in the run folders (the report then links none)."""
     jobs = max(1, min(jobs or os.cpu_count() or 1, len(files)))
     out_dir.mkdir(parents=True, exist_ok=True)
     dirs = tuple(str(d) for d in aircraft_dirs)
     params = str(params_path) if params_path else None
     platform = str(platform_path) if platform_path else None
     chosen = tuple(washouts) if washouts else None
-    args = [(str(f), str(out_dir), params, platform, chosen, tuple(variants), dirs, max_time_s) for f in files]
+    args = [(str(f), str(out_dir), params, platform, chosen, tuple(variants), dirs, max_time_s, recording)
+            for f in files]
     outcomes: dict[str, list[Outcome]] = {}
     start = time.perf_counter()
     if progress:
@@ -187,7 +191,7 @@ def run_suite(
         for a in args:
             outcomes[a[0]] = _report(_run_one(*a), len(outcomes) + 1, len(files), start, progress)
     else:
-        ctx, initializer = pool_context()
+        ctx, initializer = pool_context(recording)
         with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=initializer) as pool:
             futures = [pool.submit(_run_one, *a) for a in args]
             for fut in as_completed(futures):
@@ -342,6 +346,7 @@ def suite_command(
     aircraft_dirs: Sequence[Path] = (),
     jsbsim_scripts: Sequence[str] = (),
     max_time_s: float | None = None,
+    recording: bool = True,
 ) -> int:
     """CLI entry: run the suite, write its results, print where they are; 0 if all succeeded, else 1.
 
@@ -383,6 +388,7 @@ def suite_command(
         dask=dask,
         aircraft_dirs=aircraft_dirs,
         max_time_s=max_time_s,
+        recording=recording,
     )
     write_suite_results(outcomes, out_dir, provenance)
     n_ok = sum(o.run.ok for o in outcomes)
