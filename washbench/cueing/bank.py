@@ -70,6 +70,7 @@ from washbench.cueing.kernel import (
 )
 from washbench.cueing.params import WashoutParams, check_washouts
 from washbench.errors import WashbenchError
+from washbench.io.results import DT_RANGE_S
 from washbench.platform.limits import PlatformLimits, wheel_jacobian
 
 _KINDS = {"small-angle": KIND_SMALL, "large-angle": KIND_LARGE, "unrestricted": KIND_UNRESTRICTED}
@@ -77,8 +78,9 @@ _KINDS = {"small-angle": KIND_SMALL, "large-angle": KIND_LARGE, "unrestricted": 
 
 def _check_dt(dt_s: float) -> float:
     dt = float(dt_s)
-    if not (math.isfinite(dt) and dt > 0.0):
-        raise WashbenchError(f"time step must be a positive number of seconds, got {dt_s!r}")
+    lo, hi = DT_RANGE_S
+    if not (math.isfinite(dt) and lo <= dt <= hi):
+        raise WashbenchError(f"time step must be {lo:g}..{hi:g} s, got {dt_s!r}")
     return dt
 
 

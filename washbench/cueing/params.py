@@ -34,9 +34,14 @@ def check_washouts(washouts: Sequence[str]) -> tuple[str, ...]:
     return names
 
 
-Positive = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
-NonNegative = Annotated[float, Field(ge=0.0, allow_inf_nan=False)]
-Finite = Annotated[float, Field(allow_inf_nan=False)]
+# Accepted ranges (a finite but absurd number, e.g. a scale of 1e300, would make the platform model meaningless
+# or slow): break frequencies up to 1000 rad/s, scale factors up to 10, gravity 1..100 m/s^2, rates in deg/s.
+Positive = Annotated[float, Field(gt=0.0, le=1e3, allow_inf_nan=False)]
+NonNegative = Annotated[float, Field(ge=0.0, le=1e3, allow_inf_nan=False)]
+Finite = Annotated[float, Field(ge=-10.0, le=10.0, allow_inf_nan=False)]  # head offset, m
+ScaleFactor = Annotated[float, Field(gt=0.0, le=10.0, allow_inf_nan=False)]
+Gravity = Annotated[float, Field(ge=1.0, le=100.0, allow_inf_nan=False)]
+RateLimit = Annotated[float, Field(gt=0.0, le=3600.0, allow_inf_nan=False)]  # deg/s
 
 
 class TranslationalAxes(StrictModel):
@@ -63,8 +68,8 @@ class RotationalAxes(StrictModel):
 class Scale(StrictModel):
     """Scale factors applied to the aircraft motion before the washout (dimensionless)."""
 
-    specific_force: Positive
-    angular_velocity: Positive
+    specific_force: ScaleFactor
+    angular_velocity: ScaleFactor
 
 
 class Tilt(StrictModel):
@@ -72,20 +77,20 @@ class Tilt(StrictModel):
 
     lowpass_wn_radps: TranslationalAxes
     gain_per_s: Positive
-    rate_limit_degps: Positive
+    rate_limit_degps: RateLimit
 
 
 class Rotational(StrictModel):
     """Rotational channel."""
 
     highpass_wn_radps: RotationalAxes
-    saturation_degps: Positive
+    saturation_degps: RateLimit
 
 
 class Head(StrictModel):
     """Simulator pilot-head motion (paper Eqs. 7-10, 18-19)."""
 
-    derivative_wn_radps: Positive
+    derivative_wn_radps: Annotated[float, Field(gt=0.0, le=1e4, allow_inf_nan=False)]
     offset_m: tuple[Finite, Finite, Finite]
 
 
@@ -99,14 +104,14 @@ class WashoutParams(StrictModel):
     """A complete washout parameter set (e.g. CW1), shared by the three washouts."""
 
     name: str
-    gravity_mps2: Positive
+    gravity_mps2: Gravity
     scale: Scale
     translational_highpass_wn_radps: TranslationalAxes
     tilt: Tilt
     rotational: Rotational
     head: Head
     small_angle: SmallAngle
-    free_fall_threshold_mps2: Positive
+    free_fall_threshold_mps2: Annotated[float, Field(gt=0.0, le=100.0, allow_inf_nan=False)]
 
 
 def load_washout_params(path: Path | None = None) -> WashoutParams:

@@ -17,7 +17,7 @@ from typing import Any
 
 from washbench.errors import WashbenchError
 from washbench.flight.geo import DEFAULT_LATITUDE_DEG, DEFAULT_LONGITUDE_DEG, LocalFrame
-from washbench.flight.manoeuvre import Hold, Manoeuvre, aircraft_path, jsbsim_root
+from washbench.flight.manoeuvre import Hold, Manoeuvre, aircraft_path, jsbsim_root, pilot_profile_path
 from washbench.flight.pilot import Pilot
 from washbench.flight.profile import PilotProfile
 
@@ -69,12 +69,12 @@ def make_fdm(m: Manoeuvre, profile: PilotProfile) -> tuple[Any, Setup]:
 
     root = aircraft_path(m.aircraft)
     if root is None:  # load_manoeuvre checked it; guard against a file removed since
-        raise WashbenchError(f"{m.aircraft}: unknown aircraft")
+        raise WashbenchError(m.located(("aircraft",), f"unknown aircraft '{m.aircraft}'"))
     fdm = jsbsim.FGFDMExec(str(jsbsim_root()), None)
     fdm.set_aircraft_path(str(root))
     with _quiet_stdout():
         if not fdm.load_model(m.aircraft):
-            raise WashbenchError(f"{root / m.aircraft}: JSBSim could not load the model")
+            raise WashbenchError(m.located(("aircraft",), f"JSBSim could not load the model {root / m.aircraft}"))
     fdm.set_dt(m.dt_s)
 
     rw = m.runway
@@ -143,8 +143,11 @@ def make_fdm(m: Manoeuvre, profile: PilotProfile) -> tuple[Any, Setup]:
                     fdm.do_trim(1)
             except RuntimeError as exc:
                 raise WashbenchError(
-                    f"{m.aircraft}: JSBSim could not trim straight flight at {air.airspeed_kts:g} kt, "
-                    f"{air.altitude_ft:g} ft, flaps {air.flaps_deg:g} deg ({exc})"
+                    m.located(
+                        ("start", "air"),
+                        f"{m.aircraft}: JSBSim could not trim straight flight at {air.airspeed_kts:g} kt, "
+                        f"{air.altitude_ft:g} ft, flaps {air.flaps_deg:g} deg ({exc})",
+                    )
                 ) from None
         if wind_n or wind_e:
             crab = air.heading_deg is None  # on a runway's extended centreline: crab to track it
@@ -166,8 +169,8 @@ def make_fdm(m: Manoeuvre, profile: PilotProfile) -> tuple[Any, Setup]:
     fdm.suspend_integration()
     fdm.run()
     fdm.resume_integration()
-    if fdm["simulation/sim-time-sec"] != 0.0:
-        raise WashbenchError("JSBSim advanced time while initialising")  # guards the t = k * dt time base
+    if fdm["simulation/sim-time-sec"] != 0.0:  # guards the t = k * dt time base
+        raise WashbenchError(m.located(("start",), "JSBSim advanced time while initialising"))
     return fdm, Setup(frame, threshold, rw_heading, elevation)
 
 
@@ -181,7 +184,9 @@ def _set_engine_levers(fdm: Any, aircraft: str, profile: PilotProfile) -> None:
         if value is None:
             continue
         if not pm.hasNode(name):
-            raise WashbenchError(f"{aircraft}: the pilot profile sets {name}, which the JSBSim model lacks")
+            raise WashbenchError(
+                f"{pilot_profile_path(aircraft)}: engine: sets {name}, which the JSBSim model {aircraft} lacks"
+            )
         fdm[name] = float(value)
 
 
@@ -235,9 +240,12 @@ def _flying_start(fdm: Any, m: Manoeuvre, profile: PilotProfile, heading_deg: fl
     off = (abs(vc - air.airspeed_kts), abs(hdot - vs_fpm / 60.0), max(abs(p), abs(q), abs(r)))
     if off[0] > SETTLED_KTS or off[1] > SETTLED_FPS or off[2] > SETTLED_RADPS:
         raise WashbenchError(
-            f"{m.aircraft}: the flying start did not settle at {air.airspeed_kts:g} kt, {air.altitude_ft:g} ft, "
-            f"flight path {air.flight_path_deg:g} deg in {profile.start.settle_s:g} s (airspeed off by "
-            f"{off[0]:.1f} kt, climb rate by {off[1]:.1f} ft/s, body rates up to {off[2]:.3f} rad/s)"
+            m.located(
+                ("start", "air"),
+                f"{m.aircraft}: the flying start did not settle at {air.airspeed_kts:g} kt, {air.altitude_ft:g} ft, "
+                f"flight path {air.flight_path_deg:g} deg in {profile.start.settle_s:g} s (airspeed off by "
+                f"{off[0]:.1f} kt, climb rate by {off[1]:.1f} ft/s, body rates up to {off[2]:.3f} rad/s)",
+            )
         )
     u, v, w = fdm["velocities/u-fps"], fdm["velocities/v-fps"], fdm["velocities/w-fps"]
     fdm["ic/h-sl-ft"] = air.altitude_ft

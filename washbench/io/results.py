@@ -63,6 +63,13 @@ TIME_RTOL = 1e-6
 
 SUFFIXES = {".csv": "csv", ".parquet": "parquet", ".pq": "parquet"}
 
+#: Accepted time steps of an input motion, s (10 kHz to 1 Hz): outside, the filters cannot be discretised
+#: meaningfully (a subnormal step, or one of 8e307 s, overflows them).
+DT_RANGE_S = (1e-4, 1.0)
+#: Largest magnitude accepted in the motion columns: 1000 m/s^2 (about 100 g) and 3600 deg/s (10 turns a
+#: second); beyond, a recording is corrupt, not a flight.
+MOTION_MAX = {**dict.fromkeys(F_COLUMNS, 1000.0), **dict.fromkeys(OMEGA_COLUMNS, 3600.0)}
+
 
 # --------------------------------------------------------------------------- column names
 
@@ -314,6 +321,17 @@ def _numeric_column(path: Path, kind: str, table: pa.Table, name: str) -> np.nda
         line, row = _where(kind, i)
         what = "NaN" if np.isnan(arr[i]) else "infinite"
         raise WashbenchError(located(path, f"{row}value is {what}", line=line, field=name))
+    limit = MOTION_MAX.get(name)
+    if limit is not None:
+        big = np.abs(arr) > limit
+        if big.any():
+            i = int(np.argmax(big))
+            line, row = _where(kind, i)
+            unit = "m/s^2" if name in F_COLUMNS else "deg/s"
+            raise WashbenchError(
+                located(path, f"{row}{arr[i]:.6g} is beyond the accepted range +-{limit:g} {unit}", line=line,
+                        field=name)
+            )  # fmt: skip
     return np.ascontiguousarray(arr, dtype=np.float64)
 
 
@@ -330,6 +348,11 @@ def _check_time(path: Path, kind: str, t: np.ndarray) -> float:
             )
         )
     typical = float(np.median(steps))
+    if not DT_RANGE_S[0] <= typical <= DT_RANGE_S[1]:
+        raise WashbenchError(
+            located(path, f"time step {typical:.6g} s is outside the accepted {DT_RANGE_S[0]:g}..{DT_RANGE_S[1]:g} s "
+                    f"({1 / DT_RANGE_S[1]:g} Hz to {1 / DT_RANGE_S[0]:g} Hz)", field=TIME_COLUMN)
+        )  # fmt: skip
     bad = np.abs(steps - typical) > TIME_RTOL * typical
     if bad.any():
         i = int(np.argmax(bad)) + 1

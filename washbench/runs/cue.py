@@ -216,14 +216,16 @@ def run_cue(
     Raises WashbenchError (one line) for bad names, parameter files or input; writes nothing then.
     """
     from washbench.cueing import load_washout_params
+    from washbench.io.lock import output_lock
     from washbench.platform import load_platform_limits
 
     names = check_washout_names(washouts)
     params = load_washout_params(params_path)
     limits = load_platform_limits(platform_path)
     motion = read_motion(input_path)
-    result = cue_motion(motion, names, params, limits)
-    traces_path, metrics_path = write_results(out_dir, result)
+    with output_lock(out_dir):
+        result = cue_motion(motion, names, params, limits)
+        traces_path, metrics_path = write_results(out_dir, result)
     print(
         f"{input_path}: {motion.n} rows, {motion.duration_s:.3f} s at dt = {motion.dt_s:.6g} s "
         f"({1.0 / motion.dt_s:.6g} Hz)"

@@ -25,7 +25,6 @@ from __future__ import annotations
 import contextlib
 import json
 import math
-import os
 import shutil
 import sys
 import time
@@ -40,6 +39,14 @@ from washbench.analysis.metrics import MetricRow, integral_abs_error
 from washbench.analysis.ranking import DOFS
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
+from washbench.io.publish import (
+    check_replaceable,
+    clean_partials,
+    partial_dir,
+    publish_dir,
+    remove_if_empty,
+    result_path,
+)
 
 if TYPE_CHECKING:
     from washbench.flight.fly import FlightResult
@@ -105,13 +112,17 @@ def metrics_markdown(title: str, rows: list[MetricRow]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _publish(partial: Path, final: Path) -> None:
-    """Replace ``final`` with the finished folder ``partial`` (two renames; the old one is removed)."""
-    old = final.with_name(f".{final.name}.old-{os.getpid()}")
-    if final.exists():
-        os.replace(final, old)
-    os.replace(partial, final)
-    shutil.rmtree(old, ignore_errors=True)
+#: The file that marks a folder as a ``washbench run`` result (only such a folder is ever replaced).
+RUN_MARKER = "run.json"
+
+
+def run_dir(out_root: Path, aircraft: str, manoeuvre: str) -> Path:
+    """``OUT/<aircraft>/<manoeuvre>``, proven inside ``out_root`` (both names are identifiers)."""
+    return result_path(out_root, aircraft, manoeuvre)
+
+
+def _marker(aircraft: str, manoeuvre: str) -> dict[str, object]:
+    return {"aircraft": aircraft, "manoeuvre": manoeuvre}
 
 
 def run_manoeuvre(
@@ -124,9 +135,10 @@ def run_manoeuvre(
 ) -> RunSummary:
     """Fly one manoeuvre with the washouts in lockstep and write its results folder.
 
-    Raises WashbenchError for a bad manoeuvre, parameter or platform file (nothing written).
-    A flight that crashes or fails a check still writes its results (what was flown), with
-    ``ok`` False and the reason.
+    Raises WashbenchError for a bad manoeuvre, parameter or platform file, or a result place that
+    cannot be used (all checked before flying; nothing written). A flight that crashes or fails a check
+    still writes its results (what was flown), with ``ok`` False and the reason. The result folder
+    replaces only a previous ``washbench run`` result of the same manoeuvre (recognised by its run.json).
     """
     from washbench.cueing import WASHOUT_NAMES, CueingBank, WashoutTrace, load_washout_params
     from washbench.flight.fly import fly, write_flight
@@ -138,6 +150,10 @@ def run_manoeuvre(
     manoeuvre = load_manoeuvre(manoeuvre_path)
     params = load_washout_params(params_path)
     limits = load_platform_limits(platform_path)
+    final = run_dir(Path(out_root), manoeuvre.aircraft, manoeuvre.name)
+    marker = _marker(manoeuvre.aircraft, manoeuvre.name)
+    check_replaceable(final, RUN_MARKER, marker)  # before flying: a folder in the way fails now, not after
+    clean_partials(final.parent)
     washouts = tuple(WASHOUT_NAMES)
     bank = CueingBank(washouts, params, limits, manoeuvre.dt_s)
     rows: list[np.ndarray] = []
@@ -156,10 +172,8 @@ def run_manoeuvre(
     if len(rows) != n:
         raise RuntimeError(f"washouts ran {len(rows)} steps for {n} recorded samples")
 
-    final = Path(out_root) / manoeuvre.aircraft / manoeuvre.name
-    partial = final.with_name(f".{final.name}.partial-{os.getpid()}")
-    shutil.rmtree(partial, ignore_errors=True)
-    partial.mkdir(parents=True)
+    partial = partial_dir(final)
+    published = False
     try:
         write_flight(partial, flight, str(manoeuvre_path))
         if n < 2:
@@ -189,11 +203,14 @@ def run_manoeuvre(
             motion=felt,
             saturations={w: dict(traces[w].saturation_counts) for w in washouts},
         )
-        _write_run_json(partial / "run.json", summary, time.perf_counter() - start)
-        _publish(partial, final)
+        _write_run_json(partial / RUN_MARKER, summary, time.perf_counter() - start)
+        publish_dir(partial, final, RUN_MARKER, marker)
+        published = True
     finally:
         with contextlib.suppress(FileNotFoundError):
             shutil.rmtree(partial)
+        if not published:
+            remove_if_empty(final.parent)
     return summary
 
 
@@ -283,15 +300,21 @@ def run_command(
     platform_path: Path | None = None,
     progress: bool = True,
 ) -> int:
-    """CLI entry of ``washbench run``: 0 if the flight ran and passed its checks, else 1."""
+    """CLI entry of ``washbench run``: 0 if the flight ran and passed its checks, else 1.
+
+    Holds the lock of ``out_root`` (:func:`washbench.io.lock.output_lock`) while it runs.
+    """
+    from washbench.io.lock import output_lock
+
     start = time.perf_counter()
-    s = run_manoeuvre(
-        manoeuvre_path,
-        out_root,
-        params_path=params_path,
-        platform_path=platform_path,
-        progress=progress and sys.stderr.isatty(),
-    )
+    with output_lock(out_root):
+        s = run_manoeuvre(
+            manoeuvre_path,
+            out_root,
+            params_path=params_path,
+            platform_path=platform_path,
+            progress=progress and sys.stderr.isatty(),
+        )
     state = "ok" if s.ok else f"FAILED ({s.reason})"
     print(
         f"{s.aircraft}/{s.manoeuvre}: {state}; checks {s.checks_passed}/{s.checks_total}; "
