@@ -394,6 +394,7 @@ def _check_semantics(m: Manoeuvre, where: _Where) -> None:
         if names.index(phase.name) != i:
             where.add((*base, "name"), f"duplicate phase name '{phase.name}'")
         hold, until = phase.hold, phase.until
+        phase_problems = len(where.problems)
         lateral = _set_fields(hold, LATERAL_TARGETS)
         pitch = _set_fields(hold, PITCH_TARGETS)
         if len(lateral) > 1:
@@ -422,7 +423,9 @@ def _check_semantics(m: Manoeuvre, where: _Where) -> None:
             where.add((*base, "hold", key), "needs a top-level 'runway'")
         conditions = _set_fields(until, [f for f in Until.model_fields if f != "timeout_s"])
         reasons = [_never_reason(c, until, hold, on_ground, profile, m) for c in conditions]
-        if not conditions:
+        if len(where.problems) > phase_problems:
+            pass  # whether the phase can end depends on a hold already in error: no consequential error
+        elif not conditions:
             where.add((*base, "until"), "the phase can never end: give at least one end condition")
         elif all(r is not None for r in reasons):
             where.add((*base, "until", conditions[0]), f"the phase can never end: {reasons[0]}")

@@ -146,6 +146,11 @@ def publish_dir(partial: str | Path, final: str | Path, marker: str, expect: Map
     shutil.rmtree(old, ignore_errors=True)
 
 
+def is_leftover(name: str) -> bool:
+    """Whether ``name`` is a leftover of an interrupted run (``.NAME.partial-PID`` or ``.NAME.old-PID``)."""
+    return _LEFTOVER.match(name) is not None
+
+
 def _pid_alive(pid: int) -> bool:
     try:
         os.kill(pid, 0)

@@ -20,7 +20,8 @@ import json
 import math
 import re
 from pathlib import Path
-from typing import Any, TypeVar
+from collections.abc import Mapping
+from typing import Any, Self, TypeVar
 
 import pydantic
 import yaml
@@ -34,9 +35,24 @@ Loc = tuple[str | int, ...]
 
 
 class StrictModel(BaseModel):
-    """Base for models read from YAML: unknown keys rejected, strict types, frozen."""
+    """Base for models read from YAML: unknown keys rejected, strict types, no NaN or infinity, frozen.
+
+    No invalid instance can be built from Python either: :meth:`model_copy` with ``update`` validates
+    the result like a new instance (pydantic's own skips validation).
+    """
 
     model_config = ConfigDict(extra="forbid", strict=True, frozen=True, allow_inf_nan=False)
+
+    def model_copy(self, *, update: Mapping[str, Any] | None = None, deep: bool = False) -> Self:
+        """A copy; with ``update``, a new validated instance (raises ``pydantic.ValidationError``)."""
+        if not update:
+            return super().model_copy(deep=deep)
+        unknown = sorted(set(update) - set(type(self).model_fields))
+        if unknown:
+            raise ValueError(f"{type(self).__name__}.model_copy: unknown field(s) {', '.join(unknown)}")
+        values = {name: getattr(self, name) for name in type(self).model_fields if name in self.model_fields_set}
+        values.update(update)
+        return type(self).model_validate(values)
 
 
 class _UniqueKeyLoader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):  # type: ignore[misc]

@@ -1,7 +1,7 @@
 """``washbench suite``: many manoeuvres in parallel processes, then a comparison of the washouts.
 
 Each manoeuvre runs through :func:`washbench.runs.pipeline.run_manoeuvre` in its own worker process
-and writes ``OUT/<aircraft>/<manoeuvre>/`` (published atomically as a whole folder). A manoeuvre
+and writes ``<aircraft>/<manoeuvre>/`` (published atomically as a whole folder). A manoeuvre
 that fails (bad file, crash, divergence, failed check, or an unexpected error) is reported with its
 reason; the others still complete and are kept. Then the suite writes, each file atomically:
 
@@ -10,22 +10,35 @@ reason; the others still complete and are kept. Then the suite writes, each file
   (positive = better than small-angle), like the paper's Table 4
 - ``OUT/ranking.csv``: the three washouts ranked per manoeuvre by the rule of
   :mod:`washbench.analysis.ranking`
-- ``OUT/report.md``: all of it, with links to each recording, written last.
+- ``OUT/report.md``: all of it, with links to each recording;
+- ``OUT/suite.json``: what the suite wrote (how the next suite recognises it), written last.
+
+The output folder holds exactly one suite's results. The suite builds them in a hidden folder inside
+``OUT`` (``OUT/.suite.partial-PID/``) and, once complete, replaces the previous results as a whole: the
+previous suite's files and every ``washbench run`` result folder. Anything in ``OUT`` that washbench did
+not write makes the suite refuse to start (nothing is ever deleted that washbench did not write). An
+interrupted or failed suite leaves the previous results untouched. A lock on ``OUT`` keeps a second
+writer out (:mod:`washbench.io.lock`). Two files with the same aircraft and name are refused before
+flying. On SIGINT or SIGTERM the workers are stopped at once and the hidden folder removed.
 
 The exit status is 0 only if every manoeuvre ran and passed its checks.
 """
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import io
+import json
 import math
 import multiprocessing
 import os
+import shutil
+import signal
 import sys
 import time
 import traceback
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
@@ -42,9 +55,15 @@ from washbench.analysis.ranking import (
 from washbench.cueing.params import WASHOUT_NAMES
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
+from washbench.io.lock import LOCK_NAME, output_lock
 from washbench.io.paths import MANOEUVRES_DIR
+from washbench.io.publish import clean_partials, is_leftover, is_washbench_result, read_marker
 from washbench.io.results import csv_number
-from washbench.runs.pipeline import RunSummary
+from washbench.runs.pipeline import RUN_MARKER, RunSummary
+
+#: The suite's own files in ``OUT`` (``suite.json`` lists everything a suite wrote at the top level).
+SUITE_FILES = ("metrics.csv", "comparison.csv", "ranking.csv", "report.md")
+SUITE_MARKER = "suite.json"
 
 
 @dataclass
@@ -72,6 +91,37 @@ def find_manoeuvres(inputs: Sequence[Path]) -> list[Path]:
     if not unique:
         raise WashbenchError(located(inputs[0], "no manoeuvre files (*.yaml) found"))
     return unique
+
+
+def _worker_init() -> None:
+    """In each worker: Ctrl-C is for the main process (it stops the workers); SIGTERM stops a worker at once."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
+@contextlib.contextmanager
+def _signals_held() -> Iterator[None]:
+    """Ignore SIGINT and SIGTERM for a short critical section (stopping workers, swapping results in)."""
+    saved = {sig: signal.signal(sig, signal.SIG_IGN) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for sig, handler in saved.items():
+            signal.signal(sig, handler)
+
+
+def _stop_pool(pool: ProcessPoolExecutor) -> None:
+    """Stop every worker now (SIGTERM, then SIGKILL after 5 s) and drop the queued runs."""
+    processes = list((getattr(pool, "_processes", None) or {}).values())  # the executor keeps no public list
+    for p in processes:
+        with contextlib.suppress(Exception):
+            p.terminate()
+    pool.shutdown(wait=False, cancel_futures=True)
+    for p in processes:
+        p.join(5.0)
+        if p.is_alive():
+            p.kill()
+            p.join(5.0)
 
 
 def _run_one(path: str, out_dir: str, params_path: str | None, platform_path: str | None) -> Outcome:
@@ -104,7 +154,11 @@ def run_suite(
     platform_path: Path | None = None,
     progress: bool = True,
 ) -> list[Outcome]:
-    """Run every file in parallel processes; return the outcomes in the order of ``files``."""
+    """Run every file in parallel processes; return the outcomes in the order of ``files``.
+
+    On any exception (KeyboardInterrupt and :class:`washbench.errors.Terminated` included) the workers are
+    stopped before it propagates, so no worker writes anything afterwards.
+    """
     jobs = max(1, min(jobs or os.cpu_count() or 1, len(files)))
     out_dir.mkdir(parents=True, exist_ok=True)
     args = [
@@ -126,12 +180,18 @@ def run_suite(
         ctx = multiprocessing.get_context("forkserver")
         # Workers fork from a server that has already imported the heavy modules (JSBSim, numba
         # kernels, rerun, pyarrow), so each worker starts in milliseconds instead of seconds.
-        ctx.set_forkserver_preload(["washbench.runs.preload"])
-        with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as pool:
+        ctx.set_forkserver_preload(["washbench.runs.worker_signals", "washbench.runs.preload"])
+        pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_init)
+        try:
             futures = [pool.submit(_run_one, *a) for a in args]
             for fut in as_completed(futures):
                 outcome = fut.result()
                 outcomes[outcome.path] = _report(outcome, len(outcomes) + 1, len(files), start, progress)
+        except BaseException:
+            with _signals_held():
+                _stop_pool(pool)
+            raise
+        pool.shutdown(wait=True)
     return [outcomes[a[0]] for a in args]
 
 
@@ -292,7 +352,10 @@ def _md_num(x: float, signed: bool = False) -> str:
 
 
 def write_suite_results(outcomes: Sequence[Outcome], out_dir: Path) -> None:
-    """Write metrics.csv, comparison.csv, ranking.csv and (last) report.md, each atomically."""
+    """Write metrics.csv, comparison.csv, ranking.csv, report.md and (last) suite.json, each atomically.
+
+    ``suite.json`` lists every top-level entry of ``out_dir`` at that moment: what the next suite may replace.
+    """
     rankings = {
         (o.run.aircraft, o.run.manoeuvre): rank(o.run.metrics, o.run.motion) for o in _runs_with_metrics(outcomes)
     }
@@ -300,6 +363,79 @@ def write_suite_results(outcomes: Sequence[Outcome], out_dir: Path) -> None:
     write_text_atomic(out_dir / "comparison.csv", comparison_table(outcomes))
     write_text_atomic(out_dir / "ranking.csv", ranking_table(rankings))
     write_text_atomic(out_dir / "report.md", report_markdown(outcomes, rankings, out_dir))
+    entries = sorted(e.name for e in out_dir.iterdir() if not e.name.startswith(".") and e.name != SUITE_MARKER)
+    doc = {"washbench": "suite", "manoeuvres": len(outcomes), "entries": entries}
+    write_text_atomic(out_dir / SUITE_MARKER, json.dumps(doc, indent=2) + "\n")
+
+
+def check_unique_names(files: Sequence[Path]) -> None:
+    """Refuse two manoeuvre files with the same aircraft and name (they would share a result folder).
+
+    Files that do not load are left for the run to report. Raises WashbenchError naming both files.
+    """
+    from washbench.flight.manoeuvre import load_manoeuvre
+
+    seen: dict[tuple[str, str], Path] = {}
+    for path in files:
+        try:
+            m = load_manoeuvre(path)
+        except WashbenchError:
+            continue
+        key = (m.aircraft, m.name)
+        if key in seen:
+            raise WashbenchError(
+                m.located(("name",), f"'{m.name}' ({m.aircraft}) is also the name of {seen[key]}: both would "
+                          f"write {m.aircraft}/{m.name}/; give each manoeuvre its own name")
+            )  # fmt: skip
+        seen[key] = path
+
+
+def _is_run_folder(entry: Path, aircraft: str) -> bool:
+    return is_washbench_result(entry, RUN_MARKER, {"aircraft": aircraft, "manoeuvre": entry.name})
+
+
+def previous_results(out_dir: Path) -> list[Path]:
+    """The entries of ``out_dir`` a new suite replaces: a previous suite's files and run result folders.
+
+    Raises WashbenchError naming the first entry washbench did not write (the suite then does not start).
+    """
+    marker = read_marker(out_dir, SUITE_MARKER) or {}
+    listed = marker.get("entries", []) if marker.get("washbench") == "suite" else []
+    listed = {n for n in listed if isinstance(n, str) and "/" not in n and n not in ("", ".", "..")}
+    found: list[Path] = []
+    for entry in sorted(out_dir.iterdir()):
+        name = entry.name
+        if name == LOCK_NAME or is_leftover(name):
+            continue
+        if name in SUITE_FILES or name == SUITE_MARKER or name in listed:
+            found.append(entry)
+            continue
+        if entry.is_dir() and not entry.is_symlink():
+            subs = [e for e in entry.iterdir() if not is_leftover(e.name)]
+            if all(_is_run_folder(e, name) for e in subs):
+                found.append(entry)
+                continue
+            stranger = next(e for e in subs if not _is_run_folder(e, name))
+            entry = stranger
+        raise WashbenchError(
+            located(entry, "washbench did not write this: a suite replaces only a previous washbench result as a "
+                    "whole; choose an empty or new --out folder")
+        )  # fmt: skip
+    return found
+
+
+def _swap_in(stage: Path, out_dir: Path, previous: Sequence[Path]) -> None:
+    """Replace ``previous`` entries of ``out_dir`` by everything in ``stage`` (renames, signals held)."""
+    with _signals_held():
+        old = out_dir / f".suite.old-{os.getpid()}"
+        old.mkdir()
+        for entry in previous:
+            if entry.exists() or entry.is_symlink():
+                os.replace(entry, old / entry.name)
+        for entry in sorted(stage.iterdir()):
+            os.replace(entry, out_dir / entry.name)
+        stage.rmdir()
+        shutil.rmtree(old, ignore_errors=True)
 
 
 def suite_command(
@@ -311,7 +447,10 @@ def suite_command(
     platform_path: Path | None = None,
     progress: bool = True,
 ) -> int:
-    """CLI entry: run the suite, write its results, print where they are; 0 if all succeeded, else 1."""
+    """CLI entry: run the suite, write its results, print where they are; 0 if all succeeded, else 1.
+
+    See the module docstring for the output folder policy (lock, whole replacement, interruption).
+    """
     if jobs is not None and jobs < 1:
         raise WashbenchError(f"--jobs: expected a whole number of at least 1, got {jobs}")
     files = find_manoeuvres(inputs)
@@ -321,11 +460,24 @@ def suite_command(
 
     load_washout_params(params_path)
     load_platform_limits(platform_path)
+    check_unique_names(files)
     start = time.perf_counter()
-    outcomes = run_suite(
-        files, out_dir, jobs=jobs, params_path=params_path, platform_path=platform_path, progress=progress
-    )
-    write_suite_results(outcomes, out_dir)
+    with output_lock(out_dir):
+        clean_partials(out_dir, only_dead=False)  # under the lock every leftover is stale
+        previous = previous_results(out_dir)
+        for entry in previous:
+            if entry.is_dir():
+                clean_partials(entry, only_dead=False)
+        stage = out_dir / f".suite.partial-{os.getpid()}"
+        stage.mkdir()
+        try:
+            outcomes = run_suite(
+                files, stage, jobs=jobs, params_path=params_path, platform_path=platform_path, progress=progress
+            )
+            write_suite_results(outcomes, stage)
+            _swap_in(stage, out_dir, previous)
+        finally:
+            shutil.rmtree(stage, ignore_errors=True)
     n_ok = sum(o.run.ok for o in outcomes)
     print(
         f"suite: {n_ok}/{len(outcomes)} manoeuvres ok in {time.perf_counter() - start:.1f} s; "
@@ -334,4 +486,14 @@ def suite_command(
     return 0 if n_ok == len(outcomes) else 1
 
 
-__all__ = ["DOFS", "METRICS", "Outcome", "find_manoeuvres", "run_suite", "suite_command", "write_suite_results"]
+__all__ = [
+    "DOFS",
+    "METRICS",
+    "Outcome",
+    "check_unique_names",
+    "find_manoeuvres",
+    "previous_results",
+    "run_suite",
+    "suite_command",
+    "write_suite_results",
+]
