@@ -48,8 +48,10 @@ def _acquire(out_dir: Path, path: Path) -> int:
 def output_lock(out_dir: str | Path) -> Iterator[Path]:
     """Hold the exclusive lock of folder ``out_dir`` (created and checked writable first); yield the folder.
 
-    Raises WashbenchError at once (no waiting) if another process holds it, naming that process.
+    Raises WashbenchError at once (no waiting) if another process holds it, naming that process. A folder
+    created here and still empty at the end (the command failed before writing) is removed again.
     """
+    existed = Path(out_dir).is_dir()
     out_dir = prepare_output_dir(out_dir)
     path = out_dir / LOCK_NAME
     fd = _acquire(out_dir, path)
@@ -61,3 +63,6 @@ def output_lock(out_dir: str | Path) -> Iterator[Path]:
         with contextlib.suppress(OSError):
             os.unlink(path)  # while still holding it: a waiting process then finds the inode changed
         os.close(fd)
+        if not existed:
+            with contextlib.suppress(OSError):
+                out_dir.rmdir()  # only if empty

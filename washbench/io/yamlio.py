@@ -19,8 +19,8 @@ import difflib
 import json
 import math
 import re
-from pathlib import Path
 from collections.abc import Mapping
+from pathlib import Path
 from typing import Any, Self, TypeVar
 
 import pydantic

@@ -62,6 +62,8 @@ def brake_speed(r: float, a_max: float, dt: float) -> float:
     for _ in range(2):
         if 0.5 * h * (j + 1) * (j + 2) <= r:
             j += 1
+    if j == 0:  # also where h overflowed (a huge time step): one step covers r
+        return r / dt
     s_j = 0.5 * h * j * (j + 1)
     return j * a_max * dt + (r - s_j) / (dt * (j + 1))
 

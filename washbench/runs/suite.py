@@ -53,7 +53,7 @@ from washbench.analysis.ranking import (
     wins,
 )
 from washbench.cueing.params import WASHOUT_NAMES
-from washbench.errors import WashbenchError, located
+from washbench.errors import Terminated, WashbenchError, located
 from washbench.io.atomic import write_text_atomic
 from washbench.io.lock import LOCK_NAME, output_lock
 from washbench.io.paths import MANOEUVRES_DIR
@@ -108,6 +108,29 @@ def _signals_held() -> Iterator[None]:
     finally:
         for sig, handler in saved.items():
             signal.signal(sig, handler)
+
+
+@contextlib.contextmanager
+def _signals_deferred() -> Iterator[None]:
+    """Hold SIGINT and SIGTERM back while worker processes are being started, then act on them.
+
+    A worker is started by sending it its start-up data through the process server; interrupted half-way,
+    the worker would start after this process exits and print a traceback. So a signal arriving meanwhile is
+    noted and raised (KeyboardInterrupt or Terminated) once the workers exist and can be stopped.
+    """
+    noted: list[int] = []
+
+    def note(signum: int, frame: object) -> None:
+        noted.append(signum)
+
+    saved = {sig: signal.signal(sig, note) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for sig, handler in saved.items():
+            signal.signal(sig, handler)
+    if noted:
+        raise KeyboardInterrupt if noted[0] == signal.SIGINT else Terminated()
 
 
 def _stop_pool(pool: ProcessPoolExecutor) -> None:
@@ -183,7 +206,8 @@ def run_suite(
         ctx.set_forkserver_preload(["washbench.runs.worker_signals", "washbench.runs.preload"])
         pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_init)
         try:
-            futures = [pool.submit(_run_one, *a) for a in args]
+            with _signals_deferred():  # submitting starts the workers (up to ``jobs``)
+                futures = [pool.submit(_run_one, *a) for a in args]
             for fut in as_completed(futures):
                 outcome = fut.result()
                 outcomes[outcome.path] = _report(outcome, len(outcomes) + 1, len(files), start, progress)
