@@ -33,7 +33,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from washbench.analysis.metrics import MetricRow, integral_abs_error
 from washbench.analysis.ranking import DOFS
@@ -90,6 +89,8 @@ def perceived_motion(perceived_f_mps2: np.ndarray, perceived_omega_radps: np.nda
 
 def aircraft_attitude(phi_deg: np.ndarray, theta_deg: np.ndarray, psi_deg: np.ndarray) -> np.ndarray:
     """Body->NED quaternions (N, 4), scalar first, from ZYX Euler angles in degrees."""
+    from scipy.spatial.transform import Rotation  # here: a failing command need not import scipy
+
     angles = np.column_stack([psi_deg, theta_deg, phi_deg])
     return Rotation.from_euler("ZYX", angles, degrees=True).as_quat(scalar_first=True)
 
@@ -140,13 +141,11 @@ def run_manoeuvre(
     still writes its results (what was flown), with ``ok`` False and the reason. The result folder
     replaces only a previous ``washbench run`` result of the same manoeuvre (recognised by its run.json).
     """
-    from washbench.cueing import WASHOUT_NAMES, CueingBank, WashoutTrace, load_washout_params
-    from washbench.flight.fly import fly, write_flight
+    from washbench.cueing.params import load_washout_params
     from washbench.flight.manoeuvre import load_manoeuvre
-    from washbench.io.results import read_motion
-    from washbench.platform import load_platform_limits
-    from washbench.runs.cue import analyse, write_results
+    from washbench.platform.limits import load_platform_limits
 
+    # every input and the result place first (light imports): a bad one fails in a fraction of a second
     manoeuvre = load_manoeuvre(manoeuvre_path)
     params = load_washout_params(params_path)
     limits = load_platform_limits(platform_path)
@@ -154,6 +153,11 @@ def run_manoeuvre(
     marker = _marker(manoeuvre.aircraft, manoeuvre.name)
     check_replaceable(final, RUN_MARKER, marker)  # before flying: a folder in the way fails now, not after
     clean_partials(final.parent)
+
+    from washbench.cueing import WASHOUT_NAMES, CueingBank, WashoutTrace
+    from washbench.flight.fly import fly, write_flight
+    from washbench.io.results import read_motion
+    from washbench.runs.cue import analyse, write_results
     washouts = tuple(WASHOUT_NAMES)
     bank = CueingBank(washouts, params, limits, manoeuvre.dt_s)
     rows: list[np.ndarray] = []
