@@ -68,7 +68,9 @@ SUFFIXES = {".csv": "csv", ".parquet": "parquet", ".pq": "parquet"}
 DT_RANGE_S = (1e-4, 1.0)
 #: Largest magnitude accepted in the motion columns: 1000 m/s^2 (about 100 g) and 3600 deg/s (10 turns a
 #: second); beyond, a recording is corrupt, not a flight.
-MOTION_MAX = {**dict.fromkeys(F_COLUMNS, 1000.0), **dict.fromkeys(OMEGA_COLUMNS, 3600.0)}
+F_MAX_MPS2 = 1000.0
+OMEGA_MAX_DEGPS = 3600.0
+MOTION_MAX = {**dict.fromkeys(F_COLUMNS, F_MAX_MPS2), **dict.fromkeys(OMEGA_COLUMNS, OMEGA_MAX_DEGPS)}
 
 
 # --------------------------------------------------------------------------- column names
