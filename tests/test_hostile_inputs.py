@@ -6,7 +6,9 @@ process of their own are checked in-process through the same loaders.
 
 from __future__ import annotations
 
+import errno
 import math
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -20,6 +22,7 @@ from washbench.cueing.kernel import O_ACC, O_POS
 from washbench.cueing.params import DEFAULT_PARAMS_PATH
 from washbench.errors import WashbenchError
 from washbench.flight.manoeuvre import Manoeuvre, load_manoeuvre
+from washbench.io.atomic import atomic_path
 from washbench.io.names import IDENTIFIER_MAX_LENGTH
 from washbench.io.paths import MANOEUVRES_DIR
 from washbench.io.results import read_motion
@@ -352,3 +355,27 @@ def test_python_api_cannot_build_an_invalid_object() -> None:
     assert Manoeuvre.model_validate(
         {**data, "start": {"air": {**data["start"]["air"], "heading_deg": 360.0}}}
     ).start.air.heading_deg == 360.0  # fmt: skip
+
+
+def test_a_file_system_failure_while_writing_is_one_line_and_leaves_nothing(tmp_path: Path) -> None:
+    """What a full disk does to any writer (os.write raising ENOSPC): one line naming the file, no temporary left."""
+    dest = tmp_path / "flight.parquet"
+    dest.write_bytes(b"the previous result")
+    with pytest.raises(WashbenchError) as info, atomic_path(dest) as tmp:
+        with tmp.open("wb") as fh:
+            fh.write(b"half")
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+    assert str(info.value) == f"{dest}: cannot write: No space left on device"
+    assert tree(tmp_path) == ["flight.parquet"] and dest.read_bytes() == b"the previous result"
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root writes into read-only folders")
+def test_a_read_only_output_folder_is_one_line_before_flying(tmp_path: Path) -> None:
+    out = tmp_path / "ro"
+    out.mkdir()
+    out.chmod(0o555)
+    try:
+        proc = washbench("run", short(tmp_path), "--out", out, timeout=60)
+        assert_clean_error(proc, f"{out}: cannot write into the output folder")
+    finally:
+        out.chmod(0o755)
