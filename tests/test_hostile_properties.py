@@ -113,7 +113,7 @@ def _write(path: Path, data: Any) -> None:
     path.write_text(yaml.safe_dump(data, allow_unicode=True, sort_keys=False))
 
 
-@settings(max_examples=60, deadline=2000, **SETTINGS)
+@settings(max_examples=40, deadline=2000, **SETTINGS)
 @given(data=st.data())
 def test_mutated_bundled_manoeuvres_load_or_fail_cleanly(tmp_path: Path, data: st.DataObject) -> None:
     source = data.draw(st.sampled_from(BUNDLED))
@@ -168,7 +168,7 @@ EXTREMES = st.one_of(
 STEPS = st.sampled_from([1e-21, 5e-324, 1e-4, 1 / 1000, 1 / 120, 1 / 120, 1 / 50, 0.5, 1.0, 1.5, 8e307])
 
 
-@settings(max_examples=25, deadline=10000, **SETTINGS)
+@settings(max_examples=20, deadline=10000, **SETTINGS)
 @given(n=st.integers(min_value=2, max_value=40), dt=STEPS, data=st.data())
 def test_extreme_cue_inputs_give_a_clean_error_or_output_within_every_limit(
     tmp_path: Path, n: int, dt: float, data: st.DataObject

@@ -80,7 +80,7 @@ def _check_dt(dt_s: float) -> float:
     dt = float(dt_s)
     lo, hi = DT_RANGE_S
     if not (math.isfinite(dt) and lo <= dt <= hi):
-        raise WashbenchError(f"time step must be {lo:g}..{hi:g} s, got {dt_s!r}")
+        raise WashbenchError(f"time step must be a positive number of seconds, {lo:g}..{hi:g} s, got {dt_s!r}")
     return dt
 
 

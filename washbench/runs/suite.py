@@ -192,7 +192,7 @@ def run_suite(
     start = time.perf_counter()
     if progress:
         print(
-            f"suite: {len(files)} manoeuvres on {jobs} process{'es' if jobs > 1 else ''} -> {out_dir}\n"
+            f"suite: {len(files)} manoeuvres on {jobs} process{'es' if jobs > 1 else ''} -> {_destination(out_dir)}\n"
             "suite: loading JSBSim, rerun and the washout kernel (compiled once after install: a few seconds)",
             file=sys.stderr,
         )
@@ -217,6 +217,11 @@ def run_suite(
             raise
         pool.shutdown(wait=True)
     return [outcomes[a[0]] for a in args]
+
+
+def _destination(out_dir: Path) -> Path:
+    """Where the results end up: the suite folder, not the hidden one they are built in."""
+    return out_dir.parent if is_leftover(out_dir.name) else out_dir
 
 
 def _report(outcome: Outcome, done: int, total: int, start: float, progress: bool) -> Outcome:
