@@ -158,6 +158,7 @@ def run_manoeuvre(
     from washbench.flight.fly import fly, write_flight
     from washbench.io.results import read_motion
     from washbench.runs.cue import analyse, write_results
+
     washouts = tuple(WASHOUT_NAMES)
     bank = CueingBank(washouts, params, limits, manoeuvre.dt_s)
     rows: list[np.ndarray] = []
@@ -170,15 +171,14 @@ def run_manoeuvre(
         np.degrees(omega_radps, out=omega_deg)
         rows.append(step(f_mps2, np.radians(omega_deg)).copy())
 
-    start = time.perf_counter()
-    flight = fly(manoeuvre, step_hook=lockstep, progress=progress)
-    n = len(flight.t_s)
-    if len(rows) != n:
-        raise RuntimeError(f"washouts ran {len(rows)} steps for {n} recorded samples")
-
-    partial = partial_dir(final)
+    partial = partial_dir(final)  # before flying: a file in the way of OUT/<aircraft>/ fails now
     published = False
     try:
+        start = time.perf_counter()
+        flight = fly(manoeuvre, step_hook=lockstep, progress=progress)
+        n = len(flight.t_s)
+        if len(rows) != n:
+            raise RuntimeError(f"washouts ran {len(rows)} steps for {n} recorded samples")
         write_flight(partial, flight, str(manoeuvre_path))
         if n < 2:
             raise WashbenchError(located(manoeuvre_path, f"the flight recorded {n} sample(s): nothing to cue"))
