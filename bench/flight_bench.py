@@ -17,14 +17,14 @@ from pathlib import Path
 
 from washbench.flight.fdm import make_fdm
 from washbench.flight.fly import fly
-from washbench.flight.manoeuvre import Manoeuvre, load_manoeuvre, pilot_profile_path
+from washbench.flight.manoeuvre import Manoeuvre, load_manoeuvre
 from washbench.flight.profile import load_profile
 from washbench.io.paths import MANOEUVRES_DIR
 
 
 def bare_steps_per_s(m: Manoeuvre, steps: int) -> float:
     """JSBSim alone: ``fdm.run()`` with constant controls from the manoeuvre's start."""
-    fdm, _ = make_fdm(m, load_profile(pilot_profile_path(m.aircraft)))
+    fdm, _ = make_fdm(m, load_profile(m.aircraft_files.profile))
     run = fdm.run
     t0 = time.perf_counter()
     for _ in range(steps):

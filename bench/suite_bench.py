@@ -24,11 +24,11 @@ from pathlib import Path
 def bare_run(path: str, steps: int) -> float:
     """Seconds of ``steps`` bare ``fdm.run()`` calls from the start of manoeuvre ``path``."""
     from washbench.flight.fdm import make_fdm
-    from washbench.flight.manoeuvre import load_manoeuvre, pilot_profile_path
+    from washbench.flight.manoeuvre import load_manoeuvre
     from washbench.flight.profile import load_profile
 
     m = load_manoeuvre(Path(path))
-    fdm, _ = make_fdm(m, load_profile(pilot_profile_path(m.aircraft)))
+    fdm, _ = make_fdm(m, load_profile(m.aircraft_files.profile))
     run = fdm.run
     start = time.perf_counter()
     for _ in range(steps):

@@ -56,7 +56,7 @@ def test_model_loads_with_pilot_inputs_structure_points_and_weights() -> None:
 
 
 def test_unknown_aircraft_is_one_clear_error() -> None:
-    with pytest.raises(WashbenchError, match="no such aircraft"):
+    with pytest.raises(WashbenchError, match=r"unknown aircraft .no_such_plane.: no no_such_plane/no_such_plane\.xml"):
         airdata.make_fdm("no_such_plane")
 
 

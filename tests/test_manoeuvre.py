@@ -44,9 +44,7 @@ EXPECTED = {
     "quoted_number.yaml": ":11: phases[1].hold.bank_deg: expected a number, got '30'",
     "runway_start_without_runway.yaml": ":4: start.runway: a runway start needs a top-level 'runway'",
     "start_below_stall.yaml": (":4: start.air.airspeed_kts: 30 kt is outside c172p's flight envelope (48..158 kt)"),
-    "unknown_aircraft.yaml": (
-        ":2: aircraft: unknown aircraft 'c999x' (neither in the project's aircraft/ folder nor bundled with JSBSim)"
-    ),
+    "unknown_aircraft.yaml": ":2: aircraft: unknown aircraft 'c999x': no c999x/c999x.xml in the searched folders (",
     "unknown_key.yaml": ":11: phases[1].hold.bank_dge: unknown key (did you mean 'bank_deg'?)",
     "unknown_signal.yaml": (
         ":15: checks[0].signal: unknown signal 'bank' (a signal is a flight.parquet column, see README.md)"
@@ -69,7 +67,10 @@ def test_bad_file_gives_its_one_line_error(name: str) -> None:
     path = BAD / name
     with pytest.raises(WashbenchError) as info:
         load_manoeuvre(path)
-    assert str(info.value) == f"{path}{EXPECTED[name]}"
+    if name == "unknown_aircraft.yaml":  # the searched folders depend on the machine: tests/test_paths.py
+        assert str(info.value).startswith(f"{path}{EXPECTED[name]}")
+    else:
+        assert str(info.value) == f"{path}{EXPECTED[name]}"
 
 
 def test_validate_cli_reports_every_bad_file_on_one_line_each_and_exits_2() -> None:
@@ -78,7 +79,9 @@ def test_validate_cli_reports_every_bad_file_on_one_line_each_and_exits_2() -> N
     assert out.returncode == 2
     assert "Traceback" not in out.stderr
     lines = out.stderr.strip().splitlines()
-    assert lines == [f"washbench: error: {BAD / n}{EXPECTED[n]}" for n in names]
+    assert len(lines) == len(names)
+    for line, n in zip(lines, names, strict=True):
+        assert line.startswith(f"washbench: error: {BAD / n}{EXPECTED[n]}")
     assert out.stdout == ""
 
 
@@ -95,7 +98,8 @@ def test_fly_cli_rejects_bad_file_without_writing_anything(name: str, tmp_path: 
     out_dir = tmp_path / "out"
     out = cli("fly", str(BAD / name), "--out", str(out_dir))
     assert out.returncode == 2
-    assert out.stderr.strip() == f"washbench: error: {BAD / name}{EXPECTED[name]}"
+    assert out.stderr.strip().startswith(f"washbench: error: {BAD / name}{EXPECTED[name]}")
+    assert len(out.stderr.strip().splitlines()) == 1
     assert not out_dir.exists()
 
 

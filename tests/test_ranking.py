@@ -42,9 +42,11 @@ def test_rank_by_weighted_relative_error() -> None:
     assert wins([ranking]) == {"unrestricted": 1, "large-angle": 0, "small-angle": 0}
 
 
-def test_ties_are_broken_deterministically() -> None:
+def test_ties_are_broken_by_the_order_the_washouts_were_listed() -> None:
     same = {"surge": 1.0}
     ranking = rank(rows_for("unrestricted", same) + rows_for("small-angle", same), {"surge": 1.0})
+    assert [r.washout for r in ranking] == ["unrestricted", "small-angle"]
+    ranking = rank(rows_for("small-angle", same) + rows_for("unrestricted", same), {"surge": 1.0})
     assert [r.washout for r in ranking] == ["small-angle", "unrestricted"]
 
 

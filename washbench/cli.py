@@ -13,8 +13,35 @@ import signal
 import sys
 from pathlib import Path
 
-from washbench.cueing.params import WASHOUT_NAMES
+from washbench.cueing.params import WASHOUT_KINDS
 from washbench.errors import Terminated, WashbenchError
+
+_VARIANT_HELP = "add a washout NAME of KIND with dotted-key overrides of the parameter file, repeatable"
+
+
+def _washout_options(p: argparse.ArgumentParser, variants: bool = True) -> None:
+    """--washout (built-in washouts) and --variant (named variants), shared by cue, run, suite (and omct)."""
+    p.add_argument(
+        "--washout",
+        action="append",
+        metavar="NAME",
+        help=f"built-in washout to run, repeatable: {', '.join(WASHOUT_KINDS)} (default: all three, or none with "
+        "a variant)",
+    )
+    if variants:
+        p.add_argument("--variant", action="append", default=[], metavar="NAME=KIND[,KEY=VALUE...]", help=_VARIANT_HELP)
+
+
+def _study_options(p: argparse.ArgumentParser) -> None:
+    """What sweep and tune share."""
+    p.add_argument("--params", type=Path, help="base washout parameter YAML (default: bundled CW1)")
+    p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
+    p.add_argument("--from", dest="from_dir", type=Path, metavar="RESULTS_DIR",
+                   help="read RESULTS_DIR/<aircraft>/<manoeuvre>/flight.parquet instead of flying")
+    p.add_argument("--jobs", type=_jobs, help="parallel processes for the flights (default: number of cores)")
+    p.add_argument("--dask", metavar="ADDRESS", help="send the work to this Dask scheduler (washbench[cluster])")
+    p.add_argument("--quiet", action="store_true", help="no progress display")
+    _aircraft_dir_option(p)
 
 
 class _Parser(argparse.ArgumentParser):
@@ -38,45 +65,76 @@ def _jobs(text: str) -> int:
 def build_parser() -> argparse.ArgumentParser:
     """The full command-line interface."""
     parser = _Parser(prog="washbench", description=__doc__.splitlines()[0] if __doc__ else None)
+    parser.add_argument("--version", action="version", version=_version_line())
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
     p = sub.add_parser("cue", help="run washouts, Atlas model, vestibular models and metrics on a recorded trace")
     p.add_argument("input", type=Path, help="CSV or Parquet: t_s, f_{x,y,z}_mps2, omega_{x,y,z}_degps (body axes)")
     p.add_argument("--out", type=Path, required=True, help="output folder (traces.parquet, metrics.csv)")
-    p.add_argument(
-        "--washout",
-        action="append",
-        metavar="NAME",
-        help=f"washout to run, repeatable: {', '.join(WASHOUT_NAMES)} (default: all three)",
-    )
+    _washout_options(p)
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
 
     p = sub.add_parser("fly", help="fly a manoeuvre file with JSBSim and the scripted pilot")
-    p.add_argument("manoeuvre", type=Path, help="manoeuvre YAML file")
+    p.add_argument("manoeuvre", type=Path, help="manoeuvre YAML file, or a bundled one by name (c172/takeoff)")
     p.add_argument("--out", type=Path, required=True, help="output folder (flight.parquet, flight.json)")
+    _aircraft_dir_option(p)
     p.add_argument("--quiet", action="store_true", help="no progress display")
 
     p = sub.add_parser("validate", help="check manoeuvre files without flying them")
     p.add_argument("manoeuvres", type=Path, nargs="+", help="manoeuvre YAML files")
+    _aircraft_dir_option(p)
 
     p = sub.add_parser("schema", help="print the manoeuvre file JSON Schema")
     p.add_argument("--out", type=Path, help="write to this file instead of standard output")
 
     p = sub.add_parser("run", help="fly a manoeuvre with the washouts in lockstep; write traces, metrics, recording")
-    p.add_argument("manoeuvre", type=Path, help="manoeuvre YAML file")
+    p.add_argument("manoeuvre", type=Path, help="manoeuvre YAML file, or a bundled one by name (c172/takeoff)")
     p.add_argument("--out", type=Path, required=True, help="results folder; writes OUT/<aircraft>/<manoeuvre>/")
+    _washout_options(p)
+    _aircraft_dir_option(p)
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
     p.add_argument("--quiet", action="store_true", help="no progress display")
 
     p = sub.add_parser("suite", help="run many manoeuvres in parallel and compare the washouts")
-    p.add_argument("inputs", type=Path, nargs="*", help="manoeuvre files or folders (default: bundled manoeuvres/)")
+    p.add_argument(
+        "inputs",
+        type=Path,
+        nargs="*",
+        help="manoeuvre files or folders, or bundled ones by name (c172, columbia400/takeoff); default: all bundled",
+    )
     p.add_argument("--out", type=Path, required=True, help="results folder")
+    _aircraft_dir_option(p)
     p.add_argument("--jobs", type=_jobs, help="parallel processes (default: number of cores)")
+    _washout_options(p)
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
+    p.add_argument("--dask", metavar="ADDRESS", help="run on this Dask scheduler instead of local processes")
     p.add_argument("--quiet", action="store_true", help="no progress display")
+
+    p = sub.add_parser("sweep", help="a grid of washout parameters on recorded flights: scores and metrics per point")
+    p.add_argument("manoeuvres", type=Path, nargs="+", help="manoeuvre files or folders")
+    p.add_argument("--washout", action="append", metavar="KIND", help="washout kind, repeatable (default: all three)")
+    p.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=V1,V2,...",
+                   help="a parameter-file key and its values, repeatable (the grid is every combination)")
+    p.add_argument("--out", type=Path, required=True, help="output folder (sweep.csv, sweep_metrics.csv, sweep.png)")
+    _study_options(p)
+
+    p = sub.add_parser("tune", help="tune washout parameters on training manoeuvres (differential evolution)")
+    p.add_argument("manoeuvres", type=Path, nargs="+", help="training manoeuvre files or folders")
+    p.add_argument("--washout", required=True, metavar="KIND", help=f"washout kind: {', '.join(WASHOUT_KINDS)}")
+    p.add_argument("--tune", dest="tunes", action="append", default=[], metavar="KEY=LOW:HIGH",
+                   help="a parameter-file key and its search interval, repeatable")
+    p.add_argument("--test", type=Path, nargs="+", default=[], metavar="MANOEUVRE", help="test manoeuvres")
+    p.add_argument("--budget", type=int, default=200, help="evaluations at most (default 200)")
+    p.add_argument("--seed", type=int, default=0, help="random seed (default 0): same seed, same result")
+    p.add_argument("--saturation-weight", type=float, default=1.0,
+                   help="penalty per unit fraction of time at a platform limit (default 1)")
+    p.add_argument("--out", type=Path, required=True, help="output folder (tuned.yaml, tune.csv, report.md)")
+    _study_options(p)
+    p = sub.add_parser("examples", help="copy the bundled manoeuvres and pilot profiles into a folder to edit")
+    p.add_argument("folder", type=Path, help="destination (created; existing files are never overwritten)")
 
     p = sub.add_parser("replay", help="open a recording in the rerun viewer")
     p.add_argument("recording", type=Path, help=".rrd file written by washbench run or suite")
@@ -84,20 +142,64 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _aircraft_dir_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--aircraft-dir",
+        type=Path,
+        action="append",
+        default=[],
+        metavar="DIR",
+        help="folder of aircraft (<DIR>/<name>/<name>.xml, <DIR>/<name>/pilot.yaml), searched first; repeatable",
+    )
+
+
+def _version_line() -> str:
+    """``washbench X (JSBSim Y, rerun-sdk Z, Python W)`` from the installed distributions (no heavy imports)."""
+    import platform
+    from importlib.metadata import PackageNotFoundError, version
+
+    from washbench import __version__
+
+    def dist(name: str) -> str:
+        try:
+            return version(name)
+        except PackageNotFoundError:
+            return "not installed"
+
+    return (
+        f"washbench {__version__} (JSBSim {dist('jsbsim')}, rerun-sdk {dist('rerun-sdk')}, "
+        f"numpy {dist('numpy')}, Python {platform.python_version()})"
+    )
+
+
 def _dispatch(args: argparse.Namespace) -> int:
+    if hasattr(args, "manoeuvre") or hasattr(args, "manoeuvres"):
+        from washbench.io.paths import resolve_manoeuvre  # a bundled name such as c172/takeoff
+
+        if hasattr(args, "manoeuvre"):
+            args.manoeuvre = resolve_manoeuvre(args.manoeuvre)
+        else:
+            args.manoeuvres = [resolve_manoeuvre(m) for m in args.manoeuvres]
     if args.command == "cue":
         from washbench.runs.cue import run_cue
 
-        run_cue(args.input, args.out, washouts=args.washout, params_path=args.params, platform_path=args.platform)
+        run_cue(
+            args.input,
+            args.out,
+            washouts=args.washout,
+            params_path=args.params,
+            platform_path=args.platform,
+            variants=args.variant,
+        )
         return 0
     if args.command == "fly":
         from washbench.flight.fly import fly_command
 
-        return fly_command(args.manoeuvre, args.out, progress=not args.quiet)
+        return fly_command(args.manoeuvre, args.out, progress=not args.quiet, aircraft_dirs=args.aircraft_dir)
     if args.command == "validate":
         from washbench.flight.manoeuvre import validate_command
 
-        return validate_command(args.manoeuvres)
+        return validate_command(args.manoeuvres, aircraft_dirs=args.aircraft_dir)
     if args.command == "schema":
         from washbench.flight.manoeuvre import schema_command
 
@@ -106,7 +208,14 @@ def _dispatch(args: argparse.Namespace) -> int:
         from washbench.runs.pipeline import run_command
 
         return run_command(
-            args.manoeuvre, args.out, params_path=args.params, platform_path=args.platform, progress=not args.quiet
+            args.manoeuvre,
+            args.out,
+            params_path=args.params,
+            platform_path=args.platform,
+            progress=not args.quiet,
+            washouts=args.washout,
+            variants=args.variant,
+            aircraft_dirs=args.aircraft_dir,
         )
     if args.command == "suite":
         from washbench.runs.suite import suite_command
@@ -118,12 +227,51 @@ def _dispatch(args: argparse.Namespace) -> int:
             params_path=args.params,
             platform_path=args.platform,
             progress=not args.quiet,
+            aircraft_dirs=args.aircraft_dir,
+            washouts=args.washout,
+            variants=args.variant,
+            dask=args.dask,
         )
+    if args.command in ("sweep", "tune"):
+        return _study(args)
+    if args.command == "examples":
+        from washbench.io.examples import copy_examples
+
+        return copy_examples(args.folder)
     if args.command == "replay":
         from washbench.review.replay import replay_command
 
         return replay_command(args.recording, web=args.web)
     raise AssertionError(f"unhandled command {args.command}")  # unreachable: argparse restricts choices
+
+
+def _study(args: argparse.Namespace) -> int:
+    common = dict(
+        params_path=args.params,
+        platform_path=args.platform,
+        from_dir=args.from_dir,
+        jobs=args.jobs,
+        dask=args.dask,
+        progress=not args.quiet,
+        aircraft_dirs=args.aircraft_dir,
+    )
+    if args.command == "sweep":
+        from washbench.runs.sweep import sweep_command
+
+        return sweep_command(args.manoeuvres, args.out, washouts=args.washout, sets=args.sets, **common)
+    from washbench.runs.tune import tune_command
+
+    return tune_command(
+        args.manoeuvres,
+        args.out,
+        washout=args.washout,
+        tunes=args.tunes,
+        test=args.test,
+        budget=args.budget,
+        seed=args.seed,
+        saturation_weight=args.saturation_weight,
+        **common,
+    )
 
 
 def _terminate(signum: int, frame: object) -> None:

@@ -9,13 +9,16 @@ simulator pilot's perceived signal ``y`` sampled on the same uniform grid:
     Eq. 21; written as ``inf`` in CSV, read back as ``float('inf')``).
   - a flat signal (standard deviation at most 1e-9 of its own peak magnitude, or exactly zero)
     leaves PC undefined: NPC is ``nan`` (an empty field in CSV), never a made-up number.
-* ``integral_error``: Eq. 22, ``integral |x - y| dt`` by the trapezoid rule on the uniform grid
-  (``numpy.trapezoid``), from the first to the last sample.
+* ``integral_error``: Eq. 22, ``integral |x - y| dt`` by the trapezoid rule on the uniform grid,
+  from the first to the last sample.
 * ``max_error``: ``max |x - y|``.
 
 Units in reports: surge, sway, heave come from perceived specific force x, y, z in m/s^2
 (integral in m/s^2*s); roll, pitch, yaw from perceived angular velocity x, y, z in deg/s
 (integral in deg). NPC has no unit.
+
+All three come from one compiled pass over the samples (:mod:`washbench.analysis.metric_sums`), the same code
+the studies' evaluation kernel runs per sample.
 """
 
 from __future__ import annotations
@@ -25,11 +28,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from washbench.analysis.metric_sums import FLAT_RTOL, signal_metrics
+
 NPC_K = 1.0
 """The K of Eq. 21 used in the paper."""
-
-FLAT_RTOL = 1e-9
-"""A signal whose standard deviation is at most this fraction of its peak |value| is flat."""
 
 ANTI_CORRELATED_TOL = 1e-12
 """PC within this of -1 counts as -1 (NPC reported as inf)."""
@@ -56,12 +58,7 @@ def is_flat(x: np.ndarray, rtol: float = FLAT_RTOL) -> bool:
 def pearson(x: np.ndarray, y: np.ndarray) -> float:
     """Pearson correlation PC (Eq. 20) in [-1, 1]; ``nan`` if either signal is flat (see :func:`is_flat`)."""
     x, y = _as_pair(x, y)
-    if is_flat(x) or is_flat(y):
-        return math.nan
-    dx = x - x.mean()
-    dy = y - y.mean()
-    pc = float(np.dot(dx, dy) / (math.sqrt(float(np.dot(dx, dx))) * math.sqrt(float(np.dot(dy, dy)))))
-    return min(1.0, max(-1.0, pc))
+    return float(signal_metrics(x, y, 1.0)[0])
 
 
 def npc_from_pc(pc: float, k: float = NPC_K) -> float:
@@ -81,13 +78,13 @@ def npc(x: np.ndarray, y: np.ndarray, k: float = NPC_K) -> float:
 def integral_abs_error(x: np.ndarray, y: np.ndarray, dt_s: float) -> float:
     """Eq. 22: ``integral |x - y| dt`` over the trace, trapezoid rule on a uniform grid of step ``dt_s`` [s]."""
     x, y = _as_pair(x, y)
-    return float(np.trapezoid(np.abs(x - y), dx=dt_s))
+    return float(signal_metrics(x, y, float(dt_s))[1])
 
 
 def max_abs_error(x: np.ndarray, y: np.ndarray) -> float:
     """``max |x - y|`` over the trace."""
     x, y = _as_pair(x, y)
-    return float(np.max(np.abs(x - y)))
+    return float(signal_metrics(x, y, 1.0)[2])
 
 
 @dataclass(frozen=True)
@@ -121,14 +118,14 @@ def dof_metrics(
         a = np.ascontiguousarray(np.asarray(a, dtype=np.float64).T) * scale  # (3, N): contiguous per axis
         s = np.ascontiguousarray(np.asarray(s, dtype=np.float64).T) * scale
         for axis in range(3):
-            x, y = a[axis], s[axis]
+            pc, integral, max_error = signal_metrics(*_as_pair(a[axis], s[axis]), float(dt_s))
             rows.append(
                 MetricRow(
                     washout=washout,
                     dof=next(dofs),
-                    npc=npc(x, y),
-                    integral_error=integral_abs_error(x, y, dt_s),
-                    max_error=max_abs_error(x, y),
+                    npc=npc_from_pc(float(pc)),
+                    integral_error=float(integral),
+                    max_error=float(max_error),
                 )
             )
     return rows

@@ -1,8 +1,9 @@
 """Comparing washouts across a suite: the Table-4 style comparison and a per-manoeuvre ranking.
 
 Comparison (like the paper's Table 4). For each manoeuvre, degree of freedom and metric, every
-washout's value and its difference from the small-angle washout, signed so that POSITIVE MEANS
-BETTER than small-angle. All three metrics are "lower is better" (NPC is 1.0 for a perfect
+washout's value and its difference from the reference washout (small-angle when it runs, otherwise the
+first washout listed: :func:`reference_washout`), signed so that POSITIVE MEANS BETTER than the
+reference. All three metrics are "lower is better" (NPC is 1.0 for a perfect
 correlation and grows as the correlation worsens), so the difference is ``small_angle - washout``.
 An undefined NPC (flat signal) gives an empty difference.
 
@@ -23,7 +24,8 @@ Ranking (the scoring rule). For one manoeuvre, washout W gets the score
   ``MOTION_FLOOR``) weighs nothing, so a tiny denominator cannot blow a score up. If a whole group is
   below the floor, the other group takes all the weight.
 
-Lower score is better; ranks are 1 (best) to 3, ties broken by name for determinism. The score is
+Lower score is better; ranks are 1 (best) to the number of washouts, ties broken by the order the washouts
+were listed in (the configuration's), for determinism. The score is
 objective (computed from the traces only) and is reported next to every rank.
 """
 
@@ -33,8 +35,9 @@ import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
-from washbench.analysis.metrics import DOFS, MetricRow
-from washbench.cueing.params import WASHOUT_NAMES
+import numpy as np
+
+from washbench.analysis.metrics import DOFS, MetricRow, integral_abs_error
 
 TRANSLATIONAL_DOFS = DOFS[:3]  # surge, sway, heave
 ROTATIONAL_DOFS = DOFS[3:]  # roll, pitch, yaw
@@ -67,10 +70,21 @@ class RankRow:
     weights: dict[str, float]
 
 
-def compare(rows: Sequence[MetricRow], reference: str = REFERENCE_WASHOUT) -> list[ComparisonRow]:
-    """Table-4 style comparison of every washout against ``reference`` (positive difference = better)."""
+def washout_order(rows: Iterable[MetricRow]) -> list[str]:
+    """The washouts of ``rows`` in the order they first appear (the order the configuration listed them)."""
+    return list(dict.fromkeys(r.washout for r in rows))
+
+
+def reference_washout(washouts: Sequence[str]) -> str:
+    """The washout the others are compared with: ``small-angle`` when it runs, otherwise the first listed."""
+    return REFERENCE_WASHOUT if REFERENCE_WASHOUT in washouts or not washouts else washouts[0]
+
+
+def compare(rows: Sequence[MetricRow], reference: str | None = None) -> list[ComparisonRow]:
+    """Table-4 style comparison of every washout against ``reference`` (default :func:`reference_washout`)."""
     by_key = {(r.washout, r.dof): r for r in rows}
-    washouts = sorted({r.washout for r in rows}, key=_washout_order)
+    washouts = washout_order(rows)
+    reference = reference_washout(washouts) if reference is None else reference
     out: list[ComparisonRow] = []
     for dof in DOFS:
         if not any((w, dof) in by_key for w in washouts):
@@ -96,25 +110,36 @@ def dof_weights(motion: Mapping[str, float]) -> dict[str, float]:
     return weights
 
 
+def perceived_motion(perceived_f_mps2: np.ndarray, perceived_omega_radps: np.ndarray, dt_s: float) -> dict[str, float]:
+    """How much the aircraft pilot felt per DOF (the M_d): integral of |perceived(t) - perceived(0)| dt.
+
+    Surge, sway, heave in m/s^2*s; roll, pitch, yaw in deg (the units of metrics.csv).
+    """
+    columns = np.column_stack([perceived_f_mps2, np.degrees(perceived_omega_radps)])
+    return {dof: integral_abs_error(x, np.full_like(x, x[0]), dt_s) for dof, x in zip(DOFS, columns.T, strict=True)}
+
+
+def score_of(integral_error: np.ndarray, weights: Mapping[str, float], motion: Mapping[str, float]) -> np.ndarray:
+    """The rule's score from integral errors (..., 6) in DOFS order: sum of w_d * E_d / M_d (shape (...))."""
+    e = np.asarray(integral_error, dtype=np.float64)
+    total = np.zeros(e.shape[:-1])
+    for j, d in enumerate(DOFS):
+        wd = weights[d]
+        if wd > 0.0:
+            total = total + wd * e[..., j] / motion[d]
+    return total
+
+
 def rank(rows: Sequence[MetricRow], motion: Mapping[str, float]) -> list[RankRow]:
     """Score and rank the washouts of one manoeuvre (module doc gives the rule)."""
     weights = dof_weights(motion)
-    washouts = sorted({r.washout for r in rows}, key=_washout_order)
+    washouts = washout_order(rows)
     by_key = {(r.washout, r.dof): r for r in rows}
-    scores: dict[str, float] = {}
-    for w in washouts:
-        total = 0.0
-        for d, wd in weights.items():
-            if wd > 0.0:
-                total += wd * by_key[(w, d)].integral_error / motion[d]
-        scores[w] = total
-    ordered = sorted(washouts, key=lambda w: (scores[w], _washout_order(w)))
+    scores = {w: float(score_of(np.array([by_key[(w, d)].integral_error for d in DOFS]), weights, motion))
+              for w in washouts}
+    order = {w: i for i, w in enumerate(washouts)}
+    ordered = sorted(washouts, key=lambda w: (scores[w], order[w]))
     return [RankRow(washout=w, score=scores[w], rank=i + 1, weights=weights) for i, w in enumerate(ordered)]
-
-
-def _washout_order(name: str) -> tuple[int, str]:
-    known = WASHOUT_NAMES
-    return (known.index(name) if name in known else len(known), name)
 
 
 def wins(rankings: Iterable[Sequence[RankRow]]) -> dict[str, int]:

@@ -4,14 +4,16 @@ Public API::
 
     from washbench.cueing import (WASHOUT_NAMES, check_washouts, WashoutParams, load_washout_params,
                                   CueingBank, WashoutTrace, cue_trace)
+    from washbench.cueing.variants import Washout, parse_variant, select_washouts   # named variants
 
 See ``docs/cueing.md`` for the block diagrams as implemented and every interpretation of the paper.
 Frames and units: aircraft and simulator body axes x forward, y right, z down; inertial NED with
 g_I = [0, 0, +g]; specific force f = a - g (m/s^2, [0, 0, -g] at rest); body angular velocity rad/s;
 quaternions scalar first, body->inertial; break frequencies rad/s.
 
-Modules: ``params`` (cw1.yaml model), ``filters`` (transfer functions, discretisation), ``rotations``
-(quaternion and Euler kinematics), ``kernel`` (the compiled step), ``bank`` (CueingBank, cue_trace).
+Modules: ``params`` (cw1.yaml model), ``variants`` (named washouts with their own parameters), ``filters``
+(transfer functions, discretisation), ``rotations`` (quaternion and Euler kinematics), ``kernel`` (the
+compiled step), ``bank`` (CueingBank, cue_trace).
 The bank names are loaded lazily so that :mod:`washbench.platform` can use ``rotations`` without an
 import cycle.
 """
@@ -20,12 +22,22 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from washbench.cueing.params import WASHOUT_NAMES, WashoutParams, check_washouts, load_washout_params
+from washbench.cueing.jitcache import configure_cache
+from washbench.cueing.params import (
+    WASHOUT_KINDS,
+    WASHOUT_NAMES,
+    WashoutParams,
+    check_washouts,
+    load_washout_params,
+)
+
+configure_cache()  # before any jitted module is imported (numba reads its cache folder at decoration)
 
 if TYPE_CHECKING:
     from washbench.cueing.bank import CueingBank, WashoutTrace, cue_trace
 
 __all__ = [
+    "WASHOUT_KINDS",
     "WASHOUT_NAMES",
     "CueingBank",
     "WashoutParams",

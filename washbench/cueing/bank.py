@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from washbench.cueing import filters
+from washbench.cueing.jitcache import announce_compile
 from washbench.cueing.kernel import (
     C_ALPHA,
     C_AMAX,
@@ -29,13 +30,16 @@ from washbench.cueing.kernel import (
     C_DT,
     C_FREEFALL,
     C_G,
+    C_HEAD_EULER,
     C_JAC,
     C_KIND,
+    C_LP_BEFORE,
     C_PMAX,
     C_R,
     C_ROT_SAT,
     C_SF,
     C_SW,
+    C_TILT_AXIS,
     C_TILT_K,
     C_TILT_RATE,
     C_VMAX,
@@ -68,7 +72,8 @@ from washbench.cueing.kernel import (
     bank_step,
     bank_trace,
 )
-from washbench.cueing.params import WashoutParams, check_washouts
+from washbench.cueing.params import WashoutParams
+from washbench.cueing.variants import Washout, as_washouts
 from washbench.errors import WashbenchError
 from washbench.io.results import DT_RANGE_S
 from washbench.platform.limits import PlatformLimits, wheel_jacobian
@@ -84,54 +89,70 @@ def _check_dt(dt_s: float) -> float:
     return dt
 
 
-def _build_arrays(
-    names: tuple[str, ...], params: WashoutParams, limits: PlatformLimits, dt: float
-) -> tuple[np.ndarray, np.ndarray]:
-    """The compiled bank's configuration (n, NCFG) and discretised filters (n, NFILT, 9), all SI.
+def _off(limit: float | None) -> float:
+    """A limit in deg/s as rad/s; ``None`` (off) as infinity."""
+    return math.inf if limit is None else math.radians(limit)
 
-    ``names`` (:func:`check_washouts`) and ``dt`` (s, :func:`_check_dt`) are already checked. Only the kind,
-    the tilt low-pass and the rotational high-pass differ between washouts.
+
+def washout_arrays(washout: Washout, limits: PlatformLimits, dt: float) -> tuple[np.ndarray, np.ndarray]:
+    """One washout's row of the compiled configuration (NCFG,) and its discretised filters (NFILT, 9), all SI.
+
+    ``dt`` (s) is already checked (:func:`_check_dt`).
     """
+    params, kind = washout.params, _KINDS[washout.kind]
     lim = limits.translation
-    common = np.zeros(NCFG)
-    common[C_DT] = dt
-    common[C_G] = params.gravity_mps2
-    common[C_SF] = params.scale.specific_force
-    common[C_SW] = params.scale.angular_velocity
-    common[C_TILT_K] = params.tilt.gain_per_s
-    common[C_TILT_RATE] = math.radians(params.tilt.rate_limit_degps)
-    common[C_ROT_SAT] = math.radians(params.rotational.saturation_degps)
-    common[C_COSMIN] = params.small_angle.min_cos_pitch
-    common[C_FREEFALL] = params.free_fall_threshold_mps2
-    common[C_R : C_R + 3] = params.head.offset_m
-    common[C_PMAX : C_PMAX + 3] = lim.position_limit_m.xyz
-    common[C_VMAX : C_VMAX + 3] = lim.velocity_limit_mps.xyz
-    common[C_AMAX : C_AMAX + 3] = lim.acceleration_limit_mps2.xyz
-    common[C_WMAX] = math.radians(limits.rotation.rate_limit_degps)
-    common[C_ALPHA] = math.radians(limits.rotation.acceleration_limit_degps2)
-    common[C_CATCH] = limits.rotation.catch_up_fraction
-    common[C_JAC : C_JAC + 9] = wheel_jacobian(limits).ravel()
-    cfg = np.tile(common, (len(names), 1))
+    cfg = np.zeros(NCFG)
+    cfg[C_KIND] = kind
+    cfg[C_DT] = dt
+    cfg[C_G] = params.gravity_mps2
+    cfg[C_SF] = params.scale.specific_force
+    cfg[C_SW] = params.scale.angular_velocity
+    cfg[C_TILT_K] = params.tilt.gain_per_s
+    cfg[C_TILT_RATE] = _off(params.tilt.rate_limit_degps)
+    cfg[C_TILT_AXIS] = 1.0 if params.tilt.rate_limit_mode == "axis" else 0.0
+    cfg[C_ROT_SAT] = _off(params.rotational.saturation_degps)
+    cfg[C_COSMIN] = params.small_angle.min_cos_pitch
+    cfg[C_FREEFALL] = params.free_fall_threshold_mps2
+    cfg[C_R : C_R + 3] = params.head.offset_m
+    cfg[C_PMAX : C_PMAX + 3] = lim.position_limit_m.xyz
+    cfg[C_VMAX : C_VMAX + 3] = lim.velocity_limit_mps.xyz
+    cfg[C_AMAX : C_AMAX + 3] = lim.acceleration_limit_mps2.xyz
+    cfg[C_WMAX] = math.radians(limits.rotation.rate_limit_degps)
+    cfg[C_ALPHA] = math.radians(limits.rotation.acceleration_limit_degps2)
+    cfg[C_CATCH] = limits.rotation.catch_up_fraction
+    cfg[C_JAC : C_JAC + 9] = wheel_jacobian(limits).ravel()
+    # the paper's choices ("auto"): small-angle filters the tilt rate after the cross product and estimates the
+    # head rate from Euler angles (Eq. 8); the quaternion washouts filter f before it and difference quaternions
+    position = params.tilt.lowpass_position
+    before = position == "before_cross_product" or (position == "auto" and kind != KIND_SMALL)
+    cfg[C_LP_BEFORE] = 1.0 if before else 0.0
+    method = params.head.rate_method
+    cfg[C_HEAD_EULER] = 1.0 if method == "euler_estimator" or (method == "auto" and kind == KIND_SMALL) else 0.0
 
-    coef = np.zeros((len(names), NFILT, filters.NCOEF))
+    coef = np.zeros((NFILT, filters.NCOEF))
     for j, wn in enumerate(params.translational_highpass_wn_radps.xyz):
-        coef[:, F_TRANS_HP + j] = filters.discretise(filters.translational_highpass(wn), dt)
+        coef[F_TRANS_HP + j] = filters.discretise(filters.translational_highpass(wn), dt)
     derivative = filters.discretise(filters.derivative_estimator(params.head.derivative_wn_radps), dt)
-    coef[:, F_EULER_D : F_EULER_D + 3] = derivative
-    coef[:, F_OMEGA_D : F_OMEGA_D + 3] = derivative
+    coef[F_EULER_D : F_EULER_D + 3] = derivative
+    coef[F_OMEGA_D : F_OMEGA_D + 3] = derivative
     lp = params.tilt.lowpass_wn_radps
     rot = params.rotational.highpass_wn_radps
-    for i, name in enumerate(names):
-        kind = _KINDS[name]
-        cfg[i, C_KIND] = kind
-        # small-angle: the tilt low-pass filters the roll, pitch, yaw tilt rates; roll is made by f_y
-        # (sway wn), pitch by f_x (surge wn), yaw by the z wn. Large-angle: it filters f_x, f_y, f_z.
-        tilt_wn = (lp.y, lp.x, lp.z) if kind == KIND_SMALL else (lp.x, lp.y, lp.z)
-        rot_wn = (0.0, 0.0, 0.0) if kind == KIND_UNRESTRICTED else (rot.roll, rot.pitch, rot.yaw)
-        for j in range(3):
-            coef[i, F_TILT_LP + j] = filters.discretise(filters.tilt_lowpass(tilt_wn[j]), dt)
-            coef[i, F_ROT_HP + j] = filters.discretise(filters.rotational_highpass(rot_wn[j]), dt)
+    # on f (before the cross product) the low-pass filters f_x, f_y, f_z with the surge, sway, heave wn; on the
+    # tilt rate (after it) the roll rate is made by f_y (sway wn), the pitch rate by f_x (surge wn), yaw: heave wn
+    tilt_wn = (lp.x, lp.y, lp.z) if before else (lp.y, lp.x, lp.z)
+    rot_wn = (0.0, 0.0, 0.0) if kind == KIND_UNRESTRICTED else (rot.roll, rot.pitch, rot.yaw)
+    for j in range(3):
+        coef[F_TILT_LP + j] = filters.discretise(filters.tilt_lowpass(tilt_wn[j]), dt)
+        coef[F_ROT_HP + j] = filters.discretise(filters.rotational_highpass(rot_wn[j]), dt)
     return cfg, coef
+
+
+def build_arrays(
+    washouts: Sequence[Washout], limits: PlatformLimits, dt: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """The compiled bank's configuration (n, NCFG) and filters (n, NFILT, 9) for checked washouts and dt."""
+    rows = [washout_arrays(w, limits, dt) for w in washouts]
+    return np.stack([r[0] for r in rows]), np.stack([r[1] for r in rows])
 
 
 @dataclass(frozen=True)
@@ -169,6 +190,23 @@ class WashoutTrace:
             return np.ascontiguousarray(rows[:, start : start + n])
 
         saturated = {k: rows[:, O_SAT + j] != 0.0 for j, k in enumerate(SAT_KINDS)}
+        return cls._build(cols, saturated)
+
+    @classmethod
+    def from_fields(cls, block: np.ndarray) -> WashoutTrace:
+        """Build from a field-major block (N_FIELDS, N) of one washout (no copy: the arrays are views, (N, k)
+        in column-major order, each column contiguous)."""
+        if block.ndim != 2 or block.shape[0] != NFIELDS:
+            raise ValueError(f"block must have shape ({NFIELDS}, N), got {block.shape}")
+
+        def cols(start: int, n: int) -> np.ndarray:
+            return block[start : start + n].T
+
+        saturated = {k: block[O_SAT + j] != 0.0 for j, k in enumerate(SAT_KINDS)}
+        return cls._build(cols, saturated)
+
+    @classmethod
+    def _build(cls, cols, saturated: dict[str, np.ndarray]) -> WashoutTrace:
         return cls(
             pos_m=cols(O_POS, 3),
             vel_mps=cols(O_VEL, 3),
@@ -193,6 +231,7 @@ def _warm_up() -> None:
     """
     if bank_step.signatures:
         return
+    announce_compile(bank_step)
     cfg = np.zeros((0, NCFG))
     bank_step(
         np.zeros(3),
@@ -218,10 +257,17 @@ class CueingBank:
     FIELDS: tuple[str, ...] = FIELDS
     SAT_KINDS: tuple[str, ...] = SAT_KINDS
 
-    def __init__(self, washouts: Sequence[str], params: WashoutParams, limits: PlatformLimits, dt_s: float) -> None:
-        self.washouts = check_washouts(washouts)
+    def __init__(
+        self,
+        washouts: Sequence[str | Washout],
+        params: WashoutParams | None,
+        limits: PlatformLimits,
+        dt_s: float,
+    ) -> None:
+        self.specs = as_washouts(washouts, params)
+        self.washouts = tuple(w.name for w in self.specs)
         self.dt_s = _check_dt(dt_s)
-        self._cfg, self._coef = _build_arrays(self.washouts, params, limits, self.dt_s)
+        self._cfg, self._coef = build_arrays(self.specs, limits, self.dt_s)
         n = len(self.washouts)
         self._state = np.zeros((n, NSTATE))
         self._counts = np.zeros((n, len(SAT_KINDS)), dtype=np.int64)
@@ -249,18 +295,20 @@ def cue_trace(
     f_mps2: np.ndarray,
     omega_radps: np.ndarray,
     dt_s: float,
-    washouts: Sequence[str],
-    params: WashoutParams,
+    washouts: Sequence[str | Washout],
+    params: WashoutParams | None,
     limits: PlatformLimits,
 ) -> dict[str, WashoutTrace]:
     """Whole-trace form: run the washouts over arrays f (N, 3) m/s^2 and omega (N, 3) rad/s sampled every dt_s.
 
-    Uses the same compiled step as :class:`CueingBank` and gives identical results. Raises WashbenchError
-    for wrong shapes or non-finite samples (naming the first bad sample) and for a step outside
-    ``washbench.io.results.DT_RANGE_S``. Magnitudes are not limited here (the platform stays within its
-    limits whatever the input); ``read_motion`` refuses physically absurd recordings at the file edge.
+    ``washouts``: built-in names (with ``params``) or :class:`Washout` variants. Uses the same compiled step as
+    :class:`CueingBank` and gives identical results. Raises WashbenchError for wrong shapes or non-finite samples
+    (naming the first bad sample) and for a step outside ``washbench.io.results.DT_RANGE_S``. Magnitudes are not
+    limited here (the platform stays within its limits whatever the input); ``read_motion`` refuses physically
+    absurd recordings at the file edge.
     """
-    names = check_washouts(washouts)
+    specs = as_washouts(washouts, params)
+    names = [w.name for w in specs]
     dt = _check_dt(dt_s)
     f = np.ascontiguousarray(f_mps2, dtype=np.float64)
     w = np.ascontiguousarray(omega_radps, dtype=np.float64)
@@ -269,9 +317,10 @@ def cue_trace(
     bad = ~(np.isfinite(f).all(axis=1) & np.isfinite(w).all(axis=1))
     if bad.any():
         raise WashbenchError(f"non-finite specific force or angular velocity at sample {int(np.argmax(bad))}")
-    cfg, coef = _build_arrays(names, params, limits, dt)
+    cfg, coef = build_arrays(specs, limits, dt)
     state = np.zeros((len(names), NSTATE))
     counts = np.zeros((len(names), len(SAT_KINDS)), dtype=np.int64)
-    out = np.zeros((len(names), f.shape[0], NFIELDS))
+    out = np.empty((len(names), NFIELDS, f.shape[0]))
+    announce_compile(bank_trace)
     bank_trace(f, w, cfg, coef, state, counts, out)
-    return {name: WashoutTrace.from_rows(out[i]) for i, name in enumerate(names)}
+    return {name: WashoutTrace.from_fields(out[i]) for i, name in enumerate(names)}

@@ -17,6 +17,8 @@ Filters of the paper (all break frequencies wn in rad/s):
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from numba import njit
 from scipy import signal
@@ -49,8 +51,16 @@ def derivative_estimator(w2: float) -> TransferFunction:
 
 
 def discretise(tf: TransferFunction, dt_s: float) -> np.ndarray:
-    """Bilinear discretisation of a continuous transfer function into the packed (9,) float64 form."""
+    """Bilinear discretisation of a continuous transfer function into the packed (9,) float64 form.
+
+    Cached per (transfer function, dt): a study builds thousands of parameter sets that share most filters.
+    """
     num, den = tf
+    return _discretise(tuple(map(float, num)), tuple(map(float, den)), float(dt_s)).copy()
+
+
+@functools.lru_cache(maxsize=4096)
+def _discretise(num: tuple[float, ...], den: tuple[float, ...], dt_s: float) -> np.ndarray:
     coef = np.zeros(NCOEF)
     if len(den) == 1:  # static gain
         coef[8] = num[-1] / den[0]

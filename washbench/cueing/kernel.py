@@ -21,7 +21,8 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from numba import njit
+import numpy as np
+from numba import njit, prange
 
 from washbench.cueing.filters import filt_init, filt_step
 from washbench.cueing.jitcache import drop_stale_cache
@@ -70,7 +71,10 @@ C_R = 10  # head offset R_SS (3)
 C_PMAX, C_VMAX, C_AMAX = 13, 16, 19  # per axis (3 each)
 C_WMAX, C_ALPHA, C_CATCH = 22, 23, 24
 C_JAC = 25  # wheel Jacobian, row-major (9)
-NCFG = 34
+C_TILT_AXIS = 34  # 1: the tilt-rate limit clips each axis; 0: it limits the norm (direction kept)
+C_LP_BEFORE = 35  # 1: tilt low-pass on f before the cross product; 0: on the tilt rate after it
+C_HEAD_EULER = 36  # 1: head rate by the Eq. 8 estimator on Euler angles; 0: quaternion difference (Eqs. 18-19)
+NCFG = 37
 
 # filter indices (each 3 consecutive axes)
 F_TRANS_HP, F_TILT_LP, F_ROT_HP, F_EULER_D, F_OMEGA_D = 0, 3, 6, 9, 12
@@ -97,6 +101,18 @@ def _tilt_rate(g_s, f, gain, eps):
     c = cross(g_s, f)
     k = gain / (nf * ng)
     return (c[0] * k, c[1] * k, c[2] * k)
+
+
+@njit(cache=True, inline="always")
+def _limit_tilt(v, vmax, per_axis):
+    """The tilt-rate limit: on the norm (direction kept) or on each axis; returns (v, 1 if it limited)."""
+    if per_axis == 0.0:
+        return limit_norm(v, vmax)
+    out0 = min(vmax, max(-vmax, v[0]))
+    out1 = min(vmax, max(-vmax, v[1]))
+    out2 = min(vmax, max(-vmax, v[2]))
+    hit = 1 if (out0 != v[0] or out1 != v[1] or out2 != v[2]) else 0
+    return (out0, out1, out2), hit
 
 
 @njit(cache=True)
@@ -153,12 +169,12 @@ def _init_washout(kind, c, coef, state, fs, ws):
     if kind == KIND_SMALL:
         a_i = rot_euler(phi0, theta0, 0.0, fs)
         g_s = rot_euler_inv(phi0, theta0, 0.0, g_i)
-        tilt_in = _tilt_rate(g_s, fs, c[C_TILT_K], c[C_FREEFALL])
         rot_in = euler_rates(phi0, theta0, ws, c[C_COSMIN])
     else:
         a_i = qrot(q0, fs)
-        tilt_in = fs
+        g_s = qrot_inv(q0, g_i)
         rot_in = ws
+    tilt_in = fs if c[C_LP_BEFORE] != 0.0 else _tilt_rate(g_s, fs, c[C_TILT_K], c[C_FREEFALL])
     _init3(coef, state, F_TRANS_HP, (a_i[0], a_i[1], a_i[2] + g))
     _init3(coef, state, F_TILT_LP, tilt_in)
     _init3(coef, state, F_ROT_HP, rot_in)
@@ -186,9 +202,11 @@ def step_one(f, om, c, coef, state, counts, row):
         psi = state[S_BT + 2] + state[S_BR + 2]
         a_i = rot_euler(phi, theta, psi, fs)
         g_s = rot_euler_inv(phi, theta, psi, g_i)
-        wt = _tilt_rate(g_s, fs, c[C_TILT_K], c[C_FREEFALL])
-        wt = _filt3(coef, state, F_TILT_LP, wt)
-        bdot_t, sat_tilt = limit_norm(euler_rates(phi, theta, wt, c[C_COSMIN]), c[C_TILT_RATE])
+        if c[C_LP_BEFORE] != 0.0:
+            wt = _tilt_rate(g_s, _filt3(coef, state, F_TILT_LP, fs), c[C_TILT_K], c[C_FREEFALL])
+        else:
+            wt = _filt3(coef, state, F_TILT_LP, _tilt_rate(g_s, fs, c[C_TILT_K], c[C_FREEFALL]))
+        bdot_t, sat_tilt = _limit_tilt(euler_rates(phi, theta, wt, c[C_COSMIN]), c[C_TILT_RATE], c[C_TILT_AXIS])
         bdot_r = _filt3(coef, state, F_ROT_HP, euler_rates(phi, theta, ws, c[C_COSMIN]))
         for j in range(3):
             state[S_BT + j] += bdot_t[j] * dt
@@ -199,8 +217,11 @@ def step_one(f, om, c, coef, state, counts, row):
     else:
         a_i = qrot(q_sp_prev, fs)
         g_s = qrot_inv(q_sp_prev, g_i)
-        f_lp = _filt3(coef, state, F_TILT_LP, fs)
-        wt, sat_tilt = limit_norm(_tilt_rate(g_s, f_lp, c[C_TILT_K], c[C_FREEFALL]), c[C_TILT_RATE])
+        if c[C_LP_BEFORE] != 0.0:
+            wt = _tilt_rate(g_s, _filt3(coef, state, F_TILT_LP, fs), c[C_TILT_K], c[C_FREEFALL])
+        else:
+            wt = _filt3(coef, state, F_TILT_LP, _tilt_rate(g_s, fs, c[C_TILT_K], c[C_FREEFALL]))
+        wt, sat_tilt = _limit_tilt(wt, c[C_TILT_RATE], c[C_TILT_AXIS])
         wr = _filt3(coef, state, F_ROT_HP, ws)
         q_sp = qintegrate(q_sp_prev, (wt[0] + wr[0], wt[1] + wr[1], wt[2] + wr[2]), dt)
     for j in range(4):
@@ -254,7 +275,7 @@ def step_one(f, om, c, coef, state, counts, row):
         state[S_W + j] = w[j]
 
     # ---- simulator pilot-head motion from what the platform actually does
-    if kind == KIND_SMALL:
+    if c[C_HEAD_EULER] != 0.0:
         e = euler_from_quat(q)
         if first:
             ephi, etheta, epsi = e
@@ -321,15 +342,20 @@ def bank_step(f, om, cfg, coef, state, counts, out):
         step_one(f, om, cfg[i], coef[i], state[i], counts[i], out[i])
 
 
-@njit(cache=True)
+@njit(cache=True, parallel=True)
 def bank_trace(f, om, cfg, coef, state, counts, out):
-    """Whole-trace form: f, om (N, 3), already checked finite; out (n_washouts, N, NFIELDS).
+    """Whole-trace form: f, om (N, 3), already checked finite; out (n_washouts, NFIELDS, N), field-major so that
+    every output column is contiguous (no copy to split it into traces).
 
-    Same per-washout step as bank_step.
+    Same per-washout step as bank_step; the washouts are independent, so they run in parallel threads (one
+    washout's samples in order on one thread: the same operations in the same order as streaming).
     """
-    for k in range(f.shape[0]):
-        for i in range(cfg.shape[0]):
-            step_one(f[k], om[k], cfg[i], coef[i], state[i], counts[i], out[i, k])
+    for i in prange(cfg.shape[0]):
+        row = np.zeros(NFIELDS)
+        for k in range(f.shape[0]):
+            step_one(f[k], om[k], cfg[i], coef[i], state[i], counts[i], row)
+            for j in range(NFIELDS):
+                out[i, j, k] = row[j]
 
 
 _HERE = Path(__file__).resolve().parent
@@ -338,4 +364,8 @@ drop_stale_cache(
     [_HERE / "rotations.py", _HERE / "filters.py", _HERE / "jitcache.py", _HERE.parent / "platform" / "kinematics.py"],
 )
 
-__all__ = ["FIELDS", "NCFG", "NFIELDS", "NFILT", "NSTATE", "SAT_KINDS", "bank_step", "bank_trace", "step_one"]
+__all__ = [
+    "C_HEAD_EULER",
+    "C_LP_BEFORE",
+    "C_TILT_AXIS",
+    "FIELDS", "NCFG", "NFIELDS", "NFILT", "NSTATE", "SAT_KINDS", "bank_step", "bank_trace", "step_one"]

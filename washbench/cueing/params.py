@@ -7,28 +7,35 @@ non-positive values are rejected with one line naming file, line and field.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any, Literal
 
-from pydantic import Field
+from pydantic import BeforeValidator, Field
 
 from washbench.errors import WashbenchError
 from washbench.io.paths import DATA_DIR
-from washbench.io.yamlio import StrictModel, load_yaml_model
+from washbench.io.yamlio import StrictModel, validate_data
 
-WASHOUT_NAMES: tuple[str, ...] = ("small-angle", "large-angle", "unrestricted")
+WASHOUT_KINDS: tuple[str, ...] = ("small-angle", "large-angle", "unrestricted")
+"""The three washout algorithms (kinds). A run's washouts are a list of (name, kind, parameters): the
+built-in washouts are named after their kind, variants (:mod:`washbench.cueing.variants`) have their own names."""
+
+WASHOUT_NAMES = WASHOUT_KINDS
+"""The built-in washouts run by default (one per kind, named after it)."""
+
 DEFAULT_PARAMS_PATH = DATA_DIR / "cw1.yaml"
 
 
 def check_washouts(washouts: Sequence[str]) -> tuple[str, ...]:
-    """The names as a tuple; WashbenchError if none, one is unknown or one is listed twice."""
+    """Built-in washout names as a tuple; WashbenchError if none, one is unknown or one is listed twice."""
     names = tuple(washouts)
     if not names:
         raise WashbenchError("no washout selected")
     for name in names:
-        if name not in WASHOUT_NAMES:
-            raise WashbenchError(f"unknown washout {name!r} (valid: {', '.join(WASHOUT_NAMES)})")
+        if name not in WASHOUT_KINDS:
+            raise WashbenchError(f"unknown washout {name!r} (valid: {', '.join(WASHOUT_KINDS)})")
     if len(set(names)) != len(names):
         raise WashbenchError(f"washout listed twice: {', '.join(names)}")
     return names
@@ -41,7 +48,22 @@ NonNegative = Annotated[float, Field(ge=0.0, le=1e3, allow_inf_nan=False)]
 Finite = Annotated[float, Field(ge=-10.0, le=10.0, allow_inf_nan=False)]  # head offset, m
 ScaleFactor = Annotated[float, Field(gt=0.0, le=10.0, allow_inf_nan=False)]
 Gravity = Annotated[float, Field(ge=1.0, le=100.0, allow_inf_nan=False)]
-RateLimit = Annotated[float, Field(gt=0.0, le=3600.0, allow_inf_nan=False)]  # deg/s
+RATE_LIMIT_MAX_DEGPS = 3600.0
+
+
+def _positive_or_off(value: Any) -> float | None:
+    """A positive finite number, or ``off`` (YAML reads a bare ``off`` as false): None means no limit."""
+    if value is False or value is None or value == "off":
+        return None
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value) or value <= 0.0:
+        raise ValueError(f"expected a positive number or off, got {value!r}")
+    if value > RATE_LIMIT_MAX_DEGPS:
+        raise ValueError(f"expected at most {RATE_LIMIT_MAX_DEGPS:g} deg/s or off, got {value!r}")
+    return float(value)
+
+
+PositiveOrOff = Annotated[float | None, BeforeValidator(_positive_or_off)]
+"""A rate limit (deg/s, at most RATE_LIMIT_MAX_DEGPS) that can be switched off: ``off`` in YAML (None here)."""
 
 
 class TranslationalAxes(StrictModel):
@@ -77,14 +99,16 @@ class Tilt(StrictModel):
 
     lowpass_wn_radps: TranslationalAxes
     gain_per_s: Positive
-    rate_limit_degps: RateLimit
+    rate_limit_degps: PositiveOrOff
+    rate_limit_mode: Literal["norm", "axis"] = "norm"
+    lowpass_position: Literal["auto", "before_cross_product", "after_cross_product"] = "auto"
 
 
 class Rotational(StrictModel):
     """Rotational channel."""
 
     highpass_wn_radps: RotationalAxes
-    saturation_degps: RateLimit
+    saturation_degps: PositiveOrOff
 
 
 class Head(StrictModel):
@@ -92,6 +116,7 @@ class Head(StrictModel):
 
     derivative_wn_radps: Annotated[float, Field(gt=0.0, le=1e4, allow_inf_nan=False)]
     offset_m: tuple[Finite, Finite, Finite]
+    rate_method: Literal["auto", "euler_estimator", "quaternion_difference"] = "auto"
 
 
 class SmallAngle(StrictModel):
@@ -117,6 +142,14 @@ class WashoutParams(StrictModel):
 def load_washout_params(path: Path | None = None) -> WashoutParams:
     """Load a washout parameter YAML file (``None``: the bundled CW1 set, ``washbench/data/cw1.yaml``).
 
+    A ``variants:`` section is checked and left out (:func:`washbench.cueing.variants.load_param_file` reads it).
     Raises :class:`washbench.errors.WashbenchError` with ``file:line: field: problem`` on bad input.
     """
-    return load_yaml_model(DEFAULT_PARAMS_PATH if path is None else Path(path), WashoutParams)
+    from washbench.cueing.variants import load_param_file
+
+    return load_param_file(path)[0]
+
+
+def load_base_params(path: Path, data: Any, lines: dict[Any, int]) -> WashoutParams:
+    """Validate parsed YAML ``data`` (without its ``variants:`` section) into a WashoutParams."""
+    return validate_data(path, data, lines, WashoutParams)

@@ -33,8 +33,7 @@ import numpy as np
 from scipy.optimize import curve_fit
 
 from washbench.errors import WashbenchError
-from washbench.flight.manoeuvre import aircraft_path, jsbsim_root
-from washbench.io.paths import AIRCRAFT_DIR
+from washbench.io.paths import find_aircraft
 from washbench.io.yamlio import StrictModel, load_yaml_model
 
 DT_S = 1.0 / 120.0
@@ -50,10 +49,7 @@ class Loading:
 
 def aircraft_root(name: str) -> Path:
     """Folder holding ``name/name.xml``: washbench's ``aircraft/`` first, then the jsbsim package's."""
-    root = aircraft_path(name)
-    if root is None:
-        raise WashbenchError(f"{name}: no such aircraft in {AIRCRAFT_DIR} or {jsbsim_root() / 'aircraft'}")
-    return root
+    return find_aircraft(name)
 
 
 def make_fdm(name: str, loading: Loading | None = None) -> jsbsim.FGFDMExec:

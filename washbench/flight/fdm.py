@@ -17,9 +17,10 @@ from typing import Any
 
 from washbench.errors import WashbenchError
 from washbench.flight.geo import DEFAULT_LATITUDE_DEG, DEFAULT_LONGITUDE_DEG, LocalFrame
-from washbench.flight.manoeuvre import Hold, Manoeuvre, aircraft_path, jsbsim_root, pilot_profile_path
+from washbench.flight.manoeuvre import Hold, Manoeuvre
 from washbench.flight.pilot import Pilot
 from washbench.flight.profile import PilotProfile
+from washbench.io.paths import jsbsim_root
 
 KT_TO_FPS = 1852.0 / 3600.0 / 0.3048
 FT_TO_M = 0.3048
@@ -67,9 +68,7 @@ def make_fdm(m: Manoeuvre, profile: PilotProfile) -> tuple[Any, Setup]:
     os.environ["JSBSIM_DEBUG"] = "0"
     import jsbsim
 
-    root = aircraft_path(m.aircraft)
-    if root is None:  # load_manoeuvre checked it; guard against a file removed since
-        raise WashbenchError(m.located(("aircraft",), f"unknown aircraft '{m.aircraft}'"))
+    root = m.aircraft_files.root
     fdm = jsbsim.FGFDMExec(str(jsbsim_root()), None)
     fdm.set_aircraft_path(str(root))
     with _quiet_stdout():
@@ -184,9 +183,7 @@ def _set_engine_levers(fdm: Any, aircraft: str, profile: PilotProfile) -> None:
         if value is None:
             continue
         if not pm.hasNode(name):
-            raise WashbenchError(
-                f"{pilot_profile_path(aircraft)}: engine: sets {name}, which the JSBSim model {aircraft} lacks"
-            )
+            raise WashbenchError(f"{aircraft}: the pilot profile sets {name}, which the JSBSim model lacks")
         fdm[name] = float(value)
 
 

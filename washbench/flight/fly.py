@@ -14,7 +14,7 @@ import math
 import sys
 import time
 from array import array
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -24,7 +24,7 @@ from washbench.errors import WashbenchError
 from washbench.flight.checks import evaluate
 from washbench.flight.columns import COLUMN_NAMES
 from washbench.flight.fdm import make_fdm
-from washbench.flight.manoeuvre import Manoeuvre, Until, load_manoeuvre, pilot_profile_path
+from washbench.flight.manoeuvre import Manoeuvre, Until, load_manoeuvre
 from washbench.flight.monitor import Monitor
 from washbench.flight.pilot import Pilot
 from washbench.flight.profile import load_profile
@@ -149,7 +149,7 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
     body axes x forward, y right, z down).
     """
     m = manoeuvre
-    profile = load_profile(pilot_profile_path(m.aircraft))
+    profile = load_profile(m.aircraft_files.profile)
     fdm, setup = make_fdm(m, profile)
     dt = m.dt_s
     (phi_get, theta_get, psi_get, p_get, q_get, r_get, alpha_get, beta_get, vc_get, vg_get, trk_get, hdot_get,
@@ -385,14 +385,14 @@ def write_flight(out_dir: str | Path, result: FlightResult, source: str = "") ->
     write_text_atomic(out / "flight.json", json.dumps(flight_summary(result, source), indent=2) + "\n")
 
 
-def fly_command(manoeuvre_path: Path, out_dir: Path, progress: bool = True) -> int:
+def fly_command(manoeuvre_path: Path, out_dir: Path, progress: bool = True, aircraft_dirs: Sequence[Path] = ()) -> int:
     """``washbench fly FILE --out DIR``: 0 if flown with every check passing, else 1.
 
     The output folder is checked (and locked) before flying, so a bad ``--out`` costs no flight.
     """
     from washbench.io.lock import output_lock
 
-    m = load_manoeuvre(manoeuvre_path)
+    m = load_manoeuvre(manoeuvre_path, aircraft_dirs)
     show = progress and sys.stderr.isatty()
     with output_lock(out_dir):
         wall = time.monotonic()

@@ -26,7 +26,7 @@ from washbench.flight.columns import COLUMN_NAMES, RUNWAY_COLUMNS
 from washbench.flight.profile import PilotProfile, load_profile
 from washbench.io.atomic import write_text_atomic
 from washbench.io.names import Identifier
-from washbench.io.paths import AIRCRAFT_DIR, DATA_DIR
+from washbench.io.paths import AircraftFiles, find_aircraft, find_aircraft_files, find_profile
 from washbench.io.publish import prepare_output_file
 from washbench.io.yamlio import Loc, StrictModel, format_field_path, line_of, read_yaml, validate_data
 
@@ -251,6 +251,7 @@ class Manoeuvre(StrictModel):
     name: Identifier
     description: str = ""
     aircraft: Identifier
+    pilot_profile: str | None = None  # path of the pilot profile YAML, relative to this file (default: searched)
     rate_hz: Annotated[int, Field(ge=30, le=1000)] = 120
     runway: Runway | None = None
     start: Start
@@ -258,6 +259,7 @@ class Manoeuvre(StrictModel):
     phases: Annotated[list[Phase], Field(min_length=1)]
     checks: list[Check] = Field(default_factory=list)
 
+    _files: AircraftFiles | None = PrivateAttr(default=None)
     _source: Path | None = PrivateAttr(default=None)
     _lines: dict[Loc, int] = PrivateAttr(default_factory=dict)
 
@@ -283,7 +285,7 @@ class Manoeuvre(StrictModel):
         context = info.context if isinstance(info.context, dict) else {}
         source = context.get("source")
         where = _Where(Path(source) if source is not None else None, context.get("lines", {}))
-        _check_semantics(self, where)
+        _check_semantics(self, where, context.get("aircraft_dirs", ()))
         if where.problems:
             if source is not None:  # from a file: one located line per problem (WashbenchError passes through)
                 raise WashbenchError(where.problems[0], where.problems[1:])
@@ -293,28 +295,31 @@ class Manoeuvre(StrictModel):
             self._lines = context.get("lines", {})
         return self
 
+    @property
+    def aircraft_files(self) -> AircraftFiles:
+        """Where the aircraft model and the pilot profile are (found when the file was loaded).
+
+        For a manoeuvre built in Python, searched now without a manoeuvre file or ``--aircraft-dir``.
+        """
+        if self._files is None:
+            self._files = find_aircraft_files(self.aircraft, self._source, (), self.pilot_profile)
+        return self._files
+
 
 # --- aircraft lookup ---------------------------------------------------------------------------
 
 
-def jsbsim_root() -> Path:
-    """The folder of the installed jsbsim package (its ``aircraft/``, ``engine/``, ``systems/``)."""
-    import jsbsim
-
-    return Path(jsbsim.__file__).resolve().parent
-
-
-def aircraft_path(name: str) -> Path | None:
-    """The folder holding ``<name>/<name>.xml``: the project's ``aircraft/`` first, then jsbsim's."""
-    for root in (AIRCRAFT_DIR, jsbsim_root() / "aircraft"):
-        if (root / name / f"{name}.xml").is_file():
-            return root
-    return None
+def aircraft_path(name: str, manoeuvre_file: Path | None = None, aircraft_dirs: Sequence[Path] = ()) -> Path | None:
+    """The folder holding ``<name>/<name>.xml`` along the search path (washbench.io.paths), or None."""
+    try:
+        return find_aircraft(name, manoeuvre_file, aircraft_dirs)
+    except WashbenchError:
+        return None
 
 
-def pilot_profile_path(aircraft: str) -> Path:
-    """Where the scripted pilot's profile for ``aircraft`` lives."""
-    return DATA_DIR / f"pilot_{aircraft}.yaml"
+def pilot_profile_path(aircraft: str, manoeuvre_file: Path | None = None, aircraft_dirs: Sequence[Path] = ()) -> Path:
+    """The scripted pilot's profile for ``aircraft`` along the search path (WashbenchError if there is none)."""
+    return find_profile(aircraft, manoeuvre_file, aircraft_dirs)
 
 
 # --- semantic checks ---------------------------------------------------------------------------
@@ -340,19 +345,17 @@ def _set_fields(model: StrictModel, names: Sequence[str]) -> list[str]:
     return [n for n in names if getattr(model, n) is not None and getattr(model, n) is not False]
 
 
-def _check_semantics(m: Manoeuvre, where: _Where) -> None:
+def _check_semantics(m: Manoeuvre, where: _Where, aircraft_dirs: Sequence[Path] = ()) -> None:
     """Checks a schema cannot express; every problem is added to ``where`` (in file order)."""
-    if aircraft_path(m.aircraft) is None:
-        where.add(
-            ("aircraft",),
-            f"unknown aircraft '{m.aircraft}' (neither in the project's aircraft/ folder nor bundled with JSBSim)",
-        )
+    try:
+        files = find_aircraft_files(m.aircraft, where.path, aircraft_dirs, m.pilot_profile)
+    except WashbenchError as exc:
+        field = "pilot_profile" if str(exc).startswith("pilot_profile:") else "aircraft"
+        where.add((field,), str(exc).removeprefix("pilot_profile: "))
         return
-    profile_file = pilot_profile_path(m.aircraft)
-    if not profile_file.is_file():
-        where.add(("aircraft",), f"no scripted-pilot profile for '{m.aircraft}' (expected {profile_file})")
-        return
-    profile = load_profile(profile_file)
+    m._files = files
+    m._source = where.path
+    profile = load_profile(files.profile)
 
     starts = _set_fields(m.start, ("air", "runway"))
     if len(starts) != 1:
@@ -515,22 +518,25 @@ def _never_reason(
 # --- public API ----------------------------------------------------------------------------------
 
 
-def load_manoeuvre(path: str | Path) -> Manoeuvre:
+def load_manoeuvre(path: str | Path, aircraft_dirs: Sequence[Path] = ()) -> Manoeuvre:
     """Read, validate and semantically check a manoeuvre file.
 
+    The aircraft and its pilot profile are found along the search path of :mod:`washbench.io.paths`
+    (``aircraft_dirs`` are the ``--aircraft-dir`` folders) and kept in :attr:`Manoeuvre.aircraft_files`.
     Raises WashbenchError holding every problem of the file (``problems``: one located line each).
     """
     path = Path(path)
     data, lines = read_yaml(path)
-    return validate_data(path, data, lines, Manoeuvre, context={"source": path, "lines": lines})
+    context = {"source": path, "lines": lines, "aircraft_dirs": tuple(aircraft_dirs)}
+    return validate_data(path, data, lines, Manoeuvre, context=context)
 
 
-def validate_command(paths: Sequence[Path]) -> int:
+def validate_command(paths: Sequence[Path], aircraft_dirs: Sequence[Path] = ()) -> int:
     """``washbench validate FILE...``: print ``FILE: OK`` or the error line per file; 2 if any is bad."""
     bad = 0
     for path in paths:
         try:
-            load_manoeuvre(path)
+            load_manoeuvre(path, aircraft_dirs)
         except WashbenchError as exc:
             for problem in exc.problems:
                 print(f"washbench: error: {problem}", file=sys.stderr)

@@ -2,7 +2,7 @@
 
 The pilot's control laws are the same for every aircraft; what differs (V-speeds, load
 limits, the height of the centre of gravity at rest, the sign of nosewheel steering, the
-loop gains) is read from ``washbench/data/pilot_<aircraft>.yaml``. Gains are given at
+loop gains) is read from the aircraft's ``pilot.yaml`` (found as :mod:`washbench.io.paths` says). Gains are given at
 ``reference_airspeed_kts`` and scaled with (V_ref / V)^2 so the loops keep their bandwidth
 as dynamic pressure changes.
 """

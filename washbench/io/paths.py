@@ -1,18 +1,184 @@
-"""Where washbench finds its bundled files: package data, found through importlib.resources.
+"""Where washbench finds its files: the bundled package data and the user's own aircraft and pilot profiles.
 
-The authored aircraft, the bundled manoeuvres, the pilot profiles and the parameter files live under
-``washbench/data/`` in the source tree and in the wheel alike, so an editable checkout and an installed wheel
-find them the same way.
+Bundled files live under ``washbench/data/`` in the source tree and in the wheel alike and are found through
+:mod:`importlib.resources`, so an editable checkout and an installed wheel behave the same.
+
+A user's aircraft (``<folder>/<name>/<name>.xml`` with its ``Engines/`` and ``Systems/``) is searched, in this
+order:
+
+1. the folders given with ``--aircraft-dir DIR`` (repeatable), in the order given;
+2. the folders in the ``WASHBENCH_AIRCRAFT_PATH`` environment variable (``os.pathsep``-separated);
+3. an ``aircraft/`` folder next to the manoeuvre file or in one of its parents, up to the project root (the
+   first parent that holds ``.git``, ``pyproject.toml`` or ``.washbench``; the filesystem root if none does);
+4. the bundled aircraft (``washbench/data/aircraft``);
+5. JSBSim's own models (``<jsbsim package>/aircraft``).
+
+A pilot profile is, in this order: the file named by the manoeuvre's ``pilot_profile`` key (relative to the
+manoeuvre file); ``<folder>/<name>/pilot.yaml`` in the same folders as above, in the same order (so a profile
+can sit next to the user's copy of an aircraft, or alone in ``aircraft/<name>/pilot.yaml`` for a JSBSim model);
+the bundled profiles are the ``pilot.yaml`` files of the bundled aircraft folders (``washbench/data/aircraft/
+<name>/pilot.yaml``). Errors for an unknown aircraft or a missing profile list every place searched.
 """
 
 from __future__ import annotations
 
+import importlib.util
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass
 from importlib.resources import files
 from pathlib import Path
 
-#: ``washbench/data``: parameter sets, platform limits, pilot profiles, aircraft, manoeuvres.
+from washbench.errors import WashbenchError
+
+#: ``washbench/data``: parameter sets, platform limits, aircraft with their pilot profiles, manoeuvres.
 DATA_DIR = Path(str(files("washbench") / "data"))
-#: Bundled aircraft models (``<name>/<name>.xml``), searched before JSBSim's own.
+#: Bundled aircraft models (``<name>/<name>.xml``) and pilot profiles (``<name>/pilot.yaml``).
 AIRCRAFT_DIR = DATA_DIR / "aircraft"
 #: Bundled manoeuvres (``<aircraft>/<name>.yaml``): what ``washbench suite`` runs by default.
 MANOEUVRES_DIR = DATA_DIR / "manoeuvres"
+#: Environment variable with extra aircraft folders, separated by ``os.pathsep``.
+AIRCRAFT_PATH_ENV = "WASHBENCH_AIRCRAFT_PATH"
+#: Files or folders that mark a project root (where the search for ``aircraft/`` next to a manoeuvre stops).
+PROJECT_MARKERS = (".git", "pyproject.toml", ".washbench")
+#: File name of a pilot profile inside an aircraft folder.
+PROFILE_NAME = "pilot.yaml"
+
+
+def jsbsim_root() -> Path:
+    """The folder of the installed jsbsim package (its ``aircraft/``, ``engine/``, ``systems/``, ``scripts/``).
+
+    Found without importing jsbsim (validation and ``--version`` stay fast).
+    """
+    spec = importlib.util.find_spec("jsbsim")
+    if spec is None or spec.origin is None:  # pragma: no cover - jsbsim is a dependency
+        raise WashbenchError("the jsbsim package is not installed")
+    return Path(spec.origin).resolve().parent
+
+
+@dataclass(frozen=True)
+class SearchPlace:
+    """One folder of the search path and why it is on it (for error messages)."""
+
+    folder: Path
+    why: str
+
+
+def _project_folders(manoeuvre_file: Path) -> list[Path]:
+    """``aircraft/`` next to the manoeuvre file and in each parent up to the project root."""
+    out = []
+    for parent in Path(os.path.abspath(manoeuvre_file)).parents:
+        out.append(parent / "aircraft")
+        if any((parent / marker).exists() for marker in PROJECT_MARKERS):
+            break
+    return out
+
+
+def search_places(manoeuvre_file: Path | None = None, aircraft_dirs: Sequence[Path] = ()) -> list[SearchPlace]:
+    """The aircraft search path, in order (see the module docstring); folders that do not exist included."""
+    places = [SearchPlace(Path(os.path.abspath(d)), "--aircraft-dir") for d in aircraft_dirs]
+    env = os.environ.get(AIRCRAFT_PATH_ENV, "")
+    places += [SearchPlace(Path(os.path.abspath(d)), AIRCRAFT_PATH_ENV) for d in env.split(os.pathsep) if d]
+    if manoeuvre_file is not None:
+        places += [SearchPlace(p, "next to the manoeuvre") for p in _project_folders(manoeuvre_file)]
+    places.append(SearchPlace(AIRCRAFT_DIR, "bundled"))
+    places.append(SearchPlace(jsbsim_root() / "aircraft", "JSBSim"))
+    return places
+
+
+def _listing(places: Sequence[SearchPlace]) -> str:
+    """``why: folder, folder; why: folder`` in search order (one line)."""
+    groups: dict[str, list[str]] = {}
+    for p in places:
+        groups.setdefault(p.why, []).append(str(p.folder))
+    return "; ".join(f"{why}: {', '.join(folders)}" for why, folders in groups.items())
+
+
+@dataclass(frozen=True)
+class AircraftFiles:
+    """Where one manoeuvre's aircraft model and pilot profile were found.
+
+    ``root`` is the folder given to JSBSim's ``set_aircraft_path`` (it holds ``<name>/<name>.xml``).
+    """
+
+    name: str
+    root: Path
+    profile: Path
+
+    @property
+    def model_dir(self) -> Path:
+        """``<root>/<name>``: the model's own folder (``Engines/``, ``Systems/``)."""
+        return self.root / self.name
+
+
+def find_aircraft(name: str, manoeuvre_file: Path | None = None, aircraft_dirs: Sequence[Path] = ()) -> Path:
+    """The folder holding ``<name>/<name>.xml``, first along the search path.
+
+    Raises WashbenchError listing every place searched when none holds the model.
+    """
+    places = search_places(manoeuvre_file, aircraft_dirs)
+    for place in places:
+        if (place.folder / name / f"{name}.xml").is_file():
+            return place.folder
+    raise WashbenchError(
+        f"unknown aircraft '{name}': no {name}/{name}.xml in the searched folders ({_listing(places)})"
+    )
+
+
+def find_profile(
+    name: str,
+    manoeuvre_file: Path | None = None,
+    aircraft_dirs: Sequence[Path] = (),
+    pilot_profile: str | None = None,
+) -> Path:
+    """The pilot profile for aircraft ``name``: the manoeuvre's ``pilot_profile`` or ``<folder>/<name>/pilot.yaml``.
+
+    ``pilot_profile`` is relative to the manoeuvre file (or absolute). Raises WashbenchError listing every place
+    searched when no profile exists.
+    """
+    if pilot_profile is not None:
+        base = Path(os.path.abspath(manoeuvre_file)).parent if manoeuvre_file is not None else Path.cwd()
+        path = base / pilot_profile
+        if path.is_file():
+            return path
+        raise WashbenchError(f"pilot_profile: no such file {path}")
+    places = search_places(manoeuvre_file, aircraft_dirs)
+    for place in places:
+        path = place.folder / name / PROFILE_NAME
+        if path.is_file():
+            return path
+    raise WashbenchError(
+        f"no scripted-pilot profile for '{name}': no {name}/{PROFILE_NAME} in the searched folders "
+        f"({_listing(places)}) "
+        "(or name one with 'pilot_profile:' in the manoeuvre file)"
+    )
+
+
+def find_aircraft_files(
+    name: str,
+    manoeuvre_file: Path | None = None,
+    aircraft_dirs: Sequence[Path] = (),
+    pilot_profile: str | None = None,
+) -> AircraftFiles:
+    """Model folder and pilot profile of one manoeuvre's aircraft (see :func:`find_aircraft`, :func:`find_profile`)."""
+    root = find_aircraft(name, manoeuvre_file, aircraft_dirs)
+    return AircraftFiles(name, root, find_profile(name, manoeuvre_file, aircraft_dirs, pilot_profile))
+
+
+def bundled_names() -> list[str]:
+    """Names of the bundled manoeuvres, ``<aircraft>/<name>`` (what :func:`resolve_manoeuvre` accepts)."""
+    return sorted(p.relative_to(MANOEUVRES_DIR).with_suffix("").as_posix() for p in MANOEUVRES_DIR.glob("*/*.yaml"))
+
+
+def resolve_manoeuvre(item: Path) -> Path:
+    """A manoeuvre argument as given, or, when no such file or folder exists, the bundled one of that name.
+
+    ``c172/takeoff`` (or ``c172/takeoff.yaml``) names a bundled manoeuvre and ``c172`` the bundled folder of an
+    aircraft, so ``washbench run c172/takeoff`` works from any folder. An existing path always wins.
+    """
+    if item.exists() or item.is_absolute():
+        return item
+    for candidate in (MANOEUVRES_DIR / item, MANOEUVRES_DIR / f"{item}.yaml"):
+        if candidate.exists():
+            return candidate
+    return item

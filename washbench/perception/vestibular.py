@@ -34,7 +34,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.signal
 from pydantic import Field
 
 from washbench.io.yamlio import StrictModel
@@ -149,6 +148,11 @@ class DiscreteModel:
     b: tuple[tuple[float, float], ...]  # per section: (coefficient of u[k], coefficient of u[k-1])
     phi: tuple[float, ...]
     dc_gain: float
+    steady: tuple[float, ...] = ()  # per section: its state for a unit constant input (its DC gain, -r/p)
+
+    def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The sections as the compiled core wants them: b (S, 2), phi (S,), steady (S,), float64."""
+        return np.array(self.b, dtype=np.float64), np.array(self.phi), np.array(self.steady)
 
     @classmethod
     def from_partial_fractions(cls, pf: PartialFractions, dt_s: float) -> DiscreteModel:
@@ -160,27 +164,23 @@ class DiscreteModel:
             g0, g1 = _foh_weights(a * dt_s)
             b.append((r * dt_s * g1, r * dt_s * g0))
             phi.append(math.exp(-a * dt_s))
-        dc = sum(-r / p for r, p in zip(pf.residues, pf.poles, strict=True))
-        return cls(dt_s=dt_s, b=tuple(b), phi=tuple(phi), dc_gain=dc)
+        steady = tuple(-r / p for r, p in zip(pf.residues, pf.poles, strict=True))
+        return cls(dt_s=dt_s, b=tuple(b), phi=tuple(phi), dc_gain=sum(steady), steady=steady)
 
     def apply(self, u: np.ndarray) -> np.ndarray:
         """Filter ``u`` (N,) or (N, m) along axis 0, starting in the steady state of ``u[0]``.
 
-        Returns float64 of the same shape. Vectorised (``scipy.signal.lfilter``), no Python loop over samples.
+        Returns float64 of the same shape. One compiled pass per column (:mod:`washbench.perception.sections`),
+        the same step the studies' evaluation kernel takes per sample.
         """
+        from washbench.perception.sections import sections_apply
+
         u = np.asarray(u, dtype=np.float64)
         if u.ndim not in (1, 2) or u.shape[0] == 0:
             raise ValueError(f"expected a non-empty (N,) or (N, m) array, got shape {u.shape}")
-        y = np.zeros_like(u)
-        u0 = u[0]
-        for (b1, b0), phi in zip(self.b, self.phi, strict=True):
-            bb = np.array([b1, b0])
-            aa = np.array([1.0, -phi])
-            zi = scipy.signal.lfilter_zi(bb, aa)  # (1,): steady state for a unit constant input
-            zi = zi.reshape((1,) + (1,) * (u.ndim - 1)) * u0
-            out, _ = scipy.signal.lfilter(bb, aa, u, axis=0, zi=zi)
-            y += out
-        return y
+        b, phi, steady = self.arrays()
+        y = sections_apply(b, phi, steady, u if u.ndim == 2 else u.reshape(-1, 1))
+        return y.reshape(u.shape)
 
 
 def otolith_model(p: OtolithParams, dt_s: float) -> DiscreteModel:

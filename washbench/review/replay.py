@@ -71,12 +71,13 @@ def find_rerun() -> Path:
     The bundled binary is preferred over the ``bin/rerun`` wrapper script because the wrapper runs the binary as a
     grandchild, which would survive terminating the wrapper.
     """
+    exe = "rerun.exe" if sys.platform.startswith("win") else "rerun"
     spec = importlib.util.find_spec("rerun_cli")
     if spec is not None and spec.origin is not None:
-        bundled = Path(spec.origin).parent / "rerun"
+        bundled = Path(spec.origin).parent / exe
         if bundled.is_file() and os.access(bundled, os.X_OK):
             return bundled
-    beside = Path(sys.executable).parent / "rerun"
+    beside = Path(sys.executable).parent / exe  # bin/ of a venv (Scripts\ on Windows)
     if beside.is_file() and os.access(beside, os.X_OK):
         return beside
     found = shutil.which("rerun")
@@ -85,8 +86,14 @@ def find_rerun() -> Path:
     return Path(found)
 
 
-def _has_display() -> bool:
-    return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+def _has_display(platform: str | None = None, environ: dict[str, str] | None = None) -> bool:
+    """Whether the native viewer can open a window: always on macOS and Windows desktops; elsewhere (Linux, BSD)
+    only with an X11 or Wayland display (``DISPLAY`` / ``WAYLAND_DISPLAY``), e.g. not over plain SSH."""
+    platform = sys.platform if platform is None else platform
+    environ = os.environ if environ is None else environ
+    if platform == "darwin" or platform.startswith(("win", "cygwin")):
+        return not environ.get("SSH_CONNECTION")  # a remote shell on a desktop machine has no window either
+    return bool(environ.get("DISPLAY") or environ.get("WAYLAND_DISPLAY"))
 
 
 def _die_with_parent() -> None:
@@ -167,10 +174,10 @@ def stop_viewer(proc: subprocess.Popen[str], timeout_s: float = 10.0) -> None:
 def replay_command(path: Path, web: bool) -> int:
     """Open ``path`` in the rerun viewer; return the exit status.
 
-    The native viewer where a display exists (DISPLAY or WAYLAND_DISPLAY set) and ``web`` is false; otherwise the web
-    viewer on 127.0.0.1 with system-chosen ports, whose address is printed; it runs until Ctrl-C (status 0).
-    SIGTERM stops the viewer too (status 143), and a viewer outlives washbench in no case (Linux: not even
-    a SIGKILL of washbench, through the parent-death signal).
+    The native viewer where a display exists (a macOS or Windows desktop, or DISPLAY / WAYLAND_DISPLAY set) and
+    ``web`` is false; otherwise the web viewer on 127.0.0.1 with system-chosen ports, whose address is printed;
+    it runs until Ctrl-C (status 0). SIGTERM stops the viewer too (status 143), and a viewer outlives washbench
+    in no case (Linux: not even a SIGKILL of washbench, through the parent-death signal).
     """
     path = Path(path)
     check_recording(path)

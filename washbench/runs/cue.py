@@ -166,12 +166,13 @@ def _put(table: dict[str, np.ndarray], names: Sequence[str], values: np.ndarray)
 
 def cue_motion(
     motion: Motion,
-    washouts: Sequence[str],
+    washouts: Sequence[Any],
     params: Any,
     limits: Any,
     vestibular: VestibularParams | None = None,
 ) -> CueResult:
-    """Run the named washouts and the Atlas model over ``motion`` (``cueing.cue_trace``), then :func:`analyse`."""
+    """Run the washouts (names with ``params``, or Washout variants) and the Atlas model over ``motion``
+    (``cueing.cue_trace``, one compiled call), then :func:`analyse`."""
     from washbench.cueing import cue_trace
 
     traces = cue_trace(motion.f_mps2, motion.omega_radps, motion.dt_s, washouts, params, limits)
@@ -210,21 +211,24 @@ def run_cue(
     washouts: Sequence[str] | None = None,
     params_path: Path | None = None,
     platform_path: Path | None = None,
+    variants: Sequence[str] = (),
 ) -> None:
     """The ``washbench cue`` command: read ``input_path``, cue it, write results into ``out_dir``.
 
+    ``washouts``, ``variants`` and ``params_path`` select the washouts
+    (:func:`washbench.cueing.variants.select_washouts`).
     Raises WashbenchError (one line) for bad names, parameter files or input; writes nothing then.
     """
-    from washbench.cueing import load_washout_params
+    from washbench.cueing.variants import select_washouts
     from washbench.io.lock import output_lock
     from washbench.platform import load_platform_limits
 
-    names = check_washout_names(washouts)
-    params = load_washout_params(params_path)
+    specs = select_washouts(washouts, variants, params_path)
+    names = [w.name for w in specs]
     limits = load_platform_limits(platform_path)
     motion = read_motion(input_path)
     with output_lock(out_dir):
-        result = cue_motion(motion, names, params, limits)
+        result = cue_motion(motion, specs, None, limits)
         traces_path, metrics_path = write_results(out_dir, result)
     print(
         f"{input_path}: {motion.n} rows, {motion.duration_s:.3f} s at dt = {motion.dt_s:.6g} s "

@@ -28,14 +28,15 @@ import math
 import shutil
 import sys
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from washbench.analysis.metrics import MetricRow, integral_abs_error
-from washbench.analysis.ranking import DOFS
+from washbench.analysis.metrics import MetricRow
+from washbench.analysis.ranking import DOFS, perceived_motion
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
 from washbench.io.publish import (
@@ -76,15 +77,6 @@ class RunSummary:
     metrics: list[MetricRow] = field(default_factory=list)
     motion: dict[str, float] = field(default_factory=dict)  # DOF -> aircraft pilot's perceived motion
     saturations: dict[str, dict[str, int]] = field(default_factory=dict)
-
-
-def perceived_motion(perceived_f_mps2: np.ndarray, perceived_omega_radps: np.ndarray, dt_s: float) -> dict[str, float]:
-    """How much the aircraft pilot felt per DOF: integral of |perceived(t) - perceived(0)| dt.
-
-    Surge, sway, heave in m/s^2*s; roll, pitch, yaw in deg (the units of metrics.csv).
-    """
-    columns = np.column_stack([perceived_f_mps2, np.degrees(perceived_omega_radps)])
-    return {dof: integral_abs_error(x, np.full_like(x, x[0]), dt_s) for dof, x in zip(DOFS, columns.T, strict=True)}
 
 
 def aircraft_attitude(phi_deg: np.ndarray, theta_deg: np.ndarray, psi_deg: np.ndarray) -> np.ndarray:
@@ -133,34 +125,40 @@ def run_manoeuvre(
     params_path: Path | None = None,
     platform_path: Path | None = None,
     progress: bool = False,
+    washouts: Sequence[str] | None = None,
+    variants: Sequence[str] = (),
+    aircraft_dirs: Sequence[Path] = (),
 ) -> RunSummary:
     """Fly one manoeuvre with the washouts in lockstep and write its results folder.
+
+    ``washouts`` (built-in names), ``variants`` (``--variant`` texts) and the parameter file's ``variants:``
+    select the washouts (:func:`washbench.cueing.variants.select_washouts`; default the three built-in ones).
 
     Raises WashbenchError for a bad manoeuvre, parameter or platform file, or a result place that
     cannot be used (all checked before flying; nothing written). A flight that crashes or fails a check
     still writes its results (what was flown), with ``ok`` False and the reason. The result folder
     replaces only a previous ``washbench run`` result of the same manoeuvre (recognised by its run.json).
     """
-    from washbench.cueing.params import load_washout_params
+    from washbench.cueing.variants import select_washouts
     from washbench.flight.manoeuvre import load_manoeuvre
     from washbench.platform.limits import load_platform_limits
 
-    # every input and the result place first (light imports): a bad one fails in a fraction of a second
-    manoeuvre = load_manoeuvre(manoeuvre_path)
-    params = load_washout_params(params_path)
+    # every input and the result place first: a bad one fails before anything is flown
+    manoeuvre = load_manoeuvre(manoeuvre_path, aircraft_dirs)
+    specs = select_washouts(washouts, variants, params_path)
     limits = load_platform_limits(platform_path)
     final = run_dir(Path(out_root), manoeuvre.aircraft, manoeuvre.name)
     marker = _marker(manoeuvre.aircraft, manoeuvre.name)
     check_replaceable(final, RUN_MARKER, marker)  # before flying: a folder in the way fails now, not after
     clean_partials(final.parent)
 
-    from washbench.cueing import WASHOUT_NAMES, CueingBank, WashoutTrace
+    from washbench.cueing import CueingBank, WashoutTrace
     from washbench.flight.fly import fly, write_flight
     from washbench.io.results import read_motion
     from washbench.runs.cue import analyse, write_results
 
-    washouts = tuple(WASHOUT_NAMES)
-    bank = CueingBank(washouts, params, limits, manoeuvre.dt_s)
+    bank = CueingBank(specs, None, limits, manoeuvre.dt_s)
+    washouts = bank.washouts
     rows: list[np.ndarray] = []
     step = bank.step
     omega_deg = np.empty(3)
@@ -303,6 +301,9 @@ def run_command(
     params_path: Path | None = None,
     platform_path: Path | None = None,
     progress: bool = True,
+    washouts: Sequence[str] | None = None,
+    variants: Sequence[str] = (),
+    aircraft_dirs: Sequence[Path] = (),
 ) -> int:
     """CLI entry of ``washbench run``: 0 if the flight ran and passed its checks, else 1.
 
@@ -318,6 +319,9 @@ def run_command(
             params_path=params_path,
             platform_path=platform_path,
             progress=progress and sys.stderr.isatty(),
+            washouts=washouts,
+            variants=variants,
+            aircraft_dirs=aircraft_dirs,
         )
     state = "ok" if s.ok else f"FAILED ({s.reason})"
     print(

@@ -6,9 +6,9 @@ that fails (bad file, crash, divergence, failed check, or an unexpected error) i
 reason; the others still complete and are kept. Then the suite writes, each file atomically:
 
 - ``OUT/metrics.csv``: ``aircraft,manoeuvre,washout,dof,npc,integral_error,max_error``
-- ``OUT/comparison.csv``: every metric per washout and DOF with its difference from small-angle
-  (positive = better than small-angle), like the paper's Table 4
-- ``OUT/ranking.csv``: the three washouts ranked per manoeuvre by the rule of
+- ``OUT/comparison.csv``: every metric per washout and DOF with its difference from the reference washout
+  (small-angle when it runs, otherwise the first listed; positive = better), like the paper's Table 4
+- ``OUT/ranking.csv``: the washouts (built-in or variants) ranked per manoeuvre by the rule of
   :mod:`washbench.analysis.ranking`
 - ``OUT/report.md``: all of it, with links to each recording;
 - ``OUT/suite.json``: what the suite wrote (how the next suite recognises it), written last.
@@ -38,7 +38,7 @@ import signal
 import sys
 import time
 import traceback
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
@@ -46,17 +46,16 @@ from pathlib import Path
 from washbench.analysis.ranking import (
     DOFS,
     METRICS,
-    REFERENCE_WASHOUT,
     RankRow,
     compare,
     rank,
+    reference_washout,
     wins,
 )
-from washbench.cueing.params import WASHOUT_NAMES
 from washbench.errors import Terminated, WashbenchError, located
 from washbench.io.atomic import write_text_atomic
 from washbench.io.lock import LOCK_NAME, output_lock
-from washbench.io.paths import MANOEUVRES_DIR
+from washbench.io.paths import MANOEUVRES_DIR, bundled_names, resolve_manoeuvre
 from washbench.io.publish import clean_partials, is_leftover, is_washbench_result, read_marker
 from washbench.io.results import csv_number
 from washbench.runs.pipeline import RUN_MARKER, RunSummary
@@ -80,23 +79,30 @@ def find_manoeuvres(inputs: Sequence[Path]) -> list[Path]:
     if not inputs:
         inputs = [MANOEUVRES_DIR]
     found: list[Path] = []
-    for item in inputs:
+    for item in map(resolve_manoeuvre, inputs):
         if item.is_dir():
             found.extend(sorted(p for p in item.rglob("*.yaml") if p.is_file()))
         elif item.is_file():
             found.append(item)
         else:
-            raise WashbenchError(located(item, "no such file or folder"))
+            raise WashbenchError(
+                located(item, f"no such file or folder, nor a bundled manoeuvre ({', '.join(bundled_names())})")
+            )
     unique = list(dict.fromkeys(p.resolve() for p in found))
     if not unique:
         raise WashbenchError(located(inputs[0], "no manoeuvre files (*.yaml) found"))
     return unique
 
 
-def _worker_init() -> None:
-    """In each worker: Ctrl-C is for the main process (it stops the workers); SIGTERM stops a worker at once."""
+def _worker_init(then: Callable[[], None] | None = None) -> None:
+    """In each worker: Ctrl-C is for the main process (it stops the workers); SIGTERM stops a worker at once.
+
+    ``then``: the start method's own initializer (:func:`pool_context`).
+    """
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    if then is not None:
+        then()
 
 
 @contextlib.contextmanager
@@ -147,7 +153,15 @@ def _stop_pool(pool: ProcessPoolExecutor) -> None:
             p.join(5.0)
 
 
-def _run_one(path: str, out_dir: str, params_path: str | None, platform_path: str | None) -> Outcome:
+def _run_one(
+    path: str,
+    out_dir: str,
+    params_path: str | None,
+    platform_path: str | None,
+    washouts: tuple[str, ...] | None = None,
+    variants: tuple[str, ...] = (),
+    aircraft_dirs: tuple[str, ...] = (),
+) -> Outcome:
     """Worker: run one manoeuvre; never raises (failures come back as an Outcome)."""
     from washbench.runs.pipeline import run_manoeuvre
 
@@ -158,6 +172,9 @@ def _run_one(path: str, out_dir: str, params_path: str | None, platform_path: st
             Path(out_dir),
             params_path=Path(params_path) if params_path else None,
             platform_path=Path(platform_path) if platform_path else None,
+            washouts=washouts,
+            variants=variants,
+            aircraft_dirs=[Path(d) for d in aircraft_dirs],
         )
     except WashbenchError as exc:
         summary = RunSummary(ok=False, reason=str(exc))
@@ -168,6 +185,29 @@ def _run_one(path: str, out_dir: str, params_path: str | None, platform_path: st
     return Outcome(path=path, wall_s=time.perf_counter() - start, run=summary)
 
 
+def _preload() -> None:
+    """Worker initializer where there is no forkserver: load the heavy modules once per worker."""
+    import washbench.runs.preload  # noqa: F401
+
+
+def pool_context(
+    main_stops_workers: bool = False,
+) -> tuple[multiprocessing.context.BaseContext, Callable[[], None] | None]:
+    """The process pool's start method and worker initializer.
+
+    ``forkserver`` (Linux, macOS) where it exists: workers fork from a server that has already imported the heavy
+    modules (JSBSim, the numba kernels, rerun, pyarrow), so each starts in milliseconds. Elsewhere (Windows)
+    ``spawn``, with every worker importing them once at its start. With ``main_stops_workers`` (the suite, which
+    stops its workers itself on Ctrl-C) the server and its workers ignore SIGINT.
+    """
+    if "forkserver" in multiprocessing.get_all_start_methods():
+        ctx = multiprocessing.get_context("forkserver")
+        first = ["washbench.runs.worker_signals"] if main_stops_workers else []
+        ctx.set_forkserver_preload([*first, "washbench.runs.preload"])
+        return ctx, None
+    return multiprocessing.get_context("spawn"), _preload
+
+
 def run_suite(
     files: Sequence[Path],
     out_dir: Path,
@@ -176,16 +216,23 @@ def run_suite(
     params_path: Path | None = None,
     platform_path: Path | None = None,
     progress: bool = True,
+    washouts: Sequence[str] | None = None,
+    variants: Sequence[str] = (),
+    dask: str | None = None,
+    aircraft_dirs: Sequence[Path] = (),
 ) -> list[Outcome]:
-    """Run every file in parallel processes; return the outcomes in the order of ``files``.
+    """Run every file in parallel processes (or on the Dask cluster at ``dask``); outcomes in the order of ``files``.
 
-    On any exception (KeyboardInterrupt and :class:`washbench.errors.Terminated` included) the workers are
+    On any exception (KeyboardInterrupt and :class:`washbench.errors.Terminated` included) the local workers are
     stopped before it propagates, so no worker writes anything afterwards.
     """
     jobs = max(1, min(jobs or os.cpu_count() or 1, len(files)))
     out_dir.mkdir(parents=True, exist_ok=True)
+    dirs = tuple(str(d) for d in aircraft_dirs)
+    params = str(params_path) if params_path else None
+    platform = str(platform_path) if platform_path else None
     args = [
-        (str(f), str(out_dir), str(params_path) if params_path else None, str(platform_path) if platform_path else None)
+        (str(f), str(out_dir), params, platform, tuple(washouts) if washouts else None, tuple(variants), dirs)
         for f in files
     ]
     outcomes: dict[str, Outcome] = {}
@@ -196,15 +243,17 @@ def run_suite(
             "suite: loading JSBSim, rerun and the washout kernel (compiled once after install: a few seconds)",
             file=sys.stderr,
         )
-    if jobs == 1:
+    if dask:
+        from washbench.runs.cluster import dask_map
+
+        for outcome in dask_map(dask, _run_one, args):
+            outcomes[outcome.path] = _report(outcome, len(outcomes) + 1, len(files), start, progress)
+    elif jobs == 1:
         for a in args:
             outcomes[a[0]] = _report(_run_one(*a), len(outcomes) + 1, len(files), start, progress)
     else:
-        ctx = multiprocessing.get_context("forkserver")
-        # Workers fork from a server that has already imported the heavy modules (JSBSim, numba
-        # kernels, rerun, pyarrow), so each worker starts in milliseconds instead of seconds.
-        ctx.set_forkserver_preload(["washbench.runs.worker_signals", "washbench.runs.preload"])
-        pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_init)
+        ctx, initializer = pool_context(main_stops_workers=True)
+        pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_init, initargs=(initializer,))
         try:
             with _signals_deferred():  # submitting starts the workers (up to ``jobs``)
                 futures = [pool.submit(_run_one, *a) for a in args]
@@ -273,13 +322,15 @@ def metrics_table(outcomes: Sequence[Outcome]) -> str:
 
 
 def comparison_table(outcomes: Sequence[Outcome]) -> str:
-    """``comparison.csv``: each metric per washout and DOF and its improvement over small-angle."""
+    """``comparison.csv``: each metric per washout and DOF and its improvement over the reference washout
+    (small-angle when it runs, otherwise the first listed: ``<washout>_better_by`` = reference - washout)."""
     washouts = _washouts(outcomes)
-    others = [w for w in washouts if w != REFERENCE_WASHOUT]
+    reference = reference_washout(washouts)
+    others = [w for w in washouts if w != reference]
     header = ["aircraft", "manoeuvre", "dof", "metric", *washouts, *[f"{w}_better_by" for w in others]]
     rows = [header]
     for o in _runs_with_metrics(outcomes):
-        for c in compare(o.run.metrics):
+        for c in compare(o.run.metrics, reference):
             rows.append(
                 [o.run.aircraft, o.run.manoeuvre, c.dof, c.metric]
                 + [csv_number(c.values.get(w, math.nan)) for w in washouts]
@@ -298,13 +349,15 @@ def ranking_table(rankings: dict[tuple[str, str], list[RankRow]]) -> str:
 
 
 def _washouts(outcomes: Sequence[Outcome]) -> list[str]:
-    seen = {m.washout for o in outcomes for m in o.run.metrics}
-    return [w for w in WASHOUT_NAMES if w in seen] + sorted(seen - set(WASHOUT_NAMES))
+    """Every washout of the suite in the order the configuration listed them."""
+    return list(dict.fromkeys(m.washout for o in outcomes for m in o.run.metrics))
 
 
 def report_markdown(outcomes: Sequence[Outcome], rankings: dict[tuple[str, str], list[RankRow]], out_dir: Path) -> str:
     """``report.md``: status, ranking, Table-4 comparison and metrics of every manoeuvre."""
     ok = [o for o in outcomes if o.run.ok]
+    washouts = _washouts(outcomes)
+    reference = reference_washout(washouts)
     lines = [
         "# washbench suite report",
         "",
@@ -313,15 +366,15 @@ def report_markdown(outcomes: Sequence[Outcome], rankings: dict[tuple[str, str],
         "Metrics compare the aircraft pilot's perceived motion with each simulator pilot's: NPC is the",
         "normalized Pearson correlation (1 is perfect, larger is worse, empty where a signal is flat),",
         "integral and maximum of |error| in m/s^2 (integral m/s^2*s) for surge, sway, heave and deg/s",
-        "(integral deg) for roll, pitch, yaw. In the comparison, `better by` is small-angle minus the",
-        "washout: positive means better than small-angle. The score (lower is better) is the weighted",
+        f"(integral deg) for roll, pitch, yaw. In the comparison, `better by` is {reference} minus the",
+        f"washout: positive means better than {reference}. The score (lower is better) is the weighted",
         "relative integral error of `washbench/analysis/ranking.py`: each DOF's error over the aircraft pilot's own",
         "perceived motion in it, DOFs weighted by how much was felt there (half the weight to specific",
         "force, half to rotation); a DOF the pilot did not feel weighs nothing.",
         "",
         "## Summary",
         "",
-        "| aircraft | manoeuvre | status | checks | best washout | scores (small / large / unrestricted) | recording |",
+        f"| aircraft | manoeuvre | status | checks | best washout | scores ({' / '.join(washouts)}) | recording |",
         "|---|---|---|---|---|---|---|",
     ]
     for o in outcomes:
@@ -329,7 +382,7 @@ def report_markdown(outcomes: Sequence[Outcome], rankings: dict[tuple[str, str],
         ranking = rankings.get(key, [])
         best = ranking[0].washout if ranking else ""
         by_name = {r.washout: r.score for r in ranking}
-        scores = " / ".join(f"{by_name[w]:.3f}" if w in by_name else "-" for w in WASHOUT_NAMES)
+        scores = " / ".join(f"{by_name[w]:.3f}" if w in by_name else "-" for w in washouts)
         status = "ok" if o.run.ok else "FAILED"
         rec = ""
         if o.run.run_dir and (o.run.run_dir / "recording.rrd").exists():
@@ -364,10 +417,11 @@ def report_markdown(outcomes: Sequence[Outcome], rankings: dict[tuple[str, str],
 
 def _comparison_md(o: Outcome) -> list[str]:
     washouts = _washouts([o])
-    others = [w for w in washouts if w != REFERENCE_WASHOUT]
+    reference = reference_washout(washouts)
+    others = [w for w in washouts if w != reference]
     head = "| DOF | metric | " + " | ".join(washouts) + " | " + " | ".join(f"{w} better by" for w in others) + " |"
     lines = [head, "|" + "---|" * (2 + len(washouts) + len(others))]
-    for c in compare(o.run.metrics):
+    for c in compare(o.run.metrics, reference):
         vals = " | ".join(_md_num(c.values.get(w, math.nan)) for w in washouts)
         diffs = " | ".join(_md_num(c.better_than_reference.get(w, math.nan), signed=True) for w in others)
         lines.append(f"| {c.dof} | {c.metric} | {vals} | {diffs} |")
@@ -397,7 +451,7 @@ def write_suite_results(outcomes: Sequence[Outcome], out_dir: Path) -> None:
     write_text_atomic(out_dir / SUITE_MARKER, json.dumps(doc, indent=2) + "\n")
 
 
-def check_unique_names(files: Sequence[Path]) -> None:
+def check_unique_names(files: Sequence[Path], aircraft_dirs: Sequence[Path] = ()) -> None:
     """Refuse two manoeuvre files with the same aircraft and name (they would share a result folder).
 
     Files that do not load are left for the run to report. Raises WashbenchError naming both files.
@@ -407,7 +461,7 @@ def check_unique_names(files: Sequence[Path]) -> None:
     seen: dict[tuple[str, str], Path] = {}
     for path in files:
         try:
-            m = load_manoeuvre(path)
+            m = load_manoeuvre(path, aircraft_dirs)
         except WashbenchError:
             continue
         key = (m.aircraft, m.name)
@@ -475,6 +529,10 @@ def suite_command(
     params_path: Path | None = None,
     platform_path: Path | None = None,
     progress: bool = True,
+    washouts: Sequence[str] | None = None,
+    variants: Sequence[str] = (),
+    dask: str | None = None,
+    aircraft_dirs: Sequence[Path] = (),
 ) -> int:
     """CLI entry: run the suite, write its results, print where they are; 0 if all succeeded, else 1.
 
@@ -483,13 +541,13 @@ def suite_command(
     if jobs is not None and jobs < 1:
         raise WashbenchError(f"--jobs: expected a whole number of at least 1, got {jobs}")
     files = find_manoeuvres(inputs)
-    # Fail fast on a bad parameter or platform file: every run would fail the same way.
-    from washbench.cueing import load_washout_params
+    # Fail fast on a bad parameter, variant or platform file: every run would fail the same way.
+    from washbench.cueing.variants import select_washouts
     from washbench.platform import load_platform_limits
 
-    load_washout_params(params_path)
+    select_washouts(washouts, variants, params_path)
     load_platform_limits(platform_path)
-    check_unique_names(files)
+    check_unique_names(files, aircraft_dirs)
     start = time.perf_counter()
     with output_lock(out_dir):
         clean_partials(out_dir, only_dead=False)  # under the lock every leftover is stale
@@ -501,7 +559,16 @@ def suite_command(
         stage.mkdir()
         try:
             outcomes = run_suite(
-                files, stage, jobs=jobs, params_path=params_path, platform_path=platform_path, progress=progress
+                files,
+                stage,
+                jobs=jobs,
+                params_path=params_path,
+                platform_path=platform_path,
+                progress=progress,
+                washouts=washouts,
+                variants=variants,
+                dask=dask,
+                aircraft_dirs=aircraft_dirs,
             )
             write_suite_results(outcomes, stage)
             _swap_in(stage, out_dir, previous)

@@ -1,0 +1,62 @@
+"""Portability: the spawn start method (Windows has no forkserver), the user cache folder for numba's cache when
+the package folder is read-only, and when the native viewer is chosen."""
+
+from __future__ import annotations
+
+import csv
+import multiprocessing
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from washbench.io.paths import MANOEUVRES_DIR
+from washbench.review.replay import _has_display
+from washbench.runs import suite
+
+
+def test_suite_runs_with_spawn_where_forkserver_does_not_exist(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(multiprocessing, "get_all_start_methods", lambda: ["spawn"])
+    ctx, initializer = suite.pool_context()
+    assert ctx.get_start_method() == "spawn" and initializer is not None
+    files = [MANOEUVRES_DIR / "c172" / "stall_recovery.yaml", MANOEUVRES_DIR / "c172" / "coordinated_turn.yaml"]
+    outcomes = suite.run_suite(files, tmp_path, jobs=2, progress=False)
+    assert [o.run.ok for o in outcomes] == [True, True]
+    with open(tmp_path / "c172p" / "stall_recovery" / "metrics.csv", newline="") as f:
+        assert len(list(csv.DictReader(f))) == 18  # 3 washouts x 6 DOFs
+
+
+def test_numba_cache_goes_to_the_user_cache_folder_when_the_package_is_read_only(tmp_path: Path) -> None:
+    """In a fresh interpreter with the package folders reported read-only, NUMBA_CACHE_DIR points at the user cache
+    (XDG_CACHE_HOME here) and numba writes the kernel's cache there."""
+    code = (
+        "import os, washbench.cueing.jitcache as j\n"
+        "j._writable = lambda folder: False\n"
+        "j.configure_cache()\n"
+        "print(os.environ['NUMBA_CACHE_DIR'])\n"
+        "from washbench.platform.kinematics import brake_speed\n"
+        "brake_speed(1.0, 2.0, 0.01)\n"
+    )
+    env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
+    env["XDG_CACHE_HOME"] = str(tmp_path / "cache")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=300)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == str(tmp_path / "cache" / "washbench" / "numba")
+    assert list((tmp_path / "cache" / "washbench" / "numba").rglob("kinematics.brake_speed-*.nbi"))
+
+
+@pytest.mark.parametrize(
+    ("platform", "environ", "native"),
+    [
+        ("linux", {}, False),
+        ("linux", {"DISPLAY": ":0"}, True),
+        ("linux", {"WAYLAND_DISPLAY": "wayland-0"}, True),
+        ("darwin", {}, True),
+        ("win32", {}, True),
+        ("darwin", {"SSH_CONNECTION": "1.2.3.4 5 6.7.8.9 22"}, False),
+    ],
+)
+def test_native_viewer_on_desktops(platform: str, environ: dict[str, str], native: bool) -> None:
+    assert _has_display(platform, environ) is native

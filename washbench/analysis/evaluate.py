@@ -1,0 +1,194 @@
+"""Evaluations for studies: many washout candidates on one recorded flight, in one compiled call.
+
+An evaluation is one washout (kind + parameter set) on one recorded trace: the washout, the Atlas platform and
+the simulator pilot's head motion (the same compiled step as streaming, :func:`washbench.cueing.kernel.step_one`),
+the vestibular models (:func:`washbench.perception.sections.sections_step`), the metrics
+(:func:`washbench.analysis.metric_sums.acc_update`) and the ranking rule's score. :func:`evaluate_batch` runs a
+batch of candidates in parallel threads (numba ``prange``, one candidate per thread at a time), sample by sample,
+keeping only each candidate's running sums: nothing per sample is stored or written. Because every stage is the
+same code as ``washbench cue``, the metrics and scores are those of ``washbench cue`` on the same trace, bit for
+bit.
+
+Units: metrics as in ``metrics.csv`` (m/s^2 and m/s^2*s for surge, sway, heave; deg/s and deg for roll, pitch,
+yaw); ``saturated_s`` the time (s) during which any platform limit (position, velocity, acceleration, sphere rate,
+angular acceleration) was active.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from numba import njit, prange
+
+from washbench.analysis.metric_sums import NACC, acc_update, finish
+from washbench.analysis.metrics import DOFS, MetricRow, npc_from_pc
+from washbench.analysis.ranking import dof_weights, perceived_motion, score_of
+from washbench.cueing.jitcache import announce_compile, drop_stale_cache
+from washbench.cueing.kernel import NFIELDS, NSTATE, O_HEAD_F, O_HEAD_OMEGA, O_SAT, SAT_KINDS, step_one
+from washbench.perception.sections import sections_init, sections_step
+
+PLATFORM_SAT = tuple(SAT_KINDS.index(k) for k in ("pos", "vel", "acc", "rate", "angacc"))
+"""Indices of the platform's own limits among the saturation kinds (the tilt-rate and rotational limits are the
+washout's)."""
+
+_DEG = 180.0 / math.pi
+
+
+@njit(cache=True, parallel=True)
+def evaluate_batch(f, om, cfg, coef, oto, can, ac_perceived, dt, acc_out, counts_out):
+    """Run candidates i = 0..M-1 (``cfg`` (M, NCFG), ``coef`` (M, NFILT, 9)) over f, om (N, 3), checked finite.
+
+    ``oto`` and ``can``: (b (S, 2), phi (S,), steady (S,)) of the otolith and canal models. ``ac_perceived`` (N, 6):
+    the aircraft pilot's perceived specific force (m/s^2) and angular velocity (deg/s). Writes per candidate the
+    six DOF accumulators ``acc_out`` (M, 6, NACC) and ``counts_out`` (M, 8) int64: steps at each limit kind, then
+    steps at any platform limit.
+    """
+    n = f.shape[0]
+    ob, ophi, oss = oto
+    cb, cphi, css = can
+    for i in prange(cfg.shape[0]):
+        state = np.zeros(NSTATE)
+        counts = np.zeros(len(SAT_KINDS), dtype=np.int64)
+        row = np.zeros(NFIELDS)
+        xo = np.zeros((3, ophi.shape[0]))
+        xc = np.zeros((3, cphi.shape[0]))
+        u_prev = np.zeros(6)
+        acc = acc_out[i]
+        any_sat = 0
+        for k in range(n):
+            step_one(f[k], om[k], cfg[i], coef[i], state, counts, row)
+            if k == 0:
+                for j in range(3):
+                    sections_init(oss, xo[j], row[O_HEAD_F + j])
+                    sections_init(css, xc[j], row[O_HEAD_OMEGA + j])
+                    u_prev[j] = row[O_HEAD_F + j]
+                    u_prev[3 + j] = row[O_HEAD_OMEGA + j]
+            for j in range(3):
+                u = row[O_HEAD_F + j]
+                y = sections_step(ob, ophi, xo[j], u_prev[j], u)
+                u_prev[j] = u
+                acc_update(acc[j], ac_perceived[k, j], y)
+            for j in range(3):
+                u = row[O_HEAD_OMEGA + j]
+                y = sections_step(cb, cphi, xc[j], u_prev[3 + j], u)
+                u_prev[3 + j] = u
+                acc_update(acc[3 + j], ac_perceived[k, 3 + j], y * _DEG)
+            hit = 0
+            for j in PLATFORM_SAT:
+                if row[O_SAT + j] != 0.0:
+                    hit = 1
+            any_sat += hit
+        for j in range(len(SAT_KINDS)):
+            counts_out[i, j] = counts[j]
+        counts_out[i, len(SAT_KINDS)] = any_sat
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """Results of M candidates on one flight: ``npc``, ``integral_error``, ``max_error`` (M, 6) in DOFS order
+    (units of metrics.csv), ``score`` (M,) (the ranking rule's, lower is better), ``saturated_s`` (M,) and
+    ``saturation_steps`` (M, 7) per limit kind (SAT_KINDS order)."""
+
+    npc: np.ndarray
+    integral_error: np.ndarray
+    max_error: np.ndarray
+    score: np.ndarray
+    saturated_s: np.ndarray
+    saturation_steps: np.ndarray
+
+    def metric_rows(self, i: int, washout: str) -> list[MetricRow]:
+        """Candidate i's six rows of metrics.csv."""
+        return [
+            MetricRow(washout, d, float(self.npc[i, j]), float(self.integral_error[i, j]), float(self.max_error[i, j]))
+            for j, d in enumerate(DOFS)
+        ]
+
+
+class FlightEvaluator:
+    """One recorded flight, ready to evaluate batches of washout candidates on it.
+
+    Built once per flight: the aircraft pilot's perception, the DOF weights and motion of the ranking rule, the
+    vestibular models' sections. :meth:`evaluate` then costs one compiled call per batch.
+    """
+
+    def __init__(self, f_mps2: np.ndarray, omega_radps: np.ndarray, dt_s: float, limits: object) -> None:
+        from washbench.perception.vestibular import VestibularModel
+
+        self.f = np.ascontiguousarray(f_mps2, dtype=np.float64)
+        self.om = np.ascontiguousarray(omega_radps, dtype=np.float64)
+        if self.f.ndim != 2 or self.f.shape[1] != 3 or self.om.shape != self.f.shape or len(self.f) < 2:
+            raise ValueError(f"f and omega must both be (N >= 2, 3), got {self.f.shape} and {self.om.shape}")
+        if not (np.isfinite(self.f).all() and np.isfinite(self.om).all()):
+            raise ValueError("non-finite specific force or angular velocity")
+        self.dt_s = float(dt_s)
+        self.limits = limits
+        model = VestibularModel(self.dt_s)
+        p = model.perceive(self.f, self.om)
+        self.ac_perceived = np.ascontiguousarray(np.column_stack([p.f_mps2, p.omega_radps * _DEG]))
+        self.motion = perceived_motion(p.f_mps2, p.omega_radps, self.dt_s)
+        self.weights = dof_weights(self.motion)
+        self.oto = model.otolith.arrays()
+        self.can = model.canals.arrays()
+
+    @property
+    def n(self) -> int:
+        """Samples in the flight."""
+        return len(self.f)
+
+    def arrays(self, washouts: Sequence[object]) -> tuple[np.ndarray, np.ndarray]:
+        """The compiled configuration and filters of the candidates (Washout objects)."""
+        from washbench.cueing.bank import build_arrays
+
+        return build_arrays(washouts, self.limits, self.dt_s)  # type: ignore[arg-type]
+
+    def evaluate(self, washouts: Sequence[object]) -> Evaluation:
+        """Evaluate every candidate (:class:`washbench.cueing.variants.Washout`) on this flight."""
+        cfg, coef = self.arrays(washouts)
+        return self.evaluate_arrays(cfg, coef)
+
+    def evaluate_arrays(self, cfg: np.ndarray, coef: np.ndarray) -> Evaluation:
+        """Evaluate candidates given as compiled arrays (M, NCFG), (M, NFILT, 9)."""
+        m = cfg.shape[0]
+        acc = np.zeros((m, len(DOFS), NACC))
+        counts = np.zeros((m, len(SAT_KINDS) + 1), dtype=np.int64)
+        if m:
+            announce_compile(evaluate_batch)
+            evaluate_batch(self.f, self.om, cfg, coef, self.oto, self.can, self.ac_perceived, self.dt_s, acc, counts)
+        npc = np.empty((m, len(DOFS)))
+        integral = np.empty((m, len(DOFS)))
+        max_error = np.empty((m, len(DOFS)))
+        for i in range(m):
+            for j in range(len(DOFS)):
+                pc, e, mx = finish(acc[i, j], self.dt_s)
+                npc[i, j] = npc_from_pc(float(pc))
+                integral[i, j] = e
+                max_error[i, j] = mx
+        return Evaluation(
+            npc=npc,
+            integral_error=integral,
+            max_error=max_error,
+            score=score_of(integral, self.weights, self.motion),
+            saturated_s=counts[:, -1] * self.dt_s,
+            saturation_steps=counts[:, :-1],
+        )
+
+
+_HERE = Path(__file__).resolve().parent
+_PKG = _HERE.parent
+drop_stale_cache(
+    __file__,
+    [
+        _HERE / "metric_sums.py",
+        _PKG / "cueing" / "kernel.py",
+        _PKG / "cueing" / "rotations.py",
+        _PKG / "cueing" / "filters.py",
+        _PKG / "platform" / "kinematics.py",
+        _PKG / "perception" / "sections.py",
+    ],
+)
+
+__all__ = ["PLATFORM_SAT", "Evaluation", "FlightEvaluator", "evaluate_batch"]

@@ -1,0 +1,291 @@
+"""Washout variants: named washouts of a kind with their own parameters (a parameter set, not code).
+
+A run's washouts are a list of :class:`Washout` (name, kind, complete parameter set). The built-in washouts are
+named after their kind and use the parameter file as it is; a variant has its own name and the parameter file
+with overrides given as dotted keys of the file::
+
+    --variant sa_gain2=small-angle,tilt.gain_per_s=2,rotational.highpass_wn_radps.yaw=0.3
+
+or, with the same meaning, in the parameter file::
+
+    variants:
+      sa_gain2: {kind: small-angle, tilt.gain_per_s: 2}
+      la_free:
+        kind: large-angle
+        tilt: {rate_limit_degps: off}        # nested keys work too
+
+Selection (:func:`select_washouts`): with no variant, the washouts named by ``--washout`` (default: all three
+built-in ones); with any variant (command line or file), the ``--washout`` ones followed by the variants.
+A variant name is a plain identifier (letters, digits, ``_`` and ``-``): it becomes a column prefix, an entity
+path and part of file names. It must not be a built-in washout's name or ``aircraft``.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import pydantic
+from pydantic import BaseModel
+
+from washbench.cueing.params import DEFAULT_PARAMS_PATH, WASHOUT_KINDS, WashoutParams, check_washouts
+from washbench.errors import WashbenchError, located
+from washbench.io.yamlio import Loc, line_of, read_yaml, validate_data
+
+NAME_PATTERN = re.compile(r"[A-Za-z0-9_-]+")
+RESERVED_NAMES = frozenset({"aircraft", "limit", "t_s"})
+
+
+@dataclass(frozen=True)
+class Washout:
+    """One washout to run: ``name`` (in every output), ``kind`` (one of WASHOUT_KINDS), its complete parameters."""
+
+    name: str
+    kind: str
+    params: WashoutParams
+
+
+@dataclass(frozen=True)
+class VariantText:
+    """A parsed ``--variant`` (or ``variants:`` entry) before its overrides are applied: dotted key -> value."""
+
+    name: str
+    kind: str
+    overrides: tuple[tuple[str, Any], ...]
+
+
+def parse_value(text: str) -> Any:
+    """A command-line value: a number if it reads as one, ``off``/``false`` as off, otherwise the text."""
+    text = text.strip()
+    try:
+        return int(text)
+    except ValueError:
+        pass
+    try:
+        return float(text)
+    except ValueError:
+        pass
+    return False if text.lower() in ("off", "false") else text
+
+
+def check_name(name: str, where: str = "--variant") -> str:
+    """A variant name, checked: a plain identifier, not a built-in washout's name, not reserved."""
+    if not NAME_PATTERN.fullmatch(name):
+        raise WashbenchError(f"{where}: variant name {name!r} must be letters, digits, '_' or '-' only")
+    if name in WASHOUT_KINDS or name in RESERVED_NAMES:
+        raise WashbenchError(f"{where}: variant name {name!r} is reserved (a built-in washout or output name)")
+    return name
+
+
+def check_kind(kind: str, where: str = "--variant") -> str:
+    """A washout kind, checked."""
+    if kind not in WASHOUT_KINDS:
+        raise WashbenchError(f"{where}: unknown washout kind {kind!r} (valid: {', '.join(WASHOUT_KINDS)})")
+    return kind
+
+
+def parse_variant(text: str) -> VariantText:
+    """Parse ``NAME=KIND[,KEY=VALUE...]`` (one ``--variant``); keys are checked against the parameter model.
+
+    Raises WashbenchError (one line naming the variant and the key) for a bad name, kind or key.
+    """
+    head, _, rest = text.partition(",")
+    name, eq, kind = head.partition("=")
+    where = f"--variant {text}"
+    if not eq:
+        raise WashbenchError(f"{where}: expected NAME=KIND[,KEY=VALUE...]")
+    name, kind = check_name(name.strip(), where), check_kind(kind.strip(), where)
+    overrides: dict[str, Any] = {}
+    for item in (p for p in rest.split(",") if p.strip()) if rest else ():
+        key, eq, value = item.partition("=")
+        key = key.strip()
+        if not eq:
+            raise WashbenchError(f"{where}: {key}: expected KEY=VALUE")
+        check_key(key, where)
+        if key in overrides:
+            raise WashbenchError(f"{where}: {key}: given twice")
+        overrides[key] = parse_value(value)
+    return VariantText(name=name, kind=kind, overrides=tuple(overrides.items()))
+
+
+def check_key(key: str, where: str, model: type[BaseModel] = WashoutParams) -> tuple[str, ...]:
+    """The parts of a dotted key that names one value of the parameter model; WashbenchError otherwise."""
+    import difflib
+
+    parts = tuple(key.split("."))
+    current: type[BaseModel] = model
+    for i, part in enumerate(parts):
+        fields = current.model_fields
+        if part not in fields:
+            prefix = ".".join(parts[:i])
+            options = [f"{prefix}.{f}" if prefix else f for f in fields]
+            hint = difflib.get_close_matches(key, options, n=1)
+            extra = f" (did you mean '{hint[0]}'?)" if hint else f" (valid here: {', '.join(options)})"
+            raise WashbenchError(f"{where}: {key}: unknown parameter{extra}")
+        annotation = fields[part].annotation
+        sub = annotation if isinstance(annotation, type) and issubclass(annotation, BaseModel) else None
+        if i == len(parts) - 1:
+            if sub is not None:
+                leaves = ", ".join(f"{key}.{f}" for f in sub.model_fields)
+                raise WashbenchError(f"{where}: {key}: is a group; set its values one by one ({leaves})")
+            return parts
+        if sub is None:
+            raise WashbenchError(f"{where}: {key}: {'.'.join(parts[: i + 1])} has no sub-keys")
+        current = sub
+    return parts
+
+
+def apply_overrides(
+    params: WashoutParams,
+    overrides: Mapping[str, Any] | Sequence[tuple[str, Any]],
+    where: str,
+    lines: Mapping[str, int | None] | None = None,
+    field_prefix: str = "",
+) -> WashoutParams:
+    """``params`` with dotted-key overrides applied and validated (same rules as the parameter file).
+
+    ``where`` names the source in errors (a file, or ``--variant ...``); ``lines`` optionally maps a key to the
+    line it was written on, and ``field_prefix`` is put before the key in errors (``variants.NAME.``). Raises
+    WashbenchError: ``WHERE[:LINE]: KEY: problem``.
+    """
+    items = list(overrides.items()) if isinstance(overrides, Mapping) else list(overrides)
+    if not items:
+        return params
+    data = params.model_dump(mode="json")
+    for key, value in items:
+        parts = check_key(key, where)
+        node = data
+        for part in parts[:-1]:
+            node = node[part]
+        node[parts[-1]] = value
+    try:
+        return WashoutParams.model_validate_json(json.dumps(data, allow_nan=True))
+    except pydantic.ValidationError as exc:
+        from washbench.io.yamlio import _problem  # the same wording as for the file itself
+
+        err = exc.errors(include_url=False)[0]
+        loc = tuple(str(p) for p in err["loc"] if isinstance(p, str))
+        key = next((k for k, _ in items if tuple(k.split(".")) == loc[: len(k.split("."))]), ".".join(loc))
+        line = (lines or {}).get(key)
+        problem = _problem(err, WashoutParams, loc)
+        raise WashbenchError(located(where, problem, line=line, field=field_prefix + key)) from None
+
+
+def resolve(variant: VariantText, base: WashoutParams, where: str | None = None) -> Washout:
+    """The variant as a :class:`Washout`: ``base`` with its overrides applied."""
+    src = where or f"--variant {variant.name}"
+    return Washout(variant.name, variant.kind, apply_overrides(base, variant.overrides, src))
+
+
+def _flatten(value: Any, prefix: str, loc: Loc, out: dict[str, tuple[Any, Loc]]) -> None:
+    if isinstance(value, dict):
+        for k, v in value.items():
+            _flatten(v, f"{prefix}.{k}" if prefix else str(k), (*loc, k), out)
+    else:
+        out[prefix] = (value, loc)
+
+
+def _file_variants(path: Path, data: Any, lines: dict[Loc, int], base: WashoutParams) -> tuple[Washout, ...]:
+    """The ``variants:`` section of a parameter file as Washouts (errors name file, line and field)."""
+    if not isinstance(data, dict):
+        raise WashbenchError(
+            located(
+                path,
+                "expected a mapping of variant name -> {kind, keys}",
+                line=line_of(lines, ("variants",)),
+                field="variants",
+            )
+        )
+    out = []
+    for name, body in data.items():
+        loc: Loc = ("variants", name)
+        field = f"variants.{name}"
+        check_name(str(name), located(path, field, line=line_of(lines, loc)))
+        if not isinstance(body, dict) or "kind" not in body:
+            raise WashbenchError(
+                located(
+                    path, "expected a mapping with 'kind' and parameter keys", line=line_of(lines, loc), field=field
+                )
+            )
+        kind = check_kind(str(body["kind"]), located(path, f"{field}.kind", line=line_of(lines, (*loc, "kind"))))
+        flat: dict[str, tuple[Any, Loc]] = {}
+        _flatten({k: v for k, v in body.items() if k != "kind"}, "", loc, flat)
+        key_lines = {k: line_of(lines, where) for k, (_, where) in flat.items()}
+        for key in flat:
+            check_key(key, located(path, field, line=key_lines[key]))
+        params = apply_overrides(base, {k: v for k, (v, _) in flat.items()}, str(path), key_lines, f"{field}.")
+        out.append(Washout(str(name), kind, params))
+    return tuple(out)
+
+
+def load_param_file(path: Path | None = None) -> tuple[WashoutParams, tuple[Washout, ...]]:
+    """A parameter file's base set and its ``variants:`` section (``None``: the bundled CW1, no variants)."""
+    from washbench.cueing.params import load_base_params
+
+    path = DEFAULT_PARAMS_PATH if path is None else Path(path)
+    data, lines = read_yaml(path)
+    if not isinstance(data, dict):
+        return validate_data(path, data, lines, WashoutParams), ()
+    variants = data.pop("variants", None)
+    base = load_base_params(path, data, lines)
+    return base, (() if variants is None else _file_variants(path, variants, lines, base))
+
+
+def builtin(names: Sequence[str], params: WashoutParams) -> tuple[Washout, ...]:
+    """Built-in washouts (named after their kind) with one parameter set."""
+    return tuple(Washout(n, n, params) for n in check_washouts(names))
+
+
+def as_washouts(washouts: Sequence[str | Washout], params: WashoutParams | None) -> tuple[Washout, ...]:
+    """Names (built-in washouts, using ``params``) and Washouts as one checked tuple of Washouts."""
+    out: list[Washout] = []
+    for w in washouts:
+        if isinstance(w, Washout):
+            out.append(w)
+        else:
+            if params is None:
+                raise ValueError(f"washout {w!r} given by name needs a parameter set")
+            out.extend(builtin([w], params))
+    if not out:
+        raise WashbenchError("no washout selected")
+    names = [w.name for w in out]
+    if len(set(names)) != len(names):
+        raise WashbenchError(f"washout listed twice: {', '.join(names)}")
+    return tuple(out)
+
+
+def select_washouts(
+    washouts: Sequence[str] | None = None,
+    variants: Sequence[str] = (),
+    params_path: Path | None = None,
+) -> tuple[Washout, ...]:
+    """The washouts a command runs, from ``--washout`` names, ``--variant`` texts and ``--params FILE``.
+
+    No variant anywhere: the named built-in washouts (default all three). Any variant (command line or the
+    file's ``variants:`` section): the named built-in washouts (default none), then the file's variants, then
+    the command line's. Raises WashbenchError (one line) for any bad name, kind, key or value.
+    """
+    base, from_file = load_param_file(params_path)
+    parsed = [parse_variant(v) for v in variants]
+    extra = from_file + tuple(resolve(v, base) for v in parsed)
+    named = list(dict.fromkeys(washouts)) if washouts else ([] if extra else list(WASHOUT_KINDS))
+    return as_washouts([*builtin(named, base), *extra] if named else list(extra), None)
+
+
+__all__ = [
+    "VariantText",
+    "Washout",
+    "apply_overrides",
+    "as_washouts",
+    "builtin",
+    "check_key",
+    "load_param_file",
+    "parse_value",
+    "parse_variant",
+    "resolve",
+    "select_washouts",
+]

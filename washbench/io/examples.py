@@ -1,0 +1,54 @@
+"""``washbench examples DIR``: copy the bundled manoeuvres and pilot profiles into a folder the user can edit.
+
+The copy is laid out as a washbench project: ``DIR/manoeuvres/<aircraft>/<name>.yaml`` and
+``DIR/aircraft/<aircraft>/pilot.yaml``. A manoeuvre in ``DIR/manoeuvres/`` finds ``DIR/aircraft/`` by the
+"``aircraft/`` next to the manoeuvre or in a parent" rule, so an edited profile there is the one flown (the
+aircraft models themselves are still found bundled or in JSBSim; copy a model folder into ``DIR/aircraft/``
+to change it too).
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+from washbench.errors import WashbenchError, located
+from washbench.io.atomic import write_text_atomic
+from washbench.io.paths import AIRCRAFT_DIR, MANOEUVRES_DIR, PROFILE_NAME
+
+
+def example_files(dest: Path) -> list[tuple[Path, Path]]:
+    """(bundled source, destination) pairs for every file ``washbench examples`` copies."""
+    pairs = [
+        (src, dest / "manoeuvres" / src.relative_to(MANOEUVRES_DIR)) for src in sorted(MANOEUVRES_DIR.rglob("*.yaml"))
+    ]
+    pairs += [
+        (src, dest / "aircraft" / src.parent.name / PROFILE_NAME)
+        for src in sorted(AIRCRAFT_DIR.glob(f"*/{PROFILE_NAME}"))
+    ]
+    return pairs
+
+
+def copy_examples(dest: Path) -> int:
+    """Copy the examples into ``dest`` (created); refuse before writing anything if a destination file exists."""
+    if dest.exists() and not dest.is_dir():
+        raise WashbenchError(located(dest, "exists and is not a folder"))
+    pairs = example_files(dest)
+    existing = [d for _, d in pairs if d.exists()]
+    if existing:
+        raise WashbenchError(
+            located(existing[0], f"already exists ({len(existing)} of the files to copy do); nothing copied")
+        )
+    try:
+        for src, dst in pairs:
+            dst.parent.mkdir(parents=True, exist_ok=True)
+            write_text_atomic(dst, src.read_text())
+    except OSError as exc:
+        raise WashbenchError(located(dest, f"cannot write ({exc.strerror or exc})")) from None
+    n_m = sum(1 for _, d in pairs if d.suffix == ".yaml" and "manoeuvres" in d.parts)
+    print(f"{n_m} manoeuvres and {len(pairs) - n_m} pilot profiles copied to {dest}")
+    print(f"  run one:   washbench run {dest / 'manoeuvres' / 'c172' / 'coordinated_turn.yaml'} --out results")
+    print(f"  run all:   washbench suite {dest / 'manoeuvres'} --out results")
+    print(f"  profiles:  {dest / 'aircraft'}/<aircraft>/pilot.yaml are used by the manoeuvres under {dest}")
+    sys.stdout.flush()
+    return 0

@@ -1,0 +1,51 @@
+"""The vestibular models' compiled core: parallel first-order sections, stepped per sample or over a trace.
+
+A model discretised for one time step (:class:`washbench.perception.vestibular.DiscreteModel`) is a sum of
+first-order sections ``x_i[k] = phi_i x_i[k-1] + b_i0 u[k] + b_i1 u[k-1]``, output ``y[k] = sum_i x_i[k]``
+(summed in section order). :func:`sections_step` is that one step; :func:`sections_apply` runs it over whole
+columns, and the studies' evaluation kernel (:mod:`washbench.analysis.evaluate`) calls the same step per sample,
+so both give the same bits. A filter starts in the steady state of its first sample: ``x_i = s_i u[0]`` with
+``s_i`` the section's DC gain.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+import washbench.cueing.jitcache  # noqa: F401  (numba's cache folder is set before anything here is compiled)
+
+
+@njit(cache=True, inline="always")
+def sections_init(steady, x, u0):
+    """Set the section states ``x`` (S,) to the steady state of a constant input ``u0``."""
+    for i in range(x.shape[0]):
+        x[i] = steady[i] * u0
+
+
+@njit(cache=True, inline="always")
+def sections_step(b, phi, x, u_prev, u):
+    """One sample: advance the section states ``x`` (S,) with input ``u`` (previous ``u_prev``); return y."""
+    y = 0.0
+    for i in range(x.shape[0]):
+        x[i] = phi[i] * x[i] + b[i, 0] * u + b[i, 1] * u_prev
+        y += x[i]
+    return y
+
+
+@njit(cache=True, parallel=True)
+def sections_apply(b, phi, steady, u):
+    """Filter every column of ``u`` (N, m) along axis 0, each starting in its first sample's steady state.
+
+    Returns (N, m) in column-major order (each column contiguous, as the metrics and tables read them).
+    """
+    n, m = u.shape
+    yt = np.empty((m, n))
+    for j in prange(m):
+        x = np.empty(phi.shape[0])
+        sections_init(steady, x, u[0, j])
+        u_prev = u[0, j]
+        for k in range(n):
+            yt[j, k] = sections_step(b, phi, x, u_prev, u[k, j])
+            u_prev = u[k, j]
+    return yt.T

@@ -1,0 +1,162 @@
+"""What the studies (``sweep``, ``tune``) share: the flights, flown once, and batches of evaluations on them.
+
+Flights are flown once per study (in parallel processes, or on a Dask cluster) and written as
+``DIR/flights/<aircraft>/<manoeuvre>/flight.parquet`` + ``flight.json`` (what ``washbench fly`` writes), or read
+from earlier results (``--from RESULTS_DIR``: a ``suite`` or ``run`` results folder, or a study's ``flights/``).
+Each flight is read back exactly as ``washbench cue`` reads it, so an evaluation equals ``washbench cue`` on that
+file. Evaluations never fly JSBSim and write nothing: :class:`washbench.analysis.evaluate.FlightEvaluator` runs a
+batch of candidates in one compiled call over the whole trace, parallel over candidates on every core.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+from collections.abc import Sequence
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from washbench.analysis.evaluate import Evaluation, FlightEvaluator
+from washbench.cueing.variants import Washout
+from washbench.errors import WashbenchError, located
+
+FLIGHTS_DIR = "flights"
+
+
+@dataclass(frozen=True)
+class StudyFlight:
+    """One recorded flight of a study, ready to evaluate."""
+
+    aircraft: str
+    manoeuvre: str
+    source: str  # the flight.parquet read
+    ok: bool  # flown and passed its checks (True for flights read with --from)
+    reason: str
+    evaluator: FlightEvaluator
+
+
+def _fly_one(path: str, flights_dir: str, aircraft_dirs: tuple[str, ...] = ()) -> tuple[str, str, bool, str]:
+    """Worker: fly one manoeuvre (no washouts, no recording) and write its flight; (aircraft, name, ok, reason)."""
+    from washbench.flight.fly import fly, write_flight
+    from washbench.flight.manoeuvre import load_manoeuvre
+
+    m = load_manoeuvre(Path(path), [Path(d) for d in aircraft_dirs])
+    result = fly(m)
+    write_flight(Path(flights_dir) / m.aircraft / m.name, result, path)
+    return m.aircraft, m.name, result.ok, result.reason
+
+
+def _identify(paths: Sequence[Path], aircraft_dirs: Sequence[Path]) -> list[tuple[str, str, str]]:
+    """(path, aircraft, name) of every manoeuvre file, validated (bad files stop the study before any work)."""
+    from washbench.flight.manoeuvre import load_manoeuvre
+
+    out = []
+    for p in paths:
+        m = load_manoeuvre(p, aircraft_dirs)
+        out.append((str(p), m.aircraft, m.name))
+    names = [(a, n) for _, a, n in out]
+    if len(set(names)) != len(names):
+        raise WashbenchError("two manoeuvre files have the same aircraft and name: results would overwrite")
+    return out
+
+
+def load_flights(
+    manoeuvres: Sequence[Path],
+    out_dir: Path,
+    limits: object,
+    *,
+    from_dir: Path | None = None,
+    jobs: int | None = None,
+    dask: str | None = None,
+    progress: bool = True,
+    aircraft_dirs: Sequence[Path] = (),
+) -> list[StudyFlight]:
+    """The study's flights: flown once into ``out_dir/flights/`` or read from ``from_dir``; in manoeuvre order."""
+    from washbench.io.results import read_motion
+
+    ids = _identify(manoeuvres, aircraft_dirs)
+    status: dict[tuple[str, str], tuple[bool, str]] = {}
+    if from_dir is not None:
+        root = Path(from_dir)
+        for _, aircraft, name in ids:
+            status[(aircraft, name)] = (True, "")
+    else:
+        root = Path(out_dir) / FLIGHTS_DIR
+        dirs = tuple(str(d) for d in aircraft_dirs)
+        args = [(p, str(root), dirs) for p, _, _ in ids]
+        if progress:
+            print(f"study: flying {len(args)} manoeuvre(s) once -> {root}", file=sys.stderr, flush=True)
+        for aircraft, name, ok, reason in _map(_fly_one, args, jobs, dask):
+            status[(aircraft, name)] = (ok, reason)
+            if progress:
+                print(f"  {aircraft}/{name}: {'ok' if ok else 'FAILED (' + reason + ')'}", file=sys.stderr, flush=True)
+    flights = []
+    for _, aircraft, name in ids:
+        src = root / aircraft / name / "flight.parquet"
+        if not src.is_file():
+            raise WashbenchError(located(src, f"no flight for {aircraft}/{name} (run or suite it first)"))
+        motion = read_motion(src)
+        ok, reason = status[(aircraft, name)]
+        ev = FlightEvaluator(motion.f_mps2, motion.omega_radps, motion.dt_s, limits)
+        flights.append(StudyFlight(aircraft, name, str(src), ok, reason, ev))
+    return flights
+
+
+def _map(fn, args: list[tuple], jobs: int | None, dask: str | None) -> list:
+    """``fn(*a)`` for each ``a``: on the Dask cluster, in forked worker processes, or here (one job)."""
+    if dask:
+        from washbench.runs.cluster import dask_map
+
+        return list(dask_map(dask, fn, args))
+    jobs = max(1, min(jobs or os.cpu_count() or 1, len(args)))
+    if jobs == 1:
+        return [fn(*a) for a in args]
+    from washbench.runs.suite import pool_context
+
+    ctx, initializer = pool_context()
+    with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=initializer) as pool:
+        return list(pool.map(fn, *zip(*args, strict=True)))
+
+
+def _evaluate_task(evaluator: FlightEvaluator, cfg: np.ndarray, coef: np.ndarray) -> Evaluation:
+    """Cluster task: one batch of candidates (compiled arrays) on one flight."""
+    return evaluator.evaluate_arrays(cfg, coef)
+
+
+def _concat(parts: Sequence[Evaluation]) -> Evaluation:
+    fields = Evaluation.__dataclass_fields__
+    return Evaluation(**{k: np.concatenate([getattr(p, k) for p in parts]) for k in fields})
+
+
+def evaluate(
+    flights: Sequence[StudyFlight], candidates: Sequence[Washout], dask: str | None = None
+) -> list[Evaluation]:
+    """Every candidate on every flight: one Evaluation (M candidates) per flight, in flight order.
+
+    Locally one compiled call per flight uses every core (threads over candidates); with ``dask`` the batches go
+    to the cluster as tasks (each flight sent to every worker once) and give the same numbers.
+    """
+    if not candidates:
+        raise WashbenchError("no candidate to evaluate")
+    if not dask:
+        return [f.evaluator.evaluate(candidates) for f in flights]
+    from washbench.runs.cluster import client
+
+    c = client(dask)
+    n_workers = max(1, len(c.scheduler_info().get("workers", {})))
+    chunk = max(1, math.ceil(len(candidates) / (2 * n_workers)))
+    futures = []
+    for f in flights:
+        cfg, coef = f.evaluator.arrays(candidates)
+        [ev] = c.scatter([f.evaluator], broadcast=True)
+        futures.append(
+            [
+                c.submit(_evaluate_task, ev, cfg[i : i + chunk], coef[i : i + chunk], pure=False)
+                for i in range(0, len(candidates), chunk)
+            ]
+        )
+    return [_concat(c.gather(fs)) for fs in futures]

@@ -1,0 +1,233 @@
+"""``washbench tune``: tune a washout's parameters on training manoeuvres, check them on test manoeuvres.
+
+Minimises ``mean score over the training flights + saturation_weight * mean fraction of time at a platform limit``
+(:mod:`washbench.analysis.tune` says why a penalty and why differential evolution) within ``--budget``
+evaluations, deterministic for ``--seed``. Flights are flown once (or read with ``--from``); every evaluation is a
+batch member of one compiled call per flight. Writes, each atomically:
+
+- ``DIR/tuned.yaml``: a complete parameter file (loadable with ``--params``) with the tuned values;
+- ``DIR/tune.csv``: every evaluation (index 0 is the starting set): ``index``, the tuned keys, ``score`` (mean
+  over the training flights), ``saturated_s`` (summed over them), ``objective``;
+- ``DIR/report.md`` and ``DIR/convergence.png``: the base set (e.g. CW1) against the tuned set on the training and
+  the test manoeuvres.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import time
+from collections.abc import Sequence
+from datetime import UTC, datetime
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from washbench.analysis.sweep import format_value
+from washbench.analysis.tune import Bound, minimise, parse_tune
+from washbench.cueing.params import WashoutParams
+from washbench.cueing.variants import Washout, apply_overrides, check_kind
+from washbench.errors import WashbenchError
+from washbench.io.atomic import write_text_atomic
+from washbench.io.results import csv_number
+
+
+def params_yaml(params: WashoutParams, header: str) -> str:
+    """A complete parameter file for ``params`` (switched-off limits written ``off``), after a comment header."""
+
+    def off(v: object) -> object:
+        if isinstance(v, dict):
+            return {k: off(x) for k, x in v.items()}
+        return "off" if v is None else v
+
+    body = yaml.safe_dump(off(params.model_dump(mode="json")), sort_keys=False, default_flow_style=None)
+    comment = "".join(f"# {line}\n" if line else "#\n" for line in header.splitlines())
+    return comment + body
+
+
+def tune_command(
+    manoeuvres: Sequence[Path],
+    out_dir: Path,
+    *,
+    washout: str,
+    tunes: Sequence[str],
+    test: Sequence[Path] = (),
+    budget: int = 200,
+    seed: int = 0,
+    saturation_weight: float = 1.0,
+    params_path: Path | None = None,
+    platform_path: Path | None = None,
+    from_dir: Path | None = None,
+    jobs: int | None = None,
+    dask: str | None = None,
+    progress: bool = True,
+    aircraft_dirs: Sequence[Path] = (),
+) -> int:
+    """CLI entry of ``washbench tune``; 0 on success (the flights' own check results are reported, not fatal)."""
+    from washbench.cueing.variants import load_param_file
+    from washbench.platform import load_platform_limits
+    from washbench.runs.study import evaluate, load_flights
+    from washbench.runs.suite import find_manoeuvres
+
+    start = time.perf_counter()
+    kind = check_kind(washout, "--washout")
+    if not tunes:
+        raise WashbenchError("tune: give at least one --tune KEY=LOW:HIGH")
+    if not (saturation_weight >= 0.0 and np.isfinite(saturation_weight)):
+        raise WashbenchError(f"--saturation-weight: expected a number >= 0, got {saturation_weight}")
+    if budget < 6:
+        raise WashbenchError(f"--budget: expected at least 6 evaluations (1 for the starting set), got {budget}")
+    bounds = [parse_tune(t) for t in tunes]
+    keys = [b.key for b in bounds]
+    if len(set(keys)) != len(keys):
+        raise WashbenchError(f"--tune: a key is tuned twice: {', '.join(keys)}")
+    base, _ = load_param_file(params_path)
+    for b in bounds:  # both ends must be valid values of the key
+        for v in (b.low, b.high):
+            apply_overrides(base, {b.key: v}, f"--tune {b.key}={b.low}:{b.high}")
+    limits = load_platform_limits(platform_path)
+    train_files = find_manoeuvres(manoeuvres)
+    test_files = [p for p in (find_manoeuvres(test) if test else []) if p not in train_files]
+    flights = load_flights(
+        [*train_files, *test_files],
+        out_dir,
+        limits,
+        from_dir=from_dir,
+        jobs=jobs,
+        dask=dask,
+        progress=progress,
+        aircraft_dirs=aircraft_dirs,
+    )
+    train, tests = flights[: len(train_files)], flights[len(train_files) :]
+    durations = np.array([f.evaluator.n * f.evaluator.dt_s for f in train])
+
+    def candidate(x: np.ndarray) -> Washout:
+        point = dict(zip(keys, (float(v) for v in x), strict=True))
+        return Washout(kind, kind, apply_overrides(base, point, "--tune"))
+
+    history: list[tuple[np.ndarray, float, float, float]] = []
+
+    def objective(xs: np.ndarray) -> np.ndarray:
+        results = evaluate(train, [candidate(x) for x in xs], dask)
+        score = np.mean([r.score for r in results], axis=0)
+        sat = np.sum([r.saturated_s for r in results], axis=0)
+        frac = np.mean([r.saturated_s / d for r, d in zip(results, durations, strict=True)], axis=0)
+        obj = score + saturation_weight * frac
+        history.extend((x.copy(), float(s), float(t), float(o)) for x, s, t, o in zip(xs, score, sat, obj, strict=True))
+        return obj
+
+    x0 = np.array([_value(base, k) for k in keys])
+    [base_obj] = objective(x0[None, :])  # evaluation 0: the starting set
+    best_x = minimise(objective, bounds, budget - 1, seed, x0)
+    tuned = candidate(best_x).params
+    label = f"{base.name} tuned for {kind}"
+    tuned = tuned.model_copy(update={"name": label})
+    _write(out_dir, base, tuned, kind, bounds, history, budget, seed, saturation_weight, manoeuvres, base_obj)
+
+    both = [Washout(base.name, kind, base), Washout("tuned", kind, tuned)]
+    table = []
+    for group, fl in (("training", train), ("test", tests)):
+        for f, r in zip(fl, evaluate(fl, both, dask) if fl else [], strict=True):
+            table.append((group, f.aircraft, f.manoeuvre, r))
+    _report(out_dir, base, tuned, kind, bounds, best_x, table, history, base_obj, budget, seed, saturation_weight)
+    best = min(history, key=lambda h: h[3])
+    print(
+        f"tune: {kind}, {len(history)} evaluations on {len(train)} training flight(s) in "
+        f"{time.perf_counter() - start:.1f} s; objective {base.name} {base_obj:.4f} -> tuned {best[3]:.4f} "
+        f"({', '.join(f'{k}={v:.6g}' for k, v in zip(keys, best_x, strict=True))}); wrote {out_dir / 'tuned.yaml'}"
+    )
+    return 0
+
+
+def _value(params: WashoutParams, key: str) -> float:
+    node: object = params
+    for part in key.split("."):
+        node = getattr(node, part)
+    if node is None or isinstance(node, bool | str):
+        raise WashbenchError(f"--tune {key}: the base value is {format_value(node)}, not a number to start from")
+    return float(node)  # type: ignore[arg-type]
+
+
+def _write(
+    out_dir: Path,
+    base: WashoutParams,
+    tuned: WashoutParams,
+    kind: str,
+    bounds: list[Bound],
+    history: list[tuple[np.ndarray, float, float, float]],
+    budget: int,
+    seed: int,
+    weight: float,
+    manoeuvres: Sequence[Path],
+    base_obj: float,
+) -> None:
+    keys = [b.key for b in bounds]
+    header = (
+        f"{tuned.name}: written by washbench tune ({datetime.now(UTC):%Y-%m-%d}).\n"
+        f"Differential evolution (scipy), seed {seed}, budget {budget} evaluations, starting from {base.name}.\n"
+        f"Minimised: mean score over {len(manoeuvres)} training input(s) of the {kind} washout\n"
+        f"+ {weight:g} x mean fraction of time at a platform limit (objective {base.name} {base_obj:.6g}).\n"
+        f"Tuned: " + ", ".join(f"{b.key} in [{b.low:g}, {b.high:g}]" for b in bounds) + ".\n"
+        "Every other value is the starting set's; see washbench/data/cw1.yaml for what each key means."
+    )
+    out_dir.mkdir(parents=True, exist_ok=True)
+    write_text_atomic(out_dir / "tuned.yaml", params_yaml(tuned, header))
+    rows = [["index", *keys, "score", "saturated_s", "objective"]]
+    for i, (x, s, t, o) in enumerate(history):
+        rows.append([str(i), *(csv_number(float(v)) for v in x), csv_number(s), csv_number(t), csv_number(o)])
+    buf = io.StringIO()
+    csv.writer(buf, lineterminator="\n").writerows(rows)
+    write_text_atomic(out_dir / "tune.csv", buf.getvalue())
+
+
+def _report(
+    out_dir: Path,
+    base: WashoutParams,
+    tuned: WashoutParams,
+    kind: str,
+    bounds: list[Bound],
+    best_x: np.ndarray,
+    table: list,
+    history: list,
+    base_obj: float,
+    budget: int,
+    seed: int,
+    weight: float,
+) -> None:
+    from washbench.review.study_figures import convergence_figure
+
+    objective = np.array([h[3] for h in history])
+    convergence_figure(out_dir / "convergence.png", objective, base_obj, base.name)
+    lines = [
+        f"# Tuning the {kind} washout",
+        "",
+        f"Differential evolution (scipy), seed {seed}, {len(history)} of {budget} evaluations (0: {base.name}).",
+        f"Objective: mean score over the training manoeuvres + {weight:g} x mean fraction of time at a platform",
+        "limit (a penalty: see washbench/analysis/tune.py). Score: the ranking rule (lower is better, 1 = no better",
+        "than a simulator that stands still). Saturation: seconds at any platform limit.",
+        "",
+        "| key | bounds | " + base.name + " | tuned |",
+        "|---|---|---|---|",
+    ]
+    for b, x in zip(bounds, best_x, strict=True):
+        lines.append(f"| `{b.key}` | {b.low:g} .. {b.high:g} | {_value(base, b.key):.6g} | {x:.6g} |")
+    lines += [
+        "",
+        f"| set | aircraft | manoeuvre | score {base.name} | score tuned | saturated s {base.name} "
+        "| saturated s tuned |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    means: dict[str, list[tuple[float, float]]] = {}
+    for group, aircraft, manoeuvre, r in table:
+        means.setdefault(group, []).append((float(r.score[0]), float(r.score[1])))
+        lines.append(
+            f"| {group} | {aircraft} | {manoeuvre} | {r.score[0]:.4f} | {r.score[1]:.4f} | "
+            f"{r.saturated_s[0]:.2f} | {r.saturated_s[1]:.2f} |"
+        )
+    lines.append("")
+    for group, pairs in means.items():
+        a, b = np.mean(pairs, axis=0)
+        lines.append(f"Mean score on the {group} manoeuvres: {base.name} {a:.4f}, tuned {b:.4f}.")
+    lines += ["", "![convergence](convergence.png)", "", "Tuned parameter file: [tuned.yaml](tuned.yaml).", ""]
+    write_text_atomic(out_dir / "report.md", "\n".join(lines))
