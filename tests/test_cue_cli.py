@@ -68,8 +68,15 @@ def test_cue_writes_traces_and_metrics(kind: str, inputs: dict[str, Path], tmp_p
     out = tmp_path / "new" / "results"  # created if missing
     res = cue(inputs[kind], "--out", out)
     assert res.returncode == 0, res.stderr
-    assert "2401 rows" in res.stdout and str(out / "traces.parquet") in res.stdout
-    assert sorted(p.name for p in out.iterdir()) == ["metrics.csv", "traces.parquet"]
+    assert "2401 rows" in res.stdout and f"wrote {out}" in res.stdout
+    assert sorted(p.name for p in out.iterdir()) == [
+        "metrics.csv",
+        "ranking.csv",
+        "recording.rrd",
+        "report.md",
+        "run.json",
+        "traces.parquet",
+    ]
 
     rows = read_metrics_csv(out / "metrics.csv")
     assert len(rows) == 18
@@ -156,7 +163,7 @@ def bad_cases(d: Path) -> dict[str, tuple[list[str | Path], str]]:
         "inf": ([variant("f.csv", omega_y_degps=(9, math.inf))], "f.csv:11: omega_y_degps: value is infinite"),
         "empty": ([empty], "empty.csv: the file is empty"),
         "unreadable": ([junk], "junk.parquet: not a readable Parquet file"),
-        "extension": ([d / "trace.txt"], "trace.txt: unknown file type '.txt'"),
+        "extension": ([d / "trace.dat"], "trace.dat: unknown file type '.dat'"),
         "washout": ([d / "ok.csv", "--washout", "big-angle"], "unknown washout 'big-angle' (valid: small-angle"),
         "params": ([d / "ok.csv", "--params", params], f"params.yaml:{params_line}: surge_gain: unknown key"),
     }
@@ -166,7 +173,7 @@ def test_bad_inputs_one_line_exit_2_nothing_written(tmp_path: Path) -> None:
     d = tmp_path / "in"
     d.mkdir()
     write_csv(d / "ok.csv", synthetic())
-    (d / "trace.txt").write_text("t_s\n0\n")
+    (d / "trace.dat").write_text("t_s\n0\n")
     cases = bad_cases(d)
     # a results folder holding an earlier metrics.csv: a failing run must not touch it
     out = tmp_path / "out"

@@ -44,7 +44,16 @@ def run_dir(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFac
 def test_run_writes_every_file_and_nothing_else(run_dir: Path) -> None:
     names = sorted(p.name for p in run_dir.iterdir())
     assert names == sorted(
-        ["flight.json", "flight.parquet", "traces.parquet", "metrics.csv", "recording.rrd", "run.json"]
+        [
+            "flight.json",
+            "flight.parquet",
+            "traces.parquet",
+            "metrics.csv",
+            "recording.rrd",
+            "run.json",
+            "ranking.csv",
+            "report.md",
+        ]
     )
     assert not list(run_dir.parent.glob(".*")), "temporary folders left behind"
     flight = json.loads((run_dir / "flight.json").read_text())

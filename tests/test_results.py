@@ -122,7 +122,7 @@ def test_bad_inputs_name_file_line_and_problem(tmp_path: Path) -> None:
     assert "only one data row" in error_of(p)
 
     assert "no such file" in error_of(tmp_path / "nope.csv")
-    assert "unknown file type '.txt'" in error_of(tmp_path / "x.txt")
+    assert "unknown file type '.dat'" in error_of(tmp_path / "x.dat")
     (tmp_path / "dir.csv").mkdir()
     assert "is a folder" in error_of(tmp_path / "dir.csv")
 
@@ -146,10 +146,14 @@ def test_bad_parquet(tmp_path: Path) -> None:
     assert "str.parquet: f_x_mps2: row 1: not a number: 'a'" in error_of(tmp_path / "str.parquet")
 
 
-def test_time_rounded_to_few_digits_is_not_uniform(tmp_path: Path) -> None:
-    """6-decimal times at 120 Hz jitter by 1e-4 of a step: rejected (tolerance 1e-6), with advice."""
-    msg = error_of(write_csv(tmp_path / "r.csv", columns(20), fmt=lambda v: f"{v:.6f}"))
-    assert "full precision" in msg
+def test_time_rounded_to_few_digits(tmp_path: Path) -> None:
+    """6-decimal times at 120 Hz lie within 6e-5 of a step of the grid: on it (tolerance 1e-3 of a step);
+    3-decimal times (up to 0.06 of a step off) are not, and the error says how far off and what to do."""
+    m = read_motion(write_csv(tmp_path / "r6.csv", columns(20), fmt=lambda v: f"{v:.6f}"))
+    assert m.dt_s == pytest.approx(DT, rel=1e-4)
+    msg = error_of(write_csv(tmp_path / "r3.csv", columns(20), fmt=lambda v: f"{v:.3f}"))
+    assert "time step is not uniform" in msg and "of a step off a uniform grid" in msg
+    assert msg.endswith("resample with --resample 120")
 
 
 def test_traces_round_trip(tmp_path: Path) -> None:

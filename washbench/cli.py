@@ -36,8 +36,13 @@ def _study_options(p: argparse.ArgumentParser) -> None:
     """What sweep and tune share."""
     p.add_argument("--params", type=Path, help="base washout parameter YAML (default: bundled CW1)")
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
-    p.add_argument("--from", dest="from_dir", type=Path, metavar="RESULTS_DIR",
-                   help="read RESULTS_DIR/<aircraft>/<manoeuvre>/flight.parquet instead of flying")
+    p.add_argument(
+        "--from",
+        dest="from_dir",
+        type=Path,
+        metavar="RESULTS_DIR",
+        help="read RESULTS_DIR/<aircraft>/<manoeuvre>/flight.parquet instead of flying",
+    )
     p.add_argument("--jobs", type=_jobs, help="parallel processes for the flights (default: number of cores)")
     p.add_argument("--dask", metavar="ADDRESS", help="send the work to this Dask scheduler (washbench[cluster])")
     p.add_argument("--quiet", action="store_true", help="no progress display")
@@ -69,8 +74,14 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
     p = sub.add_parser("cue", help="run washouts, Atlas model, vestibular models and metrics on a recorded trace")
-    p.add_argument("input", type=Path, help="CSV or Parquet: t_s, f_{x,y,z}_mps2, omega_{x,y,z}_degps (body axes)")
-    p.add_argument("--out", type=Path, required=True, help="output folder (traces.parquet, metrics.csv)")
+    p.add_argument(
+        "input",
+        type=Path,
+        help="CSV/TSV/TXT (.gz too), Parquet, X-Plane Data.txt or JSBSim CSV output; washbench's own columns "
+        "t_s, f_{x,y,z}_mps2, omega_{x,y,z}_degps unless mapped",
+    )
+    p.add_argument("--out", type=Path, required=True, help="output folder (a run result folder's files)")
+    _cue_input_options(p)
     _washout_options(p)
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
@@ -89,10 +100,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", type=Path, help="write to this file instead of standard output")
 
     p = sub.add_parser("run", help="fly a manoeuvre with the washouts in lockstep; write traces, metrics, recording")
-    p.add_argument("manoeuvre", type=Path, help="manoeuvre YAML file, or a bundled one by name (c172/takeoff)")
+    p.add_argument(
+        "manoeuvre", type=Path, help="manoeuvre YAML file, a bundled one by name (c172/takeoff), or a JSBSim script"
+    )
     p.add_argument("--out", type=Path, required=True, help="results folder; writes OUT/<aircraft>/<manoeuvre>/")
     _washout_options(p)
     _aircraft_dir_option(p)
+    p.add_argument("--max-time-s", type=float, metavar="S", help="JSBSim script: stop after S s simulated")
+    p.add_argument("--filter-start", choices=("steady", "rest"), default="steady", help="filters' start state")
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
     p.add_argument("--quiet", action="store_true", help="no progress display")
@@ -102,8 +117,11 @@ def build_parser() -> argparse.ArgumentParser:
         "inputs",
         type=Path,
         nargs="*",
-        help="manoeuvre files or folders, or bundled ones by name (c172, columbia400/takeoff); default: all bundled",
+        help="manoeuvre files, JSBSim scripts or folders, or bundled manoeuvres by name (c172, columbia400/takeoff); "
+        "default: all bundled",
     )
+    p.add_argument("--jsbsim-scripts", nargs="+", default=[], metavar="NAME", help="scripts shipped with JSBSim")
+    p.add_argument("--max-time-s", type=float, metavar="S", help="JSBSim scripts: stop each after S s simulated")
     p.add_argument("--out", type=Path, required=True, help="results folder")
     _aircraft_dir_option(p)
     p.add_argument("--jobs", type=_jobs, help="parallel processes (default: number of cores)")
@@ -116,21 +134,37 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("sweep", help="a grid of washout parameters on recorded flights: scores and metrics per point")
     p.add_argument("manoeuvres", type=Path, nargs="+", help="manoeuvre files or folders")
     p.add_argument("--washout", action="append", metavar="KIND", help="washout kind, repeatable (default: all three)")
-    p.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=V1,V2,...",
-                   help="a parameter-file key and its values, repeatable (the grid is every combination)")
+    p.add_argument(
+        "--set",
+        dest="sets",
+        action="append",
+        default=[],
+        metavar="KEY=V1,V2,...",
+        help="a parameter-file key and its values, repeatable (the grid is every combination)",
+    )
     p.add_argument("--out", type=Path, required=True, help="output folder (sweep.csv, sweep_metrics.csv, sweep.png)")
     _study_options(p)
 
     p = sub.add_parser("tune", help="tune washout parameters on training manoeuvres (differential evolution)")
     p.add_argument("manoeuvres", type=Path, nargs="+", help="training manoeuvre files or folders")
     p.add_argument("--washout", required=True, metavar="KIND", help=f"washout kind: {', '.join(WASHOUT_KINDS)}")
-    p.add_argument("--tune", dest="tunes", action="append", default=[], metavar="KEY=LOW:HIGH",
-                   help="a parameter-file key and its search interval, repeatable")
+    p.add_argument(
+        "--tune",
+        dest="tunes",
+        action="append",
+        default=[],
+        metavar="KEY=LOW:HIGH",
+        help="a parameter-file key and its search interval, repeatable",
+    )
     p.add_argument("--test", type=Path, nargs="+", default=[], metavar="MANOEUVRE", help="test manoeuvres")
     p.add_argument("--budget", type=int, default=200, help="evaluations at most (default 200)")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0): same seed, same result")
-    p.add_argument("--saturation-weight", type=float, default=1.0,
-                   help="penalty per unit fraction of time at a platform limit (default 1)")
+    p.add_argument(
+        "--saturation-weight",
+        type=float,
+        default=1.0,
+        help="penalty per unit fraction of time at a platform limit (default 1)",
+    )
     p.add_argument("--out", type=Path, required=True, help="output folder (tuned.yaml, tune.csv, report.md)")
     _study_options(p)
     p = sub.add_parser("examples", help="copy the bundled manoeuvres and pilot profiles into a folder to edit")
@@ -140,6 +174,54 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("recording", type=Path, help=".rrd file written by washbench run or suite")
     p.add_argument("--web", action="store_true", help="always use the web viewer")
     return parser
+
+
+def _cue_input_options(p: argparse.ArgumentParser) -> None:
+    """``washbench cue``'s options for reading, converting, cutting and checking a recording."""
+    g = p.add_argument_group("reading and converting the input")
+    g.add_argument(
+        "--columns", metavar="MAP", help="field=[-]COLUMN[:UNIT],... e.g. t=Time:ms,f_x=ax:g,omega_x=p:radps"
+    )
+    g.add_argument("--input-format", type=Path, metavar="FILE", help="YAML: format, delimiter, axes, columns")
+    g.add_argument("--axes", metavar="XYZ", help="sensor axes as body directions, e.g. flu (z up, y left); default frd")
+    g.add_argument("--delimiter", metavar="D", help="CSV delimiter (default: detected): , ; tab | or a character")
+    g = p.add_argument_group("time")
+    g.add_argument("--resample", type=float, metavar="HZ", help="interpolate onto a uniform grid at HZ (anti-alias)")
+    g.add_argument("--max-gap-s", type=float, metavar="S", help="largest allowed time step (default: 5 median steps)")
+    g.add_argument("--no-split", action="store_true", help="refuse a time reset instead of cueing each part")
+    g.add_argument("--start-s", type=float, metavar="S", help="cue from this time on (input time, s)")
+    g.add_argument("--end-s", type=float, metavar="S", help="cue up to this time (input time, s)")
+    g.add_argument("--filter-start", choices=("steady", "rest"), default="steady",
+                   help="filters start in the first sample's steady state (default) or at rest")  # fmt: skip
+    g = p.add_argument_group("checks and outputs")
+    g.add_argument("--strict", action="store_true", help="plausibility warnings are errors")
+    g.add_argument("--no-recording", action="store_true", help="do not write recording.rrd")
+
+
+def _cue(args: argparse.Namespace) -> int:
+    from washbench.io.input_format import input_format
+    from washbench.runs.cue import CueOptions, run_cue
+
+    opts = CueOptions(
+        fmt=input_format(args.columns, args.input_format, args.axes, args.delimiter),
+        resample_hz=args.resample,
+        max_gap_s=args.max_gap_s,
+        split=not args.no_split,
+        start_s=args.start_s,
+        end_s=args.end_s,
+        filter_start=args.filter_start,
+        strict=args.strict,
+        recording=not args.no_recording,
+    )
+    return run_cue(
+        args.input,
+        args.out,
+        washouts=args.washout,
+        params_path=args.params,
+        platform_path=args.platform,
+        variants=args.variant,
+        options=opts,
+    )
 
 
 def _aircraft_dir_option(p: argparse.ArgumentParser) -> None:
@@ -181,17 +263,7 @@ def _dispatch(args: argparse.Namespace) -> int:
         else:
             args.manoeuvres = [resolve_manoeuvre(m) for m in args.manoeuvres]
     if args.command == "cue":
-        from washbench.runs.cue import run_cue
-
-        run_cue(
-            args.input,
-            args.out,
-            washouts=args.washout,
-            params_path=args.params,
-            platform_path=args.platform,
-            variants=args.variant,
-        )
-        return 0
+        return _cue(args)
     if args.command == "fly":
         from washbench.flight.fly import fly_command
 
@@ -213,6 +285,8 @@ def _dispatch(args: argparse.Namespace) -> int:
             params_path=args.params,
             platform_path=args.platform,
             progress=not args.quiet,
+            max_time_s=args.max_time_s,
+            filter_start=args.filter_start,
             washouts=args.washout,
             variants=args.variant,
             aircraft_dirs=args.aircraft_dir,
@@ -227,6 +301,8 @@ def _dispatch(args: argparse.Namespace) -> int:
             params_path=args.params,
             platform_path=args.platform,
             progress=not args.quiet,
+            jsbsim_scripts=args.jsbsim_scripts,
+            max_time_s=args.max_time_s,
             aircraft_dirs=args.aircraft_dir,
             washouts=args.washout,
             variants=args.variant,

@@ -36,6 +36,7 @@ from washbench.cueing.kernel import (
     C_LP_BEFORE,
     C_PMAX,
     C_R,
+    C_REST,
     C_ROT_SAT,
     C_SF,
     C_SW,
@@ -87,6 +88,18 @@ def _check_dt(dt_s: float) -> float:
     if not (math.isfinite(dt) and lo <= dt <= hi):
         raise WashbenchError(f"time step must be a positive number of seconds, {lo:g}..{hi:g} s, got {dt_s!r}")
     return dt
+
+
+FILTER_STARTS = ("steady", "rest")
+"""Start states: ``steady`` of the first sample (a recording that begins in steady flight), or ``rest`` (the
+simulator level and still, f = [0, 0, -g]: the first sample is a change, as for a recording begun mid-manoeuvre)."""
+
+
+def check_filter_start(start: str) -> str:
+    """``start`` if it is one of :data:`FILTER_STARTS`, else WashbenchError."""
+    if start not in FILTER_STARTS:
+        raise WashbenchError(f"unknown filter start {start!r} (valid: {', '.join(FILTER_STARTS)})")
+    return start
 
 
 def _off(limit: float | None) -> float:
@@ -148,11 +161,15 @@ def washout_arrays(washout: Washout, limits: PlatformLimits, dt: float) -> tuple
 
 
 def build_arrays(
-    washouts: Sequence[Washout], limits: PlatformLimits, dt: float
+    washouts: Sequence[Washout], limits: PlatformLimits, dt: float, filter_start: str = "steady"
 ) -> tuple[np.ndarray, np.ndarray]:
-    """The compiled bank's configuration (n, NCFG) and filters (n, NFILT, 9) for checked washouts and dt."""
+    """The compiled bank's configuration (n, NCFG) and filters (n, NFILT, 9) for checked washouts and dt.
+
+    ``filter_start``: the start state of every washout (:data:`FILTER_STARTS`)."""
     rows = [washout_arrays(w, limits, dt) for w in washouts]
-    return np.stack([r[0] for r in rows]), np.stack([r[1] for r in rows])
+    cfg = np.stack([r[0] for r in rows])
+    cfg[:, C_REST] = 1.0 if check_filter_start(filter_start) == "rest" else 0.0
+    return cfg, np.stack([r[1] for r in rows])
 
 
 @dataclass(frozen=True)
@@ -250,7 +267,8 @@ class CueingBank:
 
     ``step`` returns a (n_washouts, N_FIELDS) float64 array that is REUSED: the next call overwrites it,
     so copy it (e.g. into a preallocated buffer) if you keep it. The first call initialises every filter
-    to the steady state of that sample. ``f_mps2`` and ``omega_radps`` are best given as float64 arrays
+    to the steady state of that sample (``filter_start="rest"``: of rest, see :data:`FILTER_STARTS`).
+    ``f_mps2`` and ``omega_radps`` are best given as float64 arrays
     of shape (3,) (anything else is converted, more slowly). Non-finite input raises ValueError.
     """
 
@@ -263,11 +281,12 @@ class CueingBank:
         params: WashoutParams | None,
         limits: PlatformLimits,
         dt_s: float,
+        filter_start: str = "steady",
     ) -> None:
         self.specs = as_washouts(washouts, params)
         self.washouts = tuple(w.name for w in self.specs)
         self.dt_s = _check_dt(dt_s)
-        self._cfg, self._coef = build_arrays(self.specs, limits, self.dt_s)
+        self._cfg, self._coef = build_arrays(self.specs, limits, self.dt_s, filter_start)
         n = len(self.washouts)
         self._state = np.zeros((n, NSTATE))
         self._counts = np.zeros((n, len(SAT_KINDS)), dtype=np.int64)
@@ -298,14 +317,16 @@ def cue_trace(
     washouts: Sequence[str | Washout],
     params: WashoutParams | None,
     limits: PlatformLimits,
+    filter_start: str = "steady",
 ) -> dict[str, WashoutTrace]:
     """Whole-trace form: run the washouts over arrays f (N, 3) m/s^2 and omega (N, 3) rad/s sampled every dt_s.
 
     ``washouts``: built-in names (with ``params``) or :class:`Washout` variants. Uses the same compiled step as
     :class:`CueingBank` and gives identical results. Raises WashbenchError for wrong shapes or non-finite samples
     (naming the first bad sample) and for a step outside ``washbench.io.results.DT_RANGE_S``. Magnitudes are not
-    limited here (the platform stays within its limits whatever the input); ``read_motion`` refuses physically
+    limited here (the platform stays within its limits whatever the input); the readers refuse physically
     absurd recordings at the file edge.
+    ``filter_start``: see :data:`FILTER_STARTS`.
     """
     specs = as_washouts(washouts, params)
     names = [w.name for w in specs]
@@ -317,7 +338,7 @@ def cue_trace(
     bad = ~(np.isfinite(f).all(axis=1) & np.isfinite(w).all(axis=1))
     if bad.any():
         raise WashbenchError(f"non-finite specific force or angular velocity at sample {int(np.argmax(bad))}")
-    cfg, coef = build_arrays(specs, limits, dt)
+    cfg, coef = build_arrays(specs, limits, dt, filter_start)
     state = np.zeros((len(names), NSTATE))
     counts = np.zeros((len(names), len(SAT_KINDS)), dtype=np.int64)
     out = np.empty((len(names), NFIELDS, f.shape[0]))

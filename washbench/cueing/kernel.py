@@ -74,7 +74,8 @@ C_JAC = 25  # wheel Jacobian, row-major (9)
 C_TILT_AXIS = 34  # 1: the tilt-rate limit clips each axis; 0: it limits the norm (direction kept)
 C_LP_BEFORE = 35  # 1: tilt low-pass on f before the cross product; 0: on the tilt rate after it
 C_HEAD_EULER = 36  # 1: head rate by the Eq. 8 estimator on Euler angles; 0: quaternion difference (Eqs. 18-19)
-NCFG = 37
+C_REST = 37  # 1: start from rest (level, f = [0, 0, -g], no rotation) instead of the first sample's steady state
+NCFG = 38
 
 # filter indices (each 3 consecutive axes)
 F_TRANS_HP, F_TILT_LP, F_ROT_HP, F_EULER_D, F_OMEGA_D = 0, 3, 6, 9, 12
@@ -189,8 +190,12 @@ def step_one(f, om, c, coef, state, counts, row):
     fs = (c[C_SF] * f[0], c[C_SF] * f[1], c[C_SF] * f[2])
     ws, sat_rot = limit_norm((c[C_SW] * om[0], c[C_SW] * om[1], c[C_SW] * om[2]), c[C_ROT_SAT])
     first = state[S_INIT] == 0.0
+    rest = c[C_REST] != 0.0
     if first:
-        _init_washout(kind, c, coef, state, fs, ws)
+        if rest:  # the simulator was at rest before the recording began: the first sample is a change
+            _init_washout(kind, c, coef, state, (0.0, 0.0, -c[C_SF] * g), (0.0, 0.0, 0.0))
+        else:
+            _init_washout(kind, c, coef, state, fs, ws)
     g_i = (0.0, 0.0, g)
     q_sp_prev = (state[S_QSP], state[S_QSP + 1], state[S_QSP + 2], state[S_QSP + 3])
     p_sp_prev = (state[S_PSP], state[S_PSP + 1], state[S_PSP + 2])
@@ -241,7 +246,7 @@ def step_one(f, om, c, coef, state, counts, row):
             state[S_Q + j] = q_sp_prev[j]
         w0 = qrate_body(q_sp, q_sp_prev, dt)  # already moving at the set point's rate: no start jolt
         for j in range(3):
-            state[S_W + j] = w0[j]
+            state[S_W + j] = 0.0 if rest else w0[j]
     sat_pos = 0
     sat_vel = 0
     sat_acc = 0
@@ -288,7 +293,7 @@ def step_one(f, om, c, coef, state, counts, row):
         state[S_EUL + 2] = epsi
         beta = (ephi, etheta, epsi)
         if first:
-            _init3(coef, state, F_EULER_D, beta)
+            _init3(coef, state, F_EULER_D, euler_from_quat(q_prev) if rest else beta)
         bdot = _filt3(coef, state, F_EULER_D, beta)
         wh = body_rates(ephi, etheta, bdot)
         a_s = rot_euler_inv(ephi, etheta, epsi, acc)
@@ -298,7 +303,7 @@ def step_one(f, om, c, coef, state, counts, row):
         a_s = qrot_inv(q, acc)
         g_sh = qrot_inv(q, g_i)
     if first:
-        _init3(coef, state, F_OMEGA_D, wh)
+        _init3(coef, state, F_OMEGA_D, (0.0, 0.0, 0.0) if rest else wh)
     wdot = _filt3(coef, state, F_OMEGA_D, wh)
     r = (c[C_R], c[C_R + 1], c[C_R + 2])
     t1 = cross(wdot, r)
@@ -368,4 +373,13 @@ __all__ = [
     "C_HEAD_EULER",
     "C_LP_BEFORE",
     "C_TILT_AXIS",
-    "FIELDS", "NCFG", "NFIELDS", "NFILT", "NSTATE", "SAT_KINDS", "bank_step", "bank_trace", "step_one"]
+    "FIELDS",
+    "NCFG",
+    "NFIELDS",
+    "NFILT",
+    "NSTATE",
+    "SAT_KINDS",
+    "bank_step",
+    "bank_trace",
+    "step_one",
+]

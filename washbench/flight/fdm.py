@@ -40,7 +40,7 @@ class Setup:
 
 
 @contextlib.contextmanager
-def _quiet_stdout() -> Iterator[None]:
+def quiet_stdout() -> Iterator[None]:
     """Silence JSBSim's C++ console messages (trim reports) by redirecting file descriptor 1."""
     sys.stdout.flush()
     try:
@@ -71,7 +71,7 @@ def make_fdm(m: Manoeuvre, profile: PilotProfile) -> tuple[Any, Setup]:
     root = m.aircraft_files.root
     fdm = jsbsim.FGFDMExec(str(jsbsim_root()), None)
     fdm.set_aircraft_path(str(root))
-    with _quiet_stdout():
+    with quiet_stdout():
         if not fdm.load_model(m.aircraft):
             raise WashbenchError(m.located(("aircraft",), f"JSBSim could not load the model {root / m.aircraft}"))
     fdm.set_dt(m.dt_s)
@@ -128,7 +128,7 @@ def make_fdm(m: Manoeuvre, profile: PilotProfile) -> tuple[Any, Setup]:
     _set_engine_levers(fdm, m.aircraft, profile)
     seed = env.turbulence.seed if env.turbulence is not None else 0
     fdm["simulation/randomseed"] = seed
-    with _quiet_stdout():
+    with quiet_stdout():
         fdm.run_ic()
     fdm["fcs/mixture-cmd-norm"] = 1.0
 
@@ -138,7 +138,7 @@ def make_fdm(m: Manoeuvre, profile: PilotProfile) -> tuple[Any, Setup]:
             _flying_start(fdm, m, profile, heading_deg)
         else:
             try:
-                with _quiet_stdout():
+                with quiet_stdout():
                     fdm.do_trim(1)
             except RuntimeError as exc:
                 raise WashbenchError(
@@ -205,7 +205,7 @@ def _flying_start(fdm: Any, m: Manoeuvre, profile: PilotProfile, heading_deg: fl
     air = m.start.air
     assert air is not None  # only called for air starts
     dt = m.dt_s
-    with _quiet_stdout():
+    with quiet_stdout():
         fdm.run_ic()
     fdm["fcs/mixture-cmd-norm"] = 1.0
     fdm["fcs/flap-cmd-norm"] = air.flaps_deg / profile.limits.flaps_full_cmd_deg
@@ -255,7 +255,7 @@ def _flying_start(fdm: Any, m: Manoeuvre, profile: PilotProfile, heading_deg: fl
     fdm["ic/p-rad_sec"] = 0.0
     fdm["ic/q-rad_sec"] = 0.0
     fdm["ic/r-rad_sec"] = 0.0
-    with _quiet_stdout():
+    with quiet_stdout():
         fdm.run_ic()
     fdm.set_sim_time(0.0)
 
@@ -286,5 +286,5 @@ def _add_wind_to_trimmed_state(fdm: Any, wind_n: float, wind_e: float, crab: boo
     fdm["ic/u-fps"] = u + xb
     fdm["ic/v-fps"] = v + yb
     fdm["ic/w-fps"] = w + zb
-    with _quiet_stdout():
+    with quiet_stdout():
         fdm.run_ic()

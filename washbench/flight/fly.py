@@ -163,7 +163,7 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
 
     pilot = Pilot(profile, m.runway, dt)
     pilot.set_controls(ail_w.get_double_value(), elev_w.get_double_value(), rud_w.get_double_value())
-    monitor = Monitor(profile)
+    monitor = Monitor.for_profile(profile)
     frame = setup.frame
     lat0, lon0, mlat, mlon = frame.lat0, frame.lon0, frame.m_per_rad_lat, frame.m_per_rad_lon
     has_runway = setup.threshold_ne_m is not None

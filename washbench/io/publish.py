@@ -101,16 +101,25 @@ def read_marker(folder: Path, marker: str) -> dict[str, object] | None:
     return doc if isinstance(doc, dict) else None
 
 
-def is_washbench_result(folder: str | Path, marker: str, expect: Mapping[str, object]) -> bool:
-    """Whether ``folder`` holds a result washbench wrote: ``marker`` is a JSON object with the ``expect`` items."""
-    doc = read_marker(Path(folder), marker)
-    return doc is not None and all(doc.get(k) == v for k, v in expect.items())
+def is_washbench_result(folder: str | Path, marker: str, expect: Mapping[str, object], nested: bool = False) -> bool:
+    """Whether ``folder`` holds a result washbench wrote: ``marker`` is a JSON object with the ``expect`` items.
+
+    With ``nested``, a folder of such results (each sub-folder one, e.g. the runs of a JSBSim script) counts too.
+    """
+    folder = Path(folder)
+    doc = read_marker(folder, marker)
+    if doc is not None and all(doc.get(k) == v for k, v in expect.items()):
+        return True
+    if not nested or folder.is_symlink() or not folder.is_dir():
+        return False
+    subs = [e for e in folder.iterdir() if not is_leftover(e.name)]
+    return bool(subs) and all(is_washbench_result(e, marker, expect) for e in subs)
 
 
-def check_replaceable(final: str | Path, marker: str, expect: Mapping[str, object]) -> None:
+def check_replaceable(final: str | Path, marker: str, expect: Mapping[str, object], nested: bool = False) -> None:
     """Raise WashbenchError unless ``final`` is absent or a washbench result that may be replaced."""
     final = Path(final)
-    if (final.exists() or final.is_symlink()) and not is_washbench_result(final, marker, expect):
+    if (final.exists() or final.is_symlink()) and not is_washbench_result(final, marker, expect, nested):
         what = ", ".join(f"{k} {v}" for k, v in expect.items())
         problem = f"exists and is not a washbench result of {what} (no matching {marker}): not replaced"
         raise WashbenchError(located(final, f"{problem}; move it away or choose another --out"))
@@ -128,14 +137,16 @@ def partial_dir(final: str | Path) -> Path:
     return partial
 
 
-def publish_dir(partial: str | Path, final: str | Path, marker: str, expect: Mapping[str, object]) -> None:
+def publish_dir(
+    partial: str | Path, final: str | Path, marker: str, expect: Mapping[str, object], nested: bool = False
+) -> None:
     """Rename the finished folder ``partial`` to ``final``, replacing a previous washbench result there.
 
     What stands at ``final`` is replaced only if :func:`is_washbench_result` recognises it; anything else
     raises WashbenchError and is left untouched (``partial`` is then removed by the caller).
     """
     partial, final = Path(partial), Path(final)
-    check_replaceable(final, marker, expect)
+    check_replaceable(final, marker, expect, nested)
     old = final.with_name(f".{final.name}.old-{os.getpid()}")
     try:
         if final.exists():

@@ -1,7 +1,7 @@
 """On-disk formats: the one place that knows column names.
 
-Input motion (``washbench cue INPUT``), CSV or Parquet, one row per sample, body axes
-(x forward, y right, z down), time uniform and increasing::
+Input motion (``washbench cue INPUT``) in washbench's own columns, one row per sample, body axes
+(x forward, y right, z down), time uniform and increasing (other layouts: :mod:`washbench.io.readers`)::
 
     t_s, f_x_mps2, f_y_mps2, f_z_mps2, omega_x_degps, omega_y_degps, omega_z_degps
 
@@ -38,8 +38,6 @@ from pathlib import Path
 
 import numpy as np
 import pyarrow as pa
-import pyarrow.compute as pc
-import pyarrow.csv as pacsv
 import pyarrow.parquet as pq
 
 from washbench.analysis.metrics import MetricRow
@@ -57,11 +55,6 @@ AIRCRAFT = "aircraft"
 """Source name of the aircraft pilot in traces.parquet."""
 
 METRICS_COLUMNS = ("washout", "dof", "npc", "integral_error", "max_error")
-
-TIME_RTOL = 1e-6
-"""Time steps may differ from the typical (median) step by at most this fraction of it."""
-
-SUFFIXES = {".csv": "csv", ".parquet": "parquet", ".pq": "parquet"}
 
 #: Accepted time steps of an input motion, s (10 kHz to 1 Hz): outside, the filters cannot be discretised
 #: meaningfully (a subnormal step, or one of 8e307 s, overflows them).
@@ -218,214 +211,21 @@ class Motion:
         return self.omega_degps if self.omega_degps is not None else np.degrees(self.omega_radps)
 
 
-def _where(kind: str, index: int) -> tuple[int | None, str]:
-    """(line for located(), row text) for data row ``index`` (0-based)."""
-    if kind == "csv":
-        return index + 2, ""
-    return None, f"row {index + 1}: "
-
-
-def _read_csv_table(path: Path) -> pa.Table:
-    invalid: list[int | None] = []
-
-    def on_invalid(row: pacsv.InvalidRow) -> str:
-        invalid.append(row.number)
-        return "error"
-
-    try:
-        size = path.stat().st_size
-    except OSError as exc:
-        raise WashbenchError(located(path, f"cannot read: {exc.strerror or exc}")) from None
-    if size == 0:
-        raise WashbenchError(located(path, "the file is empty"))
-    read = pacsv.ReadOptions(use_threads=False, block_size=int(min(max(size + 1, 1 << 20), (1 << 31) - 1)))
-    parse = pacsv.ParseOptions(ignore_empty_lines=False, invalid_row_handler=on_invalid)
-    convert = pacsv.ConvertOptions(
-        null_values=[""],
-        strings_can_be_null=True,
-        column_types=dict.fromkeys(INPUT_COLUMNS, pa.string()),
-    )
-    try:
-        return pacsv.read_csv(path, read_options=read, parse_options=parse, convert_options=convert)
-    except pa.ArrowInvalid as exc:
-        text = str(exc)
-        if invalid:
-            raise WashbenchError(
-                located(path, f"wrong number of fields ({text.split(': ', 2)[-1]})", line=invalid[0])
-            ) from None
-        if "Empty CSV" in text:
-            raise WashbenchError(located(path, "the file is empty")) from None
-        raise WashbenchError(located(path, f"not a readable CSV file: {text}")) from None
-    except UnicodeDecodeError:
-        raise WashbenchError(located(path, "not a readable CSV file: it is not UTF-8 text")) from None
-    except OSError as exc:
-        raise WashbenchError(located(path, f"cannot read: {getattr(exc, 'strerror', None) or exc}")) from None
-
-
-def _read_parquet_table(path: Path) -> pa.Table:
-    try:
-        return pq.read_table(path)
-    except FileNotFoundError:
-        raise WashbenchError(located(path, "no such file")) from None
-    except IsADirectoryError:
-        raise WashbenchError(located(path, "is a folder, not a file")) from None
-    except PermissionError as exc:
-        raise WashbenchError(located(path, f"cannot read: {exc.strerror}")) from None
-    except (pa.ArrowException, OSError) as exc:
-        if path.is_file() and path.stat().st_size == 0:
-            raise WashbenchError(located(path, "the file is empty")) from None
-        raise WashbenchError(located(path, f"not a readable Parquet file ({exc})")) from None
-
-
-def _drop_trailing_empty_rows(table: pa.Table) -> pa.Table:
-    """Blank lines at the end of a CSV file read as all-null rows: drop them."""
-    n = table.num_rows
-    if n == 0 or table.num_columns == 0:
-        return table
-    all_null = np.ones(n, dtype=bool)
-    for col in table.columns:
-        all_null &= col.is_null().to_numpy(zero_copy_only=False)
-    end = n
-    while end > 0 and all_null[end - 1]:
-        end -= 1
-    return table.slice(0, end) if end < n else table
-
-
-def _numeric_column(path: Path, kind: str, table: pa.Table, name: str) -> np.ndarray:
-    """A required column as float64, checked: no missing, non-numeric, NaN or infinite values."""
-    col = table.column(name)
-    nulls = col.is_null().to_numpy(zero_copy_only=False)
-    if nulls.any():
-        i = int(np.argmax(nulls))
-        line, row = _where(kind, i)
-        raise WashbenchError(located(path, f"{row}missing value", line=line, field=name))
-    if pa.types.is_string(col.type) or pa.types.is_large_string(col.type):
-        stripped = pc.utf8_trim_whitespace(col)
-        try:
-            col = pc.cast(stripped, pa.float64())
-        except pa.ArrowInvalid:
-            values = stripped.to_pylist()
-            for i, v in enumerate(values):
-                try:
-                    float(v)
-                except ValueError:
-                    line, row = _where(kind, i)
-                    raise WashbenchError(located(path, f"{row}not a number: {v!r}", line=line, field=name)) from None
-            raise WashbenchError(located(path, "column is not numeric", field=name)) from None
-    elif pa.types.is_integer(col.type) or pa.types.is_floating(col.type):
-        col = pc.cast(col, pa.float64())
-    else:
-        raise WashbenchError(located(path, f"column is not numeric (type {col.type})", field=name))
-    arr = col.to_numpy()
-    bad = ~np.isfinite(arr)
-    if bad.any():
-        i = int(np.argmax(bad))
-        line, row = _where(kind, i)
-        what = "NaN" if np.isnan(arr[i]) else "infinite"
-        raise WashbenchError(located(path, f"{row}value is {what}", line=line, field=name))
-    limit = MOTION_MAX.get(name)
-    if limit is not None:
-        big = np.abs(arr) > limit
-        if big.any():
-            i = int(np.argmax(big))
-            line, row = _where(kind, i)
-            unit = "m/s^2" if name in F_COLUMNS else "deg/s"
-            raise WashbenchError(
-                located(path, f"{row}{arr[i]:.6g} is beyond the accepted range +-{limit:g} {unit}", line=line,
-                        field=name)
-            )  # fmt: skip
-    return np.ascontiguousarray(arr, dtype=np.float64)
-
-
-def _check_time(path: Path, kind: str, t: np.ndarray) -> float:
-    """Check that time increases on a uniform grid; return the step [s] (mean over the trace)."""
-    steps = np.diff(t)
-    bad = steps <= 0.0
-    if bad.any():
-        i = int(np.argmax(bad)) + 1
-        line, row = _where(kind, i)
-        raise WashbenchError(
-            located(
-                path, f"{row}time does not increase ({t[i]:.9g} after {t[i - 1]:.9g})", line=line, field=TIME_COLUMN
-            )
-        )
-    typical = float(np.median(steps))
-    if not DT_RANGE_S[0] <= typical <= DT_RANGE_S[1]:
-        raise WashbenchError(
-            located(path, f"time step {typical:.6g} s is outside the accepted {DT_RANGE_S[0]:g}..{DT_RANGE_S[1]:g} s "
-                    f"({1 / DT_RANGE_S[1]:g} Hz to {1 / DT_RANGE_S[0]:g} Hz)", field=TIME_COLUMN)
-        )  # fmt: skip
-    bad = np.abs(steps - typical) > TIME_RTOL * typical
-    if bad.any():
-        i = int(np.argmax(bad)) + 1
-        line, row = _where(kind, i)
-        raise WashbenchError(
-            located(
-                path,
-                f"{row}time step is not uniform: {steps[i - 1]:.9g} s from {t[i - 1]:.9g} to {t[i]:.9g} s, "
-                f"the typical step is {typical:.9g} s (write t_s with full precision)",
-                line=line,
-                field=TIME_COLUMN,
-            )
-        )
-    dt = float((t[-1] - t[0]) / (t.size - 1))
-    k = np.arange(t.size, dtype=np.float64)
-    drift = np.abs(t - (t[0] + k * dt))
-    tol = TIME_RTOL * dt + 4.0 * np.spacing(np.maximum(np.abs(t), abs(dt)))
-    bad = drift > tol
-    if bad.any():
-        i = int(np.argmax(bad))
-        line, row = _where(kind, i)
-        raise WashbenchError(
-            located(path, f"{row}time drifts off the uniform grid of step {dt:.9g} s", line=line, field=TIME_COLUMN)
-        )
-    # A trace written on the grid t_k = t_0 + k * dt (washbench fly, a fixed-step simulator) gets
-    # back exactly that dt, so cueing it again reproduces the original run bit for bit; the mean
-    # step can differ from it in the last bit.
-    first = float(t[1] - t[0])
-    if np.array_equal(t[0] + k * first, t):
-        return first
-    return dt
-
-
 def read_motion(path: str | Path) -> Motion:
-    """Read a motion trace from CSV or Parquet (by extension) and validate it.
+    """Read a motion trace in washbench's own columns and units (CSV, Parquet, ...) on a uniform grid.
 
-    Raises WashbenchError with one line naming the file (and, for CSV, the line) for: a missing,
-    unreadable or empty file, an unknown extension, no or one data row, a missing or non-numeric
-    column, missing, NaN or infinite values, time that does not increase or is not uniform.
+    The plain form of ``washbench cue INPUT`` (no mapping, resampling or splitting; see
+    :mod:`washbench.io.readers` and :mod:`washbench.io.resample` for those). Raises WashbenchError with one
+    line naming the file (and, for text files, the line) for: a missing, unreadable or empty file, an
+    unknown extension, no or one data row, a missing or non-numeric column, missing, NaN or infinite
+    values, time that does not increase, jumps back or is not uniform.
     """
-    path = Path(path)
-    kind = SUFFIXES.get(path.suffix.lower())
-    if kind is None:
-        raise WashbenchError(
-            located(path, f"unknown file type {path.suffix or '(no extension)'!r}: expected .csv or .parquet")
-        )
-    if not path.exists():
-        raise WashbenchError(located(path, "no such file"))
-    if path.is_dir():
-        raise WashbenchError(located(path, "is a folder, not a file"))
-    table = _read_csv_table(path) if kind == "csv" else _read_parquet_table(path)
-    if kind == "csv":
-        table = _drop_trailing_empty_rows(table)
-    names = table.column_names
-    missing = [c for c in INPUT_COLUMNS if c not in names]
-    if missing:
-        raise WashbenchError(located(path, f"missing column {missing[0]!r} (found: {', '.join(names) or 'none'})"))
-    dup = sorted({c for c in names if names.count(c) > 1})
-    if dup:
-        raise WashbenchError(located(path, f"column {dup[0]!r} appears more than once"))
-    if table.num_rows == 0:
-        raise WashbenchError(located(path, "no data rows"))
-    if table.num_rows < 2:
-        raise WashbenchError(located(path, "only one data row: need at least 2 samples"))
-    cols = {c: _numeric_column(path, kind, table, c) for c in INPUT_COLUMNS}
-    t = cols[TIME_COLUMN]
-    dt = _check_time(path, kind, t)
-    f = np.column_stack([cols[c] for c in F_COLUMNS])
-    w_deg = np.column_stack([cols[c] for c in OMEGA_COLUMNS])
-    extra = {name: table.column(name).to_numpy(zero_copy_only=False) for name in names if name not in INPUT_COLUMNS}
-    return Motion(t_s=t, dt_s=dt, f_mps2=f, omega_radps=np.radians(w_deg), extra=extra, omega_degps=w_deg)
+    from washbench.io.readers import read_samples
+    from washbench.io.resample import split_resets, to_motion
+
+    samples = read_samples(Path(path))
+    (only,) = split_resets(samples, split=False)
+    return to_motion(only)
 
 
 # --------------------------------------------------------------------------- writers and readers

@@ -49,3 +49,19 @@ def sections_apply(b, phi, steady, u):
             yt[j, k] = sections_step(b, phi, x, u_prev, u[k, j])
             u_prev = u[k, j]
     return yt.T
+
+
+@njit(cache=True, parallel=True)
+def sections_apply_from(b, phi, steady, u, u0):
+    """:func:`sections_apply` with each column starting in the steady state of ``u0[j]`` (m,) instead of its
+    first sample (the input held at ``u0`` before the trace, ramping to ``u[0]`` over the first step)."""
+    n, m = u.shape
+    yt = np.empty((m, n))
+    for j in prange(m):
+        x = np.empty(phi.shape[0])
+        sections_init(steady, x, u0[j])
+        u_prev = u0[j]
+        for k in range(n):
+            yt[j, k] = sections_step(b, phi, x, u_prev, u[k, j])
+            u_prev = u[k, j]
+    return yt.T

@@ -21,8 +21,11 @@ interpolated input, for any uniform ``dt`` (1/50, 1/120, 1/1000 s ...). The para
 full precision where a direct polynomial form would not (poles within 3e-5 of z = 1 at 1 kHz,
 and the canal's exact DC gain of 0).
 
-Filters start in the steady state of the first sample: a trace that begins in level flight
-(f = [0, 0, -g], omega = 0) perceives [0, 0, -g] and zero rotation from the first sample on.
+Filters start in the steady state of the first sample (``start="steady"``): a trace that begins in level
+flight (f = [0, 0, -g], omega = 0) perceives [0, 0, -g] and zero rotation from the first sample on. With
+``start="rest"`` they start in the steady state of a pilot at rest (f = [0, 0, -g0], g0 = 9.80665 m/s^2,
+omega = 0), the input ramping from rest to the first sample over the step before it: a recording that
+begins mid-manoeuvre is then felt as a change, not as motion the pilot has long adapted to.
 
 Optional perception thresholds (:mod:`washbench.perception.thresholds`) are applied to the
 model outputs as a dead band; they are off by default.
@@ -36,6 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 from pydantic import Field
 
+from washbench.io.units import G0_MPS2
 from washbench.io.yamlio import StrictModel
 from washbench.perception.thresholds import Thresholds, apply_deadband
 
@@ -167,19 +171,24 @@ class DiscreteModel:
         steady = tuple(-r / p for r, p in zip(pf.residues, pf.poles, strict=True))
         return cls(dt_s=dt_s, b=tuple(b), phi=tuple(phi), dc_gain=sum(steady), steady=steady)
 
-    def apply(self, u: np.ndarray) -> np.ndarray:
-        """Filter ``u`` (N,) or (N, m) along axis 0, starting in the steady state of ``u[0]``.
+    def apply(self, u: np.ndarray, start: np.ndarray | None = None) -> np.ndarray:
+        """Filter ``u`` (N,) or (N, m) along axis 0, starting in the steady state of ``start`` (default ``u[0]``).
 
         Returns float64 of the same shape. One compiled pass per column (:mod:`washbench.perception.sections`),
         the same step the studies' evaluation kernel takes per sample.
         """
-        from washbench.perception.sections import sections_apply
+        from washbench.perception.sections import sections_apply, sections_apply_from
 
         u = np.asarray(u, dtype=np.float64)
         if u.ndim not in (1, 2) or u.shape[0] == 0:
             raise ValueError(f"expected a non-empty (N,) or (N, m) array, got shape {u.shape}")
         b, phi, steady = self.arrays()
-        y = sections_apply(b, phi, steady, u if u.ndim == 2 else u.reshape(-1, 1))
+        u2 = u if u.ndim == 2 else u.reshape(-1, 1)
+        if start is None:
+            y = sections_apply(b, phi, steady, u2)
+        else:
+            u0 = np.ascontiguousarray(np.broadcast_to(np.asarray(start, dtype=np.float64), u2.shape[1:]))
+            y = sections_apply_from(b, phi, steady, u2, u0)
         return y.reshape(u.shape)
 
 
@@ -203,6 +212,13 @@ class Perceived:
     omega_radps: np.ndarray
 
 
+FILTER_STARTS = ("steady", "rest")
+"""Start states of the filters: the first sample's steady state, or a pilot at rest (see the module notes)."""
+
+REST_F_MPS2 = (0.0, 0.0, -G0_MPS2)
+"""Specific force of a pilot at rest, body axes [m/s^2] (standard gravity, z down)."""
+
+
 class VestibularModel:
     """Both models discretised once for ``dt_s``; :meth:`perceive` applies them to whole traces."""
 
@@ -212,12 +228,18 @@ class VestibularModel:
         self.otolith = otolith_model(self.params.otolith, self.dt_s)
         self.canals = canal_model(self.params.canals, self.dt_s)
 
-    def perceive(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> Perceived:
-        """Perceived specific force and angular velocity for one pilot's head motion (N, 3) each."""
+    def perceive(self, f_mps2: np.ndarray, omega_radps: np.ndarray, start: str = "steady") -> Perceived:
+        """Perceived specific force and angular velocity for one pilot's head motion (N, 3) each.
+
+        ``start``: ``"steady"`` (the first sample's steady state) or ``"rest"`` (:data:`FILTER_STARTS`).
+        """
         f = _check_n3(f_mps2, "f_mps2")
         w = _check_n3(omega_radps, "omega_radps")
-        f_hat = self.otolith.apply(f)
-        w_hat = self.canals.apply(w)
+        if start not in FILTER_STARTS:
+            raise ValueError(f"unknown filter start {start!r} (valid: {', '.join(FILTER_STARTS)})")
+        rest = start == "rest"
+        f_hat = self.otolith.apply(f, np.array(REST_F_MPS2) if rest else None)
+        w_hat = self.canals.apply(w, np.zeros(3) if rest else None)
         th = self.params.thresholds
         if th is not None:
             f_hat, w_hat = apply_deadband(f_hat, w_hat, th)

@@ -5,15 +5,20 @@ the post-processing:
 
 * :func:`analyse` (motion + finished washout traces -> perception, metrics, tables);
 * :func:`cue_motion` = ``cueing.cue_trace`` + :func:`analyse`;
-* :func:`run_cue` (the CLI): validate, load, compute, then write ``traces.parquet`` and
-  ``metrics.csv`` atomically into the output folder.
+* :func:`run_cue` (the CLI), in stages: :func:`read_input` (reading and conversion to washbench units
+  and axes), :func:`prepare_segments` (time resets, window, gaps, uniform grid or resampling,
+  plausibility), :func:`cue_segments` (cueing), :func:`write_outputs` (per segment the files of a
+  ``run`` result folder, all renamed into place together).
 """
 
 from __future__ import annotations
 
+import contextlib
 import math
+import sys
+import time
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -22,6 +27,12 @@ import numpy as np
 from washbench.analysis.metrics import MetricRow, dof_metrics
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import atomic_path
+from washbench.io.input_format import InputFormat
+from washbench.io.names import check_identifier
+from washbench.io.plausibility import Finding, check_motion
+from washbench.io.publish import result_path
+from washbench.io.readers import Samples, read_samples
+from washbench.io.resample import check_gaps, resample, split_resets, to_motion, window
 from washbench.io.results import (
     AIRCRAFT,
     TIME_COLUMN,
@@ -34,7 +45,6 @@ from washbench.io.results import (
     perceived_omega_columns,
     pos_columns,
     q_columns,
-    read_motion,
     sat_column,
     sp_pos_columns,
     sp_q_columns,
@@ -47,6 +57,7 @@ from washbench.perception.vestibular import Perceived, VestibularModel, Vestibul
 
 TRACES_FILE = "traces.parquet"
 METRICS_FILE = "metrics.csv"
+RECORDING_FILE = "recording.rrd"
 
 _DEG = 180.0 / math.pi
 
@@ -113,15 +124,21 @@ def _checked_trace(name: str, trace: TraceLike, n: int) -> dict[str, np.ndarray]
     return out
 
 
-def analyse(motion: Motion, traces: Mapping[str, TraceLike], vestibular: VestibularParams | None = None) -> CueResult:
+def analyse(
+    motion: Motion,
+    traces: Mapping[str, TraceLike],
+    vestibular: VestibularParams | None = None,
+    filter_start: str = "steady",
+) -> CueResult:
     """Vestibular models for the aircraft pilot and each simulator pilot, metrics, and the traces table.
 
     ``traces`` maps washout name -> its trace on the same time grid as ``motion``. Perception
-    starts each filter in the steady state of its first sample (see :mod:`washbench.perception`).
+    starts each filter in the steady state of its first sample, or of rest (``filter_start="rest"``;
+    see :mod:`washbench.perception`).
     """
     model = VestibularModel(motion.dt_s, vestibular)
     n = motion.n
-    perceived: dict[str, Perceived] = {AIRCRAFT: model.perceive(motion.f_mps2, motion.omega_radps)}
+    perceived: dict[str, Perceived] = {AIRCRAFT: model.perceive(motion.f_mps2, motion.omega_radps, filter_start)}
     table: dict[str, np.ndarray] = {TIME_COLUMN: motion.t_s}
     _put(table, f_columns(AIRCRAFT), motion.f_mps2)
     _put(table, omega_columns(AIRCRAFT), motion.omega_degps_out())
@@ -131,7 +148,7 @@ def analyse(motion: Motion, traces: Mapping[str, TraceLike], vestibular: Vestibu
     ac = perceived[AIRCRAFT]
     for name, trace in traces.items():
         arr = _checked_trace(name, trace, n)
-        p = model.perceive(arr["head_f_mps2"], arr["head_omega_radps"])
+        p = model.perceive(arr["head_f_mps2"], arr["head_omega_radps"], filter_start)
         perceived[name] = p
         rows += dof_metrics(name, ac.f_mps2, ac.omega_radps, p.f_mps2, p.omega_radps, motion.dt_s)
         _put(table, f_columns(name), arr["head_f_mps2"])
@@ -170,13 +187,17 @@ def cue_motion(
     params: Any,
     limits: Any,
     vestibular: VestibularParams | None = None,
+    filter_start: str = "steady",
 ) -> CueResult:
     """Run the washouts (names with ``params``, or Washout variants) and the Atlas model over ``motion``
-    (``cueing.cue_trace``, one compiled call), then :func:`analyse`."""
+    (``cueing.cue_trace``, one compiled call), then :func:`analyse`.
+
+    ``filter_start``: ``steady`` (every filter in the first sample's steady state) or ``rest``.
+    """
     from washbench.cueing import cue_trace
 
-    traces = cue_trace(motion.f_mps2, motion.omega_radps, motion.dt_s, washouts, params, limits)
-    return analyse(motion, traces, vestibular)
+    traces = cue_trace(motion.f_mps2, motion.omega_radps, motion.dt_s, washouts, params, limits, filter_start)
+    return analyse(motion, traces, vestibular, filter_start)
 
 
 def check_washout_names(names: Sequence[str] | None) -> tuple[str, ...]:
@@ -205,6 +226,165 @@ def write_results(out_dir: Path, result: CueResult) -> tuple[Path, Path]:
     return traces_path, metrics_path
 
 
+# --------------------------------------------------------------------------- the cue command, stage by stage
+
+
+@dataclass(frozen=True)
+class CueOptions:
+    """Everything ``washbench cue`` is told besides the input, washouts and parameter files."""
+
+    fmt: InputFormat = field(default_factory=InputFormat)
+    resample_hz: float | None = None
+    max_gap_s: float | None = None
+    split: bool = True
+    start_s: float | None = None
+    end_s: float | None = None
+    filter_start: str = "steady"
+    strict: bool = False
+    recording: bool = True
+
+
+@dataclass(frozen=True, eq=False)
+class Segment:
+    """One part of the input between time resets, ready to cue: its name (a plain identifier, its
+    subfolder when there are several), the motion on its uniform grid, what was done to it and what
+    looks implausible."""
+
+    name: str
+    motion: Motion
+    notes: tuple[str, ...]
+    findings: tuple[Finding, ...]
+
+
+def check_segment_name(name: str) -> str:
+    """``name`` if it is a plain identifier (:mod:`washbench.io.names`: it names a folder)."""
+    return check_identifier(name, "segment name")
+
+
+def read_input(path: Path, fmt: InputFormat) -> Samples:
+    """Reading and conversion: the file, in washbench units and axes (:func:`washbench.io.readers.read_samples`)."""
+    return read_samples(path, fmt)
+
+
+def prepare_segments(samples: Samples, opts: CueOptions) -> list[Segment]:
+    """Window and segments: split at time resets, cut the window, check gaps, put on a uniform grid
+    (``--resample``, else the grid check), then the plausibility checks (errors with ``--strict``)."""
+    parts = split_resets(samples, split=opts.split)
+    out = []
+    for i, part in enumerate(parts):
+        name = check_segment_name(f"segment_{i + 1}") if len(parts) > 1 else ""
+        part = window(part, opts.start_s, opts.end_s)
+        check_gaps(part, opts.max_gap_s)
+        notes = list(part.notes)
+        if opts.resample_hz is not None:
+            motion, note = resample(part, opts.resample_hz)
+            notes.append(note)
+        else:
+            motion = to_motion(part)
+        findings = tuple(check_motion(motion))
+        if opts.strict and findings:
+            where = f" ({name})" if name else ""
+            raise WashbenchError(located(samples.path, f"{findings[0].text}{where} [--strict]"))
+        out.append(Segment(name=name, motion=motion, notes=tuple(notes), findings=findings))
+    return out
+
+
+def cue_segments(
+    segments: Sequence[Segment], washouts: Sequence[Any], params: Any, limits: Any, filter_start: str
+) -> list[CueResult]:
+    """Cueing: washouts (names with ``params``, or Washout variants), Atlas model, perception and metrics of
+    every segment."""
+    return [cue_motion(seg.motion, washouts, params, limits, filter_start=filter_start) for seg in segments]
+
+
+def segment_summary(input_path: Path, seg: Segment, result: CueResult, out_dir: Path) -> Any:
+    """The run summary (``run.json``, report) of one cued segment; a crash in the data makes it failed."""
+    from washbench.runs.pipeline import RunSummary, perceived_motion
+
+    crash = [f.text for f in seg.findings if f.crash]
+    ac = result.perceived[AIRCRAFT]
+    return RunSummary(
+        ok=not crash,
+        reason="the data holds a crash or spike: " + crash[0] if crash else "",
+        aircraft="recorded",
+        manoeuvre=input_path.name.split(".")[0] + (f"/{seg.name}" if seg.name else ""),
+        run_dir=out_dir,
+        steps=seg.motion.n,
+        dt_s=seg.motion.dt_s,
+        metrics=list(result.metrics),
+        motion=perceived_motion(ac.f_mps2, ac.omega_radps, seg.motion.dt_s),
+        saturations={w: dict(t.saturation_counts) for w, t in result.traces.items()},
+    )
+
+
+def recorded_attitude(motion: Motion) -> np.ndarray:
+    """The aircraft's attitude for the recording: from ``phi_deg``/``theta_deg``/``psi_deg`` when the input
+    has them, else level (an attitude is not needed by the cueing and is not invented)."""
+    from washbench.runs.pipeline import aircraft_attitude
+
+    cols = [motion.extra.get(c) for c in ("phi_deg", "theta_deg", "psi_deg")]
+    if all(c is not None and c.dtype.kind == "f" for c in cols):
+        return aircraft_attitude(*cols)  # type: ignore[arg-type]
+    q = np.zeros((motion.n, 4))
+    q[:, 0] = 1.0
+    return q
+
+
+def write_outputs(
+    out_dir: Path,
+    input_path: Path,
+    segments: Sequence[Segment],
+    results: Sequence[CueResult],
+    limits: Any,
+    opts: CueOptions,
+    wall_s: float,
+) -> list[Any]:
+    """Outputs: per segment (``out_dir`` itself, or ``out_dir/<segment>/`` when there are several) the files
+    of a ``run`` result folder: traces.parquet, metrics.csv, run.json, ranking.csv, report.md and
+    recording.rrd (unless ``opts.recording`` is False). Every file is written under a temporary name and
+    all are renamed into place together, then ranking.csv and report.md are written (atomically) last, so
+    a failure leaves no half-written file."""
+    from washbench.runs.pipeline import write_run_json, write_run_recording
+    from washbench.runs.suite import write_run_review
+
+    out_dir = Path(out_dir)
+    if out_dir.exists() and not out_dir.is_dir():
+        raise WashbenchError(located(out_dir, "output path exists and is not a folder"))
+    summaries = []
+    try:
+        with contextlib.ExitStack() as stack:
+            for seg, result in zip(segments, results, strict=True):
+                folder = result_path(out_dir, seg.name) if seg.name else out_dir
+                folder.mkdir(parents=True, exist_ok=True)
+                names = (TRACES_FILE, METRICS_FILE, "run.json") + ((RECORDING_FILE,) if opts.recording else ())
+                tmp = {name: stack.enter_context(atomic_path(folder / name)) for name in names}
+                summary = segment_summary(input_path, seg, result, folder)
+                write_traces(tmp[TRACES_FILE], result.table)
+                write_metrics_csv(tmp[METRICS_FILE], result.metrics)
+                extra = {
+                    "input": str(input_path),
+                    "segment": seg.name,
+                    "t_start_s": float(seg.motion.t_s[0]),
+                    "t_end_s": float(seg.motion.t_s[-1]),
+                    "filter_start": opts.filter_start,
+                    "conversions": list(seg.notes),
+                    "warnings": [f.text for f in seg.findings],
+                }
+                write_run_json(tmp["run.json"], summary, wall_s, extra)
+                if opts.recording:
+                    title = f"{summary.aircraft} / {summary.manoeuvre}"
+                    q = recorded_attitude(seg.motion)
+                    write_run_recording(tmp[RECORDING_FILE], title, seg.motion, result, limits, q, [])
+                summaries.append(summary)
+        for summary in summaries:  # last, as a suite's report: each written atomically once the rest is in place
+            if not opts.recording:  # a recording of an earlier run would not show these results
+                (summary.run_dir / RECORDING_FILE).unlink(missing_ok=True)
+            write_run_review(summary.run_dir, summary, str(input_path))
+    except OSError as exc:
+        raise WashbenchError(located(out_dir, f"cannot write results: {exc.strerror or exc}")) from None
+    return summaries
+
+
 def run_cue(
     input_path: Path,
     out_dir: Path,
@@ -212,30 +392,48 @@ def run_cue(
     params_path: Path | None = None,
     platform_path: Path | None = None,
     variants: Sequence[str] = (),
-) -> None:
-    """The ``washbench cue`` command: read ``input_path``, cue it, write results into ``out_dir``.
+    options: CueOptions | None = None,
+) -> int:
+    """The ``washbench cue`` command: read, convert, cut and check, cue, write; 0, or 1 if the data holds a crash.
 
     ``washouts``, ``variants`` and ``params_path`` select the washouts
     (:func:`washbench.cueing.variants.select_washouts`).
     Raises WashbenchError (one line) for bad names, parameter files or input; writes nothing then.
     """
+    from washbench.cueing.bank import check_filter_start
     from washbench.cueing.variants import select_washouts
     from washbench.io.lock import output_lock
     from washbench.platform import load_platform_limits
 
+    opts = options or CueOptions()
+    for flag, value in (("--max-gap-s", opts.max_gap_s), ("--resample", opts.resample_hz)):
+        if value is not None and not (math.isfinite(value) and value > 0.0):
+            raise WashbenchError(f"{flag}: expected a positive number, got {value:g}")
+    start = time.perf_counter()
     specs = select_washouts(washouts, variants, params_path)
     names = [w.name for w in specs]
+    check_filter_start(opts.filter_start)
     limits = load_platform_limits(platform_path)
-    motion = read_motion(input_path)
+    samples = read_input(input_path, opts.fmt)
+    segments = prepare_segments(samples, opts)
     with output_lock(out_dir):
-        result = cue_motion(motion, specs, None, limits)
-        traces_path, metrics_path = write_results(out_dir, result)
-    print(
-        f"{input_path}: {motion.n} rows, {motion.duration_s:.3f} s at dt = {motion.dt_s:.6g} s "
-        f"({1.0 / motion.dt_s:.6g} Hz)"
-    )
-    for name in names:
-        counts = result.traces[name].saturation_counts
-        sat = ", ".join(f"{k} {v}" for k, v in counts.items() if v) or "none"
-        print(f"  {name}: saturated samples: {sat}")
-    print(f"wrote {traces_path} and {metrics_path}")
+        results = cue_segments(segments, specs, None, limits, opts.filter_start)
+        for seg in segments:
+            for f in seg.findings:
+                where = f"{input_path}{f' ({seg.name})' if seg.name else ''}"
+                print(f"washbench: warning: {where}: {f.text}", file=sys.stderr)
+        summaries = write_outputs(out_dir, input_path, segments, results, limits, opts, time.perf_counter() - start)
+    for seg, result, summary in zip(segments, results, summaries, strict=True):
+        m = seg.motion
+        label = f"{input_path}{f' {seg.name}' if seg.name else ''}"
+        print(f"{label}: {m.n} rows, {m.duration_s:.3f} s at dt = {m.dt_s:.6g} s ({1.0 / m.dt_s:.6g} Hz)")
+        for note in seg.notes:
+            print(f"  {note}")
+        for name in names:
+            counts = result.traces[name].saturation_counts
+            sat = ", ".join(f"{k} {v}" for k, v in counts.items() if v) or "none"
+            print(f"  {name}: saturated samples: {sat}")
+        if not summary.ok:
+            print(f"  FAILED: {summary.reason}")
+        print(f"wrote {summary.run_dir}")
+    return 0 if all(s.ok for s in summaries) else 1

@@ -23,6 +23,7 @@ an interrupted run never leaves a half-written folder that looks complete)::
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import json
 import math
 import shutil
@@ -31,7 +32,7 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -49,7 +50,6 @@ from washbench.io.publish import (
 )
 
 if TYPE_CHECKING:
-    from washbench.flight.fly import FlightResult
     from washbench.io.results import Motion
     from washbench.platform import PlatformLimits
     from washbench.review.rerun_log import PlatformEnvelope
@@ -127,12 +127,14 @@ def run_manoeuvre(
     progress: bool = False,
     washouts: Sequence[str] | None = None,
     variants: Sequence[str] = (),
+    filter_start: str = "steady",
     aircraft_dirs: Sequence[Path] = (),
 ) -> RunSummary:
     """Fly one manoeuvre with the washouts in lockstep and write its results folder.
 
     ``washouts`` (built-in names), ``variants`` (``--variant`` texts) and the parameter file's ``variants:``
     select the washouts (:func:`washbench.cueing.variants.select_washouts`; default the three built-in ones).
+    ``filter_start``: the washouts' and vestibular models' start state (``steady`` or ``rest``).
 
     Raises WashbenchError for a bad manoeuvre, parameter or platform file, or a result place that
     cannot be used (all checked before flying; nothing written). A flight that crashes or fails a check
@@ -152,23 +154,10 @@ def run_manoeuvre(
     check_replaceable(final, RUN_MARKER, marker)  # before flying: a folder in the way fails now, not after
     clean_partials(final.parent)
 
-    from washbench.cueing import CueingBank, WashoutTrace
     from washbench.flight.fly import fly, write_flight
-    from washbench.io.results import read_motion
-    from washbench.runs.cue import analyse, write_results
 
-    bank = CueingBank(specs, None, limits, manoeuvre.dt_s)
-    washouts = bank.washouts
-    rows: list[np.ndarray] = []
-    step = bank.step
-    omega_deg = np.empty(3)
-
-    def lockstep(k: int, f_mps2: np.ndarray, omega_radps: np.ndarray) -> None:
-        # The washouts see the angular velocity exactly as flight.parquet stores it (deg/s) and
-        # washbench cue reads it back (np.radians), so both paths give the same bits.
-        np.degrees(omega_radps, out=omega_deg)
-        rows.append(step(f_mps2, np.radians(omega_deg)).copy())
-
+    washouts = tuple(w.name for w in specs)
+    rows, lockstep = lockstep_washouts(specs, limits, manoeuvre.dt_s, filter_start)
     partial = partial_dir(final)  # before flying: a file in the way of OUT/<aircraft>/ fails now
     published = False
     try:
@@ -180,16 +169,7 @@ def run_manoeuvre(
         write_flight(partial, flight, str(manoeuvre_path))
         if n < 2:
             raise WashbenchError(located(manoeuvre_path, f"the flight recorded {n} sample(s): nothing to cue"))
-        motion = read_motion(partial / "flight.parquet")
-        block = np.stack(rows)  # (N, washouts, fields)
-        traces = {w: WashoutTrace.from_rows(block[:, i, :]) for i, w in enumerate(washouts)}
-        result = analyse(motion, traces)
-        write_results(partial, result)
-        title = f"{manoeuvre.aircraft} / {manoeuvre.name}"
-        _write_recording(partial / "recording.rrd", title, motion, flight, result, limits)
-        felt = perceived_motion(
-            result.perceived["aircraft"].f_mps2, result.perceived["aircraft"].omega_radps, motion.dt_s
-        )
+        cols = flight.columns
         # the flight is "failed" when the monitor stopped it or a check failed, with the reason
         summary = RunSummary(
             ok=flight.ok,
@@ -197,15 +177,11 @@ def run_manoeuvre(
             aircraft=manoeuvre.aircraft,
             manoeuvre=manoeuvre.name,
             run_dir=final,
-            steps=n,
-            dt_s=motion.dt_s,
             checks_passed=sum(1 for c in flight.checks if c[3]),
             checks_total=len(flight.checks),
-            metrics=list(result.metrics),
-            motion=felt,
-            saturations={w: dict(traces[w].saturation_counts) for w in washouts},
         )
-        _write_run_json(partial / RUN_MARKER, summary, time.perf_counter() - start)
+        ac_q = aircraft_attitude(cols["phi_deg"], cols["theta_deg"], cols["psi_deg"])
+        summary = write_cued_folder(partial, summary, rows, washouts, limits, ac_q, flight.phases, start, filter_start)
         publish_dir(partial, final, RUN_MARKER, marker)
         published = True
     finally:
@@ -216,8 +192,150 @@ def run_manoeuvre(
     return summary
 
 
-def _write_run_json(path: Path, s: RunSummary, wall_s: float) -> None:
-    doc = {
+def check_max_time(max_time_s: float | None) -> None:
+    """``--max-time-s``: None or a positive, finite number of seconds (WashbenchError otherwise)."""
+    if max_time_s is not None and not (math.isfinite(max_time_s) and max_time_s > 0.0):
+        raise WashbenchError(f"--max-time-s: expected a positive number of seconds, got {max_time_s:g}")
+
+
+def lockstep_washouts(
+    specs: Sequence[Any], limits: Any, dt_s: float, filter_start: str = "steady"
+) -> tuple[list[np.ndarray], Any]:
+    """A washout bank (selected :class:`washbench.cueing.variants.Washout` s) run in lockstep with a flight:
+    (the rows it fills, the flight's step hook)."""
+    from washbench.cueing import CueingBank
+
+    bank = CueingBank(specs, None, limits, dt_s, filter_start)
+    rows: list[np.ndarray] = []
+    step = bank.step
+    omega_deg = np.empty(3)
+
+    def lockstep(k: int, f_mps2: np.ndarray, omega_radps: np.ndarray) -> None:
+        # The washouts see the angular velocity exactly as flight.parquet stores it (deg/s) and
+        # washbench cue reads it back (np.radians), so both paths give the same bits.
+        np.degrees(omega_radps, out=omega_deg)
+        rows.append(step(f_mps2, np.radians(omega_deg)).copy())
+
+    return rows, lockstep
+
+
+def write_cued_folder(
+    folder: Path,
+    summary: RunSummary,
+    rows: list[np.ndarray],
+    washouts: tuple[str, ...],
+    limits: Any,
+    aircraft_q: np.ndarray,
+    phases: list[tuple[str, float, float]],
+    start: float,
+    filter_start: str = "steady",
+    extra: dict[str, object] | None = None,
+) -> RunSummary:
+    """Everything after the flight, into ``folder`` (which already holds ``flight.parquet``): perception and
+    metrics on the flight read back (as ``washbench cue`` reads it), traces.parquet, metrics.csv, recording.rrd,
+    run.json, ranking.csv and report.md. Returns ``summary`` completed with the steps, metrics and saturations."""
+    from washbench.cueing import WashoutTrace
+    from washbench.io.results import read_motion
+    from washbench.runs.cue import analyse, write_results
+    from washbench.runs.suite import write_run_review
+
+    motion = read_motion(folder / "flight.parquet")
+    block = np.stack(rows)  # (N, washouts, fields)
+    traces = {w: WashoutTrace.from_rows(block[:, i, :]) for i, w in enumerate(washouts)}
+    result = analyse(motion, traces, filter_start=filter_start)
+    write_results(folder, result)
+    title = f"{summary.aircraft} / {summary.manoeuvre}"
+    write_run_recording(folder / "recording.rrd", title, motion, result, limits, aircraft_q, phases)
+    ac = result.perceived["aircraft"]
+    summary = dataclasses.replace(
+        summary,
+        steps=motion.n,
+        dt_s=motion.dt_s,
+        metrics=list(result.metrics),
+        motion=perceived_motion(ac.f_mps2, ac.omega_radps, motion.dt_s),
+        saturations={w: dict(traces[w].saturation_counts) for w in washouts},
+    )
+    write_run_json(folder / "run.json", summary, time.perf_counter() - start, extra)
+    write_run_review(folder, dataclasses.replace(summary, run_dir=folder))
+    return summary
+
+
+def run_script(
+    script_path: Path,
+    out_root: Path,
+    *,
+    params_path: Path | None = None,
+    platform_path: Path | None = None,
+    max_time_s: float | None = None,
+    filter_start: str = "steady",
+    aircraft_dirs: Sequence[Path] = (),
+    washouts: Sequence[str] | None = None,
+    variants: Sequence[str] = (),
+) -> list[RunSummary]:
+    """Fly a JSBSim script (:mod:`washbench.flight.scripts`) with the washouts in lockstep, one result per run.
+
+    Writes ``OUT/<aircraft>/<script>/`` (one run) or ``OUT/<aircraft>/<script>/<run_i>/`` (a script that
+    resets), published as one folder. A crash still writes what was flown, with ``ok`` False and the reason.
+    """
+    from washbench.cueing.bank import check_filter_start
+    from washbench.cueing.variants import select_washouts
+    from washbench.flight.scripts import fly_script, load_script_info, write_script_flight
+    from washbench.platform import load_platform_limits
+
+    info = load_script_info(script_path, aircraft_dirs)
+    check_filter_start(filter_start)
+    check_max_time(max_time_s)
+    specs = select_washouts(washouts, variants, params_path)
+    limits = load_platform_limits(platform_path)
+    final = run_dir(Path(out_root), info.aircraft, info.name)
+    marker = {"aircraft": info.aircraft}  # one run.json, or one per run of a script that resets
+    check_replaceable(final, RUN_MARKER, marker, nested=True)
+    clean_partials(final.parent)
+    names = tuple(w.name for w in specs)
+    banks: list[list[np.ndarray]] = []
+
+    def segment_hook(i: int, dt_s: float) -> Any:
+        rows, hook = lockstep_washouts(specs, limits, dt_s, filter_start)
+        banks.append(rows)
+        return hook
+
+    start = time.perf_counter()
+    flight = fly_script(script_path, max_time_s=max_time_s, segment_hook=segment_hook, aircraft_dirs=aircraft_dirs)
+    partial = partial_dir(final)
+    several = len(flight.segments) > 1
+    summaries = []
+    try:
+        for seg, rows in zip(flight.segments, banks, strict=True):
+            folder = partial / seg.name if several else partial
+            folder.mkdir(exist_ok=True)
+            write_script_flight(folder, flight, seg)
+            summary = RunSummary(
+                ok=seg.ok,
+                reason=seg.reason,
+                aircraft=info.aircraft,
+                manoeuvre=f"{info.name}/{seg.name}" if several else info.name,
+                run_dir=final / seg.name if several else final,
+            )
+            if seg.n < 2:
+                summaries.append(dataclasses.replace(summary, ok=False, reason=seg.reason or "nothing recorded"))
+                continue
+            cols = seg.columns
+            ac_q = aircraft_attitude(cols["phi_deg"], cols["theta_deg"], cols["psi_deg"])
+            extra = {"script": str(info.path), "segment": seg.name, "stopped_by_time_limit": flight.stopped_by_limit}
+            summaries.append(
+                write_cued_folder(folder, summary, rows, names, limits, ac_q, [], start, filter_start, extra)
+            )
+        publish_dir(partial, final, RUN_MARKER, marker, nested=True)
+    finally:
+        with contextlib.suppress(FileNotFoundError):
+            shutil.rmtree(partial)
+        remove_if_empty(final.parent)
+    return summaries
+
+
+def write_run_json(path: Path, s: RunSummary, wall_s: float, extra: dict[str, object] | None = None) -> None:
+    """``run.json``: the summary of one result folder (``extra``: more keys, e.g. what ``cue`` read)."""
+    doc: dict[str, object] = {
         "aircraft": s.aircraft,
         "manoeuvre": s.manoeuvre,
         "ok": s.ok,
@@ -232,16 +350,25 @@ def _write_run_json(path: Path, s: RunSummary, wall_s: float) -> None:
         },
         "saturations": s.saturations,
     }
+    doc |= extra or {}
     write_text_atomic(path, json.dumps(doc, indent=2) + "\n")
 
 
-def _write_recording(
-    path: Path, title: str, motion: Motion, flight: FlightResult, result: CueResult, limits: PlatformLimits
+def write_run_recording(
+    path: Path,
+    title: str,
+    motion: Motion,
+    result: CueResult,
+    limits: PlatformLimits,
+    aircraft_q: np.ndarray,
+    phases: list[tuple[str, float, float]],
 ) -> None:
+    """The recording of one result folder (``run`` and ``cue`` alike): the one call of the recording writer.
+
+    ``aircraft_q`` (N, 4) the aircraft's attitude, body -> NED, scalar first; ``phases`` (name, start, end) [s].
+    """
     from washbench.review.rerun_log import MotionSeries, PlatformSeries, RecordingData, write_recording
 
-    cols = flight.columns
-    ac_q = aircraft_attitude(cols["phi_deg"], cols["theta_deg"], cols["psi_deg"])
     ac = result.perceived["aircraft"]
     washouts: dict[str, MotionSeries] = {}
     platforms: dict[str, PlatformSeries] = {}
@@ -265,12 +392,12 @@ def _write_recording(
             omega_radps=motion.omega_radps,
             perceived_f_mps2=ac.f_mps2,
             perceived_omega_radps=ac.omega_radps,
-            q=ac_q,
+            q=aircraft_q,
         ),
         washouts=washouts,
         platforms=platforms,
         envelope=platform_envelope(limits),
-        phases=[(p[0], float(p[1]), float(p[2])) for p in flight.phases],
+        phases=[(p[0], float(p[1]), float(p[2])) for p in phases],
         metrics_markdown=metrics_markdown(title, list(result.metrics)),
     )
     write_recording(path, data)
@@ -301,34 +428,63 @@ def run_command(
     params_path: Path | None = None,
     platform_path: Path | None = None,
     progress: bool = True,
+    max_time_s: float | None = None,
+    filter_start: str = "steady",
     washouts: Sequence[str] | None = None,
     variants: Sequence[str] = (),
     aircraft_dirs: Sequence[Path] = (),
 ) -> int:
-    """CLI entry of ``washbench run``: 0 if the flight ran and passed its checks, else 1.
+    """CLI entry of ``washbench run`` (a YAML manoeuvre or a JSBSim script): 0 if every run was ok, else 1.
 
     Holds the lock of ``out_root`` (:func:`washbench.io.lock.output_lock`) while it runs.
     """
+    from washbench.cueing.bank import check_filter_start
+    from washbench.flight.scripts import is_script
     from washbench.io.lock import output_lock
 
+    check_filter_start(filter_start)
+    check_max_time(max_time_s)
     start = time.perf_counter()
-    with output_lock(out_root):
-        s = run_manoeuvre(
-            manoeuvre_path,
-            out_root,
-            params_path=params_path,
-            platform_path=platform_path,
-            progress=progress and sys.stderr.isatty(),
-            washouts=washouts,
-            variants=variants,
-            aircraft_dirs=aircraft_dirs,
+    with output_lock(out_root):  # held while it runs: a second writer gets one line at once
+        if is_script(manoeuvre_path):
+            runs = run_script(
+                manoeuvre_path,
+                out_root,
+                params_path=params_path,
+                platform_path=platform_path,
+                max_time_s=max_time_s,
+                filter_start=filter_start,
+                aircraft_dirs=aircraft_dirs,
+                washouts=washouts,
+                variants=variants,
+            )
+        else:
+            if max_time_s is not None:
+                raise WashbenchError(
+                    "--max-time-s applies to JSBSim scripts only (a manoeuvre's phases set its length)"
+                )
+            runs = [
+                run_manoeuvre(
+                    manoeuvre_path,
+                    out_root,
+                    params_path=params_path,
+                    platform_path=platform_path,
+                    progress=progress and sys.stderr.isatty(),
+                    filter_start=filter_start,
+                    aircraft_dirs=aircraft_dirs,
+                    washouts=washouts,
+                    variants=variants,
+                )
+            ]
+    wall = time.perf_counter() - start
+    for s in runs:
+        state = "ok" if s.ok else f"FAILED ({s.reason})"
+        checks = f"; checks {s.checks_passed}/{s.checks_total}" if s.checks_total else ""
+        print(
+            f"{s.aircraft}/{s.manoeuvre}: {state}{checks}; {s.steps * s.dt_s:.1f} s flown in {wall:.1f} s; "
+            f"results in {s.run_dir}"
         )
-    state = "ok" if s.ok else f"FAILED ({s.reason})"
-    print(
-        f"{s.aircraft}/{s.manoeuvre}: {state}; checks {s.checks_passed}/{s.checks_total}; "
-        f"{s.steps * s.dt_s:.1f} s flown in {time.perf_counter() - start:.1f} s; results in {s.run_dir}"
-    )
-    for w, kinds in s.saturations.items():
-        sat = ", ".join(f"{k} {v}" for k, v in kinds.items() if v) or "none"
-        print(f"  {w}: platform saturations (steps): {sat}", file=sys.stdout)
-    return 0 if s.ok else 1
+        for w, kinds in s.saturations.items():
+            sat = ", ".join(f"{k} {v}" for k, v in kinds.items() if v) or "none"
+            print(f"  {w}: platform saturations (steps): {sat}", file=sys.stdout)
+    return 0 if all(s.ok for s in runs) else 1

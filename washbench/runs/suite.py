@@ -74,23 +74,39 @@ class Outcome:
     run: RunSummary
 
 
-def find_manoeuvres(inputs: Sequence[Path]) -> list[Path]:
-    """Manoeuvre files from files and folders (folders are searched recursively for ``*.yaml``)."""
-    if not inputs:
+def _is_runscript(path: Path) -> bool:
+    """True for an XML file whose root element is a JSBSim ``<runscript>`` (cheap: reads the first element)."""
+    import xml.etree.ElementTree as ET
+
+    try:
+        for _, elem in ET.iterparse(path, events=("start",)):
+            return elem.tag == "runscript"
+    except (ET.ParseError, OSError):
+        return False
+    return False
+
+
+def find_manoeuvres(inputs: Sequence[Path], scripts: Sequence[Path] = ()) -> list[Path]:
+    """Manoeuvre files and JSBSim scripts from files and folders (folders are searched recursively for
+    ``*.yaml`` manoeuvres and ``*.xml`` JSBSim scripts), then ``scripts``; no inputs at all: the bundled
+    manoeuvres."""
+    if not inputs and not scripts:
         inputs = [MANOEUVRES_DIR]
     found: list[Path] = []
     for item in map(resolve_manoeuvre, inputs):
         if item.is_dir():
             found.extend(sorted(p for p in item.rglob("*.yaml") if p.is_file()))
+            found.extend(sorted(p for p in item.rglob("*.xml") if p.is_file() and _is_runscript(p)))
         elif item.is_file():
             found.append(item)
         else:
             raise WashbenchError(
                 located(item, f"no such file or folder, nor a bundled manoeuvre ({', '.join(bundled_names())})")
             )
+    found.extend(scripts)
     unique = list(dict.fromkeys(p.resolve() for p in found))
     if not unique:
-        raise WashbenchError(located(inputs[0], "no manoeuvre files (*.yaml) found"))
+        raise WashbenchError(located(inputs[0], "no manoeuvre files (*.yaml) or JSBSim scripts (*.xml) found"))
     return unique
 
 
@@ -161,28 +177,32 @@ def _run_one(
     washouts: tuple[str, ...] | None = None,
     variants: tuple[str, ...] = (),
     aircraft_dirs: tuple[str, ...] = (),
-) -> Outcome:
-    """Worker: run one manoeuvre; never raises (failures come back as an Outcome)."""
-    from washbench.runs.pipeline import run_manoeuvre
+    max_time_s: float | None = None,
+) -> list[Outcome]:
+    """Worker: run one manoeuvre or JSBSim script (one outcome per run segment); never raises (failures
+    come back as an Outcome)."""
+    from washbench.flight.scripts import is_script
+    from washbench.runs.pipeline import run_manoeuvre, run_script
 
     start = time.perf_counter()
+    params = Path(params_path) if params_path else None
+    platform = Path(platform_path) if platform_path else None
     try:
-        summary = run_manoeuvre(
-            Path(path),
-            Path(out_dir),
-            params_path=Path(params_path) if params_path else None,
-            platform_path=Path(platform_path) if platform_path else None,
-            washouts=washouts,
-            variants=variants,
-            aircraft_dirs=[Path(d) for d in aircraft_dirs],
-        )
+        dirs = [Path(d) for d in aircraft_dirs]
+        common = {"params_path": params, "platform_path": platform, "aircraft_dirs": dirs}
+        common |= {"washouts": washouts, "variants": variants}
+        if is_script(Path(path)):
+            runs = run_script(Path(path), Path(out_dir), max_time_s=max_time_s, **common)
+        else:
+            runs = [run_manoeuvre(Path(path), Path(out_dir), **common)]
     except WashbenchError as exc:
-        summary = RunSummary(ok=False, reason=str(exc))
+        runs = [RunSummary(ok=False, reason=str(exc))]
     except Exception as exc:  # an unexpected bug in one run must not take the suite down
         tb = traceback.format_exc(limit=-3).strip().splitlines()
         where = tb[-3].strip() if len(tb) >= 3 else ""
-        summary = RunSummary(ok=False, reason=f"internal error: {type(exc).__name__}: {exc} ({where})")
-    return Outcome(path=path, wall_s=time.perf_counter() - start, run=summary)
+        runs = [RunSummary(ok=False, reason=f"internal error: {type(exc).__name__}: {exc} ({where})")]
+    wall = time.perf_counter() - start
+    return [Outcome(path=path, wall_s=wall / len(runs), run=r) for r in runs]
 
 
 def _preload() -> None:
@@ -220,8 +240,10 @@ def run_suite(
     variants: Sequence[str] = (),
     dask: str | None = None,
     aircraft_dirs: Sequence[Path] = (),
+    max_time_s: float | None = None,
 ) -> list[Outcome]:
-    """Run every file in parallel processes (or on the Dask cluster at ``dask``); outcomes in the order of ``files``.
+    """Run every file in parallel processes (or on the Dask cluster at ``dask``); outcomes in the order of ``files``
+    (a JSBSim script that resets gives one outcome per run segment, in order).
 
     On any exception (KeyboardInterrupt and :class:`washbench.errors.Terminated` included) the local workers are
     stopped before it propagates, so no worker writes anything afterwards.
@@ -231,11 +253,9 @@ def run_suite(
     dirs = tuple(str(d) for d in aircraft_dirs)
     params = str(params_path) if params_path else None
     platform = str(platform_path) if platform_path else None
-    args = [
-        (str(f), str(out_dir), params, platform, tuple(washouts) if washouts else None, tuple(variants), dirs)
-        for f in files
-    ]
-    outcomes: dict[str, Outcome] = {}
+    chosen = tuple(washouts) if washouts else None
+    args = [(str(f), str(out_dir), params, platform, chosen, tuple(variants), dirs, max_time_s) for f in files]
+    outcomes: dict[str, list[Outcome]] = {}
     start = time.perf_counter()
     if progress:
         print(
@@ -246,8 +266,8 @@ def run_suite(
     if dask:
         from washbench.runs.cluster import dask_map
 
-        for outcome in dask_map(dask, _run_one, args):
-            outcomes[outcome.path] = _report(outcome, len(outcomes) + 1, len(files), start, progress)
+        for runs in dask_map(dask, _run_one, args):
+            outcomes[runs[0].path] = _report(runs, len(outcomes) + 1, len(files), start, progress)
     elif jobs == 1:
         for a in args:
             outcomes[a[0]] = _report(_run_one(*a), len(outcomes) + 1, len(files), start, progress)
@@ -258,14 +278,14 @@ def run_suite(
             with _signals_deferred():  # submitting starts the workers (up to ``jobs``)
                 futures = [pool.submit(_run_one, *a) for a in args]
             for fut in as_completed(futures):
-                outcome = fut.result()
-                outcomes[outcome.path] = _report(outcome, len(outcomes) + 1, len(files), start, progress)
+                runs = fut.result()
+                outcomes[runs[0].path] = _report(runs, len(outcomes) + 1, len(files), start, progress)
         except BaseException:
             with _signals_held():
                 _stop_pool(pool)
             raise
         pool.shutdown(wait=True)
-    return [outcomes[a[0]] for a in args]
+    return [o for a in args for o in outcomes[a[0]]]
 
 
 def _destination(out_dir: Path) -> Path:
@@ -273,7 +293,13 @@ def _destination(out_dir: Path) -> Path:
     return out_dir.parent if is_leftover(out_dir.name) else out_dir
 
 
-def _report(outcome: Outcome, done: int, total: int, start: float, progress: bool) -> Outcome:
+def _report(runs: list[Outcome], done: int, total: int, start: float, progress: bool) -> list[Outcome]:
+    for outcome in runs:
+        _report_one(outcome, done, total, start, progress)
+    return runs
+
+
+def _report_one(outcome: Outcome, done: int, total: int, start: float, progress: bool) -> None:
     if progress:
         name = f"{outcome.run.aircraft}/{outcome.run.manoeuvre}" if outcome.run.aircraft else _short(outcome.path)
         state = "ok  " if outcome.run.ok else "FAIL"
@@ -282,7 +308,6 @@ def _report(outcome: Outcome, done: int, total: int, start: float, progress: boo
         if not outcome.run.ok:
             line += f"\n        {outcome.run.reason}"
         print(f"{line}   (elapsed {time.perf_counter() - start:.0f} s)", file=sys.stderr, flush=True)
-    return outcome
 
 
 def _short(path: str) -> str:
@@ -353,13 +378,18 @@ def _washouts(outcomes: Sequence[Outcome]) -> list[str]:
     return list(dict.fromkeys(m.washout for o in outcomes for m in o.run.metrics))
 
 
-def report_markdown(outcomes: Sequence[Outcome], rankings: dict[tuple[str, str], list[RankRow]], out_dir: Path) -> str:
+def report_markdown(
+    outcomes: Sequence[Outcome],
+    rankings: dict[tuple[str, str], list[RankRow]],
+    out_dir: Path,
+    title: str = "washbench suite report",
+) -> str:
     """``report.md``: status, ranking, Table-4 comparison and metrics of every manoeuvre."""
     ok = [o for o in outcomes if o.run.ok]
     washouts = _washouts(outcomes)
     reference = reference_washout(washouts)
     lines = [
-        "# washbench suite report",
+        f"# {title}",
         "",
         f"{len(ok)} of {len(outcomes)} manoeuvres ran and passed their checks.",
         "",
@@ -474,7 +504,8 @@ def check_unique_names(files: Sequence[Path], aircraft_dirs: Sequence[Path] = ()
 
 
 def _is_run_folder(entry: Path, aircraft: str) -> bool:
-    return is_washbench_result(entry, RUN_MARKER, {"aircraft": aircraft, "manoeuvre": entry.name})
+    """A ``run`` result of this aircraft (a JSBSim script that resets: a folder of such results)."""
+    return is_washbench_result(entry, RUN_MARKER, {"aircraft": aircraft}, nested=True)
 
 
 def previous_results(out_dir: Path) -> list[Path]:
@@ -521,6 +552,19 @@ def _swap_in(stage: Path, out_dir: Path, previous: Sequence[Path]) -> None:
         shutil.rmtree(old, ignore_errors=True)
 
 
+def write_run_review(run_dir: Path, summary: RunSummary, source: str = "") -> None:
+    """``ranking.csv`` and ``report.md`` of one result folder (the same tables as a suite's, for one run).
+
+    The one call site for a result folder's report (``washbench cue`` uses it; the report of the review
+    issue replaces its body).
+    """
+    rankings = {(summary.aircraft, summary.manoeuvre): rank(summary.metrics, summary.motion)} if summary.metrics else {}
+    outcome = Outcome(path=source or str(run_dir), wall_s=0.0, run=summary)
+    write_text_atomic(run_dir / "ranking.csv", ranking_table(rankings))
+    title = f"washbench report: {summary.aircraft} / {summary.manoeuvre}" if summary.aircraft else "washbench report"
+    write_text_atomic(run_dir / "report.md", report_markdown([outcome], rankings, run_dir, title=title))
+
+
 def suite_command(
     inputs: Sequence[Path],
     out_dir: Path,
@@ -533,14 +577,22 @@ def suite_command(
     variants: Sequence[str] = (),
     dask: str | None = None,
     aircraft_dirs: Sequence[Path] = (),
+    jsbsim_scripts: Sequence[str] = (),
+    max_time_s: float | None = None,
 ) -> int:
     """CLI entry: run the suite, write its results, print where they are; 0 if all succeeded, else 1.
 
-    See the module docstring for the output folder policy (lock, whole replacement, interruption).
+    ``jsbsim_scripts``: names of scripts shipped with JSBSim (``c1723``) run besides ``inputs``. See the module
+    docstring for the output folder policy (lock, whole replacement, interruption).
     """
+    from washbench.flight.scripts import bundled_script
+
     if jobs is not None and jobs < 1:
         raise WashbenchError(f"--jobs: expected a whole number of at least 1, got {jobs}")
-    files = find_manoeuvres(inputs)
+    from washbench.runs.pipeline import check_max_time
+
+    check_max_time(max_time_s)
+    files = find_manoeuvres(inputs, [bundled_script(n) for n in jsbsim_scripts])
     # Fail fast on a bad parameter, variant or platform file: every run would fail the same way.
     from washbench.cueing.variants import select_washouts
     from washbench.platform import load_platform_limits
@@ -569,6 +621,7 @@ def suite_command(
                 variants=variants,
                 dask=dask,
                 aircraft_dirs=aircraft_dirs,
+                max_time_s=max_time_s,
             )
             write_suite_results(outcomes, stage)
             _swap_in(stage, out_dir, previous)
@@ -576,8 +629,7 @@ def suite_command(
             shutil.rmtree(stage, ignore_errors=True)
     n_ok = sum(o.run.ok for o in outcomes)
     print(
-        f"suite: {n_ok}/{len(outcomes)} manoeuvres ok in {time.perf_counter() - start:.1f} s; "
-        f"report: {out_dir / 'report.md'}"
+        f"suite: {n_ok}/{len(outcomes)} runs ok in {time.perf_counter() - start:.1f} s; report: {out_dir / 'report.md'}"
     )
     return 0 if n_ok == len(outcomes) else 1
 

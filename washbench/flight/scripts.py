@@ -1,0 +1,351 @@
+"""JSBSim's own scripts as manoeuvres: the script's aircraft, initial conditions and events fly it.
+
+``washbench run SCRIPT.xml`` flies a JSBSim script (``<runscript>``: ``<use aircraft=... initialize=...>``,
+``<run start end dt>`` with its events) instead of a YAML manoeuvre. There is no scripted pilot: the
+script's events (and the aircraft's own autopilot, where it has one) are the pilot. The recorder is the
+manoeuvres' (:mod:`washbench.flight.fly`): sample ``k`` is the state at ``t = k * dt``, and JSBSim's
+eyepoint acceleration ``accelerations/a-pilot-*`` (computed before the forces of the step) read after
+step ``k + 1`` belongs to sample ``k`` (the one-frame lag removed).
+
+Run segments: a script that resets (``simulation/reset``; JSBSim's time jumps back to 0) gives one
+segment per run, named ``run_1``, ``run_2``, ... The sample before a reset has no pilot acceleration
+of its own (the step that would have produced it reset the model) and is dropped; the state after the
+reset is sample 0 of the next segment.
+
+Crash monitor: :meth:`washbench.flight.monitor.Monitor.for_script` (non-finite state, an airframe
+contact point on the ground while no landing gear is, the centre of gravity below the ground, load
+factors beyond any aircraft's). A
+crash stops the flight; what was recorded up to it is kept and the segment is ``failed`` with the time
+and cause.
+
+The scripts shipped in the jsbsim package (``jsbsim.get_default_root_dir()/scripts``) are found by name
+(:func:`bundled_script`); their aircraft are JSBSim's own. The script's ``<output>`` directives are
+switched off (they would write into the current folder), and its console messages are silenced.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import tempfile
+import xml.etree.ElementTree as ET
+from array import array
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from washbench.errors import WashbenchError, located
+from washbench.flight.fdm import quiet_stdout
+from washbench.flight.fly import FPS_TO_KT, FT_S2_TO_M_S2, R2D, StepHook
+from washbench.flight.manoeuvre import aircraft_path
+from washbench.flight.monitor import Monitor
+from washbench.io.paths import jsbsim_root
+
+SEGMENT_PREFIX = "run_"
+
+#: (name, description) of a script flight's ``flight.parquet`` columns, in order.
+SCRIPT_COLUMNS: tuple[tuple[str, str], ...] = (
+    ("t_s", "time since the segment's start, s (k * dt)"),
+    ("f_x_mps2", "specific force at the pilot's eyepoint, body x (forward), m/s^2"),
+    ("f_y_mps2", "specific force at the pilot's eyepoint, body y (right), m/s^2"),
+    ("f_z_mps2", "specific force at the pilot's eyepoint, body z (down), m/s^2"),
+    ("omega_x_degps", "body angular velocity p (roll rate), deg/s"),
+    ("omega_y_degps", "body angular velocity q (pitch rate), deg/s"),
+    ("omega_z_degps", "body angular velocity r (yaw rate), deg/s"),
+    ("phi_deg", "bank angle, deg"),
+    ("theta_deg", "pitch angle, deg"),
+    ("psi_deg", "true heading, deg in [0, 360)"),
+    ("alpha_deg", "angle of attack, deg"),
+    ("beta_deg", "sideslip angle, deg"),
+    ("vc_kts", "calibrated airspeed, kt"),
+    ("gs_kts", "ground speed, kt"),
+    ("altitude_ft", "altitude above mean sea level, ft"),
+    ("h_agl_ft", "height of the centre of gravity above the ground, ft"),
+    ("nz", "load factor at the centre of gravity, g (+1 in level flight)"),
+    ("wow", "1 while any landing gear touches the ground, else 0"),
+)
+SCRIPT_COLUMN_NAMES = tuple(n for n, _ in SCRIPT_COLUMNS)
+
+_STATE = (
+    "attitude/phi-rad",
+    "attitude/theta-rad",
+    "attitude/psi-rad",
+    "velocities/p-rad_sec",
+    "velocities/q-rad_sec",
+    "velocities/r-rad_sec",
+    "aero/alpha-rad",
+    "aero/beta-rad",
+    "velocities/vc-kts",
+    "velocities/vg-fps",
+    "position/h-sl-ft",
+    "position/h-agl-ft",
+    "simulation/sim-time-sec",
+)
+_AFTER = ("accelerations/a-pilot-x-ft_sec2", "accelerations/a-pilot-y-ft_sec2", "accelerations/a-pilot-z-ft_sec2",
+          "accelerations/Nz")  # fmt: skip
+
+
+@dataclass(frozen=True)
+class ScriptInfo:
+    """What a JSBSim script file says about itself: ``name`` (the file stem, names the result folder),
+    ``aircraft`` and ``initialize`` (the model and its initial-conditions file), ``dt_s`` and ``end_s``."""
+
+    path: Path
+    name: str
+    aircraft: str
+    initialize: str
+    dt_s: float
+    end_s: float
+    aircraft_root: Path
+    description: str = ""
+
+
+@dataclass
+class ScriptSegment:
+    """One run of a script: its recorded columns (:data:`SCRIPT_COLUMNS`), status and reason."""
+
+    name: str
+    columns: dict[str, np.ndarray]
+    status: str = "ok"
+    reason: str = ""
+
+    @property
+    def ok(self) -> bool:
+        return self.status == "ok"
+
+    @property
+    def n(self) -> int:
+        return len(self.columns["t_s"])
+
+
+@dataclass
+class ScriptFlight:
+    """A flown script: its info, the FDM step and one :class:`ScriptSegment` per run."""
+
+    info: ScriptInfo
+    dt_s: float
+    segments: list[ScriptSegment] = field(default_factory=list)
+    stopped_by_limit: bool = False
+
+
+def scripts_dir() -> Path:
+    """The scripts shipped in the jsbsim package."""
+    return jsbsim_root() / "scripts"
+
+
+def bundled_script(name: str) -> Path:
+    """A script shipped with JSBSim by name (``c1723`` or ``c1723.xml``); WashbenchError listing them if unknown."""
+    stem = name[:-4] if name.endswith(".xml") else name
+    path = scripts_dir() / f"{stem}.xml"
+    if not path.is_file():
+        known = sorted(p.stem for p in scripts_dir().glob("*.xml"))
+        raise WashbenchError(f"--jsbsim-scripts: no script {name!r} ships with JSBSim (known: {', '.join(known)})")
+    return path
+
+
+def is_script(path: Path) -> bool:
+    """True for a ``.xml`` file (a JSBSim script), as opposed to a YAML manoeuvre."""
+    return path.suffix.lower() == ".xml"
+
+
+def load_script_info(path: str | Path, aircraft_dirs: Sequence[Path] = ()) -> ScriptInfo:
+    """Read a script's header; WashbenchError (file, line, what) if it is not a usable JSBSim script.
+
+    The aircraft is looked up along washbench's search path (``aircraft_dirs``, an ``aircraft/`` folder next
+    to the script, washbench's bundled aircraft, JSBSim's own)."""
+    path = Path(path)
+    try:
+        root = ET.parse(path).getroot()
+    except FileNotFoundError:
+        raise WashbenchError(located(path, "no such file")) from None
+    except IsADirectoryError:
+        raise WashbenchError(located(path, "is a folder, not a file")) from None
+    except ET.ParseError as exc:
+        raise WashbenchError(located(path, f"not well-formed XML ({exc.msg})", line=exc.position[0])) from None
+    except OSError as exc:
+        raise WashbenchError(located(path, f"cannot read: {exc.strerror or exc}")) from None
+    if root.tag != "runscript":
+        raise WashbenchError(located(path, f"not a JSBSim script: the root element is <{root.tag}>, not <runscript>"))
+    use = root.find("use")
+    run = root.find("run")
+    if use is None or not use.get("aircraft"):
+        raise WashbenchError(located(path, "<use aircraft=...> is missing: which aircraft does the script fly?"))
+    if run is None:
+        raise WashbenchError(located(path, "<run> is missing"))
+    aircraft = str(use.get("aircraft"))
+    root_dir = aircraft_path(aircraft, path, aircraft_dirs)
+    if root_dir is None:
+        raise WashbenchError(
+            located(path, f"<use aircraft={aircraft!r}>: unknown aircraft (neither washbench's nor JSBSim's)")
+        )
+    try:
+        dt = float(run.get("dt", "nan"))
+        end = float(run.get("end", "nan"))
+    except ValueError:
+        raise WashbenchError(located(path, "<run>: dt and end must be numbers")) from None
+    if not (dt > 0.0 and math.isfinite(dt)) or not (end > 0.0 and math.isfinite(end)):
+        raise WashbenchError(located(path, f"<run>: needs dt > 0 and end > 0 s, got dt={dt:g}, end={end:g}"))
+    desc = (root.findtext("description") or root.get("name") or "").strip()
+    name = re.sub(r"[^A-Za-z0-9_-]", "_", path.stem)
+    return ScriptInfo(path, name, aircraft, str(use.get("initialize", "")), dt, end, root_dir, " ".join(desc.split()))
+
+
+def _structure_contacts(fdm: object) -> list[object]:
+    """``contact/unit[i]/WOW`` nodes of the airframe's structural contact points (not landing gear)."""
+    pm = fdm.get_property_manager()  # type: ignore[attr-defined]
+    out = []
+    i = 0
+    while pm.hasNode(f"contact/unit[{i}]/WOW") or pm.hasNode(f"gear/unit[{i}]/WOW"):
+        if pm.hasNode(f"contact/unit[{i}]/WOW") and not pm.hasNode(f"gear/unit[{i}]/WOW"):
+            out.append(pm.get_node(f"contact/unit[{i}]/WOW"))
+        i += 1
+    return out
+
+
+def _make_fdm(info: ScriptInfo, output_dir: Path) -> object:
+    """The FDM with the script loaded and initialised. JSBSim opens the script's and the aircraft's
+    ``<output>`` files at load time (relative to its root folder, i.e. inside the jsbsim package): they are
+    sent to ``output_dir`` (a temporary folder) and switched off."""
+    import jsbsim
+
+    root = info.aircraft_root
+    with quiet_stdout():
+        fdm = jsbsim.FGFDMExec(str(jsbsim_root()), None)
+        fdm.set_debug_level(0)
+        fdm.set_output_path(str(output_dir))
+        fdm.set_aircraft_path(str(root))
+        try:
+            ok = fdm.load_script(str(info.path.resolve()))
+        except Exception as exc:  # JSBSim raises plain exceptions on broken scripts or models
+            raise WashbenchError(located(info.path, f"JSBSim could not load the script ({exc})")) from None
+        if not ok:
+            raise WashbenchError(located(info.path, "JSBSim could not load the script"))
+        fdm.disable_output()
+        fdm.run_ic()
+    return fdm
+
+
+def fly_script(
+    path: str | Path,
+    *,
+    max_time_s: float | None = None,
+    segment_hook: Callable[[int, float], StepHook | None] | None = None,
+    aircraft_dirs: Sequence[Path] = (),
+) -> ScriptFlight:
+    """Fly a JSBSim script to its end, a crash or ``max_time_s`` of simulated time (summed over segments).
+
+    ``segment_hook(i, dt_s)`` is called when segment ``i`` starts and may return a step hook
+    ``hook(k, f_mps2, omega_radps)`` called once per recorded sample of it, in order (eyepoint specific
+    force m/s^2 and body rates rad/s, body axes x forward, y right, z down).
+    """
+    info = load_script_info(path, aircraft_dirs)
+    with tempfile.TemporaryDirectory(prefix="washbench-jsbsim-") as junk:
+        return _fly(info, _make_fdm(info, Path(junk)), max_time_s, segment_hook)
+
+
+def _fly(
+    info: ScriptInfo,
+    fdm: object,
+    max_time_s: float | None,
+    segment_hook: Callable[[int, float], StepHook | None] | None,
+) -> ScriptFlight:
+    """The recording loop of :func:`fly_script`."""
+    dt = float(fdm.get_delta_t())  # type: ignore[attr-defined]
+    pm = fdm.get_property_manager()  # type: ignore[attr-defined]
+    missing = [n for n in (*_STATE, *_AFTER) if not pm.hasNode(n)]
+    if missing:
+        raise WashbenchError(located(info.path, f"the model lacks the properties {', '.join(missing)}"))
+    gets = [pm.get_node(n).get_double_value for n in _STATE]
+    ax_get, ay_get, az_get, nz_get = (pm.get_node(n).get_double_value for n in _AFTER)
+    wow_get = pm.get_node("gear/wow").get_double_value if pm.hasNode("gear/wow") else (lambda: 0.0)
+    structure = [n.get_double_value for n in _structure_contacts(fdm)]
+    monitor = Monitor.for_script()
+    flight = ScriptFlight(info=info, dt_s=dt)
+    limit_steps = math.inf if max_time_s is None else round(max_time_s / dt)
+    ncol = len(SCRIPT_COLUMN_NAMES)
+    run = fdm.run  # type: ignore[attr-defined]
+
+    def new_segment() -> tuple[array, StepHook | None]:
+        return array("d"), segment_hook(len(flight.segments), dt) if segment_hook is not None else None
+
+    def close(rows: array, status: str = "ok", reason: str = "") -> None:
+        data = np.frombuffer(rows, dtype=np.float64).reshape(-1, ncol) if rows else np.zeros((0, ncol))
+        cols = {n: np.ascontiguousarray(data[:, i]) for i, n in enumerate(SCRIPT_COLUMN_NAMES)}
+        cols["wow"] = cols["wow"].astype(np.int8)
+        flight.segments.append(ScriptSegment(f"{SEGMENT_PREFIX}{len(flight.segments) + 1}", cols, status, reason))
+
+    rows, hook = new_segment()
+    k = 0
+    total = 0
+    with quiet_stdout():
+        while True:
+            phi, theta, psi, p, q, r, alpha, beta, vc, vg, h, agl, t_sim = (g() for g in gets)
+            wow = wow_get() > 0.5
+            sw = 0.0
+            if not wow:  # on its gear, a tail skid or wing tip scraping is no crash (c172_cross_wind's oscillation)
+                for g in structure:
+                    sw += g()
+            t = k * dt
+            problem = monitor.state(phi + theta + p + q + r + vc + h + agl + alpha, vc, alpha, agl, wow, sw)
+            if problem:
+                close(rows, "failed", f"t={t:.2f} s: {problem}")
+                return flight
+            if total >= limit_steps:
+                flight.stopped_by_limit = True
+                break
+            if not run():
+                break  # the script's end: the last state has no pilot acceleration of its own
+            total += 1
+            if fdm.get_sim_time() < t_sim - 0.5 * dt:  # type: ignore[attr-defined]
+                close(rows)  # a reset: the sample before it is dropped, the state now is the next run's sample 0
+                rows, hook = new_segment()
+                k = 0
+                continue
+            fx, fy, fz = ax_get() * FT_S2_TO_M_S2, ay_get() * FT_S2_TO_M_S2, az_get() * FT_S2_TO_M_S2
+            nz = nz_get()
+            rows.extend((t, fx, fy, fz, p * R2D, q * R2D, r * R2D, phi * R2D, theta * R2D, psi * R2D % 360.0,
+                         alpha * R2D, beta * R2D, vc, vg * FPS_TO_KT, h, agl, nz, 1.0 if wow else 0.0))  # fmt: skip
+            if hook is not None:
+                hook(k, np.array((fx, fy, fz)), np.array((p, q, r)))
+            if not wow:
+                problem = monitor.load_factor(nz)
+                if problem:
+                    close(rows, "failed", f"t={t:.2f} s: {problem}")
+                    return flight
+            k += 1
+    close(rows)
+    return flight
+
+
+def write_script_flight(out_dir: Path, flight: ScriptFlight, seg: ScriptSegment) -> None:
+    """``flight.parquet`` (:data:`SCRIPT_COLUMNS`) and ``flight.json`` of one segment, atomically."""
+    import json
+
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    from washbench.io.atomic import atomic_path, write_text_atomic
+
+    info = flight.info
+    table = pa.table({n: seg.columns[n] for n in SCRIPT_COLUMN_NAMES})
+    table = table.replace_schema_metadata({"washbench.script": str(info.path), "washbench.aircraft": info.aircraft})
+    with atomic_path(out_dir / "flight.parquet") as tmp:
+        pq.write_table(table, tmp)
+    doc = {
+        "name": info.name,
+        "aircraft": info.aircraft,
+        "script_file": str(info.path),
+        "description": info.description,
+        "initialize": info.initialize,
+        "segment": seg.name,
+        "segments": len(flight.segments),
+        "status": seg.status,
+        "reason": seg.reason,
+        "dt_s": flight.dt_s,
+        "samples": seg.n,
+        "duration_s": float(seg.columns["t_s"][-1]) if seg.n else 0.0,
+        "stopped_by_time_limit": flight.stopped_by_limit,
+    }
+    write_text_atomic(out_dir / "flight.json", json.dumps(doc, indent=2) + "\n")
