@@ -70,9 +70,14 @@ def test_suite_stops_at_once_and_leaves_the_previous_results(
     else:
         proc.send_signal(sig)
     _, err = proc.communicate(timeout=60)
-    assert proc.returncode == status, err
-    assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
-    assert err.strip().splitlines()[-1] == f"washbench: {word}", err
+    if proc.returncode == -sig and delay_s < 1:
+        # on a loaded machine the signal can come before Python has started at all: the default action ends the
+        # process, which a shell reports as the same 130 (128 + SIGINT); nothing was printed or written
+        assert err == "", err
+    else:
+        assert proc.returncode == status, err
+        assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
+        assert err.strip().splitlines()[-1] == f"washbench: {word}", err
     assert wait_for_no_process(proc.pid) == []
     assert tree(out) == before  # no half-built folder, no lock, nothing new
     time.sleep(1.0)
