@@ -14,6 +14,7 @@ import pytest
 
 from washbench.io.paths import MANOEUVRES_DIR
 from washbench.review.rerun_log import read_scalar_series, read_text_documents
+from washbench.review.rrd_read import read_static
 
 MANOEUVRES = [MANOEUVRES_DIR / "c172" / "coordinated_turn.yaml", MANOEUVRES_DIR / "c172" / "takeoff.yaml"]
 DOF_COLUMNS = {
@@ -96,17 +97,31 @@ def test_fly_then_cue_gives_the_same_numbers_bit_for_bit(run_dir: Path, tmp_path
 
 
 def test_recording_holds_the_computed_traces(run_dir: Path) -> None:
+    """Stated precision: perceived motion bit-equal to traces.parquet (float64), raw motion too except angular rates
+    that went deg/s -> rad/s -> deg/s (relative 1e-14); times within 0.5 ns."""
     traces = pq.read_table(run_dir / "traces.parquet")
     t = traces.column("t_s").to_numpy()
-    series = read_scalar_series(run_dir / "recording.rrd")
+    rrd = run_dir / "recording.rrd"
+    series = read_scalar_series(rrd)
+    sources = ("aircraft", "small-angle", "large-angle", "unrestricted")
+    assert read_static(rrd, "SeriesLines:names")["/perceived/surge"] == list(sources)
     for dof, col in DOF_COLUMNS.items():
-        for source in ("aircraft", "small-angle", "large-angle", "unrestricted"):
-            rec_t, rec_v = series[f"/perceived/{dof}/{source}"]
-            expected = traces.column(f"{source}.{col}").to_numpy()
-            assert np.allclose(rec_t, t, rtol=0, atol=1e-9)
-            assert np.allclose(np.ravel(rec_v), expected, rtol=1e-12, atol=1e-12), (dof, source)
-    text = "\n".join(read_text_documents(run_dir / "recording.rrd").values())
-    assert "integral error" in text and "large-angle" in text
+        rec_t, perceived = series[f"/perceived/{dof}"]
+        _, raw = series[f"/raw/{dof}"]
+        assert np.allclose(rec_t, t, rtol=0, atol=0.5e-9)
+        for i, source in enumerate(sources):
+            assert np.array_equal(perceived[:, i], traces.column(f"{source}.{col}").to_numpy()), (dof, source)
+            raw_col = f"{source}.{col.removeprefix('perceived_')}"
+            expected = traces.column(raw_col).to_numpy()
+            if dof in ("surge", "sway", "heave"):
+                assert np.array_equal(raw[:, i], expected), (dof, source)
+            else:
+                np.testing.assert_allclose(raw[:, i], expected, rtol=1e-14, atol=0, err_msg=f"{dof} {source}")
+    text = "\n".join(read_text_documents(rrd).values())
+    assert "integral of |error|" in text and "| DOF | small-angle | large-angle | better by |" in text
+    size_per_step = rrd.stat().st_size / len(t)
+    print(f"\nrecording: {size_per_step:.0f} bytes per step ({len(t)} steps)")
+    assert size_per_step < 1400  # was 2,030 before rows were shared per panel (issue 14); a regression guard
 
 
 def test_run_summary_is_consistent(run_dir: Path) -> None:

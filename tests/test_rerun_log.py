@@ -24,20 +24,26 @@ from washbench.review.rerun_log import (
     AIRCRAFT,
     DOFS,
     ENVELOPE_QUANTITIES,
+    PLATFORM_DETAIL_TOLERANCE,
     MotionSeries,
     PlatformEnvelope,
     PlatformSeries,
     RecordingData,
     envelope_usage_path,
+    limit_lane_path,
     perceived_path,
+    phase_lane_path,
     platform_path,
     quat_wxyz_to_xyzw,
     raw_path,
     read_component,
+    read_properties,
     read_scalar_series,
     read_text_documents,
+    washout_lane_path,
     write_recording,
 )
+from washbench.review.rrd_read import read_blueprint_components, read_static
 
 WASHOUTS = ("small-angle", "large-angle", "unrestricted")
 G = 9.80665
@@ -86,33 +92,48 @@ def make_data(n: int = 600, washouts: tuple[str, ...] = WASHOUTS, seed: int = 7)
 def written(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, RecordingData]:
     data = make_data()
     path = tmp_path_factory.mktemp("rec") / "recording.rrd"
-    write_recording(path, data)
+    write_recording(path, data, {"washbench_version": "0.1.0", "params_sha256": "ab" * 32})
     return path, data
 
 
 def test_time_axis_is_k_dt_to_the_nanosecond(written):
     path, data = written
     series = read_scalar_series(path)
-    t, _ = series[perceived_path("surge", AIRCRAFT)]
+    t, _ = series[perceived_path("surge")]
     assert t.shape == data.t_s.shape
     np.testing.assert_allclose(t, data.t_s, rtol=0, atol=0.5e-9 + 1e-15)
 
 
-def test_motion_traces_equal_the_inputs(written):
+def test_motion_traces_equal_the_inputs_one_line_per_source(written):
+    """Stated precision: float64, bit-equal for specific force; angular rates in deg/s to 1e-14."""
     path, data = written
     series = read_scalar_series(path)
-    sources = {AIRCRAFT: data.aircraft, **data.washouts}
+    sources = [data.aircraft, *data.washouts.values()]
     for dof, sig, axis, _unit in DOFS:
-        for src, m in sources.items():
-            _, perceived = series[perceived_path(dof, src)]
-            _, raw = series[raw_path(dof, src)]
-            assert perceived.dtype == np.float64
+        _, perceived = series[perceived_path(dof)]
+        _, raw = series[raw_path(dof)]
+        assert perceived.shape == (data.t_s.size, 1 + len(WASHOUTS)) and perceived.dtype == np.float64
+        for i, m in enumerate(sources):
             if sig == "f":  # m/s^2, stored unchanged
-                np.testing.assert_array_equal(perceived, m.perceived_f_mps2[:, axis])
-                np.testing.assert_array_equal(raw, m.f_mps2[:, axis])
+                np.testing.assert_array_equal(perceived[:, i], m.perceived_f_mps2[:, axis])
+                np.testing.assert_array_equal(raw[:, i], m.f_mps2[:, axis])
             else:  # shown in deg/s
-                np.testing.assert_allclose(perceived, m.perceived_omega_radps[:, axis] * 180 / np.pi, rtol=1e-14)
-                np.testing.assert_allclose(raw, m.omega_radps[:, axis] * 180 / np.pi, rtol=1e-14)
+                np.testing.assert_allclose(perceived[:, i], m.perceived_omega_radps[:, axis] * 180 / np.pi, rtol=1e-14)
+                np.testing.assert_allclose(raw[:, i], m.omega_radps[:, axis] * 180 / np.pi, rtol=1e-14)
+    names = read_static(path, "SeriesLines:names")
+    assert names[perceived_path("surge")] == [AIRCRAFT, *WASHOUTS]
+
+
+def test_perception_thresholds_are_drawn_as_plus_minus_lines(written):
+    """Zacharias (1978) values, typed here from the table in washbench/perception/thresholds.py."""
+    path, data = written
+    series = read_scalar_series(path)
+    expected = {"surge": (0, 0.17), "sway": (0, 0.17), "heave": (-9.80665, 0.28),
+                "roll": (0, 3.0), "pitch": (0, 3.6), "yaw": (0, 2.6)}  # fmt: skip
+    for dof, (centre, th) in expected.items():
+        t, v = series[f"/perceived/{dof}/threshold"]
+        np.testing.assert_allclose(t, data.t_s[[0, -1]], atol=1e-9)
+        np.testing.assert_allclose(v, [[centre + th, centre - th]] * 2, rtol=1e-12)
 
 
 def test_platform_traces_and_envelope_usage(written):
@@ -123,49 +144,108 @@ def test_platform_traces_and_envelope_usage(written):
         t_lim, v_lim = series[f"/envelope/{q}/limit"]
         np.testing.assert_array_equal(v_lim, [1.0, 1.0])
         np.testing.assert_allclose(t_lim, data.t_s[[0, -1]], atol=1e-9)
-        for w in WASHOUTS:
+        _, usage = series[envelope_usage_path(q)]
+        assert usage.shape == (data.t_s.size, len(WASHOUTS))
+        for i, w in enumerate(WASHOUTS):
             values = getattr(data.platforms[w], fname)
-            _, usage = series[envelope_usage_path(q, w)]
             expected = np.linalg.norm(values / limit, ord=np.inf, axis=1)
-            np.testing.assert_allclose(usage, expected, rtol=1e-15)
+            np.testing.assert_allclose(usage[:, i], expected, rtol=1e-15)
             if q == "position":  # first sample: x, y at 0.3 of 1.5 m, z at 0.9 of its own 1.0 m limit
-                assert usage[0] == 0.9
-            np.testing.assert_array_equal(series[platform_path(w, q)][1], values)
+                assert usage[0, i] == 0.9
+            np.testing.assert_array_equal(series[platform_path(w, q)][1], values)  # random data: every sample kept
             np.testing.assert_array_equal(series[f"/platform/{w}/{q}/limit_max"][1], [limit, limit])
             np.testing.assert_array_equal(series[f"/platform/{w}/{q}/limit_min"][1], [-limit, -limit])
             if limit.ndim:  # per-axis limits are drawn one line per axis
                 assert series[f"/platform/{w}/{q}/limit_max"][1].shape == (2, 3)
+    aggregation = read_static(path, "SeriesLines:aggregation_policy")
+    assert {aggregation[envelope_usage_path(q)][0] for q, _, _ in ENVELOPE_QUANTITIES} == {3}  # 3 = Max
 
 
-def test_saturation_markers_and_onset_events(written):
+def test_smooth_platform_traces_are_thinned_within_the_stated_tolerance(tmp_path):
+    """Position and velocity that interpolate linearly within 0.2 % of the limit keep every 2nd-4th sample; the
+    recorded samples are exact and linear interpolation between them reproduces every step within the tolerance."""
+    base = make_data(n=1200)
+    t = base.t_s
+    smooth = np.column_stack([np.sin(0.5 * t), 0.5 * np.cos(0.3 * t), 0.2 * np.sin(t)])
+    platforms = {
+        w: PlatformSeries(smooth, 0.5 * smooth, p.acc_mps2, p.wheel_radps, p.saturated)
+        for w, p in base.platforms.items()
+    }
+    data = RecordingData(**{**base.__dict__, "platforms": platforms})
+    write_recording(tmp_path / "r.rrd", data)
+    series = read_scalar_series(tmp_path / "r.rrd")
+    for w in WASHOUTS:
+        for q, values, limit in (("position", smooth, (1.5, 1.5, 1.0)), ("velocity", 0.5 * smooth, (2.0,) * 3)):
+            t_rec, v_rec = series[platform_path(w, q)]
+            assert t.size / 4 <= t_rec.size < t.size / 2  # thinned
+            assert t_rec[0] == 0.0 and abs(t_rec[-1] - t[-1]) < 1e-9
+            k = np.round(t_rec * 120).astype(int)
+            np.testing.assert_array_equal(v_rec, values[k])
+            for j in range(3):
+                err = np.abs(np.interp(t, t_rec, v_rec[:, j]) - values[:, j])
+                assert err.max() <= PLATFORM_DETAIL_TOLERANCE * limit[j] + 1e-12
+        assert series[platform_path(w, "acceleration")][0].size == t.size  # random: every sample
+
+
+def _state_at(t_change: np.ndarray, states: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """The state in force at each time of ``t`` (latest change at or before it), from a lane read back."""
+    i = np.searchsorted(t_change, t + 1e-9, side="right") - 1
+    return np.where(i >= 0, states[np.maximum(i, 0)], "")  # before the first change: no state
+
+
+def test_limit_lanes_reproduce_the_saturation_flags(written):
     path, data = written
-    series = read_scalar_series(path)
+    lanes = read_component(path, "StateChange:state")
+    for w in WASHOUTS:
+        sat = data.platforms[w].saturated
+        # one lane per kind reached, in data order ("vel" is never reached: no lane)
+        t_ch, states = lanes[limit_lane_path(data, w)]
+        assert states.shape[1] == 2
+        for j, kind in enumerate(("pos", "rate")):
+            np.testing.assert_array_equal(_state_at(t_ch, states[:, j], data.t_s) == kind, sat[kind])
+        # the washout's own lane: the kinds held at, joined by "+"
+        t_ch, joined = lanes[washout_lane_path(data, w)]
+        at = _state_at(t_ch, joined, data.t_s)
+        expected = np.where(
+            sat["pos"] & sat["rate"], "pos+rate", np.where(sat["pos"], "pos", np.where(sat["rate"], "rate", ""))
+        )
+        np.testing.assert_array_equal(at, expected)
+    assert [p.rsplit("/", 1)[1] for p in sorted(k for k in lanes if k.startswith("/lanes/"))] == [
+        "0_phase", "1_small-angle", "2_large-angle", "3_unrestricted"]  # fmt: skip
+
+
+def test_saturation_onset_events(written):
+    path, data = written
     expected_onsets = []
     for w in WASHOUTS:
-        for kind, panel in (("pos", "position"), ("rate", "other")):
+        for kind in ("pos", "rate"):
             flags = data.platforms[w].saturated[kind]
-            t, v = series[f"/envelope/{panel}/saturation/{w}/{kind}"]
-            np.testing.assert_allclose(t, data.t_s[flags], atol=1e-9)
-            np.testing.assert_array_equal(v, np.ones(flags.sum()))
             rising = np.flatnonzero(np.diff(flags.astype(int), prepend=0) == 1)
             expected_onsets += [(data.t_s[i], f"{w}: {kind} limit") for i in rising]
-        assert not any(k.endswith(f"{w}/vel") for k in series), "a limit never reached must not get markers"
     t_ev, text = read_component(path, "TextLog:text")["/events/saturation"]
     assert len(text) == len(expected_onsets)
-    got = sorted((round(float(tt), 6), s.split(" reached")[0]) for tt, s in zip(t_ev, text, strict=True))
+    got = sorted(
+        (round(float(tt), 6), s.split("  ", 1)[1].split(" reached")[0]) for tt, s in zip(t_ev, text, strict=True)
+    )
+    assert all(s.startswith(f"{tt:.2f} s  ") for tt, s in zip(t_ev, text, strict=True))
     assert got == sorted((round(float(tt), 6), s) for tt, s in expected_onsets)
+    assert "1.50 s  small-angle: pos limit reached for 0.167 s" in text  # 20 samples at 120 Hz, from k = 180
+    assert "0.04 s  small-angle: rate limit reached for 0.008 s" in text  # 1 sample, k = 5
     _, levels = read_component(path, "TextLog:level")["/events/saturation"]
     assert set(levels) == {"WARN"}
 
 
-def test_phases_on_the_timeline(written):
+def test_phases_as_a_lane_and_as_events(written):
     path, data = written
     t, text = read_component(path, "TextLog:text")["/events/phases"]
     np.testing.assert_allclose(t, [p[1] for p in data.phases], atol=1e-9)
-    assert [s.split()[1] for s in text] == ["entry", "hold", "exit"]
+    assert [s.split()[3] for s in text] == ["entry", "hold", "exit"]
+    t_ch, states = read_component(path, "StateChange:state")[phase_lane_path()]
+    np.testing.assert_allclose(t_ch, [p[1] for p in data.phases], atol=1e-9)
+    assert list(states) == ["entry", "hold", "exit"]
 
 
-def test_metrics_markdown_document(written):
+def test_metrics_markdown_document_and_provenance_properties(written):
     path, _ = written
     docs = read_text_documents(path)
     assert docs["/metrics"] == METRICS
@@ -175,33 +255,52 @@ def test_metrics_markdown_document(written):
         if ch.entity_path == "/metrics"
     ]
     assert media == ["text/markdown"]
+    assert read_properties(path) == {"washbench_version": "0.1.0", "params_sha256": "ab" * 32}
 
 
-def test_3d_scene_quaternions_are_scalar_last_and_platforms_side_by_side(written):
+def test_properties_must_be_strings(tmp_path):
+    with pytest.raises(ValueError, match="properties"):
+        write_recording(tmp_path / "x.rrd", make_data(n=20), {"seed": 42})  # type: ignore[dict-item]
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_3d_scene_relative_heading_scalar_last_and_30_hz(written):
     path, data = written
     quats = read_component(path, "Transform3D:quaternion")
     trans = read_component(path, "Transform3D:translation")
-    x_fwd = np.array([1.0, 0.0, 0.0])
-    for entity, m in [("/world/aircraft", data.aircraft)] + [(f"/world/atlas/{w}", data.washouts[w]) for w in WASHOUTS]:
-        _, q_xyzw = quats[entity]
-        assert q_xyzw.shape == (data.t_s.size, 4)
-        assert q_xyzw.dtype == np.float32  # rerun stores quaternions as float32
-        # Independent check of the order: scipy reads rerun's quaternion as scalar-last and must rotate "forward" as
-        # the scalar-first input does.
-        np.testing.assert_allclose(
-            Rotation.from_quat(q_xyzw.astype(np.float64)).apply(x_fwd),
-            Rotation.from_quat(m.q, scalar_first=True).apply(x_fwd),
-            atol=1e-6,
-        )
+    stride = 4  # 120 Hz -> 30 Hz
+    k = np.arange(0, data.t_s.size, stride)
+    # aircraft: relative to its initial heading; checked with scipy's ZYX Euler angles
+    t_ac, q_ac = quats["/world/aircraft/body"]
+    np.testing.assert_allclose(t_ac, data.t_s[k], atol=1e-9)
+    assert q_ac.dtype == np.float32  # rerun stores quaternions as float32
+    ypr = Rotation.from_quat(data.aircraft.q[k], scalar_first=True).as_euler("ZYX")
+    ypr0 = Rotation.from_quat(data.aircraft.q[0], scalar_first=True).as_euler("ZYX")
+    ypr[:, 0] -= ypr0[0]
+    x_fwd, z_down = np.array([1.0, 0.0, 0.0]), np.array([0.0, 0.0, 1.0])
+    got = Rotation.from_quat(q_ac.astype(np.float64))  # scipy reads scalar-last
+    want = Rotation.from_euler("ZYX", ypr)
+    for v in (x_fwd, z_down):
+        np.testing.assert_allclose(got.apply(v), want.apply(v), atol=1e-6)
+    np.testing.assert_allclose(got[0].as_euler("ZYX")[0], 0.0, atol=1e-6)
+    # cockpits: attitude unchanged (the simulator starts at yaw 0), translated by the stage position
+    static_t = read_static(path, "Transform3D:translation")
     offsets = []
     for w in WASHOUTS:
-        _, tr = trans[f"/world/atlas/{w}"]
-        offset = tr.astype(np.float64) - data.platforms[w].pos_m
-        np.testing.assert_allclose(offset, np.tile(offset[0], (len(offset), 1)), atol=1e-6)  # stage moves the sphere
-        offsets.append(offset[0])
-    gaps = np.diff(np.array(offsets)[:, 1])
+        _, q = quats[f"/world/atlas/{w}/cockpit"]
+        np.testing.assert_allclose(
+            Rotation.from_quat(q.astype(np.float64)).apply(x_fwd),
+            Rotation.from_quat(data.washouts[w].q[k], scalar_first=True).apply(x_fwd),
+            atol=1e-6,
+        )
+        np.testing.assert_allclose(trans[f"/world/atlas/{w}/cockpit"][1], data.platforms[w].pos_m[k], atol=1e-6)
+        offsets.append(static_t[f"/world/atlas/{w}"][0][1])
+    gaps = np.diff([static_t["/world/aircraft"][0][1], *offsets])
     sphere_plus_travel = data.envelope.sphere_diameter_m + 2 * data.envelope.pos_m[1]
     assert np.all(gaps >= sphere_plus_travel)  # spheres at the extremes of their travel never overlap
+    labels = read_static(path, "Points3D:labels")
+    assert labels["/world/labels"] == [AIRCRAFT, *WASHOUTS]  # one label per object
+    assert not any(k != "/world/labels" for k in read_static(path, "Boxes3D:labels"))
 
 
 def test_quaternion_order_conversion_matches_scipy():
@@ -213,37 +312,129 @@ def test_quaternion_order_conversion_matches_scipy():
     )
 
 
-def test_blueprint_stored_with_one_panel_per_dof(written):
-    path, _ = written
-    reader = RrdReader(str(path))
-    assert len(reader.recordings()) == 1
-    (blueprint,) = reader.blueprints()
-    names = set()
-    for ch in reader.stream(store=blueprint):
-        batch = ch.to_record_batch()
-        if "ViewBlueprint:display_name" in batch.schema.names:
-            names.update(row[0] for row in batch.column("ViewBlueprint:display_name").to_pylist() if row)
+def _views(path: Path) -> dict[str, dict[str, list]]:
+    """Stored blueprint: view id -> its components (own and properties), plus "name", "class", "origin"."""
+    views: dict[str, dict[str, list]] = {}
+    for entity, comps in read_blueprint_components(path).items():
+        parts = entity.strip("/").split("/")
+        if parts[0] == "view":
+            views.setdefault(parts[1], {}).update(comps)
+    return views
+
+
+def _containers(path: Path) -> dict[str, dict[str, list]]:
+    return {
+        e.strip("/").split("/")[1]: c for e, c in read_blueprint_components(path).items() if e.startswith("/container/")
+    }
+
+
+def test_blueprint_stacks_the_perceived_panels_on_the_whole_manoeuvre(written):
+    path, data = written
+    views = _views(path)
+    by_name = {v["ViewBlueprint:display_name"][0]: (vid, v) for vid, v in views.items()}
+    t_end_ns = round(data.t_s[-1] * 1e9)
+    perceived = []
+    series = read_scalar_series(path)
     for dof, _, _, unit in DOFS:
-        assert f"Perceived {dof} ({unit})" in names
-    assert "Specific force surge (m/s^2)" in names and "Angular velocity yaw (deg/s)" in names
-    assert "Aircraft attitude and Atlas platforms (NED)" in names
-    assert {f"Envelope: {q} (max |axis| / limit)" for q, _, _ in ENVELOPE_QUANTITIES} <= names
-    assert "Other limits reached (rate)" in names
-    assert "Metrics" in names
+        vid, v = by_name[f"perceived {dof} [{unit}]"]
+        perceived.append(vid)
+        assert v["ViewBlueprint:space_origin"] == [f"/perceived/{dof}"]
+        assert v["TimeAxis:view_range"] == [{"start": 0, "end": t_end_ns}]  # whole manoeuvre on opening
+        assert v["VisibleTimeRanges:ranges"][0]["range"] == {"start": None, "end": None}  # all data queried
+        assert v["PlotLegend:visible"] == [False]  # the one legend has its own panel
+        lo, hi = v["ScalarAxis:range"][0]
+        m = series[perceived_path(dof)][1]
+        assert lo < m.min() and hi > m.max()  # every trace inside the fixed range
+    # the lanes above, then the six panels, stacked in one container (a tab named "Perceived")
+    stacks = [c for c in _containers(path).values() if c.get("ContainerBlueprint:display_name") == ["Perceived"]]
+    (stack,) = stacks
+    contents = [c.split("/")[1] for c in stack["ContainerBlueprint:contents"]]
+    assert contents[1:] == perceived
+    assert views[contents[0]]["ViewBlueprint:class_identifier"] == ["StateTimeline"]
+    assert views[contents[0]]["ViewBlueprint:space_origin"] == ["/lanes"]
+    legend = [v for v in views.values() if v["ViewBlueprint:space_origin"] == ["/legend"]]
+    assert len(legend) == 1 and legend[0]["PlotLegend:visible"] == [True]
+    for name in ("Raw motion", "Platform envelope", "Atlas small-angle", "Atlas unrestricted"):
+        assert any(c.get("ContainerBlueprint:display_name") == [name] for c in _containers(path).values())
+    assert {f"{q}: max |axis| / limit" for q, _, _ in ENVELOPE_QUANTITIES} <= {n.split(" (")[0] for n in by_name}
+    # panels collapsed so the plots get the screen (2 = Collapsed)
+    comps = read_blueprint_components(path)
+    assert comps["/blueprint_panel"]["PanelBlueprint:state"] == [2]
+    assert comps["/selection_panel"]["PanelBlueprint:state"] == [2]
+    assert comps["/time_panel"]["TimePanelBlueprint:state"] == [2]
 
 
-def test_series_have_fixed_colours_per_washout(written):
+def test_blueprint_3d_camera_frames_the_aircraft_and_every_platform(written):
+    """Every object centre within 40 deg of the line of sight: inside the side pane (2:1) at rerun's 55 deg vertical
+    field of view, about 45 deg each side horizontally."""
     path, _ = written
-    colours: dict[str, set[int]] = {}
-    for ch in RrdReader(str(path)).stream():
-        batch = ch.to_record_batch()
-        if ch.is_static and "SeriesLines:colors" in batch.schema.names:
-            src = ch.entity_path.rsplit("/", 1)[-1]
-            if ch.entity_path.startswith(("/perceived/", "/raw/", "/envelope/")) and src != "limit":
-                colours.setdefault(src, set()).add(batch.column("SeriesLines:colors").to_pylist()[0][0])
-    assert set(colours) == {AIRCRAFT, *WASHOUTS}
-    assert all(len(c) == 1 for c in colours.values()), colours  # one colour per source everywhere
-    assert len({next(iter(c)) for c in colours.values()}) == 4  # and four distinct colours
+    (scene,) = [v for v in _views(path).values() if v["ViewBlueprint:class_identifier"] == ["3D"]]
+    eye = np.array(scene["EyeControls3D:position"][0])
+    target = np.array(scene["EyeControls3D:look_target"][0])
+    np.testing.assert_allclose(scene["EyeControls3D:eye_up"][0], [0, 0, -1])  # NED: up is -z
+    static_t = read_static(path, "Transform3D:translation")
+    centres = [static_t["/world/aircraft"][0]] + [static_t[f"/world/atlas/{w}"][0] for w in WASHOUTS]
+    sight = (target - eye) / np.linalg.norm(target - eye)
+    for c in centres:
+        to_c = (np.array(c) - eye) / np.linalg.norm(np.array(c) - eye)
+        assert np.degrees(np.arccos(np.clip(to_c @ sight, -1, 1))) < 40.0
+
+
+def _relative_luminance(rgb: tuple[int, int, int]) -> float:
+    """WCAG 2 relative luminance of an sRGB colour."""
+    c = np.array(rgb) / 255.0
+    lin = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+    return float(lin @ [0.2126, 0.7152, 0.0722])
+
+
+def _contrast(a: tuple[int, int, int], b: tuple[int, int, int]) -> float:
+    la, lb = sorted((_relative_luminance(a), _relative_luminance(b)), reverse=True)
+    return (la + 0.05) / (lb + 0.05)
+
+
+def _series_colours(path: Path) -> dict[str, list[int]]:
+    return read_static(path, "SeriesLines:colors")
+
+
+def _rgba(rgb: tuple[int, int, int]) -> int:
+    r, g, b = rgb
+    return (r << 24) | (g << 16) | (b << 8) | 0xFF
+
+
+def test_colours_fixed_and_the_aircraft_readable_on_both_themes(written):
+    path, _ = written
+    colours = _series_colours(path)
+    blue, orange, green = (31, 119, 180), (255, 127, 14), (44, 160, 44)
+    aircraft = rerun_log.series_color(AIRCRAFT)
+    for dof, _, _, _ in DOFS:
+        assert colours[perceived_path(dof)] == [_rgba(c) for c in (aircraft, blue, orange, green)]
+        assert colours[raw_path(dof)] == colours[perceived_path(dof)]
+    for q, _, _ in ENVELOPE_QUANTITIES:
+        assert colours[envelope_usage_path(q)] == [_rgba(c) for c in (blue, orange, green)]
+    # the reference trace reads on the viewer's light (247,246,246) and dark (24,24,23) backgrounds (WCAG >= 3:1)
+    assert _contrast(aircraft, (247, 246, 246)) >= 3.0 and _contrast(aircraft, (24, 24, 23)) >= 3.0
+    widths = read_static(path, "SeriesLines:widths")[perceived_path("surge")]
+    assert widths[0] > max(widths[1:])  # the aircraft drawn wider
+
+
+def test_washout_names_come_from_the_data(tmp_path):
+    """User-named variants: the names, their order and fixed colours for the known three, distinct spare ones."""
+    names = ("large-angle", "cw1-soft", "small-angle", "my_variant")
+    path = tmp_path / "r.rrd"
+    data = make_data(n=60, washouts=names)
+    write_recording(path, data)
+    lines = read_static(path, "SeriesLines:names")
+    assert lines[perceived_path("yaw")] == [AIRCRAFT, *names]
+    colours = _series_colours(path)[perceived_path("yaw")]
+    assert colours[1] == _rgba((255, 127, 14)) and colours[3] == _rgba((31, 119, 180))
+    assert len(set(colours)) == 5
+    lanes = read_component(path, "StateChange:state")
+    assert washout_lane_path(data, "my_variant") == "/lanes/4_my_variant" and "/lanes/4_my_variant" in lanes
+    views = {v["ViewBlueprint:display_name"][0] for v in _views(path).values()}
+    assert {
+        "cw1-soft: position [m] (x red, y green, z blue)",
+        "my_variant: wheels [rad/s] (w1 red, w2 green, w3 blue)",
+    } <= views
 
 
 def test_rerun_cli_verifies_the_file(written):
@@ -268,7 +459,7 @@ def test_exception_while_writing_leaves_no_partial_file(tmp_path, monkeypatch):
     def boom(*args, **kwargs):
         raise RuntimeError("disk full (simulated)")
 
-    monkeypatch.setattr(rerun_log, "_send_scene", boom)  # fails after the motion and platform columns were sent
+    monkeypatch.setattr(rerun_log.scene3d, "send_scene", boom)  # fails after the motion and platform columns were sent
     with pytest.raises(RuntimeError, match="simulated"):
         write_recording(dest, make_data(n=50))
     with pytest.raises(RuntimeError, match="simulated"):
@@ -312,7 +503,7 @@ def test_write_time_15000_samples_three_washouts(tmp_path):
     size_mb = (tmp_path / "big.rrd").stat().st_size / 1e6
     print(f"\nwrite_recording: 15,000 samples x 3 washouts in {elapsed:.3f} s, {size_mb:.1f} MB")
     series = read_scalar_series(tmp_path / "big.rrd")
-    assert len(series[perceived_path("yaw", "unrestricted")][1]) == 15_000
+    assert len(series[perceived_path("yaw")][1][:, 3]) == 15_000
 
 
 def test_rerun_disabled_by_environment_is_an_error_not_an_empty_file(tmp_path):

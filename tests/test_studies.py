@@ -21,7 +21,7 @@ from washbench.analysis.ranking import perceived_motion, rank
 from washbench.cli import main
 from washbench.io.paths import DATA_DIR
 from washbench.io.results import read_metrics_csv
-from washbench.review.rerun_log import read_scalar_series
+from washbench.review.rrd_read import read_static
 from washbench.runs.pipeline import RunSummary
 from washbench.runs.suite import Outcome, write_suite_results
 
@@ -172,8 +172,8 @@ def test_variant_names_in_every_output(variant_run: Path) -> None:
     assert {c.split(".")[0] for c in columns if "." in c} == {"aircraft", *names}
     assert "fast_tilt.perceived_f_x_mps2" in columns and "cw1.sat_pos" in columns
     assert set(json.loads((variant_run / "run.json").read_text())["saturations"]) == names
-    series = read_scalar_series(variant_run / "recording.rrd")
-    assert {"/perceived/surge/cw1", "/perceived/surge/fast_tilt"} <= set(series)
+    lines = read_static(variant_run / "recording.rrd", "SeriesLines:names")["/perceived/surge"]
+    assert lines[0] == "aircraft" and set(lines[1:]) == names  # one line per source, names from the data
     # the suite's tables: better_by against the first washout listed when small-angle does not run
     summary = json.loads((variant_run / "run.json").read_text())
     run = RunSummary(

@@ -170,8 +170,10 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("examples", help="copy the bundled manoeuvres and pilot profiles into a folder to edit")
     p.add_argument("folder", type=Path, help="destination (created; existing files are never overwritten)")
 
-    p = sub.add_parser("replay", help="open a recording in the rerun viewer")
-    p.add_argument("recording", type=Path, help=".rrd file written by washbench run or suite")
+    p = sub.add_parser("replay", help="open a recording (or compare two) in the rerun viewer")
+    p.add_argument(
+        "recording", type=Path, nargs="+", help=".rrd file(s) from washbench run or suite: one, or two to compare"
+    )
     p.add_argument("--web", action="store_true", help="always use the web viewer")
     return parser
 

@@ -26,6 +26,7 @@ from washbench.flight.columns import COLUMN_NAMES
 from washbench.flight.fdm import make_fdm
 from washbench.flight.manoeuvre import Manoeuvre, Until, load_manoeuvre
 from washbench.flight.monitor import Monitor
+from washbench.flight.openloop import OpenLoop
 from washbench.flight.pilot import Pilot
 from washbench.flight.profile import load_profile
 from washbench.io.atomic import atomic_path, write_text_atomic
@@ -89,6 +90,7 @@ class FlightResult:
     status: str  # "ok" or "failed"
     reason: str = ""
     events: dict[str, list[float]] = field(default_factory=dict)
+    probes: dict[str, np.ndarray] = field(default_factory=dict)  # fly(probes=...): JSBSim properties after each step
 
     @property
     def ok(self) -> bool:
@@ -141,12 +143,16 @@ def _end_reached(u: Until, t_phase: float, turned: float, rolled: float, pitched
     )
 
 
-def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool = False) -> FlightResult:
+def fly(
+    manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool = False, probes: Sequence[str] = ()
+) -> FlightResult:
     """Fly ``manoeuvre`` to its end (or to a crash) and return the recording and check results.
 
     ``step_hook(k, f_mps2, omega_radps)`` is called once per recorded sample, in order, as soon
     as the sample is final (specific force at the eyepoint in m/s^2 and body rates in rad/s,
-    body axes x forward, y right, z down).
+    body axes x forward, y right, z down). ``probes`` names JSBSim properties read after each
+    step (sample ``k``: the value the step from ``k`` produced, e.g. a surface position), returned
+    in ``FlightResult.probes``.
     """
     m = manoeuvre
     profile = load_profile(m.aircraft_files.profile)
@@ -164,6 +170,9 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
     pilot = Pilot(profile, m.runway, dt)
     pilot.set_controls(ail_w.get_double_value(), elev_w.get_double_value(), rud_w.get_double_value())
     monitor = Monitor.for_profile(profile)
+    openloop = OpenLoop(fdm, profile, pilot)
+    probe_gets = [n.get_double_value for n in _nodes(fdm, tuple(probes))]
+    probe_rows: list[list[float]] = [[] for _ in probe_gets]
     frame = setup.frame
     lat0, lon0, mlat, mlon = frame.lat0, frame.lon0, frame.m_per_rad_lat, frame.m_per_rad_lon
     has_runway = setup.threshold_ne_m is not None
@@ -279,23 +288,30 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
                 turned = rolled = pitched = 0.0
                 phase_events = set()
                 pilot.begin_phase(phase.hold, theta, thr_w.get_double_value(), flap_get())
+                openloop.begin_phase(phase.inputs)
                 flapc_w.set_double_value(pilot.flaps_cmd)
                 lbrk_w.set_double_value(pilot.brakes)
                 rbrk_w.set_double_value(pilot.brakes)
                 if progress:
                     _progress(m.name, iphase, nphases, phase.name, t)
 
+        ail, elev, rud, thr = pilot.aileron, pilot.elevator, pilot.rudder, pilot.throttle
         if not final:
             pilot.step(phi, theta, psi, p, q, r, beta, vc, vg, trk, hdot, h, agl, x_rw * 3.2808399,
                        y_rw * 3.2808399, wow, nz_last, alpha, vt_get(), fy_last)  # fmt: skip
-            ail_set(pilot.aileron)
-            elev_set(pilot.elevator)
-            rud_set(pilot.rudder)
+            ail, elev, rud, thr = pilot.aileron, pilot.elevator, pilot.rudder, pilot.throttle
+            if openloop.active:  # the phase's open-loop inputs, on top of or instead of the pilot's commands
+                ail, elev, rud, thr = openloop.apply((k - phase_k0) * dt, ail, elev, rud, thr)
+            ail_set(ail)
+            elev_set(elev)
+            rud_set(rud)
             steer_set(pilot.steer)
-            thr_set(pilot.throttle)
+            thr_set(thr)
             if k % mix_every == 0:
                 mix_w.set_double_value(float(np.interp(h, mix_h_ft, mix_norm)))
         fdm.run()
+        for get, out in zip(probe_gets, probe_rows, strict=True):
+            out.append(get())
         fx = ax_get() * FT_S2_TO_M_S2
         fy = ay_get() * FT_S2_TO_M_S2
         fz = az_get() * FT_S2_TO_M_S2
@@ -304,7 +320,7 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
         fy_last = fy
         rows.extend((t, fx, fy, fz, p * R2D, q * R2D, r * R2D, phi * R2D, theta * R2D, psi * R2D % 360.0,
                      alpha * R2D, beta * R2D, vc, vg * FPS_TO_KT, h, agl, hdot * 60.0, north, east, lat * R2D,
-                     lon * R2D, x_rw, y_rw, nz, pilot.aileron, pilot.elevator, pilot.rudder, pilot.throttle,
+                     lon * R2D, x_rw, y_rw, nz, ail, elev, rud, thr,
                      flap_get(), pilot.brakes, rpm_get(), 1.0 if wow else 0.0, float(iphase if not final
                                                                                       else nphases - 1)))  # fmt: skip
         if step_hook is not None:
@@ -339,7 +355,8 @@ def fly(manoeuvre: Manoeuvre, step_hook: StepHook | None = None, progress: bool 
     elif not all(c.passed for c in results):
         status = "failed"
         reason = "checks failed: " + ", ".join(c.name for c in results if not c.passed)
-    return FlightResult(m.name, m.aircraft, dt, columns, phases_out, checks, status, reason, events)
+    probed = {name: np.array(v) for name, v in zip(probes, probe_rows, strict=True)}
+    return FlightResult(m.name, m.aircraft, dt, columns, phases_out, checks, status, reason, events, probed)
 
 
 def _progress(name: str, iphase: int, nphases: int, phase: str, t: float) -> None:

@@ -19,14 +19,14 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Annotated, Any, Literal, get_args
 
-from pydantic import Field, PrivateAttr, ValidationInfo, model_validator
+from pydantic import Field, PrivateAttr, ValidationInfo, field_validator, model_validator
 
 from washbench.errors import WashbenchError, located
 from washbench.flight.columns import COLUMN_NAMES, RUNWAY_COLUMNS
 from washbench.flight.profile import PilotProfile, load_profile
 from washbench.io.atomic import write_text_atomic
 from washbench.io.names import Identifier
-from washbench.io.paths import AircraftFiles, find_aircraft, find_aircraft_files, find_profile
+from washbench.io.paths import AircraftFiles, find_aircraft, find_aircraft_files, find_profile, jsbsim_root
 from washbench.io.publish import prepare_output_file
 from washbench.io.yamlio import Loc, StrictModel, format_field_path, line_of, read_yaml, validate_data
 
@@ -36,6 +36,7 @@ Fraction = Annotated[float, Field(ge=0, le=1)]
 Heading = Annotated[float, Field(ge=0, le=360)]  # true, deg; 360 is north, as a pilot says it
 Latitude = Annotated[float, Field(ge=-89, le=89)]
 Longitude = Annotated[float, Field(ge=-180, le=180)]
+FiniteFloat = Annotated[float, Field(allow_inf_nan=False)]
 # Ranges that keep every number physical (a finite but absurd number must not reach the flight model).
 Altitude = Annotated[float, Field(ge=-1500, le=60000)]  # ft MSL: the Dead Sea shore to above any piston aircraft
 Height = Annotated[float, Field(ge=-1000, le=60000)]  # ft above the ground
@@ -58,13 +59,21 @@ class Runway(StrictModel):
     """A runway: threshold centre, true heading of the landing/takeoff direction, size."""
 
     name: str = ""
+    """Free text naming the runway (e.g. '07')."""
     latitude_deg: Latitude
+    """Geodetic latitude of the threshold centre, deg."""
     longitude_deg: Longitude
+    """Longitude of the threshold centre, deg."""
     heading_deg: Heading
+    """True heading of the landing / takeoff direction, deg."""
     elevation_ft: Annotated[float, Field(ge=-1500, le=15000)] = 0.0
+    """Elevation of the runway above mean sea level, ft."""
     length_ft: Annotated[float, Field(gt=0, le=50000)]
+    """Length of the runway, ft."""
     width_ft: Annotated[float, Field(gt=0, le=1000)]
-    aim_point_ft: Annotated[float, Field(ge=0, le=50000)] = 1000.0  # glide path meets the runway, past threshold
+    """Width of the runway, ft."""
+    aim_point_ft: Annotated[float, Field(ge=0, le=50000)] = 1000.0
+    """Where the glide path meets the runway, ft past the threshold."""
 
 
 class AirStart(StrictModel):
@@ -75,44 +84,64 @@ class AirStart(StrictModel):
     """
 
     altitude_ft: Altitude
+    """Altitude above mean sea level at the start, ft."""
     airspeed_kts: Annotated[float, Field(gt=0, le=1000)]
-    heading_deg: Heading | None = None  # default: the runway heading
+    """Calibrated airspeed at the start, kt."""
+    heading_deg: Heading | None = None
+    """True heading at the start, deg (default: the runway heading)."""
     latitude_deg: Latitude | None = None
+    """Geodetic latitude of the start, deg (with longitude_deg)."""
     longitude_deg: Longitude | None = None
-    # on the extended centreline, this far before the threshold
+    """Longitude of the start, deg (with latitude_deg)."""
     before_threshold_ft: Annotated[float, Field(ge=-50000, le=200000)] | None = None
-    flight_path_deg: Annotated[float, Field(ge=-10, le=10)] = 0.0  # trimmed climb (+) or descent (-)
+    """Start on the runway's extended centreline, this far before the threshold, ft."""
+    flight_path_deg: Annotated[float, Field(ge=-10, le=10)] = 0.0
+    """Trimmed flight-path angle, deg: climb (+) or descent (-)."""
     flaps_deg: Annotated[float, Field(ge=0, le=90)] = 0.0
+    """Flap angle at the start, deg."""
 
 
 class RunwayStart(StrictModel):
     """Start at rest on the runway centreline, engine running, brakes set."""
 
     past_threshold_ft: Annotated[float, Field(ge=0, le=50000)] = 0.0
+    """Where on the centreline the aircraft stands, ft past the threshold."""
 
 
 class Start(StrictModel):
+    """Where and how the flight starts: exactly one of air or runway."""
+
     air: AirStart | None = None
+    """Start in the air, trimmed."""
     runway: RunwayStart | None = None
+    """Start at rest on the runway (needs a top-level runway)."""
 
 
 class Wind(StrictModel):
     """Steady wind; ``from_deg`` is the true direction the wind blows FROM."""
 
     from_deg: Heading
+    """True direction the wind blows FROM, deg (270: a westerly)."""
     speed_kts: Annotated[float, Field(ge=0, le=150)]
+    """Wind speed, kt."""
 
 
 class Turbulence(StrictModel):
     """JSBSim MIL-F-8785C turbulence; the seed makes it repeatable."""
 
     severity: Literal["none", "light", "moderate", "severe"]
+    """Turbulence severity (MIL-F-8785C): none, light, moderate or severe."""
     seed: Annotated[int, Field(ge=0, lt=2**31)]
+    """Seed of JSBSim's random generator: the same seed gives the same gusts."""
 
 
 class Environment(StrictModel):
+    """The weather: steady wind and turbulence."""
+
     wind: Wind | None = None
+    """Steady wind."""
     turbulence: Turbulence | None = None
+    """Turbulence (JSBSim's milspec model)."""
 
 
 LATERAL_TARGETS = ("wings_level", "bank_deg", "heading_deg", "roll_rate_degps", "centreline")
@@ -144,22 +173,39 @@ class Hold(StrictModel):
     """
 
     wings_level: bool | None = None
+    """Lateral target: hold the wings level (the default)."""
     bank_deg: Annotated[float, Field(ge=-80, le=80)] | None = None
+    """Lateral target: hold this bank angle, deg (+ right wing down)."""
     heading_deg: Heading | None = None
+    """Lateral target: turn to and hold this true heading, deg."""
     roll_rate_degps: Annotated[float, Field(ge=-90, le=90)] | None = None
+    """Lateral target: roll at this body roll rate, deg/s (0: keep the roll attitude)."""
     centreline: bool | None = None
+    """Lateral target: track the runway centreline (in the air and on the ground)."""
     wing_low: bool | None = None
+    """With centreline: align the nose with the runway and bank into the wind (crosswind landing)."""
     pitch_deg: Annotated[float, Field(ge=-45, le=45)] | None = None
+    """Pitch target: hold this pitch attitude, deg."""
     altitude_ft: Altitude | None = None
+    """Pitch target: climb or descend to and hold this altitude above mean sea level, ft."""
     vertical_speed_fpm: Annotated[float, Field(ge=-10000, le=10000)] | None = None
+    """Pitch target: hold this rate of climb, ft/min (negative: descent)."""
     glide_path_deg: Annotated[float, Field(gt=0, le=10)] | None = None
+    """Pitch target: follow a glide path of this angle to the runway aim point, deg."""
     pitch_rate_degps: Annotated[float, Field(ge=-30, le=30)] | None = None
-    load_factor: Annotated[float, Field(ge=-3, le=6)] | None = None  # g, +1 in level flight
+    """Pitch target: pitch at this body pitch rate, deg/s."""
+    load_factor: Annotated[float, Field(ge=-3, le=6)] | None = None
+    """Pitch target: pull this load factor, g (+1 in level flight)."""
     flare: bool | None = None
+    """Pitch target: flare, a sink rate proportional to the height of the wheels, to touchdown."""
     airspeed_kts: Annotated[float, Field(gt=0, le=1000)] | None = None
+    """Calibrated airspeed to hold, kt: with the throttle, or with the elevator when throttle is fixed."""
     throttle: Fraction | None = None
+    """Fixed throttle, 0..1."""
     flaps_deg: Annotated[float, Field(ge=0, le=90)] | None = None
+    """Flap angle, deg."""
     brakes: Fraction | None = None
+    """Wheel brakes, 0..1."""
 
 
 Event = Literal["liftoff", "touchdown", "stopped", "stall"]
@@ -176,27 +222,128 @@ class Until(StrictModel):
     """
 
     duration_s: PhaseTime | None = None
+    """End after this time in the phase, s."""
     event: Event | None = None
+    """End at an event: liftoff, touchdown, stopped or stall (angle of attack past the profile's stall angle)."""
     turned_deg: Rotation | None = None
+    """End when the heading has changed this much since the phase began, deg."""
     rolled_deg: Rotation | None = None
+    """End when the integral of the body roll rate p since the phase began reaches this magnitude, deg."""
     pitched_deg: Rotation | None = None
+    """End when the integral of the body pitch rate q since the phase began reaches this magnitude, deg."""
     airspeed_above_kts: Airspeed | None = None
+    """End when the calibrated airspeed reaches this value or more, kt."""
     airspeed_below_kts: Airspeed | None = None
+    """End when the calibrated airspeed falls to this value or less, kt."""
     altitude_above_ft: Altitude | None = None
+    """End when the altitude above mean sea level reaches this value or more, ft."""
     altitude_below_ft: Altitude | None = None
+    """End when the altitude above mean sea level falls to this value or less, ft."""
     agl_above_ft: Height | None = None
+    """End when the height of the centre of gravity above the ground reaches this value or more, ft."""
     agl_below_ft: Height | None = None
+    """End when the height of the centre of gravity above the ground falls to this value or less, ft."""
     bank_above_deg: Annotated[float, Field(ge=0, lt=90)] | None = None
+    """End when the magnitude of the bank angle reaches this value, deg."""
     pitch_above_deg: Angle | None = None
+    """End when the pitch angle reaches this value or more, deg."""
     pitch_below_deg: Angle | None = None
+    """End when the pitch angle falls to this value or less, deg."""
     alpha_above_deg: Angle | None = None
+    """End when the angle of attack reaches this value or more, deg."""
     timeout_s: PhaseTime = 120.0
+    """Not an end condition: a phase still running after this time fails the flight, s."""
+
+
+Shape = Literal["step", "pulse", "doublet", "3211", "sine", "chirp"]
+
+
+class Signal(StrictModel):
+    """The shape keys shared by control and property inputs (times from the start of the phase)."""
+
+    shape: Shape | None = None
+    """Excitation signal added to the base: step, pulse, doublet, 3211, sine or chirp (frequency sweep)."""
+    start_s: NonNegative = 0.0
+    """When the signal starts, s after the start of the phase."""
+    duration_s: Positive | None = None
+    """Length of the signal, s: pulse width, whole doublet (two halves), whole 3211 (7 units), sweep; sine: optional."""
+    period_s: Positive | None = None
+    """Period of a sine, s."""
+    start_hz: Positive | None = None
+    """Chirp: frequency at the start of the sweep, Hz."""
+    end_hz: Positive | None = None
+    """Chirp: frequency at the end of the sweep, Hz."""
+    sweep: Literal["linear", "logarithmic"] = "linear"
+    """Chirp: how the frequency moves from start_hz to end_hz: linearly or logarithmically in time."""
+
+    @field_validator("shape", mode="before")
+    @classmethod
+    def _shape_3211_unquoted(cls, value: object) -> object:
+        """YAML reads ``shape: 3211`` as a number: take it as the name it means."""
+        return "3211" if value == 3211 and type(value) is int else value
+
+
+class ControlInput(Signal):
+    """An open-loop input on one control axis.
+
+    The base is the pilot's command (the pilot keeps the axis closed-loop and the signal is added
+    on top), or, when the axis is free, a fixed value: ``fixed_norm`` / ``fixed_deg``, else the
+    command at the start of the phase (``free: true``, controls fixed at trim), or the base of the
+    previous phase if that had the axis free too (a signal ends with its phase, the base stays). Degrees are the
+    deflection of the surface the pilot profile names (its ``surfaces`` travel, from the model's
+    flight-control system), with the sign of that JSBSim property.
+    """
+
+    free: bool = False
+    """Release the axis: the pilot lets go and the base is fixed (fixed_norm / fixed_deg, else the command
+    at the start of the phase, or the base of the previous phase if that had the axis free too)."""
+    fixed_norm: FiniteFloat | None = None
+    """Release the axis to this normalised command (-1..1; throttle 0..1)."""
+    fixed_deg: FiniteFloat | None = None
+    """Release the axis to this surface deflection, deg."""
+    amplitude_norm: FiniteFloat | None = None
+    """Amplitude of the signal in normalised command (full travel = 1)."""
+    amplitude_deg: FiniteFloat | None = None
+    """Amplitude of the signal in surface deflection, deg."""
+
+
+class PropertyInput(Signal):
+    """An open-loop input on any JSBSim property, in that property's own unit (named in the property)."""
+
+    property: Annotated[str, Field(min_length=1)]
+    """JSBSim property name, e.g. fcs/speedbrake-cmd-norm (must exist in the model)."""
+    fixed: FiniteFloat | None = None
+    """Value written during the phase (default: the value at the start of the phase); the signal is added."""
+    amplitude: FiniteFloat | None = None
+    """Amplitude of the signal, in the property's unit."""
+
+
+class Inputs(StrictModel):
+    """Open-loop inputs of a phase, per control; the axes not named stay with the closed-loop pilot."""
+
+    elevator: ControlInput | None = None
+    """Elevator (+ nose down, as fcs/elevator-cmd-norm)."""
+    aileron: ControlInput | None = None
+    """Ailerons (+ rolls right, as fcs/aileron-cmd-norm)."""
+    rudder: ControlInput | None = None
+    """Rudder (sign of fcs/rudder-cmd-norm; on the c172p + yaws the nose left)."""
+    throttle: ControlInput | None = None
+    """Throttle, 0..1 (fcs/throttle-cmd-norm)."""
+    properties: list[PropertyInput] = Field(default_factory=list)
+    """Inputs on other JSBSim properties, by name."""
 
 
 class Phase(StrictModel):
+    """One phase of the manoeuvre: what the pilot holds, the open-loop inputs, and when it ends."""
+
     name: Annotated[str, Field(min_length=1)]
+    """Name of the phase, unique in the file (checks select phases by name)."""
     hold: Hold = Hold()
+    """What the closed-loop pilot holds or tracks."""
+    inputs: Inputs | None = None
+    """Open-loop control inputs: fixed controls and excitation signals (doublet, 3211, chirp, ...)."""
     until: Until
+    """When the phase ends."""
 
 
 #: Statistics over the selected samples, and those taken at an event (the first touchdown or lift-off).
@@ -212,12 +359,21 @@ SampleStat = Literal[
     "max_deviation",
     "turned",
     "rotated",
+    "oscillation_period",
+    "damping_ratio",
+    "oscillation_amplitude",
 ]
 EventStat = Literal["at_touchdown", "at_liftoff"]
 STATS: tuple[str, ...] = get_args(SampleStat)
 EVENT_STATS: tuple[str, ...] = get_args(EventStat)
 #: Signals the ``rotated`` statistic integrates (body angular velocity, deg/s).
 RATE_SIGNALS = ("omega_x_degps", "omega_y_degps", "omega_z_degps")
+#: Headings (deg in [0, 360)): their statistics and limits wrap at north.
+HEADING_SIGNALS = ("psi_deg",)
+#: The statistics of a heading that are headings themselves (limits are an arc from min to max).
+HEADING_VALUE_STATS = ("min", "max", "mean", "initial", "final", "at_touchdown", "at_liftoff")
+#: Statistics of an oscillation (a free response after an excitation).
+OSCILLATION_STATS = ("oscillation_period", "damping_ratio", "oscillation_amplitude")
 
 
 class Check(StrictModel):
@@ -231,11 +387,17 @@ class Check(StrictModel):
     """
 
     name: Annotated[str, Field(min_length=1)]
+    """What the check proves, in words (shown in flight.json and reports)."""
     signal: str
+    """A flight.parquet column (e.g. phi_deg), or sink_fps at an event."""
     stat: Literal[SampleStat, EventStat]  # one literal type (nested literals flatten): one error message
+    """The statistic measured over the selected samples, or at_touchdown / at_liftoff."""
     phases: list[str] | None = None
-    min: float | None = None
-    max: float | None = None
+    """Phases whose samples are measured (default: the whole flight)."""
+    min: FiniteFloat | None = None
+    """Lowest value that passes (a heading's min may exceed its max: the arc through north)."""
+    max: FiniteFloat | None = None
+    """Highest value that passes."""
 
 
 class Manoeuvre(StrictModel):
@@ -249,15 +411,25 @@ class Manoeuvre(StrictModel):
     """
 
     name: Identifier
+    """Identifier of the manoeuvre (names the result folders)."""
     description: str = ""
+    """Free text: what is flown and why."""
     aircraft: Identifier
-    pilot_profile: str | None = None  # path of the pilot profile YAML, relative to this file (default: searched)
+    """JSBSim model name (the project's aircraft folder first, then JSBSim's); needs a pilot profile."""
+    pilot_profile: str | None = None
+    """Path of the pilot profile YAML, relative to this file (default: searched for the aircraft)."""
     rate_hz: Annotated[int, Field(ge=30, le=1000)] = 120
+    """Flight-model rate, Hz (t = k / rate_hz)."""
     runway: Runway | None = None
+    """The runway of a takeoff, approach or landing."""
     start: Start
+    """Where and how the flight starts."""
     environment: Environment = Environment()
+    """Wind and turbulence."""
     phases: Annotated[list[Phase], Field(min_length=1)]
+    """The phases, flown in order."""
     checks: list[Check] = Field(default_factory=list)
+    """Measured values that must lie within limits."""
 
     _files: AircraftFiles | None = PrivateAttr(default=None)
     _source: Path | None = PrivateAttr(default=None)
@@ -339,6 +511,14 @@ class _Where:
             self.problems.append(f"{field}: {problem}")
         else:
             self.problems.append(located(self.path, problem, line=line_of(self.lines, loc), field=field))
+
+    def error(self, loc: Loc, problem: str) -> Exception:
+        """Add the problem and return the error to raise now, holding every problem so far (for checks that
+        cannot go on after it): WashbenchError for a file, ValueError (pydantic's ValidationError) from Python."""
+        self.add(loc, problem)
+        if self.path is None:
+            return ValueError("; ".join(self.problems))
+        return WashbenchError(self.problems[0], self.problems[1:])
 
 
 def _set_fields(model: StrictModel, names: Sequence[str]) -> list[str]:
@@ -424,6 +604,8 @@ def _check_semantics(m: Manoeuvre, where: _Where, aircraft_dirs: Sequence[Path] 
         if (hold.centreline or hold.glide_path_deg is not None or hold.flare) and m.runway is None:
             key = "centreline" if hold.centreline else ("flare" if hold.flare else "glide_path_deg")
             where.add((*base, "hold", key), "needs a top-level 'runway'")
+        if phase.inputs is not None:
+            _check_inputs(phase, (*base, "inputs"), profile, where)
         conditions = _set_fields(until, [f for f in Until.model_fields if f != "timeout_s"])
         reasons = [_never_reason(c, until, hold, on_ground, profile, m) for c in conditions]
         if len(where.problems) > phase_problems:
@@ -464,11 +646,167 @@ def _check_semantics(m: Manoeuvre, where: _Where, aircraft_dirs: Sequence[Path] 
             where.add((*base, "stat"), f"'rotated' integrates a body rate: {', '.join(RATE_SIGNALS)}")
         if check.min is None and check.max is None:
             where.add(base, "give a 'min', a 'max' or both")
-        if check.min is not None and check.max is not None and check.min > check.max:
+        arc = check.signal in HEADING_SIGNALS and check.stat in HEADING_VALUE_STATS  # min > max: through north
+        if check.min is not None and check.max is not None and check.min > check.max and not arc:
             where.add((*base, "min"), f"greater than max ({check.min:g} > {check.max:g})")
+        if arc:
+            for key in ("min", "max"):
+                v = getattr(check, key)
+                if v is not None and not 0 <= v <= 360:
+                    where.add((*base, key), f"a heading limit is 0..360 deg, got {v:g}")
         for k, name in enumerate(check.phases or ()):
             if name not in names:
                 where.add((*base, "phases", k), f"no phase named '{name}'")
+    _check_properties(m, where)
+
+
+#: Shape keys each input shape uses (the others must be left out: a stray key is a mistake).
+SHAPE_KEYS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {  # shape: (required, optional)
+    "step": ((), ()),
+    "pulse": (("duration_s",), ()),
+    "doublet": (("duration_s",), ()),
+    "3211": (("duration_s",), ()),
+    "sine": (("period_s",), ("duration_s",)),
+    "chirp": (("duration_s", "start_hz", "end_hz"), ("sweep",)),
+}
+_SHAPE_PARAMS = ("duration_s", "period_s", "start_hz", "end_hz")
+#: What each axis's free / fixed input takes away from the pilot's hold targets.
+_AXIS_TARGETS = {
+    "aileron": LATERAL_TARGETS,
+    "elevator": PITCH_TARGETS,
+    "rudder": ("wing_low",),
+    "throttle": ("throttle",),
+}
+#: JSBSim properties the flight loop writes: open-loop inputs reach them through the axis keys.
+PILOT_PROPERTIES = (
+    "fcs/aileron-cmd-norm",
+    "fcs/elevator-cmd-norm",
+    "fcs/rudder-cmd-norm",
+    "fcs/throttle-cmd-norm",
+    "fcs/steer-cmd-norm",
+    "fcs/mixture-cmd-norm",
+    "fcs/flap-cmd-norm",
+    "fcs/left-brake-cmd-norm",
+    "fcs/right-brake-cmd-norm",
+)
+
+
+def _check_signal(sig: Signal, amplitude: float | None, loc: Loc, amp_key: str, phase: Phase, where: _Where) -> None:
+    """A signal's keys fit its shape, it has an amplitude, and it ends within a fixed-length phase."""
+    if sig.shape is None:
+        stray = [k for k in (*_SHAPE_PARAMS, "start_s") if k in sig.model_fields_set]
+        if amplitude is not None:
+            keys = ("amplitude_norm", "amplitude_deg", "amplitude")
+            given = next(k for k in keys if getattr(sig, k, None) is not None)
+            raise where.error((*loc, given), "an amplitude needs a 'shape'")
+        if stray:
+            raise where.error((*loc, stray[0]), "needs a 'shape'")
+        return
+    if amplitude is None:
+        raise where.error((*loc, "shape"), f"a {sig.shape} needs an amplitude ({amp_key})")
+    required, optional = SHAPE_KEYS[sig.shape]
+    for key in required:
+        if getattr(sig, key) is None:
+            raise where.error((*loc, "shape"), f"a {sig.shape} needs '{key}'")
+    for key in (*_SHAPE_PARAMS, "sweep"):
+        if key in sig.model_fields_set and key not in required and key not in optional:
+            raise where.error((*loc, key), f"not used by a {sig.shape}")
+    if sig.shape == "chirp" and sig.sweep == "logarithmic" and sig.start_hz == sig.end_hz:
+        raise where.error((*loc, "end_hz"), "a logarithmic sweep needs end_hz different from start_hz")
+    end = sig.start_s + (sig.duration_s or 0.0)
+    limit = phase.until.duration_s
+    if limit is not None and end > limit + 1e-9:
+        raise where.error(
+            (*loc, "start_s"), f"the {sig.shape} runs to {end:g} s, past the phase's duration_s of {limit:g} s"
+        )
+
+
+def _check_inputs(phase: Phase, loc: Loc, profile: PilotProfile, where: _Where) -> None:
+    """The open-loop inputs of a phase are complete, consistent with the hold, and in range."""
+    inputs = phase.inputs
+    if inputs is None:
+        return
+    hold = phase.hold
+    for axis in ("elevator", "aileron", "rudder", "throttle"):
+        ci: ControlInput | None = getattr(inputs, axis)
+        if ci is None:
+            continue
+        at: Loc = (*loc, axis)
+        if ci.fixed_norm is not None and ci.fixed_deg is not None:
+            raise where.error((*at, "fixed_deg"), "give either fixed_norm or fixed_deg")
+        if ci.amplitude_norm is not None and ci.amplitude_deg is not None:
+            raise where.error((*at, "amplitude_deg"), "give either amplitude_norm or amplitude_deg")
+        uses_deg = ci.fixed_deg is not None or ci.amplitude_deg is not None
+        key = "fixed_deg" if ci.fixed_deg is not None else "amplitude_deg"
+        if uses_deg and axis == "throttle":
+            raise where.error((*at, key), "the throttle has no surface: use the _norm keys")
+        if uses_deg and profile.surfaces is None:
+            raise where.error((*at, key), f"the pilot profile of '{profile.aircraft}' gives no surface travel")
+        if ci.fixed_norm is not None:
+            lo = 0.0 if axis == "throttle" else -1.0
+            if not lo <= ci.fixed_norm <= 1.0:
+                raise where.error((*at, "fixed_norm"), f"outside the command range {lo:g}..1")
+        if ci.fixed_deg is not None and profile.surfaces is not None:
+            travel = getattr(profile.surfaces, axis)
+            if not travel.min_deg <= ci.fixed_deg <= travel.max_deg:
+                raise where.error(
+                    (*at, "fixed_deg"), f"outside the surface travel {travel.min_deg:g}..{travel.max_deg:g} deg"
+                )
+        amplitude = ci.amplitude_norm if ci.amplitude_norm is not None else ci.amplitude_deg
+        _check_signal(ci, amplitude, at, "amplitude_norm or amplitude_deg", phase, where)
+        released = ci.free or ci.fixed_norm is not None or ci.fixed_deg is not None
+        if not released and ci.shape is None:
+            raise where.error(at, "does nothing: give a 'shape', 'free: true' or a fixed value")
+        if released:
+            taken = _set_fields(hold, _AXIS_TARGETS[axis])
+            if taken:
+                raise where.error(
+                    (*at,), f"the {axis} is released, which contradicts 'hold.{taken[0]}' (the {axis} is its control)"
+                )
+            if axis == "throttle" and hold.airspeed_kts is not None:  # without a fixed throttle it holds the speed
+                raise where.error(at, "the throttle is released, which contradicts 'hold.airspeed_kts' (held with it)")
+            if axis == "elevator" and hold.airspeed_kts is not None and hold.throttle is not None:
+                raise where.error(at, "the elevator is released, which contradicts 'hold.airspeed_kts' (held with it)")
+    seen: set[str] = set()
+    for j, pi in enumerate(inputs.properties):
+        at = (*loc, "properties", j)
+        if pi.property in PILOT_PROPERTIES:
+            raise where.error((*at, "property"), f"'{pi.property}' is written by the pilot: use the axis keys")
+        if pi.property in seen:
+            raise where.error((*at, "property"), f"'{pi.property}' is given twice in this phase")
+        seen.add(pi.property)
+        _check_signal(pi, pi.amplitude, at, "amplitude", phase, where)
+        if pi.shape is None and pi.fixed is None:
+            raise where.error(at, "does nothing: give a 'shape' or a 'fixed' value")
+
+
+def _check_properties(m: Manoeuvre, where: _Where) -> None:
+    """Every JSBSim property an input names exists in the model (JSBSim itself ignores typos)."""
+    wanted = [
+        ((("phases", i, "inputs", "properties", j, "property")), pi.property)
+        for i, phase in enumerate(m.phases)
+        if phase.inputs is not None
+        for j, pi in enumerate(phase.inputs.properties)
+    ]
+    if not wanted:
+        return
+    import os
+
+    import jsbsim
+
+    from washbench.flight.fdm import quiet_stdout  # here: fdm imports this module
+
+    os.environ["JSBSIM_DEBUG"] = "0"
+    fdm = jsbsim.FGFDMExec(str(jsbsim_root()), None)
+    fdm.set_aircraft_path(str(m.aircraft_files.root))
+    with quiet_stdout():
+        loaded = fdm.load_model(m.aircraft)
+    if not loaded:
+        raise where.error(("aircraft",), "JSBSim could not load the model")
+    pm = fdm.get_property_manager()
+    for loc, name in wanted:
+        if not pm.hasNode(name):
+            raise where.error(loc, f"unknown JSBSim property '{name}' (not in the {m.aircraft} model)")
 
 
 def _never_reason(
@@ -548,10 +886,24 @@ def validate_command(paths: Sequence[Path], aircraft_dirs: Sequence[Path] = ()) 
 
 def manoeuvre_json_schema() -> dict[str, Any]:
     """The JSON Schema of manoeuvre files (for editors: completion and checking)."""
-    schema = Manoeuvre.model_json_schema()
+    schema = _plain_descriptions(Manoeuvre.model_json_schema())
     schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
     schema["title"] = "washbench manoeuvre"
     return schema
+
+
+def _plain_descriptions(node: Any) -> Any:
+    """Docstrings as editor hover text: ``code`` as Markdown `code`, lines joined within a paragraph."""
+    if isinstance(node, dict):
+        out = {k: _plain_descriptions(v) for k, v in node.items()}
+        text = node.get("description")
+        if isinstance(text, str):
+            paragraphs = [" ".join(p.split()) for p in text.replace("``", "`").split("\n\n")]
+            out["description"] = "\n\n".join(p for p in paragraphs if p)
+        return out
+    if isinstance(node, list):
+        return [_plain_descriptions(v) for v in node]
+    return node
 
 
 def schema_command(out: Path | None) -> int:

@@ -191,6 +191,19 @@ class Pilot:
         self.aileron, self.elevator, self.rudder = aileron, elevator, rudder
         self.i_p, self.i_q, self.i_beta, self.i_psi = aileron, -elevator, -rudder, -rudder
 
+    def take_back(self, axis: str, command: float) -> None:
+        """Take an axis back after open-loop inputs freed it: its loop starts from ``command`` (bumpless)."""
+        if axis == "aileron":
+            self.aileron = self.i_p = command
+        elif axis == "elevator":
+            self.elevator = command
+            self.i_q = -command
+        elif axis == "rudder":
+            self.rudder = command
+            self.i_beta = self.i_psi = -command
+        elif axis == "throttle":
+            self.throttle = self.i_thr = command
+
     def begin_phase(self, hold: Hold, theta: float, throttle: float, flaps_deg: float) -> None:
         """Set the loops for a phase from the current pitch (rad), throttle and flap angle."""
         self.centreline = bool(hold.centreline)

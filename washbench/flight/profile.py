@@ -66,6 +66,31 @@ class StartOptions(StrictModel):
     settle_s: Positive = 30.0  # flying start: settling time, s
 
 
+class Surface(StrictModel):
+    """Travel of one control surface, as the model's flight-control system maps the command onto it.
+
+    JSBSim's ``aerosurface_scale`` maps the command plus trim (``trim_property``), -1..1, zero-centred
+    onto the travel: +1 gives ``max_deg``, -1 ``min_deg``. ``property`` reads the deflection back.
+    """
+
+    property: str
+    """JSBSim property of the surface deflection, deg (e.g. fcs/elevator-pos-deg)."""
+    trim_property: str | None = None
+    """JSBSim property of the trim command added to the pilot's command before the scale."""
+    min_deg: Annotated[float, Field(le=0)]
+    """Deflection at command -1, deg."""
+    max_deg: Annotated[float, Field(ge=0)]
+    """Deflection at command +1, deg."""
+
+
+class Surfaces(StrictModel):
+    """Surface travel of the three primary controls (from the model XML), for inputs given in degrees."""
+
+    elevator: Surface
+    aileron: Surface
+    rudder: Surface
+
+
 class RollGains(StrictModel):
     bank_to_rate: Positive  # roll-rate command per bank error, 1/s
     rate_max_degps: Positive
@@ -155,6 +180,7 @@ class PilotProfile(StrictModel):
     engine: Engine
     gains: Gains
     start: StartOptions = StartOptions()
+    surfaces: Surfaces | None = None
 
 
 def load_profile(path: str | Path) -> PilotProfile:

@@ -41,7 +41,9 @@ class StrictModel(BaseModel):
     the result like a new instance (pydantic's own skips validation).
     """
 
-    model_config = ConfigDict(extra="forbid", strict=True, frozen=True, allow_inf_nan=False)
+    model_config = ConfigDict(
+        extra="forbid", strict=True, frozen=True, allow_inf_nan=False, use_attribute_docstrings=True
+    )
 
     def model_copy(self, *, update: Mapping[str, Any] | None = None, deep: bool = False) -> Self:
         """A copy; with ``update``, a new validated instance (raises ``pydantic.ValidationError``)."""

@@ -171,16 +171,34 @@ def stop_viewer(proc: subprocess.Popen[str], timeout_s: float = 10.0) -> None:
             proc.wait(timeout_s)
 
 
-def replay_command(path: Path, web: bool) -> int:
-    """Open ``path`` in the rerun viewer; return the exit status.
+def replay_command(paths: Path | list[Path], web: bool) -> int:
+    """Open one recording, or the comparison of two (:mod:`washbench.review.compare`), in the rerun viewer.
 
     The native viewer where a display exists (a macOS or Windows desktop, or DISPLAY / WAYLAND_DISPLAY set) and
-    ``web`` is false; otherwise the web viewer on 127.0.0.1 with system-chosen ports, whose address is printed;
-    it runs until Ctrl-C (status 0). SIGTERM stops the viewer too (status 143), and a viewer outlives washbench
-    in no case (Linux: not even a SIGKILL of washbench, through the parent-death signal).
+    ``web`` is false; otherwise the web viewer on 127.0.0.1 with system-chosen ports, whose address is printed; it
+    runs until Ctrl-C (status 0). Returns the exit status. The comparison recording lives in a temporary folder
+    removed when the viewer stops. SIGTERM stops the viewer too (status 143), and a viewer outlives washbench in no
+    case (Linux: not even a SIGKILL of washbench, through the parent-death signal).
     """
-    path = Path(path)
-    check_recording(path)
+    files = [Path(p) for p in (paths if isinstance(paths, list) else [paths])]
+    if len(files) not in (1, 2):
+        raise WashbenchError(f"replay: expected one recording, or two to compare, got {len(files)}")
+    for f in files:
+        check_recording(f)
+    if len(files) == 1:
+        return _replay(files[0], web)
+    import tempfile
+
+    from washbench.review.compare import write_comparison
+
+    with tempfile.TemporaryDirectory(prefix="washbench-compare-") as tmp:
+        out = Path(tmp) / "comparison.rrd"
+        write_comparison(files[0], files[1], out)
+        print(f"washbench: comparing {files[0]} with {files[1]}", flush=True)
+        return _replay(out, web)
+
+
+def _replay(path: Path, web: bool) -> int:
     if not web and _has_display():
         return subprocess.run([str(find_rerun()), "--bind", "127.0.0.1", str(path)], check=False).returncode
     proc, url = start_web_viewer(path)

@@ -1,23 +1,31 @@
-"""Everything rerun: the data handed to the recorder, entity paths, the blueprint, writing and reading .rrd files.
+"""Everything rerun: the data handed to the recorder, entity paths, writing and reading .rrd files.
 
-A recording holds, on one timeline named ``time`` (a duration, seconds since the start of the run):
+A recording holds, on one timeline named ``time`` (a duration, seconds since the start of the run, k * dt rounded to
+the nanosecond):
 
-- ``/perceived/<dof>/<source>``: perceived motion per degree of freedom (surge, sway, heave in m/s^2, roll, pitch,
-  yaw in deg/s), for the aircraft pilot (``source = "aircraft"``) and each washout's simulator pilot;
-- ``/raw/<dof>/<source>``: the same for the unperceived specific force and angular velocity;
-- ``/envelope/<quantity>/<washout>``: platform envelope usage, max over the three axes of |value| / limit
-  (``quantity`` in position, velocity, acceleration, wheels), the limit line ``/envelope/<quantity>/limit`` at 1, and
-  saturation markers ``/envelope/<panel>/saturation/<washout>/<kind>`` at value 1 at every saturated sample;
+- ``/perceived/<dof>``: perceived motion in one degree of freedom (surge, sway, heave in m/s^2; roll, pitch, yaw in
+  deg/s), one row per step with one scalar per source: the aircraft pilot first, then each washout's simulator pilot in
+  the order of ``RecordingData.washouts`` (:func:`sources`); ``/perceived/<dof>/threshold`` the perception threshold as
+  two lines (+-threshold around 0, around -g for heave);
+- ``/raw/<dof>``: the same layout for the unperceived specific force and angular velocity;
+- ``/envelope/<quantity>``: platform envelope usage, max over the three axes of |value| / limit, one scalar per
+  washout (``quantity`` in position, velocity, acceleration, wheels), drawn with Max aggregation, and the limit line
+  ``/envelope/<quantity>/limit`` at 1;
 - ``/platform/<washout>/<quantity>/axes``: the platform's stage position, velocity, acceleration (NED, SI) and
   omni-wheel speeds (rad/s), three scalars per row, with ``limit_max`` and ``limit_min`` lines;
-- ``/world/...``: a 3D scene (NED, x north, y east, z down) with the aircraft's attitude and, per washout, the Atlas
-  sphere (``envelope.sphere_diameter_m``, 2.9 m) translated by the stage position and rotated by the simulator
-  cockpit's attitude;
-- ``/events/phases`` and ``/events/saturation``: text log entries at phase starts and saturation onsets;
-- ``/metrics``: the metric table as a Markdown document.
+- ``/lanes/0_phase`` (flight phases) and ``/lanes/<i>_<washout>`` (the limits a washout is held at, joined by "+";
+  i = 1, 2, ... in washout order, as the viewer sorts lanes by name): state lanes; ``/limits/<i>_<washout>/<kind>``:
+  one entity per washout with one lane (instance) per limit kind it ever reaches;
+- ``/world/...``: the 3D scene (:mod:`washbench.review.scene3d`);
+- ``/events/phases`` and ``/events/saturation``: text log entries at phase starts and limit onsets, each text
+  starting with its time (the viewer's time column is narrow);
+- ``/metrics``: the metric table as a Markdown document; the recording properties ``provenance`` (strings).
 
-All time-varying data is sent as whole columns (``send_columns``), never one ``log`` call per sample. A blueprint for
-review is stored in the same file.
+Precision: every scalar is stored as float64, bit-equal to the traces it came from (angular rates converted to deg/s
+once, ``np.rad2deg``); times to the nanosecond; 3D poses as float32 (rerun's type) at most at 30 Hz. All time-varying
+data is sent as whole columns (``send_columns``), never one ``log`` call per sample; the sources of one panel share one
+row (one time and one row id for all of them), which is most of what a recording weighs. The review blueprint
+(:mod:`washbench.review.blueprint`) is stored in the same file.
 """
 
 from __future__ import annotations
@@ -28,13 +36,24 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-import pyarrow as pa
-import pyarrow.compute as pc
 import rerun as rr
-import rerun.blueprint as rrb
 
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import atomic_path
+from washbench.perception.thresholds import STANDARD_GRAVITY_MPS2, ZACHARIAS, Thresholds
+from washbench.review import scene3d
+from washbench.review.blueprint import (
+    AIRCRAFT_WIDTH,
+    AXIS_COLORS,
+    LIMIT_COLOR,
+    THRESHOLD_COLOR,
+    WASHOUT_WIDTH,
+    Layout,
+    build_blueprint,
+    series_color,
+    source_colors,
+)
+from washbench.review.rrd_read import read_component, read_properties, read_scalar_series, read_text_documents
 
 __all__ = [
     "AIRCRAFT",
@@ -45,18 +64,24 @@ __all__ = [
     "PlatformEnvelope",
     "PlatformSeries",
     "RecordingData",
-    "build_blueprint",
     "envelope_usage_path",
+    "limit_lane_path",
     "perceived_path",
+    "phase_lane_path",
     "platform_path",
     "quat_wxyz_to_xyzw",
     "raw_path",
     "read_component",
+    "read_properties",
     "read_scalar_series",
     "read_text_documents",
     "series_color",
+    "sources",
+    "washout_lane_path",
     "write_recording",
 ]
+
+quat_wxyz_to_xyzw = scene3d.quat_wxyz_to_xyzw
 
 TIMELINE = "time"
 """Name of the rerun timeline: a duration in seconds since the start of the run."""
@@ -82,19 +107,14 @@ ENVELOPE_QUANTITIES: tuple[tuple[str, str, str], ...] = (
 )
 """Platform quantities with an envelope: (name in entity paths, field of PlatformSeries / PlatformEnvelope, unit)."""
 
-_SATURATION_PANEL = {"pos": "position", "vel": "velocity", "acc": "acceleration", "wheel": "wheels"}
-"""Saturation kind -> envelope panel it is marked in; other kinds go to the panel ``other``."""
+PLATFORM_DETAIL_TOLERANCE = 0.002
+"""The per-axis platform traces may be thinned (to every 2nd-4th sample) where linear interpolation between the
+recorded samples reproduces every step within this fraction of the axis's limit; envelope usage, perceived and raw
+motion keep every step."""
+PLATFORM_MAX_STRIDE = 4
 
-_WASHOUT_COLORS: dict[str, tuple[int, int, int]] = {
-    "small-angle": (31, 119, 180),  # blue
-    "large-angle": (255, 127, 14),  # orange
-    "unrestricted": (44, 160, 44),  # green
-}
-_EXTRA_COLORS: tuple[tuple[int, int, int], ...] = ((214, 39, 40), (148, 103, 189), (140, 86, 75), (227, 119, 194))
-_AIRCRAFT_COLOR = (235, 235, 235)  # near white: the viewer's background is dark
-_LIMIT_COLOR = (150, 150, 150)
-_AXIS_COLORS = ((230, 80, 80), (80, 200, 80), (90, 140, 255))  # x, y, z (or wheel 1, 2, 3) inside one washout panel
-_SATURATION_MARKERS = ("Cross", "Diamond", "Square", "Up", "Down", "Plus", "Asterisk", "Left", "Right", "Circle")
+PROPERTIES = "provenance"
+"""Name of the recording property that holds the caller's provenance strings."""
 
 
 @dataclass(frozen=True)
@@ -143,9 +163,11 @@ class PlatformEnvelope:
 
 @dataclass(frozen=True)
 class RecordingData:
-    """Everything one recording shows; ``washouts`` and ``platforms`` have the same keys.
+    """Everything one recording shows; ``washouts`` and ``platforms`` have the same keys, in the same order.
 
-    A washout's MotionSeries is its simulator pilot's motion; its attitude ``q`` is the Atlas sphere's orientation.
+    Washout names are any identifiers except ``"aircraft"``; their order is the order of every panel and legend. A
+    washout's MotionSeries is its simulator pilot's motion; its attitude ``q`` is the Atlas sphere's orientation.
+    ``thresholds``: the perception thresholds drawn as +- lines (default Zacharias 1978).
     """
 
     title: str  # e.g. "c172p / coordinated_turn"
@@ -156,25 +178,26 @@ class RecordingData:
     envelope: PlatformEnvelope
     phases: list[tuple[str, float, float]]  # (name, t_start_s, t_end_s)
     metrics_markdown: str
+    thresholds: Thresholds = ZACHARIAS
 
 
 # ---------------------------------------------------------------------------------------------------------------------
-# Names and colours
+# Names
 
 
-def perceived_path(dof: str, source: str) -> str:
-    """Entity path of the perceived motion of ``source`` ("aircraft" or a washout name) in ``dof``."""
-    return f"/perceived/{dof}/{source}"
+def perceived_path(dof: str) -> str:
+    """Entity path of the perceived motion in ``dof``: one scalar per source per row, in :func:`sources` order."""
+    return f"/perceived/{dof}"
 
 
-def raw_path(dof: str, source: str) -> str:
-    """Entity path of the unperceived motion (specific force or angular velocity) of ``source`` in ``dof``."""
-    return f"/raw/{dof}/{source}"
+def raw_path(dof: str) -> str:
+    """Entity path of the unperceived motion (specific force or angular velocity) in ``dof``, as perceived_path."""
+    return f"/raw/{dof}"
 
 
-def envelope_usage_path(quantity: str, washout: str) -> str:
-    """Entity path of the envelope usage (max |axis| / limit, dimensionless) of ``washout`` for ``quantity``."""
-    return f"/envelope/{quantity}/{washout}"
+def envelope_usage_path(quantity: str) -> str:
+    """Entity path of the envelope usage (max |axis| / limit, dimensionless), one scalar per washout per row."""
+    return f"/envelope/{quantity}"
 
 
 def platform_path(washout: str, quantity: str) -> str:
@@ -182,31 +205,43 @@ def platform_path(washout: str, quantity: str) -> str:
     return f"/platform/{washout}/{quantity}/axes"
 
 
-def series_color(source: str, washouts: list[str] | tuple[str, ...] = ()) -> tuple[int, int, int]:
-    """Fixed RGB colour of a source: the aircraft near white, each known washout its own colour everywhere.
-
-    An unknown washout name takes a spare colour by its position among the unknown names in ``washouts``.
-    """
-    if source == AIRCRAFT:
-        return _AIRCRAFT_COLOR
-    if source in _WASHOUT_COLORS:
-        return _WASHOUT_COLORS[source]
-    unknown = [w for w in washouts if w not in _WASHOUT_COLORS]
-    index = unknown.index(source) if source in unknown else 0
-    return _EXTRA_COLORS[index % len(_EXTRA_COLORS)]
+def _lane_name(data: RecordingData, washout: str) -> str:
+    """``<i>_<washout>``, i = 1, 2, ... in data order, zero-padded: the viewer sorts lanes by name."""
+    names = list(data.washouts)
+    width = len(str(len(names)))
+    return f"{names.index(washout) + 1:0{width}d}_{washout}"
 
 
-def quat_wxyz_to_xyzw(q_wxyz: np.ndarray) -> np.ndarray:
-    """Convert scalar-first quaternions (..., 4) [w, x, y, z] to rerun's scalar-last [x, y, z, w].
+def phase_lane_path() -> str:
+    """State lane of the flight phases (sorted first among the lanes)."""
+    return "/lanes/0_phase"
 
-    The only place in washbench where quaternion order changes.
-    """
-    q_wxyz = np.asarray(q_wxyz, dtype=np.float64)
-    return np.concatenate([q_wxyz[..., 1:4], q_wxyz[..., 0:1]], axis=-1)
+
+def washout_lane_path(data: RecordingData, washout: str) -> str:
+    """State lane of the limits ``washout`` is held at (joined by "+"), ordered as the washouts."""
+    return f"/lanes/{_lane_name(data, washout)}"
+
+
+def limit_lane_path(data: RecordingData, washout: str) -> str:
+    """State lanes of one washout's limits: one lane (instance) per limit kind it reaches, in data order."""
+    return f"/limits/{_lane_name(data, washout)}"
+
+
+def sources(data: RecordingData) -> list[str]:
+    """The instance order of the perceived and raw entities: ``["aircraft", *washouts]``."""
+    return [AIRCRAFT, *data.washouts]
 
 
 def _axis_names(quantity: str) -> tuple[str, str, str]:
     return ("w1", "w2", "w3") if quantity == "wheels" else ("x", "y", "z")
+
+
+def _threshold_lines(th: Thresholds) -> list[tuple[float, float]]:
+    """Per DOF: (centre, threshold) in the recording's units; heave's dead band is around -g (thresholds.py)."""
+    f = th.f_mps2()
+    w = np.degrees(th.omega_radps())
+    centres = (0.0, 0.0, -STANDARD_GRAVITY_MPS2, 0.0, 0.0, 0.0)
+    return [(c, float(v)) for c, v in zip(centres, [*f, *w], strict=True)]
 
 
 # ---------------------------------------------------------------------------------------------------------------------
@@ -264,67 +299,6 @@ def _check(data: RecordingData) -> int:
 
 
 # ---------------------------------------------------------------------------------------------------------------------
-# Blueprint
-
-
-def build_blueprint(washouts: list[str] | tuple[str, ...], saturation_kinds: Mapping[str, list[str]]) -> rrb.Blueprint:
-    """The review layout: tabs of time-series panels on the left, the 3D scene, metrics and events on the right.
-
-    ``saturation_kinds`` maps each washout to its saturation kinds (to place the "other limits" panel only if needed).
-    """
-    perceived = [
-        rrb.TimeSeriesView(origin=f"/perceived/{dof}", name=f"Perceived {dof} ({unit})") for dof, _, _, unit in DOFS
-    ]
-    raw = [
-        rrb.TimeSeriesView(
-            origin=f"/raw/{dof}", name=f"{'Specific force' if sig == 'f' else 'Angular velocity'} {dof} ({unit})"
-        )
-        for dof, sig, _, unit in DOFS
-    ]
-    usage = [
-        rrb.TimeSeriesView(origin=f"/envelope/{q}", name=f"Envelope: {q} (max |axis| / limit)")
-        for q, _, _ in ENVELOPE_QUANTITIES
-    ]
-    other_kinds = sorted({k for kinds in saturation_kinds.values() for k in kinds if k not in _SATURATION_PANEL})
-    if other_kinds:
-        usage.append(
-            rrb.TimeSeriesView(origin="/envelope/other", name=f"Other limits reached ({', '.join(other_kinds)})")
-        )
-    per_washout = [
-        rrb.Grid(
-            *[
-                rrb.TimeSeriesView(origin=f"/platform/{w}/{q}", name=f"Atlas {w}: {q} ({unit})")
-                for q, _, unit in ENVELOPE_QUANTITIES
-            ],
-            grid_columns=2,
-            name=f"Atlas {w}",
-        )
-        for w in washouts
-    ]
-    tabs = rrb.Tabs(
-        rrb.Grid(*perceived, grid_columns=3, name="Perceived motion"),
-        rrb.Grid(*raw, grid_columns=3, name="Raw motion"),
-        rrb.Grid(*usage, grid_columns=2, name="Platform envelope"),
-        *per_washout,
-        active_tab=0,
-    )
-    side = rrb.Vertical(
-        rrb.Spatial3DView(origin="/world", name="Aircraft attitude and Atlas platforms (NED)"),
-        rrb.Tabs(
-            rrb.TextDocumentView(origin="/metrics", name="Metrics"),
-            rrb.TextLogView(origin="/events", name="Phases and saturation events"),
-            active_tab=0,
-        ),
-        row_shares=[3, 2],
-    )
-    return rrb.Blueprint(
-        rrb.Horizontal(tabs, side, column_shares=[3, 2]),
-        rrb.TimePanel(state="expanded"),
-        collapse_panels=False,
-    )
-
-
-# ---------------------------------------------------------------------------------------------------------------------
 # Writing
 
 
@@ -335,9 +309,18 @@ def _time_column(t_s: np.ndarray) -> rr.TimeColumn:
 
 
 def _series(
-    rec: rr.RecordingStream, path: str, time: rr.TimeColumn, values: np.ndarray, name: str, color: tuple[int, int, int]
+    rec: rr.RecordingStream,
+    path: str,
+    time: rr.TimeColumn,
+    values: np.ndarray,
+    names: list[str],
+    colors: list[tuple[int, int, int]],
+    widths: list[float],
+    aggregation: str | None = None,
 ) -> None:
-    rec.log(path, rr.SeriesLines(colors=[color], names=[name], widths=[1.5]), static=True, strict=True)
+    """One entity, one row per time, one scalar per named line: ``values`` (N,) or (N, len(names))."""
+    style = rr.SeriesLines(colors=colors, names=names, widths=widths, aggregation_policy=aggregation)
+    rec.log(path, style, static=True, strict=True)
     rec.send_columns(
         path, indexes=[time], columns=rr.Scalars.columns(scalars=np.asarray(values, np.float64)), strict=True
     )
@@ -353,86 +336,181 @@ def _limit_line(
 ) -> None:
     """Horizontal lines (one per value) from the first to the last time (two samples each)."""
     ends = np.array([t_s[0], t_s[-1]], dtype=np.float64)
-    colors = colors if colors is not None else [_LIMIT_COLOR] * len(values)
+    colors = colors if colors is not None else [LIMIT_COLOR] * len(values)
     rec.log(path, rr.SeriesLines(colors=colors, names=names, widths=[1.0] * len(values)), static=True, strict=True)
     scalars = np.array([values, values], dtype=np.float64)  # (2, len(values)): one row of len(values) per end
     rec.send_columns(path, indexes=[_time_column(ends)], columns=rr.Scalars.columns(scalars=scalars), strict=True)
 
 
-def _send_motion(rec: rr.RecordingStream, data: RecordingData, time: rr.TimeColumn) -> None:
-    washouts = list(data.washouts)
-    sources = {AIRCRAFT: data.aircraft, **data.washouts}
-    for dof, sig, axis, unit in DOFS:
-        for src, m in sources.items():
-            label = "aircraft pilot" if src == AIRCRAFT else f"{src} simulator pilot"
-            color = series_color(src, washouts)
-            if sig == "f":
-                perceived, raw = m.perceived_f_mps2[:, axis], m.f_mps2[:, axis]
-            else:
-                perceived, raw = np.rad2deg(m.perceived_omega_radps[:, axis]), np.rad2deg(m.omega_radps[:, axis])
-            _series(rec, perceived_path(dof, src), time, perceived, f"{label} ({unit})", color)
-            _series(rec, raw_path(dof, src), time, raw, f"{label} ({unit})", color)
+def _span(values: list[np.ndarray], extra: tuple[float, ...] = ()) -> tuple[float, float]:
+    """y range holding every finite value and ``extra``, 6 % margin each side (at least +-0.05 around a flat line)."""
+    finite = [v[np.isfinite(v)] for v in values]
+    lo = min([float(v.min()) for v in finite if v.size] + list(extra) + [np.inf])
+    hi = max([float(v.max()) for v in finite if v.size] + list(extra) + [-np.inf])
+    if not np.isfinite(lo) or not np.isfinite(hi):
+        return (-1.0, 1.0)
+    pad = max(0.06 * (hi - lo), 0.05)
+    return (lo - pad, hi + pad)
 
 
-def _send_platforms(rec: rr.RecordingStream, data: RecordingData, time: rr.TimeColumn) -> None:
+def _dof_columns(data: RecordingData) -> tuple[list[np.ndarray], list[np.ndarray]]:
+    """Per DOF, (N, sources) arrays of perceived and raw motion in the recording's units."""
+    every = [data.aircraft, *data.washouts.values()]
+    perceived, raw = [], []
+    for _dof, sig, axis, _unit in DOFS:
+        if sig == "f":
+            perceived.append(np.column_stack([m.perceived_f_mps2[:, axis] for m in every]))
+            raw.append(np.column_stack([m.f_mps2[:, axis] for m in every]))
+        else:
+            perceived.append(np.rad2deg(np.column_stack([m.perceived_omega_radps[:, axis] for m in every])))
+            raw.append(np.rad2deg(np.column_stack([m.omega_radps[:, axis] for m in every])))
+    return perceived, raw
+
+
+def _send_motion(
+    rec: rr.RecordingStream,
+    data: RecordingData,
+    time: rr.TimeColumn,
+    perceived: list[np.ndarray],
+    raw: list[np.ndarray],
+) -> None:
+    names = sources(data)
+    colors = source_colors(list(data.washouts))
+    widths = [AIRCRAFT_WIDTH] + [WASHOUT_WIDTH] * len(data.washouts)
+    t_s = np.asarray(data.t_s, dtype=np.float64)
+    for (dof, _, _, _), p, r, (centre, th) in zip(DOFS, perceived, raw, _threshold_lines(data.thresholds), strict=True):
+        _series(rec, perceived_path(dof), time, p, names, colors, widths)
+        _series(rec, raw_path(dof), time, r, names, colors, widths)
+        _limit_line(
+            rec,
+            f"/perceived/{dof}/threshold",
+            t_s,
+            [centre + th, centre - th],
+            ["perception threshold", "perception threshold"],
+            [THRESHOLD_COLOR, THRESHOLD_COLOR],
+        )
+
+
+def _usage(data: RecordingData) -> dict[str, np.ndarray]:
+    """Envelope usage per quantity: (N, washouts) max over the axes of |value| / limit."""
+    out = {}
+    for q, fname, _unit in ENVELOPE_QUANTITIES:
+        limit = data.envelope.axes(fname)
+        cols = []
+        for w in data.washouts:
+            ratio = np.abs(np.asarray(getattr(data.platforms[w], fname), dtype=np.float64)) / limit
+            # max over the three axes column by column: np.max(ratio, axis=1) is several times slower on (N, 3)
+            cols.append(np.maximum(np.maximum(ratio[:, 0], ratio[:, 1]), ratio[:, 2]))
+        out[q] = np.column_stack(cols)
+    return out
+
+
+def _send_platforms(
+    rec: rr.RecordingStream, data: RecordingData, time: rr.TimeColumn, usage: dict[str, np.ndarray]
+) -> None:
     t_s = np.asarray(data.t_s, dtype=np.float64)
     washouts = list(data.washouts)
+    colors = [series_color(w, washouts) for w in washouts]
     for q, fname, unit in ENVELOPE_QUANTITIES:
         limit = data.envelope.axes(fname)
         axes = _axis_names(q)
         uniform = bool(np.all(limit == limit[0]))
-        text = f"{limit[0]:g}" if uniform else "/".join(f"{v:g}" for v in limit)
-        _limit_line(rec, f"/envelope/{q}/limit", t_s, [1.0], [f"limit (+-{text} {unit})"])
-        names = [f"{axis} ({unit})" for axis in axes]
+        _limit_line(rec, f"/envelope/{q}/limit", t_s, [1.0], [f"limit (+-{_limit_text(limit)} {unit})"])
+        _series(rec, envelope_usage_path(q), time, usage[q], washouts, colors, [WASHOUT_WIDTH] * len(washouts), "Max")
         for w in washouts:
             values = np.asarray(getattr(data.platforms[w], fname), dtype=np.float64)
-            ratio = np.abs(values) / limit
-            # max over the three axes column by column: np.max(ratio, axis=1) is several times slower on (N, 3)
-            usage = np.maximum(np.maximum(ratio[:, 0], ratio[:, 1]), ratio[:, 2])
-            _series(rec, envelope_usage_path(q, w), time, usage, f"{w}", series_color(w, washouts))
-            axes_path = platform_path(w, q)
-            rec.log(axes_path, rr.SeriesLines(colors=list(_AXIS_COLORS), names=names), static=True, strict=True)
-            # an (N, 3) array is sent as N rows of three scalars
-            rec.send_columns(axes_path, indexes=[time], columns=rr.Scalars.columns(scalars=values), strict=True)
+            idx = detail_samples(values, PLATFORM_DETAIL_TOLERANCE * limit)
+            # an (M, 3) array is sent as M rows of three scalars
+            axes_time = time if idx.size == t_s.size else _time_column(t_s[idx])
+            _series(rec, platform_path(w, q), axes_time, values[idx], list(axes), list(AXIS_COLORS), [1.5] * 3)
             for sign, end, bound in (("+", "max", limit), ("-", "min", -limit)):
                 line_path = f"/platform/{w}/{q}/limit_{end}"
                 if uniform:  # one line for all axes
-                    _limit_line(rec, line_path, t_s, [bound[0]], [f"{sign}limit ({unit})"])
+                    _limit_line(rec, line_path, t_s, [bound[0]], [f"{sign}limit"])
                 else:  # one line per axis, in the axis colours
-                    labels = [f"{sign}{a} limit" for a in axes]
-                    _limit_line(rec, line_path, t_s, list(bound), labels, list(_AXIS_COLORS))
+                    _limit_line(rec, line_path, t_s, list(bound), [f"{sign}{a} limit" for a in axes], list(AXIS_COLORS))
+
+
+def detail_samples(values: np.ndarray, tolerance: np.ndarray, max_stride: int = PLATFORM_MAX_STRIDE) -> np.ndarray:
+    """Indices of the samples of ``values`` (N, k) to record: every s-th and the last, for the largest s up to
+    ``max_stride`` whose linear interpolation reproduces every sample within ``tolerance`` (k,); else all."""
+    n = values.shape[0]
+    k = np.arange(n, dtype=np.float64)
+    for stride in range(max_stride, 1, -1):
+        idx = np.unique(np.append(np.arange(0, n, stride), n - 1))
+        if idx.size < 2:
+            break
+        ok = all(
+            np.max(np.abs(np.interp(k, idx, values[idx, j]) - values[:, j])) <= tolerance[j]
+            for j in range(values.shape[1])
+        )
+        if ok:
+            return idx
+    return np.arange(n)
+
+
+def _limit_text(limit: np.ndarray) -> str:
+    """ "2" for one limit on all axes, "1.5/1.5/1" for per-axis limits."""
+    return f"{limit[0]:.3g}" if bool(np.all(limit == limit[0])) else "/".join(f"{v:.3g}" for v in limit)
+
+
+def _runs(flags: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Start and end indices (inclusive) of the runs of True in ``flags``."""
+    starts = np.flatnonzero(flags & ~np.concatenate([[False], flags[:-1]]))
+    ends = np.flatnonzero(flags & ~np.concatenate([flags[1:], [False]]))
+    return starts, ends
+
+
+def _send_states(rec: rr.RecordingStream, path: str, t_s: np.ndarray, states: list[str], changes: np.ndarray) -> None:
+    """A state lane: ``states[i]`` from ``t_s[changes[i]]`` on; "" is a gap."""
+    rec.send_columns(
+        path,
+        indexes=[_time_column(t_s[changes])],
+        columns=rr.StateChange.columns(state=states),
+        strict=True,
+    )
+
+
+def _send_lanes(rec: rr.RecordingStream, data: RecordingData) -> None:
+    """Phase lane, one lane per washout (its limits joined by "+"), one per washout and limit kind; onset events."""
+    t_s = np.asarray(data.t_s, dtype=np.float64)
+    n = t_s.size
+    if data.phases:
+        starts = [t0 for _, t0, _ in data.phases]
+        names = [name for name, _, _ in data.phases]
+        idx = np.searchsorted(t_s, np.array(starts) - 0.5e-9)
+        if data.phases[-1][2] < t_s[-1]:
+            idx = np.append(idx, np.searchsorted(t_s, data.phases[-1][2] - 0.5e-9))
+            names.append("")
+        _send_states(rec, phase_lane_path(), t_s, names, np.minimum(idx, n - 1))
     onsets: list[tuple[float, str]] = []
-    for w in washouts:
-        for j, (kind, flags) in enumerate(sorted(data.platforms[w].saturated.items())):
-            flags = np.asarray(flags, dtype=bool)
-            if not flags.any():
-                continue
-            panel = _SATURATION_PANEL.get(kind, "other")
-            path = f"/envelope/{panel}/saturation/{w}/{kind}"
-            rec.log(
-                path,
-                rr.SeriesPoints(
-                    colors=[series_color(w, washouts)],
-                    names=[f"{w}: {kind} limit"],
-                    markers=[_SATURATION_MARKERS[j % len(_SATURATION_MARKERS)]],
-                    marker_sizes=[4.0],
-                ),
-                static=True,
-                strict=True,
-            )
-            idx = np.flatnonzero(flags)
-            rec.send_columns(
-                path,
-                indexes=[_time_column(t_s[idx])],
-                columns=rr.Scalars.columns(scalars=np.ones(idx.size)),
-                strict=True,
-            )
-            starts = np.flatnonzero(flags & ~np.concatenate([[False], flags[:-1]]))
-            ends = np.flatnonzero(flags & ~np.concatenate([flags[1:], [False]]))
+    for w in data.washouts:
+        kinds = [(k, np.asarray(v, dtype=bool)) for k, v in data.platforms[w].saturated.items() if np.any(v)]
+        code = np.zeros(n, dtype=np.int64)
+        dt = float(t_s[1] - t_s[0]) if n > 1 else 0.0
+        for j, (kind, flags) in enumerate(kinds):
+            code |= flags.astype(np.int64) << j
+            starts, ends = _runs(flags)
             onsets.extend(
-                (float(t_s[s]), f"{w}: {kind} limit reached for {t_s[e] - t_s[s]:.3f} s")
+                (float(t_s[s]), f"{t_s[s]:.2f} s  {w}: {kind} limit reached for {t_s[e] - t_s[s] + dt:.3f} s")
                 for s, e in zip(starts, ends, strict=True)
             )
+        change = np.flatnonzero(np.diff(code, prepend=0))
+        if kinds:  # one entity per washout, one lane (instance) per kind reached, in a fixed order
+            rows = [[k if code[i] >> j & 1 else "" for j, (k, _) in enumerate(kinds)] for i in change]
+            states = rr.StateChange.columns(state=[x for row in rows for x in row])
+            rec.send_columns(
+                limit_lane_path(data, w),
+                indexes=[_time_column(t_s[change])],
+                columns=states.partition([len(kinds)] * len(rows)),
+                strict=True,
+            )
+        change = np.flatnonzero(np.diff(code, prepend=0))
+        if change.size:
+            states = ["+".join(k for j, (k, _) in enumerate(kinds) if code[i] >> j & 1) for i in change]
+            _send_states(rec, washout_lane_path(data, w), t_s, states, change)
+        else:  # an empty lane: never held at a limit
+            _send_states(rec, washout_lane_path(data, w), t_s, [""], np.array([0]))
     if onsets:
         onsets.sort(key=lambda item: item[0])
         rec.send_columns(
@@ -441,75 +519,6 @@ def _send_platforms(rec: rr.RecordingStream, data: RecordingData, time: rr.TimeC
             columns=rr.TextLog.columns(text=[s for _, s in onsets], level=["WARN"] * len(onsets)),
             strict=True,
         )
-
-
-def _send_scene(rec: rr.RecordingStream, data: RecordingData, time: rr.TimeColumn) -> None:
-    """3D scene: aircraft attitude triad, and per washout the stage-translated, attitude-rotated Atlas sphere."""
-    n = np.asarray(data.t_s).size
-    washouts = list(data.washouts)
-    travel = data.envelope.axes("pos_m")
-    diameter = float(data.envelope.sphere_diameter_m)
-    spacing = 2.0 * travel[1] + diameter + 1.0
-    rec.log("/world", rr.ViewCoordinates.FRD, static=True, strict=True)  # x north, y east, z down
-
-    def body_triad(path: str, length: float, color: tuple[int, int, int]) -> None:
-        rec.log(
-            path,
-            rr.Arrows3D(
-                vectors=[[length, 0, 0], [0, 0.5 * length, 0], [0, 0, 0.5 * length]],
-                colors=[color, _AXIS_COLORS[1], _AXIS_COLORS[2]],
-                labels=["forward", "right", "down"],
-                radii=[0.04 * length],
-            ),
-            static=True,
-            strict=True,
-        )
-
-    aircraft_offset = np.array([0.0, -spacing, 0.0])
-    rec.send_columns(
-        "/world/aircraft",
-        indexes=[time],
-        columns=rr.Transform3D.columns(
-            translation=np.tile(aircraft_offset, (n, 1)), quaternion=quat_wxyz_to_xyzw(data.aircraft.q)
-        ),
-        strict=True,
-    )
-    body_triad("/world/aircraft/body", 2.0, _AIRCRAFT_COLOR)
-    for i, w in enumerate(washouts):
-        offset = np.array([0.0, i * spacing, 0.0])
-        color = series_color(w, washouts)
-        rec.log(
-            f"/world/stage_range/{w}",
-            rr.Boxes3D(
-                centers=[offset],
-                half_sizes=[travel],
-                colors=[_LIMIT_COLOR],
-                fill_mode="MajorWireframe",
-                labels=[f"{w} stage range"],
-            ),
-            static=True,
-            strict=True,
-        )
-        pos = np.asarray(data.platforms[w].pos_m, dtype=np.float64)
-        rec.send_columns(
-            f"/world/atlas/{w}",
-            indexes=[time],
-            columns=rr.Transform3D.columns(translation=pos + offset, quaternion=quat_wxyz_to_xyzw(data.washouts[w].q)),
-            strict=True,
-        )
-        half = diameter / 2.0
-        rec.log(
-            f"/world/atlas/{w}/sphere",
-            rr.Ellipsoids3D(
-                half_sizes=[[half, half, half]],
-                colors=[(*color, 90)],
-                fill_mode="MajorWireframe",
-                labels=[f"Atlas {w}"],
-            ),
-            static=True,
-            strict=True,
-        )
-        body_triad(f"/world/atlas/{w}/cockpit", half, color)
 
 
 def _send_text(rec: rr.RecordingStream, data: RecordingData) -> None:
@@ -521,15 +530,56 @@ def _send_text(rec: rr.RecordingStream, data: RecordingData) -> None:
             "/events/phases",
             indexes=[_time_column(np.array([t0 for _, t0, _ in data.phases], dtype=np.float64))],
             columns=rr.TextLog.columns(
-                text=[f"phase {name} ({t0:.2f}-{t1:.2f} s)" for name, t0, t1 in data.phases],
+                text=[f"{t0:.2f} s  phase {name} ({t0:.2f}-{t1:.2f} s)" for name, t0, t1 in data.phases],
                 level=["INFO"] * len(data.phases),
             ),
             strict=True,
         )
 
 
-def write_recording(path: Path, data: RecordingData) -> None:
+def _send_legend(rec: rr.RecordingStream, data: RecordingData) -> None:
+    """The one legend: a panel of its own (lines outside its y range, so it covers no data)."""
+    names = [*sources(data), "perception threshold"]
+    colors = [*source_colors(list(data.washouts)), THRESHOLD_COLOR]
+    widths = [AIRCRAFT_WIDTH] + [WASHOUT_WIDTH] * len(data.washouts) + [1.0]
+    rec.log("/legend", rr.SeriesLines(colors=colors, names=names, widths=widths), static=True, strict=True)
+    t_s = np.asarray(data.t_s, dtype=np.float64)
+    rec.send_columns(
+        "/legend",
+        indexes=[_time_column(np.array([t_s[0], t_s[-1]]))],
+        columns=rr.Scalars.columns(scalars=np.zeros((2, len(names)))),
+        strict=True,
+    )
+
+
+def _limit_lanes(data: RecordingData) -> list[tuple[str, str]]:
+    """(washout, kind) for every limit kind a washout reaches at least once, in data order."""
+    return [(w, k) for w, p in data.platforms.items() for k, v in p.saturated.items() if np.any(v)]
+
+
+def _layout(data: RecordingData, perceived: list[np.ndarray], raw: list[np.ndarray]) -> Layout:
+    offsets = scene3d.object_offsets(len(data.washouts), data.envelope.axes("pos_m"), data.envelope.sphere_diameter_m)
+    return Layout(
+        washouts=tuple(data.washouts),
+        dofs=tuple((dof, unit) for dof, _, _, unit in DOFS),
+        t_end_s=float(data.t_s[-1]),
+        perceived_ranges=tuple(
+            _span([p], (c - th, c + th))
+            for p, (c, th) in zip(perceived, _threshold_lines(data.thresholds), strict=True)
+        ),
+        raw_ranges=tuple(_span([r]) for r in raw),
+        limit_lanes=tuple(_limit_lanes(data)),
+        camera=scene3d.camera(offsets, data.envelope.sphere_diameter_m),
+        envelope_quantities=tuple((q, unit) for q, _, unit in ENVELOPE_QUANTITIES),
+        limits_text=tuple(f"+-{_limit_text(data.envelope.axes(f))} {unit}" for _, f, unit in ENVELOPE_QUANTITIES),
+    )
+
+
+def write_recording(path: Path, data: RecordingData, properties: Mapping[str, str] | None = None) -> None:
     """Write ``data`` to the .rrd file ``path`` atomically (temp file in the same folder, then rename).
+
+    ``properties``: provenance strings (e.g. software versions, file hashes), stored as the recording property
+    ``provenance`` (shown in the viewer's recording properties; :func:`read_properties` reads them back).
 
     No viewer and no network: the recording stream's only sink is the file. The review blueprint is stored in the same
     file. Raises ValueError on inconsistent shapes, WashbenchError if the environment disables rerun (``RERUN=off``:
@@ -539,8 +589,10 @@ def write_recording(path: Path, data: RecordingData) -> None:
     """
     path = Path(path)
     _check(data)
-    saturation_kinds = {w: [k for k, v in p.saturated.items() if np.any(v)] for w, p in data.platforms.items()}
-    blueprint = build_blueprint(list(data.washouts), saturation_kinds)
+    props = dict(properties or {})
+    bad = [k for k, v in props.items() if not (isinstance(k, str) and k and isinstance(v, str))]
+    if bad:
+        raise ValueError(f"properties: expected non-empty str keys and str values, got {bad[:3]!r}")
     rec = rr.RecordingStream("washbench", recording_id=uuid.uuid4(), send_properties=False)
     if not rec.is_enabled():
         raise WashbenchError(
@@ -548,92 +600,30 @@ def write_recording(path: Path, data: RecordingData) -> None:
                 path, "rerun logging is disabled by the environment (RERUN=off): unset RERUN to write the recording"
             )
         )
+    perceived, raw = _dof_columns(data)
+    blueprint = build_blueprint(_layout(data, perceived, raw))
     with atomic_path(path) as tmp:
         try:
             rec.save(tmp, default_blueprint=blueprint)
             rec.send_recording_name(data.title)
+            if props:
+                rec.send_property(PROPERTIES, rr.AnyValues(**props))
             time = _time_column(data.t_s)
-            _send_motion(rec, data, time)
-            _send_platforms(rec, data, time)
-            _send_scene(rec, data, time)
+            _send_motion(rec, data, time, perceived, raw)
+            _send_platforms(rec, data, time, _usage(data))
+            _send_lanes(rec, data)
+            scene3d.send_scene(
+                rec,
+                _time_column,
+                np.asarray(data.t_s, dtype=np.float64),
+                data.aircraft.q,
+                {w: m.q for w, m in data.washouts.items()},
+                {w: p.pos_m for w, p in data.platforms.items()},
+                data.envelope.axes("pos_m"),
+                float(data.envelope.sphere_diameter_m),
+            )
             _send_text(rec, data)
+            _send_legend(rec, data)
         finally:
             rec.flush()
             rec.disconnect()
-
-
-# ---------------------------------------------------------------------------------------------------------------------
-# Reading back (tests, including the pipeline's end-to-end test)
-
-
-def _time_seconds(col: pa.Array) -> np.ndarray:
-    ns = np.asarray(col.cast(pa.int64()).to_numpy(zero_copy_only=False), dtype=np.int64)
-    return ns * 1e-9
-
-
-def _component_values(col: pa.Array) -> np.ndarray:
-    """A component column (a list of instances per row) -> array (rows, [instances,] *shape).
-
-    The instance axis is dropped when every row holds one instance; rows of unequal length give an object array.
-    """
-    lengths = pc.list_value_length(col)
-    if col.null_count == 0 and len(col) > 0 and pc.min_max(lengths).as_py()["min"] == pc.max(lengths).as_py():
-        per_row = int(lengths[0].as_py())
-        inner = col.flatten()
-        shape = [len(col)] if per_row == 1 else [len(col), per_row]
-        while pa.types.is_fixed_size_list(inner.type):
-            shape.append(inner.type.list_size)
-            inner = inner.flatten()
-        return np.asarray(inner.to_numpy(zero_copy_only=False)).reshape(shape)
-    return np.array(col.to_pylist(), dtype=object)
-
-
-def read_component(path: Path, component: str) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """Every entity's time-indexed values of ``component`` (e.g. "Scalars:scalars", "Transform3D:quaternion").
-
-    Returns entity path -> (t_s (M,), values), sorted by time. When each row holds one instance, ``values`` has shape
-    (M,) for scalars and (M, k) for k-vectors; with L > 1 instances in every row, (M, L) and (M, L, k). Values keep
-    the dtype rerun stores (scalars float64, vectors and quaternions float32); rows of unequal length give an object
-    array of per-row lists. Static data is ignored. Reads with
-    ``rerun.chunk.RrdReader`` (pyarrow only, no viewer).
-    """
-    from rerun.chunk import RrdReader
-
-    parts: dict[str, list[tuple[np.ndarray, np.ndarray]]] = {}
-    for chunk in RrdReader(str(path)).stream():
-        if chunk.is_static or TIMELINE not in chunk.timeline_names:
-            continue
-        batch = chunk.to_record_batch()
-        if component not in batch.schema.names:
-            continue
-        t = _time_seconds(batch.column(TIMELINE))
-        parts.setdefault(chunk.entity_path, []).append((t, _component_values(batch.column(component))))
-    out: dict[str, tuple[np.ndarray, np.ndarray]] = {}
-    for entity, pieces in parts.items():
-        t = np.concatenate([p[0] for p in pieces])
-        v = np.concatenate([p[1] for p in pieces])
-        order = np.argsort(t, kind="stable")
-        out[entity] = (t[order], v[order])
-    return out
-
-
-def read_scalar_series(path: Path) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """Every scalar series in the .rrd file: entity path -> (t_s (M,), values float64).
-
-    ``values`` is (M,) for a single series and (M, 3) for the platform's per-axis entities (:func:`platform_path`).
-    """
-    return read_component(path, "Scalars:scalars")
-
-
-def read_text_documents(path: Path) -> dict[str, str]:
-    """Every static text document in the .rrd file: entity path -> text."""
-    from rerun.chunk import RrdReader
-
-    out: dict[str, str] = {}
-    for chunk in RrdReader(str(path)).stream():
-        batch = chunk.to_record_batch()
-        if "TextDocument:text" in batch.schema.names:
-            for row in batch.column("TextDocument:text").to_pylist():
-                if row:
-                    out[chunk.entity_path] = row[0]
-    return out

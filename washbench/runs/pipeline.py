@@ -88,21 +88,10 @@ def aircraft_attitude(phi_deg: np.ndarray, theta_deg: np.ndarray, psi_deg: np.nd
 
 
 def metrics_markdown(title: str, rows: list[MetricRow]) -> str:
-    """The metric table of one run as Markdown (for the recording and the report)."""
-    lines = [
-        f"# {title}",
-        "",
-        "Aircraft pilot's perceived motion vs each simulator pilot's. NPC: 1 is perfect, larger is worse,",
-        "empty where a signal is flat. Errors in m/s^2 (integral m/s^2*s) for surge, sway, heave and deg/s",
-        "(integral deg) for roll, pitch, yaw.",
-        "",
-        "| washout | DOF | NPC | integral error | max error |",
-        "|---|---|---|---|---|",
-    ]
-    for r in rows:
-        npc = "" if math.isnan(r.npc) else f"{r.npc:.4f}"
-        lines.append(f"| {r.washout} | {r.dof} | {npc} | {r.integral_error:.4g} | {r.max_error:.4g} |")
-    return "\n".join(lines) + "\n"
+    """The metric table of one run as Markdown, DOF by washout (for the recording)."""
+    from washbench.review.metrics_table import metrics_table_markdown
+
+    return metrics_table_markdown(title, rows)
 
 
 #: The file that marks a folder as a ``washbench run`` result (only such a folder is ever replaced).

@@ -1,0 +1,224 @@
+"""The review layout of a recording, and the colours every view shares.
+
+Laid out for one question: which washout feels most like the aircraft? The first tab stacks the six perceived-motion
+panels (surge, sway, heave, roll, pitch, yaw, as the paper's Figures 8-16) under one lane view (flight phases, and
+per washout the platform limits it is held at), all on one linked time axis showing the whole manoeuvre; beside them
+the 3D scene (aircraft and Atlas cockpits) and the metric table. The viewer's own side panels start collapsed.
+
+Colours are fixed: the aircraft pilot (the reference) in a strong magenta, drawn wider, readable on the viewer's
+light and dark themes; the three washouts in blue, orange and green, in the order small-angle, large-angle,
+unrestricted; any other washout name (a user's variant) takes the next spare colour in the order the recording
+lists it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import rerun.blueprint as rrb
+
+__all__ = [
+    "AIRCRAFT_COLOR",
+    "AIRCRAFT_WIDTH",
+    "LIMIT_COLOR",
+    "THRESHOLD_COLOR",
+    "WASHOUT_WIDTH",
+    "Layout",
+    "build_blueprint",
+    "series_color",
+    "source_colors",
+]
+
+AIRCRAFT_COLOR = (200, 0, 160)
+"""The aircraft pilot's colour (magenta): visible on white and on the viewer's near-black background."""
+AIRCRAFT_WIDTH = 2.5
+WASHOUT_WIDTH = 1.5
+WASHOUT_COLORS: dict[str, tuple[int, int, int]] = {
+    "small-angle": (31, 119, 180),  # blue
+    "large-angle": (255, 127, 14),  # orange
+    "unrestricted": (44, 160, 44),  # green
+}
+EXTRA_COLORS: tuple[tuple[int, int, int], ...] = (
+    (23, 190, 207),  # cyan
+    (140, 86, 75),  # brown
+    (188, 189, 34),  # olive
+    (255, 200, 0),  # gold
+    (40, 60, 140),  # navy
+)
+"""Colours for washout names other than the three above, taken in the order the recording lists them."""
+LIMIT_COLOR = (128, 128, 128)
+THRESHOLD_COLOR = (128, 128, 128)
+AXIS_COLORS = ((220, 60, 60), (60, 170, 60), (70, 120, 230))
+"""x, y, z (or wheel 1, 2, 3) inside one washout's Atlas panels."""
+
+
+def series_color(source: str, washouts: Sequence[str] = ()) -> tuple[int, int, int]:
+    """Fixed RGB colour of ``"aircraft"`` or a washout name.
+
+    The three named washouts have their own colours; any other name takes a spare colour by its position among the
+    other names in ``washouts`` (cycling after five).
+    """
+    if source == "aircraft":
+        return AIRCRAFT_COLOR
+    if source in WASHOUT_COLORS:
+        return WASHOUT_COLORS[source]
+    others = [w for w in washouts if w not in WASHOUT_COLORS]
+    index = others.index(source) if source in others else 0
+    return EXTRA_COLORS[index % len(EXTRA_COLORS)]
+
+
+def source_colors(washouts: Sequence[str]) -> list[tuple[int, int, int]]:
+    """Colours of ``["aircraft", *washouts]`` in that order."""
+    return [AIRCRAFT_COLOR] + [series_color(w, washouts) for w in washouts]
+
+
+@dataclass(frozen=True)
+class Layout:
+    """What the blueprint needs to know about the data (the blueprint is built with the recording).
+
+    ``perceived_ranges`` and ``raw_ranges``: per DOF (in the order of ``dofs``) the y range to show, thresholds and
+    all traces inside.
+    ``limit_lanes``: (washout, kind) pairs that reach a limit at least once. ``camera``: (eye, target) in the scene's
+    NED frame, metres.
+    """
+
+    washouts: tuple[str, ...]
+    dofs: tuple[tuple[str, str], ...]  # (name, unit)
+    t_end_s: float
+    perceived_ranges: tuple[tuple[float, float], ...]
+    raw_ranges: tuple[tuple[float, float], ...]
+    limit_lanes: tuple[tuple[str, str], ...]
+    camera: tuple[tuple[float, float, float], tuple[float, float, float]]
+    envelope_quantities: tuple[tuple[str, str], ...]  # (name, unit)
+    limits_text: tuple[str, ...]  # per envelope quantity, e.g. "+-1.5/1.5/1 m"
+
+
+def _whole_manoeuvre(t_end_s: float) -> rrb.TimeAxis:
+    """Time axis linked across views, opening on the whole manoeuvre (0 to ``t_end_s``)."""
+    return rrb.TimeAxis(
+        link="Independent",
+        view_range=rrb.TimeRange(
+            start=rrb.TimeRangeBoundary.absolute(nanos=0),
+            end=rrb.TimeRangeBoundary.absolute(nanos=round(t_end_s * 1e9)),  # as the time column rounds
+        ),
+    )
+
+
+def _all_data() -> rrb.VisibleTimeRange:
+    return rrb.VisibleTimeRange("time", start=rrb.TimeRangeBoundary.infinite(), end=rrb.TimeRangeBoundary.infinite())
+
+
+def _stack(layout: Layout, prefix: str, ranges: Sequence[tuple[float, float]], title: str) -> list[rrb.TimeSeriesView]:
+    """Six stacked panels (one per DOF) without legends, y ranges fixed to hold all the data and the thresholds."""
+    views = []
+    for (dof, unit), (lo, hi) in zip(layout.dofs, ranges, strict=True):
+        legend = rrb.PlotLegend(visible=False)  # the one legend has a panel of its own
+        views.append(
+            rrb.TimeSeriesView(
+                origin=f"/{prefix}/{dof}",
+                name=f"{title}{dof} [{unit}]",
+                axis_x=_whole_manoeuvre(layout.t_end_s),
+                axis_y=rrb.ScalarAxis(range=(lo, hi)),
+                plot_legend=legend,
+                time_ranges=_all_data(),
+            )
+        )
+    return views
+
+
+def _lanes(layout: Layout, origin: str, name: str) -> rrb.StateTimelineView:
+    return rrb.StateTimelineView(
+        origin=origin, name=name, time_view=_whole_manoeuvre(layout.t_end_s), time_ranges=_all_data()
+    )
+
+
+def build_blueprint(layout: Layout) -> rrb.Blueprint:
+    """The review layout (see the module docstring); tabs: perceived, raw, envelope, one per washout, events."""
+    eye, target = layout.camera
+    side = rrb.Vertical(
+        rrb.Spatial3DView(
+            origin="/world",
+            name="Aircraft (from its initial heading) and Atlas cockpits",
+            eye_controls=rrb.EyeControls3D(kind="Orbital", position=eye, look_target=target, eye_up=(0.0, 0.0, -1.0)),
+            line_grid=rrb.LineGrid3D(visible=False),
+        ),
+        rrb.TimeSeriesView(
+            origin="/legend",
+            name="Legend",
+            axis_x=_whole_manoeuvre(layout.t_end_s),
+            axis_y=rrb.ScalarAxis(range=(1.0, 2.0)),  # its lines lie at 0: only the legend shows
+            plot_legend=rrb.PlotLegend(corner="LeftTop", visible=True),
+            time_ranges=_all_data(),
+        ),
+        rrb.TextDocumentView(origin="/metrics", name="Metrics"),
+        row_shares=[2.0, 1.3 + 0.25 * len(layout.washouts), 2.4],
+    )
+    perceived = rrb.Vertical(
+        _lanes(layout, "/lanes", "Phases; limits reached"),
+        *_stack(layout, "perceived", layout.perceived_ranges, "perceived "),
+        row_shares=[0.9 + 0.6 * (1 + len(layout.washouts))] + [2.0] * len(layout.dofs),
+        name="Perceived",
+    )
+    raw = rrb.Vertical(
+        _lanes(layout, "/lanes", "Phases; limits reached"),
+        *_stack(layout, "raw", layout.raw_ranges, ""),
+        row_shares=[0.9 + 0.6 * (1 + len(layout.washouts))] + [2.0] * len(layout.dofs),
+        name="Raw motion",
+    )
+    usage = [
+        rrb.TimeSeriesView(
+            origin=f"/envelope/{q}",
+            name=f"{q}: max |axis| / limit ({limit})",
+            axis_x=_whole_manoeuvre(layout.t_end_s),
+            axis_y=rrb.ScalarAxis(range=(0.0, 1.15)),
+            plot_legend=rrb.PlotLegend(visible=False),  # the colours are those of the one legend
+            time_ranges=_all_data(),
+        )
+        for (q, _), limit in zip(layout.envelope_quantities, layout.limits_text, strict=True)
+    ]
+    lane_share = 1.0 + 0.45 * len(layout.limit_lanes) + 0.4 * len(layout.washouts)
+    envelope = rrb.Vertical(
+        _lanes(layout, "/limits", "Limits reached (one lane per washout and limit kind)"),
+        *usage,
+        row_shares=[lane_share] + [2.0] * len(usage),
+        name="Platform envelope",
+    )
+    per_washout = [
+        rrb.Grid(
+            *[
+                rrb.TimeSeriesView(
+                    origin=f"/platform/{w}/{q}",
+                    name=f"{w}: {q} [{unit}] ({axes})",
+                    axis_x=_whole_manoeuvre(layout.t_end_s),
+                    plot_legend=rrb.PlotLegend(visible=False),
+                    time_ranges=_all_data(),
+                )
+                for q, unit in layout.envelope_quantities
+                for axes in ["w1 red, w2 green, w3 blue" if q == "wheels" else "x red, y green, z blue"]
+            ],
+            grid_columns=2,
+            name=f"Atlas {w}",
+        )
+        for w in layout.washouts
+    ]
+    enc = rrb.encodings
+    events = rrb.TextLogView(
+        origin="/events",
+        name="Phases and limit events",
+        columns=rrb.archetypes.TextLogColumns(
+            timeline_columns=[enc.TimelineColumn("time")],
+            text_log_columns=[
+                enc.TextLogColumn("LogLevel"),
+                enc.TextLogColumn("Body"),
+                enc.TextLogColumn("EntityPath", visible=False),
+            ],
+        ),
+    )
+    tabs = rrb.Tabs(perceived, raw, envelope, *per_washout, events, active_tab=0)
+    return rrb.Blueprint(
+        rrb.Horizontal(tabs, side, column_shares=[3, 1.4]),
+        rrb.BlueprintPanel(state="collapsed"),
+        rrb.SelectionPanel(state="collapsed"),
+        rrb.TimePanel(state="collapsed", timeline="time", play_state="paused"),
+    )

@@ -1,0 +1,170 @@
+"""The recording's 3D scene: the aircraft and each washout's Atlas cockpit side by side, in one NED frame.
+
+Every object is the same line shape (fuselage with a nose chevron, wings, tailplane, fin) over a translucent floor
+plate, so roll, pitch and yaw read at a glance and the aircraft and the cockpits point the same way when their
+attitudes agree. The aircraft is shown relative to its initial heading (the cockpits start at yaw 0). Each Atlas
+cockpit sits in its sphere (``envelope.sphere_diameter_m``) and is translated by the stage position inside the stage's
+range box. One label per object. Poses are sent at most at :data:`SCENE_RATE_HZ`: the 3D view shows one instant, and
+scrubbing or playing needs no more.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import rerun as rr
+
+from washbench.review.blueprint import AIRCRAFT_COLOR, LIMIT_COLOR, series_color
+
+__all__ = ["SCENE_RATE_HZ", "camera", "object_offsets", "relative_to_initial_heading", "scene_stride", "send_scene"]
+
+SCENE_RATE_HZ = 30.0
+"""Highest rate of the 3D poses, Hz."""
+
+
+def quat_wxyz_to_xyzw(q_wxyz: np.ndarray) -> np.ndarray:
+    """Convert scalar-first quaternions (..., 4) [w, x, y, z] to rerun's scalar-last [x, y, z, w].
+
+    The only place in washbench where quaternion order changes.
+    """
+    q_wxyz = np.asarray(q_wxyz, dtype=np.float64)
+    return np.concatenate([q_wxyz[..., 1:4], q_wxyz[..., 0:1]], axis=-1)
+
+
+def relative_to_initial_heading(q_wxyz: np.ndarray) -> np.ndarray:
+    """Body->NED quaternions (N, 4), scalar first, turned about NED z so that the first sample's heading is 0.
+
+    ``q_rel = q_z(-psi_0) q``, with psi_0 the ZYX yaw of ``q[0]``; roll and pitch are unchanged.
+    """
+    q = np.asarray(q_wxyz, dtype=np.float64)
+    w, x, y, z = q[0]
+    psi0 = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+    c, s = math.cos(-psi0 / 2.0), math.sin(-psi0 / 2.0)  # r = [c, 0, 0, s]; r * q (Hamilton)
+    return np.column_stack(
+        [
+            c * q[:, 0] - s * q[:, 3],
+            c * q[:, 1] - s * q[:, 2],
+            c * q[:, 2] + s * q[:, 1],
+            c * q[:, 3] + s * q[:, 0],
+        ]
+    )
+
+
+def scene_stride(dt_s: float) -> int:
+    """Send every k-th pose so that the 3D rate is at most SCENE_RATE_HZ."""
+    return max(1, math.floor(1.0 / (dt_s * SCENE_RATE_HZ) + 1e-9))
+
+
+def object_offsets(n_washouts: int, travel_m: np.ndarray, diameter_m: float) -> np.ndarray:
+    """Centre of each object (aircraft first, then the washouts) along NED y (east), (1 + n_washouts, 3), metres."""
+    spacing = 2.0 * float(travel_m[1]) + diameter_m + 1.0
+    offsets = np.zeros((1 + n_washouts, 3))
+    offsets[:, 1] = np.arange(1 + n_washouts) * spacing
+    return offsets
+
+
+def camera(offsets: np.ndarray, diameter_m: float) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+    """Eye and target (NED, m): behind (south of) the row of objects and above it, looking north at its middle."""
+    width = float(offsets[-1, 1] - offsets[0, 1]) + 2.0 * diameter_m
+    centre = 0.5 * float(offsets[0, 1] + offsets[-1, 1])
+    eye = (-0.52 * width, centre, -0.27 * width)
+    return eye, (0.0, centre, 0.0)
+
+
+def _shape(size: float) -> list[list[list[float]]]:
+    """Line strips of the attitude shape in body axes (x forward, y right, z down), ``size`` = half length, m."""
+    s = size
+    return [
+        [[-s, 0, 0], [s, 0, 0]],  # fuselage
+        [[0.72 * s, -0.18 * s, 0], [s, 0, 0], [0.72 * s, 0.18 * s, 0]],  # nose chevron
+        [[0.1 * s, -s, 0], [0.1 * s, s, 0]],  # wings
+        [[-0.9 * s, -0.38 * s, 0], [-0.9 * s, 0.38 * s, 0]],  # tailplane
+        [[-0.8 * s, 0, 0], [-s, 0, -0.5 * s]],  # fin (up is -z)
+    ]
+
+
+def _log_object(rec: rr.RecordingStream, path: str, size: float, color: tuple[int, int, int]) -> None:
+    rec.log(
+        f"{path}/shape",
+        rr.LineStrips3D(_shape(size), colors=[color], radii=[0.035 * size]),
+        static=True,
+        strict=True,
+    )
+    rec.log(
+        f"{path}/floor",
+        rr.Boxes3D(
+            half_sizes=[[0.75 * size, 0.55 * size, 0.02 * size]],
+            colors=[(*color, 110)],
+            fill_mode="Solid",
+        ),
+        static=True,
+        strict=True,
+    )
+
+
+def send_scene(
+    rec: rr.RecordingStream,
+    time_of: object,
+    t_s: np.ndarray,
+    aircraft_q: np.ndarray,
+    washout_q: dict[str, np.ndarray],
+    stage_pos_m: dict[str, np.ndarray],
+    travel_m: np.ndarray,
+    diameter_m: float,
+) -> None:
+    """Log the scene; ``time_of(t_s)`` makes the time column. Quaternions scalar first, body->NED."""
+    washouts = list(washout_q)
+    stride = scene_stride(float(t_s[1] - t_s[0])) if t_s.size > 1 else 1
+    idx = np.arange(0, t_s.size, stride)
+    time = time_of(t_s[idx])
+    offsets = object_offsets(len(washouts), travel_m, diameter_m)
+    half = diameter_m / 2.0
+    rec.log("/world", rr.ViewCoordinates.FRD, static=True, strict=True)  # x north, y east, z down
+
+    rec.log("/world/aircraft", rr.Transform3D(translation=offsets[0]), static=True, strict=True)
+    q_ac = relative_to_initial_heading(aircraft_q)[idx]
+    rec.send_columns(
+        "/world/aircraft/body",
+        indexes=[time],
+        columns=rr.Transform3D.columns(quaternion=quat_wxyz_to_xyzw(q_ac)),
+        strict=True,
+    )
+    _log_object(rec, "/world/aircraft/body", half, AIRCRAFT_COLOR)
+    # one label per object, under it (z down), where it hides no shape
+    rec.log(
+        "/world/labels",
+        rr.Points3D(
+            offsets + np.array([0.0, 0.0, half + 0.5]),
+            labels=["aircraft", *washouts],
+            colors=[AIRCRAFT_COLOR, *[series_color(w, washouts) for w in washouts]],
+            radii=[0.05],
+            show_labels=True,
+        ),
+        static=True,
+        strict=True,
+    )
+    for i, w in enumerate(washouts):
+        color = series_color(w, washouts)
+        base = f"/world/atlas/{w}"
+        rec.log(base, rr.Transform3D(translation=offsets[i + 1]), static=True, strict=True)
+        rec.log(
+            f"{base}/stage_range",
+            rr.Boxes3D(half_sizes=[travel_m], colors=[(*LIMIT_COLOR, 160)], fill_mode="MajorWireframe"),
+            static=True,
+            strict=True,
+        )
+        pos = np.asarray(stage_pos_m[w], dtype=np.float64)[idx]
+        rec.send_columns(
+            f"{base}/cockpit",
+            indexes=[time],
+            columns=rr.Transform3D.columns(translation=pos, quaternion=quat_wxyz_to_xyzw(washout_q[w][idx])),
+            strict=True,
+        )
+        rec.log(
+            f"{base}/cockpit/sphere",
+            rr.Ellipsoids3D(half_sizes=[[half, half, half]], colors=[(*color, 70)], fill_mode="MajorWireframe"),
+            static=True,
+            strict=True,
+        )
+        _log_object(rec, f"{base}/cockpit", 0.8 * half, color)
