@@ -403,11 +403,10 @@ class Check(StrictModel):
 class Manoeuvre(StrictModel):
     """One manoeuvre file, checked in full however it is built.
 
-    ``name`` and ``aircraft`` become result folders (``OUT/<aircraft>/<name>/``), so both are plain
-    identifiers (:mod:`washbench.io.names`). After the schema, the semantic checks run (a known aircraft
-    with a pilot profile, one start, phases that can end, a manoeuvre no longer than
-    :data:`MAX_MANOEUVRE_S`, ...): :meth:`model_validate` from Python raises ``ValidationError`` listing
-    every problem; :func:`load_manoeuvre` raises WashbenchError with ``file:line: field: problem`` lines.
+    The name and the aircraft become result folders (OUT/aircraft/name/), so both are plain identifiers:
+    letters, digits, '_' and '-'. After the schema the semantic checks run (a known aircraft with a pilot
+    profile, one start, phases that can end, at most an hour of flight): from Python a ValidationError lists
+    every problem, from a file every problem is one line naming the file, the line and the field.
     """
 
     name: Identifier
