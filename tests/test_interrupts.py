@@ -71,9 +71,9 @@ def test_suite_stops_at_once_and_leaves_the_previous_results(
         proc.send_signal(sig)
     _, err = proc.communicate(timeout=60)
     if proc.returncode == -sig and delay_s < 1:
-        # on a loaded machine the signal can come before Python has started at all: the default action ends the
-        # process, which a shell reports as the same 130 (128 + SIGINT); nothing was printed or written
-        assert err == "", err
+        # the signal can come before Python has started (or, seen once, as it ends): the default action ends the
+        # process, which a shell reports as the same 130 (128 + SIGINT); at most the one line was printed
+        assert "Traceback" not in err and err.strip() in ("", f"washbench: {word}"), err
     else:
         assert proc.returncode == status, err
         assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
