@@ -131,6 +131,25 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--dask", metavar="ADDRESS", help="run on this Dask scheduler instead of local processes")
     p.add_argument("--quiet", action="store_true", help="no progress display")
 
+    p = sub.add_parser("omct", help="Objective Motion Cueing Test: gain and phase of each washout, Bode plots")
+    p.add_argument("--out", type=Path, required=True, help="output folder (omct.csv, bode_<test>.png, report.md)")
+    _washout_options(p)
+    p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
+    p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
+    p.add_argument("--boundaries", type=Path, help="gain/phase boundaries YAML, drawn and checked (README)")
+    p.add_argument("--rate-hz", type=float, default=120.0, help="washout sample rate (default 120)")
+    p.add_argument("--amplitude-scale", type=float, default=1.0, help="multiply every input amplitude (default 1)")
+
+    p = sub.add_parser("signal", help="write a test signal on one axis as a washbench cue input")
+    p.add_argument("kind", help="signal shape: sine, step, pulse, doublet, chirp, multisine")
+    p.add_argument("--axis", required=True, help="body axis: f_x, f_y, f_z (specific force), roll, pitch, yaw")
+    p.add_argument("--amplitude", type=float, required=True, help="m/s^2 (f_x, f_y, f_z) or deg/s (rotations)")
+    p.add_argument("--frequency-hz", type=float, help="frequency (every kind but step; see README)")
+    p.add_argument("--duration-s", type=float, default=20.0, help="length (default 20 s)")
+    p.add_argument("--rate-hz", type=float, default=120.0, help="sample rate (default 120 Hz)")
+    p.add_argument("--start-s", type=float, default=1.0, help="onset of step, pulse, doublet, chirp (default 1 s)")
+    p.add_argument("--out", type=Path, required=True, help="output file, .csv or .parquet")
+
     p = sub.add_parser("sweep", help="a grid of washout parameters on recorded flights: scores and metrics per point")
     p.add_argument("manoeuvres", type=Path, nargs="+", help="manoeuvre files or folders")
     p.add_argument("--washout", action="append", metavar="KIND", help="washout kind, repeatable (default: all three)")
@@ -309,6 +328,33 @@ def _dispatch(args: argparse.Namespace) -> int:
             washouts=args.washout,
             variants=args.variant,
             dask=args.dask,
+        )
+    if args.command == "omct":
+        from washbench.runs.omct import run_omct
+
+        run_omct(
+            args.out,
+            args.washout,
+            args.params,
+            args.platform,
+            args.boundaries,
+            rate_hz=args.rate_hz,
+            amplitude_scale=args.amplitude_scale,
+            variants=args.variant,
+        )
+        return 0
+    if args.command == "signal":
+        from washbench.runs.omct import signal_command
+
+        return signal_command(
+            args.kind,
+            args.axis,
+            args.amplitude,
+            args.frequency_hz,
+            args.duration_s,
+            args.rate_hz,
+            args.start_s,
+            args.out,
         )
     if args.command in ("sweep", "tune"):
         return _study(args)

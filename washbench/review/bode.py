@@ -1,0 +1,120 @@
+"""Bode plots of the OMCT (``washbench omct``): one PNG per test, every washout overlaid.
+
+Left column: the simulator's motion at the pilot's head (gain on a log axis, absolute, as the OMCT literature
+plots it; phase in degrees), with the boundaries if given (dashed, the band between them shaded). Right
+column: what the pilot perceives through the vestibular models, each simulator pilot against the aircraft
+pilot (black, dashed) for the same input. Non-linear points are drawn as crosses, points outside the
+boundaries get a red ring. matplotlib is imported
+lazily with the Agg backend (no display needed).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from washbench.analysis.omct import TESTS, Bounds, bounds_at
+from washbench.io.atomic import atomic_path
+
+_COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown", "tab:pink", "tab:olive")
+_STYLES = (("-", "o"), ("--", "s"), (":", "^"), ("-.", "D"))  # washouts that coincide stay visible
+
+
+def _pyplot() -> Any:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _boundary_lines(ax_gain: Any, ax_phase: Any, b: Bounds) -> None:
+    w = np.geomspace(b.frequency_radps[0], b.frequency_radps[-1], 200)
+    vals = np.array([[np.nan if v is None else v for v in bounds_at(b, x)] for x in w], dtype=float)
+    for ax, lo, hi in ((ax_gain, vals[:, 0], vals[:, 1]), (ax_phase, vals[:, 2], vals[:, 3])):
+        for line in (lo, hi):
+            if np.isfinite(line).any():
+                ax.plot(w, line, "k--", lw=1.0, label="_bound")
+        if np.isfinite(lo).any() and np.isfinite(hi).any():
+            ax.fill_between(w, lo, hi, color="0.85", zorder=0)
+
+
+def _series(
+    ax_gain: Any, ax_phase: Any, w: np.ndarray, g: np.ndarray, ph: np.ndarray, lin: np.ndarray, i: int, **kw: Any
+) -> None:
+    line, marker = _STYLES[i % len(_STYLES)]
+    ax_gain.plot(w, g, line, **kw)
+    ax_phase.plot(w, ph, line, **kw)
+    kw.pop("label", None)
+    ax_gain.plot(w[lin], g[lin], marker, ms=4, fillstyle="none", **kw)
+    ax_phase.plot(w[lin], ph[lin], marker, ms=4, fillstyle="none", **kw)
+    ax_gain.plot(w[~lin], g[~lin], "x", ms=7, mew=2, **kw)
+    ax_phase.plot(w[~lin], ph[~lin], "x", ms=7, mew=2, **kw)
+
+
+def write_bode_plots(
+    out_dir: Path, points: Sequence[Any], bounds: dict[str, Bounds], washouts: Sequence[str]
+) -> dict[str, str]:
+    """Write ``bode_<test>.png`` for every test in ``points`` (OmctPoint); return test -> file name."""
+    plt = _pyplot()
+    files: dict[str, str] = {}
+    for test in TESTS:
+        pts = [p for p in points if p.test == test.name]
+        if not pts:
+            continue
+        fig, axes = plt.subplots(2, 2, figsize=(11, 7), sharex=True)
+        (ag, apg), (aph, app) = axes
+        if test.name in bounds:
+            _boundary_lines(ag, aph, bounds[test.name])
+        aircraft_drawn = False
+        for i, name in enumerate(washouts):
+            mine = sorted((p for p in pts if p.washout == name), key=lambda p: p.frequency_radps)
+            if not mine:
+                continue
+            w = np.array([p.frequency_radps for p in mine])
+            lin = np.array([p.linear for p in mine])
+            colour = _COLOURS[i % len(_COLOURS)]
+            _series(ag, aph, w, np.array([p.gain for p in mine]), np.array([p.phase_deg for p in mine]), lin, i,
+                    color=colour, label=name)  # fmt: skip
+            _series(apg, app, w, np.array([p.perceived_gain for p in mine]),
+                    np.array([p.perceived_phase_deg for p in mine]), lin, i, color=colour, label=name)  # fmt: skip
+            for p in mine:  # outside the boundaries: a red ring
+                if p.gain_inside is False:
+                    ag.plot(p.frequency_radps, p.gain, "o", ms=11, mfc="none", mec="red", mew=1.5)
+                if p.phase_inside is False:
+                    aph.plot(p.frequency_radps, p.phase_deg, "o", ms=11, mfc="none", mec="red", mew=1.5)
+            if not aircraft_drawn:
+                ga = np.array([p.aircraft_perceived_gain for p in mine])
+                pa = np.array([p.aircraft_perceived_phase_deg for p in mine])
+                if np.any(ga > 0):
+                    apg.plot(w, ga, "k--", lw=1.5, label="aircraft pilot")
+                    app.plot(w, pa, "k--", lw=1.5, label="aircraft pilot")
+                else:
+                    apg.text(0.02, 0.04, "aircraft pilot: no rotation (gain 0)", transform=apg.transAxes, fontsize=8)
+                aircraft_drawn = True
+        for ax in (ag, apg):
+            ax.set_xscale("log")
+            ax.set_yscale("log")
+            ax.grid(True, which="both", alpha=0.3)
+        for ax in (aph, app):
+            ax.set_xscale("log")
+            ax.grid(True, which="both", alpha=0.3)
+            ax.set_xlabel("frequency (rad/s)")
+        ag.set_ylabel("gain (-)")
+        aph.set_ylabel("phase (deg)")
+        ag.set_title(f"{test.input_axis} -> {test.output_axis}: motion at the pilot's head")
+        apg.set_title("perceived (vestibular models)")
+        ag.legend(fontsize=8, loc="best")
+        apg.legend(fontsize=8, loc="best")
+        fig.suptitle(f"OMCT {test.name}  (x: non-linear point; red ring: outside the boundaries)", fontsize=11)
+        fig.tight_layout()
+        name = f"bode_{test.name}.png"
+        with atomic_path(Path(out_dir) / name) as tmp:
+            fig.savefig(tmp, format="png", dpi=90)
+        plt.close(fig)
+        files[test.name] = name
+    return files

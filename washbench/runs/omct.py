@@ -1,0 +1,326 @@
+"""``washbench omct``: the Objective Motion Cueing Test of each washout; omct.csv, Bode plots, report.md.
+
+A list of :class:`washbench.cueing.variants.Washout` (name, kind, parameters) drives it, so a built-in washout
+and a variant (``--variant``, a ``variants:`` section of ``--params``) go through the same code. For every test
+and frequency the input is generated once (:func:`washbench.analysis.omct.input_spec`, the same sine
+``washbench signal`` writes) and all washouts run on it in ONE ``washbench.cueing.cue_trace`` call, side by side
+as the compiled bank runs them. The analysis is :mod:`washbench.analysis.omct`.
+
+Perceived motion (the issue's "beyond the standard"): the vestibular models are linear, so at the test
+frequency the perceived response is the model's own discrete frequency response at the run's step
+(:func:`washbench.analysis.omct.discrete_frequency_response` of the discretised sections that
+``washbench cue`` applies) times the measured head response; the aircraft pilot's likewise, from the
+aircraft's own motion. This is the periodic steady state of those filters without the canal's 30 s
+adaptation transient to wait for (checked against filtering a long sine in the tests).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from washbench.analysis import omct
+from washbench.analysis.omct_boundaries import BoundaryFile
+from washbench.analysis.signals import amplitude_unit, generate
+from washbench.cueing.variants import Washout
+from washbench.errors import WashbenchError, located
+from washbench.io.atomic import write_text_atomic
+from washbench.io.results import csv_number
+from washbench.io.yamlio import load_yaml_model
+from washbench.perception.vestibular import VestibularModel, VestibularParams
+from washbench.platform.limits import PlatformLimits
+from washbench.review.omct_report import report_text
+
+CSV_FILE = "omct.csv"
+REPORT_FILE = "report.md"
+CSV_COLUMNS: tuple[str, ...] = (
+    "washout", "test", "input", "output", "frequency_radps", "amplitude", "amplitude_unit", "gain", "phase_deg",
+    "linear", "distortion", "saturated", "gain_inside", "phase_inside",
+    "perceived_gain", "perceived_phase_deg", "aircraft_perceived_gain", "aircraft_perceived_phase_deg",
+)  # fmt: skip
+
+
+@dataclass(frozen=True)
+class OmctPoint:
+    """One test of one washout at one frequency. Phases in degrees, continuous along frequency.
+
+    ``saturated``: limit kinds that bound during the run; ``gain_inside``/``phase_inside``: None where no
+    boundary covers the point; ``*_phase_deg``: NaN where the gain is 0 (the aircraft pilot of a tilt test).
+    """
+
+    washout: str
+    test: str
+    input: str
+    output: str
+    frequency_radps: float
+    amplitude: float
+    amplitude_unit: str
+    gain: float
+    phase_deg: float
+    linear: bool
+    distortion: float
+    saturated: tuple[str, ...]
+    gain_inside: bool | None
+    phase_inside: bool | None
+    perceived_gain: float
+    perceived_phase_deg: float
+    aircraft_perceived_gain: float
+    aircraft_perceived_phase_deg: float
+
+
+@dataclass(frozen=True)
+class OmctSettings:
+    """How the runs were made: sample rate [Hz], settle time [s], slowest decay [1/s], amplitude scale."""
+
+    rate_hz: float
+    settle_s: float
+    slowest_decay_radps: float
+    amplitude_scale: float = 1.0
+
+
+def _phase(h: complex) -> float:
+    return math.degrees(math.atan2(h.imag, h.real)) if h != 0 else math.nan
+
+
+def slowest_decay(entries: Sequence[Washout]) -> float:
+    """The slowest linearised decay rate [1/s] over the washouts (one settle time for all, same input)."""
+    rates = []
+    for e in entries:
+        p = e.params
+        rot = p.rotational.highpass_wn_radps
+        rates.append(
+            omct.slowest_decay_radps(
+                e.kind,
+                p.tilt.gain_per_s,
+                (rot.roll, rot.pitch, rot.yaw),
+                p.translational_highpass_wn_radps.xyz,
+                p.tilt.lowpass_wn_radps.xyz,
+                p.head.derivative_wn_radps,
+            )
+        )
+    return min(rates)
+
+
+def measure(
+    entries: Sequence[Washout],
+    limits: PlatformLimits,
+    rate_hz: float = 120.0,
+    tests: Sequence[omct.OmctTest] = omct.TESTS,
+    frequencies_radps: Sequence[float] = omct.FREQUENCIES_RADPS,
+    boundaries: dict[str, omct.Bounds] | None = None,
+    vestibular: VestibularParams | None = None,
+    amplitude_scale: float = 1.0,
+) -> tuple[list[OmctPoint], OmctSettings]:
+    """Run every test at every frequency for every washout; points ordered washout, test, frequency.
+
+    ``amplitude_scale`` multiplies every input amplitude (1: the amplitudes of :func:`omct.amplitude`), to
+    probe where a washout stops being linear.
+    """
+    from washbench.cueing import cue_trace
+
+    if not entries:
+        raise WashbenchError("no washout selected")
+    if not (math.isfinite(rate_hz) and rate_hz > 0.0):
+        raise WashbenchError(f"--rate-hz must be a positive number, got {rate_hz!r}")
+    if not (math.isfinite(amplitude_scale) and amplitude_scale > 0.0):
+        raise WashbenchError(f"--amplitude-scale must be a positive number, got {amplitude_scale!r}")
+    top = max(frequencies_radps)
+    if top >= math.pi * rate_hz:
+        raise WashbenchError(f"--rate-hz {rate_hz}: {top:.4g} rad/s is at or above the Nyquist frequency")
+    dt = 1.0 / rate_hz
+    sigma = slowest_decay(entries)
+    model = VestibularModel(dt, vestibular)
+    raw: dict[tuple[str, str], list[tuple[float, float, str, complex, float, tuple[str, ...], complex]]] = {}
+    for test in tests:
+        for w in frequencies_radps:
+            tm = omct.timing(w, sigma)
+            spec = omct.input_spec(test, w, rate_hz, tm.duration_s, amplitude_scale)
+            sig = generate(spec)
+            ref = omct.reference_fit(test, sig.f_mps2, sig.omega_radps, dt, w, tm.periods)
+            aircraft = omct.response(test, ref, sig.f_mps2, sig.omega_radps, dt, w, tm.periods, _g(entries[0]))
+            traces = cue_trace(sig.f_mps2, sig.omega_radps, dt, entries, None, limits)
+            for m in entries:
+                tr = traces[m.name]
+                r = omct.response(test, ref, tr.head_f_mps2, tr.head_omega_radps, dt, w, tm.periods, _g(m))
+                sat = omct.saturated_kinds(tr.saturation_counts)
+                raw.setdefault((m.name, test.name), []).append(
+                    (w, spec.amplitude, amplitude_unit(test.input_axis), r.h, r.distortion, sat, aircraft.h)
+                )
+    points: list[OmctPoint] = []
+    for e in entries:
+        for test in tests:
+            points += _points(e.name, test, raw[(e.name, test.name)], model, dt, (boundaries or {}).get(test.name))
+    return points, OmctSettings(rate_hz, omct.settle_time_s(sigma), sigma, amplitude_scale)
+
+
+def _g(entry: Washout) -> float:
+    return float(entry.params.gravity_mps2)
+
+
+def _points(
+    washout: str,
+    test: omct.OmctTest,
+    rows: list[tuple[float, float, str, complex, float, tuple[str, ...], complex]],
+    model: VestibularModel,
+    dt: float,
+    bounds: omct.Bounds | None,
+) -> list[OmctPoint]:
+    """One washout's points of one test, phases unwrapped along frequency, boundaries checked."""
+    vest = model.canals if test.output_kind == "omega" else model.otolith
+    rows = sorted(rows, key=lambda r: r[0])
+    v = [omct.discrete_frequency_response(vest.b, vest.phi, r[0], dt) for r in rows]
+    phase = omct.unwrap_phase_deg([_phase(r[3]) for r in rows])
+    p_phase = omct.unwrap_phase_deg([_phase(vi * r[3]) for vi, r in zip(v, rows, strict=True)])
+    a_phase = omct.unwrap_phase_deg([_phase(vi * r[6]) for vi, r in zip(v, rows, strict=True)])
+    out = []
+    for i, (w, amp, unit, h, dist, sat, h_ac) in enumerate(rows):
+        gain_in, phase_in = omct.check_bounds(bounds, w, abs(h), phase[i])
+        out.append(
+            OmctPoint(
+                washout=washout,
+                test=test.name,
+                input=test.input_axis,
+                output=test.output_axis,
+                frequency_radps=w,
+                amplitude=amp,
+                amplitude_unit=unit,
+                gain=abs(h),
+                phase_deg=phase[i],
+                linear=omct.is_linear(dist, sat),
+                distortion=dist,
+                saturated=sat,
+                gain_inside=gain_in,
+                phase_inside=phase_in,
+                perceived_gain=abs(v[i] * h),
+                perceived_phase_deg=p_phase[i],
+                aircraft_perceived_gain=abs(v[i] * h_ac),
+                aircraft_perceived_phase_deg=a_phase[i],
+            )
+        )
+    return out
+
+
+# ---------------------------------------------------------------- files
+
+
+def _flag(x: bool | None) -> str:
+    return "" if x is None else ("true" if x else "false")
+
+
+def csv_text(points: Sequence[OmctPoint]) -> str:
+    """omct.csv: one row per point, numbers in full precision (repr), NaN/None as empty fields."""
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(CSV_COLUMNS)
+    for p in points:
+        w.writerow(
+            [
+                p.washout, p.test, p.input, p.output, csv_number(p.frequency_radps), csv_number(p.amplitude),
+                p.amplitude_unit, csv_number(p.gain), csv_number(p.phase_deg), _flag(p.linear),
+                csv_number(p.distortion), ";".join(p.saturated), _flag(p.gain_inside), _flag(p.phase_inside),
+                csv_number(p.perceived_gain), csv_number(p.perceived_phase_deg),
+                csv_number(p.aircraft_perceived_gain), csv_number(p.aircraft_perceived_phase_deg),
+            ]
+        )  # fmt: skip
+    return buf.getvalue()
+
+
+def load_boundaries(path: str | Path) -> BoundaryFile:
+    """Read and check a boundary file; WashbenchError ``file:line: field: problem`` on bad input."""
+    return load_yaml_model(Path(path), BoundaryFile)
+
+
+def run_omct(
+    out_dir: Path,
+    washouts: Sequence[str] | None = None,
+    params_path: Path | None = None,
+    platform_path: Path | None = None,
+    boundaries_path: Path | None = None,
+    rate_hz: float = 120.0,
+    amplitude_scale: float = 1.0,
+    plots: bool = True,
+    variants: Sequence[str] = (),
+) -> list[OmctPoint]:
+    """The ``washbench omct`` command: the washouts of ``--washout``, ``--variant`` and ``--params``.
+
+    (:func:`washbench.cueing.variants.select_washouts`: by default the three built-in washouts.) Writes
+    ``omct.csv``, ``bode_<test>.png`` (with ``plots``) and ``report.md`` into ``out_dir``; bad input raises
+    WashbenchError before anything is written.
+    """
+    from washbench.cueing.variants import select_washouts
+    from washbench.platform import load_platform_limits
+
+    entries = select_washouts(washouts, variants, params_path)
+    limits = load_platform_limits(platform_path)
+    boundary = load_boundaries(boundaries_path) if boundaries_path is not None else None
+    return run_entries(
+        out_dir, entries, limits, boundary, rate_hz=rate_hz, amplitude_scale=amplitude_scale, plots=plots
+    )
+
+
+def run_entries(
+    out_dir: Path,
+    entries: Sequence[Washout],
+    limits: PlatformLimits,
+    boundary: BoundaryFile | None,
+    rate_hz: float = 120.0,
+    amplitude_scale: float = 1.0,
+    plots: bool = True,
+) -> list[OmctPoint]:
+    """Measure ``entries`` and write the results (the part of :func:`run_omct` a variant list can call)."""
+    out_dir = Path(out_dir)
+    if out_dir.exists() and not out_dir.is_dir():
+        raise WashbenchError(located(out_dir, "output path exists and is not a folder"))
+    bounds = boundary.bounds() if boundary else None
+    points, settings = measure(entries, limits, rate_hz=rate_hz, boundaries=bounds, amplitude_scale=amplitude_scale)
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+        files: dict[str, str] = {}
+        if plots:
+            from washbench.review.bode import write_bode_plots
+
+            files = write_bode_plots(out_dir, points, boundary.bounds() if boundary else {}, [e.name for e in entries])
+        write_text_atomic(out_dir / CSV_FILE, csv_text(points))
+        write_text_atomic(out_dir / REPORT_FILE, report_text(points, settings, entries, boundary, files))
+    except OSError as exc:
+        raise WashbenchError(located(out_dir, f"cannot write results: {exc.strerror or exc}")) from None
+    n_bad = sum(1 for p in points if not p.linear)
+    print(
+        f"OMCT: {len(entries)} washout{'s' if len(entries) != 1 else ''} x {len({p.test for p in points})} tests x "
+        f"{len({p.frequency_radps for p in points})} frequencies at {settings.rate_hz:g} Hz; "
+        f"{n_bad} non-linear points"
+    )
+    if boundary is not None:
+        n_out = sum(1 for p in points if p.gain_inside is False or p.phase_inside is False)
+        print(f"  boundaries {boundary.name}: {n_out} points outside")
+    print(f"wrote {out_dir / CSV_FILE}, {out_dir / REPORT_FILE}" + (f" and {len(files)} Bode plots" if files else ""))
+    return points
+
+
+def signal_command(
+    kind: str,
+    axis: str,
+    amplitude: float,
+    frequency_hz: float | None,
+    duration_s: float,
+    rate_hz: float,
+    start_s: float,
+    out: Path,
+) -> int:
+    """The ``washbench signal`` command: generate a test signal and write it as a ``washbench cue`` input."""
+    from washbench.analysis.signals import SignalSpec, amplitude_unit
+    from washbench.io.motion_file import write_motion
+
+    spec = SignalSpec(kind, axis, amplitude, frequency_hz, duration_s, rate_hz, start_s)
+    sig = generate(spec)
+    write_motion(out, sig.t_s, sig.f_mps2, sig.omega_radps)
+    freq = "" if frequency_hz is None or kind == "step" else f" at {frequency_hz:g} Hz"
+    print(
+        f"wrote {out}: {kind} on {axis}, amplitude {amplitude:g} {amplitude_unit(axis)}{freq}, "
+        f"{sig.t_s.shape[0]} samples at {rate_hz:g} Hz"
+    )
+    return 0
