@@ -162,3 +162,38 @@ def test_cli_without_display_serves_the_web_viewer_until_interrupted(recording):
         if proc.poll() is None:
             proc.kill()
             proc.wait(10)
+
+
+@pytest.mark.parametrize(("sig", "status"), [(signal.SIGTERM, 143), (signal.SIGKILL, -9)])
+def test_the_web_viewer_stops_with_washbench_however_it_is_stopped(recording, sig, status):
+    """SIGTERM (and on Linux even SIGKILL) of ``washbench replay`` takes the viewer it started down with it."""
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "washbench", "replay", "--web", str(recording)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
+    try:
+        line = proc.stdout.readline()  # the address, once the viewer serves
+        found = re.search(r"at (http://127\.0\.0\.1:\d+)", line)
+        assert found, line + proc.stderr.read()
+        url = found.group(1)
+        proc.send_signal(sig)
+        assert proc.wait(timeout=30) == status
+        if sig == signal.SIGTERM:
+            assert proc.stderr.read().strip() == "washbench: terminated"
+        deadline = time.monotonic() + 15
+        while time.monotonic() < deadline:
+            try:
+                http_get(url + "/")
+            except (urllib.error.URLError, ConnectionError):
+                break
+            time.sleep(0.2)
+        else:
+            pytest.fail("the viewer still serves after washbench ended")
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait(10)

@@ -8,11 +8,13 @@ printed here as one line (no traceback) with exit status 2.
 from __future__ import annotations
 
 import argparse
+import os
+import signal
 import sys
 from pathlib import Path
 
 from washbench.cueing.params import WASHOUT_KINDS
-from washbench.errors import WashbenchError
+from washbench.errors import Terminated, WashbenchError
 
 _VARIANT_HELP = "add a washout NAME of KIND with dotted-key overrides of the parameter file, repeatable"
 
@@ -41,7 +43,7 @@ def _study_options(p: argparse.ArgumentParser) -> None:
         metavar="RESULTS_DIR",
         help="read RESULTS_DIR/<aircraft>/<manoeuvre>/flight.parquet instead of flying",
     )
-    p.add_argument("--jobs", type=int, help="parallel processes for the flights (default: number of cores)")
+    p.add_argument("--jobs", type=_jobs, help="parallel processes for the flights (default: number of cores)")
     p.add_argument("--dask", metavar="ADDRESS", help="send the work to this Dask scheduler (washbench[cluster])")
     p.add_argument("--quiet", action="store_true", help="no progress display")
     _aircraft_dir_option(p)
@@ -52,6 +54,17 @@ class _Parser(argparse.ArgumentParser):
 
     def error(self, message: str) -> None:  # type: ignore[override]
         self.exit(2, f"{self.prog}: error: {message}\n")
+
+
+def _jobs(text: str) -> int:
+    """``--jobs``: a whole number of at least 1 (argparse reports anything else as a usage error)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"invalid int value: {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected at least 1 process, got {value}")
+    return value
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -112,7 +125,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--max-time-s", type=float, metavar="S", help="JSBSim scripts: stop each after S s simulated")
     p.add_argument("--out", type=Path, required=True, help="results folder")
     _aircraft_dir_option(p)
-    p.add_argument("--jobs", type=int, help="parallel processes (default: number of cores)")
+    p.add_argument("--jobs", type=_jobs, help="parallel processes (default: number of cores)")
     _washout_options(p)
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
@@ -396,17 +409,50 @@ def _study(args: argparse.Namespace) -> int:
     )
 
 
-def main(argv: list[str] | None = None) -> int:
-    """Entry point of the ``washbench`` console script; returns the exit status."""
-    args = build_parser().parse_args(argv)
+def _terminate(signum: int, frame: object) -> None:
+    raise Terminated()
+
+
+def _quiet_broken_pipe() -> int:
+    """Standard output was closed early (``washbench validate ... | head -1``): exit quietly, like a Unix tool."""
     try:
-        return _dispatch(args)
-    except WashbenchError as exc:
-        print(f"washbench: error: {exc}", file=sys.stderr)
-        return 2
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())  # the interpreter's last flush must not fail again
+    except (OSError, ValueError):
+        pass
+    return 141  # 128 + SIGPIPE, what a shell reports for a tool stopped by a closed pipe
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``washbench`` console script; returns the exit status.
+
+    SIGINT and SIGTERM stop the command at once: cleanup code runs (half-built results are removed, worker
+    processes and viewers stopped), one line is printed and the status is 130 or 143.
+    """
+    args = build_parser().parse_args(argv)
+    signal.signal(signal.SIGTERM, _terminate)
+    try:
+        try:
+            status = _dispatch(args)
+            sys.stdout.flush()
+            return status
+        except WashbenchError as exc:
+            print(f"washbench: error: {exc}", file=sys.stderr)
+            return 2
+        except BrokenPipeError:
+            return _quiet_broken_pipe()
+        except OSError as exc:  # the environment (disk full, permissions) where no file-specific message was made
+            where = f"{exc.filename}: " if exc.filename else ""
+            print(f"washbench: error: {where}{exc.strerror or exc}", file=sys.stderr)
+            return 2
     except KeyboardInterrupt:
         print("washbench: interrupted", file=sys.stderr)
         return 130
+    except Terminated:
+        print("washbench: terminated", file=sys.stderr)
+        return 143
+    finally:
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
 if __name__ == "__main__":

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 
 
@@ -11,6 +12,22 @@ class WashbenchError(Exception):
     The message must name the file (and where known the line and the field) and the
     problem, e.g. ``manoeuvres/c172/turn.yaml:14: phases[2].hold.bank_deg: expected a
     number, got 'thirty'``. The CLI prints it after ``washbench: error:`` and exits 2.
+
+    A file with several problems gives one error holding all of them: :attr:`problems`
+    (one line each, the first is the message); ``str()`` stays one line and says how many
+    more there are (``washbench validate`` prints every one).
+    """
+
+    def __init__(self, message: str, more: Sequence[str] = ()) -> None:
+        self.problems: tuple[str, ...] = (message, *more)
+        text = message if not more else f"{message} (and {len(more)} more problem{'s' if len(more) > 1 else ''})"
+        super().__init__(text)
+
+
+class Terminated(BaseException):
+    """SIGTERM arrived: raised in the main thread by the CLI's handler so cleanup code runs (exit 143).
+
+    A BaseException like :class:`KeyboardInterrupt`, so ``except Exception`` does not swallow it.
     """
 
 

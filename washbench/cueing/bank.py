@@ -77,6 +77,7 @@ from washbench.cueing.kernel import (
 from washbench.cueing.params import WashoutParams
 from washbench.cueing.variants import Washout, as_washouts
 from washbench.errors import WashbenchError
+from washbench.io.results import DT_RANGE_S
 from washbench.platform.limits import PlatformLimits, wheel_jacobian
 
 _KINDS = {"small-angle": KIND_SMALL, "large-angle": KIND_LARGE, "unrestricted": KIND_UNRESTRICTED}
@@ -84,8 +85,9 @@ _KINDS = {"small-angle": KIND_SMALL, "large-angle": KIND_LARGE, "unrestricted": 
 
 def _check_dt(dt_s: float) -> float:
     dt = float(dt_s)
-    if not (math.isfinite(dt) and dt > 0.0):
-        raise WashbenchError(f"time step must be a positive number of seconds, got {dt_s!r}")
+    lo, hi = DT_RANGE_S
+    if not (math.isfinite(dt) and lo <= dt <= hi):
+        raise WashbenchError(f"time step must be a positive number of seconds, {lo:g}..{hi:g} s, got {dt_s!r}")
     return dt
 
 
@@ -341,7 +343,9 @@ def cue_trace(
 
     ``washouts``: built-in names (with ``params``) or :class:`Washout` variants. Uses the same compiled step as
     :class:`CueingBank` and gives identical results. Raises WashbenchError for wrong shapes or non-finite samples
-    (naming the first bad sample).
+    (naming the first bad sample) and for a step outside ``washbench.io.results.DT_RANGE_S``. Magnitudes are not
+    limited here (the platform stays within its limits whatever the input); the readers refuse physically
+    absurd recordings at the file edge.
     ``filter_start``: see :data:`FILTER_STARTS`.
     """
     specs = as_washouts(washouts, params)

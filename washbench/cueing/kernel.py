@@ -265,7 +265,8 @@ def step_one(f, om, c, coef, state, counts, row):
         )
         state[S_P + j] = p
         state[S_V + j] = v
-        row[O_ACC + j] = (v - v_prev) / dt
+        # the acceleration the stage made, within its limit exactly (the difference quotient rounds)
+        row[O_ACC + j] = min(max((v - v_prev) / dt, -c[C_AMAX + j]), c[C_AMAX + j])
         sat_pos |= s_p
         sat_vel |= s_v
         sat_acc |= s_a

@@ -41,9 +41,14 @@ def check_washouts(washouts: Sequence[str]) -> tuple[str, ...]:
     return names
 
 
-Positive = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
-NonNegative = Annotated[float, Field(ge=0.0, allow_inf_nan=False)]
-Finite = Annotated[float, Field(allow_inf_nan=False)]
+# Accepted ranges (a finite but absurd number, e.g. a scale of 1e300, would make the platform model meaningless
+# or slow): break frequencies up to 1000 rad/s, scale factors up to 10, gravity 1..100 m/s^2, rates in deg/s.
+Positive = Annotated[float, Field(gt=0.0, le=1e3, allow_inf_nan=False)]
+NonNegative = Annotated[float, Field(ge=0.0, le=1e3, allow_inf_nan=False)]
+Finite = Annotated[float, Field(ge=-10.0, le=10.0, allow_inf_nan=False)]  # head offset, m
+ScaleFactor = Annotated[float, Field(gt=0.0, le=10.0, allow_inf_nan=False)]
+Gravity = Annotated[float, Field(ge=1.0, le=100.0, allow_inf_nan=False)]
+RATE_LIMIT_MAX_DEGPS = 3600.0
 
 
 def _positive_or_off(value: Any) -> float | None:
@@ -52,11 +57,13 @@ def _positive_or_off(value: Any) -> float | None:
         return None
     if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value) or value <= 0.0:
         raise ValueError(f"expected a positive number or off, got {value!r}")
+    if value > RATE_LIMIT_MAX_DEGPS:
+        raise ValueError(f"expected at most {RATE_LIMIT_MAX_DEGPS:g} deg/s or off, got {value!r}")
     return float(value)
 
 
 PositiveOrOff = Annotated[float | None, BeforeValidator(_positive_or_off)]
-"""A limit that can be switched off: ``off`` in YAML (None here)."""
+"""A rate limit (deg/s, at most RATE_LIMIT_MAX_DEGPS) that can be switched off: ``off`` in YAML (None here)."""
 
 
 class TranslationalAxes(StrictModel):
@@ -83,8 +90,8 @@ class RotationalAxes(StrictModel):
 class Scale(StrictModel):
     """Scale factors applied to the aircraft motion before the washout (dimensionless)."""
 
-    specific_force: Positive
-    angular_velocity: Positive
+    specific_force: ScaleFactor
+    angular_velocity: ScaleFactor
 
 
 class Tilt(StrictModel):
@@ -107,7 +114,7 @@ class Rotational(StrictModel):
 class Head(StrictModel):
     """Simulator pilot-head motion (paper Eqs. 7-10, 18-19)."""
 
-    derivative_wn_radps: Positive
+    derivative_wn_radps: Annotated[float, Field(gt=0.0, le=1e4, allow_inf_nan=False)]
     offset_m: tuple[Finite, Finite, Finite]
     rate_method: Literal["auto", "euler_estimator", "quaternion_difference"] = "auto"
 
@@ -122,14 +129,14 @@ class WashoutParams(StrictModel):
     """A complete washout parameter set (e.g. CW1), shared by the three washouts."""
 
     name: str
-    gravity_mps2: Positive
+    gravity_mps2: Gravity
     scale: Scale
     translational_highpass_wn_radps: TranslationalAxes
     tilt: Tilt
     rotational: Rotational
     head: Head
     small_angle: SmallAngle
-    free_fall_threshold_mps2: Positive
+    free_fall_threshold_mps2: Annotated[float, Field(gt=0.0, le=100.0, allow_inf_nan=False)]
 
 
 def load_washout_params(path: Path | None = None) -> WashoutParams:

@@ -41,11 +41,20 @@ def norm3(a: Vec3) -> float:
 
 @njit(cache=True, inline="always")
 def limit_norm(v: Vec3, vmax: float) -> tuple[Vec3, int]:
-    """``v`` scaled down to norm ``vmax`` if longer (direction kept); returns (v, 1 if limited else 0)."""
+    """``v`` scaled down to norm ``vmax`` if longer (direction kept); returns (v, 1 if limited else 0).
+
+    ``norm3`` of the result is ``<= vmax`` exactly (the scale is nudged down by ulps where rounding lands above).
+    """
     n = norm3(v)
     if n > vmax:
         s = vmax / n
-        return (v[0] * s, v[1] * s, v[2] * s), 1
+        out = (v[0] * s, v[1] * s, v[2] * s)
+        for _ in range(8):
+            if norm3(out) <= vmax:
+                break
+            s *= 1.0 - 2.0**-52
+            out = (v[0] * s, v[1] * s, v[2] * s)
+        return out, 1
     return v, 0
 
 

@@ -23,7 +23,6 @@ path and part of file names. It must not be a built-in washout's name or ``aircr
 from __future__ import annotations
 
 import json
-import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -34,9 +33,9 @@ from pydantic import BaseModel
 
 from washbench.cueing.params import DEFAULT_PARAMS_PATH, WASHOUT_KINDS, WashoutParams, check_washouts
 from washbench.errors import WashbenchError, located
+from washbench.io.names import identifier_problem
 from washbench.io.yamlio import Loc, line_of, read_yaml, validate_data
 
-NAME_PATTERN = re.compile(r"[A-Za-z0-9_-]+")
 RESERVED_NAMES = frozenset({"aircraft", "limit", "t_s"})
 
 
@@ -74,8 +73,9 @@ def parse_value(text: str) -> Any:
 
 def check_name(name: str, where: str = "--variant") -> str:
     """A variant name, checked: a plain identifier, not a built-in washout's name, not reserved."""
-    if not NAME_PATTERN.fullmatch(name):
-        raise WashbenchError(f"{where}: variant name {name!r} must be letters, digits, '_' or '-' only")
+    problem = identifier_problem(name)
+    if problem is not None:
+        raise WashbenchError(f"{where}: variant name: {problem}")
     if name in WASHOUT_KINDS or name in RESERVED_NAMES:
         raise WashbenchError(f"{where}: variant name {name!r} is reserved (a built-in washout or output name)")
     return name

@@ -73,7 +73,7 @@ def make_fdm(m: Manoeuvre, profile: PilotProfile) -> tuple[Any, Setup]:
     fdm.set_aircraft_path(str(root))
     with quiet_stdout():
         if not fdm.load_model(m.aircraft):
-            raise WashbenchError(f"{root / m.aircraft}: JSBSim could not load the model")
+            raise WashbenchError(m.located(("aircraft",), f"JSBSim could not load the model {root / m.aircraft}"))
     fdm.set_dt(m.dt_s)
 
     rw = m.runway
@@ -142,8 +142,11 @@ def make_fdm(m: Manoeuvre, profile: PilotProfile) -> tuple[Any, Setup]:
                     fdm.do_trim(1)
             except RuntimeError as exc:
                 raise WashbenchError(
-                    f"{m.aircraft}: JSBSim could not trim straight flight at {air.airspeed_kts:g} kt, "
-                    f"{air.altitude_ft:g} ft, flaps {air.flaps_deg:g} deg ({exc})"
+                    m.located(
+                        ("start", "air"),
+                        f"{m.aircraft}: JSBSim could not trim straight flight at {air.airspeed_kts:g} kt, "
+                        f"{air.altitude_ft:g} ft, flaps {air.flaps_deg:g} deg ({exc})",
+                    )
                 ) from None
         if wind_n or wind_e:
             crab = air.heading_deg is None  # on a runway's extended centreline: crab to track it
@@ -165,8 +168,8 @@ def make_fdm(m: Manoeuvre, profile: PilotProfile) -> tuple[Any, Setup]:
     fdm.suspend_integration()
     fdm.run()
     fdm.resume_integration()
-    if fdm["simulation/sim-time-sec"] != 0.0:
-        raise WashbenchError("JSBSim advanced time while initialising")  # guards the t = k * dt time base
+    if fdm["simulation/sim-time-sec"] != 0.0:  # guards the t = k * dt time base
+        raise WashbenchError(m.located(("start",), "JSBSim advanced time while initialising"))
     return fdm, Setup(frame, threshold, rw_heading, elevation)
 
 
@@ -234,9 +237,12 @@ def _flying_start(fdm: Any, m: Manoeuvre, profile: PilotProfile, heading_deg: fl
     off = (abs(vc - air.airspeed_kts), abs(hdot - vs_fpm / 60.0), max(abs(p), abs(q), abs(r)))
     if off[0] > SETTLED_KTS or off[1] > SETTLED_FPS or off[2] > SETTLED_RADPS:
         raise WashbenchError(
-            f"{m.aircraft}: the flying start did not settle at {air.airspeed_kts:g} kt, {air.altitude_ft:g} ft, "
-            f"flight path {air.flight_path_deg:g} deg in {profile.start.settle_s:g} s (airspeed off by "
-            f"{off[0]:.1f} kt, climb rate by {off[1]:.1f} ft/s, body rates up to {off[2]:.3f} rad/s)"
+            m.located(
+                ("start", "air"),
+                f"{m.aircraft}: the flying start did not settle at {air.airspeed_kts:g} kt, {air.altitude_ft:g} ft, "
+                f"flight path {air.flight_path_deg:g} deg in {profile.start.settle_s:g} s (airspeed off by "
+                f"{off[0]:.1f} kt, climb rate by {off[1]:.1f} ft/s, body rates up to {off[2]:.3f} rad/s)",
+            )
         )
     u, v, w = fdm["velocities/u-fps"], fdm["velocities/v-fps"], fdm["velocities/w-fps"]
     fdm["ic/h-sl-ft"] = air.altitude_ft

@@ -474,15 +474,21 @@ def write_flight(
 
 
 def fly_command(manoeuvre_path: Path, out_dir: Path, progress: bool = True, aircraft_dirs: Sequence[Path] = ()) -> int:
-    """``washbench fly FILE --out DIR``: 0 if flown with every check passing, else 1."""
+    """``washbench fly FILE --out DIR``: 0 if flown with every check passing, else 1.
+
+    The output folder is checked (and locked) before flying, so a bad ``--out`` costs no flight.
+    """
+    from washbench.io.lock import output_lock
+
     m = load_manoeuvre(manoeuvre_path, aircraft_dirs)
-    wall = time.monotonic()
-    result = fly(m, progress=progress)
-    wall = time.monotonic() - wall
-    prov = build_provenance(
-        manoeuvre_path=manoeuvre_path, turbulence=m.environment.turbulence, aircraft_files=m.aircraft_files
-    )
-    write_flight(out_dir, result, str(manoeuvre_path), prov)
+    with output_lock(out_dir):
+        wall = time.monotonic()
+        result = fly(m, progress=progress)
+        wall = time.monotonic() - wall
+        prov = build_provenance(
+            manoeuvre_path=manoeuvre_path, turbulence=m.environment.turbulence, aircraft_files=m.aircraft_files
+        )
+        write_flight(out_dir, result, str(manoeuvre_path), prov)
     passed = sum(1 for c in result.checks if c[3])
     line = (
         f"{m.name} ({m.aircraft}): {result.status}, {passed}/{len(m.checks)} checks passed, "

@@ -19,22 +19,40 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Annotated, Any, Literal, get_args
 
-from pydantic import Field, PrivateAttr, field_validator
+from pydantic import Field, PrivateAttr, ValidationInfo, field_validator, model_validator
 
 from washbench.errors import WashbenchError, located
 from washbench.flight.columns import COLUMN_NAMES, RUNWAY_COLUMNS
 from washbench.flight.profile import PilotProfile, load_profile
 from washbench.io.atomic import write_text_atomic
+from washbench.io.names import Identifier
 from washbench.io.paths import AircraftFiles, find_aircraft, find_aircraft_files, find_profile, jsbsim_root
+from washbench.io.publish import prepare_output_file
 from washbench.io.yamlio import Loc, StrictModel, format_field_path, line_of, read_yaml, validate_data
 
 Positive = Annotated[float, Field(gt=0)]
 NonNegative = Annotated[float, Field(ge=0)]
 Fraction = Annotated[float, Field(ge=0, le=1)]
-Heading = Annotated[float, Field(ge=0, lt=360)]
+Heading = Annotated[float, Field(ge=0, le=360)]  # true, deg; 360 is north, as a pilot says it
 Latitude = Annotated[float, Field(ge=-89, le=89)]
 Longitude = Annotated[float, Field(ge=-180, le=180)]
 FiniteFloat = Annotated[float, Field(allow_inf_nan=False)]
+# Ranges that keep every number physical (a finite but absurd number must not reach the flight model).
+Altitude = Annotated[float, Field(ge=-1500, le=60000)]  # ft MSL: the Dead Sea shore to above any piston aircraft
+Height = Annotated[float, Field(ge=-1000, le=60000)]  # ft above the ground
+Angle = Annotated[float, Field(ge=-90, le=90)]  # pitch or angle of attack, deg
+Airspeed = Annotated[float, Field(ge=0, le=1000)]  # kt
+Rotation = Annotated[float, Field(gt=0, le=36000)]  # deg turned or rotated in one phase (100 turns)
+
+#: The longest manoeuvre accepted: the sum over its phases of ``duration_s`` (or ``timeout_s`` where a phase
+#: has no duration) may not exceed it, and neither may that time in flight-model steps.
+MAX_MANOEUVRE_S = 3600.0
+MAX_MANOEUVRE_STEPS = 432_000  # one hour at the default 120 Hz
+PhaseTime = Annotated[float, Field(gt=0, le=MAX_MANOEUVRE_S)]
+#: Lowest air start above the ground (ft): lower, there is no room to trim or recover.
+AIR_START_MIN_AGL_FT = 100.0
+#: Highest air start when the pilot profile gives no ``limits.ceiling_ft``.
+DEFAULT_CEILING_FT = 50000.0
 
 
 class Runway(StrictModel):
@@ -48,13 +66,13 @@ class Runway(StrictModel):
     """Longitude of the threshold centre, deg."""
     heading_deg: Heading
     """True heading of the landing / takeoff direction, deg."""
-    elevation_ft: float = 0.0
+    elevation_ft: Annotated[float, Field(ge=-1500, le=15000)] = 0.0
     """Elevation of the runway above mean sea level, ft."""
-    length_ft: Positive
+    length_ft: Annotated[float, Field(gt=0, le=50000)]
     """Length of the runway, ft."""
-    width_ft: Positive
+    width_ft: Annotated[float, Field(gt=0, le=1000)]
     """Width of the runway, ft."""
-    aim_point_ft: NonNegative = 1000.0
+    aim_point_ft: Annotated[float, Field(ge=0, le=50000)] = 1000.0
     """Where the glide path meets the runway, ft past the threshold."""
 
 
@@ -65,9 +83,9 @@ class AirStart(StrictModel):
     the heading defaults to the runway's and the aircraft starts crabbed into the wind).
     """
 
-    altitude_ft: float
+    altitude_ft: Altitude
     """Altitude above mean sea level at the start, ft."""
-    airspeed_kts: Positive
+    airspeed_kts: Annotated[float, Field(gt=0, le=1000)]
     """Calibrated airspeed at the start, kt."""
     heading_deg: Heading | None = None
     """True heading at the start, deg (default: the runway heading)."""
@@ -75,18 +93,18 @@ class AirStart(StrictModel):
     """Geodetic latitude of the start, deg (with longitude_deg)."""
     longitude_deg: Longitude | None = None
     """Longitude of the start, deg (with latitude_deg)."""
-    before_threshold_ft: float | None = None
+    before_threshold_ft: Annotated[float, Field(ge=-50000, le=200000)] | None = None
     """Start on the runway's extended centreline, this far before the threshold, ft."""
     flight_path_deg: Annotated[float, Field(ge=-10, le=10)] = 0.0
     """Trimmed flight-path angle, deg: climb (+) or descent (-)."""
-    flaps_deg: NonNegative = 0.0
+    flaps_deg: Annotated[float, Field(ge=0, le=90)] = 0.0
     """Flap angle at the start, deg."""
 
 
 class RunwayStart(StrictModel):
     """Start at rest on the runway centreline, engine running, brakes set."""
 
-    past_threshold_ft: NonNegative = 0.0
+    past_threshold_ft: Annotated[float, Field(ge=0, le=50000)] = 0.0
     """Where on the centreline the aircraft stands, ft past the threshold."""
 
 
@@ -104,7 +122,7 @@ class Wind(StrictModel):
 
     from_deg: Heading
     """True direction the wind blows FROM, deg (270: a westerly)."""
-    speed_kts: NonNegative
+    speed_kts: Annotated[float, Field(ge=0, le=150)]
     """Wind speed, kt."""
 
 
@@ -168,9 +186,9 @@ class Hold(StrictModel):
     """With centreline: align the nose with the runway and bank into the wind (crosswind landing)."""
     pitch_deg: Annotated[float, Field(ge=-45, le=45)] | None = None
     """Pitch target: hold this pitch attitude, deg."""
-    altitude_ft: float | None = None
+    altitude_ft: Altitude | None = None
     """Pitch target: climb or descend to and hold this altitude above mean sea level, ft."""
-    vertical_speed_fpm: float | None = None
+    vertical_speed_fpm: Annotated[float, Field(ge=-10000, le=10000)] | None = None
     """Pitch target: hold this rate of climb, ft/min (negative: descent)."""
     glide_path_deg: Annotated[float, Field(gt=0, le=10)] | None = None
     """Pitch target: follow a glide path of this angle to the runway aim point, deg."""
@@ -180,11 +198,11 @@ class Hold(StrictModel):
     """Pitch target: pull this load factor, g (+1 in level flight)."""
     flare: bool | None = None
     """Pitch target: flare, a sink rate proportional to the height of the wheels, to touchdown."""
-    airspeed_kts: Positive | None = None
+    airspeed_kts: Annotated[float, Field(gt=0, le=1000)] | None = None
     """Calibrated airspeed to hold, kt: with the throttle, or with the elevator when throttle is fixed."""
     throttle: Fraction | None = None
     """Fixed throttle, 0..1."""
-    flaps_deg: NonNegative | None = None
+    flaps_deg: Annotated[float, Field(ge=0, le=90)] | None = None
     """Flap angle, deg."""
     brakes: Fraction | None = None
     """Wheel brakes, 0..1."""
@@ -203,37 +221,37 @@ class Until(StrictModel):
     flight fails (a phase that cannot end must not run forever).
     """
 
-    duration_s: Positive | None = None
+    duration_s: PhaseTime | None = None
     """End after this time in the phase, s."""
     event: Event | None = None
     """End at an event: liftoff, touchdown, stopped or stall (angle of attack past the profile's stall angle)."""
-    turned_deg: Positive | None = None
+    turned_deg: Rotation | None = None
     """End when the heading has changed this much since the phase began, deg."""
-    rolled_deg: Positive | None = None
+    rolled_deg: Rotation | None = None
     """End when the integral of the body roll rate p since the phase began reaches this magnitude, deg."""
-    pitched_deg: Positive | None = None
+    pitched_deg: Rotation | None = None
     """End when the integral of the body pitch rate q since the phase began reaches this magnitude, deg."""
-    airspeed_above_kts: float | None = None
+    airspeed_above_kts: Airspeed | None = None
     """End when the calibrated airspeed reaches this value or more, kt."""
-    airspeed_below_kts: float | None = None
+    airspeed_below_kts: Airspeed | None = None
     """End when the calibrated airspeed falls to this value or less, kt."""
-    altitude_above_ft: float | None = None
+    altitude_above_ft: Altitude | None = None
     """End when the altitude above mean sea level reaches this value or more, ft."""
-    altitude_below_ft: float | None = None
+    altitude_below_ft: Altitude | None = None
     """End when the altitude above mean sea level falls to this value or less, ft."""
-    agl_above_ft: float | None = None
+    agl_above_ft: Height | None = None
     """End when the height of the centre of gravity above the ground reaches this value or more, ft."""
-    agl_below_ft: float | None = None
+    agl_below_ft: Height | None = None
     """End when the height of the centre of gravity above the ground falls to this value or less, ft."""
     bank_above_deg: Annotated[float, Field(ge=0, lt=90)] | None = None
     """End when the magnitude of the bank angle reaches this value, deg."""
-    pitch_above_deg: float | None = None
+    pitch_above_deg: Angle | None = None
     """End when the pitch angle reaches this value or more, deg."""
-    pitch_below_deg: float | None = None
+    pitch_below_deg: Angle | None = None
     """End when the pitch angle falls to this value or less, deg."""
-    alpha_above_deg: float | None = None
+    alpha_above_deg: Angle | None = None
     """End when the angle of attack reaches this value or more, deg."""
-    timeout_s: Positive = 120.0
+    timeout_s: PhaseTime = 120.0
     """Not an end condition: a phase still running after this time fails the flight, s."""
 
 
@@ -383,13 +401,19 @@ class Check(StrictModel):
 
 
 class Manoeuvre(StrictModel):
-    """One manoeuvre file. ``source`` is the file it was loaded from (not a YAML key)."""
+    """One manoeuvre file, checked in full however it is built.
 
-    name: Annotated[str, Field(min_length=1)]
+    The name and the aircraft become result folders (OUT/aircraft/name/), so both are plain identifiers:
+    letters, digits, '_' and '-'. After the schema the semantic checks run (a known aircraft with a pilot
+    profile, one start, phases that can end, at most an hour of flight): from Python a ValidationError lists
+    every problem, from a file every problem is one line naming the file, the line and the field.
+    """
+
+    name: Identifier
     """Identifier of the manoeuvre (names the result folders)."""
     description: str = ""
     """Free text: what is flown and why."""
-    aircraft: Annotated[str, Field(min_length=1)]
+    aircraft: Identifier
     """JSBSim model name (the project's aircraft folder first, then JSBSim's); needs a pilot profile."""
     pilot_profile: str | None = None
     """Path of the pilot profile YAML, relative to this file (default: searched for the aircraft)."""
@@ -408,6 +432,7 @@ class Manoeuvre(StrictModel):
 
     _files: AircraftFiles | None = PrivateAttr(default=None)
     _source: Path | None = PrivateAttr(default=None)
+    _lines: dict[Loc, int] = PrivateAttr(default_factory=dict)
 
     @property
     def dt_s(self) -> float:
@@ -418,6 +443,28 @@ class Manoeuvre(StrictModel):
     def source(self) -> Path | None:
         """The file this manoeuvre was loaded from (None when built in Python)."""
         return self._source
+
+    def located(self, loc: Loc, problem: str) -> str:
+        """``FILE:LINE: FIELD: PROBLEM`` for a problem found later (e.g. in flight) with a field of this manoeuvre."""
+        field = format_field_path(loc)
+        if self._source is None:
+            return f"manoeuvre '{self.name}': {field}: {problem}"
+        return located(self._source, problem, line=line_of(self._lines, loc), field=field)
+
+    @model_validator(mode="after")
+    def _semantic_checks(self, info: ValidationInfo) -> Manoeuvre:
+        context = info.context if isinstance(info.context, dict) else {}
+        source = context.get("source")
+        where = _Where(Path(source) if source is not None else None, context.get("lines", {}))
+        _check_semantics(self, where, context.get("aircraft_dirs", ()))
+        if where.problems:
+            if source is not None:  # from a file: one located line per problem (WashbenchError passes through)
+                raise WashbenchError(where.problems[0], where.problems[1:])
+            raise ValueError("; ".join(where.problems))
+        if source is not None:
+            self._source = Path(source)
+            self._lines = context.get("lines", {})
+        return self
 
     @property
     def aircraft_files(self) -> AircraftFiles:
@@ -450,14 +497,27 @@ def pilot_profile_path(aircraft: str, manoeuvre_file: Path | None = None, aircra
 
 
 class _Where:
-    """Formats one-line errors for a file using the YAML line map."""
+    """Collects one-line problems for a file (``FILE:LINE: FIELD: PROBLEM``; ``FIELD: PROBLEM`` without a file)."""
 
-    def __init__(self, path: Path, lines: dict[Loc, int]) -> None:
+    def __init__(self, path: Path | None, lines: dict[Loc, int]) -> None:
         self.path = path
         self.lines = lines
+        self.problems: list[str] = []
 
-    def error(self, loc: Loc, problem: str) -> WashbenchError:
-        return WashbenchError(located(self.path, problem, line=line_of(self.lines, loc), field=format_field_path(loc)))
+    def add(self, loc: Loc, problem: str) -> None:
+        field = format_field_path(loc)
+        if self.path is None:
+            self.problems.append(f"{field}: {problem}")
+        else:
+            self.problems.append(located(self.path, problem, line=line_of(self.lines, loc), field=field))
+
+    def error(self, loc: Loc, problem: str) -> Exception:
+        """Add the problem and return the error to raise now, holding every problem so far (for checks that
+        cannot go on after it): WashbenchError for a file, ValueError (pydantic's ValidationError) from Python."""
+        self.add(loc, problem)
+        if self.path is None:
+            return ValueError("; ".join(self.problems))
+        return WashbenchError(self.problems[0], self.problems[1:])
 
 
 def _set_fields(model: StrictModel, names: Sequence[str]) -> list[str]:
@@ -465,81 +525,94 @@ def _set_fields(model: StrictModel, names: Sequence[str]) -> list[str]:
 
 
 def _check_semantics(m: Manoeuvre, where: _Where, aircraft_dirs: Sequence[Path] = ()) -> None:
-    """Checks a schema cannot express; raise one-line WashbenchError on the first problem."""
+    """Checks a schema cannot express; every problem is added to ``where`` (in file order)."""
     try:
         files = find_aircraft_files(m.aircraft, where.path, aircraft_dirs, m.pilot_profile)
     except WashbenchError as exc:
         field = "pilot_profile" if str(exc).startswith("pilot_profile:") else "aircraft"
-        raise where.error((field,), str(exc).removeprefix("pilot_profile: ")) from None
+        where.add((field,), str(exc).removeprefix("pilot_profile: "))
+        return
     m._files = files
     m._source = where.path
     profile = load_profile(files.profile)
 
     starts = _set_fields(m.start, ("air", "runway"))
     if len(starts) != 1:
-        raise where.error(("start",), "give exactly one of 'air' or 'runway'")
+        where.add(("start",), "give exactly one of 'air' or 'runway'")
     if m.start.runway is not None and m.runway is None:
-        raise where.error(("start", "runway"), "a runway start needs a top-level 'runway'")
+        where.add(("start", "runway"), "a runway start needs a top-level 'runway'")
     air = m.start.air
     if air is not None:
         if air.before_threshold_ft is not None and m.runway is None:
-            raise where.error(("start", "air", "before_threshold_ft"), "needs a top-level 'runway'")
+            where.add(("start", "air", "before_threshold_ft"), "needs a top-level 'runway'")
         if air.heading_deg is None and m.runway is None:
-            raise where.error(("start", "air", "heading_deg"), "missing required field (no runway to take it from)")
+            where.add(("start", "air", "heading_deg"), "missing required field (no runway to take it from)")
         if (air.latitude_deg is None) != (air.longitude_deg is None):
-            raise where.error(("start", "air", "latitude_deg"), "give both latitude_deg and longitude_deg, or neither")
+            where.add(("start", "air", "latitude_deg"), "give both latitude_deg and longitude_deg, or neither")
         if air.before_threshold_ft is not None and air.latitude_deg is not None:
-            raise where.error(("start", "air", "before_threshold_ft"), "give either lat/lon or before_threshold_ft")
+            where.add(("start", "air", "before_threshold_ft"), "give either lat/lon or before_threshold_ft")
         if not profile.speeds.stall_kts <= air.airspeed_kts <= profile.speeds.vne_kts:
-            raise where.error(
+            where.add(
                 ("start", "air", "airspeed_kts"),
                 f"{air.airspeed_kts:g} kt is outside {m.aircraft}'s flight envelope "
                 f"({profile.speeds.stall_kts:g}..{profile.speeds.vne_kts:g} kt)",
             )
         if air.flaps_deg > profile.limits.flaps_max_deg:
-            raise where.error(("start", "air", "flaps_deg"), f"more than the {profile.limits.flaps_max_deg:g} deg max")
+            where.add(("start", "air", "flaps_deg"), f"more than the {profile.limits.flaps_max_deg:g} deg max")
+        ground_ft = m.runway.elevation_ft if m.runway is not None else 0.0
+        ceiling_ft = profile.limits.ceiling_ft if profile.limits.ceiling_ft is not None else DEFAULT_CEILING_FT
+        if not ground_ft + AIR_START_MIN_AGL_FT <= air.altitude_ft <= ceiling_ft:
+            where.add(
+                ("start", "air", "altitude_ft"),
+                f"{air.altitude_ft:g} ft is outside {m.aircraft}'s air-start range "
+                f"({ground_ft + AIR_START_MIN_AGL_FT:g}..{ceiling_ft:g} ft: at least {AIR_START_MIN_AGL_FT:g} ft "
+                f"above the {'runway' if m.runway is not None else 'ground'} at {ground_ft:g} ft, at most the ceiling)",
+            )
 
     on_ground = m.start.runway is not None
     names = [p.name for p in m.phases]
     for i, phase in enumerate(m.phases):
         base: Loc = ("phases", i)
         if names.index(phase.name) != i:
-            raise where.error((*base, "name"), f"duplicate phase name '{phase.name}'")
+            where.add((*base, "name"), f"duplicate phase name '{phase.name}'")
         hold, until = phase.hold, phase.until
+        phase_problems = len(where.problems)
         lateral = _set_fields(hold, LATERAL_TARGETS)
         pitch = _set_fields(hold, PITCH_TARGETS)
         if len(lateral) > 1:
-            raise where.error((*base, "hold", lateral[1]), f"contradicts '{lateral[0]}' (one lateral target at a time)")
+            where.add((*base, "hold", lateral[1]), f"contradicts '{lateral[0]}' (one lateral target at a time)")
         if len(pitch) > 1:
-            raise where.error((*base, "hold", pitch[1]), f"contradicts '{pitch[0]}' (one pitch target at a time)")
+            where.add((*base, "hold", pitch[1]), f"contradicts '{pitch[0]}' (one pitch target at a time)")
         if hold.airspeed_kts is not None and hold.throttle is not None and pitch:
-            raise where.error(
+            where.add(
                 (*base, "hold", "airspeed_kts"),
                 f"contradicts 'throttle' and '{pitch[0]}': airspeed needs the throttle or the elevator free",
             )
         if hold.load_factor is not None and not profile.limits.nz_min <= hold.load_factor <= profile.limits.nz_max:
-            raise where.error(
+            where.add(
                 (*base, "hold", "load_factor"),
                 f"{hold.load_factor:g} g is outside {m.aircraft}'s load-factor limits "
                 f"({profile.limits.nz_min:g}..{profile.limits.nz_max:g} g)",
             )
         if hold.airspeed_kts is not None and hold.airspeed_kts > profile.speeds.vne_kts:
-            raise where.error((*base, "hold", "airspeed_kts"), f"above {m.aircraft}'s VNE")
+            where.add((*base, "hold", "airspeed_kts"), f"above {m.aircraft}'s VNE")
         if hold.flaps_deg is not None and hold.flaps_deg > profile.limits.flaps_max_deg:
-            raise where.error((*base, "hold", "flaps_deg"), f"more than the {profile.limits.flaps_max_deg:g} deg max")
+            where.add((*base, "hold", "flaps_deg"), f"more than the {profile.limits.flaps_max_deg:g} deg max")
         if hold.wing_low and not hold.centreline:
-            raise where.error((*base, "hold", "wing_low"), "needs 'centreline: true' (the track it holds)")
+            where.add((*base, "hold", "wing_low"), "needs 'centreline: true' (the track it holds)")
         if (hold.centreline or hold.glide_path_deg is not None or hold.flare) and m.runway is None:
             key = "centreline" if hold.centreline else ("flare" if hold.flare else "glide_path_deg")
-            raise where.error((*base, "hold", key), "needs a top-level 'runway'")
+            where.add((*base, "hold", key), "needs a top-level 'runway'")
         if phase.inputs is not None:
             _check_inputs(phase, (*base, "inputs"), profile, where)
         conditions = _set_fields(until, [f for f in Until.model_fields if f != "timeout_s"])
-        if not conditions:
-            raise where.error((*base, "until"), "the phase can never end: give at least one end condition")
         reasons = [_never_reason(c, until, hold, on_ground, profile, m) for c in conditions]
-        if all(r is not None for r in reasons):
-            raise where.error((*base, "until", conditions[0]), f"the phase can never end: {reasons[0]}")
+        if len(where.problems) > phase_problems:
+            pass  # whether the phase can end depends on a hold already in error: no consequential error
+        elif not conditions:
+            where.add((*base, "until"), "the phase can never end: give at least one end condition")
+        elif all(r is not None for r in reasons):
+            where.add((*base, "until", conditions[0]), f"the phase can never end: {reasons[0]}")
         if until.event == "liftoff":
             on_ground = False
         elif until.event in ("touchdown",):
@@ -547,33 +620,42 @@ def _check_semantics(m: Manoeuvre, where: _Where, aircraft_dirs: Sequence[Path] 
         elif until.agl_below_ft is not None and until.agl_below_ft <= 0 and not on_ground:
             on_ground = True
 
+    longest_s = sum(p.until.duration_s if p.until.duration_s is not None else p.until.timeout_s for p in m.phases)
+    if longest_s > MAX_MANOEUVRE_S or longest_s * m.rate_hz > MAX_MANOEUVRE_STEPS:
+        where.add(
+            ("phases",),
+            f"the manoeuvre may last {longest_s:g} s (each phase's duration_s, else its timeout_s), "
+            f"{longest_s * m.rate_hz:.0f} steps at {m.rate_hz} Hz: the longest accepted is {MAX_MANOEUVRE_S:g} s "
+            f"and {MAX_MANOEUVRE_STEPS} steps (split it into several manoeuvres, or give shorter timeouts)",
+        )
+
     for j, check in enumerate(m.checks):
         base = ("checks", j)
         if check.signal not in COLUMN_NAMES and check.signal != "sink_fps":
             close = difflib.get_close_matches(check.signal, [*COLUMN_NAMES, "sink_fps"], n=1, cutoff=0.7)
             hint = f"did you mean '{close[0]}'?" if close else "a signal is a flight.parquet column, see README.md"
-            raise where.error((*base, "signal"), f"unknown signal '{check.signal}' ({hint})")
+            where.add((*base, "signal"), f"unknown signal '{check.signal}' ({hint})")
         if check.signal == "sink_fps" and check.stat not in EVENT_STATS:
-            raise where.error((*base, "stat"), "sink_fps is measured at an event: use at_touchdown or at_liftoff")
+            where.add((*base, "stat"), "sink_fps is measured at an event: use at_touchdown or at_liftoff")
         if check.signal in RUNWAY_COLUMNS and m.runway is None:
-            raise where.error((*base, "signal"), f"'{check.signal}' needs a top-level 'runway'")
+            where.add((*base, "signal"), f"'{check.signal}' needs a top-level 'runway'")
         if check.stat == "turned" and check.signal != "psi_deg":
-            raise where.error((*base, "stat"), "'turned' applies to the heading signal psi_deg")
+            where.add((*base, "stat"), "'turned' applies to the heading signal psi_deg")
         if check.stat == "rotated" and check.signal not in RATE_SIGNALS:
-            raise where.error((*base, "stat"), f"'rotated' integrates a body rate: {', '.join(RATE_SIGNALS)}")
+            where.add((*base, "stat"), f"'rotated' integrates a body rate: {', '.join(RATE_SIGNALS)}")
         if check.min is None and check.max is None:
-            raise where.error(base, "give a 'min', a 'max' or both")
+            where.add(base, "give a 'min', a 'max' or both")
         arc = check.signal in HEADING_SIGNALS and check.stat in HEADING_VALUE_STATS  # min > max: through north
         if check.min is not None and check.max is not None and check.min > check.max and not arc:
-            raise where.error((*base, "min"), f"greater than max ({check.min:g} > {check.max:g})")
+            where.add((*base, "min"), f"greater than max ({check.min:g} > {check.max:g})")
         if arc:
             for key in ("min", "max"):
                 v = getattr(check, key)
                 if v is not None and not 0 <= v <= 360:
-                    raise where.error((*base, key), f"a heading limit is 0..360 deg, got {v:g}")
+                    where.add((*base, key), f"a heading limit is 0..360 deg, got {v:g}")
         for k, name in enumerate(check.phases or ()):
             if name not in names:
-                raise where.error((*base, "phases", k), f"no phase named '{name}'")
+                where.add((*base, "phases", k), f"no phase named '{name}'")
     _check_properties(m, where)
 
 
@@ -774,16 +856,16 @@ def _never_reason(
 
 
 def load_manoeuvre(path: str | Path, aircraft_dirs: Sequence[Path] = ()) -> Manoeuvre:
-    """Read, validate and semantically check a manoeuvre file; raise a one-line WashbenchError.
+    """Read, validate and semantically check a manoeuvre file.
 
     The aircraft and its pilot profile are found along the search path of :mod:`washbench.io.paths`
     (``aircraft_dirs`` are the ``--aircraft-dir`` folders) and kept in :attr:`Manoeuvre.aircraft_files`.
+    Raises WashbenchError holding every problem of the file (``problems``: one located line each).
     """
     path = Path(path)
     data, lines = read_yaml(path)
-    m = validate_data(path, data, lines, Manoeuvre)
-    _check_semantics(m, _Where(path, lines), aircraft_dirs)
-    return m
+    context = {"source": path, "lines": lines, "aircraft_dirs": tuple(aircraft_dirs)}
+    return validate_data(path, data, lines, Manoeuvre, context=context)
 
 
 def validate_command(paths: Sequence[Path], aircraft_dirs: Sequence[Path] = ()) -> int:
@@ -793,7 +875,8 @@ def validate_command(paths: Sequence[Path], aircraft_dirs: Sequence[Path] = ()) 
         try:
             load_manoeuvre(path, aircraft_dirs)
         except WashbenchError as exc:
-            print(f"washbench: error: {exc}", file=sys.stderr)
+            for problem in exc.problems:
+                print(f"washbench: error: {problem}", file=sys.stderr)
             bad += 1
         else:
             print(f"{path}: OK")
@@ -828,5 +911,5 @@ def schema_command(out: Path | None) -> int:
     if out is None:
         sys.stdout.write(text)
     else:
-        write_text_atomic(out, text)
+        write_text_atomic(prepare_output_file(out), text)
     return 0

@@ -37,6 +37,7 @@ class Limits(StrictModel):
     alpha_stall_deg: Positive  # the "stall" event
     flaps_max_deg: Positive
     flaps_full_cmd_deg: Positive  # flap angle that fcs/flap-cmd-norm = 1 commands
+    ceiling_ft: Positive | None = None  # highest air start accepted, ft MSL (service ceiling)
 
 
 class Geometry(StrictModel):

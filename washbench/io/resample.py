@@ -25,7 +25,7 @@ import numpy as np
 
 from washbench.errors import WashbenchError, located
 from washbench.io.readers import Samples
-from washbench.io.results import Motion
+from washbench.io.results import DT_RANGE_S, F_COLUMNS, F_MAX_MPS2, OMEGA_COLUMNS, OMEGA_MAX_DEGPS, Motion
 
 GRID_TOL = 1e-3
 """Samples may lie at most this fraction of a step off the uniform grid t_0 + k dt."""
@@ -137,8 +137,37 @@ def suggest_rate(t: np.ndarray) -> float:
     return float(f"{hz:.3g}")
 
 
+def check_magnitudes(s: Samples) -> None:
+    """Refuse samples beyond the accepted magnitudes (``F_MAX_MPS2``, ``OMEGA_MAX_DEGPS``), naming the first.
+
+    Beyond them a recording is corrupt, not a flight (and such numbers only make the platform model slow).
+    """
+    for values, names, limit, unit in (
+        (s.f_mps2, F_COLUMNS, F_MAX_MPS2, "m/s^2"),
+        (s.omega_degps, OMEGA_COLUMNS, OMEGA_MAX_DEGPS, "deg/s"),
+    ):
+        big = np.abs(values) > limit
+        if big.any():
+            i, j = (int(x) for x in np.argwhere(big)[0])
+            line, row = s.where(i)
+            problem = f"{row}{values[i, j]:.6g} is beyond the accepted range +-{limit:g} {unit}"
+            raise WashbenchError(located(s.path, problem, line=line, field=names[j]))
+
+
+def check_step(s: Samples, dt: float) -> None:
+    """Refuse a time step outside ``DT_RANGE_S`` (10 kHz to 1 Hz): the filters cannot be discretised sensibly."""
+    lo, hi = DT_RANGE_S
+    if not lo <= dt <= hi:
+        problem = f"time step {dt:.6g} s is outside the accepted {lo:g}..{hi:g} s ({1 / hi:g} Hz to {1 / lo:g} Hz)"
+        raise WashbenchError(located(s.path, problem, field=s.time_column))
+
+
 def to_motion(s: Samples) -> Motion:
-    """A :class:`Motion` of samples that lie on a uniform grid; else an error saying how far off, with advice."""
+    """A :class:`Motion` of samples that lie on a uniform grid; else an error saying how far off, with advice.
+
+    Magnitudes and the step must lie in the accepted ranges (:func:`check_magnitudes`, :func:`check_step`).
+    """
+    check_magnitudes(s)
     dt, worst, i = uniform_step(s.t_s)
     if dt is None:
         steps = np.diff(s.t_s)
@@ -150,6 +179,7 @@ def to_motion(s: Samples) -> Motion:
             f"{np.median(steps):.6g} s), samples up to {worst:.3g} of a step off a uniform grid (at most "
             f"{GRID_TOL:g} allowed); resample with --resample {hz:g}",
         )
+    check_step(s, dt)
     w = s.omega_degps
     return Motion(t_s=s.t_s, dt_s=dt, f_mps2=s.f_mps2, omega_radps=np.radians(w), extra=s.extra, omega_degps=w)
 
@@ -167,8 +197,10 @@ def antialias(x: np.ndarray, rate_hz: float, fs_hz: float) -> np.ndarray:
 
 def resample(s: Samples, rate_hz: float) -> tuple[Motion, str]:
     """``s`` onto the uniform grid ``t_0 + k / rate_hz`` (see the module notes); returns the motion and a note."""
-    if not (math.isfinite(rate_hz) and rate_hz > 0.0):
-        raise WashbenchError(f"--resample: expected a rate in Hz above 0, got {rate_hz!r}")
+    if not (math.isfinite(rate_hz) and rate_hz > 0.0 and DT_RANGE_S[0] <= 1.0 / rate_hz <= DT_RANGE_S[1]):
+        lo, hi = (1.0 / DT_RANGE_S[1], 1.0 / DT_RANGE_S[0])
+        raise WashbenchError(f"--resample: expected a rate of {lo:g}..{hi:g} Hz, got {rate_hz!r}")
+    check_magnitudes(s)
     t = s.t_s
     dt = 1.0 / rate_hz
     n = math.floor((t[-1] - t[0]) * rate_hz + 1e-9) + 1

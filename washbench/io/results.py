@@ -56,6 +56,17 @@ AIRCRAFT = "aircraft"
 
 METRICS_COLUMNS = ("washout", "dof", "npc", "integral_error", "max_error")
 
+#: Time steps an input motion may have, s: beyond, the filters cannot be discretised (a subnormal step, or one of
+#: 8e307 s, overflows them). Wide on purpose: a time column in ms or ns read as seconds still passes, and the
+#: plausibility warnings (:mod:`washbench.io.plausibility`) say so.
+DT_RANGE_S = (1e-6, 1e7)
+#: Largest magnitudes accepted in the motion columns (10,000 g and 100,000 deg/s): no sensor records more, and
+#: such numbers only make the platform model meaningless. Crashes and spikes well below are reported by the
+#: plausibility checks.
+F_MAX_MPS2 = 1e5
+OMEGA_MAX_DEGPS = 1e5
+MOTION_MAX = {**dict.fromkeys(F_COLUMNS, F_MAX_MPS2), **dict.fromkeys(OMEGA_COLUMNS, OMEGA_MAX_DEGPS)}
+
 
 # --------------------------------------------------------------------------- column names
 

@@ -17,8 +17,11 @@ from __future__ import annotations
 
 import difflib
 import json
+import math
+import re
+from collections.abc import Mapping
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import Any, Self, TypeVar
 
 import pydantic
 import yaml
@@ -32,9 +35,26 @@ Loc = tuple[str | int, ...]
 
 
 class StrictModel(BaseModel):
-    """Base for models read from YAML: unknown keys rejected, strict types, frozen."""
+    """Base for models read from YAML: unknown keys rejected, strict types, no NaN or infinity, frozen.
 
-    model_config = ConfigDict(extra="forbid", strict=True, frozen=True, use_attribute_docstrings=True)
+    No invalid instance can be built from Python either: :meth:`model_copy` with ``update`` validates
+    the result like a new instance (pydantic's own skips validation).
+    """
+
+    model_config = ConfigDict(
+        extra="forbid", strict=True, frozen=True, allow_inf_nan=False, use_attribute_docstrings=True
+    )
+
+    def model_copy(self, *, update: Mapping[str, Any] | None = None, deep: bool = False) -> Self:
+        """A copy; with ``update``, a new validated instance (raises ``pydantic.ValidationError``)."""
+        if not update:
+            return super().model_copy(deep=deep)
+        unknown = sorted(set(update) - set(type(self).model_fields))
+        if unknown:
+            raise ValueError(f"{type(self).__name__}.model_copy: unknown field(s) {', '.join(unknown)}")
+        values = {name: getattr(self, name) for name in type(self).model_fields if name in self.model_fields_set}
+        values.update(update)
+        return type(self).model_validate(values)
 
 
 class _UniqueKeyLoader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):  # type: ignore[misc]
@@ -48,10 +68,31 @@ class _PyUniqueKeyLoader(yaml.SafeLoader):
     """The pure-Python twin of :class:`_UniqueKeyLoader`: slower, but clearer syntax-error messages."""
 
 
+MERGE_TAG = "tag:yaml.org,2002:merge"
+#: Deepest nesting of mappings and lists accepted (the deepest bundled file uses 5).
+MAX_DEPTH = 50
+#: Most nodes a document may hold once its aliases are expanded (a "billion laughs" file is refused).
+MAX_NODES = 100_000
+#: Largest magnitude of an integer (beyond it, no count or seed in these files makes sense).
+MAX_INT = 2**63 - 1
+
+
 def _construct_mapping(loader: yaml.SafeLoader, node: yaml.MappingNode, deep: bool = False) -> dict[Any, Any]:
+    """A mapping whose own keys are plain (hashable) and unique; merge keys (``<<: *defaults``) are expanded.
+
+    Keys brought in by a merge may be overridden by the mapping's own keys, as YAML specifies.
+    """
     seen: dict[Any, int] = {}
     for key_node, _ in node.value:
+        if key_node.tag == MERGE_TAG:
+            continue
         key = loader.construct_object(key_node, deep=deep)
+        try:
+            hash(key)
+        except TypeError:
+            raise yaml.constructor.ConstructorError(
+                None, None, "a mapping key must be plain text, not a list or a mapping", key_node.start_mark
+            ) from None
         if key in seen:
             raise yaml.constructor.ConstructorError(
                 None, None, f"duplicate key {key!r} (first on line {seen[key] + 1})", key_node.start_mark
@@ -60,8 +101,88 @@ def _construct_mapping(loader: yaml.SafeLoader, node: yaml.MappingNode, deep: bo
     return loader.construct_mapping(node, deep=deep)
 
 
+def _construct_int(loader: yaml.SafeLoader, node: yaml.ScalarNode) -> int:
+    try:
+        value = yaml.constructor.SafeConstructor.construct_yaml_int(loader, node)
+    except ValueError:  # more digits than Python converts (sys.get_int_max_str_digits)
+        value = MAX_INT + 1
+    if abs(value) > MAX_INT:
+        raise yaml.constructor.ConstructorError(
+            None, None, f"the integer {node.value[:20]}... is too large", node.start_mark
+        )
+    return value
+
+
+#: Scientific notation as YAML 1.2 (and every other language) writes it: ``1e-3``, ``5E2``, ``-2.5e+4``.
+#: PyYAML's YAML 1.1 resolver reads these as text (it wants a dot and a signed exponent).
+_FLOAT_EXPONENT = re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9_]+)[eE][-+]?[0-9]+$")
+
 for _loader in (_UniqueKeyLoader, _PyUniqueKeyLoader):
     _loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_mapping)
+    _loader.add_constructor("tag:yaml.org,2002:int", _construct_int)
+    _loader.add_implicit_resolver("tag:yaml.org,2002:float", _FLOAT_EXPONENT, list("-+.0123456789"))
+
+
+class _LimitError(yaml.MarkedYAMLError):
+    """A document beyond MAX_DEPTH or MAX_NODES (no need to parse it again for clearer words)."""
+
+
+def _check_nesting(text: str, loader_class: type) -> None:
+    """Refuse nesting deeper than MAX_DEPTH before composing (composing recurses once per level)."""
+    depth = 0
+    for event in yaml.parse(text, Loader=loader_class):
+        if isinstance(event, yaml.CollectionStartEvent):
+            depth += 1
+            if depth > MAX_DEPTH:
+                raise _LimitError(
+                    problem=f"nested deeper than {MAX_DEPTH} levels", problem_mark=event.start_mark
+                )
+        elif isinstance(event, yaml.CollectionEndEvent):
+            depth -= 1
+
+
+def _children(node: yaml.Node) -> list[yaml.Node]:
+    if isinstance(node, yaml.MappingNode):
+        return [n for pair in node.value for n in pair]
+    if isinstance(node, yaml.SequenceNode):
+        return list(node.value)
+    return []
+
+
+def _check_expansion(root: yaml.Node) -> None:
+    """Refuse a node graph whose alias expansion is recursive, too large (MAX_NODES) or too deep (MAX_DEPTH).
+
+    Each node is visited once (sizes and depths are memoised), so a "billion laughs" document is measured
+    in microseconds without being expanded.
+    """
+    size: dict[int, int] = {}
+    depth: dict[int, int] = {}
+    entered: set[int] = set()
+    stack: list[tuple[yaml.Node, bool]] = [(root, False)]
+    while stack:
+        node, leaving = stack.pop()
+        key = id(node)
+        if leaving:
+            kids = _children(node)
+            size[key] = 1 + sum(size[id(k)] for k in kids)
+            depth[key] = 1 + max((depth[id(k)] for k in kids), default=0)
+            if size[key] > MAX_NODES:
+                raise _LimitError(
+                    problem=f"its aliases expand to more than {MAX_NODES} values", problem_mark=node.start_mark
+                )
+            if depth[key] > MAX_DEPTH:
+                raise _LimitError(
+                    problem=f"its aliases nest deeper than {MAX_DEPTH} levels", problem_mark=node.start_mark
+                )
+            continue
+        if key in size:
+            continue
+        if key in entered:
+            raise _LimitError(problem="an alias refers to a value that contains it",
+                                       problem_mark=node.start_mark)  # fmt: skip
+        entered.add(key)
+        stack.append((node, True))
+        stack.extend((k, False) for k in _children(node) if id(k) not in size)
 
 
 def _line_map(node: yaml.Node | None, loc: Loc = (), out: dict[Loc, int] | None = None) -> dict[Loc, int]:
@@ -202,10 +323,14 @@ def _unwrap_model(annotation: Any) -> type[BaseModel] | None:
 
 def _parse(text: str, loader_class: type) -> tuple[yaml.Node | None, Any]:
     """Compose the node tree (for line numbers) and construct the data from it, in one pass."""
+    _check_nesting(text, loader_class)
     loader = loader_class(text)
     try:
         node = loader.get_single_node()
-        return node, (None if node is None else loader.construct_document(node))
+        if node is None:
+            return None, None
+        _check_expansion(node)
+        return node, loader.construct_document(node)
     finally:
         loader.dispose()
 
@@ -226,6 +351,8 @@ def read_yaml(path: Path) -> tuple[Any, dict[Loc, int]]:
     try:
         try:
             node, data = _parse(text, _UniqueKeyLoader)
+        except _LimitError:
+            raise
         except yaml.MarkedYAMLError:
             node, data = _parse(text, _PyUniqueKeyLoader)  # same error, clearer words
     except yaml.MarkedYAMLError as exc:
@@ -240,20 +367,80 @@ def read_yaml(path: Path) -> tuple[Any, dict[Loc, int]]:
     return data, _line_map(node)
 
 
-def validate_data(path: Path, data: Any, lines: dict[Loc, int], model: type[M]) -> M:
-    """Validate parsed YAML ``data`` against ``model``; errors name file, line and field."""
+def _non_finite(data: Any, loc: Loc = ()) -> list[tuple[Loc, float]]:
+    """Every NaN or infinite number in ``data`` with its path (no file may hold one: a phase must end, a limit
+    must limit)."""
+    found: list[tuple[Loc, float]] = []
+    stack: list[tuple[Loc, Any]] = [(loc, data)]
+    while stack:
+        here, value = stack.pop()
+        if isinstance(value, float) and not math.isfinite(value):
+            found.append((here, value))
+        elif isinstance(value, dict):
+            stack.extend(((*here, k), v) for k, v in value.items() if isinstance(k, str | int))
+        elif isinstance(value, list):
+            stack.extend(((*here, i), v) for i, v in enumerate(value))
+    return sorted(found, key=lambda item: format_field_path(item[0]))
+
+
+def _messages(path: Path, data: Any, lines: dict[Loc, int], model: type[BaseModel],
+              errors: list[dict[str, Any]]) -> list[str]:  # fmt: skip
+    """One located line per pydantic error, in file order; a misspelt key gives "unknown key", not also "missing"."""
+    located_errors: dict[Loc, tuple[int, dict[str, Any]]] = {}
+    rank = {"extra_forbidden": 0, "missing": 2}
+    for err in errors:
+        loc = _data_loc(data, tuple(err["loc"]))
+        r = rank.get(err["type"], 1)
+        if loc not in located_errors or r < located_errors[loc][0]:
+            located_errors[loc] = (r, err)
+    unknown_parents = {loc[:-1] for loc, (_, e) in located_errors.items() if e["type"] == "extra_forbidden"}
+    out: list[tuple[int, str, str]] = []
+    for loc, (_, err) in located_errors.items():
+        if err["type"] == "missing" and loc[:-1] in unknown_parents:
+            continue
+        line = line_of(lines, loc)
+        text = located(path, _problem(err, model, loc), line=line, field=format_field_path(loc))
+        out.append((line or 0, format_field_path(loc), text))
+    return [text for _, _, text in sorted(out)]
+
+
+def raise_problems(messages: list[str]) -> None:
+    """Raise one WashbenchError holding every message (nothing if the list is empty)."""
+    if messages:
+        raise WashbenchError(messages[0], messages[1:])
+
+
+def validate_data(path: Path, data: Any, lines: dict[Loc, int], model: type[M], context: Any = None) -> M:
+    """Validate parsed YAML ``data`` against ``model``; errors name file, line and field.
+
+    Every problem of the file is collected (:attr:`WashbenchError.problems`), in file order. NaN and
+    infinite numbers are refused in every file, whatever the field. ``context`` is passed to the
+    model's validators (pydantic's validation context).
+    """
     if not isinstance(data, dict):
         raise WashbenchError(located(path, f"expected a mapping at the top level, got {_describe(data)}", line=1))
+    bad_numbers = _non_finite(data)
+    messages = [
+        located(path, f"expected a finite number, got {value!r}", line=line_of(lines, loc),
+                field=format_field_path(loc))
+        for loc, value in bad_numbers
+    ]  # fmt: skip
     try:
         payload = json.dumps(data, default=str, allow_nan=True)
-        return model.model_validate_json(payload)
+        result = model.model_validate_json(payload, context=context)
     except pydantic.ValidationError as exc:
-        # A misspelt key gives both "unknown key" and "missing field": name the unknown key.
-        rank = {"extra_forbidden": 0, "missing": 2}
-        err = min(exc.errors(include_url=False), key=lambda e: rank.get(e["type"], 1))
-        loc = _data_loc(data, tuple(err["loc"]))
-        problem = _problem(err, model, loc)
-        raise WashbenchError(located(path, problem, line=line_of(lines, loc), field=format_field_path(loc))) from None
+        bad = {loc for loc, _ in bad_numbers}
+        errors = [e for e in exc.errors(include_url=False) if _data_loc(data, tuple(e["loc"])) not in bad]
+        raise_problems(sorted(set(messages + _messages(path, data, lines, model, errors)), key=_line_key))
+        raise AssertionError("unreachable") from None  # pydantic gave errors only at the non-finite numbers
+    raise_problems(messages)
+    return result
+
+
+def _line_key(message: str) -> tuple[int, str]:
+    """Sort key for located messages: the line number after the file name (0 when there is none)."""
+    match = re.match(r"^.*?:(\d+): ", message)
+    return (int(match.group(1)) if match else 0, message)
 
 
 def load_yaml_model(path: str | Path, model: type[M]) -> M:

@@ -33,22 +33,37 @@ from washbench.cueing.rotations import limit_norm, norm3, qconj, qintegrate, qmu
 drop_stale_cache(__file__, [Path(__file__).resolve().parent.parent / "cueing" / "rotations.py"])
 
 
+#: Beyond this many braking steps (r / (a_max dt^2)) the discrete braking sum is inverted in its continuous form.
+_BRAKE_STEPS_EXACT = 2.0**50
+
+
 @njit(cache=True)
 def brake_speed(r: float, a_max: float, dt: float) -> float:
     """Largest speed (m/s or rad/s) that, taken this step, still lets the motion stop within distance r.
 
     Discrete: moving at v for one step and then braking at a_max (semi-implicit Euler) covers
     S(v) = v dt + dt sum_{i>=1} max(v - i a_max dt, 0). S is increasing and piecewise linear with knots
-    S(j a_max dt) = a_max dt^2 j (j + 1) / 2; the function inverts it exactly.
+    S(j a_max dt) = a_max dt^2 j (j + 1) / 2; the function inverts it exactly in closed form (at most two
+    corrections of the knot index, for rounding). Past 2^50 braking steps (absurd limits or time steps) the
+    continuous form v = sqrt(2 a r + (a dt / 2)^2) - a dt / 2 is used: it never loops and never overflows
+    an integer, whatever the finite or infinite inputs.
     """
-    if r <= 0.0:
+    if not r > 0.0:  # also NaN
         return 0.0
     h = a_max * dt * dt
-    j = math.floor(0.5 * (math.sqrt(1.0 + 8.0 * r / h) - 1.0))
-    while j > 0 and 0.5 * h * j * (j + 1) > r:
-        j -= 1
-    while 0.5 * h * (j + 1) * (j + 2) <= r:
-        j += 1
+    x = r / h if h > 0.0 else math.inf
+    if not x <= _BRAKE_STEPS_EXACT:
+        ad = a_max * dt
+        return math.sqrt(2.0 * a_max * r + 0.25 * ad * ad) - 0.5 * ad
+    j = math.floor(0.5 * (math.sqrt(1.0 + 8.0 * x) - 1.0))
+    for _ in range(2):
+        if j > 0 and 0.5 * h * j * (j + 1) > r:
+            j -= 1
+    for _ in range(2):
+        if 0.5 * h * (j + 1) * (j + 2) <= r:
+            j += 1
+    if j == 0:  # also where h overflowed (a huge time step): one step covers r
+        return r / dt
     s_j = 0.5 * h * j * (j + 1)
     return j * a_max * dt + (r - s_j) / (dt * (j + 1))
 
@@ -126,6 +141,11 @@ def track_axis(
     elif p < -p_max:
         p = -p_max
         v = (p - p_prev) / dt
+    # rounding (in the lines above, or in the caller's (v - v_prev) / dt) must not push a value past its limit
+    if v > v_max:
+        v = v_max
+    elif v < -v_max:
+        v = -v_max
     return p, v, sat_pos, sat_vel, sat_acc
 
 

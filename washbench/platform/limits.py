@@ -17,8 +17,24 @@ from washbench.io.yamlio import StrictModel, load_yaml_model
 
 DEFAULT_LIMITS_PATH = DATA_DIR / "atlas.yaml"
 
-Positive = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
-Finite = Annotated[float, Field(allow_inf_nan=False)]
+# Accepted ranges: a motion platform, not a planet. Absurd but finite limits (a travel of 1e300 m, an
+# acceleration of 1e-300 m/s^2) are refused instead of being computed with.
+Positive = Annotated[float, Field(gt=0.0, le=100.0, allow_inf_nan=False)]  # m, m/s
+Acceleration = Annotated[float, Field(ge=1e-3, le=1e3, allow_inf_nan=False)]  # m/s^2
+Finite = Annotated[float, Field(ge=-360.0, le=360.0, allow_inf_nan=False)]  # deg
+
+
+class Accelerations(StrictModel):
+    """One acceleration limit per inertial axis x, y, z (m/s^2, 1e-3..1000)."""
+
+    x: Acceleration
+    y: Acceleration
+    z: Acceleration
+
+    @property
+    def xyz(self) -> tuple[float, float, float]:
+        """The three values in axis order (x, y, z)."""
+        return (self.x, self.y, self.z)
 
 
 class Axes(StrictModel):
@@ -39,21 +55,21 @@ class Translation(StrictModel):
 
     position_limit_m: Axes
     velocity_limit_mps: Axes
-    acceleration_limit_mps2: Axes
+    acceleration_limit_mps2: Accelerations
 
 
 class Rotation(StrictModel):
     """Cockpit sphere: unlimited attitude, limited angular velocity and acceleration (norms)."""
 
-    rate_limit_degps: Positive
-    acceleration_limit_degps2: Positive
+    rate_limit_degps: Annotated[float, Field(gt=0.0, le=3600.0, allow_inf_nan=False)]
+    acceleration_limit_degps2: Annotated[float, Field(ge=0.01, le=1e5, allow_inf_nan=False)]
     catch_up_fraction: Annotated[float, Field(gt=0.0, le=1.0)]
 
 
 class Wheels(StrictModel):
     """The three omni-wheels that drive the sphere."""
 
-    radius_m: Positive
+    radius_m: Annotated[float, Field(gt=0.0, le=10.0, allow_inf_nan=False)]
     azimuth_deg: tuple[Finite, Finite, Finite]
     below_equator_deg: Annotated[float, Field(gt=0.0, lt=90.0)]
 

@@ -7,6 +7,7 @@ import importlib.util
 import os
 import re
 import shutil
+import signal
 import subprocess
 import sys
 import threading
@@ -95,6 +96,15 @@ def _has_display(platform: str | None = None, environ: dict[str, str] | None = N
     return bool(environ.get("DISPLAY") or environ.get("WAYLAND_DISPLAY"))
 
 
+def _die_with_parent() -> None:
+    """In the viewer's child process (Linux): receive SIGTERM when washbench ends, even by SIGKILL."""
+    import ctypes
+
+    with contextlib.suppress(OSError, AttributeError):
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(1, signal.SIGTERM, 0, 0, 0)  # PR_SET_PDEATHSIG
+
+
 def start_web_viewer(
     path: Path, *, web_port: int = 0, grpc_port: int = 0, timeout_s: float = 60.0
 ) -> tuple[subprocess.Popen[str], str]:
@@ -123,6 +133,7 @@ def start_web_viewer(
         text=True,
         env=env,
         start_new_session=True,
+        preexec_fn=_die_with_parent if sys.platform.startswith("linux") else None,
     )
     found: list[str] = []
     tail: deque[str] = deque(maxlen=5)
@@ -165,8 +176,9 @@ def replay_command(paths: Path | list[Path], web: bool) -> int:
 
     The native viewer where a display exists (a macOS or Windows desktop, or DISPLAY / WAYLAND_DISPLAY set) and
     ``web`` is false; otherwise the web viewer on 127.0.0.1 with system-chosen ports, whose address is printed; it
-    runs until Ctrl-C. Returns the exit status. The comparison recording lives in a temporary folder removed when the
-    viewer stops.
+    runs until Ctrl-C (status 0). Returns the exit status. The comparison recording lives in a temporary folder
+    removed when the viewer stops. SIGTERM stops the viewer too (status 143), and a viewer outlives washbench in no
+    case (Linux: not even a SIGKILL of washbench, through the parent-death signal).
     """
     files = [Path(p) for p in (paths if isinstance(paths, list) else [paths])]
     if len(files) not in (1, 2):

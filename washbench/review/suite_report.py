@@ -45,9 +45,20 @@ _HOW_TO_READ = [
 ]
 
 
-def write_suite_json(path: Path, entries: list[dict[str, Any]], provenance: dict[str, Any], created_utc: str) -> None:
-    """``suite.json``: one entry per manoeuvre file (file, ok, reason, aircraft, manoeuvre, result folder, checks)."""
-    doc = {"created_utc": created_utc, "provenance": provenance, "manoeuvres": entries}
+def write_suite_json(
+    path: Path,
+    entries: list[dict[str, Any]],
+    provenance: dict[str, Any],
+    created_utc: str,
+    top_level: list[str] | None = None,
+) -> None:
+    """``suite.json``: one entry per manoeuvre file (file, ok, reason, aircraft, manoeuvre, result folder, checks),
+    the provenance and, once the suite is complete, ``entries``: every top-level name it wrote (the marker by which
+    the next suite recognises what it may replace, :func:`washbench.runs.suite.previous_results`)."""
+    doc: dict[str, Any] = {"washbench": "suite", "created_utc": created_utc, "provenance": provenance}
+    doc["manoeuvres"] = entries
+    if top_level is not None:
+        doc["entries"] = top_level
     write_text_atomic(path, json.dumps(doc, indent=2) + "\n")
 
 

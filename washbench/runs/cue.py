@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import contextlib
 import math
-import re
 import sys
 import time
 from collections.abc import Mapping, Sequence
@@ -29,7 +28,9 @@ from washbench.analysis.metrics import MetricRow, dof_metrics
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import atomic_path
 from washbench.io.input_format import InputFormat
+from washbench.io.names import check_identifier
 from washbench.io.plausibility import Finding, check_motion
+from washbench.io.publish import result_path
 from washbench.io.readers import Samples, read_samples
 from washbench.io.resample import check_gaps, resample, split_resets, to_motion, window
 from washbench.io.results import (
@@ -258,14 +259,9 @@ class Segment:
     findings: tuple[Finding, ...]
 
 
-SEGMENT_NAME = re.compile(r"^[A-Za-z0-9_-]+$")
-
-
 def check_segment_name(name: str) -> str:
-    """``name`` if it is a plain identifier (letters, digits, ``_`` and ``-``: it names a folder)."""
-    if not SEGMENT_NAME.match(name):
-        raise ValueError(f"segment name {name!r} must hold only letters, digits, '_' and '-'")
-    return name
+    """``name`` if it is a plain identifier (:mod:`washbench.io.names`: it names a folder)."""
+    return check_identifier(name, "segment name")
 
 
 def read_input(path: Path, fmt: InputFormat) -> Samples:
@@ -364,7 +360,7 @@ def write_outputs(
     try:
         with contextlib.ExitStack() as stack:
             for seg, result in zip(segments, results, strict=True):
-                folder = out_dir / seg.name if seg.name else out_dir
+                folder = result_path(out_dir, seg.name) if seg.name else out_dir
                 folder.mkdir(parents=True, exist_ok=True)
                 names = (TRACES_FILE, METRICS_FILE, "run.json") + ((RECORDING_FILE,) if opts.recording else ())
                 tmp = {name: stack.enter_context(atomic_path(folder / name)) for name in names}
@@ -415,6 +411,7 @@ def run_cue(
     """
     from washbench.cueing.bank import check_filter_start
     from washbench.cueing.variants import select_washouts
+    from washbench.io.lock import output_lock
     from washbench.platform import load_platform_limits
 
     opts = options or CueOptions()
@@ -428,20 +425,23 @@ def run_cue(
     limits = load_platform_limits(platform_path)
     samples = read_input(input_path, opts.fmt)
     segments = prepare_segments(samples, opts)
-    results = cue_segments(segments, specs, None, limits, opts.filter_start)
-    for seg in segments:
-        for f in seg.findings:
-            print(f"washbench: warning: {input_path}{f' ({seg.name})' if seg.name else ''}: {f.text}", file=sys.stderr)
-    from washbench.io.provenance import file_record, read_parquet_provenance
-    from washbench.runs.pipeline import run_provenance
+    with output_lock(out_dir):
+        results = cue_segments(segments, specs, None, limits, opts.filter_start)
+        for seg in segments:
+            for f in seg.findings:
+                where = f"{input_path}{f' ({seg.name})' if seg.name else ''}"
+                print(f"washbench: warning: {where}: {f.text}", file=sys.stderr)
+        from washbench.io.provenance import file_record, read_parquet_provenance
+        from washbench.runs.pipeline import run_provenance
 
-    prov = run_provenance(params_path, platform_path, specs, limits)
-    prov["input"] = file_record(input_path)
-    input_prov = read_parquet_provenance(input_path) if input_path.suffix.lower() in (".parquet", ".pq") else None
-    if input_prov:
-        prov["input"]["provenance"] = input_prov
-    wall = time.perf_counter() - start
-    summaries = write_outputs(out_dir, input_path, segments, results, limits, opts, wall, prov)
+        prov = run_provenance(params_path, platform_path, specs, limits)
+        prov["input"] = file_record(input_path)
+        is_parquet = input_path.suffix.lower() in (".parquet", ".pq")
+        input_prov = read_parquet_provenance(input_path) if is_parquet else None
+        if input_prov:
+            prov["input"]["provenance"] = input_prov
+        wall = time.perf_counter() - start
+        summaries = write_outputs(out_dir, input_path, segments, results, limits, opts, wall, prov)
     for seg, result, summary in zip(segments, results, summaries, strict=True):
         m = seg.motion
         label = f"{input_path}{f' {seg.name}' if seg.name else ''}"

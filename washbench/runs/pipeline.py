@@ -26,7 +26,6 @@ import contextlib
 import dataclasses
 import json
 import math
-import os
 import shutil
 import sys
 import time
@@ -42,6 +41,14 @@ from washbench.analysis.ranking import DOFS, perceived_motion
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
 from washbench.io.provenance import build_provenance, flat_strings, utc_now
+from washbench.io.publish import (
+    check_replaceable,
+    clean_partials,
+    partial_dir,
+    publish_dir,
+    remove_if_empty,
+    result_path,
+)
 
 if TYPE_CHECKING:
     from washbench.io.results import Motion
@@ -101,13 +108,17 @@ def metrics_markdown(title: str, rows: list[MetricRow]) -> str:
     return metrics_table_markdown(title, rows)
 
 
-def _publish(partial: Path, final: Path) -> None:
-    """Replace ``final`` with the finished folder ``partial`` (two renames; the old one is removed)."""
-    old = final.with_name(f".{final.name}.old-{os.getpid()}")
-    if final.exists():
-        os.replace(final, old)
-    os.replace(partial, final)
-    shutil.rmtree(old, ignore_errors=True)
+#: The file that marks a folder as a ``washbench run`` result (only such a folder is ever replaced).
+RUN_MARKER = "run.json"
+
+
+def run_dir(out_root: Path, aircraft: str, manoeuvre: str) -> Path:
+    """``OUT/<aircraft>/<manoeuvre>``, proven inside ``out_root`` (both names are identifiers)."""
+    return result_path(out_root, aircraft, manoeuvre)
+
+
+def _marker(aircraft: str, manoeuvre: str) -> dict[str, object]:
+    return {"aircraft": aircraft, "manoeuvre": manoeuvre}
 
 
 def run_manoeuvre(
@@ -131,15 +142,16 @@ def run_manoeuvre(
     select the washouts (:func:`washbench.cueing.variants.select_washouts`; default the three built-in ones).
     ``filter_start``: the washouts' and vestibular models' start state (``steady`` or ``rest``).
 
-    Raises WashbenchError for a bad manoeuvre, parameter or platform file (nothing written).
-    A flight that crashes or fails a check still writes its results (what was flown), with
-    ``ok`` False and the reason.
+    Raises WashbenchError for a bad manoeuvre, parameter or platform file, or a result place that
+    cannot be used (all checked before flying; nothing written). A flight that crashes or fails a check
+    still writes its results (what was flown), with ``ok`` False and the reason. The result folder
+    replaces only a previous ``washbench run`` result of the same manoeuvre (recognised by its run.json).
     """
     from washbench.cueing.variants import select_washouts
-    from washbench.flight.fly import fly, write_flight
     from washbench.flight.manoeuvre import load_manoeuvre
-    from washbench.platform import load_platform_limits
+    from washbench.platform.limits import load_platform_limits
 
+    # every input and the result place first: a bad one fails before anything is flown
     manoeuvre = load_manoeuvre(manoeuvre_path, aircraft_dirs)
     specs = select_washouts(washouts, variants, params_path)
     limits = load_platform_limits(platform_path)
@@ -147,20 +159,24 @@ def run_manoeuvre(
     ac_files = manoeuvre.aircraft_files
     flight_prov = build_provenance(manoeuvre_path=manoeuvre_path, turbulence=turbulence, aircraft_files=ac_files)
     prov = run_provenance(params_path, platform_path, specs, limits, manoeuvre_path, turbulence, ac_files)
+    final = run_dir(Path(out_root), manoeuvre.aircraft, manoeuvre.name)
+    marker = _marker(manoeuvre.aircraft, manoeuvre.name)
+    check_replaceable(final, RUN_MARKER, marker)  # before flying: a folder in the way fails now, not after
+    clean_partials(final.parent)
+
+    from washbench.flight.fly import fly, write_flight
+
     washouts = tuple(w.name for w in specs)
     rows, lockstep = lockstep_blocks(specs, limits, manoeuvre.dt_s, filter_start)
-    start = time.perf_counter()
-    created = utc_now()
-    flight = fly(manoeuvre, block_hook=lockstep, block_size=LOCKSTEP_BLOCK, progress=progress)
-    n = len(flight.t_s)
-    if len(rows) != n:
-        raise RuntimeError(f"washouts ran {len(rows)} steps for {n} recorded samples")
-
-    final = Path(out_root) / manoeuvre.aircraft / manoeuvre.name
-    partial = final.with_name(f".{final.name}.partial-{os.getpid()}")
-    shutil.rmtree(partial, ignore_errors=True)
-    partial.mkdir(parents=True)
+    partial = partial_dir(final)  # before flying: a file in the way of OUT/<aircraft>/ fails now
+    published = False
     try:
+        start = time.perf_counter()
+        created = utc_now()
+        flight = fly(manoeuvre, block_hook=lockstep, block_size=LOCKSTEP_BLOCK, progress=progress)
+        n = len(flight.t_s)
+        if len(rows) != n:
+            raise RuntimeError(f"washouts ran {len(rows)} steps for {n} recorded samples")
         write_flight(partial, flight, str(manoeuvre_path), flight_prov)
         if n < 2:
             raise WashbenchError(located(manoeuvre_path, f"the flight recorded {n} sample(s): nothing to cue"))
@@ -181,10 +197,13 @@ def run_manoeuvre(
             partial, summary, rows, washouts, limits, ac_q, flight.phases, start, filter_start, extra, prov,
             recording=recording,
         )  # fmt: skip
-        _publish(partial, final)
+        publish_dir(partial, final, RUN_MARKER, marker)
+        published = True
     finally:
         with contextlib.suppress(FileNotFoundError):
             shutil.rmtree(partial)
+        if not published:
+            remove_if_empty(final.parent)
     return summary
 
 
@@ -342,6 +361,10 @@ def run_script(
     limits = load_platform_limits(platform_path)
     prov = run_provenance(params_path, platform_path, specs, limits, script_path)
     created = utc_now()
+    final = run_dir(Path(out_root), info.aircraft, info.name)
+    marker = {"aircraft": info.aircraft}  # one run.json, or one per run of a script that resets
+    check_replaceable(final, RUN_MARKER, marker, nested=True)
+    clean_partials(final.parent)
     names = tuple(w.name for w in specs)
     banks: list[list[np.ndarray]] = []
 
@@ -352,10 +375,7 @@ def run_script(
 
     start = time.perf_counter()
     flight = fly_script(script_path, max_time_s=max_time_s, segment_hook=segment_hook, aircraft_dirs=aircraft_dirs)
-    final = Path(out_root) / info.aircraft / info.name
-    partial = final.with_name(f".{final.name}.partial-{os.getpid()}")
-    shutil.rmtree(partial, ignore_errors=True)
-    partial.mkdir(parents=True)
+    partial = partial_dir(final)
     several = len(flight.segments) > 1
     summaries = []
     try:
@@ -381,10 +401,11 @@ def run_script(
                 write_cued_folder(folder, summary, rows, names, limits, ac_q, [], start, filter_start, extra, prov,
                                   recording=recording)
             )
-        _publish(partial, final)
+        publish_dir(partial, final, RUN_MARKER, marker, nested=True)
     finally:
         with contextlib.suppress(FileNotFoundError):
             shutil.rmtree(partial)
+        remove_if_empty(final.parent)
     return summaries
 
 
@@ -492,44 +513,51 @@ def run_command(
     aircraft_dirs: Sequence[Path] = (),
     recording: bool = True,
 ) -> int:
-    """CLI entry of ``washbench run`` (a YAML manoeuvre or a JSBSim script): 0 if every run was ok, else 1."""
+    """CLI entry of ``washbench run`` (a YAML manoeuvre or a JSBSim script): 0 if every run was ok, else 1.
+
+    Holds the lock of ``out_root`` (:func:`washbench.io.lock.output_lock`) while it runs.
+    """
     from washbench.cueing.bank import check_filter_start
     from washbench.flight.scripts import is_script
+    from washbench.io.lock import output_lock
     from washbench.review.numbers import pct, sig
 
     check_filter_start(filter_start)
     check_max_time(max_time_s)
     start = time.perf_counter()
-    if is_script(manoeuvre_path):
-        runs = run_script(
-            manoeuvre_path,
-            out_root,
-            params_path=params_path,
-            platform_path=platform_path,
-            max_time_s=max_time_s,
-            filter_start=filter_start,
-            aircraft_dirs=aircraft_dirs,
-            washouts=washouts,
-            variants=variants,
-            recording=recording,
-        )
-    else:
-        if max_time_s is not None:
-            raise WashbenchError("--max-time-s applies to JSBSim scripts only (a manoeuvre's phases set its length)")
-        runs = [
-            run_manoeuvre(
+    with output_lock(out_root):  # held while it runs: a second writer gets one line at once
+        if is_script(manoeuvre_path):
+            runs = run_script(
                 manoeuvre_path,
                 out_root,
                 params_path=params_path,
                 platform_path=platform_path,
-                progress=progress,
+                max_time_s=max_time_s,
                 filter_start=filter_start,
                 aircraft_dirs=aircraft_dirs,
                 washouts=washouts,
                 variants=variants,
                 recording=recording,
             )
-        ]
+        else:
+            if max_time_s is not None:
+                raise WashbenchError(
+                    "--max-time-s applies to JSBSim scripts only (a manoeuvre's phases set its length)"
+                )
+            runs = [
+                run_manoeuvre(
+                    manoeuvre_path,
+                    out_root,
+                    params_path=params_path,
+                    platform_path=platform_path,
+                    progress=progress,
+                    filter_start=filter_start,
+                    aircraft_dirs=aircraft_dirs,
+                    washouts=washouts,
+                    variants=variants,
+                    recording=recording,
+                )
+            ]
     wall = time.perf_counter() - start
     for s in runs:
         state = "ok" if s.ok else f"FAILED ({s.reason})"

@@ -1,7 +1,7 @@
 """``washbench suite``: many manoeuvres in parallel processes, then a comparison of the washouts.
 
 Each manoeuvre runs through :func:`washbench.runs.pipeline.run_manoeuvre` in its own worker process
-and writes ``OUT/<aircraft>/<manoeuvre>/`` (published atomically as a whole folder). A manoeuvre
+and writes ``<aircraft>/<manoeuvre>/`` (published atomically as a whole folder). A manoeuvre
 that fails (bad file, crash, divergence, failed check, or an unexpected error) is reported with its
 reason; the others still complete and are kept. Then the suite writes, each file atomically:
 
@@ -10,24 +10,36 @@ reason; the others still complete and are kept. Then the suite writes, each file
   (small-angle when it runs, otherwise the first listed; positive = better), like the paper's Table 4
 - ``OUT/ranking.csv``: the washouts (built-in or variants) ranked per manoeuvre by the rule of
   :mod:`washbench.analysis.ranking`
-- ``OUT/suite.json``: every manoeuvre file with its status and reason, and the suite's provenance;
 - ``OUT/report.md`` and ``OUT/figures/``: all of it, with the failures first, a score heatmap, the Table-4 figure
-  and each manoeuvre's section, built from the files by :mod:`washbench.review.suite_report` (written last).
+  and each manoeuvre's section, built from the files by :mod:`washbench.review.suite_report`;
+- ``OUT/suite.json`` (written last): every manoeuvre file with its status and reason, the suite's provenance, and
+  what the suite wrote at the top level (how the next suite recognises it).
+
+The output folder holds exactly one suite's results. The suite builds them in a hidden folder inside
+``OUT`` (``OUT/.suite.partial-PID/``) and, once complete, replaces the previous results as a whole: the
+previous suite's files and every ``washbench run`` result folder. Anything in ``OUT`` that washbench did
+not write makes the suite refuse to start (nothing is ever deleted that washbench did not write). An
+interrupted or failed suite leaves the previous results untouched. A lock on ``OUT`` keeps a second
+writer out (:mod:`washbench.io.lock`). Two files with the same aircraft and name are refused before
+flying. On SIGINT or SIGTERM the workers are stopped at once and the hidden folder removed.
 
 The exit status is 0 only if every manoeuvre ran and passed its checks.
 """
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import io
 import math
 import multiprocessing
 import os
+import shutil
+import signal
 import sys
 import time
 import traceback
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
@@ -40,11 +52,17 @@ from washbench.analysis.ranking import (
     rank,
     reference_washout,
 )
-from washbench.errors import WashbenchError, located
+from washbench.errors import Terminated, WashbenchError, located
 from washbench.io.atomic import write_text_atomic
+from washbench.io.lock import LOCK_NAME, output_lock
 from washbench.io.paths import MANOEUVRES_DIR, bundled_names, resolve_manoeuvre
+from washbench.io.publish import clean_partials, is_leftover, is_washbench_result, read_marker
 from washbench.io.results import csv_number
-from washbench.runs.pipeline import RunSummary
+from washbench.runs.pipeline import RUN_MARKER, RunSummary
+
+#: The suite's own files in ``OUT`` (``suite.json`` lists everything a suite wrote at the top level).
+SUITE_FILES = ("metrics.csv", "comparison.csv", "ranking.csv", "report.md")
+SUITE_MARKER = "suite.json"
 
 
 @dataclass
@@ -92,6 +110,65 @@ def find_manoeuvres(inputs: Sequence[Path], scripts: Sequence[Path] = ()) -> lis
     return unique
 
 
+def _worker_init(then: Callable[[], None] | None = None) -> None:
+    """In each worker: Ctrl-C is for the main process (it stops the workers); SIGTERM stops a worker at once.
+
+    ``then``: the start method's own initializer (:func:`pool_context`).
+    """
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    if then is not None:
+        then()
+
+
+@contextlib.contextmanager
+def _signals_held() -> Iterator[None]:
+    """Ignore SIGINT and SIGTERM for a short critical section (stopping workers, swapping results in)."""
+    saved = {sig: signal.signal(sig, signal.SIG_IGN) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for sig, handler in saved.items():
+            signal.signal(sig, handler)
+
+
+@contextlib.contextmanager
+def _signals_deferred() -> Iterator[None]:
+    """Hold SIGINT and SIGTERM back while worker processes are being started, then act on them.
+
+    A worker is started by sending it its start-up data through the process server; interrupted half-way,
+    the worker would start after this process exits and print a traceback. So a signal arriving meanwhile is
+    noted and raised (KeyboardInterrupt or Terminated) once the workers exist and can be stopped.
+    """
+    noted: list[int] = []
+
+    def note(signum: int, frame: object) -> None:
+        noted.append(signum)
+
+    saved = {sig: signal.signal(sig, note) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for sig, handler in saved.items():
+            signal.signal(sig, handler)
+    if noted:
+        raise KeyboardInterrupt if noted[0] == signal.SIGINT else Terminated()
+
+
+def _stop_pool(pool: ProcessPoolExecutor) -> None:
+    """Stop every worker now (SIGTERM, then SIGKILL after 5 s) and drop the queued runs."""
+    processes = list((getattr(pool, "_processes", None) or {}).values())  # the executor keeps no public list
+    for p in processes:
+        with contextlib.suppress(Exception):
+            p.terminate()
+    pool.shutdown(wait=False, cancel_futures=True)
+    for p in processes:
+        p.join(5.0)
+        if p.is_alive():
+            p.kill()
+            p.join(5.0)
+
+
 def _run_one(
     path: str,
     out_dir: str,
@@ -134,16 +211,20 @@ def _preload() -> None:
     import washbench.runs.preload  # noqa: F401
 
 
-def pool_context(recording: bool = True) -> tuple[multiprocessing.context.BaseContext, Callable[[], None] | None]:
+def pool_context(
+    recording: bool = True, main_stops_workers: bool = False
+) -> tuple[multiprocessing.context.BaseContext, Callable[[], None] | None]:
     """The process pool's start method and worker initializer.
 
     ``forkserver`` (Linux, macOS) where it exists: workers fork from a server that has already imported the heavy
     modules (JSBSim, the numba kernels, rerun, pyarrow), so each starts in milliseconds. Elsewhere (Windows)
-    ``spawn``, with every worker importing them once at its start.
+    ``spawn``, with every worker importing them once at its start. With ``main_stops_workers`` (the suite, which
+    stops its workers itself on Ctrl-C) the server and its workers ignore SIGINT.
     """
     if "forkserver" in multiprocessing.get_all_start_methods():
         ctx = multiprocessing.get_context("forkserver")
-        ctx.set_forkserver_preload(["washbench.runs.preload", *(["rerun"] if recording else [])])
+        first = ["washbench.runs.worker_signals"] if main_stops_workers else []
+        ctx.set_forkserver_preload([*first, "washbench.runs.preload", *(["rerun"] if recording else [])])
         return ctx, None
     return multiprocessing.get_context("spawn"), _preload
 
@@ -165,7 +246,11 @@ def run_suite(
 ) -> list[Outcome]:
     """Run every file in parallel processes (or on the Dask cluster at ``dask``); outcomes in the order of ``files``
     (a JSBSim script that resets gives one outcome per run segment, in order). ``recording=False``: no
-    ``recording.rrd`` in the run folders (the report then links none)."""
+    ``recording.rrd`` in the run folders (the report then links none).
+
+    On any exception (KeyboardInterrupt and :class:`washbench.errors.Terminated` included) the local workers are
+    stopped before it propagates, so no worker writes anything afterwards.
+    """
     jobs = max(1, min(jobs or os.cpu_count() or 1, len(files)))
     out_dir.mkdir(parents=True, exist_ok=True)
     dirs = tuple(str(d) for d in aircraft_dirs)
@@ -178,7 +263,7 @@ def run_suite(
     start = time.perf_counter()
     if progress:
         print(
-            f"suite: {len(files)} manoeuvres on {jobs} process{'es' if jobs > 1 else ''} -> {out_dir}\n"
+            f"suite: {len(files)} manoeuvres on {jobs} process{'es' if jobs > 1 else ''} -> {_destination(out_dir)}\n"
             "suite: loading JSBSim, rerun and the washout kernel (compiled once after install: a few seconds)",
             file=sys.stderr,
         )
@@ -191,13 +276,25 @@ def run_suite(
         for a in args:
             outcomes[a[0]] = _report(_run_one(*a), len(outcomes) + 1, len(files), start, progress)
     else:
-        ctx, initializer = pool_context(recording)
-        with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=initializer) as pool:
-            futures = [pool.submit(_run_one, *a) for a in args]
+        ctx, initializer = pool_context(recording, main_stops_workers=True)
+        pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_init, initargs=(initializer,))
+        try:
+            with _signals_deferred():  # submitting starts the workers (up to ``jobs``)
+                futures = [pool.submit(_run_one, *a) for a in args]
             for fut in as_completed(futures):
                 runs = fut.result()
                 outcomes[runs[0].path] = _report(runs, len(outcomes) + 1, len(files), start, progress)
+        except BaseException:
+            with _signals_held():
+                _stop_pool(pool)
+            raise
+        pool.shutdown(wait=True)
     return [o for a in args for o in outcomes[a[0]]]
+
+
+def _destination(out_dir: Path) -> Path:
+    """Where the results end up: the suite folder, not the hidden one they are built in."""
+    return out_dir.parent if is_leftover(out_dir.name) else out_dir
 
 
 def _report(runs: list[Outcome], done: int, total: int, start: float, progress: bool) -> list[Outcome]:
@@ -315,8 +412,83 @@ def write_suite_results(
         }
         for o in outcomes
     ]
-    write_suite_json(out_dir / "suite.json", entries, dict(provenance or {}), utc_now())
+    created = utc_now()
+    write_suite_json(out_dir / SUITE_MARKER, entries, dict(provenance or {}), created)
     write_suite_report(out_dir)
+    # last: the same document with every top-level entry written (what the next suite may replace)
+    top = sorted(e.name for e in out_dir.iterdir() if not e.name.startswith(".") and e.name != SUITE_MARKER)
+    write_suite_json(out_dir / SUITE_MARKER, entries, dict(provenance or {}), created, top)
+
+
+def check_unique_names(files: Sequence[Path], aircraft_dirs: Sequence[Path] = ()) -> None:
+    """Refuse two manoeuvre files with the same aircraft and name (they would share a result folder).
+
+    Files that do not load are left for the run to report. Raises WashbenchError naming both files.
+    """
+    from washbench.flight.manoeuvre import load_manoeuvre
+
+    seen: dict[tuple[str, str], Path] = {}
+    for path in files:
+        try:
+            m = load_manoeuvre(path, aircraft_dirs)
+        except WashbenchError:
+            continue
+        key = (m.aircraft, m.name)
+        if key in seen:
+            raise WashbenchError(
+                m.located(("name",), f"'{m.name}' ({m.aircraft}) is also the name of {seen[key]}: both would "
+                          f"write {m.aircraft}/{m.name}/; give each manoeuvre its own name")
+            )  # fmt: skip
+        seen[key] = path
+
+
+def _is_run_folder(entry: Path, aircraft: str) -> bool:
+    """A ``run`` result of this aircraft (a JSBSim script that resets: a folder of such results)."""
+    return is_washbench_result(entry, RUN_MARKER, {"aircraft": aircraft}, nested=True)
+
+
+def previous_results(out_dir: Path) -> list[Path]:
+    """The entries of ``out_dir`` a new suite replaces: a previous suite's files and run result folders.
+
+    Raises WashbenchError naming the first entry washbench did not write (the suite then does not start).
+    """
+    marker = read_marker(out_dir, SUITE_MARKER) or {}
+    listed = marker.get("entries", []) if marker.get("washbench") == "suite" else []
+    listed = {n for n in listed if isinstance(n, str) and "/" not in n and n not in ("", ".", "..")}
+    found: list[Path] = []
+    for entry in sorted(out_dir.iterdir()):
+        name = entry.name
+        if name == LOCK_NAME or is_leftover(name):
+            continue
+        if name in SUITE_FILES or name == SUITE_MARKER or name in listed:
+            found.append(entry)
+            continue
+        if entry.is_dir() and not entry.is_symlink():
+            subs = [e for e in entry.iterdir() if not is_leftover(e.name)]
+            if all(_is_run_folder(e, name) for e in subs):
+                found.append(entry)
+                continue
+            stranger = next(e for e in subs if not _is_run_folder(e, name))
+            entry = stranger
+        raise WashbenchError(
+            located(entry, "washbench did not write this: a suite replaces only a previous washbench result as a "
+                    "whole; choose an empty or new --out folder")
+        )  # fmt: skip
+    return found
+
+
+def _swap_in(stage: Path, out_dir: Path, previous: Sequence[Path]) -> None:
+    """Replace ``previous`` entries of ``out_dir`` by everything in ``stage`` (renames, signals held)."""
+    with _signals_held():
+        old = out_dir / f".suite.old-{os.getpid()}"
+        old.mkdir()
+        for entry in previous:
+            if entry.exists() or entry.is_symlink():
+                os.replace(entry, old / entry.name)
+        for entry in sorted(stage.iterdir()):
+            os.replace(entry, out_dir / entry.name)
+        stage.rmdir()
+        shutil.rmtree(old, ignore_errors=True)
 
 
 def write_run_review(run_dir: Path, summary: RunSummary, source: str = "") -> None:
@@ -350,7 +522,8 @@ def suite_command(
 ) -> int:
     """CLI entry: run the suite, write its results, print where they are; 0 if all succeeded, else 1.
 
-    ``jsbsim_scripts``: names of scripts shipped with JSBSim (``c1723``) run besides ``inputs``.
+    ``jsbsim_scripts``: names of scripts shipped with JSBSim (``c1723``) run besides ``inputs``. See the module
+    docstring for the output folder policy (lock, whole replacement, interruption).
     """
     from washbench.flight.scripts import bundled_script
 
@@ -375,22 +548,35 @@ def suite_command(
         platform_path=platform_path or DEFAULT_LIMITS_PATH,
         platform=load_platform_limits(platform_path),
     )
+    check_unique_names(files, aircraft_dirs)
     start = time.perf_counter()
-    outcomes = run_suite(
-        files,
-        out_dir,
-        jobs=jobs,
-        params_path=params_path,
-        platform_path=platform_path,
-        progress=progress,
-        washouts=washouts,
-        variants=variants,
-        dask=dask,
-        aircraft_dirs=aircraft_dirs,
-        max_time_s=max_time_s,
-        recording=recording,
-    )
-    write_suite_results(outcomes, out_dir, provenance)
+    with output_lock(out_dir):
+        clean_partials(out_dir, only_dead=False)  # under the lock every leftover is stale
+        previous = previous_results(out_dir)
+        for entry in previous:
+            if entry.is_dir():
+                clean_partials(entry, only_dead=False)
+        stage = out_dir / f".suite.partial-{os.getpid()}"
+        stage.mkdir()
+        try:
+            outcomes = run_suite(
+                files,
+                stage,
+                jobs=jobs,
+                params_path=params_path,
+                platform_path=platform_path,
+                progress=progress,
+                washouts=washouts,
+                variants=variants,
+                dask=dask,
+                aircraft_dirs=aircraft_dirs,
+                max_time_s=max_time_s,
+                recording=recording,
+            )
+            write_suite_results(outcomes, stage, provenance)
+            _swap_in(stage, out_dir, previous)
+        finally:
+            shutil.rmtree(stage, ignore_errors=True)
     n_ok = sum(o.run.ok for o in outcomes)
     print(
         f"suite: {n_ok}/{len(outcomes)} runs ok in {time.perf_counter() - start:.1f} s; report: {out_dir / 'report.md'}"
@@ -398,4 +584,14 @@ def suite_command(
     return 0 if n_ok == len(outcomes) else 1
 
 
-__all__ = ["DOFS", "METRICS", "Outcome", "find_manoeuvres", "run_suite", "suite_command", "write_suite_results"]
+__all__ = [
+    "DOFS",
+    "METRICS",
+    "Outcome",
+    "check_unique_names",
+    "find_manoeuvres",
+    "previous_results",
+    "run_suite",
+    "suite_command",
+    "write_suite_results",
+]

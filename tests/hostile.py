@@ -1,0 +1,73 @@
+"""Helpers for the hardening tests: the real command under a time limit, and what a clean failure looks like."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+#: A short level flight (one phase of ``{seconds}`` s); ``{name}`` and ``{extra}`` (top-level lines) vary.
+SHORT = """\
+name: {name}
+aircraft: c172p
+{extra}start:
+  air: {{altitude_ft: 3000, airspeed_kts: 90, heading_deg: 360}}
+phases:
+  - name: level
+    hold: {{wings_level: true, altitude_ft: 3000, airspeed_kts: 90}}
+    until: {{duration_s: {seconds}}}
+checks:
+  - {{name: altitude held, signal: altitude_ft, stat: max_deviation, max: 50}}
+"""
+
+
+def short(folder: Path, name: str = "short", seconds: float = 1, extra: str = "", file: str | None = None) -> Path:
+    """Write a short manoeuvre file into ``folder``; return its path."""
+    path = folder / (file or f"{name}.yaml")
+    path.write_text(SHORT.format(name=name, seconds=seconds, extra=extra))
+    return path
+
+
+def washbench(*args: object, timeout: float = 60, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
+    """Run ``python -m washbench ARGS`` to its end, failing the test if it takes longer than ``timeout`` s."""
+    return subprocess.run(
+        [sys.executable, "-m", "washbench", *map(str, args)],
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        cwd=cwd,
+    )
+
+
+def assert_clean_error(proc: subprocess.CompletedProcess[str], *names: str, lines: int = 1) -> list[str]:
+    """Exit 2, no traceback, ``lines`` stderr lines each starting ``washbench: error:``, mentioning ``names``."""
+    assert proc.returncode == 2, (proc.returncode, proc.stdout, proc.stderr)
+    assert "Traceback" not in proc.stderr and "Traceback" not in proc.stdout, proc.stderr
+    got = proc.stderr.strip().splitlines()
+    assert len(got) == lines, got
+    assert all(line.startswith("washbench") and ": error: " in line for line in got), got
+    for name in names:
+        assert name in proc.stderr, (name, proc.stderr)
+    return got
+
+
+def tree(root: Path) -> list[str]:
+    """Every path under ``root`` (relative, sorted), hidden ones included."""
+    return sorted(str(p.relative_to(root)) for p in root.rglob("*")) if root.exists() else []
+
+
+def live_processes(pgid: int) -> list[str]:
+    """Processes of process group ``pgid`` that are still running (zombies, already dead, excluded)."""
+    found = []
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            stat = (entry / "stat").read_text()
+        except OSError:
+            continue
+        fields = stat[stat.rindex(")") + 2 :].split()
+        state, group = fields[0], int(fields[2])
+        if group == pgid and state != "Z":
+            found.append(f"{entry.name} {stat[: stat.rindex(')') + 1]} {state}")
+    return found
