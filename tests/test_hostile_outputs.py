@@ -55,13 +55,14 @@ def test_suite_output_folder_holds_exactly_that_suite(tmp_path: Path) -> None:
     assert proc.returncode == 0, proc.stderr
     assert "Traceback" not in proc.stderr
     names = tree(out)
-    assert [n for n in names if n.count("/") < 2] == [
-        "c172p", "c172p/level_a", "comparison.csv", "metrics.csv", "ranking.csv", "report.md", "suite.json",
+    assert [n for n in names if n.count("/") < 2 and not n.startswith("figures/")] == [
+        "c172p", "c172p/level_a", "comparison.csv", "figures", "metrics.csv", "ranking.csv", "report.md", "suite.json",
     ]  # fmt: skip
+    assert "figure.png" not in names  # the older suite's file is gone with it
     report = (out / "report.md").read_text()
     assert "1 of 1 manoeuvres" in report and "level_a" in report and "old_turn" not in report
     assert json.loads((out / "suite.json").read_text())["entries"] == [
-        "c172p", "comparison.csv", "metrics.csv", "ranking.csv", "report.md",
+        "c172p", "comparison.csv", "figures", "metrics.csv", "ranking.csv", "report.md",
     ]  # fmt: skip
 
 
