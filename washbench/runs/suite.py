@@ -211,6 +211,9 @@ def _preload() -> None:
     import washbench.runs.preload  # noqa: F401
 
 
+_QUIET_TRACKER = "ignore:resource_tracker:UserWarning"
+
+
 def pool_context(
     recording: bool = True, main_stops_workers: bool = False
 ) -> tuple[multiprocessing.context.BaseContext, Callable[[], None] | None]:
@@ -221,6 +224,10 @@ def pool_context(
     ``spawn``, with every worker importing them once at its start. With ``main_stops_workers`` (the suite, which
     stops its workers itself on Ctrl-C) the server and its workers ignore SIGINT.
     """
+    # An interrupted suite stops its workers at once; the resource tracker then removes the pool's semaphores itself
+    # but warns about each on stderr ("leaked semaphore objects"). Its warning filters come from ours when it starts.
+    if _QUIET_TRACKER not in sys.warnoptions:
+        sys.warnoptions.append(_QUIET_TRACKER)
     if "forkserver" in multiprocessing.get_all_start_methods():
         ctx = multiprocessing.get_context("forkserver")
         first = ["washbench.runs.worker_signals"] if main_stops_workers else []
