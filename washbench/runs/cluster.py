@@ -40,7 +40,9 @@ def dask_map(address: str, fn: Callable[..., Any], args: Sequence[tuple[Any, ...
 def dask_gather(address: str, fn: Callable[..., Any], shared: Any, args: Sequence[tuple[Any, ...]]) -> list[Any]:
     """``fn(shared, *a)`` for every ``a`` on the cluster, ``shared`` sent to every worker once; results in order."""
     c = client(address)
-    [big] = c.scatter([shared], broadcast=True)
+    # Scattered once, to one worker; the others fetch it from there when their first task needs it. (With
+    # broadcast=True the replication raced with the tasks under load: "failed to acquire keys", "lost dependencies".)
+    [big] = c.scatter([shared], broadcast=False, hash=False)
     futures = [c.submit(fn, big, *a, pure=False) for a in args]
     return c.gather(futures)
 

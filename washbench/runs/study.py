@@ -152,7 +152,9 @@ def evaluate(
     futures = []
     for f in flights:
         cfg, coef = f.evaluator.arrays(candidates)
-        [ev] = c.scatter([f.evaluator], broadcast=True)
+        # hash=False: a fresh key per call. With content-hash keys each tune generation scattered the same key
+        # while the scheduler was still releasing the previous generation's copy: "lost dependencies".
+        [ev] = c.scatter([f.evaluator], broadcast=True, hash=False)
         futures.append(
             [
                 c.submit(_evaluate_task, ev, cfg[i : i + chunk], coef[i : i + chunk], pure=False)
