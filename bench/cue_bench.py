@@ -63,10 +63,10 @@ def best_of(fn, repeat: int = 3) -> float:
     return min(times)
 
 
-def command_cpu_s(src: Path, out: Path) -> float:
-    """CPU time (user + system) of one ``washbench cue`` process on ``src``."""
+def command_cpu_s(src: Path, out: Path, *extra: str) -> float:
+    """CPU time (user + system) of one ``washbench cue`` process on ``src`` (``extra``: more options)."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    subprocess.run([sys.executable, "-m", "washbench", "cue", str(src), "--out", str(out)], check=True,
+    subprocess.run([sys.executable, "-m", "washbench", "cue", str(src), "--out", str(out), *extra], check=True,
                    stdout=subprocess.DEVNULL)  # fmt: skip
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
@@ -123,7 +123,8 @@ def main() -> None:
                 scipy.signal.lsim(can, motion.omega_radps[:, i], t)
 
         t_lsim = best_of(lsim_all, 1)
-        cmd = min(command_cpu_s(src, Path(tmp) / "cmd") for _ in range(args.repeat))
+        cmd = min(command_cpu_s(src, Path(tmp) / f"cmd{i}") for i in range(args.repeat))
+        bare_cmd = min(command_cpu_s(src, Path(tmp) / f"bare{i}", "--no-recording") for i in range(args.repeat))
         bare = min(bare_jsbsim_cpu_s(n) for _ in range(args.repeat))
 
     total = t_read + t_cue + t_analyse + t_write
@@ -137,7 +138,8 @@ def main() -> None:
     print(f"  vestibular, one pilot        {t_vest:7.3f} s   (baseline: scipy.signal.lsim {t_lsim:.3f} s,", end=" ")
     print(f"{t_lsim / t_vest:.1f}x slower)")
     print(f"washbench cue command, CPU s   {cmd:7.3f} s   {cmd / bare:6.2f} x bare JSBSim for {n} steps "
-          f"({bare:.3f} s CPU; aim <= 1.5x)")  # fmt: skip
+          f"({bare:.3f} s CPU; aim <= 1.5x; with recording, report and figures)")  # fmt: skip
+    print(f"  the same, --no-recording     {bare_cmd:7.3f} s   {bare_cmd / bare:6.2f} x bare JSBSim")
 
 
 if __name__ == "__main__":
