@@ -37,6 +37,7 @@ from pathlib import Path
 import numpy as np
 
 from washbench.errors import WashbenchError, located
+from washbench.flight.columns import FLIGHT_COLUMNS
 from washbench.flight.fdm import quiet_stdout
 from washbench.flight.fly import FPS_TO_KT, FT_S2_TO_M_S2, R2D, StepHook
 from washbench.flight.manoeuvre import aircraft_path
@@ -45,28 +46,18 @@ from washbench.io.paths import jsbsim_root
 
 SEGMENT_PREFIX = "run_"
 
-#: (name, description) of a script flight's ``flight.parquet`` columns, in order.
-SCRIPT_COLUMNS: tuple[tuple[str, str], ...] = (
-    ("t_s", "time since the segment's start, s (k * dt)"),
-    ("f_x_mps2", "specific force at the pilot's eyepoint, body x (forward), m/s^2"),
-    ("f_y_mps2", "specific force at the pilot's eyepoint, body y (right), m/s^2"),
-    ("f_z_mps2", "specific force at the pilot's eyepoint, body z (down), m/s^2"),
-    ("omega_x_degps", "body angular velocity p (roll rate), deg/s"),
-    ("omega_y_degps", "body angular velocity q (pitch rate), deg/s"),
-    ("omega_z_degps", "body angular velocity r (yaw rate), deg/s"),
-    ("phi_deg", "bank angle, deg"),
-    ("theta_deg", "pitch angle, deg"),
-    ("psi_deg", "true heading, deg in [0, 360)"),
-    ("alpha_deg", "angle of attack, deg"),
-    ("beta_deg", "sideslip angle, deg"),
-    ("vc_kts", "calibrated airspeed, kt"),
-    ("gs_kts", "ground speed, kt"),
-    ("altitude_ft", "altitude above mean sea level, ft"),
-    ("h_agl_ft", "height of the centre of gravity above the ground, ft"),
-    ("nz", "load factor at the centre of gravity, g (+1 in level flight)"),
-    ("wow", "1 while any landing gear touches the ground, else 0"),
+#: Names of a script flight's ``flight.parquet`` columns, in order: a subset of a manoeuvre's
+#: (:data:`washbench.flight.columns.FLIGHT_COLUMNS`), with the same meanings.
+SCRIPT_COLUMN_NAMES: tuple[str, ...] = (
+    "t_s", "f_x_mps2", "f_y_mps2", "f_z_mps2", "omega_x_degps", "omega_y_degps", "omega_z_degps",
+    "phi_deg", "theta_deg", "psi_deg", "alpha_deg", "beta_deg", "vc_kts", "gs_kts", "altitude_ft", "h_agl_ft",
+    "nz", "wow",
+)  # fmt: skip
+#: (name, description) of those columns; time counts from the segment's start.
+SCRIPT_COLUMNS: tuple[tuple[str, str], ...] = tuple(
+    (n, "time since the segment's start, s (k * dt)" if n == "t_s" else dict(FLIGHT_COLUMNS)[n])
+    for n in SCRIPT_COLUMN_NAMES
 )
-SCRIPT_COLUMN_NAMES = tuple(n for n, _ in SCRIPT_COLUMNS)
 
 _STATE = (
     "attitude/phi-rad",

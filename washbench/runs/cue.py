@@ -200,13 +200,6 @@ def cue_motion(
     return analyse(motion, traces, vestibular, filter_start)
 
 
-def check_washout_names(names: Sequence[str] | None) -> tuple[str, ...]:
-    """Validated washout names in the order given, duplicates dropped; ``None`` -> all of them."""
-    from washbench.cueing import WASHOUT_NAMES, check_washouts
-
-    return check_washouts(dict.fromkeys(names) if names else WASHOUT_NAMES)
-
-
 def write_results(out_dir: Path, result: CueResult, provenance: Mapping[str, Any] | None = None) -> tuple[Path, Path]:
     """Write traces.parquet and metrics.csv into ``out_dir`` (created if missing), both or neither.
 
