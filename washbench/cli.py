@@ -69,7 +69,11 @@ def _jobs(text: str) -> int:
 
 def build_parser() -> argparse.ArgumentParser:
     """The full command-line interface."""
-    parser = _Parser(prog="washbench", description=__doc__.splitlines()[0] if __doc__ else None)
+    parser = _Parser(
+        prog="washbench",
+        description="A testbed for flight-simulator motion cueing: JSBSim manoeuvres, three washouts, a kinematic "
+        "Atlas platform, vestibular models and metrics.",
+    )
     parser.add_argument("--version", action="version", version=_version_line())
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
