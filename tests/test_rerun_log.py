@@ -96,32 +96,93 @@ def written(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, RecordingDa
     return path, data
 
 
+def assert_recorded(
+    t_rec: np.ndarray, v_rec: np.ndarray, t_s: np.ndarray, values: np.ndarray, tolerance: float | np.ndarray
+) -> None:
+    """The stated precision of a recorded series against the values it came from (``values`` (N,) or (N, L) at the
+    times ``t_s``): every recorded time is one of ``t_s`` (to 0.5 ns), the first and the last among them, none more
+    than MAX_GAP_S after the previous; each recorded value equals float32(value) exactly; linear interpolation between
+    the recorded samples is within ``tolerance`` of float32(value) at every step, so within tolerance plus float32's
+    half step (2^-24 relative) of the value itself."""
+    values = np.asarray(values, dtype=np.float64).reshape(t_s.size, -1)
+    v_rec = np.asarray(v_rec).reshape(t_rec.size, -1)
+    assert v_rec.dtype == np.float64 and v_rec.shape[1] == values.shape[1]
+    k = np.searchsorted(t_s, t_rec - 0.5e-9)
+    assert np.all(k < t_s.size) and np.all(np.abs(t_s[np.minimum(k, t_s.size - 1)] - t_rec) <= 0.5e-9 + 1e-15)
+    assert k[0] == 0 and k[-1] == t_s.size - 1 and np.all(np.diff(k) > 0)
+    assert np.all(np.diff(t_rec) <= rerun_log.MAX_GAP_S + 1e-9)
+    f32 = values.astype(np.float32).astype(np.float64)
+    np.testing.assert_array_equal(v_rec, f32[k])
+    tol = np.broadcast_to(np.asarray(tolerance, dtype=np.float64), (values.shape[1],))
+    for j in range(values.shape[1]):
+        err = np.abs(np.interp(t_s, t_rec, v_rec[:, j]) - f32[:, j])
+        assert err.max() <= tol[j] * (1 + 1e-9) + 1e-12, (j, err.max(), tol[j])
+        assert np.all(
+            np.abs(np.interp(t_s, t_rec, v_rec[:, j]) - values[:, j])
+            <= tol[j] + 2.0**-24 * np.abs(values[:, j]) + 1e-12
+        )
+
+
+def motion_tolerance_typed(dof: str) -> float:
+    """1 % of the Zacharias (1978) threshold of ``dof``, typed here from washbench/perception/thresholds.py."""
+    return 0.01 * {"surge": 0.17, "sway": 0.17, "heave": 0.28, "roll": 3.0, "pitch": 3.6, "yaw": 2.6}[dof]
+
+
 def test_time_axis_is_k_dt_to_the_nanosecond(written):
     path, data = written
     series = read_scalar_series(path)
     t, _ = series[perceived_path("surge")]
-    assert t.shape == data.t_s.shape
-    np.testing.assert_allclose(t, data.t_s, rtol=0, atol=0.5e-9 + 1e-15)
+    k = np.round(t * 120).astype(int)
+    np.testing.assert_allclose(t, data.t_s[k], rtol=0, atol=0.5e-9 + 1e-15)
+    assert k[0] == 0 and k[-1] == data.t_s.size - 1
 
 
 def test_motion_traces_equal_the_inputs_one_line_per_source(written):
-    """Stated precision: float64, bit-equal for specific force; angular rates in deg/s to 1e-14."""
+    """Stated precision: float32 values at the recorded steps, linear interpolation within 1 % of the perception
+    threshold at every step (angular rates in deg/s); the tolerance is stored with each entity."""
     path, data = written
     series = read_scalar_series(path)
+    stored = read_static(path, "interpolation_tolerance")
     sources = [data.aircraft, *data.washouts.values()]
     for dof, sig, axis, _unit in DOFS:
-        _, perceived = series[perceived_path(dof)]
-        _, raw = series[raw_path(dof)]
-        assert perceived.shape == (data.t_s.size, 1 + len(WASHOUTS)) and perceived.dtype == np.float64
-        for i, m in enumerate(sources):
-            if sig == "f":  # m/s^2, stored unchanged
-                np.testing.assert_array_equal(perceived[:, i], m.perceived_f_mps2[:, axis])
-                np.testing.assert_array_equal(raw[:, i], m.f_mps2[:, axis])
-            else:  # shown in deg/s
-                np.testing.assert_allclose(perceived[:, i], m.perceived_omega_radps[:, axis] * 180 / np.pi, rtol=1e-14)
-                np.testing.assert_allclose(raw[:, i], m.omega_radps[:, axis] * 180 / np.pi, rtol=1e-14)
+        tol = motion_tolerance_typed(dof)
+        for entity, fields in ((perceived_path(dof), ("perceived_f_mps2", "perceived_omega_radps")),
+                               (raw_path(dof), ("f_mps2", "omega_radps"))):  # fmt: skip
+            t_rec, v_rec = series[entity]
+            assert v_rec.shape[1] == 1 + len(WASHOUTS)
+            expected = np.column_stack([getattr(m, fields[0 if sig == "f" else 1])[:, axis] for m in sources])
+            if sig == "omega":
+                expected = expected * 180 / np.pi
+            assert_recorded(t_rec, v_rec, data.t_s, expected, tol)
+            np.testing.assert_allclose(stored[entity], [tol] * (1 + len(WASHOUTS)), rtol=1e-12)
     names = read_static(path, "SeriesLines:names")
     assert names[perceived_path("surge")] == [AIRCRAFT, *WASHOUTS]
+
+
+def test_smooth_motion_is_thinned_and_fast_motion_kept(tmp_path):
+    """A slow sine needs a sample about every MAX_GAP_S; a burst of fast motion keeps (nearly) every step there."""
+    base = make_data(n=2400)
+    t = base.t_s
+    slow = np.column_stack([0.5 * np.sin(0.2 * t), 0.0 * t, -G + 0.1 * np.sin(0.3 * t)])
+    fast = slow.copy()
+    burst = (t > 10.0) & (t < 12.0)
+    fast[burst, 0] += 0.4 * np.sin(2 * np.pi * 8.0 * t[burst])  # 8 Hz, 0.4 m/s^2
+    w0 = np.zeros_like(slow)
+    q = base.aircraft.q
+
+    def m(f: np.ndarray) -> MotionSeries:
+        return MotionSeries(f, w0, f, w0, q)
+
+    data = RecordingData(**{**base.__dict__, "aircraft": m(fast), "washouts": {w: m(slow) for w in WASHOUTS}})
+    write_recording(tmp_path / "r.rrd", data)
+    series = read_scalar_series(tmp_path / "r.rrd")
+    t_rec, v_rec = series[perceived_path("surge")]
+    assert_recorded(t_rec, v_rec, t, np.column_stack([fast[:, 0]] + [slow[:, 0]] * 3), motion_tolerance_typed("surge"))
+    in_burst = (t_rec > 10.0) & (t_rec < 12.0)
+    assert in_burst.sum() > 0.5 * burst.sum()  # the fast part at (almost) full rate
+    assert (~in_burst).sum() < 0.1 * (~burst).sum()  # the slow rest at a few per cent of the steps
+    t_sway, _ = series[perceived_path("sway")]
+    assert t_sway.size <= t[-1] / rerun_log.MAX_GAP_S + 2  # a flat line: one sample per MAX_GAP_S
 
 
 def test_perception_thresholds_are_drawn_as_plus_minus_lines(written):
@@ -137,6 +198,7 @@ def test_perception_thresholds_are_drawn_as_plus_minus_lines(written):
 
 
 def test_platform_traces_and_envelope_usage(written):
+    """Envelope usage within 0.002 (limit at 1), the per-axis traces within 0.2 % of each axis's limit."""
     path, data = written
     series = read_scalar_series(path)
     for q, fname, _unit in ENVELOPE_QUANTITIES:
@@ -144,15 +206,16 @@ def test_platform_traces_and_envelope_usage(written):
         t_lim, v_lim = series[f"/envelope/{q}/limit"]
         np.testing.assert_array_equal(v_lim, [1.0, 1.0])
         np.testing.assert_allclose(t_lim, data.t_s[[0, -1]], atol=1e-9)
-        _, usage = series[envelope_usage_path(q)]
-        assert usage.shape == (data.t_s.size, len(WASHOUTS))
+        t_u, usage = series[envelope_usage_path(q)]
+        assert usage.shape[1] == len(WASHOUTS)
+        expected = [np.linalg.norm(getattr(data.platforms[w], fname) / limit, ord=np.inf, axis=1) for w in WASHOUTS]
+        assert_recorded(t_u, usage, data.t_s, np.column_stack(expected), 0.002)
         for i, w in enumerate(WASHOUTS):
             values = getattr(data.platforms[w], fname)
-            expected = np.linalg.norm(values / limit, ord=np.inf, axis=1)
-            np.testing.assert_allclose(usage[:, i], expected, rtol=1e-15)
             if q == "position":  # first sample: x, y at 0.3 of 1.5 m, z at 0.9 of its own 1.0 m limit
-                assert usage[0, i] == 0.9
-            np.testing.assert_array_equal(series[platform_path(w, q)][1], values)  # random data: every sample kept
+                assert usage[0, i] == np.float32(0.9)
+            t_p, v_p = series[platform_path(w, q)]
+            assert_recorded(t_p, v_p, data.t_s, values, PLATFORM_DETAIL_TOLERANCE * np.broadcast_to(limit, (3,)))
             np.testing.assert_array_equal(series[f"/platform/{w}/{q}/limit_max"][1], [limit, limit])
             np.testing.assert_array_equal(series[f"/platform/{w}/{q}/limit_min"][1], [-limit, -limit])
             if limit.ndim:  # per-axis limits are drawn one line per axis
@@ -162,8 +225,7 @@ def test_platform_traces_and_envelope_usage(written):
 
 
 def test_smooth_platform_traces_are_thinned_within_the_stated_tolerance(tmp_path):
-    """Position and velocity that interpolate linearly within 0.2 % of the limit keep every 2nd-4th sample; the
-    recorded samples are exact and linear interpolation between them reproduces every step within the tolerance."""
+    """Smooth position and velocity keep a few per cent of the steps; random acceleration keeps (nearly) all."""
     base = make_data(n=1200)
     t = base.t_s
     smooth = np.column_stack([np.sin(0.5 * t), 0.5 * np.cos(0.3 * t), 0.2 * np.sin(t)])
@@ -177,14 +239,9 @@ def test_smooth_platform_traces_are_thinned_within_the_stated_tolerance(tmp_path
     for w in WASHOUTS:
         for q, values, limit in (("position", smooth, (1.5, 1.5, 1.0)), ("velocity", 0.5 * smooth, (2.0,) * 3)):
             t_rec, v_rec = series[platform_path(w, q)]
-            assert t.size / 4 <= t_rec.size < t.size / 2  # thinned
-            assert t_rec[0] == 0.0 and abs(t_rec[-1] - t[-1]) < 1e-9
-            k = np.round(t_rec * 120).astype(int)
-            np.testing.assert_array_equal(v_rec, values[k])
-            for j in range(3):
-                err = np.abs(np.interp(t, t_rec, v_rec[:, j]) - values[:, j])
-                assert err.max() <= PLATFORM_DETAIL_TOLERANCE * limit[j] + 1e-12
-        assert series[platform_path(w, "acceleration")][0].size == t.size  # random: every sample
+            assert t_rec.size < t.size / 10  # thinned
+            assert_recorded(t_rec, v_rec, t, values, PLATFORM_DETAIL_TOLERANCE * np.array(limit))
+        assert series[platform_path(w, "acceleration")][0].size > 0.9 * t.size  # random: (nearly) every sample
 
 
 def _state_at(t_change: np.ndarray, states: np.ndarray, t: np.ndarray) -> np.ndarray:
@@ -502,8 +559,10 @@ def test_write_time_15000_samples_three_washouts(tmp_path):
     elapsed = time.perf_counter() - start
     size_mb = (tmp_path / "big.rrd").stat().st_size / 1e6
     print(f"\nwrite_recording: 15,000 samples x 3 washouts in {elapsed:.3f} s, {size_mb:.1f} MB")
-    series = read_scalar_series(tmp_path / "big.rrd")
-    assert len(series[perceived_path("yaw")][1][:, 3]) == 15_000
+    t_rec, v_rec = read_scalar_series(tmp_path / "big.rrd")[perceived_path("yaw")]
+    sources = [data.aircraft, *data.washouts.values()]
+    expected = np.column_stack([np.rad2deg(m.perceived_omega_radps[:, 2]) for m in sources])
+    assert_recorded(t_rec, v_rec, data.t_s, expected, motion_tolerance_typed("yaw"))
 
 
 def test_rerun_disabled_by_environment_is_an_error_not_an_empty_file(tmp_path):

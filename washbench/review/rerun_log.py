@@ -30,6 +30,7 @@ row (one time and one row id for all of them), which is most of what a recording
 
 from __future__ import annotations
 
+import math
 import uuid
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -54,6 +55,7 @@ from washbench.review.blueprint import (
     source_colors,
 )
 from washbench.review.rrd_read import read_component, read_properties, read_scalar_series, read_text_documents
+from washbench.review.thinning import keep_samples
 
 __all__ = [
     "AIRCRAFT",
@@ -107,11 +109,21 @@ ENVELOPE_QUANTITIES: tuple[tuple[str, str, str], ...] = (
 )
 """Platform quantities with an envelope: (name in entity paths, field of PlatformSeries / PlatformEnvelope, unit)."""
 
+VALUE_DTYPE = np.float32
+"""Every time-varying scalar is rounded to this type before it is recorded (rerun stores it as float64): 24 bits,
+seven significant digits, more than a plot or a tooltip shows; exact values stay in traces.parquet."""
+
+THRESHOLD_FRACTION = 0.01
+"""Perceived and raw motion: interpolation tolerance as a fraction of the DOF's perception threshold."""
+
+ENVELOPE_TOLERANCE = 0.002
+"""Envelope usage (dimensionless, limit at 1): interpolation tolerance."""
+
 PLATFORM_DETAIL_TOLERANCE = 0.002
-"""The per-axis platform traces may be thinned (to every 2nd-4th sample) where linear interpolation between the
-recorded samples reproduces every step within this fraction of the axis's limit; envelope usage, perceived and raw
-motion keep every step."""
-PLATFORM_MAX_STRIDE = 4
+"""Per-axis platform traces: interpolation tolerance as a fraction of the axis's limit."""
+
+MAX_GAP_S = 1.0
+"""Recorded samples of one series are at most this far apart, s (a tooltip in the viewer is never far from one)."""
 
 PROPERTIES = "provenance"
 """Name of the recording property that holds the caller's provenance strings."""
@@ -311,19 +323,28 @@ def _time_column(t_s: np.ndarray) -> rr.TimeColumn:
 def _series(
     rec: rr.RecordingStream,
     path: str,
-    time: rr.TimeColumn,
+    t_s: np.ndarray,
     values: np.ndarray,
     names: list[str],
     colors: list[tuple[int, int, int]],
     widths: list[float],
+    tolerance: np.ndarray | float,
     aggregation: str | None = None,
 ) -> None:
-    """One entity, one row per time, one scalar per named line: ``values`` (N,) or (N, len(names))."""
+    """One entity, one row per recorded time, one scalar per named line: ``values`` (N,) or (N, len(names)).
+
+    Values are rounded to float32 (:data:`VALUE_DTYPE`), then thinned (:func:`thinning.keep_samples`): the rows kept
+    interpolate linearly to every step within ``tolerance`` (a number or one per line), at most :data:`MAX_GAP_S`
+    apart. The tolerance is stored with the entity (static component ``interpolation_tolerance``, one per line).
+    """
+    v = np.asarray(values, dtype=VALUE_DTYPE).astype(np.float64)
+    lines = 1 if v.ndim == 1 else v.shape[1]
+    tol = np.broadcast_to(np.asarray(tolerance, dtype=np.float64), (lines,))
+    dt = float(t_s[1] - t_s[0]) if t_s.size > 1 else 1.0
+    idx = keep_samples(v, tol, max(1, math.floor(MAX_GAP_S / dt + 1e-9)))
     style = rr.SeriesLines(colors=colors, names=names, widths=widths, aggregation_policy=aggregation)
-    rec.log(path, style, static=True, strict=True)
-    rec.send_columns(
-        path, indexes=[time], columns=rr.Scalars.columns(scalars=np.asarray(values, np.float64)), strict=True
-    )
+    rec.log(path, style, rr.AnyValues(interpolation_tolerance=tol), static=True, strict=True)
+    rec.send_columns(path, indexes=[_time_column(t_s[idx])], columns=rr.Scalars.columns(scalars=v[idx]), strict=True)
 
 
 def _limit_line(
@@ -367,10 +388,15 @@ def _dof_columns(data: RecordingData) -> tuple[list[np.ndarray], list[np.ndarray
     return perceived, raw
 
 
+def motion_tolerance(thresholds: Thresholds) -> list[float]:
+    """Per DOF (in :data:`DOFS` order, recording units): the interpolation tolerance of the perceived and raw motion,
+    :data:`THRESHOLD_FRACTION` of the DOF's perception threshold."""
+    return [THRESHOLD_FRACTION * th for _, th in _threshold_lines(thresholds)]
+
+
 def _send_motion(
     rec: rr.RecordingStream,
     data: RecordingData,
-    time: rr.TimeColumn,
     perceived: list[np.ndarray],
     raw: list[np.ndarray],
 ) -> None:
@@ -378,9 +404,10 @@ def _send_motion(
     colors = source_colors(list(data.washouts))
     widths = [AIRCRAFT_WIDTH] + [WASHOUT_WIDTH] * len(data.washouts)
     t_s = np.asarray(data.t_s, dtype=np.float64)
-    for (dof, _, _, _), p, r, (centre, th) in zip(DOFS, perceived, raw, _threshold_lines(data.thresholds), strict=True):
-        _series(rec, perceived_path(dof), time, p, names, colors, widths)
-        _series(rec, raw_path(dof), time, r, names, colors, widths)
+    lines, tols = _threshold_lines(data.thresholds), motion_tolerance(data.thresholds)
+    for (dof, _, _, _), p, r, (centre, th), tol in zip(DOFS, perceived, raw, lines, tols, strict=True):
+        _series(rec, perceived_path(dof), t_s, p, names, colors, widths, tol)
+        _series(rec, raw_path(dof), t_s, r, names, colors, widths, tol)
         _limit_line(
             rec,
             f"/perceived/{dof}/threshold",
@@ -405,9 +432,7 @@ def _usage(data: RecordingData) -> dict[str, np.ndarray]:
     return out
 
 
-def _send_platforms(
-    rec: rr.RecordingStream, data: RecordingData, time: rr.TimeColumn, usage: dict[str, np.ndarray]
-) -> None:
+def _send_platforms(rec: rr.RecordingStream, data: RecordingData, usage: dict[str, np.ndarray]) -> None:
     t_s = np.asarray(data.t_s, dtype=np.float64)
     washouts = list(data.washouts)
     colors = [series_color(w, washouts) for w in washouts]
@@ -416,37 +441,18 @@ def _send_platforms(
         axes = _axis_names(q)
         uniform = bool(np.all(limit == limit[0]))
         _limit_line(rec, f"/envelope/{q}/limit", t_s, [1.0], [f"limit (+-{_limit_text(limit)} {unit})"])
-        _series(rec, envelope_usage_path(q), time, usage[q], washouts, colors, [WASHOUT_WIDTH] * len(washouts), "Max")
+        widths = [WASHOUT_WIDTH] * len(washouts)
+        _series(rec, envelope_usage_path(q), t_s, usage[q], washouts, colors, widths, ENVELOPE_TOLERANCE, "Max")
         for w in washouts:
-            values = np.asarray(getattr(data.platforms[w], fname), dtype=np.float64)
-            idx = detail_samples(values, PLATFORM_DETAIL_TOLERANCE * limit)
-            # an (M, 3) array is sent as M rows of three scalars
-            axes_time = time if idx.size == t_s.size else _time_column(t_s[idx])
-            _series(rec, platform_path(w, q), axes_time, values[idx], list(axes), list(AXIS_COLORS), [1.5] * 3)
+            values = getattr(data.platforms[w], fname)  # (N, 3): N rows of three scalars
+            tol = PLATFORM_DETAIL_TOLERANCE * limit
+            _series(rec, platform_path(w, q), t_s, values, list(axes), list(AXIS_COLORS), [1.5] * 3, tol)
             for sign, end, bound in (("+", "max", limit), ("-", "min", -limit)):
                 line_path = f"/platform/{w}/{q}/limit_{end}"
                 if uniform:  # one line for all axes
                     _limit_line(rec, line_path, t_s, [bound[0]], [f"{sign}limit"])
                 else:  # one line per axis, in the axis colours
                     _limit_line(rec, line_path, t_s, list(bound), [f"{sign}{a} limit" for a in axes], list(AXIS_COLORS))
-
-
-def detail_samples(values: np.ndarray, tolerance: np.ndarray, max_stride: int = PLATFORM_MAX_STRIDE) -> np.ndarray:
-    """Indices of the samples of ``values`` (N, k) to record: every s-th and the last, for the largest s up to
-    ``max_stride`` whose linear interpolation reproduces every sample within ``tolerance`` (k,); else all."""
-    n = values.shape[0]
-    k = np.arange(n, dtype=np.float64)
-    for stride in range(max_stride, 1, -1):
-        idx = np.unique(np.append(np.arange(0, n, stride), n - 1))
-        if idx.size < 2:
-            break
-        ok = all(
-            np.max(np.abs(np.interp(k, idx, values[idx, j]) - values[:, j])) <= tolerance[j]
-            for j in range(values.shape[1])
-        )
-        if ok:
-            return idx
-    return np.arange(n)
 
 
 def _limit_text(limit: np.ndarray) -> str:
@@ -608,9 +614,8 @@ def write_recording(path: Path, data: RecordingData, properties: Mapping[str, st
             rec.send_recording_name(data.title)
             if props:
                 rec.send_property(PROPERTIES, rr.AnyValues(**props))
-            time = _time_column(data.t_s)
-            _send_motion(rec, data, time, perceived, raw)
-            _send_platforms(rec, data, time, _usage(data))
+            _send_motion(rec, data, perceived, raw)
+            _send_platforms(rec, data, _usage(data))
             _send_lanes(rec, data)
             scene3d.send_scene(
                 rec,

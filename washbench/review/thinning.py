@@ -1,0 +1,84 @@
+"""Which samples of a trace a recording needs: linear interpolation between the kept ones within a tolerance.
+
+A viewer draws a time series as straight lines between its samples. Where a signal moves slowly, most of the steps
+of a 120 Hz or 1 kHz trace lie on those lines to far below a pixel; :func:`keep_samples` keeps the fewest it can so
+that linear interpolation (in time) between the kept samples reproduces every step within a per-column tolerance.
+The kept samples are the original values (not a fit), so a reader gets the exact value at every kept step and an
+interpolation within the tolerance at every other; where the signal moves fast every step is kept.
+
+The algorithm is the "swinging door" of process historians: from the last kept sample (the anchor), the slope to
+each later sample must stay inside the band of slopes that pass within the tolerance of every sample in between;
+the first sample that leaves it makes its predecessor the next anchor. One pass, O(rows x columns), compiled.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+__all__ = ["keep_samples"]
+
+
+@njit("b1[:](f8[:, :], f8[:], i8)", cache=True)
+def _keep(values: np.ndarray, tolerance: np.ndarray, max_gap: int) -> np.ndarray:  # pragma: no cover - compiled
+    n, k = values.shape
+    keep = np.zeros(n, dtype=np.bool_)
+    if n == 0:
+        return keep
+    keep[0] = True
+    keep[n - 1] = True
+    lo = np.empty(k)
+    hi = np.empty(k)
+    a = 0
+    lo[:] = -np.inf
+    hi[:] = np.inf
+    i = 1
+    while i < n:
+        finite = True
+        for j in range(k):
+            if not (np.isfinite(values[i, j]) and np.isfinite(values[a, j])):
+                finite = False
+        if not finite:  # gaps and their ends are kept as they are
+            keep[i - 1] = True
+            keep[i] = True
+            a = i
+            lo[:] = -np.inf
+            hi[:] = np.inf
+            i += 1
+            continue
+        d = i - a
+        ok = d <= max_gap
+        if ok:
+            for j in range(k):
+                slope = (values[i, j] - values[a, j]) / d
+                if slope < lo[j] or slope > hi[j]:
+                    ok = False
+                    break
+        if ok:
+            for j in range(k):
+                lo[j] = max(lo[j], (values[i, j] - tolerance[j] - values[a, j]) / d)
+                hi[j] = min(hi[j], (values[i, j] + tolerance[j] - values[a, j]) / d)
+            i += 1
+        else:  # the predecessor becomes the anchor; the line to its neighbour i always passes
+            a = i - 1
+            keep[a] = True
+            lo[:] = -np.inf
+            hi[:] = np.inf
+    return keep
+
+
+def keep_samples(values: np.ndarray, tolerance: np.ndarray | float, max_gap: int) -> np.ndarray:
+    """Indices of the rows of ``values`` (N, k) to record, sorted, always with the first and the last.
+
+    Linear interpolation (in the row index, i.e. in time on a uniform grid) between the kept rows reproduces every
+    row within ``tolerance`` (a number or one per column, in the values' unit, >= 0) in every column; at most
+    ``max_gap`` rows apart (>= 1); rows with a non-finite value are kept with their neighbours. Tolerance 0 keeps
+    every row that is not exactly on the line between its neighbours (up to rounding).
+    """
+    v = np.ascontiguousarray(values, dtype=np.float64)
+    if v.ndim == 1:
+        v = v.reshape(-1, 1)
+    tol = np.array(np.broadcast_to(np.asarray(tolerance, dtype=np.float64), (v.shape[1],)))
+    if not np.all(tol >= 0) or max_gap < 1:
+        raise ValueError(f"tolerance must be >= 0 and max_gap >= 1, got {tol.tolist()}, {max_gap}")
+    return np.flatnonzero(_keep(v, tol, int(max_gap)))
