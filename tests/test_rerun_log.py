@@ -97,13 +97,19 @@ def written(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, RecordingDa
 
 
 def assert_recorded(
-    t_rec: np.ndarray, v_rec: np.ndarray, t_s: np.ndarray, values: np.ndarray, tolerance: float | np.ndarray
+    t_rec: np.ndarray,
+    v_rec: np.ndarray,
+    t_s: np.ndarray,
+    values: np.ndarray,
+    tolerance: float | np.ndarray,
+    ulps: int = 0,
 ) -> None:
     """The stated precision of a recorded series against the values it came from (``values`` (N,) or (N, L) at the
     times ``t_s``): every recorded time is one of ``t_s`` (to 0.5 ns), the first and the last among them, none more
     than MAX_GAP_S after the previous; each recorded value equals float32(value) exactly; linear interpolation between
     the recorded samples is within ``tolerance`` of float32(value) at every step, so within tolerance plus float32's
-    half step (2^-24 relative) of the value itself."""
+    half step (2^-24 relative) of the value itself. ``ulps``: recorded values may be this many float32 steps off
+    (for values that reached the recording by another float64 path than ``values``)."""
     values = np.asarray(values, dtype=np.float64).reshape(t_s.size, -1)
     v_rec = np.asarray(v_rec).reshape(t_rec.size, -1)
     assert v_rec.dtype == np.float64 and v_rec.shape[1] == values.shape[1]
@@ -112,15 +118,18 @@ def assert_recorded(
     assert k[0] == 0 and k[-1] == t_s.size - 1 and np.all(np.diff(k) > 0)
     assert np.all(np.diff(t_rec) <= rerun_log.MAX_GAP_S + 1e-9)
     f32 = values.astype(np.float32).astype(np.float64)
-    np.testing.assert_array_equal(v_rec, f32[k])
+    if ulps:
+        step = np.spacing(np.abs(f32[k]).astype(np.float32)).astype(np.float64)
+        assert np.all(np.abs(v_rec - f32[k]) <= ulps * step)
+    else:
+        np.testing.assert_array_equal(v_rec, f32[k])
     tol = np.broadcast_to(np.asarray(tolerance, dtype=np.float64), (values.shape[1],))
     for j in range(values.shape[1]):
         err = np.abs(np.interp(t_s, t_rec, v_rec[:, j]) - f32[:, j])
-        assert err.max() <= tol[j] * (1 + 1e-9) + 1e-12, (j, err.max(), tol[j])
-        assert np.all(
-            np.abs(np.interp(t_s, t_rec, v_rec[:, j]) - values[:, j])
-            <= tol[j] + 2.0**-24 * np.abs(values[:, j]) + 1e-12
-        )
+        slack = ulps * np.spacing(np.abs(f32[:, j]).astype(np.float32)).astype(np.float64)
+        assert np.all(err <= tol[j] * (1 + 1e-9) + 1e-12 + slack), (j, err.max(), tol[j])
+        off = np.abs(np.interp(t_s, t_rec, v_rec[:, j]) - values[:, j])
+        assert np.all(off <= tol[j] * (1 + 1e-9) + 2.0**-24 * np.abs(values[:, j]) + 1e-12 + slack)
 
 
 def motion_tolerance_typed(dof: str) -> float:

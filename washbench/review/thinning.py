@@ -9,6 +9,10 @@ interpolation within the tolerance at every other; where the signal moves fast e
 The algorithm is the "swinging door" of process historians: from the last kept sample (the anchor), the slope to
 each later sample must stay inside the band of slopes that pass within the tolerance of every sample in between;
 the first sample that leaves it makes its predecessor the next anchor. One pass, O(rows x columns), compiled.
+
+Data a viewer holds rather than interpolates (3D poses: the view shows the latest pose at or before the time cursor)
+is thinned by :func:`keep_changes` instead: a sample is kept where it differs from the last kept one by more than
+the tolerance.
 """
 
 from __future__ import annotations
@@ -16,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["keep_samples"]
+__all__ = ["keep_changes", "keep_samples"]
 
 
 @njit("b1[:](f8[:, :], f8[:], i8)", cache=True)
@@ -82,3 +86,37 @@ def keep_samples(values: np.ndarray, tolerance: np.ndarray | float, max_gap: int
     if not np.all(tol >= 0) or max_gap < 1:
         raise ValueError(f"tolerance must be >= 0 and max_gap >= 1, got {tol.tolist()}, {max_gap}")
     return np.flatnonzero(_keep(v, tol, int(max_gap)))
+
+
+@njit("b1[:](f8[:, :], f8[:], i8)", cache=True)
+def _changes(values: np.ndarray, tolerance: np.ndarray, max_gap: int) -> np.ndarray:  # pragma: no cover - compiled
+    n, k = values.shape
+    keep = np.zeros(n, dtype=np.bool_)
+    if n == 0:
+        return keep
+    keep[0] = True
+    keep[n - 1] = True
+    a = 0
+    for i in range(1, n):
+        moved = i - a >= max_gap
+        for j in range(k):
+            if not (abs(values[i, j] - values[a, j]) <= tolerance[j]):  # also where either is not finite
+                moved = True
+        if moved:
+            keep[i] = True
+            a = i
+    return keep
+
+
+def keep_changes(values: np.ndarray, tolerance: np.ndarray | float, max_gap: int) -> np.ndarray:
+    """Indices of the rows of ``values`` (N, k) to record for a viewer that holds the latest row (zero-order hold):
+    a row is kept where some column differs from the last kept row by more than ``tolerance`` (a number or one per
+    column, >= 0), or ``max_gap`` rows after it; always the first and the last. Holding the kept rows reproduces every
+    row within the tolerance."""
+    v = np.ascontiguousarray(values, dtype=np.float64)
+    if v.ndim == 1:
+        v = v.reshape(-1, 1)
+    tol = np.array(np.broadcast_to(np.asarray(tolerance, dtype=np.float64), (v.shape[1],)))
+    if not np.all(tol >= 0) or max_gap < 1:
+        raise ValueError(f"tolerance must be >= 0 and max_gap >= 1, got {tol.tolist()}, {max_gap}")
+    return np.flatnonzero(_changes(v, tol, int(max_gap)))
