@@ -32,10 +32,8 @@ def test_non_finite_values_are_kept_with_their_neighbours():
     v[40] = np.nan
     idx = keep_samples(v, 0.01, max_gap=1000)
     assert {39, 40, 41} <= set(idx.tolist())
-    ok = np.isfinite(v)
     seg = np.arange(41, 100)
     np.testing.assert_allclose(np.interp(seg, idx[idx >= 41], v[idx[idx >= 41]]), v[seg], atol=0.01)
-    assert ok.sum() == 99
 
 
 def test_held_rows_stay_within_the_tolerance():

@@ -4,9 +4,9 @@ A recording holds, on one timeline named ``time`` (a duration, seconds since the
 the nanosecond):
 
 - ``/perceived/<dof>``: perceived motion in one degree of freedom (surge, sway, heave in m/s^2; roll, pitch, yaw in
-  deg/s), one row per step with one scalar per source: the aircraft pilot first, then each washout's simulator pilot in
-  the order of ``RecordingData.washouts`` (:func:`sources`); ``/perceived/<dof>/threshold`` the perception threshold as
-  two lines (+-threshold around 0, around -g for heave);
+  deg/s), one row per recorded step with one scalar per source: the aircraft pilot first, then each washout's
+  simulator pilot in the order of ``RecordingData.washouts`` (:func:`sources`); ``/perceived/<dof>/threshold`` the
+  perception threshold as two lines (+-threshold around 0, around -g for heave);
 - ``/raw/<dof>``: the same layout for the unperceived specific force and angular velocity;
 - ``/envelope/<quantity>``: platform envelope usage, max over the three axes of |value| / limit, one scalar per
   washout (``quantity`` in position, velocity, acceleration, wheels), drawn with Max aggregation, and the limit line
@@ -21,10 +21,17 @@ the nanosecond):
   starting with its time (the viewer's time column is narrow);
 - ``/metrics``: the metric table as a Markdown document; the recording properties ``provenance`` (strings).
 
-Precision: every scalar is stored as float64, bit-equal to the traces it came from (angular rates converted to deg/s
-once, ``np.rad2deg``); times to the nanosecond; 3D poses as float32 (rerun's type) at most at 30 Hz. All time-varying
-data is sent as whole columns (``send_columns``), never one ``log`` call per sample; the sources of one panel share one
-row (one time and one row id for all of them), which is most of what a recording weighs. The review blueprint
+Precision: every time-varying scalar is rounded to float32 (:data:`VALUE_DTYPE`; rerun stores it as float64) after
+the angular rates are converted to deg/s once (``np.rad2deg``), and only the steps that linear interpolation needs are
+recorded (:func:`washbench.review.thinning.keep_samples`, at least one every :data:`MAX_GAP_S`): at each recorded step
+the value is float32(trace value) exactly, and interpolating between recorded steps reproduces every step within
+:data:`THRESHOLD_FRACTION` (1 %) of the DOF's perception threshold for perceived and raw motion,
+:data:`ENVELOPE_TOLERANCE` (0.002) for envelope usage and :data:`PLATFORM_DETAIL_TOLERANCE` (0.2 %) of each axis's
+limit for the platform traces; the tolerance is stored with each entity (static component ``interpolation_tolerance``,
+one per line). Where signals move fast every step is kept. Times are k * dt to the nanosecond; 3D poses float32
+(rerun's type), at most at 30 Hz and held within 0.1 deg and 1 mm (:mod:`washbench.review.scene3d`). Exact values are
+in traces.parquet. All time-varying data is sent as whole columns (``send_columns``), never one ``log`` call per
+sample; the sources of one panel share one row (one time and one row id for all of them). The review blueprint
 (:mod:`washbench.review.blueprint`) is stored in the same file.
 """
 
@@ -68,6 +75,7 @@ __all__ = [
     "RecordingData",
     "envelope_usage_path",
     "limit_lane_path",
+    "motion_tolerance",
     "perceived_path",
     "phase_lane_path",
     "platform_path",
