@@ -25,7 +25,8 @@ Precision: every time-varying scalar is rounded to float32 (:data:`VALUE_DTYPE`;
 the angular rates are converted to deg/s once (``np.rad2deg``), and only the steps that linear interpolation needs are
 recorded (:func:`washbench.review.thinning.keep_samples`, at least one every :data:`MAX_GAP_S`): at each recorded step
 the value is float32(trace value) exactly, and interpolating between recorded steps reproduces every step within
-:data:`THRESHOLD_FRACTION` (1 %) of the DOF's perception threshold for perceived and raw motion,
+:data:`THRESHOLD_FRACTION` (1 %) of the DOF's perception threshold or :data:`PANEL_FRACTION` (0.2 %) of its panel's
+height, whichever is smaller, for perceived and raw motion,
 :data:`ENVELOPE_TOLERANCE` (0.002) for envelope usage and :data:`PLATFORM_DETAIL_TOLERANCE` (0.2 %) of each axis's
 limit for the platform traces; the tolerance is stored with each entity (static component ``interpolation_tolerance``,
 one per line). Where signals move fast every step is kept. Times are k * dt to the nanosecond; 3D poses float32
@@ -39,7 +40,7 @@ from __future__ import annotations
 
 import math
 import uuid
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -122,7 +123,11 @@ VALUE_DTYPE = np.float32
 seven significant digits, more than a plot or a tooltip shows; exact values stay in traces.parquet."""
 
 THRESHOLD_FRACTION = 0.01
-"""Perceived and raw motion: interpolation tolerance as a fraction of the DOF's perception threshold."""
+"""Perceived and raw motion: interpolation tolerance at most this fraction of the DOF's perception threshold..."""
+
+PANEL_FRACTION = 0.002
+"""...and at most this fraction of the height (y range) of the panel that shows it: 0.2 pixels in a panel 100 pixels
+tall, one pixel in a panel 500 pixels tall."""
 
 ENVELOPE_TOLERANCE = 0.002
 """Envelope usage (dimensionless, limit at 1): interpolation tolerance."""
@@ -396,10 +401,13 @@ def _dof_columns(data: RecordingData) -> tuple[list[np.ndarray], list[np.ndarray
     return perceived, raw
 
 
-def motion_tolerance(thresholds: Thresholds) -> list[float]:
-    """Per DOF (in :data:`DOFS` order, recording units): the interpolation tolerance of the perceived and raw motion,
-    :data:`THRESHOLD_FRACTION` of the DOF's perception threshold."""
-    return [THRESHOLD_FRACTION * th for _, th in _threshold_lines(thresholds)]
+def motion_tolerance(thresholds: Thresholds, ranges: Sequence[tuple[float, float]]) -> list[float]:
+    """Per DOF (in :data:`DOFS` order, recording units): the interpolation tolerance of a motion panel with the y
+    ``ranges`` (lo, hi) per DOF: :data:`THRESHOLD_FRACTION` of the DOF's perception threshold or
+    :data:`PANEL_FRACTION` of the panel's height, whichever is smaller."""
+    lines = _threshold_lines(thresholds)
+    pairs = zip(lines, ranges, strict=True)
+    return [min(THRESHOLD_FRACTION * th, PANEL_FRACTION * (hi - lo)) for (_, th), (lo, hi) in pairs]
 
 
 def _send_motion(
@@ -407,15 +415,18 @@ def _send_motion(
     data: RecordingData,
     perceived: list[np.ndarray],
     raw: list[np.ndarray],
+    layout: Layout,
 ) -> None:
     names = sources(data)
     colors = source_colors(list(data.washouts))
     widths = [AIRCRAFT_WIDTH] + [WASHOUT_WIDTH] * len(data.washouts)
     t_s = np.asarray(data.t_s, dtype=np.float64)
-    lines, tols = _threshold_lines(data.thresholds), motion_tolerance(data.thresholds)
-    for (dof, _, _, _), p, r, (centre, th), tol in zip(DOFS, perceived, raw, lines, tols, strict=True):
-        _series(rec, perceived_path(dof), t_s, p, names, colors, widths, tol)
-        _series(rec, raw_path(dof), t_s, r, names, colors, widths, tol)
+    lines = _threshold_lines(data.thresholds)
+    tol_p = motion_tolerance(data.thresholds, layout.perceived_ranges)
+    tol_r = motion_tolerance(data.thresholds, layout.raw_ranges)
+    for (dof, _, _, _), p, r, (centre, th), tp, tr in zip(DOFS, perceived, raw, lines, tol_p, tol_r, strict=True):
+        _series(rec, perceived_path(dof), t_s, p, names, colors, widths, tp)
+        _series(rec, raw_path(dof), t_s, r, names, colors, widths, tr)
         _limit_line(
             rec,
             f"/perceived/{dof}/threshold",
@@ -615,14 +626,15 @@ def write_recording(path: Path, data: RecordingData, properties: Mapping[str, st
             )
         )
     perceived, raw = _dof_columns(data)
-    blueprint = build_blueprint(_layout(data, perceived, raw))
+    layout = _layout(data, perceived, raw)
+    blueprint = build_blueprint(layout)
     with atomic_path(path) as tmp:
         try:
             rec.save(tmp, default_blueprint=blueprint)
             rec.send_recording_name(data.title)
             if props:
                 rec.send_property(PROPERTIES, rr.AnyValues(**props))
-            _send_motion(rec, data, perceived, raw)
+            _send_motion(rec, data, perceived, raw, layout)
             _send_platforms(rec, data, _usage(data))
             _send_lanes(rec, data)
             scene3d.send_scene(
