@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import pyarrow.parquet as pq
 import pytest
-from report_helpers import check_images, check_tables
+from report_helpers import check_images, check_tables, without_pdf_links
 
 from washbench.io.paths import DATA_DIR
 from washbench.io.provenance import PARQUET_KEY
@@ -178,7 +178,9 @@ def test_report_is_regenerated_from_the_files_alone(run_dir: Path, inputs: dict[
         for f in inputs.values():
             shutil.move(hidden / f.name, f)
     assert proc.returncode == 0, proc.stderr
-    assert (copy / "report.md").read_text() == (run_dir / "report.md").read_text()
+    # the same report, with the PDF versions the run left to `washbench report` now linked
+    assert without_pdf_links((copy / "report.md").read_text()) == (run_dir / "report.md").read_text()
+    assert check_images(copy / "report.md", vector=True) == 2
     for name in ("perceived.png", "envelope.png"):
         assert (copy / "figures" / name).read_bytes() == (run_dir / "figures" / name).read_bytes(), name
 

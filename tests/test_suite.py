@@ -10,7 +10,7 @@ import sys
 from pathlib import Path
 
 import pytest
-from report_helpers import check_images, check_tables
+from report_helpers import check_images, check_tables, without_pdf_links
 
 from washbench.io.paths import MANOEUVRES_DIR
 
@@ -89,8 +89,11 @@ def test_report_command_rebuilds_the_suite_report(
         [sys.executable, "-m", "washbench", "report", str(copy)], capture_output=True, text=True, timeout=600
     )
     assert proc.returncode == 0, proc.stderr
-    assert (copy / "report.md").read_text() == (out / "report.md").read_text()
+    assert without_pdf_links((copy / "report.md").read_text()) == (out / "report.md").read_text()
     assert (copy / "c172p" / "stall_recovery" / "figures" / "perceived.png").is_file()
+    assert check_images(copy / "report.md", vector=True) == 2 + 2  # every figure now with its PDF
+    for name in ("coordinated_turn", "stall_recovery"):
+        assert check_images(copy / "c172p" / name / "report.md", vector=True) == 2
 
 
 def test_ranking_and_comparison_tables(first: tuple[Path, subprocess.CompletedProcess[str]]) -> None:

@@ -80,8 +80,8 @@ def _entries(suite_dir: Path) -> tuple[list[dict[str, Any]], dict[str, Any]]:
 def write_suite_report(suite_dir: Path, *, regenerate_results: bool = False) -> Path:
     """Write the suite's ``report.md`` and ``figures/`` from the suite folder's files; return the report's path.
 
-    ``regenerate_results``: first write every result folder's own report and figures again (``washbench report``);
-    otherwise the figures the runs wrote are linked.
+    ``regenerate_results`` (``washbench report``): first write every result folder's own report and figures again,
+    and every figure as PNG and PDF; otherwise the PNG figures the runs wrote are linked and the suite's are PNG.
     """
     from washbench.review.figures import score_heatmap, table4_figure
 
@@ -92,8 +92,8 @@ def write_suite_report(suite_dir: Path, *, regenerate_results: bool = False) -> 
         folder = suite_dir / e["result"] if e.get("result") else None
         if folder is not None and is_result_folder(folder):
             if regenerate_results:
-                write_result_report(folder)
-            results.append((e, load_result(folder)))
+                write_result_report(folder, pdf=True)
+            results.append((e, load_result(folder, series=False)))
         else:
             results.append((e, None))
     loaded = [d for _, d in results if d is not None]
@@ -103,6 +103,10 @@ def write_suite_report(suite_dir: Path, *, regenerate_results: bool = False) -> 
 
     fig_dir = suite_dir / FIGURES_DIR
     fig_dir.mkdir(exist_ok=True)
+    formats = ("png", "pdf") if regenerate_results else ("png",)
+    if not regenerate_results:
+        for stem in ("scores", "table4"):
+            (fig_dir / f"{stem}.pdf").unlink(missing_ok=True)
     figures: dict[str, Path] = {}
     labels = [d.title + (" (FAILED)" if d.ok is False else "") for d in loaded]
     if loaded:
@@ -110,7 +114,7 @@ def write_suite_report(suite_dir: Path, *, regenerate_results: bool = False) -> 
         for r, d in enumerate(loaded):
             for row in rankings[id(d)]:
                 scores[r, washouts.index(row.washout)] = row.score
-        figures["scores"] = score_heatmap(fig_dir / "scores", labels, washouts, scores)[0]
+        figures["scores"] = score_heatmap(fig_dir / "scores", labels, washouts, scores, formats=formats)[0]
         others = [w for w in washouts if w != reference]
         if others:
             better = {w: np.full((len(loaded), len(METRICS) * len(DOFS)), math.nan) for w in others}
@@ -121,7 +125,9 @@ def write_suite_report(suite_dir: Path, *, regenerate_results: bool = False) -> 
                     for w, diff in c.better_than_reference.items():
                         if math.isfinite(diff) and ref != 0:
                             better[w][r, col] = 100.0 * diff / ref
-            figures["table4"] = table4_figure(fig_dir / "table4", labels, reference, better, DOFS, METRICS)[0]
+            figures["table4"] = table4_figure(
+                fig_dir / "table4", labels, reference, better, DOFS, METRICS, formats=formats
+            )[0]
 
     ok = [e for e, d in results if e.get("ok", d.ok if d else False)]
     lines = ["# washbench suite report", ""]
@@ -199,5 +205,5 @@ def _existing_figures(d: ResultData) -> dict[str, Path]:
     found = {name: d.folder / FIGURES_DIR / f"{name}.png" for name in ("perceived", "envelope")}
     found = {k: p for k, p in found.items() if p.is_file()}
     if "perceived" not in found:
-        return result_figures(d)
+        return result_figures(load_result(d.folder) if len(d.perceived) <= 1 else d)
     return found

@@ -414,10 +414,10 @@ def write_outputs(
                     props = flat_strings(provenance, created) if provenance else None
                     write_run_recording(tmp[RECORDING_FILE], title, seg.motion, result, limits, q, [], props)
                 summaries.append(summary)
-        for summary in summaries:  # last, as a suite's report: each written atomically once the rest is in place
-            if not opts.recording:  # a recording of an earlier run would not show these results
-                (summary.run_dir / RECORDING_FILE).unlink(missing_ok=True)
-            write_run_review(summary.run_dir, summary, str(input_path))
+        for summary, result in zip(summaries, results, strict=True):  # last, as a suite's report: each written
+            if not opts.recording:  # atomically once the rest is in place; a recording of an earlier run would not
+                (summary.run_dir / RECORDING_FILE).unlink(missing_ok=True)  # show these results
+            write_run_review(summary.run_dir, summary, str(input_path), result.columns())
     except OSError as exc:
         raise WashbenchError(located(out_dir, f"cannot write results: {exc.strerror or exc}")) from None
     return summaries

@@ -327,7 +327,7 @@ def write_cued_folder(
         saturations={w: dict(traces[w].saturation_counts) for w in washouts},
     )
     write_run_json(folder / "run.json", summary, time.perf_counter() - start, extra)
-    write_run_review(folder, dataclasses.replace(summary, run_dir=folder))
+    write_run_review(folder, dataclasses.replace(summary, run_dir=folder), table=result.columns())
     return summary
 
 

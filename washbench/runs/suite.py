@@ -39,10 +39,11 @@ import signal
 import sys
 import time
 import traceback
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from washbench.analysis.ranking import (
     DOFS,
@@ -498,17 +499,20 @@ def _swap_in(stage: Path, out_dir: Path, previous: Sequence[Path]) -> None:
         shutil.rmtree(old, ignore_errors=True)
 
 
-def write_run_review(run_dir: Path, summary: RunSummary, source: str = "") -> None:
+def write_run_review(
+    run_dir: Path, summary: RunSummary, source: str = "", table: Mapping[str, Any] | None = None
+) -> None:
     """``ranking.csv`` and ``report.md`` of one result folder (the same tables as a suite's, for one run).
 
     The one call site for a result folder's report (``washbench run`` and ``washbench cue``); the report and its
-    figures are built from the folder's files (:func:`washbench.review.report.write_result_report`).
+    figures are built from the folder's files (:func:`washbench.review.report.write_result_report`), with the
+    traces.parquet columns taken from ``table`` when the caller still holds them.
     """
     from washbench.review.report import write_result_report
 
     rankings = {(summary.aircraft, summary.manoeuvre): rank(summary.metrics, summary.motion)} if summary.metrics else {}
     write_text_atomic(run_dir / "ranking.csv", ranking_table(rankings))
-    write_result_report(run_dir)
+    write_result_report(run_dir, table)
 
 
 def suite_command(
