@@ -13,6 +13,7 @@ import pytest
 from report_helpers import check_images, check_tables, without_pdf_links
 
 from washbench.io.paths import MANOEUVRES_DIR
+from washbench.review.report import NO_FIGURES
 
 GOOD = [MANOEUVRES_DIR / "c172" / "coordinated_turn.yaml", MANOEUVRES_DIR / "c172" / "stall_recovery.yaml"]
 
@@ -136,3 +137,14 @@ def test_bad_arguments_are_one_line(tmp_path: Path) -> None:
     proc = suite(tmp_path / "nope", "--out", tmp_path / "o")
     assert proc.returncode == 2
     assert proc.stderr.strip().count("\n") == 0 and "no such file or folder" in proc.stderr
+
+
+def test_suite_without_figures_or_recordings(tmp_path: Path) -> None:
+    out = tmp_path / "lean"
+    proc = suite(GOOD[0], "--out", out, "--jobs", "1", "--no-figures", "--no-recording")
+    assert proc.returncode == 0, proc.stderr
+    assert not list(out.rglob("figures")) and not list(out.rglob("*.png")) and not list(out.rglob("*.rrd"))
+    text = (out / "report.md").read_text()
+    assert NO_FIGURES in text and "## Summary" in text and check_tables(out / "report.md") >= 2
+    (run,) = [p.parent for p in out.rglob("run.json")]
+    assert NO_FIGURES in (run / "report.md").read_text()

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 import os
+import shutil
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -266,6 +267,9 @@ def result_figures(data: ResultData, pdf: bool = False) -> dict[str, Path]:
     return out
 
 
+NO_FIGURES = "_No figures were drawn (`--no-figures`): `washbench report` on this folder draws them from its files._"
+
+
 def _image(png: Path, start: Path, alt: str) -> list[str]:
     """The figure embedded, and its PDF linked when there is one (else how to get it)."""
     rel = _rel(png, start)
@@ -293,13 +297,15 @@ def result_sections(
         "(Zacharias 1978) around the resting value, what lies between them is not felt; shaded: the phases.",
         "",
     ]
-    lines += _image(figures["perceived"], start, "perceived motion")
+    lines += _image(figures["perceived"], start, "perceived motion") if "perceived" in figures else [NO_FIGURES, ""]
     lines += [f"{h} Metrics", "", *metric_tables(data)]
     lines += [f"{h} Platform", ""]
     if brief:
         pass
     elif "envelope" in figures:
         lines += _image(figures["envelope"], start, "platform envelope")
+    elif not figures:
+        pass
     else:
         lines += ["_No platform limits are recorded with this result: no envelope figure._", ""]
     lines += [f"Time at a limit ({sig(data.duration_s)} s manoeuvre):", "", *saturation_lines(data)]
@@ -322,13 +328,18 @@ def _status_line(data: ResultData) -> list[str]:
     return []
 
 
-def write_result_report(result_dir: Path, table: Mapping[str, np.ndarray] | None = None, pdf: bool = False) -> Path:
+def write_result_report(
+    result_dir: Path, table: Mapping[str, np.ndarray] | None = None, pdf: bool = False, figures: bool = True
+) -> Path:
     """Write ``report.md`` and ``figures/`` for one result folder from its files; return the report's path.
 
-    ``table``: the traces.parquet columns already in memory (not read again); ``pdf``: PDF figures besides the PNG.
+    ``table``: the traces.parquet columns already in memory (not read again); ``pdf``: PDF figures besides the PNG;
+    ``figures=False``: none drawn (``--no-figures``; figures of an earlier run in the folder are removed).
     """
-    data = load_result(Path(result_dir), table)
-    figures = result_figures(data, pdf)
+    data = load_result(Path(result_dir), table, series=figures)
+    if not figures:
+        shutil.rmtree(data.folder / FIGURES_DIR, ignore_errors=True)
+    drawn = result_figures(data, pdf) if figures else {}
     lines = [f"# {data.title}", "", *_status_line(data)]
     checks = f", checks {sum(bool(c.get('passed')) for c in data.checks)}/{len(data.checks)}" if data.checks else ""
     status = {True: "ok", False: "FAILED", None: "cued"}[data.ok]
@@ -338,7 +349,7 @@ def write_result_report(result_dir: Path, table: Mapping[str, np.ndarray] | None
         "",
     ]
     lines += provenance_lines(data.provenance, data.created_utc)
-    lines += result_sections(data, figures, data.folder, 2)
+    lines += result_sections(data, drawn, data.folder, 2)
     path = data.folder / REPORT_FILE
     write_text_atomic(path, "\n".join(lines).rstrip() + "\n")
     return path

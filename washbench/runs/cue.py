@@ -273,6 +273,7 @@ class CueOptions:
     filter_start: str = "steady"
     strict: bool = False
     recording: bool = True
+    figures: bool = True
 
 
 @dataclass(frozen=True, eq=False)
@@ -417,7 +418,7 @@ def write_outputs(
         for summary, result in zip(summaries, results, strict=True):  # last, as a suite's report: each written
             if not opts.recording:  # atomically once the rest is in place; a recording of an earlier run would not
                 (summary.run_dir / RECORDING_FILE).unlink(missing_ok=True)  # show these results
-            write_run_review(summary.run_dir, summary, str(input_path), result.columns())
+            write_run_review(summary.run_dir, summary, str(input_path), result.columns(), opts.figures)
     except OSError as exc:
         raise WashbenchError(located(out_dir, f"cannot write results: {exc.strerror or exc}")) from None
     return summaries
