@@ -52,7 +52,7 @@ def main() -> None:
     files = find_manoeuvres(args.inputs)
     with tempfile.TemporaryDirectory() as tmp:
         start = time.perf_counter()
-        outcomes = run_suite(files, Path(tmp), jobs=args.jobs, progress=False, recording=not args.no_recording)
+        outcomes = run_suite(files, Path(tmp), jobs=args.jobs, progress=False, outputs=outputs)
         write_suite_results(outcomes, Path(tmp), figures=outputs.figures)
         suite_s = time.perf_counter() - start
     failed = [o for o in outcomes if not o.run.ok]
