@@ -14,12 +14,14 @@ the post-processing:
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import math
 import sys
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any, Protocol
 
 import numpy as np
@@ -79,20 +81,70 @@ class TraceLike(Protocol):
     saturation_counts: Mapping[str, int]
 
 
+CHUNK_ROWS = 32768
+"""Rows of traces.parquet built and written at a time (one Parquet row group each): the table is never whole in
+memory, whatever the length of the input."""
+
+
 @dataclass(frozen=True, eq=False)
 class CueResult:
     """Everything ``washbench cue`` computes for one input trace.
 
     ``perceived``: pilot name (``"aircraft"`` or a washout name) -> perceived motion;
-    ``metrics``: six rows per washout (:mod:`washbench.analysis.metrics`); ``table``: the traces.parquet
-    columns in order (:mod:`washbench.io.results`); ``traces``: the washout traces themselves.
+    ``metrics``: six rows per washout (:mod:`washbench.analysis.metrics`); ``traces``: the washout traces
+    themselves; :meth:`columns` the traces.parquet columns (:mod:`washbench.io.results`) of a range of rows, built
+    on demand so the whole table never has to exist at once.
     """
 
     motion: Motion
     traces: Mapping[str, TraceLike]
     perceived: Mapping[str, Perceived]
     metrics: list[MetricRow]
-    table: dict[str, np.ndarray]
+    arrays: Mapping[str, Mapping[str, np.ndarray]] = field(default_factory=dict, repr=False)
+    """washout -> the trace's fields as checked float64 arrays (:func:`analyse`); else read from ``traces``."""
+
+    @property
+    def n(self) -> int:
+        """Number of samples."""
+        return self.motion.n
+
+    def columns(self, start: int = 0, stop: int | None = None) -> dict[str, np.ndarray]:
+        """The traces.parquet columns, in order, for rows ``start:stop`` (views where no unit changes)."""
+        rows = slice(start, self.n if stop is None else stop)
+        m = self.motion
+        table: dict[str, np.ndarray] = {TIME_COLUMN: m.t_s[rows]}
+        _put(table, f_columns(AIRCRAFT), m.f_mps2[rows])
+        omega_deg = m.omega_degps[rows] if m.omega_degps is not None else np.degrees(m.omega_radps[rows])
+        _put(table, omega_columns(AIRCRAFT), omega_deg)
+        ac = self.perceived[AIRCRAFT]
+        _put(table, perceived_f_columns(AIRCRAFT), ac.f_mps2[rows])
+        _put(table, perceived_omega_columns(AIRCRAFT), ac.omega_radps[rows] * _DEG)
+        for name, tr in self.traces.items():
+            p = self.perceived[name]
+            arr = self.arrays.get(name)
+            trace: Any = SimpleNamespace(**arr) if arr else tr
+            _put(table, f_columns(name), trace.head_f_mps2[rows])
+            _put(table, omega_columns(name), trace.head_omega_radps[rows] * _DEG)
+            _put(table, perceived_f_columns(name), p.f_mps2[rows])
+            _put(table, perceived_omega_columns(name), p.omega_radps[rows] * _DEG)
+            _put(table, pos_columns(name), trace.pos_m[rows])
+            _put(table, vel_columns(name), trace.vel_mps[rows])
+            _put(table, acc_columns(name), trace.acc_mps2[rows])
+            _put(table, q_columns(name), trace.q[rows])
+            _put(table, omega_platform_columns(name), trace.omega_radps[rows] * _DEG)
+            _put(table, wheel_columns(name), trace.wheel_radps[rows])
+            _put(table, sp_pos_columns(name), trace.sp_pos_m[rows])
+            _put(table, sp_q_columns(name), trace.sp_q[rows])
+            for kind, flags in tr.saturated.items():
+                table[sat_column(name, kind)] = np.asarray(flags)[rows].astype(np.int8)
+        for col, values in m.extra.items():
+            table[col] = values[rows]
+        return table
+
+    def column_chunks(self, rows: int = CHUNK_ROWS) -> Iterator[dict[str, np.ndarray]]:
+        """:meth:`columns` for consecutive ranges of ``rows`` rows (at least one range, even for no rows)."""
+        for a in range(0, max(self.n, 1), rows):
+            yield self.columns(a, min(self.n, a + rows))
 
 
 _TRACE_FIELDS = {
@@ -139,46 +191,29 @@ def analyse(
     model = VestibularModel(motion.dt_s, vestibular)
     n = motion.n
     perceived: dict[str, Perceived] = {AIRCRAFT: model.perceive(motion.f_mps2, motion.omega_radps, filter_start)}
-    table: dict[str, np.ndarray] = {TIME_COLUMN: motion.t_s}
-    _put(table, f_columns(AIRCRAFT), motion.f_mps2)
-    _put(table, omega_columns(AIRCRAFT), motion.omega_degps_out())
-    _put(table, perceived_f_columns(AIRCRAFT), perceived[AIRCRAFT].f_mps2)
-    _put(table, perceived_omega_columns(AIRCRAFT), perceived[AIRCRAFT].omega_radps * _DEG)
     rows: list[MetricRow] = []
     ac = perceived[AIRCRAFT]
+    checked: dict[str, dict[str, np.ndarray]] = {}
     for name, trace in traces.items():
         arr = _checked_trace(name, trace, n)
+        for kind, flags in trace.saturated.items():
+            if np.shape(flags) != (n,):
+                raise ValueError(f"washout {name!r}: saturated[{kind!r}] has shape {np.shape(flags)}, expected ({n},)")
         p = model.perceive(arr["head_f_mps2"], arr["head_omega_radps"], filter_start)
         perceived[name] = p
         rows += dof_metrics(name, ac.f_mps2, ac.omega_radps, p.f_mps2, p.omega_radps, motion.dt_s)
-        _put(table, f_columns(name), arr["head_f_mps2"])
-        _put(table, omega_columns(name), arr["head_omega_radps"] * _DEG)
-        _put(table, perceived_f_columns(name), p.f_mps2)
-        _put(table, perceived_omega_columns(name), p.omega_radps * _DEG)
-        _put(table, pos_columns(name), arr["pos_m"])
-        _put(table, vel_columns(name), arr["vel_mps"])
-        _put(table, acc_columns(name), arr["acc_mps2"])
-        _put(table, q_columns(name), arr["q"])
-        _put(table, omega_platform_columns(name), arr["omega_radps"] * _DEG)
-        _put(table, wheel_columns(name), arr["wheel_radps"])
-        _put(table, sp_pos_columns(name), arr["sp_pos_m"])
-        _put(table, sp_q_columns(name), arr["sp_q"])
-        for kind, flags in trace.saturated.items():
-            flags = np.asarray(flags)
-            if flags.shape != (n,):
-                raise ValueError(f"washout {name!r}: saturated[{kind!r}] has shape {flags.shape}, expected ({n},)")
-            table[sat_column(name, kind)] = flags.astype(np.int8)
-    for col, values in motion.extra.items():
-        if col in table:
+        checked[name] = arr
+    result = CueResult(motion=motion, traces=dict(traces), perceived=perceived, metrics=rows, arrays=checked)
+    own = set(dataclasses.replace(result, motion=dataclasses.replace(motion, extra={})).columns(0, 0))
+    for col in motion.extra:
+        if col in own:
             raise WashbenchError(f"input column {col!r} clashes with a result column of the same name")
-        table[col] = values
-    return CueResult(motion=motion, traces=dict(traces), perceived=perceived, metrics=rows, table=table)
+    return result
 
 
 def _put(table: dict[str, np.ndarray], names: Sequence[str], values: np.ndarray) -> None:
-    columns = np.ascontiguousarray(values.T)  # one transposing copy, then each column is a contiguous row
     for i, name in enumerate(names):
-        table[name] = columns[i]
+        table[name] = values[:, i]
 
 
 def cue_motion(
@@ -215,7 +250,7 @@ def write_results(out_dir: Path, result: CueResult, provenance: Mapping[str, Any
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
         with atomic_path(traces_path) as tmp_traces, atomic_path(metrics_path) as tmp_metrics:
-            write_traces(tmp_traces, result.table, parquet_metadata(provenance) if provenance else None)
+            write_traces(tmp_traces, result.column_chunks(), parquet_metadata(provenance) if provenance else None)
             write_metrics_csv(tmp_metrics, result.metrics)
     except OSError as exc:
         raise WashbenchError(located(out_dir, f"cannot write results: {exc.strerror or exc}")) from None
@@ -238,6 +273,7 @@ class CueOptions:
     filter_start: str = "steady"
     strict: bool = False
     recording: bool = True
+    figures: bool = True
 
 
 @dataclass(frozen=True, eq=False)
@@ -358,7 +394,8 @@ def write_outputs(
                 names = (TRACES_FILE, METRICS_FILE, "run.json") + ((RECORDING_FILE,) if opts.recording else ())
                 tmp = {name: stack.enter_context(atomic_path(folder / name)) for name in names}
                 summary = segment_summary(input_path, seg, result, folder)
-                write_traces(tmp[TRACES_FILE], result.table, parquet_metadata(provenance) if provenance else None)
+                meta = parquet_metadata(provenance) if provenance else None
+                write_traces(tmp[TRACES_FILE], result.column_chunks(), meta)
                 write_metrics_csv(tmp[METRICS_FILE], result.metrics)
                 extra = {
                     "input": str(input_path),
@@ -378,10 +415,10 @@ def write_outputs(
                     props = flat_strings(provenance, created) if provenance else None
                     write_run_recording(tmp[RECORDING_FILE], title, seg.motion, result, limits, q, [], props)
                 summaries.append(summary)
-        for summary in summaries:  # last, as a suite's report: each written atomically once the rest is in place
-            if not opts.recording:  # a recording of an earlier run would not show these results
-                (summary.run_dir / RECORDING_FILE).unlink(missing_ok=True)
-            write_run_review(summary.run_dir, summary, str(input_path))
+        for summary, result in zip(summaries, results, strict=True):  # last, as a suite's report: each written
+            if not opts.recording:  # atomically once the rest is in place; a recording of an earlier run would not
+                (summary.run_dir / RECORDING_FILE).unlink(missing_ok=True)  # show these results
+            write_run_review(summary.run_dir, summary, str(input_path), result.columns(), opts.figures)
     except OSError as exc:
         raise WashbenchError(located(out_dir, f"cannot write results: {exc.strerror or exc}")) from None
     return summaries
