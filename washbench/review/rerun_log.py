@@ -38,7 +38,6 @@ sample; the sources of one panel share one row (one time and one row id for all 
 
 from __future__ import annotations
 
-import math
 import uuid
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -353,8 +352,7 @@ def _series(
     v = np.asarray(values, dtype=VALUE_DTYPE).astype(np.float64)
     lines = 1 if v.ndim == 1 else v.shape[1]
     tol = np.broadcast_to(np.asarray(tolerance, dtype=np.float64), (lines,))
-    dt = float(t_s[1] - t_s[0]) if t_s.size > 1 else 1.0
-    idx = keep_samples(v, tol, max(1, math.floor(MAX_GAP_S / dt + 1e-9)))
+    idx = keep_samples(t_s, v, tol, MAX_GAP_S + 1e-9)
     style = rr.SeriesLines(colors=colors, names=names, widths=widths, aggregation_policy=aggregation)
     rec.log(path, style, rr.AnyValues(interpolation_tolerance=tol), static=True, strict=True)
     rec.send_columns(path, indexes=[_time_column(t_s[idx])], columns=rr.Scalars.columns(scalars=v[idx]), strict=True)

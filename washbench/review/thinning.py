@@ -23,8 +23,14 @@ from numba import njit
 __all__ = ["keep_changes", "keep_samples"]
 
 
-@njit("b1[:](f8[:, :], f8[:], i8)", cache=True)
-def _keep(values: np.ndarray, tolerance: np.ndarray, max_gap: int) -> np.ndarray:  # pragma: no cover - compiled
+def _float_array(a: np.ndarray) -> np.ndarray:
+    """C-contiguous, writable float64 (the compiled kernels take no read-only arrays, e.g. Arrow's zero-copy views)."""
+    out = np.ascontiguousarray(a, dtype=np.float64)
+    return out if out.flags.writeable else out.copy()
+
+
+@njit("b1[:](f8[:], f8[:, :], f8[:], f8)", cache=True)
+def _keep(t: np.ndarray, values: np.ndarray, tolerance: np.ndarray, max_gap: float) -> np.ndarray:  # pragma: no cover
     n, k = values.shape
     keep = np.zeros(n, dtype=np.bool_)
     if n == 0:
@@ -50,8 +56,8 @@ def _keep(values: np.ndarray, tolerance: np.ndarray, max_gap: int) -> np.ndarray
             hi[:] = np.inf
             i += 1
             continue
-        d = i - a
-        ok = d <= max_gap
+        d = t[i] - t[a]
+        ok = i == a + 1 or d <= max_gap  # the line to the neighbour always passes
         if ok:
             for j in range(k):
                 slope = (values[i, j] - values[a, j]) / d
@@ -63,7 +69,7 @@ def _keep(values: np.ndarray, tolerance: np.ndarray, max_gap: int) -> np.ndarray
                 lo[j] = max(lo[j], (values[i, j] - tolerance[j] - values[a, j]) / d)
                 hi[j] = min(hi[j], (values[i, j] + tolerance[j] - values[a, j]) / d)
             i += 1
-        else:  # the predecessor becomes the anchor; the line to its neighbour i always passes
+        else:  # the predecessor (after the anchor: i > a + 1 here) becomes the anchor
             a = i - 1
             keep[a] = True
             lo[:] = -np.inf
@@ -71,21 +77,23 @@ def _keep(values: np.ndarray, tolerance: np.ndarray, max_gap: int) -> np.ndarray
     return keep
 
 
-def keep_samples(values: np.ndarray, tolerance: np.ndarray | float, max_gap: int) -> np.ndarray:
-    """Indices of the rows of ``values`` (N, k) to record, sorted, always with the first and the last.
+def keep_samples(t: np.ndarray, values: np.ndarray, tolerance: np.ndarray | float, max_gap: float) -> np.ndarray:
+    """Indices of the rows of ``values`` (N, k) at the times ``t`` (N,) to record, sorted, always with the first and
+    the last.
 
-    Linear interpolation (in the row index, i.e. in time on a uniform grid) between the kept rows reproduces every
-    row within ``tolerance`` (a number or one per column, in the values' unit, >= 0) in every column; at most
-    ``max_gap`` rows apart (>= 1); rows with a non-finite value are kept with their neighbours. Tolerance 0 keeps
-    every row that is not exactly on the line between its neighbours (up to rounding).
+    Linear interpolation in ``t`` (strictly increasing, any spacing) between the kept rows reproduces every row within
+    ``tolerance`` (a number or one per column, in the values' unit, >= 0) in every column; kept rows are at most
+    ``max_gap`` apart in ``t`` (> 0) unless they are neighbours; rows with a non-finite value are kept with their
+    neighbours. Tolerance 0 keeps every row that is not exactly on the line between its neighbours (up to rounding).
     """
-    v = np.ascontiguousarray(values, dtype=np.float64)
+    v = _float_array(values)
     if v.ndim == 1:
         v = v.reshape(-1, 1)
+    x = _float_array(t)
     tol = np.array(np.broadcast_to(np.asarray(tolerance, dtype=np.float64), (v.shape[1],)))
-    if not np.all(tol >= 0) or max_gap < 1:
-        raise ValueError(f"tolerance must be >= 0 and max_gap >= 1, got {tol.tolist()}, {max_gap}")
-    return np.flatnonzero(_keep(v, tol, int(max_gap)))
+    if not np.all(tol >= 0) or not max_gap > 0 or x.shape != (v.shape[0],):
+        raise ValueError(f"tolerance must be >= 0, max_gap > 0 and t (N,), got {tol.tolist()}, {max_gap}, {x.shape}")
+    return np.flatnonzero(_keep(x, v, tol, float(max_gap)))
 
 
 @njit("b1[:](f8[:, :], f8[:], i8)", cache=True)
@@ -113,7 +121,7 @@ def keep_changes(values: np.ndarray, tolerance: np.ndarray | float, max_gap: int
     a row is kept where some column differs from the last kept row by more than ``tolerance`` (a number or one per
     column, >= 0), or ``max_gap`` rows after it; always the first and the last. Holding the kept rows reproduces every
     row within the tolerance."""
-    v = np.ascontiguousarray(values, dtype=np.float64)
+    v = _float_array(values)
     if v.ndim == 1:
         v = v.reshape(-1, 1)
     tol = np.array(np.broadcast_to(np.asarray(tolerance, dtype=np.float64), (v.shape[1],)))
