@@ -177,8 +177,8 @@ def run_manoeuvre(
         created = utc_now()
         flight = fly(manoeuvre, block_hook=lockstep, block_size=LOCKSTEP_BLOCK, progress=progress)
         n = len(flight.t_s)
-        if len(rows) != n:
-            raise RuntimeError(f"washouts ran {len(rows)} steps for {n} recorded samples")
+        if sample_count(rows) != n:
+            raise RuntimeError(f"washouts ran {sample_count(rows)} steps for {n} recorded samples")
         write_flight(partial, flight, str(manoeuvre_path), flight_prov)
         if n < 2:
             raise WashbenchError(located(manoeuvre_path, f"the flight recorded {n} sample(s): nothing to cue"))
@@ -271,20 +271,37 @@ def lockstep_blocks(
     specs: Sequence[Any], limits: Any, dt_s: float, filter_start: str = "steady"
 ) -> tuple[list[np.ndarray], Any]:
     """:func:`lockstep_washouts` for ``fly``'s block hook: the washouts take the flight's samples a block at a
-    time (``CueingBank.steps``, one compiled call per block); ``rows`` gets one (washouts, fields) row per sample."""
+    time (``CueingBank.steps``, one compiled call per block); ``rows`` gets one (washouts, M, fields) block per
+    call (:func:`sample_count`, :func:`stacked_rows`)."""
     from washbench.cueing import CueingBank
 
     bank = CueingBank(specs, None, limits, dt_s, filter_start)
     rows: list[np.ndarray] = []
+    done = [0]
 
     def lockstep(k0: int, f_mps2: np.ndarray, omega_radps: np.ndarray) -> None:
-        if k0 != len(rows):
-            raise RuntimeError(f"lockstep: block starts at sample {k0}, expected {len(rows)}")
+        if k0 != done[0]:
+            raise RuntimeError(f"lockstep: block starts at sample {k0}, expected {done[0]}")
         # The washouts see the angular velocity exactly as flight.parquet stores it (deg/s) and
         # washbench cue reads it back (np.radians), so both paths give the same bits.
-        rows.extend(bank.steps(f_mps2, np.radians(np.degrees(omega_radps))).transpose(1, 0, 2))
+        rows.append(bank.steps(f_mps2, np.radians(np.degrees(omega_radps))))
+        done[0] += f_mps2.shape[0]
 
     return rows, lockstep
+
+
+def sample_count(rows: list[np.ndarray]) -> int:
+    """Samples in the lockstep's ``rows``: (washouts, fields) rows, one a sample, or (washouts, M, fields) blocks."""
+    return sum(r.shape[1] if r.ndim == 3 else 1 for r in rows)
+
+
+def stacked_rows(rows: list[np.ndarray]) -> np.ndarray:
+    """The lockstep's ``rows`` as one (washouts, N, fields) array; ``rows`` is emptied (its blocks freed)."""
+    if not rows:
+        raise ValueError("no lockstep rows")
+    out = np.concatenate(rows, axis=1) if rows[0].ndim == 3 else np.stack(rows, axis=1)
+    rows.clear()
+    return out
 
 
 def write_cued_folder(
@@ -311,8 +328,9 @@ def write_cued_folder(
     from washbench.runs.suite import write_run_review
 
     motion = read_motion(folder / "flight.parquet")
-    block = np.stack(rows)  # (N, washouts, fields)
-    traces = {w: WashoutTrace.from_rows(block[:, i, :]) for i, w in enumerate(washouts)}
+    block = stacked_rows(rows)  # (washouts, N, fields); the lockstep's blocks are freed
+    traces = {w: WashoutTrace.from_rows(block[i]) for i, w in enumerate(washouts)}  # contiguous columns
+    del block
     result = analyse(motion, traces, filter_start=filter_start)
     write_results(folder, result, provenance)
     if outputs.recording:
