@@ -185,6 +185,7 @@ def fly(
 
     pilot = Pilot(profile, m.runway, dt)
     pilot.set_controls(ail_w.get_double_value(), elev_w.get_double_value(), rud_w.get_double_value())
+    pilot_step = pilot.step
     monitor = Monitor.for_profile(profile)
     openloop = OpenLoop(fdm, profile, pilot)
     probe_gets = [n.get_double_value for n in _nodes(fdm, tuple(probes))]
@@ -327,9 +328,10 @@ def fly(
                 if progress:  # a line at each phase start (in place on a terminal)
                     _progress(m.name, iphase, nphases, phase.name, t, tty)
 
-        ail, elev, rud, thr = pilot.aileron, pilot.elevator, pilot.rudder, pilot.throttle
-        if not final:
-            pilot.step(phi, theta, psi, p, q, r, beta, vc, vg, trk, hdot, h, agl, x_rw * 3.2808399,
+        if final:
+            ail, elev, rud, thr = pilot.aileron, pilot.elevator, pilot.rudder, pilot.throttle
+        else:
+            pilot_step(phi, theta, psi, p, q, r, beta, vc, vg, trk, hdot, h, agl, x_rw * 3.2808399,
                        y_rw * 3.2808399, wow, nz_last, alpha, vt_get(), fy_last)  # fmt: skip
             ail, elev, rud, thr = pilot.aileron, pilot.elevator, pilot.rudder, pilot.throttle
             if openloop.active:  # the phase's open-loop inputs, on top of or instead of the pilot's commands
@@ -342,8 +344,9 @@ def fly(
             if k % mix_every == 0:
                 mix_w.set_double_value(float(np.interp(h, mix_h_ft, mix_norm)))
         run()
-        for get, out in zip(probe_gets, probe_rows, strict=True):
-            out.append(get())
+        if probe_gets:
+            for get, out in zip(probe_gets, probe_rows, strict=True):
+                out.append(get())
         ax, ay, az = ax_get(), ay_get(), az_get()
         nz = nz_get()
         nz_last = nz
