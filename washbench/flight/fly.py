@@ -198,7 +198,7 @@ def fly(
     has_runway = setup.threshold_ne_m is not None
     rw_c = math.cos(setup.runway_heading_rad or 0.0)
     rw_s = math.sin(setup.runway_heading_rad or 0.0)
-    nan = math.nan
+    nan, pi, two_pi = math.nan, math.pi, 2 * math.pi
     mix_h_ft, mix_norm = zip(*profile.engine.mixture_schedule, strict=True)  # interpolated once a second
     mix_every = max(1, round(1.0 / dt))
     cg_h = profile.geometry.cg_height_on_ground_ft
@@ -287,10 +287,10 @@ def fly(
         # phase sequencing
         if iphase >= 0:
             d = psi - psi_prev
-            if d > math.pi:
-                d -= 2 * math.pi
-            elif d < -math.pi:
-                d += 2 * math.pi
+            if d > pi:
+                d -= two_pi
+            elif d < -pi:
+                d += two_pi
             turned += d
             rolled += 0.5 * (p_prev + p) * dt
             pitched += 0.5 * (q_prev + q) * dt

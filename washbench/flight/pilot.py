@@ -63,10 +63,6 @@ LAT_LEVEL, LAT_BANK, LAT_HEADING, LAT_RATE, LAT_TRACK = range(5)
 PITCH_HOLD, PITCH_ATT, PITCH_ALT, PITCH_VS, PITCH_GLIDE, PITCH_RATE, PITCH_FLARE, PITCH_SPEED, PITCH_NZ = range(9)
 
 
-def _clamp(x: float, lo: float, hi: float) -> float:
-    return lo if x < lo else hi if x > hi else x
-
-
 class Pilot:
     """Closed-loop pilot for one flight; ``begin_phase`` at each phase, ``step`` at every FDM step.
 
@@ -182,11 +178,6 @@ class Pilot:
         self.throttle = 0.0
         self.flaps_cmd = 0.0
         self.brakes = 0.0
-
-    def _vdot_cmd(self, vc: float, vt: float) -> float:
-        """The true-airspeed rate (kt/s) that closes the calibrated airspeed error in ``speed_tau_s``, limited."""
-        a = _clamp((self.speed_target - vc) / self.tau_v, -self.vdot_max, self.vdot_max)
-        return a * vt / vc if vc > 1.0 else a
 
     def set_controls(self, aileron: float, elevator: float, rudder: float) -> None:
         """Start from the control positions the trim left: outputs and integrators (bumpless start)."""
@@ -305,7 +296,14 @@ class Pilot:
         self.fy_f += (fy_mps2 - self.fy_f) * self.a_fy
         cphi = math.cos(phi)
         cth = math.cos(theta)
-        vdot_cmd = None  # _vdot_cmd(vc, vt), computed when first needed
+        if self.speed_on_throttle or self.pitch_mode == PITCH_SPEED:
+            # the true-airspeed rate (kt/s) that closes the calibrated airspeed error in speed_tau_s, limited
+            x = (self.speed_target - vc) / self.tau_v
+            vdot_max = self.vdot_max
+            x = -vdot_max if x < -vdot_max else vdot_max if x > vdot_max else x
+            vdot_cmd = x * vt / vc if vc > 1.0 else x
+        else:
+            vdot_cmd = 0.0  # not used
 
         # ---- lateral: bank -> roll rate -> aileron
         mode = self.lat_mode
@@ -377,7 +375,6 @@ class Pilot:
                 if mode == PITCH_SPEED:
                     # energy split: at a fixed throttle the power fixes gamma + vdot / g, so the path angle
                     # that gives the wanted acceleration differs from the present one by (vdot - vdot_cmd) / g
-                    vdot_cmd = self._vdot_cmd(vc, vt)
                     evs = (vdot - vdot_cmd) / G_KTPS
                 else:
                     if mode == PITCH_ALT:
@@ -419,8 +416,6 @@ class Pilot:
         if self.speed_on_throttle:
             # total energy: the throttle holds the specific energy rate gamma + vdot / g at what the path and
             # the speed commands need together (PI; the integrator stops where it would push a limit further)
-            if vdot_cmd is None:
-                vdot_cmd = self._vdot_cmd(vc, vt)
             e = path_err + (vdot_cmd - vdot) / G_KTPS
             thr = self.i_thr + self.kt * e
             if (thr < 1.0 or e < 0.0) and (thr > 0.0 or e > 0.0):
