@@ -96,6 +96,8 @@ class Pilot:
         self.th_max = g.pitch.pitch_max_deg * D2R
         self.n_hi = g.pitch.nz_pull_max if g.pitch.nz_pull_max is not None else math.inf
         self.n_lo = g.pitch.nz_push_min if g.pitch.nz_push_min is not None else -math.inf
+        # without limits the protection clamps nothing (q_hi is +inf or NaN, q_lo -inf or NaN): skipped
+        self.nz_protect = g.pitch.nz_pull_max is not None or g.pitch.nz_push_min is not None
         self.k_n = g.pitch.nz_kp
         self.k_n_i = g.pitch.nz_ki
         self.alpha_max = g.pitch.alpha_max_deg * D2R
@@ -296,6 +298,7 @@ class Pilot:
         self.fy_f += (fy_mps2 - self.fy_f) * self.a_fy
         cphi = math.cos(phi)
         cth = math.cos(theta)
+        sphi = math.sin(phi)
         if self.speed_on_throttle or self.pitch_mode == PITCH_SPEED:
             # the true-airspeed rate (kt/s) that closes the calibrated airspeed error in speed_tau_s, limited
             x = (self.speed_target - vc) / self.tau_v
@@ -399,9 +402,8 @@ class Pilot:
             q_max = self.q_max
             q_cmd = -q_max if x < -q_max else q_max if x > q_max else x
             if air and cphi > 0.2:
-                s = math.sin(phi)
-                q_cmd += g_v * s * s / cphi
-        if air:  # load-factor protection
+                q_cmd += g_v * sphi * sphi / cphi
+        if air and self.nz_protect:  # load-factor protection
             q_hi = g_v * (self.n_hi - z_down) + self.k_n * (self.n_hi - nz)
             q_lo = g_v * (self.n_lo - z_down) + self.k_n * (self.n_lo - nz)
             q_cmd = q_hi if q_cmd > q_hi else q_lo if q_cmd < q_lo else q_cmd
@@ -457,7 +459,7 @@ class Pilot:
             self.steer = self.steer_sign * self.rudder if wow else 0.0
             self.i_beta = -self.rudder
         else:
-            r_coord = g_v * math.sin(phi) * cth
+            r_coord = g_v * sphi * cth
             # rudder with the roll (aileron-rudder interconnect: against the adverse yaw), then PI on the sideslip
             rud = -self.k_ari * ail_ff - (self.i_beta + sc * self.kb * beta) + sc * self.kyd * (r - r_coord)
             if -1.0 < rud < 1.0:
