@@ -124,7 +124,10 @@ def main() -> None:
 
         t_lsim = best_of(lsim_all, 1)
         cmd = min(command_cpu_s(src, Path(tmp) / f"cmd{i}") for i in range(args.repeat))
-        bare_cmd = min(command_cpu_s(src, Path(tmp) / f"bare{i}", "--no-recording") for i in range(args.repeat))
+        no_rec = min(command_cpu_s(src, Path(tmp) / f"norec{i}", "--no-recording") for i in range(args.repeat))
+        no_fig = min(command_cpu_s(src, Path(tmp) / f"nofig{i}", "--no-figures") for i in range(args.repeat))
+        lean = min(command_cpu_s(src, Path(tmp) / f"lean{i}", "--no-recording", "--no-figures")
+                   for i in range(args.repeat))  # fmt: skip
         bare = min(bare_jsbsim_cpu_s(n) for _ in range(args.repeat))
 
     total = t_read + t_cue + t_analyse + t_write
@@ -139,7 +142,9 @@ def main() -> None:
     print(f"{t_lsim / t_vest:.1f}x slower)")
     print(f"washbench cue command, CPU s   {cmd:7.3f} s   {cmd / bare:6.2f} x bare JSBSim for {n} steps "
           f"({bare:.3f} s CPU; aim <= 1.5x; with recording, report and figures)")  # fmt: skip
-    print(f"  the same, --no-recording     {bare_cmd:7.3f} s   {bare_cmd / bare:6.2f} x bare JSBSim")
+    print(f"  the same, --no-recording     {no_rec:7.3f} s   {no_rec / bare:6.2f} x bare JSBSim")
+    print(f"  the same, --no-figures       {no_fig:7.3f} s   {no_fig / bare:6.2f} x bare JSBSim")
+    print(f"  the same, both               {lean:7.3f} s   {lean / bare:6.2f} x bare JSBSim")
 
 
 if __name__ == "__main__":

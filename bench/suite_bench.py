@@ -7,7 +7,7 @@ manoeuvre's own start (the same set-up the flight uses) and times bare ``fdm.run
 steps as the flight recorded, spread over the same number of processes. It prints both, their
 ratio, and the per-step figures.
 
-    .venv/bin/python bench/suite_bench.py [--jobs 2] [MANOEUVRE_OR_DIR ...]
+    .venv/bin/python bench/suite_bench.py [--jobs 2] [--no-recording] [--no-figures] [MANOEUVRE_OR_DIR ...]
 """
 
 from __future__ import annotations
@@ -41,15 +41,19 @@ def main() -> None:
     parser.add_argument("inputs", nargs="*", type=Path)
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
     parser.add_argument("--no-recording", action="store_true", help="run the suite without recording.rrd files")
+    parser.add_argument("--no-figures", action="store_true", help="run the suite without the reports' figures")
     args = parser.parse_args()
 
+    from washbench.runs.outputs import Outputs
     from washbench.runs.suite import find_manoeuvres, run_suite, write_suite_results
+
+    outputs = Outputs(recording=not args.no_recording, figures=not args.no_figures)
 
     files = find_manoeuvres(args.inputs)
     with tempfile.TemporaryDirectory() as tmp:
         start = time.perf_counter()
-        outcomes = run_suite(files, Path(tmp), jobs=args.jobs, progress=False, recording=not args.no_recording)
-        write_suite_results(outcomes, Path(tmp))
+        outcomes = run_suite(files, Path(tmp), jobs=args.jobs, progress=False, outputs=outputs)
+        write_suite_results(outcomes, Path(tmp), figures=outputs.figures)
         suite_s = time.perf_counter() - start
     failed = [o for o in outcomes if not o.run.ok]
     work = [(o.path, o.run.steps) for o in outcomes if o.run.steps]
@@ -59,7 +63,9 @@ def main() -> None:
         bare = list(pool.map(bare_run, *zip(*work, strict=True)))
     # the bare runs are independent: on `jobs` processes their wall time is their sum over `jobs`
     bare_s = sum(bare) / args.jobs
-    print(f"manoeuvres: {len(outcomes)} ({len(failed)} failed), JSBSim steps: {steps}, processes: {args.jobs}")
+    made = ", ".join(k for k, v in (("recordings", outputs.recording), ("figures", outputs.figures)) if v) or "neither"
+    print(f"manoeuvres: {len(outcomes)} ({len(failed)} failed), JSBSim steps: {steps}, processes: {args.jobs}; "
+          f"with {made}")  # fmt: skip
     print(f"washbench suite wall time: {suite_s:8.2f} s  ({suite_s / steps * args.jobs * 1e6:6.1f} us per step)")
     print(f"bare fdm.run() wall time:  {bare_s:8.2f} s  ({bare_s / steps * args.jobs * 1e6:6.1f} us per step)")
     print(f"ratio suite / bare JSBSim: {suite_s / bare_s:8.2f}")

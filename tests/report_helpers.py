@@ -17,8 +17,20 @@ def linked_files(report: Path) -> list[Path]:
     return [report.parent / t for t in targets if "://" not in t]
 
 
-def check_images(report: Path) -> int:
-    """Every linked figure exists and is a valid image; returns the number of PNGs."""
+PDF_HINT = "Vector versions for papers (PDF): `washbench report` on this folder."
+
+
+def without_pdf_links(text: str) -> str:
+    """A report's text with each PDF link replaced by the hint a run writes (``washbench report`` adds the PDFs)."""
+    return re.sub(r"Vector version for papers: \[[^]]+\.pdf\]\([^)]+\.pdf\)", PDF_HINT, text)
+
+
+def check_images(report: Path, vector: bool = False) -> int:
+    """Every linked figure exists and is a valid image; returns the number of PNGs.
+
+    ``vector``: each PNG has its PDF linked (``washbench report``); else none is linked and the report says how to
+    get them (``run``, ``cue``, ``suite`` write PNG only).
+    """
     files = linked_files(report)
     pngs = [f for f in files if f.suffix == ".png"]
     assert pngs, "the report embeds no figure"
@@ -30,9 +42,14 @@ def check_images(report: Path) -> int:
         assert image.ndim == 3 and image.shape[0] >= 200 and image.shape[1] >= 400, (f, image.shape)
         assert np.ptp(image[..., :3]) > 0.5, f"{f} is blank"
         pdf = f.with_suffix(".pdf")
-        assert pdf in files, f"no vector version linked for {f.name}"
-        data = pdf.read_bytes()
-        assert data.startswith(b"%PDF-") and data.rstrip().endswith(b"%%EOF"), pdf
+        if vector:
+            assert pdf in files, f"no vector version linked for {f.name}"
+            data = pdf.read_bytes()
+            assert data.startswith(b"%PDF-") and data.rstrip().endswith(b"%%EOF"), pdf
+        else:
+            assert pdf not in files and not pdf.exists(), f"{pdf.name}: a run writes PNG only"
+    if not vector:
+        assert report.read_text().count(PDF_HINT) == len(pngs), "the report does not say how to get the PDFs"
     return len(pngs)
 
 

@@ -16,14 +16,14 @@ from pathlib import Path
 import numpy as np
 import pyarrow.parquet as pq
 import pytest
-from report_helpers import check_images, check_tables
+from report_helpers import check_images, check_tables, without_pdf_links
 
 from washbench.io.paths import DATA_DIR
 from washbench.io.provenance import PARQUET_KEY
 from washbench.review.figures import minmax_decimate
 from washbench.review.numbers import sig
 from washbench.review.palette import AIRCRAFT_COLOR, WASHOUT_COLORS, washout_colors
-from washbench.review.report import write_result_report
+from washbench.review.report import NO_FIGURES, write_result_report
 
 MANOEUVRE = """\
 name: short_bank
@@ -178,7 +178,9 @@ def test_report_is_regenerated_from_the_files_alone(run_dir: Path, inputs: dict[
         for f in inputs.values():
             shutil.move(hidden / f.name, f)
     assert proc.returncode == 0, proc.stderr
-    assert (copy / "report.md").read_text() == (run_dir / "report.md").read_text()
+    # the same report, with the PDF versions the run left to `washbench report` now linked
+    assert without_pdf_links((copy / "report.md").read_text()) == (run_dir / "report.md").read_text()
+    assert check_images(copy / "report.md", vector=True) == 2
     for name in ("perceived.png", "envelope.png"):
         assert (copy / "figures" / name).read_bytes() == (run_dir / "figures" / name).read_bytes(), name
 
@@ -201,6 +203,28 @@ def test_cue_results_get_the_same_report(run_dir: Path, tmp_path: Path) -> None:
     assert "| sa_slow_tilt |" in text and "sa_slow_tilt vs small-angle (% better)" in text
     assert "| washouts | small-angle, sa_slow_tilt (small-angle) with its own values |" in text
     assert check_images(out / "report.md") == 2
+
+
+def test_no_figures_then_report_draws_them_with_their_pdfs(run_dir: Path, tmp_path: Path) -> None:
+    out = tmp_path / "lean"
+    proc = washbench("cue", run_dir / "flight.parquet", "--out", out, "--no-figures", "--no-recording")
+    assert proc.returncode == 0, proc.stderr
+    assert not (out / "figures").exists() and not (out / "recording.rrd").exists()
+    text = (out / "report.md").read_text()
+    assert NO_FIGURES in text and ".png" not in text
+    assert check_tables(out / "report.md") >= 5  # every table is still there
+    # the same cue with figures gives the same tables, and `washbench report` draws what --no-figures left out
+    full = tmp_path / "full"
+    assert washbench("cue", run_dir / "flight.parquet", "--out", full, "--no-recording").returncode == 0
+    def rows(t: str) -> list[str]:
+        return [ln for ln in t.splitlines() if ln.startswith("|") and not ln.startswith("| created |")]
+
+    assert rows(text) == rows((full / "report.md").read_text())
+    proc = washbench("report", out)
+    assert proc.returncode == 0, proc.stderr
+    assert check_images(out / "report.md", vector=True) == 2
+    for name in ("perceived.png", "envelope.png"):  # drawn from the files = drawn by the cue from memory
+        assert (out / "figures" / name).read_bytes() == (full / "figures" / name).read_bytes(), name
 
 
 def test_user_named_washouts_come_from_the_data(run_dir: Path, tmp_path: Path) -> None:

@@ -10,9 +10,10 @@ import sys
 from pathlib import Path
 
 import pytest
-from report_helpers import check_images, check_tables
+from report_helpers import check_images, check_tables, without_pdf_links
 
 from washbench.io.paths import MANOEUVRES_DIR
+from washbench.review.report import NO_FIGURES
 
 GOOD = [MANOEUVRES_DIR / "c172" / "coordinated_turn.yaml", MANOEUVRES_DIR / "c172" / "stall_recovery.yaml"]
 
@@ -89,8 +90,11 @@ def test_report_command_rebuilds_the_suite_report(
         [sys.executable, "-m", "washbench", "report", str(copy)], capture_output=True, text=True, timeout=600
     )
     assert proc.returncode == 0, proc.stderr
-    assert (copy / "report.md").read_text() == (out / "report.md").read_text()
+    assert without_pdf_links((copy / "report.md").read_text()) == (out / "report.md").read_text()
     assert (copy / "c172p" / "stall_recovery" / "figures" / "perceived.png").is_file()
+    assert check_images(copy / "report.md", vector=True) == 2 + 2  # every figure now with its PDF
+    for name in ("coordinated_turn", "stall_recovery"):
+        assert check_images(copy / "c172p" / name / "report.md", vector=True) == 2
 
 
 def test_ranking_and_comparison_tables(first: tuple[Path, subprocess.CompletedProcess[str]]) -> None:
@@ -133,3 +137,14 @@ def test_bad_arguments_are_one_line(tmp_path: Path) -> None:
     proc = suite(tmp_path / "nope", "--out", tmp_path / "o")
     assert proc.returncode == 2
     assert proc.stderr.strip().count("\n") == 0 and "no such file or folder" in proc.stderr
+
+
+def test_suite_without_figures_or_recordings(tmp_path: Path) -> None:
+    out = tmp_path / "lean"
+    proc = suite(GOOD[0], "--out", out, "--jobs", "1", "--no-figures", "--no-recording")
+    assert proc.returncode == 0, proc.stderr
+    assert not list(out.rglob("figures")) and not list(out.rglob("*.png")) and not list(out.rglob("*.rrd"))
+    text = (out / "report.md").read_text()
+    assert NO_FIGURES in text and "## Summary" in text and check_tables(out / "report.md") >= 2
+    (run,) = [p.parent for p in out.rglob("run.json")]
+    assert NO_FIGURES in (run / "report.md").read_text()

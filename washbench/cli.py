@@ -12,6 +12,7 @@ import os
 import signal
 import sys
 from pathlib import Path
+from typing import Any
 
 from washbench.cueing.params import WASHOUT_KINDS
 from washbench.errors import Terminated, WashbenchError
@@ -115,7 +116,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
     p.add_argument("--quiet", action="store_true", help="no progress display")
-    p.add_argument("--no-recording", action="store_true", help="do not write recording.rrd (smaller, faster)")
+    _output_options(p)
 
     p = sub.add_parser("suite", help="run many manoeuvres in parallel and compare the washouts")
     p.add_argument(
@@ -135,7 +136,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
     p.add_argument("--dask", metavar="ADDRESS", help="run on this Dask scheduler instead of local processes")
     p.add_argument("--quiet", action="store_true", help="no progress display")
-    p.add_argument("--no-recording", action="store_true", help="do not write the recording.rrd files")
+    _output_options(p)
 
     p = sub.add_parser("omct", help="Objective Motion Cueing Test: gain and phase of each washout, Bode plots")
     p.add_argument("--out", type=Path, required=True, help="output folder (omct.csv, bode_<test>.png, report.md)")
@@ -225,7 +226,20 @@ def _cue_input_options(p: argparse.ArgumentParser) -> None:
                    help="filters start in the first sample's steady state (default) or at rest")  # fmt: skip
     g = p.add_argument_group("checks and outputs")
     g.add_argument("--strict", action="store_true", help="plausibility warnings are errors")
-    g.add_argument("--no-recording", action="store_true", help="do not write recording.rrd")
+    _output_options(g)
+
+
+def _output_options(p: Any) -> None:
+    """--no-recording and --no-figures (run, suite, cue): the optional parts of a result folder."""
+    p.add_argument("--no-recording", action="store_true", help="do not write recording.rrd (smaller, faster)")
+    p.add_argument("--no-figures", action="store_true",
+                   help="report.md without figures (faster; `washbench report DIR` draws them later)")  # fmt: skip
+
+
+def _outputs(args: argparse.Namespace) -> Any:
+    from washbench.runs.outputs import Outputs
+
+    return Outputs(recording=not args.no_recording, figures=not args.no_figures)
 
 
 def _cue(args: argparse.Namespace) -> int:
@@ -242,6 +256,7 @@ def _cue(args: argparse.Namespace) -> int:
         filter_start=args.filter_start,
         strict=args.strict,
         recording=not args.no_recording,
+        figures=not args.no_figures,
     )
     return run_cue(
         args.input,
@@ -315,7 +330,7 @@ def _dispatch(args: argparse.Namespace) -> int:
             params_path=args.params,
             platform_path=args.platform,
             progress=not args.quiet,
-            recording=not args.no_recording,
+            outputs=_outputs(args),
             max_time_s=args.max_time_s,
             filter_start=args.filter_start,
             washouts=args.washout,
@@ -332,7 +347,7 @@ def _dispatch(args: argparse.Namespace) -> int:
             params_path=args.params,
             platform_path=args.platform,
             progress=not args.quiet,
-            recording=not args.no_recording,
+            outputs=_outputs(args),
             jsbsim_scripts=args.jsbsim_scripts,
             max_time_s=args.max_time_s,
             aircraft_dirs=args.aircraft_dir,

@@ -304,12 +304,13 @@ class CueingBank:
             bank_step(f, w, self._cfg, self._coef, self._state, self._counts, self._out)
         return self._out
 
-    def steps(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> np.ndarray:
-        """Advance all washouts by the next M samples, f and omega (M, 3); return new (n_washouts, M, N_FIELDS).
+    def steps(self, f_mps2: np.ndarray, omega_radps: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+        """Advance all washouts by the next M samples, f and omega (M, 3); return (n_washouts, M, N_FIELDS).
 
         The same compiled step as :meth:`step`, looped in compiled code: a block of samples gives the same
         bits as M calls of :meth:`step`, at a fraction of the per-call cost (one dispatch per block). Calls
-        of both may be mixed. Non-finite input raises ValueError.
+        of both may be mixed. Non-finite input raises ValueError. ``out``: a float64 C-contiguous array of that
+        shape to fill and return (reused chunk after chunk), else a new one.
         """
         f = np.ascontiguousarray(f_mps2, dtype=np.float64)
         w = np.ascontiguousarray(omega_radps, dtype=np.float64)
@@ -317,7 +318,11 @@ class CueingBank:
             raise ValueError(f"f and omega must both be (M, 3), got {f.shape} and {w.shape}")
         if not (np.isfinite(f).all() and np.isfinite(w).all()):
             raise ValueError("cueing input: non-finite specific force or angular velocity")
-        out = np.empty((len(self.washouts), f.shape[0], NFIELDS))
+        shape = (len(self.washouts), f.shape[0], NFIELDS)
+        if out is None:
+            out = np.empty(shape)
+        elif out.shape != shape or out.dtype != np.float64 or not out.flags.c_contiguous:
+            raise ValueError(f"out must be a C-contiguous float64 array of shape {shape}")
         bank_block(f, w, self._cfg, self._coef, self._state, self._counts, out)
         if f.shape[0]:
             self._out[:] = out[:, -1]

@@ -252,17 +252,31 @@ def parquet_writer(path: str | Path, schema: pa.Schema) -> pq.ParquetWriter:
 
 
 def write_traces(
-    path: str | Path, table: Mapping[str, np.ndarray], metadata: Mapping[bytes, bytes] | None = None
+    path: str | Path,
+    table: Mapping[str, np.ndarray] | Iterable[Mapping[str, np.ndarray]],
+    metadata: Mapping[bytes, bytes] | None = None,
 ) -> None:
     """Write the traces table (column name -> 1-D array, all the same length) to Parquet, atomically.
 
-    ``metadata``: the schema's key-value metadata (provenance, :func:`washbench.io.provenance.parquet_metadata`).
+    ``table``: the whole table, or its consecutive row ranges one after the other (each the same columns; each
+    becomes a row group, so the whole table is never in memory). ``metadata``: the schema's key-value metadata
+    (provenance, :func:`washbench.io.provenance.parquet_metadata`).
     """
-    arrow = pa.table({name: pa.array(np.asarray(col)) for name, col in table.items()})
-    if metadata:
-        arrow = arrow.replace_schema_metadata(dict(metadata))
+    chunks = [table] if isinstance(table, Mapping) else table
     with atomic_path(path) as tmp:
-        write_parquet(tmp, arrow)
+        writer = None
+        try:
+            for chunk in chunks:
+                arrow = pa.table({name: pa.array(np.asarray(col)) for name, col in chunk.items()})
+                if writer is None:
+                    schema = arrow.schema.with_metadata(dict(metadata)) if metadata else arrow.schema
+                    writer = parquet_writer(tmp, schema)
+                writer.write_table(arrow.replace_schema_metadata(schema.metadata))
+        finally:
+            if writer is not None:
+                writer.close()
+        if writer is None:
+            raise ValueError("write_traces: no rows and no columns to write")
 
 
 def read_traces(path: str | Path) -> dict[str, np.ndarray]:

@@ -266,12 +266,17 @@ class VestibularModel:
 class PerceptionStream:
     """One pilot's vestibular models fed chunk by chunk: the same bits as :meth:`VestibularModel.perceive` whole.
 
-    The filters start in the steady state of the first sample of the first chunk.
+    The filters start in the steady state of the first sample of the first chunk, or at rest (``start="rest"``,
+    :data:`FILTER_STARTS`).
     """
 
-    def __init__(self, model: VestibularModel) -> None:
+    def __init__(self, model: VestibularModel, start: str = "steady") -> None:
+        if start not in FILTER_STARTS:
+            raise ValueError(f"unknown filter start {start!r} (valid: {', '.join(FILTER_STARTS)})")
         self.model = model
         self._state: tuple[np.ndarray, np.ndarray] | None = None
+        if start == "rest":
+            self._state = (model.otolith.start(np.array(REST_F_MPS2)), model.canals.start(np.zeros(3)))
 
     def perceive(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> Perceived:
         """Perceived motion for the next samples (N, 3) each."""

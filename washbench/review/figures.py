@@ -35,7 +35,8 @@ import numpy as np
 from washbench.review.palette import AIRCRAFT_COLOR, mpl, washout_colors
 
 FIGURE_FORMATS = ("png", "pdf")
-"""Every figure is written as STEM.png (embedded in report.md) and STEM.pdf (vector, for papers)."""
+"""The formats a figure can be written in: STEM.png (embedded in report.md) and STEM.pdf (vector, for papers).
+``washbench run``/``cue``/``suite`` write the PNG only (a PDF costs as much again); ``washbench report`` both."""
 
 PNG_DPI = 110
 
@@ -77,12 +78,16 @@ def _new_figure(width_in: float, height_in: float) -> Any:
     return fig
 
 
-def save_figure(fig: Any, stem: Path) -> list[Path]:
-    """Write ``stem.png`` and ``stem.pdf`` atomically (deterministic: no date, no software stamp); return the paths."""
+def save_figure(fig: Any, stem: Path, formats: Sequence[str] = ("png",)) -> list[Path]:
+    """Write ``stem.<format>`` for each of ``formats`` (:data:`FIGURE_FORMATS`), PNG first, atomically and
+    deterministically (no date, no software stamp); return the paths in that order."""
     from washbench.io.atomic import atomic_path
 
+    unknown = [f for f in formats if f not in FIGURE_FORMATS]
+    if unknown or "png" not in formats:
+        raise ValueError(f"figure formats must include png and be among {FIGURE_FORMATS}, got {tuple(formats)}")
     paths = []
-    for fmt in FIGURE_FORMATS:
+    for fmt in sorted(formats, key=FIGURE_FORMATS.index):
         path = stem.with_suffix(f".{fmt}")
         meta = {"Software": None} if fmt == "png" else {"Creator": None, "Producer": None, "CreationDate": None}
         with atomic_path(path) as tmp:
@@ -146,8 +151,9 @@ def perceived_figure(
     phases: Sequence[tuple[str, float, float]] = (),
     thresholds: Sequence[float] | None = None,
     rest: Sequence[float] = (0.0, 0.0, -9.80665, 0.0, 0.0, 0.0),
+    formats: Sequence[str] = ("png",),
 ) -> list[Path]:
-    """The six stacked perceived-motion panels (module docstring); returns the PNG and PDF paths.
+    """The six stacked perceived-motion panels (module docstring); returns the paths (PNG first).
 
     ``perceived``: ``"aircraft"`` and each washout -> (N, 6) array, columns surge, sway, heave [m/s^2], roll, pitch,
     yaw [deg/s]; the washouts are drawn in the mapping's order. ``thresholds`` (6,) in the same units, drawn as
@@ -187,7 +193,7 @@ def perceived_figure(
         handles.append(Line2D([], [], color=_THRESHOLD_COLOR, lw=0.8, ls=(0, (4, 3)), label="perception threshold"))
     fig.legend(handles=handles, loc="outside upper center", ncol=len(handles), fontsize=8.5, frameon=False)
     axes[0].set_title(f"{title}: perceived motion", fontsize=11)
-    return save_figure(fig, stem)
+    return save_figure(fig, stem, formats)
 
 
 def _runs(flags: np.ndarray) -> list[tuple[int, int]]:
@@ -205,8 +211,9 @@ def envelope_figure(
     saturated: Mapping[str, Mapping[str, np.ndarray]],
     *,
     phases: Sequence[tuple[str, float, float]] = (),
+    formats: Sequence[str] = ("png",),
 ) -> list[Path]:
-    """Platform envelope usage and saturation lanes (module docstring); returns the PNG and PDF paths.
+    """Platform envelope usage and saturation lanes (module docstring); returns the paths (PNG first).
 
     ``usage``: panel label (e.g. "position") -> washout -> (N,) |value| / limit (dimensionless, 1 = at the limit);
     ``saturated``: washout -> limit kind -> bool (N,) (kinds without any True are left out of the lanes).
@@ -258,7 +265,7 @@ def envelope_figure(
     handles.append(Line2D([], [], color=(0.3, 0.3, 0.3), lw=0.9, ls="--", label="limit"))
     fig.legend(handles=handles, loc="outside upper center", ncol=len(handles), fontsize=8.5, frameon=False)
     axes[0].set_title(f"{title}: platform envelope", fontsize=11)
-    return save_figure(fig, stem)
+    return save_figure(fig, stem, formats)
 
 
 def _sig(x: float, digits: int = 3) -> str:
@@ -268,11 +275,16 @@ def _sig(x: float, digits: int = 3) -> str:
 
 
 def score_heatmap(
-    stem: Path, rows: Sequence[str], washouts: Sequence[str], scores: np.ndarray, title: str = "ranking score"
+    stem: Path,
+    rows: Sequence[str],
+    washouts: Sequence[str],
+    scores: np.ndarray,
+    title: str = "ranking score",
+    formats: Sequence[str] = ("png",),
 ) -> list[Path]:
     """Score per manoeuvre (row) and washout (column), lower is better; best per row framed, above 1 in red.
 
-    ``scores`` (R, W), NaN where a washout did not run. Returns the PNG and PDF paths.
+    ``scores`` (R, W), NaN where a washout did not run. Returns the paths (PNG first).
     """
     from matplotlib.colors import LinearSegmentedColormap, TwoSlopeNorm
     from matplotlib.patches import Rectangle
@@ -303,7 +315,7 @@ def score_heatmap(
     bar.set_label("score (lower is better)", fontsize=7.5)
     bar.ax.tick_params(labelsize=7)
     ax.set_title(f"{title}: best per manoeuvre framed;\n! above 1 = worse than a simulator standing still", fontsize=9)
-    return save_figure(fig, stem)
+    return save_figure(fig, stem, formats)
 
 
 def table4_figure(
@@ -313,6 +325,7 @@ def table4_figure(
     better_pct: Mapping[str, np.ndarray],
     dofs: Sequence[str],
     metrics: Sequence[str],
+    formats: Sequence[str] = ("png",),
 ) -> list[Path]:
     """The paper's Table 4 as a figure: one panel per washout other than ``reference``.
 
@@ -349,7 +362,7 @@ def table4_figure(
         bar = fig.colorbar(image, ax=list(axes), shrink=0.6, pad=0.01)
         bar.set_label("% better (green) / worse (red)", fontsize=7.5)
         bar.ax.tick_params(labelsize=7)
-    return save_figure(fig, stem)
+    return save_figure(fig, stem, formats)
 
 
 def _diverging_cmap() -> Any:

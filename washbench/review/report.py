@@ -16,6 +16,8 @@ from __future__ import annotations
 
 import math
 import os
+import shutil
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -233,12 +235,19 @@ def time_above_threshold(data: ResultData) -> dict[str, float]:
     }
 
 
-def result_figures(data: ResultData) -> dict[str, Path]:
-    """Draw the result's figures into ``folder/figures/``; returns figure name -> PNG path."""
+def result_figures(data: ResultData, pdf: bool = False) -> dict[str, Path]:
+    """Draw the result's figures into ``folder/figures/`` (PNG, and PDF with ``pdf``); figure name -> PNG path.
+
+    A PDF left from an earlier ``washbench report`` is removed when none is drawn (it would show other data).
+    """
     from washbench.review.figures import envelope_figure, perceived_figure
 
     fig_dir = data.folder / FIGURES_DIR
     fig_dir.mkdir(exist_ok=True)
+    formats = ("png", "pdf") if pdf else ("png",)
+    if not pdf:
+        for stem in ("perceived", "envelope"):
+            (fig_dir / f"{stem}.pdf").unlink(missing_ok=True)
     thresholds, rest = perception_thresholds()
     out = {}
     out["perceived"] = perceived_figure(
@@ -249,18 +258,25 @@ def result_figures(data: ResultData) -> dict[str, Path]:
         phases=data.phases,
         thresholds=thresholds,
         rest=rest,
+        formats=formats,
     )[0]
     if data.usage:
         out["envelope"] = envelope_figure(
-            fig_dir / "envelope", data.title, data.t_s, data.usage, data.saturated, phases=data.phases
+            fig_dir / "envelope", data.title, data.t_s, data.usage, data.saturated, phases=data.phases, formats=formats
         )[0]
     return out
 
 
+NO_FIGURES = "_No figures were drawn (`--no-figures`): `washbench report` on this folder draws them from its files._"
+
+
 def _image(png: Path, start: Path, alt: str) -> list[str]:
+    """The figure embedded, and its PDF linked when there is one (else how to get it)."""
     rel = _rel(png, start)
-    return [f"![{alt}]({rel})", "", f"Vector version for papers: [{Path(rel).with_suffix('.pdf').name}]"
-            f"({Path(rel).with_suffix('.pdf').as_posix()})", ""]  # fmt: skip
+    pdf = Path(rel).with_suffix(".pdf")
+    if png.with_suffix(".pdf").is_file():
+        return [f"![{alt}]({rel})", "", f"Vector version for papers: [{pdf.name}]({pdf.as_posix()})", ""]
+    return [f"![{alt}]({rel})", "", "Vector versions for papers (PDF): `washbench report` on this folder.", ""]
 
 
 def result_sections(
@@ -281,13 +297,15 @@ def result_sections(
         "(Zacharias 1978) around the resting value, what lies between them is not felt; shaded: the phases.",
         "",
     ]
-    lines += _image(figures["perceived"], start, "perceived motion")
+    lines += _image(figures["perceived"], start, "perceived motion") if "perceived" in figures else [NO_FIGURES, ""]
     lines += [f"{h} Metrics", "", *metric_tables(data)]
     lines += [f"{h} Platform", ""]
     if brief:
         pass
     elif "envelope" in figures:
         lines += _image(figures["envelope"], start, "platform envelope")
+    elif not figures:
+        pass
     else:
         lines += ["_No platform limits are recorded with this result: no envelope figure._", ""]
     lines += [f"Time at a limit ({sig(data.duration_s)} s manoeuvre):", "", *saturation_lines(data)]
@@ -310,10 +328,18 @@ def _status_line(data: ResultData) -> list[str]:
     return []
 
 
-def write_result_report(result_dir: Path) -> Path:
-    """Write ``report.md`` and ``figures/`` for one result folder from its files; return the report's path."""
-    data = load_result(Path(result_dir))
-    figures = result_figures(data)
+def write_result_report(
+    result_dir: Path, table: Mapping[str, np.ndarray] | None = None, pdf: bool = False, figures: bool = True
+) -> Path:
+    """Write ``report.md`` and ``figures/`` for one result folder from its files; return the report's path.
+
+    ``table``: the traces.parquet columns already in memory (not read again); ``pdf``: PDF figures besides the PNG;
+    ``figures=False``: none drawn (``--no-figures``; figures of an earlier run in the folder are removed).
+    """
+    data = load_result(Path(result_dir), table, series=figures)
+    if not figures:
+        shutil.rmtree(data.folder / FIGURES_DIR, ignore_errors=True)
+    drawn = result_figures(data, pdf) if figures else {}
     lines = [f"# {data.title}", "", *_status_line(data)]
     checks = f", checks {sum(bool(c.get('passed')) for c in data.checks)}/{len(data.checks)}" if data.checks else ""
     status = {True: "ok", False: "FAILED", None: "cued"}[data.ok]
@@ -323,19 +349,20 @@ def write_result_report(result_dir: Path) -> Path:
         "",
     ]
     lines += provenance_lines(data.provenance, data.created_utc)
-    lines += result_sections(data, figures, data.folder, 2)
+    lines += result_sections(data, drawn, data.folder, 2)
     path = data.folder / REPORT_FILE
     write_text_atomic(path, "\n".join(lines).rstrip() + "\n")
     return path
 
 
 def report_command(results_dir: Path) -> int:
-    """``washbench report DIR``: write report.md and the figures again from a result or suite folder's files."""
+    """``washbench report DIR``: write report.md and the figures (PNG and PDF) again from a result or suite folder's
+    files."""
     folder = Path(results_dir)
     if not folder.is_dir():
         raise WashbenchError(located(folder, "no such folder"))
     if is_result_folder(folder) and not (folder / SUITE_FILE).exists():
-        path = write_result_report(folder)
+        path = write_result_report(folder, pdf=True)
     else:
         from washbench.review.suite_report import write_suite_report
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -149,8 +150,13 @@ def envelope_usage(table: dict[str, np.ndarray], washouts: list[str], limits: An
     return {k: v for k, v in out.items() if v}
 
 
-def load_result(folder: Path) -> ResultData:
-    """Read one result folder (module docstring). WashbenchError naming the file when a required one is bad."""
+def load_result(folder: Path, table: Mapping[str, np.ndarray] | None = None, *, series: bool = True) -> ResultData:
+    """Read one result folder (module docstring). WashbenchError naming the file when a required one is bad.
+
+    ``table``: the traces.parquet columns already in memory (the run that just wrote them), read from the file
+    when None. ``series=False``: only the time and the saturation flags are read (for tables: ranking, metrics,
+    time at a limit); ``perceived`` and ``usage`` are then empty.
+    """
     import pyarrow.parquet as pq
 
     folder = Path(folder)
@@ -161,22 +167,30 @@ def load_result(folder: Path) -> ResultData:
     metrics = read_metrics_csv(folder / METRICS_FILE)
     washouts = _washout_order(metrics)
     traces_path = folder / TRACES_FILE
-    try:
-        names = set(pq.read_schema(traces_path).names)
-    except (OSError, ValueError) as exc:
-        raise WashbenchError(located(traces_path, f"not a readable Parquet file ({exc})")) from None
-    want = [TIME_COLUMN]
-    for src in (AIRCRAFT, *washouts):
-        want += [*perceived_f_columns(src), *perceived_omega_columns(src)]
-    missing = [c for c in want if c not in names]
+    if table is None:
+        try:
+            names = set(pq.read_schema(traces_path).names)
+        except (OSError, ValueError) as exc:
+            raise WashbenchError(located(traces_path, f"not a readable Parquet file ({exc})")) from None
+    else:
+        names = set(table)
+    perceived_cols = [c for src in (AIRCRAFT, *washouts) for c in (*perceived_f_columns(src),
+                                                                    *perceived_omega_columns(src))]  # fmt: skip
+    missing = [c for c in (TIME_COLUMN, *perceived_cols) if c not in names]
     if missing:
         raise WashbenchError(located(traces_path, f"missing column {missing[0]!r}"))
+    want = [TIME_COLUMN] + (perceived_cols if series else perceived_cols[:6])  # (the aircraft's six first)
     for w in washouts:
-        want += [c for c in (*pos_columns(w), *vel_columns(w), *acc_columns(w), *omega_platform_columns(w),
-                             *wheel_columns(w)) if c in names]  # fmt: skip
+        if series:
+            want += [c for c in (*pos_columns(w), *vel_columns(w), *acc_columns(w), *omega_platform_columns(w),
+                                 *wheel_columns(w)) if c in names]  # fmt: skip
         want += sorted(c for c in names if c.startswith(f"{w}.sat_"))
-    arrow = pq.read_table(traces_path, columns=want)
-    table = {c: arrow.column(c).to_numpy() for c in want}
+    if table is None:
+        try:
+            arrow = pq.read_table(traces_path, columns=want, use_threads=False)
+        except (OSError, ValueError) as exc:
+            raise WashbenchError(located(traces_path, f"not a readable Parquet file ({exc})")) from None
+        table = {c: arrow.column(c).to_numpy() for c in want}
     t = np.asarray(table[TIME_COLUMN], dtype=np.float64)
     if t.shape[0] < 2:
         raise WashbenchError(located(traces_path, "fewer than 2 samples"))
@@ -185,14 +199,15 @@ def load_result(folder: Path) -> ResultData:
     dt = float(run.get("dt_s") or flight.get("dt_s") or (t[-1] - t[0]) / (t.shape[0] - 1))
     perceived = {
         src: np.column_stack([table[c] for c in (*perceived_f_columns(src), *perceived_omega_columns(src))])
-        for src in (AIRCRAFT, *washouts)
+        for src in ((AIRCRAFT, *washouts) if series else (AIRCRAFT,))
     }
     saturated = {
-        w: {c.split(".sat_", 1)[1]: table[c] != 0 for c in want if c.startswith(f"{w}.sat_")} for w in washouts
+        w: {c.split(".sat_", 1)[1]: np.asarray(table[c]) != 0 for c in want if c.startswith(f"{w}.sat_")}
+        for w in washouts
     }
     prov = run.get("provenance") or read_parquet_provenance(traces_path)
     limits = _limits_from(prov)
-    usage = envelope_usage(table, washouts, limits) if limits is not None else {}
+    usage = envelope_usage(table, washouts, limits) if limits is not None and series else {}
     motion_doc = run.get("perceived_motion")
     if isinstance(motion_doc, dict) and set(motion_doc) >= set(DOFS):
         motion = {d: float(motion_doc[d]["value"]) for d in DOFS}  # as the suite ranked it

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import math
+import shutil
 from pathlib import Path
 from typing import Any
 
@@ -77,11 +78,11 @@ def _entries(suite_dir: Path) -> tuple[list[dict[str, Any]], dict[str, Any]]:
     return [{"file": "", "result": _rel(f, suite_dir)} for f in folders], {}
 
 
-def write_suite_report(suite_dir: Path, *, regenerate_results: bool = False) -> Path:
+def write_suite_report(suite_dir: Path, *, regenerate_results: bool = False, figures: bool = True) -> Path:
     """Write the suite's ``report.md`` and ``figures/`` from the suite folder's files; return the report's path.
 
-    ``regenerate_results``: first write every result folder's own report and figures again (``washbench report``);
-    otherwise the figures the runs wrote are linked.
+    ``regenerate_results`` (``washbench report``): first write every result folder's own report and figures again,
+    and every figure as PNG and PDF; otherwise the PNG figures the runs wrote are linked and the suite's are PNG.
     """
     from washbench.review.figures import score_heatmap, table4_figure
 
@@ -92,8 +93,8 @@ def write_suite_report(suite_dir: Path, *, regenerate_results: bool = False) -> 
         folder = suite_dir / e["result"] if e.get("result") else None
         if folder is not None and is_result_folder(folder):
             if regenerate_results:
-                write_result_report(folder)
-            results.append((e, load_result(folder)))
+                write_result_report(folder, pdf=True)
+            results.append((e, load_result(folder, series=False)))
         else:
             results.append((e, None))
     loaded = [d for _, d in results if d is not None]
@@ -102,15 +103,22 @@ def write_suite_report(suite_dir: Path, *, regenerate_results: bool = False) -> 
     rankings = {id(d): rank(d.metrics, d.motion) for d in loaded}
 
     fig_dir = suite_dir / FIGURES_DIR
-    fig_dir.mkdir(exist_ok=True)
-    figures: dict[str, Path] = {}
+    if figures:
+        fig_dir.mkdir(exist_ok=True)
+    else:
+        shutil.rmtree(fig_dir, ignore_errors=True)
+    formats = ("png", "pdf") if regenerate_results else ("png",)
+    if not regenerate_results and figures:
+        for stem in ("scores", "table4"):
+            (fig_dir / f"{stem}.pdf").unlink(missing_ok=True)
+    drawn: dict[str, Path] = {}
     labels = [d.title + (" (FAILED)" if d.ok is False else "") for d in loaded]
-    if loaded:
+    if loaded and figures:
         scores = np.full((len(loaded), len(washouts)), math.nan)
         for r, d in enumerate(loaded):
             for row in rankings[id(d)]:
                 scores[r, washouts.index(row.washout)] = row.score
-        figures["scores"] = score_heatmap(fig_dir / "scores", labels, washouts, scores)[0]
+        drawn["scores"] = score_heatmap(fig_dir / "scores", labels, washouts, scores, formats=formats)[0]
         others = [w for w in washouts if w != reference]
         if others:
             better = {w: np.full((len(loaded), len(METRICS) * len(DOFS)), math.nan) for w in others}
@@ -121,7 +129,9 @@ def write_suite_report(suite_dir: Path, *, regenerate_results: bool = False) -> 
                     for w, diff in c.better_than_reference.items():
                         if math.isfinite(diff) and ref != 0:
                             better[w][r, col] = 100.0 * diff / ref
-            figures["table4"] = table4_figure(fig_dir / "table4", labels, reference, better, DOFS, METRICS)[0]
+            drawn["table4"] = table4_figure(
+                fig_dir / "table4", labels, reference, better, DOFS, METRICS, formats=formats
+            )[0]
 
     ok = [e for e, d in results if e.get("ok", d.ok if d else False)]
     lines = ["# washbench suite report", ""]
@@ -170,14 +180,14 @@ def write_suite_report(suite_dir: Path, *, regenerate_results: bool = False) -> 
         lines += ["Manoeuvres won: " + ", ".join(f"{w} {n}" for w, n in count.items()) + ".", ""]
     if any_above:
         lines += [SCORE_NOTE, ""]
-    if "scores" in figures:
-        lines += _image(figures["scores"], suite_dir, "score per manoeuvre and washout")
-    if "table4" in figures:
+    if "scores" in drawn:
+        lines += _image(drawn["scores"], suite_dir, "score per manoeuvre and washout")
+    if "table4" in drawn:
         lines += [f"## Against {reference} (Table 4 of the paper)", ""]
         lines += [f"Each cell: how much better than {reference} the washout is, in percent of the "
                   f"{reference} value (positive, green: better). Absolute differences are in "
                   "`comparison.csv`.", ""]  # fmt: skip
-        lines += _image(figures["table4"], suite_dir, "Table 4")
+        lines += _image(drawn["table4"], suite_dir, "Table 4")
     lines += ["## How to read the numbers", "", *_HOW_TO_READ]
     for d in loaded:
         rel = _rel(d.folder, suite_dir)
@@ -186,7 +196,7 @@ def write_suite_report(suite_dir: Path, *, regenerate_results: bool = False) -> 
                   "the checks and the phases.", ""]  # fmt: skip
         if d.ok is False:
             lines += [f"> **FAILED**: {d.reason or 'a check failed'}", ""]
-        lines += result_sections(d, _existing_figures(d), suite_dir, 3, brief=True)
+        lines += result_sections(d, _existing_figures(d) if figures else {}, suite_dir, 3, brief=True)
     path = suite_dir / REPORT_FILE
     write_text_atomic(path, "\n".join(lines).rstrip() + "\n")
     return path
@@ -199,5 +209,5 @@ def _existing_figures(d: ResultData) -> dict[str, Path]:
     found = {name: d.folder / FIGURES_DIR / f"{name}.png" for name in ("perceived", "envelope")}
     found = {k: p for k, p in found.items() if p.is_file()}
     if "perceived" not in found:
-        return result_figures(d)
+        return result_figures(load_result(d.folder) if len(d.perceived) <= 1 else d)
     return found

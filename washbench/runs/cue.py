@@ -4,10 +4,12 @@ Two layers, so the flight pipeline (which builds washout traces in lockstep with
 the post-processing:
 
 * :func:`analyse` (motion + finished washout traces -> perception, metrics, tables);
-* :func:`cue_motion` = ``cueing.cue_trace`` + :func:`analyse`;
+* :func:`cue_motion` = ``cueing.cue_trace`` + :func:`analyse` (whole traces in memory);
+* :func:`stream_cue`: the same in one pass over chunks of :data:`CHUNK_ROWS` samples, writing traces.parquet as it
+  goes, the same bits; memory beyond the input is what the review needs of each row (see its docstring);
 * :func:`run_cue` (the CLI), in stages: :func:`read_input` (reading and conversion to washbench units
   and axes), :func:`prepare_segments` (time resets, window, gaps, uniform grid or resampling,
-  plausibility), :func:`cue_segments` (cueing), :func:`write_outputs` (per segment the files of a
+  plausibility), :func:`write_outputs` (per segment :func:`stream_cue` and the other files of a
   ``run`` result folder, all renamed into place together).
 """
 
@@ -17,12 +19,14 @@ import contextlib
 import math
 import sys
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any, Protocol
 
 import numpy as np
+import pyarrow as pa
 
 from washbench.analysis.metrics import MetricRow, dof_metrics
 from washbench.errors import WashbenchError, located
@@ -79,20 +83,66 @@ class TraceLike(Protocol):
     saturation_counts: Mapping[str, int]
 
 
+CHUNK_ROWS = 8192
+"""Rows of traces.parquet built and written at a time (one Parquet row group each): the table is never whole in
+memory, whatever the length of the input."""
+
+
 @dataclass(frozen=True, eq=False)
 class CueResult:
     """Everything ``washbench cue`` computes for one input trace.
 
     ``perceived``: pilot name (``"aircraft"`` or a washout name) -> perceived motion;
-    ``metrics``: six rows per washout (:mod:`washbench.analysis.metrics`); ``table``: the traces.parquet
-    columns in order (:mod:`washbench.io.results`); ``traces``: the washout traces themselves.
+    ``metrics``: six rows per washout (:mod:`washbench.analysis.metrics`); ``traces``: the washout traces
+    themselves; :meth:`columns` the traces.parquet columns (:mod:`washbench.io.results`) of a range of rows, built
+    on demand so the whole table never has to exist at once.
     """
 
     motion: Motion
     traces: Mapping[str, TraceLike]
     perceived: Mapping[str, Perceived]
     metrics: list[MetricRow]
-    table: dict[str, np.ndarray]
+    arrays: Mapping[str, Mapping[str, np.ndarray]] = field(default_factory=dict, repr=False)
+    """washout -> the trace's fields as checked float64 arrays (:func:`analyse`); else read from ``traces``."""
+
+    @property
+    def n(self) -> int:
+        """Number of samples."""
+        return self.motion.n
+
+    def columns(self, start: int = 0, stop: int | None = None) -> dict[str, np.ndarray]:
+        """The traces.parquet columns, in order, for rows ``start:stop`` (views where no unit changes)."""
+        rows = slice(start, self.n if stop is None else stop)
+        perceived = {p: Perceived(v.f_mps2[rows], v.omega_radps[rows]) for p, v in self.perceived.items()}
+        fields = {}
+        for name, tr in self.traces.items():
+            arr = self.arrays.get(name) or {f: getattr(tr, f) for f in _TRACE_FIELDS}
+            fields[name] = {f: a[rows] for f, a in arr.items()}
+        saturated = {w: {k: np.asarray(v)[rows] for k, v in tr.saturated.items()} for w, tr in self.traces.items()}
+        return _table_rows(self.motion, rows, perceived, fields, saturated)
+
+    def review_table(self) -> dict[str, np.ndarray]:
+        """What the report reads of traces.parquet (:func:`washbench.review.result_data.load_result`), whole:
+        time, every pilot's perceived motion, the platform's envelope fields and the saturation flags."""
+        m = self.motion
+        table: dict[str, np.ndarray] = {TIME_COLUMN: m.t_s}
+        for name, p in self.perceived.items():
+            _put(table, perceived_f_columns(name), p.f_mps2)
+            _put(table, perceived_omega_columns(name), p.omega_radps * _DEG)
+        for name, tr in self.traces.items():
+            _put(table, pos_columns(name), tr.pos_m)
+            _put(table, vel_columns(name), tr.vel_mps)
+            _put(table, acc_columns(name), tr.acc_mps2)
+            _put(table, omega_platform_columns(name), tr.omega_radps * _DEG)
+            _put(table, wheel_columns(name), tr.wheel_radps)
+            for kind, flags in tr.saturated.items():
+                table[sat_column(name, kind)] = np.asarray(flags)
+        return table
+
+    def column_chunks(self, rows: int = CHUNK_ROWS) -> Iterator[dict[str, np.ndarray]]:
+        """:meth:`columns` for consecutive ranges of ``rows`` rows (at least one range, even for no rows)."""
+        for a in range(0, max(self.n, 1), rows):
+            yield self.columns(a, min(self.n, a + rows))
 
 
 _TRACE_FIELDS = {
@@ -109,8 +159,9 @@ _TRACE_FIELDS = {
 }
 
 
-def _checked_trace(name: str, trace: TraceLike, n: int) -> dict[str, np.ndarray]:
-    """The trace's arrays as float64, checked for shape and finiteness (a non-finite value is an error)."""
+def _checked_trace(name: str, trace: TraceLike, n: int, first: int = 0) -> dict[str, np.ndarray]:
+    """The trace's arrays as float64, checked for shape and finiteness (a non-finite value is an error; ``first``:
+    the sample number of the trace's first row, for the message)."""
     out = {}
     for attr, width in _TRACE_FIELDS.items():
         a = np.asarray(getattr(trace, attr), dtype=np.float64)
@@ -118,7 +169,7 @@ def _checked_trace(name: str, trace: TraceLike, n: int) -> dict[str, np.ndarray]
             raise ValueError(f"washout {name!r}: {attr} has shape {a.shape}, expected ({n}, {width})")
         bad = ~np.isfinite(a)
         if bad.any():
-            row = int(np.argmax(bad.any(axis=1)))
+            row = first + int(np.argmax(bad.any(axis=1)))
             raise WashbenchError(f"washout {name!r} produced a non-finite {attr} at sample {row} (t index {row})")
         out[attr] = a
     return out
@@ -139,46 +190,66 @@ def analyse(
     model = VestibularModel(motion.dt_s, vestibular)
     n = motion.n
     perceived: dict[str, Perceived] = {AIRCRAFT: model.perceive(motion.f_mps2, motion.omega_radps, filter_start)}
-    table: dict[str, np.ndarray] = {TIME_COLUMN: motion.t_s}
-    _put(table, f_columns(AIRCRAFT), motion.f_mps2)
-    _put(table, omega_columns(AIRCRAFT), motion.omega_degps_out())
-    _put(table, perceived_f_columns(AIRCRAFT), perceived[AIRCRAFT].f_mps2)
-    _put(table, perceived_omega_columns(AIRCRAFT), perceived[AIRCRAFT].omega_radps * _DEG)
     rows: list[MetricRow] = []
     ac = perceived[AIRCRAFT]
+    checked: dict[str, dict[str, np.ndarray]] = {}
     for name, trace in traces.items():
         arr = _checked_trace(name, trace, n)
+        for kind, flags in trace.saturated.items():
+            if np.shape(flags) != (n,):
+                raise ValueError(f"washout {name!r}: saturated[{kind!r}] has shape {np.shape(flags)}, expected ({n},)")
         p = model.perceive(arr["head_f_mps2"], arr["head_omega_radps"], filter_start)
         perceived[name] = p
         rows += dof_metrics(name, ac.f_mps2, ac.omega_radps, p.f_mps2, p.omega_radps, motion.dt_s)
-        _put(table, f_columns(name), arr["head_f_mps2"])
-        _put(table, omega_columns(name), arr["head_omega_radps"] * _DEG)
-        _put(table, perceived_f_columns(name), p.f_mps2)
-        _put(table, perceived_omega_columns(name), p.omega_radps * _DEG)
-        _put(table, pos_columns(name), arr["pos_m"])
-        _put(table, vel_columns(name), arr["vel_mps"])
-        _put(table, acc_columns(name), arr["acc_mps2"])
-        _put(table, q_columns(name), arr["q"])
-        _put(table, omega_platform_columns(name), arr["omega_radps"] * _DEG)
-        _put(table, wheel_columns(name), arr["wheel_radps"])
-        _put(table, sp_pos_columns(name), arr["sp_pos_m"])
-        _put(table, sp_q_columns(name), arr["sp_q"])
-        for kind, flags in trace.saturated.items():
-            flags = np.asarray(flags)
-            if flags.shape != (n,):
-                raise ValueError(f"washout {name!r}: saturated[{kind!r}] has shape {flags.shape}, expected ({n},)")
-            table[sat_column(name, kind)] = flags.astype(np.int8)
-    for col, values in motion.extra.items():
-        if col in table:
-            raise WashbenchError(f"input column {col!r} clashes with a result column of the same name")
-        table[col] = values
-    return CueResult(motion=motion, traces=dict(traces), perceived=perceived, metrics=rows, table=table)
+        checked[name] = arr
+    result = CueResult(motion=motion, traces=dict(traces), perceived=perceived, metrics=rows, arrays=checked)
+    result.columns(0, 0)  # an input column that clashes with a result column fails now, before anything is written
+    return result
 
 
 def _put(table: dict[str, np.ndarray], names: Sequence[str], values: np.ndarray) -> None:
-    columns = np.ascontiguousarray(values.T)  # one transposing copy, then each column is a contiguous row
     for i, name in enumerate(names):
-        table[name] = columns[i]
+        table[name] = values[:, i]
+
+
+def _table_rows(
+    motion: Motion,
+    rows: slice,
+    perceived: Mapping[str, Perceived],
+    fields: Mapping[str, Mapping[str, np.ndarray]],
+    saturated: Mapping[str, Mapping[str, np.ndarray]],
+) -> dict[str, np.ndarray]:
+    """The traces.parquet columns, in order, of the input rows ``rows``: ``perceived`` (every pilot), ``fields``
+    (washout -> trace field -> array) and ``saturated`` (washout -> kind -> flags) hold those rows only."""
+    m = motion
+    table: dict[str, np.ndarray] = {TIME_COLUMN: m.t_s[rows]}
+    _put(table, f_columns(AIRCRAFT), m.f_mps2[rows])
+    omega_deg = m.omega_degps[rows] if m.omega_degps is not None else np.degrees(m.omega_radps[rows])
+    _put(table, omega_columns(AIRCRAFT), omega_deg)
+    ac = perceived[AIRCRAFT]
+    _put(table, perceived_f_columns(AIRCRAFT), ac.f_mps2)
+    _put(table, perceived_omega_columns(AIRCRAFT), ac.omega_radps * _DEG)
+    for name, f in fields.items():
+        p = perceived[name]
+        _put(table, f_columns(name), f["head_f_mps2"])
+        _put(table, omega_columns(name), f["head_omega_radps"] * _DEG)
+        _put(table, perceived_f_columns(name), p.f_mps2)
+        _put(table, perceived_omega_columns(name), p.omega_radps * _DEG)
+        _put(table, pos_columns(name), f["pos_m"])
+        _put(table, vel_columns(name), f["vel_mps"])
+        _put(table, acc_columns(name), f["acc_mps2"])
+        _put(table, q_columns(name), f["q"])
+        _put(table, omega_platform_columns(name), f["omega_radps"] * _DEG)
+        _put(table, wheel_columns(name), f["wheel_radps"])
+        _put(table, sp_pos_columns(name), f["sp_pos_m"])
+        _put(table, sp_q_columns(name), f["sp_q"])
+        for kind, flags in saturated[name].items():
+            table[sat_column(name, kind)] = flags.astype(np.int8)
+    for col, values in m.extra.items():
+        if col in table:
+            raise WashbenchError(f"input column {col!r} clashes with a result column of the same name")
+        table[col] = values[rows]
+    return table
 
 
 def cue_motion(
@@ -200,6 +271,120 @@ def cue_motion(
     return analyse(motion, traces, vestibular, filter_start)
 
 
+_REVIEW_FIELDS = ("pos_m", "vel_mps", "acc_mps2", "omega_radps", "wheel_radps")
+"""Washout trace fields a streamed cue keeps whole for the report (its envelope figure and time at a limit)."""
+_RECORDING_FIELDS = ("head_f_mps2", "head_omega_radps", "q")
+"""... and for the recording (the simulator pilot's raw motion, the sphere's attitude in the 3D view)."""
+
+
+class Progress:
+    """``cue: 45% (97,000 of 216,000 rows)`` on stderr: in place on a terminal, else a line every ``every_s``
+    (nothing for work done in less); :meth:`close` ends the line on a terminal."""
+
+    def __init__(self, label: str, total: int, every_s: float = 5.0) -> None:
+        self.label, self.total, self.every_s = label, total, every_s
+        self.offset = 0  # rows done before the part now being counted (``update`` counts from here)
+        self.tty = sys.stderr.isatty()
+        self._last = time.monotonic()
+        self._shown = False
+
+    def update(self, done: int) -> None:
+        now = time.monotonic()
+        if now - self._last < (0.2 if self.tty else self.every_s):
+            return
+        self._last = now
+        done += self.offset
+        pct = 100.0 * done / max(self.total, 1)
+        line = f"{self.label}: {pct:3.0f}% ({done:,} of {self.total:,} rows)"
+        print(f"\r{line}" if self.tty else line, end="" if self.tty else "\n", file=sys.stderr, flush=True)
+        self._shown = True
+
+    def close(self) -> None:
+        if self.tty and self._shown:
+            print(file=sys.stderr, flush=True)
+
+
+def stream_cue(
+    motion: Motion,
+    washouts: Sequence[Any],
+    limits: Any,
+    traces_path: Path,
+    metadata: Mapping[bytes, bytes] | None = None,
+    *,
+    filter_start: str = "steady",
+    recording: bool = True,
+    chunk_rows: int = CHUNK_ROWS,
+    progress: Progress | None = None,
+) -> CueResult:
+    """:func:`cue_motion` and the traces.parquet of :func:`write_results` in one pass, ``chunk_rows`` samples at a
+    time (washouts, vestibular models, one Parquet row group per chunk): the same columns and metrics, bit for bit.
+
+    ``washouts``: Washout variants (:func:`washbench.cueing.variants.select_washouts`). ``traces_path`` is written
+    (not atomically: the caller's temporary name). Held whole are only the input, every pilot's perceived motion
+    (for the metrics and figures) and per washout its saturation flags and the trace fields the report
+    (``_REVIEW_FIELDS``) and, with ``recording``, the recording (``_RECORDING_FIELDS``) show: the returned result's
+    ``traces`` hold those, so :meth:`CueResult.columns` is not available on it (the table is in the file).
+    """
+    from washbench.cueing import CueingBank, WashoutTrace
+    from washbench.io.results import parquet_writer
+    from washbench.perception.vestibular import PerceptionStream
+
+    if chunk_rows < 1:
+        raise ValueError(f"chunk_rows must be at least 1, got {chunk_rows}")
+    n = motion.n
+    bank = CueingBank(washouts, None, limits, motion.dt_s, filter_start)
+    names = bank.washouts
+    model = VestibularModel(motion.dt_s)
+    streams = {p: PerceptionStream(model, filter_start) for p in (AIRCRAFT, *names)}
+    felt = {p: Perceived(np.empty((n, 3)), np.empty((n, 3))) for p in streams}
+    keep = _REVIEW_FIELDS + (_RECORDING_FIELDS if recording else ())
+    kept = {w: {f: np.empty((n, _TRACE_FIELDS[f])) for f in keep} for w in names}
+    flags: dict[str, dict[str, np.ndarray]] = {w: {} for w in names}
+    buf = np.empty((len(names), min(chunk_rows, max(n, 1)), len(CueingBank.FIELDS)))
+    writer = None
+    try:
+        for a in range(0, n, chunk_rows):
+            b = min(n, a + chunk_rows)
+            rows = slice(a, b)
+            block = bank.steps(motion.f_mps2[rows], motion.omega_radps[rows], buf[:, : b - a] if b - a == buf.shape[1]
+                               else None)  # fmt: skip
+            perceived = {AIRCRAFT: streams[AIRCRAFT].perceive(motion.f_mps2[rows], motion.omega_radps[rows])}
+            fields, saturated = {}, {}
+            for i, w in enumerate(names):
+                tr = WashoutTrace.from_rows(block[i])
+                fields[w] = _checked_trace(w, tr, b - a, a)
+                saturated[w] = tr.saturated
+                perceived[w] = streams[w].perceive(fields[w]["head_f_mps2"], fields[w]["head_omega_radps"])
+                for f in keep:
+                    kept[w][f][rows] = fields[w][f]
+                for k, v in tr.saturated.items():
+                    flags[w].setdefault(k, np.empty(n, dtype=bool))[rows] = v
+            for pilot, per in perceived.items():
+                felt[pilot].f_mps2[rows] = per.f_mps2
+                felt[pilot].omega_radps[rows] = per.omega_radps
+            table = _table_rows(motion, rows, perceived, fields, saturated)
+            arrow = pa.table({c: pa.array(np.asarray(v)) for c, v in table.items()})
+            if writer is None:
+                schema = arrow.schema.with_metadata(dict(metadata)) if metadata else arrow.schema
+                writer = parquet_writer(traces_path, schema)
+            writer.write_table(arrow.replace_schema_metadata(schema.metadata))
+            if progress is not None:
+                progress.update(b)
+    finally:
+        if writer is not None:
+            writer.close()
+    if writer is None:
+        raise WashbenchError("nothing to cue: the input has no rows")
+    ac = felt[AIRCRAFT]
+    metrics: list[MetricRow] = []
+    for w in names:
+        p = felt[w]
+        metrics += dof_metrics(w, ac.f_mps2, ac.omega_radps, p.f_mps2, p.omega_radps, motion.dt_s)
+    counts = bank.saturation_counts()
+    traces = {w: SimpleNamespace(**kept[w], saturated=flags[w], saturation_counts=counts[w]) for w in names}
+    return CueResult(motion=motion, traces=traces, perceived=felt, metrics=metrics)
+
+
 def write_results(out_dir: Path, result: CueResult, provenance: Mapping[str, Any] | None = None) -> tuple[Path, Path]:
     """Write traces.parquet and metrics.csv into ``out_dir`` (created if missing), both or neither.
 
@@ -215,7 +400,7 @@ def write_results(out_dir: Path, result: CueResult, provenance: Mapping[str, Any
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
         with atomic_path(traces_path) as tmp_traces, atomic_path(metrics_path) as tmp_metrics:
-            write_traces(tmp_traces, result.table, parquet_metadata(provenance) if provenance else None)
+            write_traces(tmp_traces, result.column_chunks(), parquet_metadata(provenance) if provenance else None)
             write_metrics_csv(tmp_metrics, result.metrics)
     except OSError as exc:
         raise WashbenchError(located(out_dir, f"cannot write results: {exc.strerror or exc}")) from None
@@ -238,6 +423,7 @@ class CueOptions:
     filter_start: str = "steady"
     strict: bool = False
     recording: bool = True
+    figures: bool = True
 
 
 @dataclass(frozen=True, eq=False)
@@ -330,17 +516,19 @@ def write_outputs(
     out_dir: Path,
     input_path: Path,
     segments: Sequence[Segment],
-    results: Sequence[CueResult],
+    washouts: Sequence[Any],
     limits: Any,
     opts: CueOptions,
-    wall_s: float,
+    start: float,
     provenance: dict[str, Any] | None = None,
-) -> list[Any]:
-    """Outputs: per segment (``out_dir`` itself, or ``out_dir/<segment>/`` when there are several) the files
-    of a ``run`` result folder: traces.parquet, metrics.csv, run.json, ranking.csv, report.md and
-    recording.rrd (unless ``opts.recording`` is False). Every file is written under a temporary name and
-    all are renamed into place together, then ranking.csv and report.md are written (atomically) last, so
-    a failure leaves no half-written file."""
+    progress: bool = False,
+) -> list[tuple[Any, CueResult]]:
+    """Cueing and outputs: per segment (``out_dir`` itself, or ``out_dir/<segment>/`` when there are several) the
+    files of a ``run`` result folder: traces.parquet (written as it is cued, :func:`stream_cue`), metrics.csv,
+    run.json, ranking.csv, report.md and recording.rrd (unless ``opts.recording`` is False). Every file is written
+    under a temporary name and all are renamed into place together, then ranking.csv and report.md are written
+    (atomically) last, so a failure leaves no half-written file. Returns (summary, result) per segment;
+    ``start``: the command's start (``time.perf_counter()``) for run.json's wall time."""
     from washbench.io.provenance import flat_strings, parquet_metadata, utc_now
     from washbench.runs.pipeline import write_run_json, write_run_recording
     from washbench.runs.suite import write_run_review
@@ -349,16 +537,27 @@ def write_outputs(
     if out_dir.exists() and not out_dir.is_dir():
         raise WashbenchError(located(out_dir, "output path exists and is not a folder"))
     created = utc_now()
-    summaries = []
+    done: list[tuple[Any, CueResult]] = []
+    shown = Progress("cue", sum(seg.motion.n for seg in segments)) if progress else None
     try:
         with contextlib.ExitStack() as stack:
-            for seg, result in zip(segments, results, strict=True):
+            if shown is not None:
+                stack.callback(shown.close)
+            offset = 0
+            for seg in segments:
                 folder = result_path(out_dir, seg.name) if seg.name else out_dir
                 folder.mkdir(parents=True, exist_ok=True)
                 names = (TRACES_FILE, METRICS_FILE, "run.json") + ((RECORDING_FILE,) if opts.recording else ())
                 tmp = {name: stack.enter_context(atomic_path(folder / name)) for name in names}
+                meta = parquet_metadata(provenance) if provenance else None
+                if shown is not None:
+                    shown.offset = offset
+                result = stream_cue(
+                    seg.motion, washouts, limits, tmp[TRACES_FILE], meta,
+                    filter_start=opts.filter_start, recording=opts.recording, progress=shown,
+                )  # fmt: skip
+                offset += seg.motion.n
                 summary = segment_summary(input_path, seg, result, folder)
-                write_traces(tmp[TRACES_FILE], result.table, parquet_metadata(provenance) if provenance else None)
                 write_metrics_csv(tmp[METRICS_FILE], result.metrics)
                 extra = {
                     "input": str(input_path),
@@ -371,20 +570,20 @@ def write_outputs(
                 }
                 if provenance:
                     extra |= {"created_utc": created, "provenance": provenance}
-                write_run_json(tmp["run.json"], summary, wall_s, extra)
+                write_run_json(tmp["run.json"], summary, time.perf_counter() - start, extra)
                 if opts.recording:
                     title = f"{summary.aircraft} / {summary.manoeuvre}"
                     q = recorded_attitude(seg.motion)
                     props = flat_strings(provenance, created) if provenance else None
                     write_run_recording(tmp[RECORDING_FILE], title, seg.motion, result, limits, q, [], props)
-                summaries.append(summary)
-        for summary in summaries:  # last, as a suite's report: each written atomically once the rest is in place
-            if not opts.recording:  # a recording of an earlier run would not show these results
+                done.append((summary, result))
+        for summary, result in done:  # last, as a suite's report: each written atomically once the rest is in
+            if not opts.recording:  # place; a recording of an earlier run would not show these results
                 (summary.run_dir / RECORDING_FILE).unlink(missing_ok=True)
-            write_run_review(summary.run_dir, summary, str(input_path))
+            write_run_review(summary.run_dir, summary, str(input_path), result.review_table(), opts.figures)
     except OSError as exc:
         raise WashbenchError(located(out_dir, f"cannot write results: {exc.strerror or exc}")) from None
-    return summaries
+    return done
 
 
 def run_cue(
@@ -419,7 +618,6 @@ def run_cue(
     samples = read_input(input_path, opts.fmt)
     segments = prepare_segments(samples, opts)
     with output_lock(out_dir):
-        results = cue_segments(segments, specs, None, limits, opts.filter_start)
         for seg in segments:
             for f in seg.findings:
                 where = f"{input_path}{f' ({seg.name})' if seg.name else ''}"
@@ -433,9 +631,8 @@ def run_cue(
         input_prov = read_parquet_provenance(input_path) if is_parquet else None
         if input_prov:
             prov["input"]["provenance"] = input_prov
-        wall = time.perf_counter() - start
-        summaries = write_outputs(out_dir, input_path, segments, results, limits, opts, wall, prov)
-    for seg, result, summary in zip(segments, results, summaries, strict=True):
+        done = write_outputs(out_dir, input_path, segments, specs, limits, opts, start, prov, progress=True)
+    for seg, (summary, result) in zip(segments, done, strict=True):
         m = seg.motion
         label = f"{input_path}{f' {seg.name}' if seg.name else ''}"
         print(f"{label}: {m.n} rows, {m.duration_s:.3f} s at dt = {m.dt_s:.6g} s ({1.0 / m.dt_s:.6g} Hz)")
@@ -448,4 +645,4 @@ def run_cue(
         if not summary.ok:
             print(f"  FAILED: {summary.reason}")
         print(f"wrote {summary.run_dir}")
-    return 0 if all(s.ok for s in summaries) else 1
+    return 0 if all(s.ok for s, _ in done) else 1

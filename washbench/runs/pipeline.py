@@ -49,6 +49,7 @@ from washbench.io.publish import (
     remove_if_empty,
     result_path,
 )
+from washbench.runs.outputs import DEFAULT_OUTPUTS, Outputs
 
 if TYPE_CHECKING:
     from washbench.io.results import Motion
@@ -132,11 +133,12 @@ def run_manoeuvre(
     variants: Sequence[str] = (),
     filter_start: str = "steady",
     aircraft_dirs: Sequence[Path] = (),
-    recording: bool = True,
+    outputs: Outputs = DEFAULT_OUTPUTS,
 ) -> RunSummary:
     """Fly one manoeuvre with the washouts in lockstep and write its results folder.
 
-    ``recording=False`` skips ``recording.rrd`` (and the import of rerun): every other file is written.
+    ``outputs``: whether ``recording.rrd`` and the figures are written (:class:`washbench.runs.outputs.Outputs`);
+    every other file is.
 
     ``washouts`` (built-in names), ``variants`` (``--variant`` texts) and the parameter file's ``variants:``
     select the washouts (:func:`washbench.cueing.variants.select_washouts`; default the three built-in ones).
@@ -195,7 +197,7 @@ def run_manoeuvre(
         extra = {"created_utc": created, "provenance": prov}
         summary = write_cued_folder(
             partial, summary, rows, washouts, limits, ac_q, flight.phases, start, filter_start, extra, prov,
-            recording=recording,
+            outputs=outputs,
         )  # fmt: skip
         publish_dir(partial, final, RUN_MARKER, marker)
         published = True
@@ -297,7 +299,7 @@ def write_cued_folder(
     filter_start: str = "steady",
     extra: dict[str, object] | None = None,
     provenance: dict[str, Any] | None = None,
-    recording: bool = True,
+    outputs: Outputs = DEFAULT_OUTPUTS,
 ) -> RunSummary:
     """Everything after the flight, into ``folder`` (which already holds ``flight.parquet``): perception and
     metrics on the flight read back (as ``washbench cue`` reads it), traces.parquet, metrics.csv, recording.rrd,
@@ -313,7 +315,7 @@ def write_cued_folder(
     traces = {w: WashoutTrace.from_rows(block[:, i, :]) for i, w in enumerate(washouts)}
     result = analyse(motion, traces, filter_start=filter_start)
     write_results(folder, result, provenance)
-    if recording:
+    if outputs.recording:
         title = f"{summary.aircraft} / {summary.manoeuvre}"
         props = flat_strings(provenance, str((extra or {}).get("created_utc") or "")) if provenance else None
         write_run_recording(folder / "recording.rrd", title, motion, result, limits, aircraft_q, phases, props)
@@ -327,7 +329,8 @@ def write_cued_folder(
         saturations={w: dict(traces[w].saturation_counts) for w in washouts},
     )
     write_run_json(folder / "run.json", summary, time.perf_counter() - start, extra)
-    write_run_review(folder, dataclasses.replace(summary, run_dir=folder))
+    write_run_review(folder, dataclasses.replace(summary, run_dir=folder), table=result.columns(),
+                     figures=outputs.figures)
     return summary
 
 
@@ -342,7 +345,7 @@ def run_script(
     aircraft_dirs: Sequence[Path] = (),
     washouts: Sequence[str] | None = None,
     variants: Sequence[str] = (),
-    recording: bool = True,
+    outputs: Outputs = DEFAULT_OUTPUTS,
 ) -> list[RunSummary]:
     """Fly a JSBSim script (:mod:`washbench.flight.scripts`) with the washouts in lockstep, one result per run.
 
@@ -399,7 +402,7 @@ def run_script(
             extra |= {"created_utc": created, "provenance": prov}
             summaries.append(
                 write_cued_folder(folder, summary, rows, names, limits, ac_q, [], start, filter_start, extra, prov,
-                                  recording=recording)
+                                  outputs=outputs)
             )
         publish_dir(partial, final, RUN_MARKER, marker, nested=True)
     finally:
@@ -511,7 +514,7 @@ def run_command(
     washouts: Sequence[str] | None = None,
     variants: Sequence[str] = (),
     aircraft_dirs: Sequence[Path] = (),
-    recording: bool = True,
+    outputs: Outputs = DEFAULT_OUTPUTS,
 ) -> int:
     """CLI entry of ``washbench run`` (a YAML manoeuvre or a JSBSim script): 0 if every run was ok, else 1.
 
@@ -537,7 +540,7 @@ def run_command(
                 aircraft_dirs=aircraft_dirs,
                 washouts=washouts,
                 variants=variants,
-                recording=recording,
+                outputs=outputs,
             )
         else:
             if max_time_s is not None:
@@ -555,7 +558,7 @@ def run_command(
                     aircraft_dirs=aircraft_dirs,
                     washouts=washouts,
                     variants=variants,
-                    recording=recording,
+                    outputs=outputs,
                 )
             ]
     wall = time.perf_counter() - start

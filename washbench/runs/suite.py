@@ -39,10 +39,11 @@ import signal
 import sys
 import time
 import traceback
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from washbench.analysis.ranking import (
     DOFS,
@@ -58,6 +59,7 @@ from washbench.io.lock import LOCK_NAME, output_lock
 from washbench.io.paths import MANOEUVRES_DIR, bundled_names, resolve_manoeuvre
 from washbench.io.publish import clean_partials, is_leftover, is_washbench_result, read_marker
 from washbench.io.results import csv_number
+from washbench.runs.outputs import DEFAULT_OUTPUTS, Outputs
 from washbench.runs.pipeline import RUN_MARKER, RunSummary
 
 #: The suite's own files in ``OUT`` (``suite.json`` lists everything a suite wrote at the top level).
@@ -178,7 +180,7 @@ def _run_one(
     variants: tuple[str, ...] = (),
     aircraft_dirs: tuple[str, ...] = (),
     max_time_s: float | None = None,
-    recording: bool = True,
+    outputs: Outputs = DEFAULT_OUTPUTS,
 ) -> list[Outcome]:
     """Worker: run one manoeuvre or JSBSim script (one outcome per run segment); never raises (failures
     come back as an Outcome)."""
@@ -191,7 +193,7 @@ def _run_one(
     try:
         dirs = [Path(d) for d in aircraft_dirs]
         common = {"params_path": params, "platform_path": platform, "aircraft_dirs": dirs}
-        common |= {"washouts": washouts, "variants": variants, "recording": recording}
+        common |= {"washouts": washouts, "variants": variants, "outputs": outputs}
         if is_script(Path(path)):
             runs = run_script(Path(path), Path(out_dir), max_time_s=max_time_s, **common)
         else:
@@ -249,11 +251,11 @@ def run_suite(
     dask: str | None = None,
     aircraft_dirs: Sequence[Path] = (),
     max_time_s: float | None = None,
-    recording: bool = True,
+    outputs: Outputs = DEFAULT_OUTPUTS,
 ) -> list[Outcome]:
     """Run every file in parallel processes (or on the Dask cluster at ``dask``); outcomes in the order of ``files``
-    (a JSBSim script that resets gives one outcome per run segment, in order). ``recording=False``: no
-    ``recording.rrd`` in the run folders (the report then links none).
+    (a JSBSim script that resets gives one outcome per run segment, in order). ``outputs``: whether the
+    run folders get ``recording.rrd`` and figures (:class:`washbench.runs.outputs.Outputs`).
 
     On any exception (KeyboardInterrupt and :class:`washbench.errors.Terminated` included) the local workers are
     stopped before it propagates, so no worker writes anything afterwards.
@@ -264,7 +266,7 @@ def run_suite(
     params = str(params_path) if params_path else None
     platform = str(platform_path) if platform_path else None
     chosen = tuple(washouts) if washouts else None
-    args = [(str(f), str(out_dir), params, platform, chosen, tuple(variants), dirs, max_time_s, recording)
+    args = [(str(f), str(out_dir), params, platform, chosen, tuple(variants), dirs, max_time_s, outputs)
             for f in files]
     outcomes: dict[str, list[Outcome]] = {}
     start = time.perf_counter()
@@ -283,7 +285,7 @@ def run_suite(
         for a in args:
             outcomes[a[0]] = _report(_run_one(*a), len(outcomes) + 1, len(files), start, progress)
     else:
-        ctx, initializer = pool_context(recording, main_stops_workers=True)
+        ctx, initializer = pool_context(outputs.recording, main_stops_workers=True)
         pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_init, initargs=(initializer,))
         try:
             with _signals_deferred():  # submitting starts the workers (up to ``jobs``)
@@ -390,9 +392,10 @@ def _washouts(outcomes: Sequence[Outcome]) -> list[str]:
 
 
 def write_suite_results(
-    outcomes: Sequence[Outcome], out_dir: Path, provenance: dict[str, object] | None = None
+    outcomes: Sequence[Outcome], out_dir: Path, provenance: dict[str, object] | None = None, figures: bool = True
 ) -> None:
-    """Write metrics.csv, comparison.csv, ranking.csv, suite.json and (last) report.md with its figures, atomically.
+    """Write metrics.csv, comparison.csv, ranking.csv, suite.json and (last) report.md with its figures (unless
+    ``figures`` is False), atomically.
 
     The report is built from the files (:mod:`washbench.review.suite_report`), as ``washbench report`` builds it.
     """
@@ -421,7 +424,7 @@ def write_suite_results(
     ]
     created = utc_now()
     write_suite_json(out_dir / SUITE_MARKER, entries, dict(provenance or {}), created)
-    write_suite_report(out_dir)
+    write_suite_report(out_dir, figures=figures)
     # last: the same document with every top-level entry written (what the next suite may replace)
     top = sorted(e.name for e in out_dir.iterdir() if not e.name.startswith(".") and e.name != SUITE_MARKER)
     write_suite_json(out_dir / SUITE_MARKER, entries, dict(provenance or {}), created, top)
@@ -498,17 +501,24 @@ def _swap_in(stage: Path, out_dir: Path, previous: Sequence[Path]) -> None:
         shutil.rmtree(old, ignore_errors=True)
 
 
-def write_run_review(run_dir: Path, summary: RunSummary, source: str = "") -> None:
+def write_run_review(
+    run_dir: Path,
+    summary: RunSummary,
+    source: str = "",
+    table: Mapping[str, Any] | None = None,
+    figures: bool = True,
+) -> None:
     """``ranking.csv`` and ``report.md`` of one result folder (the same tables as a suite's, for one run).
 
     The one call site for a result folder's report (``washbench run`` and ``washbench cue``); the report and its
-    figures are built from the folder's files (:func:`washbench.review.report.write_result_report`).
+    figures are built from the folder's files (:func:`washbench.review.report.write_result_report`), with the
+    traces.parquet columns taken from ``table`` when the caller still holds them; ``figures=False``: none drawn.
     """
     from washbench.review.report import write_result_report
 
     rankings = {(summary.aircraft, summary.manoeuvre): rank(summary.metrics, summary.motion)} if summary.metrics else {}
     write_text_atomic(run_dir / "ranking.csv", ranking_table(rankings))
-    write_result_report(run_dir)
+    write_result_report(run_dir, table, figures=figures)
 
 
 def suite_command(
@@ -525,7 +535,7 @@ def suite_command(
     aircraft_dirs: Sequence[Path] = (),
     jsbsim_scripts: Sequence[str] = (),
     max_time_s: float | None = None,
-    recording: bool = True,
+    outputs: Outputs = DEFAULT_OUTPUTS,
 ) -> int:
     """CLI entry: run the suite, write its results, print where they are; 0 if all succeeded, else 1.
 
@@ -578,9 +588,9 @@ def suite_command(
                 dask=dask,
                 aircraft_dirs=aircraft_dirs,
                 max_time_s=max_time_s,
-                recording=recording,
+                outputs=outputs,
             )
-            write_suite_results(outcomes, stage, provenance)
+            write_suite_results(outcomes, stage, provenance, outputs.figures)
             _swap_in(stage, out_dir, previous)
         finally:
             shutil.rmtree(stage, ignore_errors=True)
