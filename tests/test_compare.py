@@ -11,7 +11,7 @@ from test_rerun_log import WASHOUTS, make_data
 from washbench.cli import main
 from washbench.errors import WashbenchError
 from washbench.review.compare import write_comparison
-from washbench.review.rerun_log import perceived_path, write_recording
+from washbench.review.rerun_log import MotionSeries, perceived_path, write_recording
 from washbench.review.rrd_read import read_component, read_scalar_series, read_static, read_text_documents
 
 
@@ -36,15 +36,48 @@ def test_both_recordings_in_one_panel_per_dof(pair):
     assert names == ["aircraft", *(f"CW1: {w}" for w in WASHOUTS), *(f"CW1-soft: {w}" for w in WASHOUTS)]
     for dof in ("surge", "heave", "yaw"):
         t, v = sc[perceived_path(dof)]
-        np.testing.assert_array_equal(t, sa[perceived_path(dof)][0])
-        np.testing.assert_array_equal(v[:, :4], sa[perceived_path(dof)][1])  # aircraft once, then A's washouts
-        np.testing.assert_array_equal(v[:, 4:], sb[perceived_path(dof)][1][:, 1:])  # then B's
+        (t_a, v_a), (t_b, v_b) = sa[perceived_path(dof)], sb[perceived_path(dof)]
+        np.testing.assert_array_equal(t, np.union1d(t_a, t_b))  # both's recorded times
+        k_a, k_b = np.searchsorted(t, t_a), np.searchsorted(t, t_b)
+        np.testing.assert_array_equal(v[k_a, :4], v_a)  # aircraft once, then A's washouts, exact at A's samples
+        np.testing.assert_array_equal(v[k_b, 4:], v_b[:, 1:])  # then B's
+        for j in range(4):  # between its samples each line is its own recording's line
+            np.testing.assert_allclose(v[:, j], np.interp(t, t_a, v_a[:, j]), rtol=1e-12, atol=1e-12)
     colours = read_static(out, "SeriesLines:colors")[perceived_path("roll")]
     assert len(set(colours)) == 7  # B's washouts in their own (washed) shades
     _, usage = sc["/envelope/position"]
-    assert usage.shape == (240, 6)
+    assert usage.shape[1] == 6
     assert read_component(out, "StateChange:state")["/lanes/phase"][1].tolist() == ["entry", "hold", "exit"]
     assert set(read_text_documents(out)) == {"/metrics/a", "/metrics/b"}
+
+
+def _smooth(data, gain: float, aircraft_gain: float = 0.3):
+    """``data`` with slow sines as motion: the recordings keep a few per cent of the steps, each its own."""
+    t = data.t_s
+    f = np.column_stack([np.sin(0.3 * t), 0.2 * np.cos(0.5 * t), -9.80665 + 0.1 * np.sin(0.2 * t)])
+    w = np.column_stack([0.05 * np.sin(0.4 * t), 0.02 * np.sin(0.25 * t), 0.01 * np.cos(0.1 * t)])
+
+    def m(g: float) -> MotionSeries:
+        return MotionSeries(g * f, g * w, g * f, g * w, data.aircraft.q)
+
+    return type(data)(**{**data.__dict__, "aircraft": m(aircraft_gain), "washouts": {x: m(gain) for x in WASHOUTS}})
+
+
+def test_thinned_recordings_share_the_aircraft_only_when_it_agrees(tmp_path):
+    base = make_data(n=2400)
+    a, b, c = tmp_path / "a.rrd", tmp_path / "b.rrd", tmp_path / "c.rrd"
+    write_recording(a, _smooth(base, 0.6), {"params_name": "one"})
+    write_recording(b, _smooth(base, 1.0), {"params_name": "two"})
+    write_recording(c, _smooth(base, 1.0, aircraft_gain=0.33), {"params_name": "three"})
+    t_a, t_b = read_scalar_series(a)[perceived_path("surge")][0], read_scalar_series(b)[perceived_path("surge")][0]
+    assert t_a.size < 240 and not np.array_equal(t_a, t_b)  # thinned, each at its own times
+    write_comparison(a, b, tmp_path / "ab.rrd")
+    write_comparison(a, c, tmp_path / "ac.rrd")
+    assert read_static(tmp_path / "ab.rrd", "SeriesLines:names")[perceived_path("surge")][0] == "aircraft"
+    assert read_static(tmp_path / "ac.rrd", "SeriesLines:names")[perceived_path("surge")][:2] == [
+        "one: aircraft",
+        "three: aircraft",
+    ]  # 10 % more motion: two lines
 
 
 def test_different_time_axes_are_refused(pair, tmp_path):

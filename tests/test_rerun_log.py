@@ -96,32 +96,121 @@ def written(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, RecordingDa
     return path, data
 
 
+def assert_recorded(
+    t_rec: np.ndarray,
+    v_rec: np.ndarray,
+    t_s: np.ndarray,
+    values: np.ndarray,
+    tolerance: float | np.ndarray,
+    ulps: int = 0,
+) -> None:
+    """The stated precision of a recorded series against the values it came from (``values`` (N,) or (N, L) at the
+    times ``t_s``): every recorded time is one of ``t_s`` (to 0.5 ns), the first and the last among them, none more
+    than MAX_GAP_S after the previous; each recorded value equals float32(value) exactly; linear interpolation between
+    the recorded samples is within ``tolerance`` of float32(value) at every step, so within tolerance plus float32's
+    half step (2^-24 relative) of the value itself. ``ulps``: recorded values may be this many float32 steps off
+    (for values that reached the recording by another float64 path than ``values``)."""
+    values = np.asarray(values, dtype=np.float64).reshape(t_s.size, -1)
+    v_rec = np.asarray(v_rec).reshape(t_rec.size, -1)
+    assert v_rec.dtype == np.float64 and v_rec.shape[1] == values.shape[1]
+    k = np.searchsorted(t_s, t_rec - 0.5e-9)
+    assert np.all(k < t_s.size) and np.all(np.abs(t_s[np.minimum(k, t_s.size - 1)] - t_rec) <= 0.5e-9 + 1e-15)
+    assert k[0] == 0 and k[-1] == t_s.size - 1 and np.all(np.diff(k) > 0)
+    assert np.all(np.diff(t_rec) <= rerun_log.MAX_GAP_S + 1e-9)
+    f32 = values.astype(np.float32).astype(np.float64)
+    if ulps:
+        step = np.spacing(np.abs(f32[k]).astype(np.float32)).astype(np.float64)
+        assert np.all(np.abs(v_rec - f32[k]) <= ulps * step)
+    else:
+        np.testing.assert_array_equal(v_rec, f32[k])
+    tol = np.broadcast_to(np.asarray(tolerance, dtype=np.float64), (values.shape[1],))
+    for j in range(values.shape[1]):
+        err = np.abs(np.interp(t_s, t_rec, v_rec[:, j]) - f32[:, j])
+        slack = ulps * np.spacing(np.abs(f32[:, j]).astype(np.float32)).astype(np.float64)
+        assert np.all(err <= tol[j] * (1 + 1e-9) + 1e-12 + slack), (j, err.max(), tol[j])
+        off = np.abs(np.interp(t_s, t_rec, v_rec[:, j]) - values[:, j])
+        assert np.all(off <= tol[j] * (1 + 1e-9) + 2.0**-24 * np.abs(values[:, j]) + 1e-12 + slack)
+
+
+THRESHOLDS = {"surge": 0.17, "sway": 0.17, "heave": 0.28, "roll": 3.0, "pitch": 3.6, "yaw": 2.6}
+"""Zacharias (1978), m/s^2 and deg/s, typed here from washbench/perception/thresholds.py."""
+
+
+def panel_ranges(path: Path) -> dict[str, tuple[float, float]]:
+    """The fixed y range of every time-series panel in the stored blueprint: origin -> (lo, hi)."""
+    out = {}
+    for v in _views(path).values():
+        if v.get("ScalarAxis:range"):
+            lo, hi = v["ScalarAxis:range"][0]
+            out[v["ViewBlueprint:space_origin"][0]] = (lo, hi)
+    return out
+
+
+def motion_tolerances(path: Path, entity: str, lines: int) -> float:
+    """The tolerance stored with a perceived or raw entity, after checking it against the stated bound: at most 1 %
+    of the DOF's perception threshold and at most 0.2 % of the height of the panel that shows it."""
+    stored = np.asarray(read_static(path, "interpolation_tolerance")[entity], dtype=np.float64)
+    assert stored.shape == (lines,) and np.all(stored == stored[0]) and stored[0] > 0
+    lo, hi = panel_ranges(path)[entity]
+    bound = min(0.01 * THRESHOLDS[entity.rsplit("/", 1)[1]], 0.002 * (hi - lo))
+    assert stored[0] <= bound * (1 + 1e-12)
+    return float(stored[0])
+
+
 def test_time_axis_is_k_dt_to_the_nanosecond(written):
     path, data = written
     series = read_scalar_series(path)
     t, _ = series[perceived_path("surge")]
-    assert t.shape == data.t_s.shape
-    np.testing.assert_allclose(t, data.t_s, rtol=0, atol=0.5e-9 + 1e-15)
+    k = np.round(t * 120).astype(int)
+    np.testing.assert_allclose(t, data.t_s[k], rtol=0, atol=0.5e-9 + 1e-15)
+    assert k[0] == 0 and k[-1] == data.t_s.size - 1
 
 
 def test_motion_traces_equal_the_inputs_one_line_per_source(written):
-    """Stated precision: float64, bit-equal for specific force; angular rates in deg/s to 1e-14."""
+    """Stated precision: float32 values at the recorded steps, linear interpolation within 1 % of the perception
+    threshold and 0.2 % of the panel's height at every step (angular rates in deg/s); the tolerance is stored with
+    each entity."""
     path, data = written
     series = read_scalar_series(path)
     sources = [data.aircraft, *data.washouts.values()]
     for dof, sig, axis, _unit in DOFS:
-        _, perceived = series[perceived_path(dof)]
-        _, raw = series[raw_path(dof)]
-        assert perceived.shape == (data.t_s.size, 1 + len(WASHOUTS)) and perceived.dtype == np.float64
-        for i, m in enumerate(sources):
-            if sig == "f":  # m/s^2, stored unchanged
-                np.testing.assert_array_equal(perceived[:, i], m.perceived_f_mps2[:, axis])
-                np.testing.assert_array_equal(raw[:, i], m.f_mps2[:, axis])
-            else:  # shown in deg/s
-                np.testing.assert_allclose(perceived[:, i], m.perceived_omega_radps[:, axis] * 180 / np.pi, rtol=1e-14)
-                np.testing.assert_allclose(raw[:, i], m.omega_radps[:, axis] * 180 / np.pi, rtol=1e-14)
+        for entity, fields in ((perceived_path(dof), ("perceived_f_mps2", "perceived_omega_radps")),
+                               (raw_path(dof), ("f_mps2", "omega_radps"))):  # fmt: skip
+            t_rec, v_rec = series[entity]
+            assert v_rec.shape[1] == 1 + len(WASHOUTS)
+            expected = np.column_stack([getattr(m, fields[0 if sig == "f" else 1])[:, axis] for m in sources])
+            if sig == "omega":
+                expected = expected * 180 / np.pi
+            assert_recorded(t_rec, v_rec, data.t_s, expected, motion_tolerances(path, entity, 1 + len(WASHOUTS)))
     names = read_static(path, "SeriesLines:names")
     assert names[perceived_path("surge")] == [AIRCRAFT, *WASHOUTS]
+
+
+def test_smooth_motion_is_thinned_and_fast_motion_kept(tmp_path):
+    """A slow sine needs a sample about every MAX_GAP_S; a burst of fast motion keeps (nearly) every step there."""
+    base = make_data(n=2400)
+    t = base.t_s
+    slow = np.column_stack([0.5 * np.sin(0.2 * t), 0.0 * t, -G + 0.1 * np.sin(0.3 * t)])
+    fast = slow.copy()
+    burst = (t > 10.0) & (t < 12.0)
+    fast[burst, 0] += 0.4 * np.sin(2 * np.pi * 8.0 * t[burst])  # 8 Hz, 0.4 m/s^2
+    w0 = np.zeros_like(slow)
+    q = base.aircraft.q
+
+    def m(f: np.ndarray) -> MotionSeries:
+        return MotionSeries(f, w0, f, w0, q)
+
+    data = RecordingData(**{**base.__dict__, "aircraft": m(fast), "washouts": {w: m(slow) for w in WASHOUTS}})
+    write_recording(tmp_path / "r.rrd", data)
+    series = read_scalar_series(tmp_path / "r.rrd")
+    t_rec, v_rec = series[perceived_path("surge")]
+    expected = np.column_stack([fast[:, 0]] + [slow[:, 0]] * 3)
+    assert_recorded(t_rec, v_rec, t, expected, motion_tolerances(tmp_path / "r.rrd", perceived_path("surge"), 4))
+    in_burst = (t_rec > 10.0) & (t_rec < 12.0)
+    assert in_burst.sum() > 0.5 * burst.sum()  # the fast part at (almost) full rate
+    assert (~in_burst).sum() < 0.1 * (~burst).sum()  # the slow rest at a few per cent of the steps
+    t_sway, _ = series[perceived_path("sway")]
+    assert t_sway.size <= t[-1] / rerun_log.MAX_GAP_S + 2  # a flat line: one sample per MAX_GAP_S
 
 
 def test_perception_thresholds_are_drawn_as_plus_minus_lines(written):
@@ -137,6 +226,7 @@ def test_perception_thresholds_are_drawn_as_plus_minus_lines(written):
 
 
 def test_platform_traces_and_envelope_usage(written):
+    """Envelope usage within 0.002 (limit at 1), the per-axis traces within 0.2 % of each axis's limit."""
     path, data = written
     series = read_scalar_series(path)
     for q, fname, _unit in ENVELOPE_QUANTITIES:
@@ -144,15 +234,16 @@ def test_platform_traces_and_envelope_usage(written):
         t_lim, v_lim = series[f"/envelope/{q}/limit"]
         np.testing.assert_array_equal(v_lim, [1.0, 1.0])
         np.testing.assert_allclose(t_lim, data.t_s[[0, -1]], atol=1e-9)
-        _, usage = series[envelope_usage_path(q)]
-        assert usage.shape == (data.t_s.size, len(WASHOUTS))
+        t_u, usage = series[envelope_usage_path(q)]
+        assert usage.shape[1] == len(WASHOUTS)
+        expected = [np.linalg.norm(getattr(data.platforms[w], fname) / limit, ord=np.inf, axis=1) for w in WASHOUTS]
+        assert_recorded(t_u, usage, data.t_s, np.column_stack(expected), 0.002)
         for i, w in enumerate(WASHOUTS):
             values = getattr(data.platforms[w], fname)
-            expected = np.linalg.norm(values / limit, ord=np.inf, axis=1)
-            np.testing.assert_allclose(usage[:, i], expected, rtol=1e-15)
             if q == "position":  # first sample: x, y at 0.3 of 1.5 m, z at 0.9 of its own 1.0 m limit
-                assert usage[0, i] == 0.9
-            np.testing.assert_array_equal(series[platform_path(w, q)][1], values)  # random data: every sample kept
+                assert usage[0, i] == np.float32(0.9)
+            t_p, v_p = series[platform_path(w, q)]
+            assert_recorded(t_p, v_p, data.t_s, values, PLATFORM_DETAIL_TOLERANCE * np.broadcast_to(limit, (3,)))
             np.testing.assert_array_equal(series[f"/platform/{w}/{q}/limit_max"][1], [limit, limit])
             np.testing.assert_array_equal(series[f"/platform/{w}/{q}/limit_min"][1], [-limit, -limit])
             if limit.ndim:  # per-axis limits are drawn one line per axis
@@ -162,8 +253,7 @@ def test_platform_traces_and_envelope_usage(written):
 
 
 def test_smooth_platform_traces_are_thinned_within_the_stated_tolerance(tmp_path):
-    """Position and velocity that interpolate linearly within 0.2 % of the limit keep every 2nd-4th sample; the
-    recorded samples are exact and linear interpolation between them reproduces every step within the tolerance."""
+    """Smooth position and velocity keep a few per cent of the steps; random acceleration keeps (nearly) all."""
     base = make_data(n=1200)
     t = base.t_s
     smooth = np.column_stack([np.sin(0.5 * t), 0.5 * np.cos(0.3 * t), 0.2 * np.sin(t)])
@@ -177,14 +267,9 @@ def test_smooth_platform_traces_are_thinned_within_the_stated_tolerance(tmp_path
     for w in WASHOUTS:
         for q, values, limit in (("position", smooth, (1.5, 1.5, 1.0)), ("velocity", 0.5 * smooth, (2.0,) * 3)):
             t_rec, v_rec = series[platform_path(w, q)]
-            assert t.size / 4 <= t_rec.size < t.size / 2  # thinned
-            assert t_rec[0] == 0.0 and abs(t_rec[-1] - t[-1]) < 1e-9
-            k = np.round(t_rec * 120).astype(int)
-            np.testing.assert_array_equal(v_rec, values[k])
-            for j in range(3):
-                err = np.abs(np.interp(t, t_rec, v_rec[:, j]) - values[:, j])
-                assert err.max() <= PLATFORM_DETAIL_TOLERANCE * limit[j] + 1e-12
-        assert series[platform_path(w, "acceleration")][0].size == t.size  # random: every sample
+            assert t_rec.size < t.size / 10  # thinned
+            assert_recorded(t_rec, v_rec, t, values, PLATFORM_DETAIL_TOLERANCE * np.array(limit))
+        assert series[platform_path(w, "acceleration")][0].size > 0.9 * t.size  # random: (nearly) every sample
 
 
 def _state_at(t_change: np.ndarray, states: np.ndarray, t: np.ndarray) -> np.ndarray:
@@ -264,36 +349,45 @@ def test_properties_must_be_strings(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
+def _held(t_rec: np.ndarray, v_rec: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """What the 3D view shows at each time of ``t``: the latest recorded row at or before it."""
+    i = np.searchsorted(t_rec, t + 1e-9, side="right") - 1
+    assert np.all(i >= 0)
+    return v_rec[i]
+
+
 def test_3d_scene_relative_heading_scalar_last_and_30_hz(written):
+    """Poses at most at 30 Hz; the pose the view holds is within 0.1 deg and 1 mm of the pose at every 30 Hz step."""
     path, data = written
     quats = read_component(path, "Transform3D:quaternion")
     trans = read_component(path, "Transform3D:translation")
     stride = 4  # 120 Hz -> 30 Hz
     k = np.arange(0, data.t_s.size, stride)
     # aircraft: relative to its initial heading; checked with scipy's ZYX Euler angles
-    t_ac, q_ac = quats["/world/aircraft/body"]
-    np.testing.assert_allclose(t_ac, data.t_s[k], atol=1e-9)
-    assert q_ac.dtype == np.float32  # rerun stores quaternions as float32
+    t_ac, q_rec = quats["/world/aircraft/body"]
+    assert np.all(np.isin(np.round(t_ac * 120).astype(int), np.append(k, data.t_s.size - 1)))
+    assert q_rec.dtype == np.float32  # rerun stores quaternions as float32
+    q_ac = _held(t_ac, q_rec, data.t_s[k])
     ypr = Rotation.from_quat(data.aircraft.q[k], scalar_first=True).as_euler("ZYX")
     ypr0 = Rotation.from_quat(data.aircraft.q[0], scalar_first=True).as_euler("ZYX")
     ypr[:, 0] -= ypr0[0]
     x_fwd, z_down = np.array([1.0, 0.0, 0.0]), np.array([0.0, 0.0, 1.0])
     got = Rotation.from_quat(q_ac.astype(np.float64))  # scipy reads scalar-last
     want = Rotation.from_euler("ZYX", ypr)
+    assert np.degrees((got * want.inv()).magnitude()).max() <= 0.1 + 1e-4
     for v in (x_fwd, z_down):
-        np.testing.assert_allclose(got.apply(v), want.apply(v), atol=1e-6)
+        np.testing.assert_allclose(got.apply(v), want.apply(v), atol=np.radians(0.1) + 1e-6)
     np.testing.assert_allclose(got[0].as_euler("ZYX")[0], 0.0, atol=1e-6)
     # cockpits: attitude unchanged (the simulator starts at yaw 0), translated by the stage position
     static_t = read_static(path, "Transform3D:translation")
     offsets = []
     for w in WASHOUTS:
-        _, q = quats[f"/world/atlas/{w}/cockpit"]
-        np.testing.assert_allclose(
-            Rotation.from_quat(q.astype(np.float64)).apply(x_fwd),
-            Rotation.from_quat(data.washouts[w].q[k], scalar_first=True).apply(x_fwd),
-            atol=1e-6,
-        )
-        np.testing.assert_allclose(trans[f"/world/atlas/{w}/cockpit"][1], data.platforms[w].pos_m[k], atol=1e-6)
+        t_q, q = quats[f"/world/atlas/{w}/cockpit"]
+        held = Rotation.from_quat(_held(t_q, q, data.t_s[k]).astype(np.float64))
+        truth = Rotation.from_quat(data.washouts[w].q[k], scalar_first=True)
+        assert np.degrees((held * truth.inv()).magnitude()).max() <= 0.1 + 1e-4
+        t_p, pos = trans[f"/world/atlas/{w}/cockpit"]
+        np.testing.assert_allclose(_held(t_p, pos, data.t_s[k]), data.platforms[w].pos_m[k], atol=1e-3 + 1e-6)
         offsets.append(static_t[f"/world/atlas/{w}"][0][1])
     gaps = np.diff([static_t["/world/aircraft"][0][1], *offsets])
     sphere_plus_travel = data.envelope.sphere_diameter_m + 2 * data.envelope.pos_m[1]
@@ -301,6 +395,29 @@ def test_3d_scene_relative_heading_scalar_last_and_30_hz(written):
     labels = read_static(path, "Points3D:labels")
     assert labels["/world/labels"] == [AIRCRAFT, *WASHOUTS]  # one label per object
     assert not any(k != "/world/labels" for k in read_static(path, "Boxes3D:labels"))
+
+
+def test_slow_3d_poses_are_held_within_the_stated_tolerance(tmp_path):
+    """A cockpit turning at 0.5 deg/s and then still: far fewer than 30 poses a second, each held within 0.1 deg."""
+    base = make_data(n=2400)
+    t = base.t_s
+    yaw = np.radians(0.5) * np.minimum(t, 10.0)  # 0.5 deg/s for 10 s, then still
+    q = Rotation.from_euler("ZYX", np.column_stack([yaw, 0.01 * np.sin(0.2 * t), 0 * t])).as_quat(scalar_first=True)
+    pos = np.column_stack([0.02 * np.sin(0.1 * t), 0 * t, 0 * t])
+    washouts = {w: MotionSeries(m.f_mps2, m.omega_radps, m.perceived_f_mps2, m.perceived_omega_radps, q)
+                for w, m in base.washouts.items()}  # fmt: skip
+    platforms = {
+        w: PlatformSeries(pos, p.vel_mps, p.acc_mps2, p.wheel_radps, p.saturated) for w, p in base.platforms.items()
+    }
+    data = RecordingData(**{**base.__dict__, "washouts": washouts, "platforms": platforms})
+    write_recording(tmp_path / "r.rrd", data)
+    t_q, q_rec = read_component(tmp_path / "r.rrd", "Transform3D:quaternion")[f"/world/atlas/{WASHOUTS[0]}/cockpit"]
+    t_p, p_rec = read_component(tmp_path / "r.rrd", "Transform3D:translation")[f"/world/atlas/{WASHOUTS[0]}/cockpit"]
+    k = np.arange(0, t.size, 4)
+    assert t_q.size < 0.4 * k.size and np.all(np.diff(t_q) <= 1.0 + 1e-9)
+    held = Rotation.from_quat(_held(t_q, q_rec, t[k]).astype(np.float64))
+    assert np.degrees((held * Rotation.from_quat(q[k], scalar_first=True).inv()).magnitude()).max() <= 0.1 + 1e-4
+    np.testing.assert_allclose(_held(t_p, p_rec, t[k]), pos[k], atol=1e-3 + 1e-6)
 
 
 def test_quaternion_order_conversion_matches_scipy():
@@ -502,8 +619,11 @@ def test_write_time_15000_samples_three_washouts(tmp_path):
     elapsed = time.perf_counter() - start
     size_mb = (tmp_path / "big.rrd").stat().st_size / 1e6
     print(f"\nwrite_recording: 15,000 samples x 3 washouts in {elapsed:.3f} s, {size_mb:.1f} MB")
-    series = read_scalar_series(tmp_path / "big.rrd")
-    assert len(series[perceived_path("yaw")][1][:, 3]) == 15_000
+    t_rec, v_rec = read_scalar_series(tmp_path / "big.rrd")[perceived_path("yaw")]
+    sources = [data.aircraft, *data.washouts.values()]
+    expected = np.column_stack([np.rad2deg(m.perceived_omega_radps[:, 2]) for m in sources])
+    tol = motion_tolerances(tmp_path / "big.rrd", perceived_path("yaw"), 4)
+    assert_recorded(t_rec, v_rec, data.t_s, expected, tol)
 
 
 def test_rerun_disabled_by_environment_is_an_error_not_an_empty_file(tmp_path):

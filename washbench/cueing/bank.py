@@ -198,14 +198,16 @@ class WashoutTrace:
     saturation_counts: dict[str, int]
 
     @classmethod
-    def from_rows(cls, rows: np.ndarray) -> WashoutTrace:
-        """Build from output rows (N, N_FIELDS) of :meth:`CueingBank.step` for one washout (columns copied)."""
+    def from_rows(cls, rows: np.ndarray, copy: bool = True) -> WashoutTrace:
+        """Build from output rows (N, N_FIELDS) of :meth:`CueingBank.step` for one washout (columns copied, or
+        with ``copy=False`` views into ``rows``: valid only as long as ``rows`` is not overwritten)."""
         rows = np.asarray(rows, dtype=np.float64)
         if rows.ndim != 2 or rows.shape[1] != NFIELDS:
             raise ValueError(f"rows must have shape (N, {NFIELDS}), got {rows.shape}")
 
         def cols(start: int, n: int) -> np.ndarray:
-            return np.ascontiguousarray(rows[:, start : start + n])
+            view = rows[:, start : start + n]
+            return np.ascontiguousarray(view) if copy else view
 
         saturated = {k: rows[:, O_SAT + j] != 0.0 for j, k in enumerate(SAT_KINDS)}
         return cls._build(cols, saturated)
@@ -241,12 +243,17 @@ class WashoutTrace:
         )
 
 
+_step_ready = False
+
+
 def _warm_up() -> None:
     """Compile (or load from the numba cache) the streaming step once, then forbid other signatures.
 
     With compilation disabled, a call with an unexpected argument type raises TypeError at once instead
     of compiling a new specialisation; :meth:`CueingBank.step` then converts the inputs and retries.
     """
+    global _step_ready
+    _step_ready = True
     if bank_step.signatures:
         return
     announce_compile(bank_step)
@@ -292,10 +299,11 @@ class CueingBank:
         self._state = np.zeros((n, NSTATE))
         self._counts = np.zeros((n, len(SAT_KINDS)), dtype=np.int64)
         self._out = np.zeros((n, NFIELDS))
-        _warm_up()
 
     def step(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> np.ndarray:
         """Advance all washouts by one sample; return the reused (n_washouts, N_FIELDS) output array."""
+        if not _step_ready:  # loaded on first use: block-only users (steps, the lockstep, cue) do not pay for it
+            _warm_up()
         try:
             bank_step(f_mps2, omega_radps, self._cfg, self._coef, self._state, self._counts, self._out)
         except TypeError:

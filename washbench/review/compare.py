@@ -4,7 +4,11 @@ E.g. two parameter sets, or two platform files, on the same manoeuvre. Both reco
 one comparison recording: the six stacked perceived-motion panels (and the raw motion) with the aircraft pilot once
 (twice if the two flights differ) and each washout of A and of B, A's in the washout's own colour, B's in the same hue
 washed towards grey, labelled ``A: <washout>`` and ``B: <washout>`` with A and B the recordings' labels; the envelope
-usage of both; the phase lanes; both metric tables side by side. The two recordings must share their time axis.
+usage of both; the phase lanes; both metric tables side by side. The two recordings must cover the same time span.
+
+Each recorded series keeps only the samples it needs (:mod:`washbench.review.thinning`): A's and B's lines of a
+panel are put on the union of their recorded times, each line interpolated linearly from its own samples (the line
+drawn is the same), and the aircraft is drawn once when A's and B's agree within their stored tolerances.
 """
 
 from __future__ import annotations
@@ -53,13 +57,18 @@ def comparison_labels(a: Path, b: Path) -> tuple[str, str]:
     return "A", "B"
 
 
-def _columns(path: Path, entity: str, series: dict[str, tuple[np.ndarray, np.ndarray]]) -> tuple[list[str], np.ndarray]:
+def _columns(
+    path: Path, entity: str, series: dict[str, tuple[np.ndarray, np.ndarray]]
+) -> tuple[list[str], np.ndarray, np.ndarray, np.ndarray]:
+    """Line names, recorded times (ns), values (M, lines) and per-line tolerance (0 where none is stored)."""
     names = read_static(path, "SeriesLines:names").get(entity)
-    _, values = series[entity]
+    t_s, values = series[entity]
     values = values.reshape(values.shape[0], -1)
     if names is None or len(names) != values.shape[1]:
         raise WashbenchError(located(path, f"{entity}: not a washbench recording layout (no line names)"))
-    return [str(n) for n in names], values
+    tol = read_static(path, "interpolation_tolerance").get(entity)
+    tolerance = np.asarray(tol, dtype=np.float64) if tol and len(tol) == len(names) else np.zeros(len(names))
+    return [str(n) for n in names], np.round(t_s * 1e9).astype(np.int64), values, tolerance
 
 
 def write_comparison(a: Path, b: Path, out: Path) -> None:
@@ -71,12 +80,11 @@ def write_comparison(a: Path, b: Path, out: Path) -> None:
         if key not in s:
             raise WashbenchError(located(path, "not a washbench recording (no /perceived/surge)"))
     ta, tb = sa[key][0], sb[key][0]
-    if ta.shape != tb.shape or not np.allclose(ta, tb, rtol=0, atol=1e-9):
+    if abs(ta[0] - tb[0]) > 1e-9 or abs(ta[-1] - tb[-1]) > 1e-9:
         raise WashbenchError(
-            located(b, f"its time axis ({tb.size} steps to {tb[-1]:.3f} s) differs from {a}'s ({ta.size} steps to "
-                    f"{ta[-1]:.3f} s): compare recordings of the same manoeuvre")
+            located(b, f"its time axis ({tb[0]:.3f}-{tb[-1]:.3f} s) differs from {a}'s ({ta[0]:.3f}-{ta[-1]:.3f} s): "
+                    "compare recordings of the same manoeuvre")
         )  # fmt: skip
-    time = _time(ta)
     rec = rr.RecordingStream("washbench-compare", recording_id=uuid.uuid4(), send_properties=False)
     if not rec.is_enabled():
         raise WashbenchError("rerun logging is disabled by the environment (RERUN=off): unset RERUN to compare")
@@ -125,7 +133,7 @@ def write_comparison(a: Path, b: Path, out: Path) -> None:
             rec.send_property("compared", rr.AnyValues(a=str(a), b=str(b), label_a=la, label_b=lb))
             for prefix in ("perceived", "raw"):
                 for dof, _, _, _ in DOFS:
-                    lines = _send_pair(rec, f"/{prefix}/{dof}", time, (a, sa, la), (b, sb, lb))
+                    lines = _send_pair(rec, f"/{prefix}/{dof}", (a, sa, la), (b, sb, lb))
                     if prefix == "perceived" and dof == "surge":
                         _send_legend(rec, ta, *lines)
                     threshold = f"/perceived/{dof}/threshold"
@@ -135,7 +143,7 @@ def write_comparison(a: Path, b: Path, out: Path) -> None:
                         rec.log(threshold, grey, static=True)
                         rec.send_columns(threshold, indexes=[_time(t_th)], columns=rr.Scalars.columns(scalars=v_th))
             for q, _, _ in ENVELOPE_QUANTITIES:
-                _send_pair(rec, f"/envelope/{q}", time, (a, sa, la), (b, sb, lb), aircraft=False, aggregation="Max")
+                _send_pair(rec, f"/envelope/{q}", (a, sa, la), (b, sb, lb), aircraft=False, aggregation="Max")
             phases = read_component(a, "StateChange:state").get(phase_lane_path())
             if phases is not None:
                 t_ph, states = phases
@@ -162,7 +170,6 @@ def _send_legend(
 def _send_pair(
     rec: rr.RecordingStream,
     entity: str,
-    time: rr.TimeColumn,
     a: tuple[Path, dict[str, tuple[np.ndarray, np.ndarray]], str],
     b: tuple[Path, dict[str, tuple[np.ndarray, np.ndarray]], str],
     *,
@@ -171,30 +178,46 @@ def _send_pair(
 ) -> tuple[list[str], list[tuple[int, int, int]], list[float]]:
     """One entity holding A's lines and B's: the aircraft once if both flights agree, then A's and B's washouts."""
     (pa, sa, la), (pb, sb, lb) = a, b
-    names_a, va = _columns(pa, entity, sa)
-    names_b, vb = _columns(pb, entity, sb)
+    names_a, ta, va, tol_a = _columns(pa, entity, sa)
+    names_b, tb, vb, tol_b = _columns(pb, entity, sb)
+    t_ns = np.union1d(ta, tb)  # each line interpolated from its own samples: the same line, drawn on both's times
+
+    def line_a(i: int) -> np.ndarray:
+        return np.interp(t_ns, ta, va[:, i])
+
+    def line_b(i: int) -> np.ndarray:
+        return np.interp(t_ns, tb, vb[:, i])
+
     washouts_a = [n for n in names_a if n != AIRCRAFT]
     washouts_b = [n for n in names_b if n != AIRCRAFT]
-    names, colors, widths, cols = [], [], [], []
+    names, colors, widths, cols, tols = [], [], [], [], []
     if aircraft and AIRCRAFT in names_a:
-        ac_a = va[:, names_a.index(AIRCRAFT)]
-        ac_b = vb[:, names_b.index(AIRCRAFT)] if AIRCRAFT in names_b else ac_a
-        same = np.array_equal(ac_a, ac_b)
+        i_a = names_a.index(AIRCRAFT)
+        ac_a = line_a(i_a)
+        same = AIRCRAFT not in names_b
+        if not same:
+            i_b = names_b.index(AIRCRAFT)
+            ac_b = line_b(i_b)
+            same = bool(np.all(np.abs(ac_a - ac_b) <= tol_a[i_a] + tol_b[i_b] + 1e-12 * np.abs(ac_a)))
         names += ["aircraft"] if same else [f"{la}: aircraft", f"{lb}: aircraft"]
         colors += [series_color(AIRCRAFT)] if same else [series_color(AIRCRAFT), _washed(series_color(AIRCRAFT))]
         widths += [AIRCRAFT_WIDTH] if same else [AIRCRAFT_WIDTH, AIRCRAFT_WIDTH]
         cols += [ac_a] if same else [ac_a, ac_b]
+        tols += [tol_a[i_a]] if same else [tol_a[i_a], tol_b[i_b]]
     for w in washouts_a:
         names.append(f"{la}: {w}")
         colors.append(series_color(w, washouts_a))
         widths.append(WASHOUT_WIDTH)
-        cols.append(va[:, names_a.index(w)])
+        cols.append(line_a(names_a.index(w)))
+        tols.append(tol_a[names_a.index(w)])
     for w in washouts_b:
         names.append(f"{lb}: {w}")
         colors.append(_washed(series_color(w, washouts_b)))
         widths.append(WASHOUT_WIDTH)
-        cols.append(vb[:, names_b.index(w)])
+        cols.append(line_b(names_b.index(w)))
+        tols.append(tol_b[names_b.index(w)])
     style = rr.SeriesLines(colors=colors, names=names, widths=widths, aggregation_policy=aggregation)
-    rec.log(entity, style, static=True)
+    rec.log(entity, style, rr.AnyValues(interpolation_tolerance=np.array(tols)), static=True)
+    time = rr.TimeColumn(TIMELINE, duration=t_ns.astype("timedelta64[ns]"))
     rec.send_columns(entity, indexes=[time], columns=rr.Scalars.columns(scalars=np.column_stack(cols)))
     return names, colors, widths

@@ -68,14 +68,33 @@ _PHASE_SHADE = (0.0, 0.0, 0.0, 0.05)
 _DECIMATE_BUCKETS = 1500
 
 
-def _new_figure(width_in: float, height_in: float) -> Any:
-    """A matplotlib Figure on an Agg canvas (no pyplot, no global backend change)."""
+def _new_figure(
+    width_in: float, height_in: float, margins_in: tuple[float, float, float, float] | None = None
+) -> Any:
+    """A matplotlib Figure on an Agg canvas (no pyplot, no global backend change).
+
+    ``margins_in`` (left, right, top, bottom) [in]: fixed margins for a figure of stacked panels whose labels are
+    known (the per-result figures, drawn for every run: the constrained layout engine measures every label and
+    costs about as much as the drawing); else the constrained layout.
+    """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    fig = Figure(figsize=(width_in, height_in), layout="constrained")
+    if margins_in is None:
+        fig = Figure(figsize=(width_in, height_in), layout="constrained")
+    else:
+        left, right, top, bottom = margins_in
+        fig = Figure(figsize=(width_in, height_in))
+        fig.subplots_adjust(left=left / width_in, right=1.0 - right / width_in, top=1.0 - top / height_in,
+                            bottom=bottom / height_in, hspace=0.16)  # fmt: skip
     FigureCanvasAgg(fig)
     return fig
+
+
+def _top_legend(fig: Any, handles: list[Any]) -> None:
+    """The legend in one row above the panels (under the figure's top edge)."""
+    fig.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, 1.0 - 0.04 / fig.get_figheight()),
+               ncol=len(handles), fontsize=8.5, frameon=False)  # fmt: skip
 
 
 def save_figure(fig: Any, stem: Path, formats: Sequence[str] = ("png",)) -> list[Path]:
@@ -163,7 +182,7 @@ def perceived_figure(
 
     washouts = [s for s in perceived if s != "aircraft"]
     colors = washout_colors(washouts)
-    fig = _new_figure(8.6, 11.0)
+    fig = _new_figure(8.6, 11.0, (0.85, 0.12, 0.62, 0.45))
     ratios = [0.35] + [1.0] * 6 if phases else [1.0] * 6
     axes = fig.subplots(len(ratios), 1, sharex=True, gridspec_kw={"height_ratios": ratios})
     if phases:
@@ -191,7 +210,7 @@ def perceived_figure(
     handles += [Line2D([], [], color=mpl(colors[w]), lw=1.2, label=w) for w in washouts]
     if thresholds is not None:
         handles.append(Line2D([], [], color=_THRESHOLD_COLOR, lw=0.8, ls=(0, (4, 3)), label="perception threshold"))
-    fig.legend(handles=handles, loc="outside upper center", ncol=len(handles), fontsize=8.5, frameon=False)
+    _top_legend(fig, handles)
     axes[0].set_title(f"{title}: perceived motion", fontsize=11)
     return save_figure(fig, stem, formats)
 
@@ -224,7 +243,9 @@ def envelope_figure(
     colors = washout_colors(washouts)
     lanes = [(w, k, flags) for w in washouts for k, flags in saturated.get(w, {}).items() if np.any(flags)]
     n_lanes = max(len(lanes), 1)
-    fig = _new_figure(8.6, 1.55 * len(usage) + 0.9 + 0.2 * n_lanes)
+    # the lane labels (7.5 pt, about 0.06 in a character) and the "limit active" label set the left margin
+    label_in = max([len(SATURATION_LABELS.get(k, k)) for _, k, _ in lanes] + [8]) * 0.062
+    fig = _new_figure(8.6, 1.55 * len(usage) + 0.9 + 0.2 * n_lanes, (max(0.85, label_in + 0.45), 0.12, 0.62, 0.45))
     ratios = [1.0] * len(usage) + [0.12 * n_lanes + 0.25]
     axes = fig.subplots(len(ratios), 1, sharex=True, gridspec_kw={"height_ratios": ratios})
     dt = float(t_s[1] - t_s[0]) if t_s.shape[0] > 1 else 0.0
@@ -263,7 +284,7 @@ def envelope_figure(
     lane_ax.set_xlim(float(t_s[0]), float(t_s[-1]))
     handles = [Line2D([], [], color=mpl(colors[w]), lw=1.2, label=w) for w in washouts]
     handles.append(Line2D([], [], color=(0.3, 0.3, 0.3), lw=0.9, ls="--", label="limit"))
-    fig.legend(handles=handles, loc="outside upper center", ncol=len(handles), fontsize=8.5, frameon=False)
+    _top_legend(fig, handles)
     axes[0].set_title(f"{title}: platform envelope", fontsize=11)
     return save_figure(fig, stem, formats)
 

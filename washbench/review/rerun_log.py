@@ -4,9 +4,9 @@ A recording holds, on one timeline named ``time`` (a duration, seconds since the
 the nanosecond):
 
 - ``/perceived/<dof>``: perceived motion in one degree of freedom (surge, sway, heave in m/s^2; roll, pitch, yaw in
-  deg/s), one row per step with one scalar per source: the aircraft pilot first, then each washout's simulator pilot in
-  the order of ``RecordingData.washouts`` (:func:`sources`); ``/perceived/<dof>/threshold`` the perception threshold as
-  two lines (+-threshold around 0, around -g for heave);
+  deg/s), one row per recorded step with one scalar per source: the aircraft pilot first, then each washout's
+  simulator pilot in the order of ``RecordingData.washouts`` (:func:`sources`); ``/perceived/<dof>/threshold`` the
+  perception threshold as two lines (+-threshold around 0, around -g for heave);
 - ``/raw/<dof>``: the same layout for the unperceived specific force and angular velocity;
 - ``/envelope/<quantity>``: platform envelope usage, max over the three axes of |value| / limit, one scalar per
   washout (``quantity`` in position, velocity, acceleration, wheels), drawn with Max aggregation, and the limit line
@@ -21,17 +21,25 @@ the nanosecond):
   starting with its time (the viewer's time column is narrow);
 - ``/metrics``: the metric table as a Markdown document; the recording properties ``provenance`` (strings).
 
-Precision: every scalar is stored as float64, bit-equal to the traces it came from (angular rates converted to deg/s
-once, ``np.rad2deg``); times to the nanosecond; 3D poses as float32 (rerun's type) at most at 30 Hz. All time-varying
-data is sent as whole columns (``send_columns``), never one ``log`` call per sample; the sources of one panel share one
-row (one time and one row id for all of them), which is most of what a recording weighs. The review blueprint
+Precision: every time-varying scalar is rounded to float32 (:data:`VALUE_DTYPE`; rerun stores it as float64) after
+the angular rates are converted to deg/s once (``np.rad2deg``), and only the steps that linear interpolation needs are
+recorded (:func:`washbench.review.thinning.keep_samples`, at least one every :data:`MAX_GAP_S`): at each recorded step
+the value is float32(trace value) exactly, and interpolating between recorded steps reproduces every step within
+:data:`THRESHOLD_FRACTION` (1 %) of the DOF's perception threshold or :data:`PANEL_FRACTION` (0.2 %) of its panel's
+height, whichever is smaller, for perceived and raw motion,
+:data:`ENVELOPE_TOLERANCE` (0.002) for envelope usage and :data:`PLATFORM_DETAIL_TOLERANCE` (0.2 %) of each axis's
+limit for the platform traces; the tolerance is stored with each entity (static component ``interpolation_tolerance``,
+one per line). Where signals move fast every step is kept. Times are k * dt to the nanosecond; 3D poses float32
+(rerun's type), at most at 30 Hz and held within 0.1 deg and 1 mm (:mod:`washbench.review.scene3d`). Exact values are
+in traces.parquet. All time-varying data is sent as whole columns (``send_columns``), never one ``log`` call per
+sample; the sources of one panel share one row (one time and one row id for all of them). The review blueprint
 (:mod:`washbench.review.blueprint`) is stored in the same file.
 """
 
 from __future__ import annotations
 
 import uuid
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -54,6 +62,7 @@ from washbench.review.blueprint import (
     source_colors,
 )
 from washbench.review.rrd_read import read_component, read_properties, read_scalar_series, read_text_documents
+from washbench.review.thinning import keep_samples
 
 __all__ = [
     "AIRCRAFT",
@@ -66,6 +75,7 @@ __all__ = [
     "RecordingData",
     "envelope_usage_path",
     "limit_lane_path",
+    "motion_tolerance",
     "perceived_path",
     "phase_lane_path",
     "platform_path",
@@ -107,11 +117,25 @@ ENVELOPE_QUANTITIES: tuple[tuple[str, str, str], ...] = (
 )
 """Platform quantities with an envelope: (name in entity paths, field of PlatformSeries / PlatformEnvelope, unit)."""
 
+VALUE_DTYPE = np.float32
+"""Every time-varying scalar is rounded to this type before it is recorded (rerun stores it as float64): 24 bits,
+seven significant digits, more than a plot or a tooltip shows; exact values stay in traces.parquet."""
+
+THRESHOLD_FRACTION = 0.01
+"""Perceived and raw motion: interpolation tolerance at most this fraction of the DOF's perception threshold..."""
+
+PANEL_FRACTION = 0.002
+"""...and at most this fraction of the height (y range) of the panel that shows it: 0.2 pixels in a panel 100 pixels
+tall, one pixel in a panel 500 pixels tall."""
+
+ENVELOPE_TOLERANCE = 0.002
+"""Envelope usage (dimensionless, limit at 1): interpolation tolerance."""
+
 PLATFORM_DETAIL_TOLERANCE = 0.002
-"""The per-axis platform traces may be thinned (to every 2nd-4th sample) where linear interpolation between the
-recorded samples reproduces every step within this fraction of the axis's limit; envelope usage, perceived and raw
-motion keep every step."""
-PLATFORM_MAX_STRIDE = 4
+"""Per-axis platform traces: interpolation tolerance as a fraction of the axis's limit."""
+
+MAX_GAP_S = 1.0
+"""Recorded samples of one series are at most this far apart, s (a tooltip in the viewer is never far from one)."""
 
 PROPERTIES = "provenance"
 """Name of the recording property that holds the caller's provenance strings."""
@@ -311,19 +335,27 @@ def _time_column(t_s: np.ndarray) -> rr.TimeColumn:
 def _series(
     rec: rr.RecordingStream,
     path: str,
-    time: rr.TimeColumn,
+    t_s: np.ndarray,
     values: np.ndarray,
     names: list[str],
     colors: list[tuple[int, int, int]],
     widths: list[float],
+    tolerance: np.ndarray | float,
     aggregation: str | None = None,
 ) -> None:
-    """One entity, one row per time, one scalar per named line: ``values`` (N,) or (N, len(names))."""
+    """One entity, one row per recorded time, one scalar per named line: ``values`` (N,) or (N, len(names)).
+
+    Values are rounded to float32 (:data:`VALUE_DTYPE`), then thinned (:func:`thinning.keep_samples`): the rows kept
+    interpolate linearly to every step within ``tolerance`` (a number or one per line), at most :data:`MAX_GAP_S`
+    apart. The tolerance is stored with the entity (static component ``interpolation_tolerance``, one per line).
+    """
+    v = np.asarray(values, dtype=VALUE_DTYPE).astype(np.float64)
+    lines = 1 if v.ndim == 1 else v.shape[1]
+    tol = np.broadcast_to(np.asarray(tolerance, dtype=np.float64), (lines,))
+    idx = keep_samples(t_s, v, tol, MAX_GAP_S + 1e-9)
     style = rr.SeriesLines(colors=colors, names=names, widths=widths, aggregation_policy=aggregation)
-    rec.log(path, style, static=True, strict=True)
-    rec.send_columns(
-        path, indexes=[time], columns=rr.Scalars.columns(scalars=np.asarray(values, np.float64)), strict=True
-    )
+    rec.log(path, style, rr.AnyValues(interpolation_tolerance=tol), static=True, strict=True)
+    rec.send_columns(path, indexes=[_time_column(t_s[idx])], columns=rr.Scalars.columns(scalars=v[idx]), strict=True)
 
 
 def _limit_line(
@@ -367,20 +399,32 @@ def _dof_columns(data: RecordingData) -> tuple[list[np.ndarray], list[np.ndarray
     return perceived, raw
 
 
+def motion_tolerance(thresholds: Thresholds, ranges: Sequence[tuple[float, float]]) -> list[float]:
+    """Per DOF (in :data:`DOFS` order, recording units): the interpolation tolerance of a motion panel with the y
+    ``ranges`` (lo, hi) per DOF: :data:`THRESHOLD_FRACTION` of the DOF's perception threshold or
+    :data:`PANEL_FRACTION` of the panel's height, whichever is smaller."""
+    lines = _threshold_lines(thresholds)
+    pairs = zip(lines, ranges, strict=True)
+    return [min(THRESHOLD_FRACTION * th, PANEL_FRACTION * (hi - lo)) for (_, th), (lo, hi) in pairs]
+
+
 def _send_motion(
     rec: rr.RecordingStream,
     data: RecordingData,
-    time: rr.TimeColumn,
     perceived: list[np.ndarray],
     raw: list[np.ndarray],
+    layout: Layout,
 ) -> None:
     names = sources(data)
     colors = source_colors(list(data.washouts))
     widths = [AIRCRAFT_WIDTH] + [WASHOUT_WIDTH] * len(data.washouts)
     t_s = np.asarray(data.t_s, dtype=np.float64)
-    for (dof, _, _, _), p, r, (centre, th) in zip(DOFS, perceived, raw, _threshold_lines(data.thresholds), strict=True):
-        _series(rec, perceived_path(dof), time, p, names, colors, widths)
-        _series(rec, raw_path(dof), time, r, names, colors, widths)
+    lines = _threshold_lines(data.thresholds)
+    tol_p = motion_tolerance(data.thresholds, layout.perceived_ranges)
+    tol_r = motion_tolerance(data.thresholds, layout.raw_ranges)
+    for (dof, _, _, _), p, r, (centre, th), tp, tr in zip(DOFS, perceived, raw, lines, tol_p, tol_r, strict=True):
+        _series(rec, perceived_path(dof), t_s, p, names, colors, widths, tp)
+        _series(rec, raw_path(dof), t_s, r, names, colors, widths, tr)
         _limit_line(
             rec,
             f"/perceived/{dof}/threshold",
@@ -405,9 +449,7 @@ def _usage(data: RecordingData) -> dict[str, np.ndarray]:
     return out
 
 
-def _send_platforms(
-    rec: rr.RecordingStream, data: RecordingData, time: rr.TimeColumn, usage: dict[str, np.ndarray]
-) -> None:
+def _send_platforms(rec: rr.RecordingStream, data: RecordingData, usage: dict[str, np.ndarray]) -> None:
     t_s = np.asarray(data.t_s, dtype=np.float64)
     washouts = list(data.washouts)
     colors = [series_color(w, washouts) for w in washouts]
@@ -416,37 +458,18 @@ def _send_platforms(
         axes = _axis_names(q)
         uniform = bool(np.all(limit == limit[0]))
         _limit_line(rec, f"/envelope/{q}/limit", t_s, [1.0], [f"limit (+-{_limit_text(limit)} {unit})"])
-        _series(rec, envelope_usage_path(q), time, usage[q], washouts, colors, [WASHOUT_WIDTH] * len(washouts), "Max")
+        widths = [WASHOUT_WIDTH] * len(washouts)
+        _series(rec, envelope_usage_path(q), t_s, usage[q], washouts, colors, widths, ENVELOPE_TOLERANCE, "Max")
         for w in washouts:
-            values = np.asarray(getattr(data.platforms[w], fname), dtype=np.float64)
-            idx = detail_samples(values, PLATFORM_DETAIL_TOLERANCE * limit)
-            # an (M, 3) array is sent as M rows of three scalars
-            axes_time = time if idx.size == t_s.size else _time_column(t_s[idx])
-            _series(rec, platform_path(w, q), axes_time, values[idx], list(axes), list(AXIS_COLORS), [1.5] * 3)
+            values = getattr(data.platforms[w], fname)  # (N, 3): N rows of three scalars
+            tol = PLATFORM_DETAIL_TOLERANCE * limit
+            _series(rec, platform_path(w, q), t_s, values, list(axes), list(AXIS_COLORS), [1.5] * 3, tol)
             for sign, end, bound in (("+", "max", limit), ("-", "min", -limit)):
                 line_path = f"/platform/{w}/{q}/limit_{end}"
                 if uniform:  # one line for all axes
                     _limit_line(rec, line_path, t_s, [bound[0]], [f"{sign}limit"])
                 else:  # one line per axis, in the axis colours
                     _limit_line(rec, line_path, t_s, list(bound), [f"{sign}{a} limit" for a in axes], list(AXIS_COLORS))
-
-
-def detail_samples(values: np.ndarray, tolerance: np.ndarray, max_stride: int = PLATFORM_MAX_STRIDE) -> np.ndarray:
-    """Indices of the samples of ``values`` (N, k) to record: every s-th and the last, for the largest s up to
-    ``max_stride`` whose linear interpolation reproduces every sample within ``tolerance`` (k,); else all."""
-    n = values.shape[0]
-    k = np.arange(n, dtype=np.float64)
-    for stride in range(max_stride, 1, -1):
-        idx = np.unique(np.append(np.arange(0, n, stride), n - 1))
-        if idx.size < 2:
-            break
-        ok = all(
-            np.max(np.abs(np.interp(k, idx, values[idx, j]) - values[:, j])) <= tolerance[j]
-            for j in range(values.shape[1])
-        )
-        if ok:
-            return idx
-    return np.arange(n)
 
 
 def _limit_text(limit: np.ndarray) -> str:
@@ -601,16 +624,16 @@ def write_recording(path: Path, data: RecordingData, properties: Mapping[str, st
             )
         )
     perceived, raw = _dof_columns(data)
-    blueprint = build_blueprint(_layout(data, perceived, raw))
+    layout = _layout(data, perceived, raw)
+    blueprint = build_blueprint(layout)
     with atomic_path(path) as tmp:
         try:
             rec.save(tmp, default_blueprint=blueprint)
             rec.send_recording_name(data.title)
             if props:
                 rec.send_property(PROPERTIES, rr.AnyValues(**props))
-            time = _time_column(data.t_s)
-            _send_motion(rec, data, time, perceived, raw)
-            _send_platforms(rec, data, time, _usage(data))
+            _send_motion(rec, data, perceived, raw, layout)
+            _send_platforms(rec, data, _usage(data))
             _send_lanes(rec, data)
             scene3d.send_scene(
                 rec,

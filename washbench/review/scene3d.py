@@ -5,7 +5,9 @@ plate, so roll, pitch and yaw read at a glance and the aircraft and the cockpits
 attitudes agree. The aircraft is shown relative to its initial heading (the cockpits start at yaw 0). Each Atlas
 cockpit sits in its sphere (``envelope.sphere_diameter_m``) and is translated by the stage position inside the stage's
 range box. One label per object. Poses are sent at most at :data:`SCENE_RATE_HZ`: the 3D view shows one instant, and
-scrubbing or playing needs no more.
+scrubbing or playing needs no more; of those, only the ones that differ from the last one sent by more than
+:data:`POSE_ANGLE_TOLERANCE_DEG` or :data:`POSE_TRANSLATION_TOLERANCE_M` (the view holds the latest pose), and one at
+least every :data:`POSE_MAX_GAP_S`.
 """
 
 from __future__ import annotations
@@ -16,11 +18,32 @@ import numpy as np
 import rerun as rr
 
 from washbench.review.blueprint import AIRCRAFT_COLOR, LIMIT_COLOR, series_color
+from washbench.review.thinning import keep_changes
 
-__all__ = ["SCENE_RATE_HZ", "camera", "object_offsets", "relative_to_initial_heading", "scene_stride", "send_scene"]
+__all__ = [
+    "POSE_ANGLE_TOLERANCE_DEG",
+    "POSE_MAX_GAP_S",
+    "POSE_TRANSLATION_TOLERANCE_M",
+    "SCENE_RATE_HZ",
+    "camera",
+    "object_offsets",
+    "pose_samples",
+    "relative_to_initial_heading",
+    "scene_stride",
+    "send_scene",
+]
 
 SCENE_RATE_HZ = 30.0
 """Highest rate of the 3D poses, Hz."""
+
+POSE_ANGLE_TOLERANCE_DEG = 0.1
+"""A held pose is at most this far (rotation angle) from the pose at any step it stands for, deg."""
+
+POSE_TRANSLATION_TOLERANCE_M = 0.001
+"""A held stage position is within this of the position at any step it stands for, per axis, m."""
+
+POSE_MAX_GAP_S = 1.0
+"""At least one pose every this many seconds, s."""
 
 
 def quat_wxyz_to_xyzw(q_wxyz: np.ndarray) -> np.ndarray:
@@ -54,6 +77,22 @@ def relative_to_initial_heading(q_wxyz: np.ndarray) -> np.ndarray:
 def scene_stride(dt_s: float) -> int:
     """Send every k-th pose so that the 3D rate is at most SCENE_RATE_HZ."""
     return max(1, math.floor(1.0 / (dt_s * SCENE_RATE_HZ) + 1e-9))
+
+
+def pose_samples(t_s: np.ndarray, q_wxyz: np.ndarray, pos_m: np.ndarray | None = None) -> np.ndarray:
+    """Indices of the poses to send: every :func:`scene_stride`-th step, of those the ones that move by more than the
+    pose tolerances from the last one kept (quaternion components within sin(angle / 4) of each other bound the
+    rotation between them by the angle), one at least every :data:`POSE_MAX_GAP_S`, and the last step."""
+    stride = scene_stride(float(t_s[1] - t_s[0])) if t_s.size > 1 else 1
+    idx = np.unique(np.append(np.arange(0, t_s.size, stride), t_s.size - 1))
+    columns = [np.asarray(q_wxyz, dtype=np.float64)[idx]]
+    tol = [np.full(4, math.sin(math.radians(POSE_ANGLE_TOLERANCE_DEG) / 4.0))]
+    if pos_m is not None:
+        columns.append(np.asarray(pos_m, dtype=np.float64)[idx])
+        tol.append(np.full(3, POSE_TRANSLATION_TOLERANCE_M))
+    dt_rows = float(t_s[idx[1]] - t_s[idx[0]]) if idx.size > 1 else 1.0
+    gap = max(1, math.floor(POSE_MAX_GAP_S / dt_rows + 1e-9))
+    return idx[keep_changes(np.column_stack(columns), np.concatenate(tol), gap)]
 
 
 def object_offsets(n_washouts: int, travel_m: np.ndarray, diameter_m: float) -> np.ndarray:
@@ -115,18 +154,17 @@ def send_scene(
 ) -> None:
     """Log the scene; ``time_of(t_s)`` makes the time column. Quaternions scalar first, body->NED."""
     washouts = list(washout_q)
-    stride = scene_stride(float(t_s[1] - t_s[0])) if t_s.size > 1 else 1
-    idx = np.arange(0, t_s.size, stride)
-    time = time_of(t_s[idx])
     offsets = object_offsets(len(washouts), travel_m, diameter_m)
     half = diameter_m / 2.0
     rec.log("/world", rr.ViewCoordinates.FRD, static=True, strict=True)  # x north, y east, z down
 
     rec.log("/world/aircraft", rr.Transform3D(translation=offsets[0]), static=True, strict=True)
-    q_ac = relative_to_initial_heading(aircraft_q)[idx]
+    q_rel = relative_to_initial_heading(aircraft_q)
+    idx = pose_samples(t_s, q_rel)
+    q_ac = q_rel[idx]
     rec.send_columns(
         "/world/aircraft/body",
-        indexes=[time],
+        indexes=[time_of(t_s[idx])],
         columns=rr.Transform3D.columns(quaternion=quat_wxyz_to_xyzw(q_ac)),
         strict=True,
     )
@@ -154,10 +192,11 @@ def send_scene(
             static=True,
             strict=True,
         )
+        idx = pose_samples(t_s, washout_q[w], stage_pos_m[w])
         pos = np.asarray(stage_pos_m[w], dtype=np.float64)[idx]
         rec.send_columns(
             f"{base}/cockpit",
-            indexes=[time],
+            indexes=[time_of(t_s[idx])],
             columns=rr.Transform3D.columns(translation=pos, quaternion=quat_wxyz_to_xyzw(washout_q[w][idx])),
             strict=True,
         )
