@@ -10,7 +10,7 @@ processes hold the core), minimum of ``--repeat`` runs each.
     .venv/bin/python bench/marginal_bench.py [--seconds 120] [--repeat 5]
 
 Three figures: flight alone (``washbench fly``'s loop), flight + the three washouts in lockstep (the
-``washbench run`` loop: :class:`washbench.runs.pipeline.Lockstep`), and the washouts alone called once per
+``washbench run`` loop: :func:`washbench.runs.pipeline.lockstep_blocks`), and the washouts alone called once per
 sample (``CueingBank.step``, the streaming form a simulator would call).
 """
 
@@ -24,12 +24,13 @@ from pathlib import Path
 import numpy as np
 
 from washbench.cueing import WASHOUT_NAMES, CueingBank, load_washout_params
+from washbench.cueing.variants import select_washouts
 from washbench.flight.fdm import make_fdm
 from washbench.flight.fly import fly
 from washbench.flight.manoeuvre import load_manoeuvre
 from washbench.flight.profile import load_profile
 from washbench.platform import load_platform_limits
-from washbench.runs.pipeline import Lockstep
+from washbench.runs.pipeline import LOCKSTEP_BLOCK, lockstep_blocks
 
 TEMPLATE = """\
 name: marginal
@@ -45,7 +46,7 @@ phases:
     until: {{duration_s: {level}}}
   - name: turn
     hold: {{bank_deg: 30, altitude_ft: 4000, airspeed_kts: 95}}
-    until: {{duration_s: {turn}, timeout_s: 10000}}
+    until: {{duration_s: {turn}, timeout_s: 3600}}
 checks:
   - {{name: altitude held, signal: altitude_ft, stat: max_deviation, max: 200}}
 """
@@ -62,11 +63,11 @@ def time_fly(path: Path, washouts: bool) -> tuple[float, int]:
     m = load_manoeuvre(path)
     hook = None
     if washouts:
-        hook = Lockstep(CueingBank(WASHOUT_NAMES, load_washout_params(), load_platform_limits(), m.dt_s))
+        rows, hook = lockstep_blocks(select_washouts(), load_platform_limits(), m.dt_s)
     t0 = time.process_time()
-    result = fly(m, block_hook=hook)
-    if hook is not None:
-        hook.finish()
+    result = fly(m, block_hook=hook, block_size=LOCKSTEP_BLOCK)
+    if washouts and len(rows) != len(result.t_s):
+        raise SystemExit(f"the washouts ran {len(rows)} steps for {len(result.t_s)} samples")
     wall = time.process_time() - t0
     if not result.ok:
         raise SystemExit(f"benchmark flight failed: {result.reason}")

@@ -273,3 +273,39 @@ def test_the_documented_example_flies_with_its_checks_passing(tmp_path: Path) ->
     example = section.split("```yaml\n", 1)[1].split("```", 1)[0]
     result = fly(load_manoeuvre(write(tmp_path, "example.yaml", example)))
     assert result.status == "ok", result.reason
+
+
+def test_pilot_without_load_factor_limits_commands_as_with_limits_that_never_bind(
+    flights: dict[str, FlightResult],
+) -> None:
+    """The pilot skips its load-factor protection when the profile sets no limits: limits of +-1e6 g, which no
+    pull reaches, must give the same commands bit for bit, step by step, on a real flight's states (c172p)."""
+    from washbench.flight.pilot import Pilot
+    from washbench.flight.profile import load_profile
+
+    m = load_manoeuvre(C172 / "steep_turn.yaml")
+    profile = load_profile(m.aircraft_files.profile)
+    assert profile.gains.pitch.nz_pull_max is None and profile.gains.pitch.nz_push_min is None
+    pitch = profile.gains.pitch.model_copy(update={"nz_pull_max": 1e6, "nz_push_min": -1e6})
+    far = profile.model_copy(update={"gains": profile.gains.model_copy(update={"pitch": pitch})})
+    c = flights[manoeuvre_id(C172 / "steep_turn.yaml")].columns
+    pilots = [Pilot(pr, m.runway, m.dt_s) for pr in (profile, far)]
+    rad = {k: np.radians(c[k]) for k in ("phi_deg", "theta_deg", "psi_deg", "alpha_deg", "beta_deg")}
+    w = {k: np.radians(c[k]) for k in ("omega_x_degps", "omega_y_degps", "omega_z_degps")}
+    phase = -1
+    for k in range(len(c["t_s"])):
+        if c["phase"][k] != phase:
+            phase = int(c["phase"][k])
+            for pilot in pilots:
+                pilot.begin_phase(m.phases[phase].hold, float(rad["theta_deg"][k]), float(c["throttle"][k]), 0.0)
+        state = (rad["phi_deg"][k], rad["theta_deg"][k], rad["psi_deg"][k], w["omega_x_degps"][k],
+                 w["omega_y_degps"][k], w["omega_z_degps"][k], rad["beta_deg"][k], c["vc_kts"][k],
+                 c["gs_kts"][k] * 1.68781, math.radians(90.0), c["climb_fpm"][k] / 60.0, c["altitude_ft"][k],
+                 c["h_agl_ft"][k], math.nan, math.nan, bool(c["wow"][k]), c["nz"][k], rad["alpha_deg"][k],
+                 c["vc_kts"][k] * 1.06, c["f_y_mps2"][k])  # fmt: skip
+        outs = []
+        for pilot in pilots:
+            pilot.step(*(float(x) for x in state))
+            outs.append((pilot.aileron, pilot.elevator, pilot.rudder, pilot.steer, pilot.throttle))
+        assert outs[0] == outs[1], f"step {k}"
+    assert not c["wow"].any() and c["nz"].max() > 1.3  # in the air throughout (protection on), pulling in the turn

@@ -11,9 +11,9 @@ from __future__ import annotations
 
 import json
 import math
+import struct
 import sys
 import time
-from array import array
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -77,6 +77,9 @@ CONTROL_PROPERTIES = (
     "fcs/left-brake-cmd-norm",
     "fcs/right-brake-cmd-norm",
 )
+
+#: One recorded row (the flight.parquet columns, raw, before the unit conversion of :func:`_columns`).
+_ROW = struct.Struct(f"={len(COLUMN_NAMES)}d")
 
 
 @dataclass
@@ -185,6 +188,7 @@ def fly(
 
     pilot = Pilot(profile, m.runway, dt)
     pilot.set_controls(ail_w.get_double_value(), elev_w.get_double_value(), rud_w.get_double_value())
+    pilot_step = pilot.step
     monitor = Monitor.for_profile(profile)
     openloop = OpenLoop(fdm, profile, pilot)
     probe_gets = [n.get_double_value for n in _nodes(fdm, tuple(probes))]
@@ -194,14 +198,15 @@ def fly(
     has_runway = setup.threshold_ne_m is not None
     rw_c = math.cos(setup.runway_heading_rad or 0.0)
     rw_s = math.sin(setup.runway_heading_rad or 0.0)
-    nan = math.nan
+    nan, pi, two_pi = math.nan, math.pi, 2 * math.pi
     mix_h_ft, mix_norm = zip(*profile.engine.mixture_schedule, strict=True)  # interpolated once a second
     mix_every = max(1, round(1.0 / dt))
     cg_h = profile.geometry.cg_height_on_ground_ft
     alpha_stall_deg = profile.limits.alpha_stall_deg
 
-    rows = array("d")
+    rows = bytearray()  # the recorded rows, ncol float64 each (native byte order)
     rows_extend = rows.extend
+    pack = _ROW.pack  # struct packs a row of floats several times faster than array('d').extend converts one
     run = fdm.run
     nz_max, nz_min = monitor.nz_max, monitor.nz_min
     vne, h_collapsed, alpha_max = monitor.vne, monitor.h_collapsed, monitor.alpha_max
@@ -282,10 +287,10 @@ def fly(
         # phase sequencing
         if iphase >= 0:
             d = psi - psi_prev
-            if d > math.pi:
-                d -= 2 * math.pi
-            elif d < -math.pi:
-                d += 2 * math.pi
+            if d > pi:
+                d -= two_pi
+            elif d < -pi:
+                d += two_pi
             turned += d
             rolled += 0.5 * (p_prev + p) * dt
             pitched += 0.5 * (q_prev + q) * dt
@@ -327,9 +332,10 @@ def fly(
                 if progress:  # a line at each phase start (in place on a terminal)
                     _progress(m.name, iphase, nphases, phase.name, t, tty)
 
-        ail, elev, rud, thr = pilot.aileron, pilot.elevator, pilot.rudder, pilot.throttle
-        if not final:
-            pilot.step(phi, theta, psi, p, q, r, beta, vc, vg, trk, hdot, h, agl, x_rw * 3.2808399,
+        if final:
+            ail, elev, rud, thr = pilot.aileron, pilot.elevator, pilot.rudder, pilot.throttle
+        else:
+            pilot_step(phi, theta, psi, p, q, r, beta, vc, vg, trk, hdot, h, agl, x_rw * 3.2808399,
                        y_rw * 3.2808399, wow, nz_last, alpha, vt_get(), fy_last)  # fmt: skip
             ail, elev, rud, thr = pilot.aileron, pilot.elevator, pilot.rudder, pilot.throttle
             if openloop.active:  # the phase's open-loop inputs, on top of or instead of the pilot's commands
@@ -342,14 +348,15 @@ def fly(
             if k % mix_every == 0:
                 mix_w.set_double_value(float(np.interp(h, mix_h_ft, mix_norm)))
         run()
-        for get, out in zip(probe_gets, probe_rows, strict=True):
-            out.append(get())
+        if probe_gets:
+            for get, out in zip(probe_gets, probe_rows, strict=True):
+                out.append(get())
         ax, ay, az = ax_get(), ay_get(), az_get()
         nz = nz_get()
         nz_last = nz
         fy_last = ay * FT_S2_TO_M_S2
         # raw values in JSBSim's units; converted column by column after the loop (same bits, fewer operations)
-        rows_extend((k, ax, ay, az, p, q, r, phi, theta, psi, alpha, beta, vc, vg, h, agl, hdot, north, east, lat,
+        rows_extend(pack(k, ax, ay, az, p, q, r, phi, theta, psi, alpha, beta, vc, vg, h, agl, hdot, north, east, lat,
                      lon, x_rw, y_rw, nz, ail, elev, rud, thr, flap_get(), pilot.brakes, rpm_get(), wow,
                      iphase if not final else nphases - 1))  # fmt: skip
         if step_hook is not None:
@@ -366,10 +373,10 @@ def fly(
             next_report = time.monotonic() + report_every_s
             _progress(m.name, iphase, nphases, m.phases[iphase].name, t, tty)
 
-    if block_hook is not None and len(rows) // ncol > k_sent:
+    if block_hook is not None and len(rows) // _ROW.size > k_sent:
         _send_block(block_hook, rows, k_sent, ncol)
     if reason and 0 <= iphase < nphases:  # the phase the flight stopped in, up to the last recorded sample
-        phases_out.append((m.phases[iphase].name, phase_k0 * dt, max(len(rows) // ncol - 1, 0) * dt))
+        phases_out.append((m.phases[iphase].name, phase_k0 * dt, max(len(rows) // _ROW.size - 1, 0) * dt))
     if tty:
         sys.stderr.write("\r\033[K")
         sys.stderr.flush()
@@ -387,10 +394,10 @@ def fly(
     return FlightResult(m.name, m.aircraft, dt, columns, phases_out, checks, status, reason, events, probed)
 
 
-def _send_block(hook: BlockHook, rows: array, k0: int, ncol: int) -> int:
+def _send_block(hook: BlockHook, rows: bytearray, k0: int, ncol: int) -> int:
     """Give ``hook`` the recorded samples from ``k0`` on (f in m/s^2, omega in rad/s); return the new count."""
     with memoryview(rows) as view:
-        raw = np.frombuffer(view[k0 * ncol :], dtype=np.float64).reshape(-1, ncol).copy()
+        raw = np.frombuffer(view[k0 * _ROW.size :], dtype=np.float64).reshape(-1, ncol).copy()
     hook(k0, raw[:, 1:4] * FT_S2_TO_M_S2, raw[:, 4:7])
     return k0 + raw.shape[0]
 

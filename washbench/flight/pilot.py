@@ -46,7 +46,6 @@ from __future__ import annotations
 
 import math
 
-from washbench.flight.geo import wrap_pi
 from washbench.flight.manoeuvre import Hold, Runway
 from washbench.flight.profile import PilotProfile
 
@@ -56,15 +55,12 @@ KT_TO_FPS = 1852.0 / 3600.0 / 0.3048
 G_KTPS = G_FPS2 / KT_TO_FPS  # standard gravity in kt/s
 G_MPS2 = 9.80665
 SIDE_FORCE_FILTER_S = 0.5  # time constant of the filter on the lateral specific force, s
+TWO_PI = 2.0 * math.pi  # as in washbench.flight.geo.wrap_pi, which the step inlines
 
 # lateral modes
 LAT_LEVEL, LAT_BANK, LAT_HEADING, LAT_RATE, LAT_TRACK = range(5)
 # pitch modes
 PITCH_HOLD, PITCH_ATT, PITCH_ALT, PITCH_VS, PITCH_GLIDE, PITCH_RATE, PITCH_FLARE, PITCH_SPEED, PITCH_NZ = range(9)
-
-
-def _clamp(x: float, lo: float, hi: float) -> float:
-    return lo if x < lo else hi if x > hi else x
 
 
 class Pilot:
@@ -100,6 +96,8 @@ class Pilot:
         self.th_max = g.pitch.pitch_max_deg * D2R
         self.n_hi = g.pitch.nz_pull_max if g.pitch.nz_pull_max is not None else math.inf
         self.n_lo = g.pitch.nz_push_min if g.pitch.nz_push_min is not None else -math.inf
+        # without limits the protection clamps nothing (q_hi is +inf or NaN, q_lo -inf or NaN): skipped
+        self.nz_protect = g.pitch.nz_pull_max is not None or g.pitch.nz_push_min is not None
         self.k_n = g.pitch.nz_kp
         self.k_n_i = g.pitch.nz_ki
         self.alpha_max = g.pitch.alpha_max_deg * D2R
@@ -113,6 +111,8 @@ class Pilot:
         self.tau_v = g.path.speed_tau_s
         self.vdot_max = g.path.accel_max_ktps
         self.tau_vdot = g.path.speed_rate_filter_s
+        self.a_vdot = dt_s / (self.tau_vdot + dt_s)  # gains of the first-order filters, per step
+        self.a_fy = dt_s / (SIDE_FORCE_FILTER_S + dt_s)
         self.kt = g.path.energy_to_throttle
         self.kt_i = g.path.energy_to_throttle_i
         self.thr_rate = g.path.throttle_rate_per_s * dt_s
@@ -180,11 +180,6 @@ class Pilot:
         self.throttle = 0.0
         self.flaps_cmd = 0.0
         self.brakes = 0.0
-
-    def _vdot_cmd(self, vc: float, vt: float) -> float:
-        """The true-airspeed rate (kt/s) that closes the calibrated airspeed error in ``speed_tau_s``, limited."""
-        a = _clamp((self.speed_target - vc) / self.tau_v, -self.vdot_max, self.vdot_max)
-        return a * vt / vc if vc > 1.0 else a
 
     def set_controls(self, aileron: float, elevator: float, rudder: float) -> None:
         """Start from the control positions the trim left: outputs and integrators (bumpless start)."""
@@ -283,61 +278,88 @@ class Pilot:
         factor (g), ``alpha`` the angle of attack (rad) and ``fy_mps2`` the last measured lateral specific force
         (body y, m/s^2).
         """
+        # Hot path (every FDM step): the clamps are written inline and repeated values kept in locals. Every
+        # expression keeps the operations and their order of the plain form, so the commands are the same bits.
         dt = self.dt
-        v = vc if vc > self.vmin else self.vmin
+        vmin = self.vmin
+        surf = self.surf_rate
+        v = vc if vc > vmin else vmin
         sc = (self.vref / v) ** 2
         air = not wow
-        vt_min = vt if vt > self.vmin else self.vmin
-        if self.vt_prev < 0.0:
-            self.vt_prev = vt
-        self.vdot += ((vt - self.vt_prev) / dt - self.vdot) * (dt / (self.tau_vdot + dt))
+        vt_min = vt if vt > vmin else vmin
+        vtk = vt_min * KT_TO_FPS  # ft/s
+        vt_prev = self.vt_prev
+        if vt_prev < 0.0:
+            vt_prev = vt
+        vdot = self.vdot
+        vdot += ((vt - vt_prev) / dt - vdot) * self.a_vdot
+        self.vdot = vdot
         self.vt_prev = vt
-        self.fy_f += (fy_mps2 - self.fy_f) * (dt / (SIDE_FORCE_FILTER_S + dt))
+        self.fy_f += (fy_mps2 - self.fy_f) * self.a_fy
+        cphi = math.cos(phi)
+        cth = math.cos(theta)
+        sphi = math.sin(phi)
+        if self.speed_on_throttle or self.pitch_mode == PITCH_SPEED:
+            # the true-airspeed rate (kt/s) that closes the calibrated airspeed error in speed_tau_s, limited
+            x = (self.speed_target - vc) / self.tau_v
+            vdot_max = self.vdot_max
+            x = -vdot_max if x < -vdot_max else vdot_max if x > vdot_max else x
+            vdot_cmd = x * vt / vc if vc > 1.0 else x
+        else:
+            vdot_cmd = 0.0  # not used
 
         # ---- lateral: bank -> roll rate -> aileron
         mode = self.lat_mode
+        p_max = self.p_max
         if mode == LAT_RATE:  # track the roll angle about the body x axis: target rate x time in the phase
             self.rolled += p * dt
             self.t_phase += dt
-            p_cmd = self.lat_target + _clamp(
-                self.k_phi * (self.lat_target * self.t_phase - self.rolled), -self.p_max, self.p_max
-            )
+            x = self.k_phi * (self.lat_target * self.t_phase - self.rolled)
+            p_cmd = self.lat_target + (-p_max if x < -p_max else p_max if x > p_max else x)
         else:
             if mode == LAT_BANK:
                 phi_cmd = self.lat_target
             elif mode == LAT_HEADING:
                 # lead the roll-out: aim at the heading the turn reaches while the bank comes off, the
                 # turn rate g tan(phi) / V times half the roll-out time |phi| / p_max + 1 / k_phi
-                bank = _clamp(phi, -1.0, 1.0)
-                lead = G_FPS2 * math.tan(bank) / (vt_min * KT_TO_FPS) * 0.5 * (abs(bank) / self.p_max + 1 / self.k_phi)
-                phi_cmd = _clamp(self.k_hdg * wrap_pi(self.lat_target - psi - lead), -self.bank_max, self.bank_max)
+                bank = -1.0 if phi < -1.0 else 1.0 if phi > 1.0 else phi
+                lead = G_FPS2 * math.tan(bank) / vtk * 0.5 * (abs(bank) / p_max + 1 / self.k_phi)
+                x = self.k_hdg * ((self.lat_target - psi - lead + math.pi) % TWO_PI - math.pi)
+                bmax = self.bank_max
+                phi_cmd = -bmax if x < -bmax else bmax if x > bmax else x
             elif mode == LAT_TRACK and air:
                 # PI on the offset: the integral finds the bank a wing-low slip needs with no offset left
                 off = self.k_y * (y_rw_ft + self.i_y)
-                if -self.icpt_max < off < self.icpt_max:
-                    self.i_y = _clamp(self.i_y + self.k_y_i * y_rw_ft * dt, -self.i_y_max, self.i_y_max)
-                trk_cmd = self.rw_hdg - _clamp(off, -self.icpt_max, self.icpt_max)
-                phi_cmd = self.k_trk * wrap_pi(trk_cmd - track)
+                imax = self.icpt_max
+                if -imax < off < imax:
+                    x = self.i_y + self.k_y_i * y_rw_ft * dt
+                    lim = self.i_y_max
+                    self.i_y = -lim if x < -lim else lim if x > lim else x
+                trk_cmd = self.rw_hdg - (-imax if off < -imax else imax if off > imax else off)
+                phi_cmd = self.k_trk * ((trk_cmd - track + math.pi) % TWO_PI - math.pi)
                 if self.wing_low:  # bank into the wind as far as the side force of the slip needs: g sin(phi) = -f_y
-                    phi_cmd += math.asin(_clamp(-self.fy_f / (G_MPS2 * math.cos(theta)), -0.5, 0.5))
-                phi_cmd = _clamp(phi_cmd, -self.bank_max, self.bank_max)
+                    x = -self.fy_f / (G_MPS2 * cth)
+                    phi_cmd += math.asin(-0.5 if x < -0.5 else 0.5 if x > 0.5 else x)
+                bmax = self.bank_max
+                phi_cmd = -bmax if phi_cmd < -bmax else bmax if phi_cmd > bmax else phi_cmd
             else:
                 phi_cmd = 0.0
-            p_cmd = _clamp(self.k_phi * (phi_cmd - phi), -self.p_max, self.p_max)
+            x = self.k_phi * (phi_cmd - phi)
+            p_cmd = -p_max if x < -p_max else p_max if x > p_max else x
         e = p_cmd - p
         # feed-forward of the aileron a steady roll at p_cmd needs (roll damping: proportional to p / V)
         ail_ff = self.k_pff * p_cmd * (self.vref / vt_min)
         ail = ail_ff + self.i_p + sc * self.kp_p * e
         if air and -1.0 < ail < 1.0:
             self.i_p += self.ki_p * e * dt
-        d = _clamp(ail, -1.0, 1.0) - self.aileron
-        self.aileron += _clamp(d, -self.surf_rate, self.surf_rate)
+        d = (-1.0 if ail < -1.0 else 1.0 if ail > 1.0 else ail) - self.aileron
+        self.aileron += -surf if d < -surf else surf if d > surf else d
 
         # ---- pitch: path -> pitch -> pitch rate -> elevator
         mode = self.pitch_mode
         path_err = 0.0  # flight-path-angle error of the path modes (rad), for the throttle
-        g_v = G_FPS2 / (vt_min * KT_TO_FPS)  # pitch rate per g of a pull, rad/s
-        z_down = math.cos(phi) * math.cos(theta)  # vertical component of the body z axis
+        g_v = G_FPS2 / vtk  # pitch rate per g of a pull, rad/s
+        z_down = cphi * cth  # vertical component of the body z axis
         if mode == PITCH_RATE:
             q_cmd = self.pitch_target
         elif mode == PITCH_NZ:
@@ -349,36 +371,39 @@ class Pilot:
             elif air:
                 self.i_n += self.k_n_i * en * dt
         else:
+            th_min, th_max = self.th_min, self.th_max
             if mode == PITCH_ATT:
                 th_cmd = self.pitch_target
             else:
                 if mode == PITCH_SPEED:
                     # energy split: at a fixed throttle the power fixes gamma + vdot / g, so the path angle
                     # that gives the wanted acceleration differs from the present one by (vdot - vdot_cmd) / g
-                    evs = (self.vdot - self._vdot_cmd(vc, vt)) / G_KTPS
-                elif mode == PITCH_ALT:
-                    vs_cmd = _clamp(self.k_alt * (self.pitch_target - h_msl), -self.vs_max, self.vs_max)
-                elif mode == PITCH_VS:
-                    vs_cmd = self.pitch_target
-                elif mode == PITCH_GLIDE:
-                    h_gp = self.rw_elev + (self.aim_ft - x_rw_ft) * self.tan_gp
-                    vs_cmd = -gs_fps * self.tan_gp + self.k_gp * (h_gp - h_msl)
-                else:  # flare: sink proportional to the height of the wheels
-                    hw = h_agl - self.cg_h
-                    vs_cmd = -(hw / self.tau if hw / self.tau > self.sink_min else self.sink_min)
-                if mode != PITCH_SPEED:
+                    evs = (vdot - vdot_cmd) / G_KTPS
+                else:
+                    if mode == PITCH_ALT:
+                        x = self.k_alt * (self.pitch_target - h_msl)
+                        vs_max = self.vs_max
+                        vs_cmd = -vs_max if x < -vs_max else vs_max if x > vs_max else x
+                    elif mode == PITCH_VS:
+                        vs_cmd = self.pitch_target
+                    elif mode == PITCH_GLIDE:
+                        h_gp = self.rw_elev + (self.aim_ft - x_rw_ft) * self.tan_gp
+                        vs_cmd = -gs_fps * self.tan_gp + self.k_gp * (h_gp - h_msl)
+                    else:  # flare: sink proportional to the height of the wheels
+                        hw = h_agl - self.cg_h
+                        vs_cmd = -(hw / self.tau if hw / self.tau > self.sink_min else self.sink_min)
                     evs = (vs_cmd - hdot) / (v * KT_TO_FPS)  # flight-path angle error, rad
-                    path_err = (vs_cmd - hdot) / (vt_min * KT_TO_FPS)
+                    path_err = (vs_cmd - hdot) / vtk
                 th_cmd = self.i_path + self.kvs * evs
-                if air and self.th_min < th_cmd < self.th_max:
+                if air and th_min < th_cmd < th_max:
                     self.i_path += self.kvs_i * evs * dt
-            th_cmd = _clamp(th_cmd, self.th_min, self.th_max)
-            q_cmd = _clamp(self.k_th * (th_cmd - theta), -self.q_max, self.q_max)
-            c = math.cos(phi)
-            if air and c > 0.2:
-                s = math.sin(phi)
-                q_cmd += g_v * s * s / c
-        if air:  # load-factor protection
+            th_cmd = th_min if th_cmd < th_min else th_max if th_cmd > th_max else th_cmd
+            x = self.k_th * (th_cmd - theta)
+            q_max = self.q_max
+            q_cmd = -q_max if x < -q_max else q_max if x > q_max else x
+            if air and cphi > 0.2:
+                q_cmd += g_v * sphi * sphi / cphi
+        if air and self.nz_protect:  # load-factor protection
             q_hi = g_v * (self.n_hi - z_down) + self.k_n * (self.n_hi - nz)
             q_lo = g_v * (self.n_lo - z_down) + self.k_n * (self.n_lo - nz)
             q_cmd = q_hi if q_cmd > q_hi else q_lo if q_cmd < q_lo else q_cmd
@@ -386,24 +411,26 @@ class Pilot:
         u = self.i_q + sc * self.kp_q * e
         if (air or (vc >= self.vr and e > 0.0)) and -1.0 < u < 1.0:  # on the ground: the rotation from Vr
             self.i_q += self.ki_q * e * dt
-        d = -_clamp(u, -1.0, 1.0) - self.elevator
-        self.elevator += _clamp(d, -self.surf_rate, self.surf_rate)
+        d = -(-1.0 if u < -1.0 else 1.0 if u > 1.0 else u) - self.elevator
+        self.elevator += -surf if d < -surf else surf if d > surf else d
 
         # ---- power
         if self.speed_on_throttle:
             # total energy: the throttle holds the specific energy rate gamma + vdot / g at what the path and
             # the speed commands need together (PI; the integrator stops where it would push a limit further)
-            e = path_err + (self._vdot_cmd(vc, vt) - self.vdot) / G_KTPS
+            e = path_err + (vdot_cmd - vdot) / G_KTPS
             thr = self.i_thr + self.kt * e
             if (thr < 1.0 or e < 0.0) and (thr > 0.0 or e > 0.0):
-                self.i_thr = _clamp(self.i_thr + self.kt_i * e * dt, 0.0, 1.0)
+                x = self.i_thr + self.kt_i * e * dt
+                self.i_thr = 0.0 if x < 0.0 else 1.0 if x > 1.0 else x
         elif self.throttle_target >= 0.0:
             thr = self.throttle_target
         else:
             thr = self.throttle
-        thr = _clamp(thr, 0.0, 1.0)
+        thr = 0.0 if thr < 0.0 else 1.0 if thr > 1.0 else thr
         d = thr - self.throttle
-        self.throttle += _clamp(d, -self.thr_rate, self.thr_rate)
+        t_rate = self.thr_rate
+        self.throttle += -t_rate if d < -t_rate else t_rate if d > t_rate else d
 
         # ---- yaw: coordination in the air, runway heading in the flare (decrab) and on the ground
         if wow or self.wing_low:
@@ -411,33 +438,34 @@ class Pilot:
                 self.i_psi = 0.0
             if self.centreline and wow:  # PI on the centreline offset: aim the nose back at it
                 off = self.kg_y * (y_rw_ft + self.i_y_ground)
-                if -self.kg_ymax < off < self.kg_ymax:
-                    self.i_y_ground = _clamp(
-                        self.i_y_ground + self.kg_y_i * y_rw_ft * dt, -self.ig_y_max, self.ig_y_max
-                    )
-                psi_cmd = self.rw_hdg - _clamp(off, -self.kg_ymax, self.kg_ymax)
+                ymax = self.kg_ymax
+                if -ymax < off < ymax:
+                    x = self.i_y_ground + self.kg_y_i * y_rw_ft * dt
+                    lim = self.ig_y_max
+                    self.i_y_ground = -lim if x < -lim else lim if x > lim else x
+                psi_cmd = self.rw_hdg - (-ymax if off < -ymax else ymax if off > ymax else off)
             elif self.centreline:
                 psi_cmd = self.rw_hdg
             else:
                 psi_cmd = psi
-            e = wrap_pi(psi_cmd - psi)
+            e = (psi_cmd - psi + math.pi) % TWO_PI - math.pi
             k = 1.0 if wow else sc
             yaw = self.i_psi + k * (self.kg_psi * e - self.kg_r * r)  # + : nose right wanted
             if -1.0 < yaw < 1.0:
                 self.i_psi += self.kg_i * e * dt
-            yaw = _clamp(yaw, -1.0, 1.0)
+            yaw = -1.0 if yaw < -1.0 else 1.0 if yaw > 1.0 else yaw
             d = -yaw - self.rudder
-            self.rudder += _clamp(d, -self.surf_rate, self.surf_rate)
+            self.rudder += -surf if d < -surf else surf if d > surf else d
             self.steer = self.steer_sign * self.rudder if wow else 0.0
             self.i_beta = -self.rudder
         else:
-            r_coord = g_v * math.sin(phi) * math.cos(theta)
+            r_coord = g_v * sphi * cth
             # rudder with the roll (aileron-rudder interconnect: against the adverse yaw), then PI on the sideslip
             rud = -self.k_ari * ail_ff - (self.i_beta + sc * self.kb * beta) + sc * self.kyd * (r - r_coord)
             if -1.0 < rud < 1.0:
                 self.i_beta += self.kb_i * beta * dt
-            d = _clamp(rud, -1.0, 1.0) - self.rudder
-            self.rudder += _clamp(d, -self.surf_rate, self.surf_rate)
+            d = (-1.0 if rud < -1.0 else 1.0 if rud > 1.0 else rud) - self.rudder
+            self.rudder += -surf if d < -surf else surf if d > surf else d
             self.steer = 0.0
             self.i_psi = -self.rudder
         self.was_wow = wow
