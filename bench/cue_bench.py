@@ -10,7 +10,9 @@ Baselines measured in the same run, printed as ratios:
 * whole command: read + cue_trace + analyse + write against the bare CSV read;
 * the ``washbench cue`` command itself (its own process, start-up included) against bare JSBSim ``fdm.run()``
   for as many steps as the input has rows (c172p in the air, this process), both as CPU time (on a shared
-  machine wall time counts other processes), minimum of ``--repeat`` runs; the aim is at most 1.5x.
+  machine wall time counts other processes), minimum of ``--repeat`` runs; the aim is at most 1.5x; as it is,
+  without the recording, without the figures, without both; and the cost of one more row without both (an input
+  twice as long minus this one, against bare JSBSim the same way: start-up cancels).
 """
 
 from __future__ import annotations
@@ -129,6 +131,12 @@ def main() -> None:
         lean = min(command_cpu_s(src, Path(tmp) / f"lean{i}", "--no-recording", "--no-figures")
                    for i in range(args.repeat))  # fmt: skip
         bare = min(bare_jsbsim_cpu_s(n) for _ in range(args.repeat))
+        # the cost of more rows: the lean command on an input twice as long, minus the one above (start-up cancels)
+        src2 = Path(tmp) / "in2.csv"
+        write_input(src2, 2 * n)
+        lean2 = min(command_cpu_s(src2, Path(tmp) / f"lean2_{i}", "--no-recording", "--no-figures")
+                    for i in range(args.repeat))  # fmt: skip
+        bare2 = min(bare_jsbsim_cpu_s(2 * n) for _ in range(args.repeat))
 
     total = t_read + t_cue + t_analyse + t_write
     print(f"{n} rows ({args.minutes:g} min at 120 Hz), 3 washouts")
@@ -145,6 +153,9 @@ def main() -> None:
     print(f"  the same, --no-recording     {no_rec:7.3f} s   {no_rec / bare:6.2f} x bare JSBSim")
     print(f"  the same, --no-figures       {no_fig:7.3f} s   {no_fig / bare:6.2f} x bare JSBSim")
     print(f"  the same, both               {lean:7.3f} s   {lean / bare:6.2f} x bare JSBSim")
+    per_row, per_step = (lean2 - lean) / n, (bare2 - bare) / n
+    print(f"  both, one more row           {per_row * 1e6:7.3f} us  {per_row / per_step:6.2f} x bare JSBSim per step "
+          f"({2 * n} rows minus {n}: start-up cancels)")  # fmt: skip
 
 
 if __name__ == "__main__":
