@@ -30,7 +30,7 @@ from washbench.flight.fly import fly
 from washbench.flight.manoeuvre import load_manoeuvre
 from washbench.flight.profile import load_profile
 from washbench.platform import load_platform_limits
-from washbench.runs.pipeline import LOCKSTEP_BLOCK, lockstep_blocks
+from washbench.runs.pipeline import LOCKSTEP_BLOCK, lockstep_blocks, sample_count
 
 TEMPLATE = """\
 name: marginal
@@ -66,8 +66,8 @@ def time_fly(path: Path, washouts: bool) -> tuple[float, int]:
         rows, hook = lockstep_blocks(select_washouts(), load_platform_limits(), m.dt_s)
     t0 = time.process_time()
     result = fly(m, block_hook=hook, block_size=LOCKSTEP_BLOCK)
-    if washouts and len(rows) != len(result.t_s):
-        raise SystemExit(f"the washouts ran {len(rows)} steps for {len(result.t_s)} samples")
+    if washouts and sample_count(rows) != len(result.t_s):
+        raise SystemExit(f"the washouts ran {sample_count(rows)} steps for {len(result.t_s)} samples")
     wall = time.process_time() - t0
     if not result.ok:
         raise SystemExit(f"benchmark flight failed: {result.reason}")

@@ -9,7 +9,8 @@ command's flight (0 for ``validate`` and ``cue``): what any JSBSim-based tool pa
 
 Commands: ``washbench validate`` (one bundled file), ``washbench cue`` on a 2 s 120 Hz CSV,
 ``washbench run`` and ``washbench run --no-recording`` on a 2 s level flight (c172p, trimmed), one
-``washbench run`` of the bundled c172 takeoff (10,668 steps), and the imports each pulls in
+``washbench run`` of the bundled c172 takeoff (10,668 steps), ``cue`` and ``run`` also with neither the recording nor
+the figures (``--no-recording --no-figures``), and the imports each pulls in
 (``python -X importtime``, the slowest top-level packages). Wall and CPU time are both printed: on a
 shared machine the CPU time is the steadier figure.
 """
@@ -27,6 +28,8 @@ import time
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
+LEAN = ("--no-recording", "--no-figures")
+"""The outputs' switches: "neither" = no recording.rrd and no figures."""
 SHORT = """\
 name: short
 description: 2 s of level flight (start-up benchmark)
@@ -110,9 +113,12 @@ def main() -> None:
         cases = [
             ("validate", ["validate", validate_file], 0),
             ("cue, 2 s at 120 Hz", ["cue", "short.csv", "--out", "cue_out"], 0),
+            ("cue, 2 s, neither", ["cue", "short.csv", "--out", "cue_out2", *LEAN], 0),
             ("run, 2 s flight", ["run", "short.yaml", "--out", "run_out", "--quiet"], 240),
             ("run --no-recording, 2 s", ["run", "short.yaml", "--out", "run_out2", "--quiet", "--no-recording"], 240),
+            ("run, 2 s, neither", ["run", "short.yaml", "--out", "run_out4", "--quiet", *LEAN], 240),
             ("run, c172 takeoff (89 s)", ["run", takeoff, "--out", "run_out3", "--quiet"], 10668),
+            ("run, takeoff, neither", ["run", takeoff, "--out", "run_out5", "--quiet", *LEAN], 10668),
         ]
         # compile or load the numba cache once, so the first timed run is not the one that compiles
         subprocess.run([*exe, "cue", "short.csv", "--out", "warm"], cwd=tmp, stdout=subprocess.DEVNULL, check=True)
@@ -122,8 +128,9 @@ def main() -> None:
         print(f"(minimum of {args.repeat} runs each; CPU = user + system of the process; JSBSIM_DEBUG={env_ok!r})")
         print(f"{'command':28s} {'wall s':>7s} {'x bare':>6s} {'CPU s':>7s} {'x bare':>6s}   slowest imports (s)")
         for label, cmd, steps in cases:
-            if "--no-recording" in cmd and "--no-recording" not in _help(exe, tmp):
-                print(f"{label:28s} {'n/a':>8s}   (this version has no --no-recording)")
+            missing = [o for o in ("--no-recording", "--no-figures") if o in cmd and o not in _help(exe, tmp)]
+            if missing:
+                print(f"{label:28s} {'n/a':>8s}   (this version has no {missing[0]})")
                 continue
             w, c = wall([*exe, *cmd], args.repeat, tmp)
             bw, bc = bare[steps]
