@@ -130,11 +130,12 @@ class CueResult:
             _put(table, perceived_f_columns(name), p.f_mps2)
             _put(table, perceived_omega_columns(name), p.omega_radps * _DEG)
         for name, tr in self.traces.items():
-            _put(table, pos_columns(name), tr.pos_m)
-            _put(table, vel_columns(name), tr.vel_mps)
-            _put(table, acc_columns(name), tr.acc_mps2)
-            _put(table, omega_platform_columns(name), tr.omega_radps * _DEG)
-            _put(table, wheel_columns(name), tr.wheel_radps)
+            if hasattr(tr, "pos_m"):  # (a streamed cue without figures keeps no platform fields)
+                _put(table, pos_columns(name), tr.pos_m)
+                _put(table, vel_columns(name), tr.vel_mps)
+                _put(table, acc_columns(name), tr.acc_mps2)
+                _put(table, omega_platform_columns(name), tr.omega_radps * _DEG)
+                _put(table, wheel_columns(name), tr.wheel_radps)
             for kind, flags in tr.saturated.items():
                 table[sat_column(name, kind)] = np.asarray(flags)
         return table
@@ -313,6 +314,7 @@ def stream_cue(
     *,
     filter_start: str = "steady",
     recording: bool = True,
+    figures: bool = True,
     chunk_rows: int = CHUNK_ROWS,
     progress: Progress | None = None,
 ) -> CueResult:
@@ -321,9 +323,10 @@ def stream_cue(
 
     ``washouts``: Washout variants (:func:`washbench.cueing.variants.select_washouts`). ``traces_path`` is written
     (not atomically: the caller's temporary name). Held whole are only the input, every pilot's perceived motion
-    (for the metrics and figures) and per washout its saturation flags and the trace fields the report
-    (``_REVIEW_FIELDS``) and, with ``recording``, the recording (``_RECORDING_FIELDS``) show: the returned result's
-    ``traces`` hold those, so :meth:`CueResult.columns` is not available on it (the table is in the file).
+    (for the metrics and figures) and per washout its saturation flags and the trace fields the report's figures
+    (``_REVIEW_FIELDS``, with ``figures`` or ``recording``) and the recording (``_RECORDING_FIELDS``, with
+    ``recording``) show: the returned result's ``traces`` hold those, so :meth:`CueResult.columns` is not available
+    on it (the table is in the file).
     """
     from washbench.cueing import CueingBank, WashoutTrace
     from washbench.io.results import parquet_writer
@@ -337,7 +340,7 @@ def stream_cue(
     model = VestibularModel(motion.dt_s)
     streams = {p: PerceptionStream(model, filter_start) for p in (AIRCRAFT, *names)}
     felt = {p: Perceived(np.empty((n, 3)), np.empty((n, 3))) for p in streams}
-    keep = _REVIEW_FIELDS + (_RECORDING_FIELDS if recording else ())
+    keep = (_REVIEW_FIELDS if figures or recording else ()) + (_RECORDING_FIELDS if recording else ())
     kept = {w: {f: np.empty((n, _TRACE_FIELDS[f])) for f in keep} for w in names}
     flags: dict[str, dict[str, np.ndarray]] = {w: {} for w in names}
     buf = np.empty((len(names), min(chunk_rows, max(n, 1)), len(CueingBank.FIELDS)))
@@ -555,7 +558,7 @@ def write_outputs(
                     shown.offset = offset
                 result = stream_cue(
                     seg.motion, washouts, limits, tmp[TRACES_FILE], meta,
-                    filter_start=opts.filter_start, recording=opts.recording, progress=shown,
+                    filter_start=opts.filter_start, recording=opts.recording, figures=opts.figures, progress=shown,
                 )  # fmt: skip
                 offset += seg.motion.n
                 summary = segment_summary(input_path, seg, result, folder)
