@@ -270,6 +270,23 @@ def _warm_up() -> None:
     bank_step.disable_compile()
 
 
+def warm_up_block() -> None:
+    """Load (or compile) the block step :meth:`CueingBank.steps` calls, with the argument types it passes, on no
+    samples: for a process that forks workers (the suite's process server), so no worker loads it again."""
+    if bank_block.signatures:
+        return
+    announce_compile(bank_block)
+    bank_block(
+        np.zeros((0, 3)),
+        np.zeros((0, 3)),
+        np.zeros((0, NCFG)),
+        np.zeros((0, NFILT, filters.NCOEF)),
+        np.zeros((0, NSTATE)),
+        np.zeros((0, len(SAT_KINDS)), dtype=np.int64),
+        np.zeros((0, 0, NFIELDS)),
+    )
+
+
 class CueingBank:
     """Washouts + Atlas platform + head motion, one sample in, one row per washout out (streaming).
 

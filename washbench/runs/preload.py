@@ -1,8 +1,8 @@
 """Imported once by the suite's process server before it forks workers.
 
-Importing this module loads what every run needs and is slow to start: JSBSim, pyarrow, matplotlib's
-Agg canvas (the report's figures) and the compiled streaming cueing step (numba loads it from its
-on-disk cache, about 0.4 s); the suite adds rerun to the preload list when it writes recordings.
+Importing this module loads what every run needs and is slow to start: JSBSim, pyarrow and the compiled
+streaming cueing step (numba loads it from its on-disk cache, about 0.4 s); the suite adds matplotlib's Agg canvas
+(``washbench.runs.suite.FIGURE_MODULES``) when it draws figures and rerun when it writes recordings.
 Workers forked afterwards start with all of it in memory. Nothing here starts a thread (rerun's
 recording streams are created in the workers), so forking stays safe.
 """
@@ -10,13 +10,12 @@ recording streams are created in the workers), so forking stays safe.
 from __future__ import annotations
 
 import jsbsim  # noqa: F401
-import matplotlib.backends.backend_agg
-import matplotlib.figure  # noqa: F401
 import pyarrow.parquet  # noqa: F401
 
 import washbench.perception.vestibular  # noqa: F401
-from washbench.cueing.bank import _warm_up
+from washbench.cueing.bank import _warm_up, warm_up_block
 
-# Only the serial streaming step is run here: a parallel (prange) kernel would start numba's OpenMP threads,
-# and a process using GNU OpenMP must not fork.
+# Only the serial steps are run here: a parallel (prange) kernel would start numba's OpenMP threads, and a process
+# using GNU OpenMP must not fork. The block step is the lockstep's; the per-sample step, JSBSim scripts'.
+warm_up_block()
 _warm_up()

@@ -215,14 +215,18 @@ def _preload() -> None:
 
 _QUIET_TRACKER = "ignore:resource_tracker:UserWarning"
 
+FIGURE_MODULES = ("matplotlib.figure", "matplotlib.backends.backend_agg")
+"""Preloaded by the process server besides :mod:`washbench.runs.preload` when the runs draw figures."""
+
 
 def pool_context(
-    recording: bool = True, main_stops_workers: bool = False
+    recording: bool = True, main_stops_workers: bool = False, figures: bool = True
 ) -> tuple[multiprocessing.context.BaseContext, Callable[[], None] | None]:
     """The process pool's start method and worker initializer.
 
     ``forkserver`` (Linux, macOS) where it exists: workers fork from a server that has already imported the heavy
-    modules (JSBSim, the numba kernels, rerun, pyarrow), so each starts in milliseconds. Elsewhere (Windows)
+    modules (JSBSim, the numba kernels, pyarrow; matplotlib with ``figures``, rerun with ``recording``), so each
+    starts in milliseconds. Elsewhere (Windows)
     ``spawn``, with every worker importing them once at its start. With ``main_stops_workers`` (the suite, which
     stops its workers itself on Ctrl-C) the server and its workers ignore SIGINT.
     """
@@ -233,7 +237,8 @@ def pool_context(
     if "forkserver" in multiprocessing.get_all_start_methods():
         ctx = multiprocessing.get_context("forkserver")
         first = ["washbench.runs.worker_signals"] if main_stops_workers else []
-        ctx.set_forkserver_preload([*first, "washbench.runs.preload", *(["rerun"] if recording else [])])
+        optional = [*(FIGURE_MODULES if figures else ()), *(["rerun"] if recording else [])]
+        ctx.set_forkserver_preload([*first, "washbench.runs.preload", *optional])
         return ctx, None
     return multiprocessing.get_context("spawn"), _preload
 
@@ -285,7 +290,7 @@ def run_suite(
         for a in args:
             outcomes[a[0]] = _report(_run_one(*a), len(outcomes) + 1, len(files), start, progress)
     else:
-        ctx, initializer = pool_context(outputs.recording, main_stops_workers=True)
+        ctx, initializer = pool_context(outputs.recording, main_stops_workers=True, figures=outputs.figures)
         pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_init, initargs=(initializer,))
         try:
             with _signals_deferred():  # submitting starts the workers (up to ``jobs``)
