@@ -35,7 +35,7 @@ checks:
   - {name: altitude held, signal: altitude_ft, stat: max_deviation, max: 60}
 """
 
-HEAVY = ("scipy.linalg", "scipy.signal", "scipy.stats", "scipy.spatial", "rerun.", "rerun_sdk")
+HEAVY = ("scipy.linalg", "scipy.signal", "scipy.stats", "scipy.spatial", "rerun.", "rerun_sdk", "matplotlib.")
 
 
 def imported_by(args: list[str]) -> set[str]:
@@ -46,7 +46,7 @@ def imported_by(args: list[str]) -> set[str]:
         "with contextlib.redirect_stdout(io.StringIO()):\n"
         f"    status = main({args!r})\n"
         f"print(status, *sorted({{'.'.join(m.split('.')[:2 if m.startswith('scipy.') else 1])"
-        f" for m in sys.modules if m.startswith({HEAVY!r}) or m == 'rerun'}}))\n"
+        f" for m in sys.modules if m.startswith({HEAVY!r}) or m in ('rerun', 'matplotlib')}}))\n"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr
@@ -61,8 +61,14 @@ def test_commands_import_only_what_they_need(tmp_path) -> None:
     lines = ["t_s,f_x_mps2,f_y_mps2,f_z_mps2,omega_x_degps,omega_y_degps,omega_z_degps"]
     lines += [f"{k / 120.0!r},0.1,0.0,-9.80665,1.0,0.0,0.0" for k in range(60)]
     (tmp_path / "in.csv").write_text("\n".join(lines) + "\n")
+    # and matplotlib (0.5 s) only for figures
     assert imported_by(["validate", str(tmp_path / "m.yaml")]) == set()
-    assert imported_by(["cue", str(tmp_path / "in.csv"), "--out", str(tmp_path / "cue"), "--no-recording"]) == set()
+    cue = ["cue", str(tmp_path / "in.csv"), "--out", str(tmp_path / "cue"), "--no-recording"]
+    assert imported_by(cue) == {"matplotlib"}
+    assert imported_by([*cue, "--no-figures"]) == set()
     no_rec = ["run", str(tmp_path / "m.yaml"), "--out", str(tmp_path / "r1"), "--quiet", "--no-recording"]
-    assert imported_by(no_rec) == set()
-    assert imported_by(["run", str(tmp_path / "m.yaml"), "--out", str(tmp_path / "r2"), "--quiet"]) == {"rerun"}
+    assert imported_by([*no_rec, "--no-figures"]) == set()
+    assert imported_by(no_rec) == {"matplotlib"}
+    assert imported_by(["run", str(tmp_path / "m.yaml"), "--out", str(tmp_path / "r2"), "--quiet"]) == {
+        "rerun", "matplotlib"
+    }  # fmt: skip
