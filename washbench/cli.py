@@ -196,7 +196,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("examples", help="copy the bundled manoeuvres and pilot profiles into a folder to edit")
     p.add_argument("folder", type=Path, help="destination (created; existing files are never overwritten)")
 
-    p = sub.add_parser("report", help="write report.md and its figures again from existing results (no flying)")
+    p = sub.add_parser("report", help="write report.md and its figures (PNG and PDF) again from existing results")
     p.add_argument("results", type=Path, help="a result folder (washbench run / cue) or a suite folder")
 
     p = sub.add_parser("replay", help="open a recording (or compare two) in the rerun viewer")
