@@ -18,18 +18,17 @@ Baselines measured in the same run, printed as ratios:
 from __future__ import annotations
 
 import argparse
-import os
 import resource
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
 import pyarrow as pa
 import pyarrow.csv as pacsv
 import scipy.signal
+from baseline import DT_S, best_of, c172p_in_air, run_cpu_s
 
 from washbench.cueing import WASHOUT_NAMES, cue_trace, load_washout_params
 from washbench.cueing.variants import select_washouts
@@ -38,8 +37,6 @@ from washbench.perception import VestibularModel
 from washbench.perception.vestibular import CanalParams, OtolithParams, canal_tf, otolith_tf
 from washbench.platform import load_platform_limits
 from washbench.runs.cue import analyse, stream_cue, write_results
-
-DT_S = 1.0 / 120.0
 
 
 def write_input(path: Path, n: int) -> None:
@@ -57,15 +54,6 @@ def write_input(path: Path, n: int) -> None:
     pacsv.write_csv(pa.table(cols), path)
 
 
-def best_of(fn, repeat: int = 3) -> float:
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return min(times)
-
-
 def command_cpu_s(src: Path, out: Path, *extra: str) -> float:
     """CPU time (user + system) of one ``washbench cue`` process on ``src`` (``extra``: more options)."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -73,26 +61,6 @@ def command_cpu_s(src: Path, out: Path, *extra: str) -> float:
                    stdout=subprocess.DEVNULL)  # fmt: skip
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-
-
-def bare_jsbsim_cpu_s(steps: int) -> float:
-    """CPU time of ``steps`` bare ``fdm.run()`` calls (c172p in the air at 120 Hz, set-up not counted)."""
-    os.environ["JSBSIM_DEBUG"] = "0"
-    import jsbsim
-
-    fdm = jsbsim.FGFDMExec(jsbsim.get_default_root_dir())
-    fdm.load_model("c172p")
-    fdm.set_dt(DT_S)
-    fdm["ic/h-sl-ft"] = 4000.0
-    fdm["ic/vc-kts"] = 100.0
-    fdm.run_ic()
-    fdm["propulsion/set-running"] = -1
-    fdm["fcs/throttle-cmd-norm"] = 0.7
-    run = fdm.run
-    t0 = time.process_time()
-    for _ in range(steps):
-        run()
-    return time.process_time() - t0
 
 
 def main() -> None:
@@ -136,13 +104,13 @@ def main() -> None:
         no_fig = min(command_cpu_s(src, Path(tmp) / f"nofig{i}", "--no-figures") for i in range(args.repeat))
         lean = min(command_cpu_s(src, Path(tmp) / f"lean{i}", "--no-recording", "--no-figures")
                    for i in range(args.repeat))  # fmt: skip
-        bare = min(bare_jsbsim_cpu_s(n) for _ in range(args.repeat))
+        bare = min(run_cpu_s(c172p_in_air(), n) for _ in range(args.repeat))
         # the cost of more rows: the lean command on an input twice as long, minus the one above (start-up cancels)
         src2 = Path(tmp) / "in2.csv"
         write_input(src2, 2 * n)
         lean2 = min(command_cpu_s(src2, Path(tmp) / f"lean2_{i}", "--no-recording", "--no-figures")
                     for i in range(args.repeat))  # fmt: skip
-        bare2 = min(bare_jsbsim_cpu_s(2 * n) for _ in range(args.repeat))
+        bare2 = min(run_cpu_s(c172p_in_air(), 2 * n) for _ in range(args.repeat))
 
     total = t_read + t_cue + t_analyse + t_write
     print(f"{n} rows ({args.minutes:g} min at 120 Hz), 3 washouts")

@@ -12,15 +12,13 @@ trace: ``cue_trace`` over a synthetic 120 Hz recording of ``--trace-minutes`` mi
 from __future__ import annotations
 
 import argparse
-import os
 import time
 
 import numpy as np
+from baseline import DT_S, c172p_in_air, run_wall_s
 
 from washbench.cueing import WASHOUT_NAMES, CueingBank, cue_trace, load_washout_params
 from washbench.platform import load_platform_limits
-
-DT_S = 1.0 / 120.0
 
 
 def synthetic_motion(n: int, dt_s: float) -> tuple[np.ndarray, np.ndarray]:
@@ -52,27 +50,10 @@ def time_cueing(n: int) -> float:
 
 
 def time_jsbsim(n: int) -> float:
-    """Seconds per step of bare fdm.run() on c172p in the air."""
-    os.environ["JSBSIM_DEBUG"] = "0"
-    import jsbsim
-
-    fdm = jsbsim.FGFDMExec(jsbsim.get_default_root_dir())
-    fdm.set_debug_level(0)
-    fdm.load_model("c172p")
-    fdm.set_dt(DT_S)
-    fdm["ic/h-sl-ft"] = 4000.0
-    fdm["ic/vc-kts"] = 100.0
-    fdm["ic/lat-geod-deg"] = 45.0
-    fdm.run_ic()
-    fdm["propulsion/set-running"] = -1
-    fdm["fcs/throttle-cmd-norm"] = 0.7
-    run = fdm.run
-    for _ in range(120):
-        run()
-    t0 = time.perf_counter()
-    for _ in range(n):
-        run()
-    return (time.perf_counter() - t0) / n
+    """Seconds per step of bare fdm.run() on c172p in the air (after one second of warm-up)."""
+    fdm = c172p_in_air()
+    run_wall_s(fdm, 120)
+    return run_wall_s(fdm, n) / n
 
 
 def main() -> None:

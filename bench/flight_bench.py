@@ -15,21 +15,11 @@ import sys
 import time
 from pathlib import Path
 
-from washbench.flight.fdm import make_fdm
+from baseline import manoeuvre_start, run_wall_s
+
 from washbench.flight.fly import fly
 from washbench.flight.manoeuvre import Manoeuvre, load_manoeuvre
-from washbench.flight.profile import load_profile
 from washbench.io.paths import MANOEUVRES_DIR
-
-
-def bare_steps_per_s(m: Manoeuvre, steps: int) -> float:
-    """JSBSim alone: ``fdm.run()`` with constant controls from the manoeuvre's start."""
-    fdm, _ = make_fdm(m, load_profile(m.aircraft_files.profile))
-    run = fdm.run
-    t0 = time.perf_counter()
-    for _ in range(steps):
-        run()
-    return steps / (time.perf_counter() - t0)
 
 
 def flight_steps_per_s(m: Manoeuvre) -> tuple[float, int]:
@@ -46,7 +36,7 @@ def main(argv: list[str]) -> int:
     for path in paths:
         m = load_manoeuvre(path)
         best_flight, n = max(flight_steps_per_s(m) for _ in range(3))
-        best_bare = max(bare_steps_per_s(m, n) for _ in range(3))
+        best_bare = max(n / run_wall_s(manoeuvre_start(m), n) for _ in range(3))
         ratio = best_bare / best_flight
         worst = max(worst, ratio)
         print(f"{path.parent.name + '/' + path.stem:34s} {n:7d} {best_flight:10.0f} {best_bare:10.0f} {ratio:8.2f}x")

@@ -22,13 +22,12 @@ import time
 from pathlib import Path
 
 import numpy as np
+from baseline import manoeuvre_start, run_cpu_s
 
 from washbench.cueing import WASHOUT_NAMES, CueingBank, load_washout_params
 from washbench.cueing.variants import select_washouts
-from washbench.flight.fdm import make_fdm
 from washbench.flight.fly import fly
 from washbench.flight.manoeuvre import load_manoeuvre
-from washbench.flight.profile import load_profile
 from washbench.platform import load_platform_limits
 from washbench.runs.pipeline import LOCKSTEP_BLOCK, lockstep_blocks, sample_count
 
@@ -74,17 +73,6 @@ def time_fly(path: Path, washouts: bool) -> tuple[float, int]:
     return wall, len(result.t_s)
 
 
-def time_bare(path: Path, steps: int) -> float:
-    """Wall time of ``steps`` bare ``fdm.run()`` calls from the manoeuvre's start (set-up not timed)."""
-    m = load_manoeuvre(path)
-    fdm, _ = make_fdm(m, load_profile(m.aircraft_files.profile))
-    run = fdm.run
-    t0 = time.process_time()
-    for _ in range(steps):
-        run()
-    return time.process_time() - t0
-
-
 def time_bank(steps: int) -> float:
     bank = CueingBank(WASHOUT_NAMES, load_washout_params(), load_platform_limits(), 1.0 / 120.0)
     f, w = np.array([0.5, 0.1, -9.8]), np.array([0.01, 0.02, 0.0])
@@ -115,8 +103,8 @@ def main() -> None:
             for label, washouts in (("flight", False), ("flight + 3 washouts", True)):
                 keep(label + " short", time_fly(short, washouts)[0])
                 keep(label + " long", time_fly(long, washouts)[0])
-            keep("bare short", time_bare(long, n_short))
-            keep("bare long", time_bare(long, n_long))
+            keep("bare short", run_cpu_s(manoeuvre_start(long), n_short))
+            keep("bare long", run_cpu_s(manoeuvre_start(long), n_long))
             keep("bank", time_bank(dn))
         figures = {label: (best[label + " long"] - best[label + " short"]) / dn
                    for label in ("flight", "flight + 3 washouts")}  # fmt: skip

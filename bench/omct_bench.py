@@ -14,33 +14,19 @@ from __future__ import annotations
 
 import time
 
-import jsbsim
 import numpy as np
+from baseline import DT_S, c172p_in_air, run_wall_s
 
 from washbench.cueing import WASHOUT_NAMES, cue_trace, load_washout_params
 from washbench.cueing.variants import Washout
 from washbench.platform import load_platform_limits
 from washbench.runs.omct import measure
 
-DT_S = 1.0 / 120.0
-
 
 def fdm_step_s(n: int = 20000) -> float:
     """Seconds per bare ``fdm.run()`` of the c172p in cruise (best of three blocks)."""
-    fdm = jsbsim.FGFDMExec(None)
-    fdm.set_debug_level(0)
-    fdm.load_model("c172p")
-    fdm.set_dt(DT_S)
-    fdm["ic/h-sl-ft"] = 3000.0
-    fdm["ic/vc-kts"] = 100.0
-    fdm.run_ic()
-    best = float("inf")
-    for _ in range(3):
-        t0 = time.perf_counter()
-        for _ in range(n // 3):
-            fdm.run()
-        best = min(best, (time.perf_counter() - t0) / (n // 3))
-    return best
+    fdm = c172p_in_air(altitude_ft=3000.0)
+    return min(run_wall_s(fdm, n // 3) for _ in range(3)) / (n // 3)
 
 
 def main() -> None:

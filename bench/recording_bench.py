@@ -17,30 +17,14 @@ from __future__ import annotations
 import argparse
 import collections
 import importlib.util
-import os
 import resource
 import tempfile
 import time
 from pathlib import Path
 
+from baseline import c172p_in_air, run_wall_s
+
 from washbench.io.paths import MANOEUVRES_DIR
-
-
-def bare_jsbsim_s(steps: int) -> float:
-    """Wall time of ``steps`` bare ``fdm.run()`` calls on c172p at 120 Hz (air start, untrimmed)."""
-    os.environ.setdefault("JSBSIM_DEBUG", "0")
-    import jsbsim
-
-    fdm = jsbsim.FGFDMExec(jsbsim.get_default_root_dir())
-    fdm.load_model("c172p")
-    fdm.set_dt(1.0 / 120.0)
-    fdm["ic/h-sl-ft"] = 4000.0
-    fdm["ic/vc-kts"] = 100.0
-    fdm.run_ic()
-    start = time.perf_counter()
-    for _ in range(steps):
-        fdm.run()
-    return time.perf_counter() - start
 
 
 def breakdown(path: Path, steps: int) -> None:
@@ -117,7 +101,7 @@ def main() -> None:
             if wall < best:
                 best, best_cpu = wall, cpu
         size = out.stat().st_size
-        jsb = bare_jsbsim_s(steps)
+        jsb = run_wall_s(c172p_in_air(), steps)
         print(f"{label}: {steps} steps")
         print(f"  recording: {size / 1e6:.2f} MB, {size / steps:.0f} B/step")
         print(f"  write time: {best:.3f} s (best of {args.repeat}) = {best / jsb:.2f}x bare JSBSim ({jsb:.3f} s)")

@@ -19,6 +19,8 @@ import time
 from collections import defaultdict
 from pathlib import Path
 
+from baseline import manoeuvre_start, run_cpu_s
+
 STAGES = (
     ("model load + start", "washbench.flight.fly", "make_fdm"),
     ("flight.parquet", "washbench.flight.fly", "write_flight"),
@@ -60,21 +62,6 @@ def timed_run(path: Path, out: Path) -> tuple[dict[str, float], int]:
     return dict(spent), summary.steps
 
 
-def bare_cpu_s(path: Path, steps: int) -> float:
-    """CPU seconds of ``steps`` bare ``fdm.run()`` calls from the start of manoeuvre ``path`` (set-up not counted)."""
-    from washbench.flight.fdm import make_fdm
-    from washbench.flight.manoeuvre import load_manoeuvre
-    from washbench.flight.profile import load_profile
-
-    m = load_manoeuvre(path)
-    fdm, _ = make_fdm(m, load_profile(m.aircraft_files.profile))
-    run = fdm.run
-    t0 = time.process_time()
-    for _ in range(steps):
-        run()
-    return time.process_time() - t0
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("manoeuvres", nargs="*", default=["c172/takeoff", "columbia400/aerobatics"])
@@ -94,7 +81,7 @@ def main() -> None:
             for i in range(args.repeat):
                 spent, steps = timed_run(path, Path(tmp) / f"{name.replace('/', '_')}{i}")
                 best = {k: min(v, best.get(k, v)) for k, v in spent.items()}
-            bare = min(bare_cpu_s(path, steps) for _ in range(args.repeat))
+            bare = min(run_cpu_s(manoeuvre_start(path), steps) for _ in range(args.repeat))
             staged = sum(v for k, v in best.items() if k not in ("whole run",))
             flight = best["whole run"] - staged
             print(f"{name}: {steps} steps; bare fdm.run() {bare:.3f} s CPU")

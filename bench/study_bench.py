@@ -17,12 +17,12 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+from baseline import best_of
 from cueing_bench import DT_S, synthetic_motion, time_jsbsim
 
 from washbench.analysis.evaluate import FlightEvaluator
@@ -41,15 +41,6 @@ def candidates(m: int) -> list[Washout]:
         Washout(f"c{i}", kinds[i % 3], apply_overrides(base, {"tilt.gain_per_s": 0.2 + 4.8 * i / max(1, m - 1)}, "b"))
         for i in range(m)
     ]
-
-
-def best_of(fn, repeat: int = 3) -> float:
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return min(times)
 
 
 def main() -> None:

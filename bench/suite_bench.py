@@ -20,20 +20,7 @@ import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
-
-def bare_run(path: str, steps: int) -> float:
-    """Seconds of ``steps`` bare ``fdm.run()`` calls from the start of manoeuvre ``path``."""
-    from washbench.flight.fdm import make_fdm
-    from washbench.flight.manoeuvre import load_manoeuvre
-    from washbench.flight.profile import load_profile
-
-    m = load_manoeuvre(Path(path))
-    fdm, _ = make_fdm(m, load_profile(m.aircraft_files.profile))
-    run = fdm.run
-    start = time.perf_counter()
-    for _ in range(steps):
-        run()
-    return time.perf_counter() - start
+from baseline import manoeuvre_wall_s
 
 
 def main() -> None:
@@ -60,7 +47,7 @@ def main() -> None:
     steps = sum(s for _, s in work)
     ctx = multiprocessing.get_context("forkserver")
     with ProcessPoolExecutor(max_workers=args.jobs, mp_context=ctx) as pool:
-        bare = list(pool.map(bare_run, *zip(*work, strict=True)))
+        bare = list(pool.map(manoeuvre_wall_s, *zip(*work, strict=True)))
     # the bare runs are independent: on `jobs` processes their wall time is their sum over `jobs`
     bare_s = sum(bare) / args.jobs
     made = ", ".join(k for k, v in (("recordings", outputs.recording), ("figures", outputs.figures)) if v) or "neither"
