@@ -251,32 +251,38 @@ def parquet_writer(path: str | Path, schema: pa.Schema) -> pq.ParquetWriter:
     return pq.ParquetWriter(path, schema, compression="zstd", use_dictionary=others, use_byte_stream_split=floats)
 
 
+def write_trace_chunks(
+    path: str | Path, chunks: Iterable[Mapping[str, np.ndarray]], metadata: Mapping[bytes, bytes] | None = None
+) -> None:
+    """Write consecutive row ranges of the traces table (each column name -> 1-D array, the same columns in each)
+    to Parquet at ``path`` (not atomic by itself), one row group each, with :func:`write_parquet`'s settings.
+
+    ``metadata``: the schema's key-value metadata (provenance, :func:`washbench.io.provenance.parquet_metadata`).
+    """
+    writer = None
+    try:
+        for chunk in chunks:
+            arrow = pa.table({name: pa.array(np.asarray(col)) for name, col in chunk.items()})
+            if writer is None:
+                schema = arrow.schema.with_metadata(dict(metadata)) if metadata else arrow.schema
+                writer = parquet_writer(path, schema)
+            writer.write_table(arrow.replace_schema_metadata(schema.metadata))
+    finally:
+        if writer is not None:
+            writer.close()
+    if writer is None:
+        raise ValueError("write_trace_chunks: no rows and no columns to write")
+
+
 def write_traces(
     path: str | Path,
     table: Mapping[str, np.ndarray] | Iterable[Mapping[str, np.ndarray]],
     metadata: Mapping[bytes, bytes] | None = None,
 ) -> None:
-    """Write the traces table (column name -> 1-D array, all the same length) to Parquet, atomically.
-
-    ``table``: the whole table, or its consecutive row ranges one after the other (each the same columns; each
-    becomes a row group, so the whole table is never in memory). ``metadata``: the schema's key-value metadata
-    (provenance, :func:`washbench.io.provenance.parquet_metadata`).
-    """
-    chunks = [table] if isinstance(table, Mapping) else table
+    """Write the traces table to Parquet atomically: the whole table (column name -> 1-D array, all the same
+    length) or its consecutive row ranges (:func:`write_trace_chunks`, so the whole table is never in memory)."""
     with atomic_path(path) as tmp:
-        writer = None
-        try:
-            for chunk in chunks:
-                arrow = pa.table({name: pa.array(np.asarray(col)) for name, col in chunk.items()})
-                if writer is None:
-                    schema = arrow.schema.with_metadata(dict(metadata)) if metadata else arrow.schema
-                    writer = parquet_writer(tmp, schema)
-                writer.write_table(arrow.replace_schema_metadata(schema.metadata))
-        finally:
-            if writer is not None:
-                writer.close()
-        if writer is None:
-            raise ValueError("write_traces: no rows and no columns to write")
+        write_trace_chunks(tmp, [table] if isinstance(table, Mapping) else table, metadata)
 
 
 def read_traces(path: str | Path) -> dict[str, np.ndarray]:

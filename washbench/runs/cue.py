@@ -26,7 +26,6 @@ from types import SimpleNamespace
 from typing import Any, Protocol
 
 import numpy as np
-import pyarrow as pa
 
 from washbench.analysis.metrics import MetricRow, dof_metrics
 from washbench.errors import WashbenchError, located
@@ -191,21 +190,28 @@ def analyse(
     model = VestibularModel(motion.dt_s, vestibular)
     n = motion.n
     perceived: dict[str, Perceived] = {AIRCRAFT: model.perceive(motion.f_mps2, motion.omega_radps, filter_start)}
-    rows: list[MetricRow] = []
-    ac = perceived[AIRCRAFT]
     checked: dict[str, dict[str, np.ndarray]] = {}
     for name, trace in traces.items():
         arr = _checked_trace(name, trace, n)
         for kind, flags in trace.saturated.items():
             if np.shape(flags) != (n,):
                 raise ValueError(f"washout {name!r}: saturated[{kind!r}] has shape {np.shape(flags)}, expected ({n},)")
-        p = model.perceive(arr["head_f_mps2"], arr["head_omega_radps"], filter_start)
-        perceived[name] = p
-        rows += dof_metrics(name, ac.f_mps2, ac.omega_radps, p.f_mps2, p.omega_radps, motion.dt_s)
+        perceived[name] = model.perceive(arr["head_f_mps2"], arr["head_omega_radps"], filter_start)
         checked[name] = arr
+    rows = _metric_rows(perceived, motion.dt_s)
     result = CueResult(motion=motion, traces=dict(traces), perceived=perceived, metrics=rows, arrays=checked)
     result.columns(0, 0)  # an input column that clashes with a result column fails now, before anything is written
     return result
+
+
+def _metric_rows(perceived: Mapping[str, Perceived], dt_s: float) -> list[MetricRow]:
+    """Six metric rows per washout: each simulator pilot's perceived motion against the aircraft pilot's."""
+    ac = perceived[AIRCRAFT]
+    rows: list[MetricRow] = []
+    for name, p in perceived.items():
+        if name != AIRCRAFT:
+            rows += dof_metrics(name, ac.f_mps2, ac.omega_radps, p.f_mps2, p.omega_radps, dt_s)
+    return rows
 
 
 def _put(table: dict[str, np.ndarray], names: Sequence[str], values: np.ndarray) -> None:
@@ -329,12 +335,14 @@ def stream_cue(
     on it (the table is in the file).
     """
     from washbench.cueing import CueingBank, WashoutTrace
-    from washbench.io.results import parquet_writer
+    from washbench.io.results import write_trace_chunks
     from washbench.perception.vestibular import PerceptionStream
 
     if chunk_rows < 1:
         raise ValueError(f"chunk_rows must be at least 1, got {chunk_rows}")
     n = motion.n
+    if n < 1:
+        raise WashbenchError("nothing to cue: the input has no rows")
     bank = CueingBank(washouts, None, limits, motion.dt_s, filter_start)
     names = bank.washouts
     model = VestibularModel(motion.dt_s)
@@ -343,9 +351,10 @@ def stream_cue(
     keep = (_REVIEW_FIELDS if figures or recording else ()) + (_RECORDING_FIELDS if recording else ())
     kept = {w: {f: np.empty((n, _TRACE_FIELDS[f])) for f in keep} for w in names}
     flags: dict[str, dict[str, np.ndarray]] = {w: {} for w in names}
-    buf = np.empty((len(names), min(chunk_rows, max(n, 1)), len(CueingBank.FIELDS)))
-    writer = None
-    try:
+    buf = np.empty((len(names), min(chunk_rows, n), len(CueingBank.FIELDS)))
+
+    def tables() -> Iterator[dict[str, np.ndarray]]:
+        """Cue the next chunk, keep what the review needs of it, and yield its traces.parquet rows."""
         for a in range(0, n, chunk_rows):
             b = min(n, a + chunk_rows)
             rows = slice(a, b)
@@ -366,24 +375,12 @@ def stream_cue(
             for pilot, per in perceived.items():
                 felt[pilot].f_mps2[rows] = per.f_mps2
                 felt[pilot].omega_radps[rows] = per.omega_radps
-            table = _table_rows(motion, rows, perceived, fields, saturated)
-            arrow = pa.table({c: pa.array(np.asarray(v)) for c, v in table.items()})
-            if writer is None:
-                schema = arrow.schema.with_metadata(dict(metadata)) if metadata else arrow.schema
-                writer = parquet_writer(traces_path, schema)
-            writer.write_table(arrow.replace_schema_metadata(schema.metadata))
+            yield _table_rows(motion, rows, perceived, fields, saturated)
             if progress is not None:
                 progress.update(b)
-    finally:
-        if writer is not None:
-            writer.close()
-    if writer is None:
-        raise WashbenchError("nothing to cue: the input has no rows")
-    ac = felt[AIRCRAFT]
-    metrics: list[MetricRow] = []
-    for w in names:
-        p = felt[w]
-        metrics += dof_metrics(w, ac.f_mps2, ac.omega_radps, p.f_mps2, p.omega_radps, motion.dt_s)
+
+    write_trace_chunks(traces_path, tables(), metadata)
+    metrics = _metric_rows(felt, motion.dt_s)
     counts = bank.saturation_counts()
     traces = {w: SimpleNamespace(**kept[w], saturated=flags[w], saturation_counts=counts[w]) for w in names}
     return CueResult(motion=motion, traces=traces, perceived=felt, metrics=metrics)
