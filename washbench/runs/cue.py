@@ -358,8 +358,7 @@ def stream_cue(
         for a in range(0, n, chunk_rows):
             b = min(n, a + chunk_rows)
             rows = slice(a, b)
-            block = bank.steps(motion.f_mps2[rows], motion.omega_radps[rows], buf[:, : b - a] if b - a == buf.shape[1]
-                               else None)  # fmt: skip
+            block = bank.steps(motion.f_mps2[rows], motion.omega_radps[rows], buf if b - a == buf.shape[1] else None)
             perceived = {AIRCRAFT: streams[AIRCRAFT].perceive(motion.f_mps2[rows], motion.omega_radps[rows])}
             fields, saturated = {}, {}
             finite = bool(np.isfinite(block).all())  # one check of the chunk; the failing field named if not
@@ -470,14 +469,6 @@ def prepare_segments(samples: Samples, opts: CueOptions) -> list[Segment]:
             raise WashbenchError(located(samples.path, f"{findings[0].text}{where} [--strict]"))
         out.append(Segment(name=name, motion=motion, notes=tuple(notes), findings=findings))
     return out
-
-
-def cue_segments(
-    segments: Sequence[Segment], washouts: Sequence[Any], params: Any, limits: Any, filter_start: str
-) -> list[CueResult]:
-    """Cueing: washouts (names with ``params``, or Washout variants), Atlas model, perception and metrics of
-    every segment."""
-    return [cue_motion(seg.motion, washouts, params, limits, filter_start=filter_start) for seg in segments]
 
 
 def segment_summary(input_path: Path, seg: Segment, result: CueResult, out_dir: Path) -> Any:
