@@ -1,0 +1,87 @@
+"""The washout stage's interface: what any washout algorithm receives and returns.
+
+A washout algorithm turns the aircraft pilot-head motion into the platform's **set points**; the kinematic Atlas
+model (:mod:`washbench.platform`) tracks them within its limits and gives the simulator pilot-head motion. So
+every algorithm, built in or a user's, sits on the same bench::
+
+    f, omega (aircraft pilot head) --> washout --> set point (position, attitude) --> Atlas --> simulator head
+
+Per sample the algorithm receives
+
+- ``f_mps2``: specific force at the aircraft pilot's head, aircraft body axes (x forward, y right, z down), m/s^2;
+  [0, 0, -g] at rest (f = a - g). float64 array of shape (3,), read-only: do not keep a reference to it.
+- ``omega_radps``: aircraft body angular velocity, body axes, rad/s, float64 (3,), read-only.
+
+and returns a :data:`SetPoint` ``(pos_m, q)``:
+
+- ``pos_m``: the platform's translational set point, inertial north-east-down axes, metres from the stage's
+  centre, array-like of 3 finite floats;
+- ``q``: the cockpit's attitude set point, a unit quaternion, scalar first [w, x, y, z], mapping simulator body
+  vectors to inertial ones (v_I = q v_B q*), array-like of 4 finite floats (normalised by the bench).
+
+The time step ``dt_s`` (s) is fixed for a run and given when the algorithm is made (:class:`WashoutContext`).
+State lives in the algorithm object (one object per run and washout: the bench makes a new one for every
+recording or flight and calls :meth:`WashoutAlgorithm.start` once before the first :meth:`~WashoutAlgorithm.step`).
+
+The platform starts at the set point :meth:`WashoutAlgorithm.start` returns, at rest (``filter_start="rest"``) or
+already moving at the rate between that set point and the first step's (``"steady"``).
+
+Optionally an algorithm has ``trace(f_mps2 (N, 3), omega_radps (N, 3)) -> (pos_m (N, 3), q (N, 4))``: the
+whole-trace form, called instead of N steps after :meth:`~WashoutAlgorithm.start` (it must give the same numbers
+as the steps; the bench uses it for recorded files, studies and the OMCT).
+
+Optionally an algorithm has ``flags() -> tuple[bool, bool]``: whether its own tilt-rate and rotational-rate limits
+acted on the last step (the ``sat_tilt_rate`` and ``sat_rot_rate`` columns); without it both are False.
+
+A plugin is a class (or any callable) ``factory(params, context) -> WashoutAlgorithm``; ``params`` is the validated
+section of the parameter file named after the plugin (an instance of the class's ``Params`` pydantic model, or
+``None`` when it declares none). See ``docs/washouts.md`` for a worked example and how to load one
+(``--washout-plugin FILE.py:NAME``, the ``washbench.washouts`` entry-point group).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Protocol, runtime_checkable
+
+import numpy as np
+
+from washbench.platform.limits import PlatformLimits
+
+SetPoint = tuple[np.ndarray, np.ndarray]
+"""(pos_m (3,) inertial NED, m; q (4,) body->inertial, scalar first)."""
+
+
+@dataclass(frozen=True)
+class WashoutContext:
+    """What an algorithm is told when it is made: the run's fixed facts, SI.
+
+    dt_s: sample interval, s. gravity_mps2: g, m/s^2 (g_I = [0, 0, +g]). limits: the platform's limits (position,
+    velocity, acceleration per inertial axis; sphere rate and acceleration), as in the platform file; the Atlas
+    model enforces them whatever the set points, an algorithm may use them to plan. filter_start: ``"steady"``
+    (the first sample is a steady state) or ``"rest"`` (the simulator was level and still before it).
+    head_offset_m: the pilot's head from the cockpit centre, simulator body axes, m.
+    """
+
+    dt_s: float
+    gravity_mps2: float
+    limits: PlatformLimits
+    filter_start: str
+    head_offset_m: tuple[float, float, float]
+
+
+@runtime_checkable
+class WashoutAlgorithm(Protocol):
+    """One washout, sample by sample (see the module docstring for units, frames and state)."""
+
+    def start(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> SetPoint:
+        """Initialise from the first sample (or, with ``filter_start="rest"``, from rest: [0, 0, -g] and 0);
+        return the set point the platform starts at."""
+        ...
+
+    def step(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> SetPoint:
+        """Advance by one sample (dt_s); return the new set point."""
+        ...
+
+
+__all__ = ["SetPoint", "WashoutAlgorithm", "WashoutContext"]
