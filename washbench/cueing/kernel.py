@@ -182,15 +182,17 @@ def _init_washout(kind, c, coef, state, fs, ws):
 
 
 @njit(cache=True)
-def step_one(f, om, c, coef, state, counts, row):
-    """Advance one washout (+ platform + head motion) by one sample and write its output ``row``."""
+def washout_classical(f, om, c, coef, state, first, rest):
+    """The classical-family washout (small-angle, large-angle, unrestricted) by one sample: scaling, the rotational
+    saturation, tilt coordination, the rotational and translational channels. Updates the set points in
+    ``state`` (S_PSP position, S_QSP attitude) and returns (sat_tilt, sat_rot): whether the tilt-rate and
+    rotational-rate limits acted; and the set points before this sample (q_sp_prev, p_sp_prev), which on the first
+    sample are the washout's start state."""
     kind = int(c[C_KIND])
     dt = c[C_DT]
     g = c[C_G]
     fs = (c[C_SF] * f[0], c[C_SF] * f[1], c[C_SF] * f[2])
     ws, sat_rot = limit_norm((c[C_SW] * om[0], c[C_SW] * om[1], c[C_SW] * om[2]), c[C_ROT_SAT])
-    first = state[S_INIT] == 0.0
-    rest = c[C_REST] != 0.0
     if first:
         if rest:  # the simulator was at rest before the recording began: the first sample is a change
             _init_washout(kind, c, coef, state, (0.0, 0.0, -c[C_SF] * g), (0.0, 0.0, 0.0))
@@ -200,7 +202,7 @@ def step_one(f, om, c, coef, state, counts, row):
     q_sp_prev = (state[S_QSP], state[S_QSP + 1], state[S_QSP + 2], state[S_QSP + 3])
     p_sp_prev = (state[S_PSP], state[S_PSP + 1], state[S_PSP + 2])
 
-    # ---- washout: attitude set point and inertial acceleration of the translational channel
+    # ---- attitude set point and inertial acceleration of the translational channel
     if kind == KIND_SMALL:
         phi = state[S_BT] + state[S_BR]
         theta = state[S_BT + 1] + state[S_BR + 1]
@@ -236,8 +238,19 @@ def step_one(f, om, c, coef, state, counts, row):
     for j in range(3):
         state[S_VSP + j] += a_hp[j] * dt
         state[S_PSP + j] += state[S_VSP + j] * dt
+    return q_sp_prev, p_sp_prev, sat_tilt, sat_rot
 
-    # ---- platform
+
+@njit(cache=True)
+def platform_head(p_sp_prev, p_sp, q_sp_prev, q_sp, first, rest, c, coef, state, counts, row, sat_tilt, sat_rot):
+    """The Atlas platform tracking the set points (from ``p_sp_prev``, ``q_sp_prev`` to ``p_sp``, ``q_sp``) within
+    its limits, and the simulator pilot-head motion from what the platform actually does; writes the output
+    ``row`` (every field, the set points and the saturation flags, the washout's two given) and counts the flags.
+
+    On the ``first`` sample the platform starts centred at attitude ``q_sp_prev``, at rest (``rest``) or turning
+    at the set point's rate."""
+    dt = c[C_DT]
+    g_i = (0.0, 0.0, c[C_G])
     if first:
         for j in range(3):
             state[S_P + j] = 0.0
@@ -256,7 +269,7 @@ def step_one(f, om, c, coef, state, counts, row):
             state[S_P + j],
             v_prev,
             p_sp_prev[j],
-            state[S_PSP + j],
+            p_sp[j],
             c[C_PMAX + j],
             c[C_VMAX + j],
             c[C_AMAX + j],
@@ -319,7 +332,7 @@ def step_one(f, om, c, coef, state, counts, row):
         row[O_HEAD_F + j] = a_s[j] - g_sh[j] + t1[j] + t2[j]
         row[O_HEAD_OMEGA + j] = wh[j]
         row[O_WHEEL + j] = wheels[j]
-        row[O_SP_POS + j] = state[S_PSP + j]
+        row[O_SP_POS + j] = p_sp[j]
     for j in range(4):
         row[O_Q + j] = q[j]
         row[O_SP_Q + j] = q_sp[j]
@@ -327,6 +340,18 @@ def step_one(f, om, c, coef, state, counts, row):
     for j in range(7):
         row[O_SAT + j] = float(flags[j])
         counts[j] += flags[j]
+
+
+@njit(cache=True)
+def step_one(f, om, c, coef, state, counts, row):
+    """Advance one washout (+ platform + head motion) by one sample and write its output ``row``:
+    washout -> set points -> platform -> head."""
+    first = state[S_INIT] == 0.0
+    rest = c[C_REST] != 0.0
+    q_sp_prev, p_sp_prev, sat_tilt, sat_rot = washout_classical(f, om, c, coef, state, first, rest)
+    q_sp = (state[S_QSP], state[S_QSP + 1], state[S_QSP + 2], state[S_QSP + 3])
+    p_sp = (state[S_PSP], state[S_PSP + 1], state[S_PSP + 2])
+    platform_head(p_sp_prev, p_sp, q_sp_prev, q_sp, first, rest, c, coef, state, counts, row, sat_tilt, sat_rot)
     state[S_INIT] = 1.0
 
 
