@@ -557,6 +557,8 @@ def bank_step(f, om, cfg, coef, state, counts, out):
     """Streaming form: advance every washout of the bank by one sample (f, om: (3,) float64)."""
     _check_input(f, om)
     for i in range(cfg.shape[0]):
+        if cfg[i, C_KIND] < 0.0:  # a set-point washout: stepped by the caller (setpoint_step)
+            continue
         step_one(f, om, cfg[i], coef[i], state[i], counts[i], out[i])
 
 
@@ -569,6 +571,8 @@ def bank_trace(f, om, cfg, coef, state, counts, out):
     washout's samples in order on one thread: the same operations in the same order as streaming).
     """
     for i in prange(cfg.shape[0]):
+        if cfg[i, C_KIND] < 0.0:
+            continue
         row = np.zeros(NFIELDS)
         for k in range(f.shape[0]):
             step_one(f[k], om[k], cfg[i], coef[i], state[i], counts[i], row)
@@ -584,6 +588,8 @@ def bank_block(f, om, cfg, coef, state, counts, out):
     """
     for k in range(f.shape[0]):
         for i in range(cfg.shape[0]):
+            if cfg[i, C_KIND] < 0.0:
+                continue
             step_one(f[k], om[k], cfg[i], coef[i], state[i], counts[i], out[i, k])
 
 
