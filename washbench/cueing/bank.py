@@ -464,6 +464,7 @@ def cue_trace(
     params: WashoutParams | None,
     limits: PlatformLimits,
     filter_start: str = "steady",
+    fields_out: np.ndarray | None = None,
 ) -> dict[str, WashoutTrace]:
     """Whole-trace form: run the washouts over arrays f (N, 3) m/s^2 and omega (N, 3) rad/s sampled every dt_s.
 
@@ -472,7 +473,8 @@ def cue_trace(
     (naming the first bad sample) and for a step outside ``washbench.io.results.DT_RANGE_S``. Magnitudes are not
     limited here (the platform stays within its limits whatever the input); the readers refuse physically
     absurd recordings at the file edge.
-    ``filter_start``: see :data:`FILTER_STARTS`.
+    ``filter_start``: see :data:`FILTER_STARTS`. ``fields_out``: for one washout, a (N_FIELDS, N) float64 array to
+    write its outputs into (the traces are views of it).
     """
     specs = as_washouts(washouts, params)
     names = [w.name for w in specs]
@@ -488,6 +490,10 @@ def cue_trace(
     state = np.zeros((len(names), NSTATE))
     counts = np.zeros((len(names), len(SAT_KINDS)), dtype=np.int64)
     out = np.empty((len(names), NFIELDS, f.shape[0]))
+    if fields_out is not None:  # one washout's field-major outputs written where the caller wants them
+        if len(names) != 1 or fields_out.shape != out.shape[1:]:
+            raise ValueError("fields_out needs one washout and shape (NFIELDS, N)")
+        out = fields_out[None]
     announce_compile(bank_trace)
     bank_trace(f, w, cfg, coef, state, counts, out)
     if len(f):

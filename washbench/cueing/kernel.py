@@ -100,7 +100,9 @@ S_SA = S_AD + 6  # d(a_sp)/dp per axis: the translational high-pass of the unsca
 S_SV, S_SX = S_AD + 9, S_AD + 12  # d(v_sp)/dp, d(x_sp)/dp (3 each)
 S_TH = S_AD + 15  # d(theta_sp)/dk: attitude sensitivity, body axes, 3x3 row-major [i, j] = component i of column j
 S_SFX = S_AD + 24  # the sensitivity high-pass filters' states (3 filters x 2)
-NSTATE = S_SFX + 6
+S_GRAD = S_AD + 30  # the last step's gradient dJ/dp (3), dJ/dk (3)
+S_COST = S_AD + 36  # the last step's cost J
+NSTATE = S_AD + 37
 
 
 @njit(cache=True)
@@ -293,6 +295,15 @@ def _adapt(c, coef, state, fs, ws, u, g_s, f_lp, wt_raw, wt, sat_tilt, a_hp, q_s
         )
     gp = (gp_l[0], gp_l[1], gp_l[2])
     gk = (gk_l[0], gk_l[1], gk_l[2])
+    for j in range(3):
+        state[S_GRAD + j] = gp[j]
+        state[S_GRAD + 3 + j] = gk[j]
+    cost = 0.0
+    for j in range(3):
+        cost += c[C_WF] * e_f[j] * e_f[j] + c[C_WW] * e_w[j] * e_w[j]
+        cost += c[C_WX] * state[S_PSP + j] ** 2 + c[C_WV] * state[S_VSP + j] ** 2
+        cost += c[C_WPG] * (state[S_GP + j] - c[C_P0]) ** 2 + c[C_WKG] * (state[S_GK + j] - c[C_TILT_K]) ** 2
+    state[S_COST] = 0.5 * cost
     # attitude sensitivity: body-frame perturbation carried by the set point's rotation, plus this step's rate
     for j in range(3):
         th = (state[S_TH + j], state[S_TH + 3 + j], state[S_TH + 6 + j])

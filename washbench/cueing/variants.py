@@ -188,6 +188,18 @@ def apply_overrides(
         raise WashbenchError(located(where, problem, line=line, field=field_prefix + key)) from None
 
 
+def value_of(params: WashoutParams, key: str) -> Any:
+    """The value of a dotted key in a parameter set (a Python algorithm's key: from its validated section)."""
+    parts = key.split(".")
+    node: Any = params
+    if parts[0] in registry.python_kinds():
+        node = registry.get(parts[0]).make_params(params.sections.get(parts[0]), "parameters")
+        parts = parts[1:]
+    for part in parts:
+        node = node[part] if isinstance(node, dict) else getattr(node, part)
+    return node
+
+
 def resolve(variant: VariantText, base: WashoutParams, where: str | None = None) -> Washout:
     """The variant as a :class:`Washout`: ``base`` with its overrides applied."""
     src = where or f"--variant {variant.name}"
@@ -310,4 +322,5 @@ __all__ = [
     "parse_variant",
     "resolve",
     "select_washouts",
+    "value_of",
 ]
