@@ -84,8 +84,10 @@ from washbench.cueing.kernel import (
     O_SP_Q,
     O_VEL,
     O_WHEEL,
+    S_COST,
     S_GK,
     S_GP,
+    S_GRAD,
     S_PSP,
     S_QSP,
     SAT_KINDS,
@@ -440,13 +442,21 @@ class CueingBank:
             self._out[:] = out[:, -1]
         return out
 
-    def adapted_gains(self) -> dict[str, tuple[tuple[float, ...], tuple[float, ...]]]:
-        """The adaptive washouts' current gains: name -> (p per inertial axis x, y, z; k per body axis, 1/s)."""
-        out = {}
+    def adaptation(self) -> dict[str, dict[str, np.ndarray | float]]:
+        """The adaptive washouts' state after the last sample: name -> ``p`` (3,) translational gains per inertial
+        axis, ``k`` (3,) tilt gains per body axis (1/s), ``grad_p``, ``grad_k`` (3,) the cost's gradient the last
+        step descended, ``cost`` J of the last step (docs/washouts.md)."""
+        out: dict[str, dict[str, np.ndarray | float]] = {}
         for i, w in enumerate(self.specs):
             if w.kind in ADAPTIVE_KINDS:
                 st = self._state[i]
-                out[w.name] = (tuple(st[S_GP : S_GP + 3].tolist()), tuple(st[S_GK : S_GK + 3].tolist()))
+                out[w.name] = {
+                    "p": st[S_GP : S_GP + 3].copy(),
+                    "k": st[S_GK : S_GK + 3].copy(),
+                    "grad_p": st[S_GRAD : S_GRAD + 3].copy(),
+                    "grad_k": st[S_GRAD + 3 : S_GRAD + 6].copy(),
+                    "cost": float(st[S_COST]),
+                }
         return out
 
     def saturation_counts(self) -> dict[str, dict[str, int]]:
