@@ -15,6 +15,7 @@ import pyarrow.parquet as pq
 import pytest
 
 from washbench.analysis.signals import SignalSpec, generate
+from washbench.cli import main
 from washbench.cueing import CueingBank, cue_trace
 from washbench.cueing.params import ADAPTIVE_KINDS, CLASSICAL_KINDS
 from washbench.cueing.variants import Washout, apply_overrides, load_param_file
@@ -155,10 +156,11 @@ def _wb(*args: str, env: dict | None = None, cwd: Path | None = None) -> subproc
 
 @pytest.fixture(scope="module")
 def plugin_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """`washbench run` of a short turn with the plugin beside large-angle and the adaptive large-angle washout."""
+    """`washbench suite` (its worker process loads the plugin from its file again) of a short turn with the plugin
+    beside large-angle and the adaptive large-angle washout; the suite runs each manoeuvre as `washbench run` does."""
     out = tmp_path_factory.mktemp("plugin_run")
     r = _wb(
-        "run", str(SHORT_TURN), "--washout-plugin", PLUGIN, "--washout", "first-order", "--washout", "large-angle",
+        "suite", str(SHORT_TURN), "--washout-plugin", PLUGIN, "--washout", "first-order", "--washout", "large-angle",
         "--washout", "adaptive-large-angle", "--out", str(out), "--no-recording", "--no-figures",
     )  # fmt: skip
     assert r.returncode == 0, r.stderr
@@ -198,22 +200,93 @@ def test_plugin_in_sweep_and_tune_gives_the_run_s_scores(plugin_run: Path, tmp_p
     assert "first-order" in (tmp_path / "tune" / "tuned.yaml").read_text()
 
 
-def test_plugin_in_cue_and_omct(tmp_path: Path) -> None:
-    sig = tmp_path / "step.csv"
-    r = _wb("signal", "step", "--axis", "f_y", "--amplitude", "2", "--duration-s", "8", "--out", str(sig))
-    assert r.returncode == 0, r.stderr
-    r = _wb("cue", str(sig), "--washout-plugin", PLUGIN, "--washout", "first-order", "--washout", "adaptive",
-            "--out", str(tmp_path / "cue"), "--no-recording", "--no-figures")  # fmt: skip
-    assert r.returncode == 0, r.stderr
+@pytest.fixture(scope="module")
+def signals(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    """Short `washbench signal` inputs for cue, written once."""
+    d = tmp_path_factory.mktemp("signals")
+    out = {"step": d / "step.csv", "sine": d / "sine.csv"}
+    assert main(["signal", "step", "--axis", "f_y", "--amplitude", "2", "--duration-s", "8",
+                 "--out", str(out["step"])]) == 0  # fmt: skip
+    assert main(["signal", "sine", "--axis", "roll", "--amplitude", "10", "--frequency-hz", "0.5", "--duration-s", "5",
+                 "--out", str(out["sine"])]) == 0  # fmt: skip
+    return out
+
+
+def test_plugin_in_cue(signals: dict[str, Path], tmp_path: Path) -> None:
+    status = main(["cue", str(signals["step"]), "--washout-plugin", PLUGIN, "--washout", "first-order",
+                   "--washout", "adaptive", "--out", str(tmp_path / "cue"), "--no-recording",
+                   "--no-figures"])  # fmt: skip
+    assert status == 0
     washouts = {row["washout"] for row in csv.DictReader((tmp_path / "cue" / "metrics.csv").open())}
     assert washouts == {"first-order", "adaptive"}
-    r = _wb("omct", "--washout-plugin", PLUGIN, "--washout", "first-order", "--rate-hz", "60",
-            "--out", str(tmp_path / "omct"))  # fmt: skip
-    assert r.returncode == 0, r.stderr
-    assert any("first-order" in p.read_text() for p in (tmp_path / "omct").glob("*.csv"))
 
 
-def test_plugin_from_an_entry_point(tmp_path: Path) -> None:
+TILT_PLUGIN = '''
+import math
+import numpy as np
+from scipy.signal import lfilter
+
+
+class LowpassTilt:
+    """Tilt only: roll, pitch follow asin(-f_y/g), asin(f_x/g) through a first-order low-pass; a whole-trace form."""
+
+    washout_name = "lowpass-tilt"
+
+    def __init__(self, params, context):
+        self.b = math.exp(-1.0 * context.dt_s)
+        self.g = context.gravity_mps2
+
+    def _target(self, f):
+        return (-math.asin(max(-1.0, min(1.0, f[1] / self.g))), math.asin(max(-1.0, min(1.0, f[0] / self.g))))
+
+    @staticmethod
+    def _q(phi, theta):
+        return (math.cos(phi / 2) * math.cos(theta / 2), math.sin(phi / 2) * math.cos(theta / 2),
+                math.cos(phi / 2) * math.sin(theta / 2), -math.sin(phi / 2) * math.sin(theta / 2))
+
+    def start(self, f, omega):
+        self.y = list(self._target(f))
+        return (0.0, 0.0, 0.0), self._q(*self.y)
+
+    def step(self, f, omega):
+        t = self._target(f)
+        self.y = [(1 - self.b) * t[j] + self.b * self.y[j] for j in range(2)]
+        return (0.0, 0.0, 0.0), self._q(*self.y)
+
+    def trace(self, f, omega):
+        g = self.g
+        targets = np.column_stack([-np.arcsin(np.clip(f[:, 1] / g, -1, 1)), np.arcsin(np.clip(f[:, 0] / g, -1, 1))])
+        y = np.column_stack([lfilter([1 - self.b], [1, -self.b], targets[:, j], zi=[self.b * self.y[j]])[0]
+                             for j in range(2)])
+        phi, theta = y[:, 0] / 2, y[:, 1] / 2
+        q = np.column_stack([np.cos(phi) * np.cos(theta), np.sin(phi) * np.cos(theta), np.cos(phi) * np.sin(theta),
+                             -np.sin(phi) * np.sin(theta)])
+        return np.zeros((len(f), 3)), q
+'''
+
+
+def test_plugin_trace_form_equals_its_steps_and_serves_the_omct(tmp_path: Path) -> None:
+    """A plugin with a whole-trace form: cue_trace (which uses it) equals the bank stepping it sample by sample, and
+    `washbench omct` measures it (through that form: the OMCT's 1.8 million samples in seconds)."""
+    from washbench.cueing import registry
+
+    plugin = tmp_path / "tilt.py"
+    plugin.write_text(TILT_PLUGIN)
+    registry.load_plugin(f"{plugin}:LowpassTilt")
+    f, w = _mixed_input(1200)
+    washouts = [Washout("lowpass-tilt", "lowpass-tilt", BASE, f"{plugin}:LowpassTilt")]
+    whole = cue_trace(f, w, DT, washouts, None, LIMITS)["lowpass-tilt"]
+    bank = CueingBank(washouts, None, LIMITS, DT)
+    rows = np.stack([bank.step(f[k], w[k])[0].copy() for k in range(len(f))])
+    np.testing.assert_allclose(whole.q, rows[:, 9:13], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(whole.head_f_mps2, rows[:, 16:19], rtol=0, atol=1e-9)
+    status = main(["omct", "--washout-plugin", f"{plugin}:LowpassTilt", "--washout", "lowpass-tilt",
+                   "--out", str(tmp_path / "omct")])  # fmt: skip
+    assert status == 0
+    assert any("lowpass-tilt" in p.read_text() for p in (tmp_path / "omct").glob("*.csv"))
+
+
+def test_plugin_from_an_entry_point(signals: dict[str, Path], tmp_path: Path) -> None:
     """An installed package's plugin, found through the washbench.washouts entry-point group (no flag)."""
     site = tmp_path / "site"
     dist = site / "myplugin-0.1.dist-info"
@@ -222,10 +295,7 @@ def test_plugin_from_an_entry_point(tmp_path: Path) -> None:
     (dist / "entry_points.txt").write_text("[washbench.washouts]\nfirst-order = my_first_order:FirstOrder\n")
     (site / "my_first_order.py").write_text(EXAMPLE.read_text())
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(site), *filter(None, [os.environ.get("PYTHONPATH")])])}
-    sig = tmp_path / "s.csv"
-    assert _wb("signal", "sine", "--axis", "roll", "--amplitude", "10", "--frequency-hz", "0.5",
-               "--duration-s", "5", "--out", str(sig)).returncode == 0  # fmt: skip
-    r = _wb("cue", str(sig), "--washout", "first-order", "--out", str(tmp_path / "cue"), "--no-recording",
+    r = _wb("cue", str(signals["sine"]), "--washout", "first-order", "--out", str(tmp_path / "cue"), "--no-recording",
             "--no-figures", env=env)  # fmt: skip
     assert r.returncode == 0, r.stderr
     assert "first-order" in (tmp_path / "cue" / "metrics.csv").read_text()
@@ -240,25 +310,27 @@ BAD = {
 
 
 @pytest.mark.parametrize("case", sorted(BAD))
-def test_a_bad_plugin_is_one_line_naming_the_step(case: str, tmp_path: Path) -> None:
+def test_a_bad_plugin_is_one_line_naming_the_step(
+    case: str, signals: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     body, expected = BAD[case]
     plugin = tmp_path / "bad.py"
     plugin.write_text(
-        "import numpy as np\n\n\nclass Bad:\n    washout_name = 'bad'\n\n    def __init__(self, params, context):\n"
-        "        self.k = 0\n\n    def start(self, f, omega):\n        return np.zeros(3), np.array([1.0, 0, 0, 0])\n\n"
+        f"import numpy as np\n\n\nclass Bad:\n    washout_name = 'bad-{case}'\n\n"
+        "    def __init__(self, params, context):\n        self.k = 0\n\n"
+        "    def start(self, f, omega):\n        return np.zeros(3), np.array([1.0, 0, 0, 0])\n\n"
         f"    def step(self, f, omega):\n        self.k += 1\n        if self.k < 50:\n"
         f"            return np.zeros(3), np.array([1.0, 0, 0, 0])\n        {body}\n"
     )
-    sig = tmp_path / "s.csv"
-    assert _wb("signal", "step", "--axis", "f_x", "--amplitude", "1", "--duration-s", "3",
-               "--out", str(sig)).returncode == 0  # fmt: skip
     out = tmp_path / "out"
-    r = _wb("cue", str(sig), "--washout-plugin", f"{plugin}:Bad", "--washout", "bad", "--out", str(out),
-            "--no-recording", "--no-figures")  # fmt: skip
-    assert r.returncode == 2
-    lines = r.stderr.strip().splitlines()
-    assert len(lines) == 1 and "Traceback" not in r.stderr, r.stderr
-    assert "washout bad" in lines[0] and "step 49" in lines[0] and "t = 0.408333 s" in lines[0], lines[0]
+    capsys.readouterr()
+    status = main(["cue", str(signals["step"]), "--washout-plugin", f"{plugin}:Bad", "--washout", f"bad-{case}",
+                   "--out", str(out), "--no-recording", "--no-figures"])  # fmt: skip
+    err = capsys.readouterr().err
+    assert status == 2
+    lines = [line for line in err.strip().splitlines() if line.startswith("washbench: error")]
+    assert len(lines) == 1 and "Traceback" not in err, err
+    assert f"washout bad-{case}" in lines[0] and "step 49" in lines[0] and "t = 0.408333 s" in lines[0], lines[0]
     assert expected in lines[0]
     assert not (out / "metrics.csv").exists()
 

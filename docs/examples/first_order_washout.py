@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
 
@@ -34,7 +33,7 @@ class Params(BaseModel):
     """The tilt's rate limit, deg/s."""
 
 
-def _quat_from_euler(phi: float, theta: float, psi: float) -> np.ndarray:
+def _quat_from_euler(phi: float, theta: float, psi: float) -> tuple[float, float, float, float]:
     """Body->inertial quaternion, scalar first, from ZYX Euler angles (rad)."""
     cr, sr = math.cos(phi / 2), math.sin(phi / 2)
     cp, sp = math.cos(theta / 2), math.sin(theta / 2)
@@ -43,11 +42,14 @@ def _quat_from_euler(phi: float, theta: float, psi: float) -> np.ndarray:
     x = sr * cp * cy - cr * sp * sy
     y = cr * sp * cy + sr * cp * sy
     z = cr * cp * sy - sr * sp * cy
-    return np.array([w, x, y, z])
+    return (w, x, y, z)
 
 
 class FirstOrder:
-    """The algorithm: made once per run with its parameters and the run's context (dt, g, platform limits)."""
+    """The algorithm: made once per run with its parameters and the run's context (dt, g, platform limits).
+
+    Plain floats rather than numpy arrays inside: a step on three numbers is several times faster that way.
+    """
 
     washout_name = "first-order"
     Params = Params
@@ -58,39 +60,42 @@ class FirstOrder:
         self.g = context.gravity_mps2
         self.a = math.exp(-params.highpass_wn_radps * self.dt)  # discrete pole of s/(s + w)
         self.b = math.exp(-params.tilt_wn_radps * self.dt)
+        self.leak = 1.0 - params.highpass_wn_radps * self.dt
+        self.max_tilt_step = math.radians(params.tilt_rate_limit_degps) * self.dt
 
-    def _tilt_target(self, f: np.ndarray) -> tuple[float, float]:
-        fx = max(-1.0, min(1.0, self.p.scale * f[0] / self.g))
-        fy = max(-1.0, min(1.0, self.p.scale * f[1] / self.g))
+    def _tilt_target(self, f) -> tuple[float, float]:
+        fx = max(-1.0, min(1.0, self.p.scale * float(f[0]) / self.g))
+        fy = max(-1.0, min(1.0, self.p.scale * float(f[1]) / self.g))
         return -math.asin(fy), math.asin(fx)  # roll, pitch that make gravity give f_x, f_y
 
     def start(self, f, omega):
-        self.f_prev = np.array(f, dtype=float)
-        self.w_prev = np.array(omega, dtype=float)
-        self.acc_hp = np.zeros(3)
-        self.rate_hp = np.zeros(3)
-        self.vel = np.zeros(3)
-        self.pos = np.zeros(3)
-        self.tilt = np.array(self._tilt_target(f))
-        self.euler = np.zeros(3)  # the rotational channel's angles (roll, pitch, yaw)
-        return self.pos.copy(), _quat_from_euler(self.tilt[0], self.tilt[1], 0.0)
+        self.f_prev = [float(v) for v in f]
+        self.w_prev = [float(v) for v in omega]
+        self.acc_hp = [0.0, 0.0, 0.0]
+        self.rate_hp = [0.0, 0.0, 0.0]
+        self.vel = [0.0, 0.0, 0.0]
+        self.pos = [0.0, 0.0, 0.0]
+        self.tilt = list(self._tilt_target(f))
+        self.euler = [0.0, 0.0, 0.0]  # the rotational channel's angles (roll, pitch, yaw)
+        return tuple(self.pos), _quat_from_euler(self.tilt[0], self.tilt[1], 0.0)
 
     def step(self, f, omega):
-        s, dt = self.p.scale, self.dt
-        # first-order high-pass y_k = a (y_{k-1} + u_k - u_{k-1}) on the specific force change and the body rates
-        self.acc_hp = self.a * (self.acc_hp + s * (f - self.f_prev))
-        self.rate_hp = self.a * (self.rate_hp + s * (omega - self.w_prev))
-        self.f_prev = np.array(f, dtype=float)
-        self.w_prev = np.array(omega, dtype=float)
-        # leaky double integration: velocity and position decay at the high-pass frequency (back to centre)
-        w = self.p.highpass_wn_radps
-        self.vel = self.vel * (1.0 - w * dt) + self.acc_hp * dt
-        self.pos = self.pos * (1.0 - w * dt) + self.vel * dt
+        s, dt, a, leak = self.p.scale, self.dt, self.a, self.leak
+        for j in range(3):
+            fj, wj = float(f[j]), float(omega[j])
+            # first-order high-pass y_k = a (y_{k-1} + u_k - u_{k-1}) on the specific force change and the body rates
+            self.acc_hp[j] = a * (self.acc_hp[j] + s * (fj - self.f_prev[j]))
+            self.rate_hp[j] = a * (self.rate_hp[j] + s * (wj - self.w_prev[j]))
+            self.f_prev[j] = fj
+            self.w_prev[j] = wj
+            # leaky double integration: velocity and position decay at the high-pass frequency (back to centre)
+            self.vel[j] = self.vel[j] * leak + self.acc_hp[j] * dt
+            self.pos[j] = self.pos[j] * leak + self.vel[j] * dt
+            self.euler[j] += self.rate_hp[j] * dt  # small-angle integration of the high-passed rates
         # tilt: first-order low-pass toward the target, rate-limited
-        target = np.array(self._tilt_target(f))
-        step = (1.0 - self.b) * (target - self.tilt)
-        limit = math.radians(self.p.tilt_rate_limit_degps) * dt
-        self.tilt += np.clip(step, -limit, limit)
-        self.euler += self.rate_hp * dt  # small-angle integration of the high-passed rates
+        target = self._tilt_target(f)
+        for j in range(2):
+            step = (1.0 - self.b) * (target[j] - self.tilt[j])
+            self.tilt[j] += max(-self.max_tilt_step, min(self.max_tilt_step, step))
         q = _quat_from_euler(self.tilt[0] + self.euler[0], self.tilt[1] + self.euler[1], self.euler[2])
-        return self.pos.copy(), q
+        return tuple(self.pos), q

@@ -72,12 +72,15 @@ class SetPointSource:
             raise WashbenchError(f"{self._where()}: set point is not numbers: {exc}") from None
         if pos.shape != (3,) or q.shape != (4,):
             raise WashbenchError(f"{self._where()}: set point shapes {pos.shape} and {q.shape}, expected (3,) and (4,)")
-        if not (np.isfinite(pos).all() and np.isfinite(q).all()):
+        p0, p1, p2 = pos.tolist()
+        q0, q1, q2, q3 = q.tolist()
+        nq = math.sqrt(q0 * q0 + q1 * q1 + q2 * q2 + q3 * q3)
+        if not (math.isfinite(p0 + p1 + p2) and math.isfinite(nq)):
             raise WashbenchError(f"{self._where()}: set point is not finite: pos_m={pos.tolist()}, q={q.tolist()}")
-        nq = math.sqrt(float(q @ q))
         if nq < 1e-6:
             raise WashbenchError(f"{self._where()}: attitude set point q is zero")
-        return pos, q / nq
+        q /= nq
+        return pos, q
 
     def _flags(self) -> tuple[int, int]:
         if not self.has_flags:
