@@ -106,6 +106,10 @@ def load_plugin(spec: str) -> Algorithm:
     path = Path(file).expanduser()
     if not path.is_file():
         raise WashbenchError(f"{where}: {path}: no such file")
+    text = f"{path.resolve()}:{name}"  # absolute: worker processes load the same file
+    for kind, loaded in _PLUGIN_SPECS.items():
+        if loaded == text:
+            return _LOADED[kind]
     module_name = f"washbench_plugin_{abs(hash(str(path.resolve())))}"
     try:
         mod_spec = importlib.util.spec_from_file_location(module_name, path)
@@ -163,6 +167,11 @@ def plugin_spec(kind: str) -> str | None:
     return _PLUGIN_SPECS.get(kind)
 
 
+def plugin_specs() -> tuple[str, ...]:
+    """Every plugin loaded from a file in this process, as ``FILE.py:NAME`` (for worker processes)."""
+    return tuple(_PLUGIN_SPECS.values())
+
+
 def get(kind: str, spec: str | None = None) -> Algorithm:
     """The Python algorithm ``kind`` (loading ``spec`` = ``FILE.py:NAME`` first if it is not loaded here)."""
     if kind in _LOADED:
@@ -199,5 +208,6 @@ __all__ = [
     "known_kinds",
     "load_plugin",
     "plugin_spec",
+    "plugin_specs",
     "python_kinds",
 ]

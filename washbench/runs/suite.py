@@ -181,9 +181,12 @@ def _run_one(
     aircraft_dirs: tuple[str, ...] = (),
     max_time_s: float | None = None,
     outputs: Outputs = DEFAULT_OUTPUTS,
+    plugins: tuple[str, ...] = (),
 ) -> list[Outcome]:
     """Worker: run one manoeuvre or JSBSim script (one outcome per run segment); never raises (failures
-    come back as an Outcome)."""
+    come back as an Outcome). ``plugins``: the washout plugins' ``FILE.py:NAME`` to load first (a worker process
+    has only what its parent loaded before it started)."""
+    from washbench.cueing import registry
     from washbench.flight.scripts import is_script
     from washbench.runs.pipeline import run_manoeuvre, run_script
 
@@ -191,6 +194,8 @@ def _run_one(
     params = Path(params_path) if params_path else None
     platform = Path(platform_path) if platform_path else None
     try:
+        for spec in plugins:
+            registry.load_plugin(spec)
         dirs = [Path(d) for d in aircraft_dirs]
         common = {"params_path": params, "platform_path": platform, "aircraft_dirs": dirs}
         common |= {"washouts": washouts, "variants": variants, "outputs": outputs}
@@ -271,7 +276,10 @@ def run_suite(
     params = str(params_path) if params_path else None
     platform = str(platform_path) if platform_path else None
     chosen = tuple(washouts) if washouts else None
-    args = [(str(f), str(out_dir), params, platform, chosen, tuple(variants), dirs, max_time_s, outputs)
+    from washbench.cueing import registry
+
+    plugins = registry.plugin_specs()
+    args = [(str(f), str(out_dir), params, platform, chosen, tuple(variants), dirs, max_time_s, outputs, plugins)
             for f in files]
     outcomes: dict[str, list[Outcome]] = {}
     start = time.perf_counter()
