@@ -184,7 +184,7 @@ class LatencyStats:
     jitter_n: int = 0
     jitter_max_s: float = 0.0
     _arrival: float | None = None
-    _t: float | None = None
+    _interval: float | None = None
 
     def add(self, latency_ns: int, dt_s: float | None) -> None:
         """One command sent ``latency_ns`` after its datagram arrived."""
@@ -198,14 +198,20 @@ class LatencyStats:
         if dt_s and latency_ns > dt_s * 1e9:
             self.late += 1
 
-    def arrival(self, arrival_s: float, t_s: float, new_segment: bool) -> None:
-        """A sample's arrival time (local clock) and source time: jitter = |arrival step - source step|."""
-        if not new_segment and self._arrival is not None and self._t is not None:
-            j = abs((arrival_s - self._arrival) - (t_s - self._t))
-            self.jitter_sum_s += j
-            self.jitter_n += 1
-            self.jitter_max_s = max(self.jitter_max_s, j)
-        self._arrival, self._t = arrival_s, t_s
+    def arrival(self, arrival_s: float, new_segment: bool) -> None:
+        """A sample's arrival time (local clock, s): jitter is the change between consecutive arrival intervals,
+        |(a_k - a_k-1) - (a_k-1 - a_k-2)| (the inter-packet delay variation of RFC 5481), whatever the rate."""
+        if new_segment:
+            self._arrival = self._interval = None
+        elif self._arrival is not None:
+            interval = arrival_s - self._arrival
+            if self._interval is not None:
+                j = abs(interval - self._interval)
+                self.jitter_sum_s += j
+                self.jitter_n += 1
+                self.jitter_max_s = max(self.jitter_max_s, j)
+            self._interval = interval
+        self._arrival = arrival_s
 
     def percentile_ms(self, q: float) -> float | None:
         """The ``q``-th percentile (0..100) of the latency [ms], to the microsecond; None with no commands."""

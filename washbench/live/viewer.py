@@ -1,0 +1,112 @@
+"""The rerun viewer during ``washbench live``: the recording's layout, filled as the samples come.
+
+The viewer is the rerun executable :func:`washbench.review.replay.find_rerun` finds, started as a child process
+(it ends with washbench) and fed over gRPC on a free local port. Shown, on the recording's timeline ``time``
+(:data:`washbench.review.rerun_log.TIMELINE`) and entity paths: ``/raw/<dof>`` (the aircraft pilot's and each
+simulator pilot's specific force and angular velocity, one scalar per source) and ``/platform/<washout>/position/
+axes``, at most :data:`RATE_HZ` rows a second (the viewer is for the eye; every sample is in the result folder).
+
+Without a display (no ``DISPLAY`` / ``WAYLAND_DISPLAY`` on Linux, a remote shell) the viewer is off with one line;
+a viewer closed while running is noticed (its process ended) and logging stops, the session goes on.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import socket
+import subprocess
+import sys
+import time
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from washbench.cueing.kernel import O_HEAD_F, O_HEAD_OMEGA, O_POS
+
+RATE_HZ = 30.0
+
+
+def _free_port() -> int:
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        s.bind(("127.0.0.1", 0))
+        return int(s.getsockname()[1])
+
+
+class LiveViewer:
+    """A running viewer and the recording stream that feeds it."""
+
+    def __init__(self, names: Sequence[str], proc: subprocess.Popen[bytes], rec: Any) -> None:
+        self.names, self.proc, self.rec = tuple(names), proc, rec
+        self.closed = False
+        self._next = 0.0
+        self._every = 1.0 / RATE_HZ
+
+    def show(self, sample: tuple[float, ...], rows: np.ndarray | None) -> None:
+        """Log the sample (and the washouts' rows) if 1/RATE_HZ has passed since the last one shown."""
+        now = time.monotonic()
+        if self.closed or rows is None or now < self._next:
+            return
+        self._next = now + self._every
+        import rerun as rr
+
+        from washbench.review.rerun_log import DOFS, TIMELINE, platform_path, raw_path
+
+        rec = self.rec
+        try:
+            rec.set_time(TIMELINE, duration=float(sample[0]))
+            for dof, sig, axis, _unit in DOFS:
+                if sig == "f":
+                    values = [sample[1 + axis], *(rows[i, O_HEAD_F + axis] for i in range(len(self.names)))]
+                else:
+                    values = [sample[4 + axis], *(np.degrees(rows[i, O_HEAD_OMEGA + axis]) for i in range(len(self.names)))]
+                rec.log(raw_path(dof), rr.Scalars(np.asarray(values, dtype=np.float64)))
+            for i, name in enumerate(self.names):
+                rec.log(platform_path(name, "position"), rr.Scalars(rows[i, O_POS : O_POS + 3]))
+        except Exception:  # noqa: BLE001 (a viewer problem must never stop the session)
+            self.closed = True
+
+    def closed_now(self) -> bool:
+        """True once, when the viewer's process has ended (the user closed it)."""
+        if not self.closed and self.proc.poll() is not None:
+            self.closed = True
+            print("live: the viewer was closed; the session goes on (the result folder has the recording)",
+                  file=sys.stderr)  # fmt: skip
+            with contextlib.suppress(Exception):
+                self.rec.disconnect()
+            return True
+        return False
+
+    def close(self) -> None:
+        with contextlib.suppress(Exception):
+            self.rec.flush()
+            self.rec.disconnect()
+
+
+def open_viewer(names: Sequence[str], limits: Any) -> LiveViewer | None:
+    """Start the viewer, or print one line and return None where it cannot open a window."""
+    from washbench.review.replay import _die_with_parent, _has_display, find_rerun
+
+    if not _has_display():
+        print("live: no display (DISPLAY / WAYLAND_DISPLAY unset): the live viewer is off; the result folder's "
+              "recording.rrd opens with `washbench replay` (--no-viewer silences this)", file=sys.stderr)  # fmt: skip
+        return None
+    try:
+        import rerun as rr
+
+        port = _free_port()
+        proc = subprocess.Popen(
+            [str(find_rerun()), "--port", str(port)],
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+            start_new_session=True,
+            preexec_fn=_die_with_parent if sys.platform.startswith("linux") else None,
+        )
+        rec = rr.RecordingStream("washbench-live")
+        time.sleep(0.5)
+        rec.connect_grpc(f"rerun+http://127.0.0.1:{port}/proxy")
+    except Exception as exc:  # noqa: BLE001
+        print(f"live: the viewer could not start ({exc}); the session goes on without it", file=sys.stderr)
+        return None
+    return LiveViewer(names, proc, rec)
