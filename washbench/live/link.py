@@ -23,6 +23,7 @@ jitter of the arrivals against the source's own clock.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections import deque
 from dataclasses import dataclass, field
@@ -163,7 +164,7 @@ class Link:
 
 def _median_step(pending: list[tuple[Sample, bool]]) -> float | None:
     """The median positive step between consecutive samples of one segment, or None if there is none."""
-    steps = [b[0][0] - a[0][0] for a, b in zip(pending, pending[1:], strict=False) if not b[1] and b[0][0] > a[0][0]]
+    steps = [b[0][0] - a[0][0] for a, b in itertools.pairwise(pending) if not b[1] and b[0][0] > a[0][0]]
     return float(np.median(steps)) if steps else None
 
 

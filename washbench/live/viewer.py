@@ -57,13 +57,14 @@ class LiveViewer:
             rec.set_time(TIMELINE, duration=float(sample[0]))
             for dof, sig, axis, _unit in DOFS:
                 if sig == "f":
-                    values = [sample[1 + axis], *(rows[i, O_HEAD_F + axis] for i in range(len(self.names)))]
+                    values = [sample[1 + axis], *rows[:, O_HEAD_F + axis]]
                 else:
-                    values = [sample[4 + axis], *(np.degrees(rows[i, O_HEAD_OMEGA + axis]) for i in range(len(self.names)))]
+                    head = rows[:, O_HEAD_OMEGA + axis]
+                    values = [sample[4 + axis], *np.degrees(head)]
                 rec.log(raw_path(dof), rr.Scalars(np.asarray(values, dtype=np.float64)))
             for i, name in enumerate(self.names):
                 rec.log(platform_path(name, "position"), rr.Scalars(rows[i, O_POS : O_POS + 3]))
-        except Exception:  # noqa: BLE001 (a viewer problem must never stop the session)
+        except Exception:  # a viewer problem must never stop the session
             self.closed = True
 
     def closed_now(self) -> bool:
@@ -106,7 +107,7 @@ def open_viewer(names: Sequence[str], limits: Any) -> LiveViewer | None:
         rec = rr.RecordingStream("washbench-live")
         time.sleep(0.5)
         rec.connect_grpc(f"rerun+http://127.0.0.1:{port}/proxy")
-    except Exception as exc:  # noqa: BLE001
+    except Exception as exc:
         print(f"live: the viewer could not start ({exc}); the session goes on without it", file=sys.stderr)
         return None
     return LiveViewer(names, proc, rec)

@@ -382,8 +382,9 @@ def _print_figures(fig: dict[str, Any]) -> None:
           f"duplicate {c['duplicate']}, reordered {c['reordered']}, restarts {c['restarts']}, foreign "
           f"{c['foreign']}, malformed {c['malformed']}")  # fmt: skip
     print(f"  commands {c['commands']} (sink sent {c['sink_sent']}, errors {c['sink_errors']}); latency median "
-          f"{ms(lat['latency_median_ms'])} ms, p99 {ms(lat['latency_p99_ms'])} ms, max {ms(lat['latency_max_ms'])} ms, "
-          f"late {lat['late']}; jitter mean {ms(lat['jitter_mean_ms'])} ms, max {ms(lat['jitter_max_ms'])} ms")  # fmt: skip
+          f"{ms(lat['latency_median_ms'])} ms, p99 {ms(lat['latency_p99_ms'])} ms, max "
+          f"{ms(lat['latency_max_ms'])} ms, late {lat['late']}; jitter mean {ms(lat['jitter_mean_ms'])} ms, "
+          f"max {ms(lat['jitter_max_ms'])} ms")  # fmt: skip
 
 
 def _auto_resample(path: Path) -> float | None:
@@ -450,9 +451,9 @@ def run_live(
         with output_lock(opts.out) as out:
             writer = InputWriter(out / INPUT_FILE)
             viewer = open_viewer(names, limits) if opts.viewer else None
+            to = f"udp://{opts.sink[0]}:{opts.sink[1]} ({opts.sink_format})" if opts.sink else "nowhere (no --sink)"
             print(f"live: listening on udp://{opts.listen[0]}:{opts.listen[1]} for {opts.fmt} packets; washouts "
-                  f"{', '.join(names)}; commands to {'udp://%s:%d' % opts.sink if opts.sink else 'nowhere (no --sink)'}"
-                  f" ({opts.sink_format})")  # fmt: skip
+                  f"{', '.join(names)}; commands to {to}")  # fmt: skip
             for note in dec.notes:
                 print(f"  {note}")
             sys.stdout.flush()

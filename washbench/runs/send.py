@@ -27,7 +27,6 @@ from washbench.live.packets import (
     ENCODERS,
     FORMATS,
     RREF_DATAREFS,
-    RREF_ID0,
     Sample,
     encode_jsbsim_labels,
     encode_rref,
