@@ -97,14 +97,14 @@ class Link:
             if t - last > MAX_JUMP_S:
                 c.time_jumps += 1
                 return []
-        elif t == last or t in self._seen:
-            c.duplicate += 1
-            return []
         elif last - t > reset_threshold_s(self.dt_s):
             c.restarts += 1
             new_segment = True
             self._recent.clear()
             self._seen.clear()
+        elif t == last or t in self._seen:
+            c.duplicate += 1
+            return []
         else:
             c.reordered += 1
             return []

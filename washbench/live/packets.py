@@ -299,13 +299,16 @@ class JsbsimDecoder(Decoder):
         self.rate_factor = 1.0
 
     def _labels(self, text: str) -> None:
-        names = [n.strip() for n in text.split(",")[1:]]
+        """Find the columns in ``<LABELS> ,Time,P,Q,R,...``. JSBSim prints a property by its last name with ``_``
+        as a space (``a-pilot-x-ft sec2``); full paths (``accelerations/a-pilot-x-ft_sec2``) are accepted too."""
+        raw = [n.strip() for n in text.split(",")[1:]]
+        short = [n.replace(" ", "_").rsplit("/", 1)[-1] for n in raw]
 
-        def find(prop: str) -> int | None:
-            for n in (prop, f"/fdm/jsbsim/{prop}"):
-                if n in names:
-                    return names.index(n)
-            return None
+        def find(name: str) -> int | None:
+            if name in raw:
+                return raw.index(name)
+            base = name.rsplit("/", 1)[-1]
+            return short.index(base) if "/" in name and base in short else None
 
         cols = [find("Time"), *(find(p) for p in JSBSIM_F)]
         for rates, factor in _RATES:
