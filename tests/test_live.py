@@ -554,3 +554,52 @@ def test_ctrl_c_and_sigterm_write_every_sample(tmp_path: Path) -> None:
         for *_, proc in runs:
             if proc.poll() is None:
                 proc.kill()
+
+
+@pytest.mark.parametrize("fmt", packets.FORMATS)
+def test_decoders_never_crash_on_garbage(fmt: str) -> None:
+    """Random datagrams, truncations and bit flips of real ones: a sample, nothing, or PacketError; never more."""
+    rng = np.random.default_rng(7)
+    dec = packets.decoder(fmt)
+    good = {
+        "washbench": packets.encode_washbench(0, motion(1)[0]),
+        "xplane": packets.encode_xplane(0, motion(1)[0]),
+        "xplane-rref": packets.encode_rref([(packets.RREF_ID0 + i, 1.0) for i in range(7)]),
+        "flightgear": packets.encode_flightgear(0, motion(1)[0]),
+        "jsbsim": packets.encode_jsbsim(0, motion(1)[0]),
+    }[fmt]
+    if fmt == "jsbsim":
+        dec.decode(packets.encode_jsbsim_labels())
+    datagrams = [rng.bytes(int(rng.integers(0, 300))) for _ in range(500)]
+    datagrams += [good[: int(rng.integers(0, len(good)))] for _ in range(200)]
+    for _ in range(500):
+        b = bytearray(good)
+        b[int(rng.integers(0, len(b)))] ^= 1 << int(rng.integers(0, 8))
+        datagrams.append(bytes(b))
+    kinds = {"sample": 0, "none": 0, "foreign": 0, "malformed": 0}
+    for d in datagrams:
+        try:
+            s = dec.decode(d)
+        except packets.PacketError as exc:
+            kinds[exc.kind] += 1
+            continue
+        kinds["sample" if s is not None else "none"] += 1
+        if s is not None:
+            assert len(s) == 7 and all(math.isfinite(v) for v in s)
+    assert kinds["foreign"] + kinds["malformed"] > 0
+
+
+def test_no_samples_before_the_duration_is_one_line_exit_2(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                          monkeypatch: pytest.MonkeyPatch) -> None:  # fmt: skip
+    """--duration stops a session; with nothing received it says so (exit 2) and leaves no folder; the viewer,
+    asked for without a display, is off with one line."""
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    port = free_udp_port()
+    status = main(["live", "--listen", f"127.0.0.1:{port}", "--format", "jsbsim", "--out", str(tmp_path / "o"),
+                   "--duration", "0.3"])  # fmt: skip
+    err = capsys.readouterr().err.strip().splitlines()
+    assert status == 2
+    assert any("no display" in line and "viewer is off" in line for line in err)
+    assert "0 sample(s) received (--duration 0.3 s): nothing to cue" in err[-1]
+    assert not (tmp_path / "o").exists()
