@@ -35,21 +35,27 @@ FLAG_NEW_SEGMENT = 2
 SINK_FORMATS = ("binary", "json")
 
 
+_IDX = np.r_[O_POS : O_POS + 3, O_VEL : O_VEL + 3, O_Q : O_Q + 4, O_OMEGA : O_OMEGA + 3]
+_BITS = 1 << np.arange(len(SAT_KINDS))
+
+
+def _fields_all(rows: np.ndarray) -> tuple[list[list[float]], list[int]]:
+    """Per washout: the 13 command values (pos, vel, q, omega) and the saturation bit mask."""
+    bits = ((rows[:, O_SAT : O_SAT + len(SAT_KINDS)] != 0.0) @ _BITS).tolist()
+    return rows[:, _IDX].tolist(), bits
+
+
 def _fields(row: np.ndarray) -> tuple[list[float], int]:
-    values = [*row[O_POS : O_POS + 3], *row[O_VEL : O_VEL + 3], *row[O_Q : O_Q + 4], *row[O_OMEGA : O_OMEGA + 3]]
-    bits = 0
-    for j in range(len(SAT_KINDS)):
-        if row[O_SAT + j] != 0.0:
-            bits |= 1 << j
-    return values, bits
+    values, bits = _fields_all(row[None, :])
+    return values[0], bits[0]
 
 
 def encode_binary(seq: int, t_s: float, flags: int, rows: np.ndarray) -> bytes:
     """The binary command of one sample: ``rows`` (n_washouts, N_FIELDS) from :meth:`CueingBank.step`."""
     parts = [HEADER.pack(MAGIC, VERSION, rows.shape[0], flags, seq & 0xFFFFFFFF, 0, t_s)]
-    for row in rows:
-        values, bits = _fields(row)
-        parts.append(WASHOUT.pack(*values, bits, 0))
+    values, bits = _fields_all(rows)
+    for v, b in zip(values, bits, strict=True):
+        parts.append(WASHOUT.pack(*v, b, 0))
     return b"".join(parts)
 
 

@@ -62,7 +62,7 @@ def check_sample(s: Sample) -> Sample:
     """``s`` if every value is finite and within the accepted magnitudes (a ``washbench cue`` input), else
     PacketError ``malformed`` (a corrupt packet must not stop the session, nor the result at its end)."""
     t, fx, fy, fz, wx, wy, wz = s
-    if not all(math.isfinite(v) for v in s):
+    if not math.isfinite(t + fx + fy + fz + wx + wy + wz):  # no finite sum overflows: the values are checked below
         raise PacketError("malformed", "non-finite value")
     if max(abs(fx), abs(fy), abs(fz)) > F_MAX_MPS2 or max(abs(wx), abs(wy), abs(wz)) > OMEGA_MAX_DEGPS:
         raise PacketError("malformed", "value beyond the accepted range")
