@@ -603,3 +603,18 @@ def test_no_samples_before_the_duration_is_one_line_exit_2(tmp_path: Path, capsy
     assert any("no display" in line and "viewer is off" in line for line in err)
     assert "0 sample(s) received (--duration 0.3 s): nothing to cue" in err[-1]
     assert not (tmp_path / "o").exists()
+
+
+def test_a_source_off_the_grid_is_resampled_as_washbench_cue_advises(tmp_path: Path) -> None:
+    """Frame stamps with 1 ms jitter (a simulator's frames): cued with the --resample washbench cue would advise."""
+    rng = np.random.default_rng(5)
+    m = [(s[0] + float(rng.uniform(-1e-3, 1e-3)), *s[1:]) for s in motion()]
+    port = free_udp_port()
+    th = in_thread(_send_samples(port, "washbench", m))
+    status, out = live(tmp_path, "washbench", port)
+    th.join(10)
+    assert status == 0
+    doc = run_json(out)
+    assert doc["live"]["resample_hz"] == 120.0 and any("resampled to 120 Hz" in n for n in doc["conversions"])
+    np.testing.assert_array_equal(saved(out)[:, 0], [s[0] for s in m])  # the stamps are saved as they came
+    assert_equals_cue(out, tmp_path)
