@@ -618,3 +618,43 @@ def test_a_source_off_the_grid_is_resampled_as_washbench_cue_advises(tmp_path: P
     assert doc["live"]["resample_hz"] == 120.0 and any("resampled to 120 Hz" in n for n in doc["conversions"])
     np.testing.assert_array_equal(saved(out)[:, 0], [s[0] for s in m])  # the stamps are saved as they came
     assert_equals_cue(out, tmp_path)
+
+
+def test_a_viewer_closed_while_running(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                       capsys: pytest.CaptureFixture[str]) -> None:  # fmt: skip
+    """The viewer's process ends mid-session (the user closed it): noticed once, logging stops, the session goes on.
+    The viewer is a short-lived process and a recording stream kept in memory (no display here)."""
+    import rerun as rr
+
+    from washbench.live import viewer as viewer_mod
+
+    made: list[viewer_mod.LiveViewer] = []
+
+    def fake_open(names: list[str], limits: object) -> viewer_mod.LiveViewer:
+        rec = rr.RecordingStream("washbench-live-test")
+        rec.memory_recording()
+        v = viewer_mod.LiveViewer(names, subprocess.Popen(["sleep", "0.3"]), rec)
+        made.append(v)
+        return v
+
+    monkeypatch.setattr(viewer_mod, "open_viewer", fake_open)
+    m = motion(360)
+    port = free_udp_port()
+
+    def go() -> None:  # 360 samples over about a second: the viewer closes after 0.3 s
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+            s.connect(("127.0.0.1", port))
+            wait_listening(s)
+            for k, smp in enumerate(m):
+                s.send(packets.encode_washbench(k, smp))
+                time.sleep(0.002)
+
+    th = in_thread(go)
+    opts = LiveOptions(listen=("127.0.0.1", port), fmt="washbench", out=tmp_path / "o", idle_timeout_s=0.6,
+                       viewer=True, recording=False, figures=False)  # fmt: skip
+    status = run_live(opts)
+    th.join(10)
+    assert status == 0 and made and made[0].closed
+    assert capsys.readouterr().err.count("the viewer was closed") == 1
+    doc = run_json(tmp_path / "o")
+    assert doc["live"]["viewer"] == "closed" and doc["live"]["counts"]["cued"] == 360

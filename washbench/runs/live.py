@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import contextlib
 import errno
+import gc
 import json
 import math
 import os
@@ -465,12 +466,15 @@ def run_live(
                 print(f"  {note}")
             sys.stdout.flush()
             session = Session(opts, dec, specs, limits, sock, writer, sink, viewer)
+            gc.collect()
+            gc.freeze()  # what exists now is never scanned again: shorter collector pauses in the loop
             with stop_on_signals() as got:
                 try:
                     session.run(got)
                 finally:
                     session.finish()
                     saved = writer.close()
+            gc.unfreeze()
             if session.viewer is not None:
                 session.viewer.close()
     finally:
