@@ -423,7 +423,7 @@ def test_port_in_use_is_one_line_exit_2(tmp_path: Path, capsys: pytest.CaptureFi
     assert status == 2 and len(err) == 1 and "already in use" in err[0] and f":{port}" in err[0]
     assert not (tmp_path / "o").exists()
     with pytest.raises(WashbenchError, match="--sink: port"):
-        from washbench.runs.live import parse_address
+        from washbench.live.endpoints import parse_address
 
         parse_address("udp://host:port", "--sink")
 

@@ -243,7 +243,8 @@ def _live_parsers(sub: Any) -> None:
 
 
 def _live(args: argparse.Namespace) -> int:
-    from washbench.runs.live import LiveOptions, parse_address, run_live
+    from washbench.live.endpoints import parse_address
+    from washbench.runs.live import LiveOptions, run_live
 
     if args.print_flightgear_protocol:
         from washbench.live.packets import flightgear_protocol
@@ -264,7 +265,7 @@ def _live(args: argparse.Namespace) -> int:
 
 
 def _send(args: argparse.Namespace) -> int:
-    from washbench.runs.live import parse_address
+    from washbench.live.endpoints import parse_address
     from washbench.runs.send import run_send
 
     to = parse_address(args.to, "--to") if args.to else None

@@ -17,11 +17,9 @@ under ``live``.
 from __future__ import annotations
 
 import contextlib
-import errno
 import gc
 import json
 import math
-import os
 import signal
 import socket
 import sys
@@ -36,56 +34,13 @@ import numpy as np
 
 from washbench.errors import WashbenchError
 from washbench.live import commands
+from washbench.live.endpoints import Sink, bind_udp
 from washbench.live.link import LatencyStats, Link, Out
 from washbench.live.packets import RREF_DATAREFS, RREF_ID0, Decoder, PacketError, decoder, rref_request
+from washbench.live.saved_input import INPUT_FILE, InputWriter
 
-INPUT_FILE = "live_input.csv"
-INPUT_COLUMNS = ("t_s", "f_x_mps2", "f_y_mps2", "f_z_mps2", "omega_x_degps", "omega_y_degps", "omega_z_degps")
-HELD_COLUMN = "live_held"
-RECV_BUFFER = 1 << 23
-"""Bytes of the receive buffer asked for (8 MiB: seconds of a 1 kHz source if the loop ever stalls)."""
 POLL_S = 0.05
 """The loop wakes up at least this often to check the stop conditions."""
-FLUSH_S = 0.25
-"""The saved input is flushed to the operating system at least this often (a killed session loses no more)."""
-
-
-def parse_address(text: str, option: str, default_host: str = "127.0.0.1") -> tuple[str, int]:
-    """``HOST:PORT``, ``udp://HOST:PORT`` or ``:PORT`` as (host, port); WashbenchError naming ``option``."""
-    s = text.strip()
-    if s.startswith("udp://"):
-        s = s[len("udp://") :]
-    elif "://" in s:
-        raise WashbenchError(f"{option}: only udp:// addresses are supported, got {text!r}")
-    host, sep, port = s.rpartition(":")
-    if not sep:
-        raise WashbenchError(f"{option}: expected HOST:PORT, got {text!r}")
-    host = host.strip("[]") or default_host
-    try:
-        number = int(port)
-    except ValueError:
-        raise WashbenchError(f"{option}: port {port!r} is not a number") from None
-    if not 0 < number < 65536:
-        raise WashbenchError(f"{option}: port {number} is outside 1..65535")
-    return host, number
-
-
-def bind_udp(address: tuple[str, int], option: str = "--listen") -> socket.socket:
-    """A UDP socket bound to ``address`` with a large receive buffer; one-line WashbenchError if it cannot be."""
-    sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-    try:
-        sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, RECV_BUFFER)
-        sock.bind(address)
-    except OSError as exc:
-        sock.close()
-        if exc.errno == errno.EADDRINUSE:
-            why = "the port is already in use (another program, or another washbench live, listens there)"
-        elif isinstance(exc, socket.gaierror):
-            why = f"unknown host ({exc.strerror})"
-        else:
-            why = exc.strerror or str(exc)
-        raise WashbenchError(f"{option} {address[0]}:{address[1]}: cannot listen: {why}") from None
-    return sock
 
 
 @dataclass(frozen=True)
@@ -107,99 +62,6 @@ class LiveOptions:
     recording: bool = True
     figures: bool = True
     filter_start: str = "steady"
-
-
-class InputWriter:
-    """``live_input.csv`` written as the samples come (a ``.part`` name until the session ends), one row per cued
-    sample with exact decimals (``repr``: read back to the same bits). A segment left with a single sample
-    (``washbench cue`` needs two) is cut off the file again."""
-
-    def __init__(self, path: Path) -> None:
-        self.path = path
-        self.part = path.with_name(path.name + ".part")
-        self._f = open(self.part, "wb")  # noqa: SIM115 (closed by close())
-        self._f.write((",".join((*INPUT_COLUMNS, HELD_COLUMN)) + "\n").encode("ascii"))
-        self.rows = 0
-        self.segments = 0
-        self.short_segments = 0
-        self._seg_start = self._f.tell()
-        self._seg_rows = 0
-        self._flushed = time.monotonic()
-
-    def row(self, s: tuple[float, ...], held: bool, new_segment: bool) -> None:
-        if new_segment:
-            self._end_segment()
-            self._seg_start = self._f.tell()
-        t, fx, fy, fz, wx, wy, wz = s
-        self._f.write(f"{t!r},{fx!r},{fy!r},{fz!r},{wx!r},{wy!r},{wz!r},{int(held)}\n".encode("ascii"))
-        self.rows += 1
-        self._seg_rows += 1
-
-    def tick(self) -> None:
-        """Flush to the operating system if :data:`FLUSH_S` has passed."""
-        now = time.monotonic()
-        if now - self._flushed > FLUSH_S:
-            self._f.flush()
-            self._flushed = now
-
-    def _end_segment(self) -> None:
-        if self._seg_rows == 1:
-            self._f.flush()
-            self._f.seek(self._seg_start)
-            self._f.truncate()
-            self.rows -= 1
-            self.short_segments += 1
-        elif self._seg_rows > 1:
-            self.segments += 1
-        self._seg_rows = 0
-
-    def close(self) -> Path:
-        """End the last segment, close and rename into place; return the final path."""
-        self._end_segment()
-        self._f.close()
-        os.replace(self.part, self.path)
-        return self.path
-
-
-class Sink:
-    """The platform command socket (connected UDP): a refused or failed send is counted, never fatal."""
-
-    def __init__(self, address: tuple[str, int] | None, fmt: str, names: Sequence[str]) -> None:
-        if fmt not in commands.SINK_FORMATS:
-            raise WashbenchError(f"--sink-format: expected one of {', '.join(commands.SINK_FORMATS)}, got {fmt!r}")
-        self.address, self.fmt, self.names = address, fmt, tuple(names)
-        self.sent = 0
-        self.errors = 0
-        self.seq = 0
-        self._sock: socket.socket | None = None
-        if address is not None:
-            sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-            try:
-                sock.connect(address)
-            except OSError as exc:
-                sock.close()
-                raise WashbenchError(f"--sink {address[0]}:{address[1]}: {exc.strerror or exc}") from None
-            sock.setblocking(False)
-            self._sock = sock
-
-    def send(self, t_s: float, flags: int, rows: np.ndarray) -> None:
-        seq = self.seq
-        self.seq += 1
-        if self._sock is None:
-            return
-        if self.fmt == "binary":
-            data = commands.encode_binary(seq, t_s, flags, rows)
-        else:
-            data = commands.encode_json(seq, t_s, flags, rows, self.names)
-        try:
-            self._sock.send(data)
-            self.sent += 1
-        except OSError:  # ECONNREFUSED (nobody listens: the ICMP answer of an earlier send), a full buffer, ...
-            self.errors += 1
-
-    def close(self) -> None:
-        if self._sock is not None:
-            self._sock.close()
 
 
 @contextlib.contextmanager
@@ -300,6 +162,7 @@ class Session:
             now = time.monotonic()
             if got_signal:
                 self.stop = "interrupted (Ctrl-C)" if got_signal[0] == signal.SIGINT else "terminated (SIGTERM)"
+                self.drain()
                 return
             if now >= deadline:
                 self.stop = f"--duration {opts.duration_s:g} s"
@@ -329,6 +192,19 @@ class Session:
             self.cpu1, self.last_done = time.process_time(), time.monotonic()
             if self.viewer is not None and self.viewer.closed_now():
                 self.viewer = None
+
+    def drain(self) -> None:
+        """Take the datagrams already waiting in the socket (received by the system before the stop)."""
+        self.sock.setblocking(False)
+        while True:
+            try:
+                data, _ = self.sock.recvfrom(65536)
+            except (BlockingIOError, InterruptedError):
+                return
+            except OSError:
+                self.socket_errors += 1
+                continue
+            self.receive(data, time.perf_counter_ns())
 
     def finish(self) -> None:
         """The samples still held back, cued; the RREF subscription cancelled."""
@@ -453,33 +329,29 @@ def run_live(
     dec = decoder(opts.fmt)
     CueingBank(specs, None, limits, 0.01, opts.filter_start).step(np.zeros(3), np.zeros(3))  # compiled before listening
     sink = Sink(opts.sink, opts.sink_format, names)
-    sock = bind_udp(opts.listen)
     t_wall = time.perf_counter()
-    try:
-        with output_lock(opts.out) as out:
-            writer = InputWriter(out / INPUT_FILE)
-            viewer = open_viewer(names, limits) if opts.viewer else None
-            to = f"udp://{opts.sink[0]}:{opts.sink[1]} ({opts.sink_format})" if opts.sink else "nowhere (no --sink)"
-            print(f"live: listening on udp://{opts.listen[0]}:{opts.listen[1]} for {opts.fmt} packets; washouts "
-                  f"{', '.join(names)}; commands to {to}")  # fmt: skip
-            for note in dec.notes:
-                print(f"  {note}")
-            sys.stdout.flush()
-            session = Session(opts, dec, specs, limits, sock, writer, sink, viewer)
-            gc.collect()
-            gc.freeze()  # what exists now is never scanned again: shorter collector pauses in the loop
-            with stop_on_signals() as got:
-                try:
-                    session.run(got)
-                finally:
-                    session.finish()
-                    saved = writer.close()
+    # a Ctrl-C or SIGTERM from the moment the port is bound only stops the loop: the result is written first
+    with stop_on_signals() as got, contextlib.closing(sink), contextlib.closing(bind_udp(opts.listen)) as sock, \
+            output_lock(opts.out) as out:  # fmt: skip
+        writer = InputWriter(out / INPUT_FILE)
+        viewer = open_viewer(names, limits) if opts.viewer else None
+        to = f"udp://{opts.sink[0]}:{opts.sink[1]} ({opts.sink_format})" if opts.sink else "nowhere (no --sink)"
+        print(f"live: listening on udp://{opts.listen[0]}:{opts.listen[1]} for {opts.fmt} packets; washouts "
+              f"{', '.join(names)}; commands to {to}")  # fmt: skip
+        for note in dec.notes:
+            print(f"  {note}")
+        sys.stdout.flush()
+        session = Session(opts, dec, specs, limits, sock, writer, sink, viewer)
+        gc.collect()
+        gc.freeze()  # what exists now is never scanned again: shorter collector pauses in the loop
+        try:
+            session.run(got)
+        finally:
             gc.unfreeze()
+            session.finish()
+            saved = writer.close()
             if session.viewer is not None:
                 session.viewer.close()
-    finally:
-        sock.close()
-        sink.close()
     fig = session.figures()
     fig["wall_s"] = round(time.perf_counter() - t_wall, 3)
     _print_figures(fig)

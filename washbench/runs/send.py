@@ -89,7 +89,7 @@ class Sender:
         self.subscribers: dict[tuple[str, int], dict[int, int]] = {}  # address -> {id: dataref index}
         self.had_subscriber = False
         if fmt == "xplane-rref":
-            from washbench.runs.live import bind_udp
+            from washbench.live.endpoints import bind_udp
 
             self.sock = bind_udp(listen or ("127.0.0.1", 49000), "--listen")
             self.sock.setblocking(False)
