@@ -658,3 +658,23 @@ def test_a_viewer_closed_while_running(tmp_path: Path, monkeypatch: pytest.Monke
     assert capsys.readouterr().err.count("the viewer was closed") == 1
     doc = run_json(tmp_path / "o")
     assert doc["live"]["viewer"] == "closed" and doc["live"]["counts"]["cued"] == 360
+
+
+def test_send_plays_xplane_for_rref(tmp_path: Path) -> None:
+    """``washbench send --format xplane-rref`` answers washbench live's subscription as X-Plane would."""
+    m = motion(240)
+    src = tmp_path / "in.csv"
+    src.write_text("t_s,f_x_mps2,f_y_mps2,f_z_mps2,omega_x_degps,omega_y_degps,omega_z_degps\n"
+                   + "".join(",".join(repr(v) for v in r) + "\n" for r in m))  # fmt: skip
+    port, xport = free_udp_port(), free_udp_port()
+    from washbench.runs.send import run_send
+
+    th = in_thread(lambda: run_send("xplane-rref", None, src, speed=8.0, listen=("127.0.0.1", xport)))
+    time.sleep(0.5)  # the sender binds X-Plane's port (live subscribes again every 2 s until answered)
+    status, out = live(tmp_path, "xplane-rref", port, xplane=("127.0.0.1", xport))
+    th.join(10)
+    assert status == 0
+    c = run_json(out)["live"]["counts"]
+    assert c["cued"] == 240 and c["foreign"] == 0
+    np.testing.assert_allclose(saved(out), np.array(m), rtol=2e-7, atol=4e-6)
+    assert not th.is_alive()  # the sender stopped when live cancelled its subscriptions

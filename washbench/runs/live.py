@@ -338,6 +338,8 @@ def run_live(
         to = f"udp://{opts.sink[0]}:{opts.sink[1]} ({opts.sink_format})" if opts.sink else "nowhere (no --sink)"
         print(f"live: listening on udp://{opts.listen[0]}:{opts.listen[1]} for {opts.fmt} packets; washouts "
               f"{', '.join(names)}; commands to {to}")  # fmt: skip
+        rcvbuf = sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF)
+        print(f"  receive buffer {rcvbuf // 1024} KiB (raise net.core.rmem_max for more)")
         for note in dec.notes:
             print(f"  {note}")
         sys.stdout.flush()
