@@ -210,7 +210,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _live_parsers(sub: Any) -> None:
     """``washbench live`` and ``washbench send`` (docs/live.md)."""
-    from washbench.live.packets import FORMATS
+    from washbench.live import FORMATS
 
     p = sub.add_parser("live", help="run the washouts live on a flight simulator's UDP output; drive a platform")
     p.add_argument("--listen", metavar="HOST:PORT", help="where to receive the simulator's datagrams")

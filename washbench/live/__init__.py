@@ -5,3 +5,7 @@ again for ``washbench send``), :mod:`~washbench.live.link` (a real link's faults
 restarts; latency figures), :mod:`~washbench.live.commands` (the platform command packet sent out).
 The commands themselves are in :mod:`washbench.runs.live` and :mod:`washbench.runs.send`.
 """
+
+FORMATS = ("washbench", "xplane", "xplane-rref", "flightgear", "jsbsim")
+"""The source formats of ``washbench live --format`` and ``washbench send --format`` (:mod:`washbench.live.packets`);
+here, so the command line lists them without importing the codecs."""

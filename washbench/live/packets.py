@@ -39,8 +39,7 @@ from importlib import resources
 from washbench.io.jsbsim_csv import JSBSIM_F
 from washbench.io.results import F_MAX_MPS2, OMEGA_MAX_DEGPS
 from washbench.io.units import FT_M, G0_MPS2
-
-FORMATS = ("washbench", "xplane", "xplane-rref", "flightgear", "jsbsim")
+from washbench.live import FORMATS  # noqa: F401 (re-exported: the codecs' formats)
 
 Sample = tuple[float, float, float, float, float, float, float]
 """(t_s, f_x_mps2, f_y_mps2, f_z_mps2, omega_x_degps, omega_y_degps, omega_z_degps), body axes frd."""
