@@ -623,17 +623,20 @@ def test_a_source_off_the_grid_is_resampled_as_washbench_cue_advises(tmp_path: P
 def test_a_viewer_closed_while_running(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
                                        capsys: pytest.CaptureFixture[str]) -> None:  # fmt: skip
     """The viewer's process ends mid-session (the user closed it): noticed once, logging stops, the session goes on.
-    The viewer is a short-lived process and a recording stream kept in memory (no display here)."""
+    The viewer is a short-lived process and a recording stream written to a file (no display here)."""
     import rerun as rr
 
     from washbench.live import viewer as viewer_mod
 
     made: list[viewer_mod.LiveViewer] = []
 
+    rrd = tmp_path / "viewer.rrd"
+
     def fake_open(names: list[str], limits: object) -> viewer_mod.LiveViewer:
         rec = rr.RecordingStream("washbench-live-test")
-        rec.memory_recording()
-        v = viewer_mod.LiveViewer(names, subprocess.Popen(["sleep", "0.3"]), rec)
+        rec.save(rrd)  # a file instead of a viewer's gRPC port: what the viewer would have got
+        rec.send_blueprint(viewer_mod.live_blueprint(names))
+        v = viewer_mod.LiveViewer(names, subprocess.Popen(["sleep", "60"]), rec)
         made.append(v)
         return v
 
@@ -641,13 +644,15 @@ def test_a_viewer_closed_while_running(tmp_path: Path, monkeypatch: pytest.Monke
     m = motion(360)
     port = free_udp_port()
 
-    def go() -> None:  # 360 samples over about a second: the viewer closes after 0.3 s
+    def go() -> None:  # 360 samples over about a second: the user closes the viewer half-way
         with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
             s.connect(("127.0.0.1", port))
             wait_listening(s)
             for k, smp in enumerate(m):
                 s.send(packets.encode_washbench(k, smp))
-                time.sleep(0.002)
+                time.sleep(0.003)
+                if k == 180:
+                    made[0].proc.kill()
 
     th = in_thread(go)
     opts = LiveOptions(listen=("127.0.0.1", port), fmt="washbench", out=tmp_path / "o", idle_timeout_s=0.6,
@@ -658,6 +663,17 @@ def test_a_viewer_closed_while_running(tmp_path: Path, monkeypatch: pytest.Monke
     assert capsys.readouterr().err.count("the viewer was closed") == 1
     doc = run_json(tmp_path / "o")
     assert doc["live"]["viewer"] == "closed" and doc["live"]["counts"]["cued"] == 360
+    # what the viewer got before it closed: the recording's entity paths, the aircraft first, the sample's values
+    from washbench.review.rerun_log import read_scalar_series
+
+    series = read_scalar_series(rrd)
+    t, surge = series["/raw/surge"]
+    assert 1 <= len(t) < 180 and surge.shape == (len(t), 4)  # at most 30 rows a second, none after the close
+    assert t[-1] <= m[180][0]
+    by_t = {round(s[0], 9): s for s in m}
+    for ti, row in zip(t, surge, strict=True):
+        assert row[0] == by_t[round(ti, 9)][1]  # the aircraft pilot's f_x at that time
+    assert "/platform/small-angle/position/axes" in series
 
 
 def test_send_plays_xplane_for_rref(tmp_path: Path) -> None:

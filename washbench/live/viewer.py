@@ -33,6 +33,43 @@ def _free_port() -> int:
         return int(s.getsockname()[1])
 
 
+WINDOW_S = 20.0
+"""The plots scroll: they show the last this-many seconds before the time cursor."""
+
+
+def live_blueprint(names: Sequence[str]) -> Any:
+    """The live layout: the six motion panels of the recording's raw-motion tab (aircraft pilot and each simulator
+    pilot, the recording's colours and names) and each platform's position, all scrolling with the time cursor."""
+    import rerun.blueprint as rrb
+
+    from washbench.review.rerun_log import DOFS, TIMELINE, platform_path, raw_path
+
+    window = rrb.VisibleTimeRange(TIMELINE, start=rrb.TimeRangeBoundary.cursor_relative(seconds=-WINDOW_S),
+                                  end=rrb.TimeRangeBoundary.cursor_relative())  # fmt: skip
+    motion = [rrb.TimeSeriesView(origin=raw_path(dof), name=f"{dof} ({unit})", time_ranges=[window])
+              for dof, _, _, unit in DOFS]  # fmt: skip
+    platforms = [rrb.TimeSeriesView(origin=platform_path(w, "position"), name=f"{w}: stage position (m)",
+                                    time_ranges=[window]) for w in names]  # fmt: skip
+    return rrb.Blueprint(rrb.Horizontal(rrb.Grid(*motion), rrb.Vertical(*platforms), column_shares=[3, 1]),
+                         collapse_panels=True)  # fmt: skip
+
+
+def send_styles(rec: Any, names: Sequence[str]) -> None:
+    """The series' names, colours and widths, as in a recording (static)."""
+    import rerun as rr
+
+    from washbench.review.blueprint import AIRCRAFT_WIDTH, AXIS_COLORS, WASHOUT_WIDTH, source_colors
+    from washbench.review.rerun_log import AIRCRAFT, DOFS, platform_path, raw_path
+
+    style = rr.SeriesLines(colors=source_colors(list(names)), names=[AIRCRAFT, *names],
+                           widths=[AIRCRAFT_WIDTH] + [WASHOUT_WIDTH] * len(names))  # fmt: skip
+    for dof, *_ in DOFS:
+        rec.log(raw_path(dof), style, static=True)
+    for w in names:
+        rec.log(platform_path(w, "position"), rr.SeriesLines(colors=list(AXIS_COLORS), names=["x", "y", "z"]),
+                static=True)  # fmt: skip
+
+
 class LiveViewer:
     """A running viewer and the recording stream that feeds it."""
 
@@ -41,6 +78,7 @@ class LiveViewer:
         self.closed = False
         self._next = 0.0
         self._every = 1.0 / RATE_HZ
+        send_styles(rec, self.names)
 
     def show(self, sample: tuple[float, ...], rows: np.ndarray | None) -> None:
         """Log the sample (and the washouts' rows) if 1/RATE_HZ has passed since the last one shown."""
@@ -107,6 +145,7 @@ def open_viewer(names: Sequence[str], limits: Any) -> LiveViewer | None:
         rec = rr.RecordingStream("washbench-live")
         time.sleep(0.5)
         rec.connect_grpc(f"rerun+http://127.0.0.1:{port}/proxy")
+        rec.send_blueprint(live_blueprint(names))
     except Exception as exc:
         print(f"live: the viewer could not start ({exc}); the session goes on without it", file=sys.stderr)
         return None
