@@ -123,6 +123,8 @@ class Session:
         flags = (commands.FLAG_HELD if o.held else 0) | (commands.FLAG_NEW_SEGMENT if o.new_segment else 0)
         self.sink.send(s[0], flags, rows)
         self.writer.row(s, o.held, o.new_segment)  # after the command: not on the latency path
+        if self.viewer is not None:
+            self.viewer.add(s, rows, self.link.dt_s, o.new_segment)
 
     def receive(self, data: bytes, arrival_ns: int) -> None:
         try:
@@ -144,8 +146,6 @@ class Session:
             if not last.held:
                 self.latency.add(done - arrival_ns, self.link.dt_s)
             self.latency.arrival(arrival_ns * 1e-9, last.new_segment)
-            if self.viewer is not None:
-                self.viewer.show(last.sample, self.rows)
 
     def run(self, got_signal: list[int]) -> None:
         """Receive until a stop condition; ``stop`` says which."""
@@ -334,7 +334,7 @@ def run_live(
     with stop_on_signals() as got, contextlib.closing(sink), contextlib.closing(bind_udp(opts.listen)) as sock, \
             output_lock(opts.out) as out:  # fmt: skip
         writer = InputWriter(out / INPUT_FILE)
-        viewer = open_viewer(names, limits) if opts.viewer else None
+        viewer = open_viewer(names, limits, opts.filter_start) if opts.viewer else None
         to = f"udp://{opts.sink[0]}:{opts.sink[1]} ({opts.sink_format})" if opts.sink else "nowhere (no --sink)"
         print(f"live: listening on udp://{opts.listen[0]}:{opts.listen[1]} for {opts.fmt} packets; washouts "
               f"{', '.join(names)}; commands to {to}")  # fmt: skip
