@@ -67,13 +67,19 @@ class Pacer:
 
 
 def file_samples(path: Path) -> Iterator[Sample]:
-    """The samples of a ``washbench cue`` input, in washbench units and axes, as the file orders them."""
+    """The samples of a ``washbench cue`` input, in washbench units and axes, as the file orders them (the file is
+    read and checked now; the rows are made tuples a block at a time)."""
     from washbench.io.readers import read_samples
 
     s = read_samples(path)
-    rows = np.column_stack([s.t_s, s.f_mps2, s.omega_degps]).tolist()
-    for r in rows:
-        yield tuple(r)  # type: ignore[misc]
+    table = np.column_stack([s.t_s, s.f_mps2, s.omega_degps])
+
+    def rows() -> Iterator[Sample]:
+        for a in range(0, table.shape[0], 4096):
+            for r in table[a : a + 4096].tolist():
+                yield tuple(r)  # type: ignore[misc]
+
+    return rows()
 
 
 class Sender:
