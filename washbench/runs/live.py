@@ -245,8 +245,9 @@ class Session:
                 "sink_errors": self.sink.errors,
             },
             "latency": self.latency.summary(),
-            "active_wall_s": round(self.last_done - self.first_arrival, 3) if self.last_done is not None and
-            self.first_arrival is not None else 0.0,  # from the first datagram to the last one handled
+            "active_wall_s": round(self.last_done - self.first_arrival, 3)
+            if self.last_done is not None and self.first_arrival is not None
+            else 0.0,  # from the first datagram to the last one handled
             "active_cpu_s": round(self.cpu1 - self.cpu0, 3),  # CPU time of this process over that span
             "sink": None if self.opts.sink is None else f"udp://{self.opts.sink[0]}:{self.opts.sink[1]}",
             "sink_format": self.opts.sink_format,
