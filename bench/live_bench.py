@@ -67,7 +67,7 @@ def free_port() -> int:
         return int(s.getsockname()[1])
 
 
-def one_rate(rate_hz: float, minutes: float, speed: float, washouts: list[str], folder: Path) -> dict:
+def one_rate(rate_hz: float, minutes: float, speed: float, washouts: list[str], folder: Path, realtime: bool) -> dict:
     dt = 1.0 / rate_hz
     n = round(minutes * 60.0 * rate_hz) + 1
     rows = flight(n, dt).tolist()
@@ -94,6 +94,8 @@ def one_rate(rate_hz: float, minutes: float, speed: float, washouts: list[str], 
            "--rate-hz", f"{rate_hz:g}", "--sink", f"udp://127.0.0.1:{sink.getsockname()[1]}"]  # fmt: skip
     for w in washouts:
         cmd += ["--washout", w]
+    if realtime:
+        cmd.append("--realtime")
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     rss: list[int] = []
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
@@ -134,13 +136,15 @@ def main() -> None:
     ap.add_argument("--speed", type=float, default=1.0, help="times real time (1: as a simulator sends)")
     ap.add_argument("--washout", action="append", default=[], help="default: the three classical washouts")
     ap.add_argument("--quick", action="store_true", help="1 minute at each rate")
+    ap.add_argument("--realtime", action="store_true", help="washbench live --realtime (SCHED_FIFO; needs root)")
     args = ap.parse_args()
     minutes = 1.0 if args.quick else args.minutes
     print(f"washbench live: {minutes:g} min at {', '.join(f'{r:g}' for r in args.rates)} Hz, "
-          f"{args.speed:g} x real time, loopback, {os.cpu_count()} cores")  # fmt: skip
+          f"{args.speed:g} x real time, loopback, {os.cpu_count()} cores, load average "
+          f"{os.getloadavg()[0]:.1f}{', --realtime' if args.realtime else ''}")  # fmt: skip
     with tempfile.TemporaryDirectory() as tmp:
         for rate in args.rates:
-            r = one_rate(rate, minutes, args.speed, args.washout, Path(tmp))
+            r = one_rate(rate, minutes, args.speed, args.washout, Path(tmp), args.realtime)
             live, c, lat = r["live"], r["live"]["counts"], r["live"]["latency"]
             fdm = c172p_in_air(dt_s=1.0 / rate)
             jsb = min(run_cpu_s(fdm, r["n"]) for _ in range(1))

@@ -225,6 +225,7 @@ def _live_parsers(sub: Any) -> None:
     p.add_argument("--xplane", metavar="HOST:PORT", default="127.0.0.1:49000", help="X-Plane's address for RREF")
     p.add_argument("--rref-hz", type=int, default=60, metavar="HZ", help="RREF subscription rate (default 60)")
     p.add_argument("--no-viewer", action="store_true", help="no live rerun viewer")
+    p.add_argument("--realtime", action="store_true", help="SCHED_FIFO priority while receiving (root/CAP_SYS_NICE)")
     p.add_argument("--filter-start", choices=("steady", "rest"), default="steady", help="filters' start state")
     p.add_argument("--print-flightgear-protocol", action="store_true", help="print FlightGear's protocol file, exit")
     _washout_options(p)
@@ -260,6 +261,7 @@ def _live(args: argparse.Namespace) -> int:
         duration_s=args.duration, idle_timeout_s=args.idle_timeout, rate_hz=args.rate_hz, resample_hz=args.resample,
         xplane=parse_address(args.xplane, "--xplane"), rref_hz=args.rref_hz, viewer=not args.no_viewer,
         recording=not args.no_recording, figures=not args.no_figures, filter_start=args.filter_start,
+        realtime=args.realtime,
     )  # fmt: skip
     return run_live(opts, args.washout, args.params, args.platform, args.variant)
 

@@ -20,6 +20,7 @@ import contextlib
 import gc
 import json
 import math
+import os
 import signal
 import socket
 import sys
@@ -62,6 +63,7 @@ class LiveOptions:
     recording: bool = True
     figures: bool = True
     filter_start: str = "steady"
+    realtime: bool = False
 
 
 @contextlib.contextmanager
@@ -256,6 +258,25 @@ class Session:
         }
 
 
+REALTIME_PRIORITY = 50
+"""``--realtime``: SCHED_FIFO at this priority (of 1..99; the kernel's own threads run at 50 too)."""
+
+
+def realtime_priority() -> tuple[int, os.sched_param] | None:
+    """Put this process at the real-time priority :data:`REALTIME_PRIORITY` (Linux SCHED_FIFO; needs root or
+    CAP_SYS_NICE); returns the policy and parameter to restore, or None with one line if it cannot."""
+    try:
+        before = (os.sched_getscheduler(0), os.sched_getparam(0))
+        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(REALTIME_PRIORITY))
+    except (AttributeError, OSError) as exc:
+        why = getattr(exc, "strerror", None) or "not supported here"
+        print(f"live: --realtime: cannot take a real-time priority ({why}); running at the ordinary one",
+              file=sys.stderr)  # fmt: skip
+        return None
+    print(f"  real-time priority: SCHED_FIFO {REALTIME_PRIORITY} while receiving")
+    return before
+
+
 def _print_figures(fig: dict[str, Any]) -> None:
     c, lat = fig["counts"], fig["latency"]
 
@@ -347,9 +368,12 @@ def run_live(
         session = Session(opts, dec, specs, limits, sock, writer, sink, viewer)
         gc.collect()
         gc.freeze()  # what exists now is never scanned again: shorter collector pauses in the loop
+        before = realtime_priority() if opts.realtime else None
         try:
             session.run(got)
         finally:
+            if before is not None:
+                os.sched_setscheduler(0, *before)  # the final cue runs at the ordinary priority again
             gc.unfreeze()
             session.finish()
             saved = writer.close()
