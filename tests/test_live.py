@@ -534,6 +534,8 @@ def test_ctrl_c_and_sigterm_write_every_sample(tmp_path: Path) -> None:
         port, out = free_udp_port(), tmp_path / f"live{int(sig)}"
         cmd = [sys.executable, "-m", "washbench", "live", "--listen", f"127.0.0.1:{port}", "--format", "washbench",
                "--out", str(out), "--no-viewer", "--no-recording", "--no-figures"]  # fmt: skip
+        if sig == signal.SIGTERM:
+            cmd.append("--realtime")  # taken (as root) or refused in one line: the session is the same
         proc = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         runs.append((sig, port, out, proc))
     try:
@@ -543,7 +545,9 @@ def test_ctrl_c_and_sigterm_write_every_sample(tmp_path: Path) -> None:
         for sig, _, _, proc in runs:
             proc.send_signal(sig)
         for sig, _, out, proc in runs:
-            _, stderr = proc.communicate(timeout=60)
+            stdout, stderr = proc.communicate(timeout=60)
+            if sig == signal.SIGTERM:
+                assert ("real-time priority: SCHED_FIFO" in stdout) != ("cannot take a real-time priority" in stderr)
             assert proc.returncode == (130 if sig == signal.SIGINT else 143), stderr
             assert "holds every sample received" in stderr
             doc = run_json(out)

@@ -344,6 +344,8 @@ def run_live(
                         ("--rate-hz", opts.rate_hz), ("--resample", opts.resample_hz)):  # fmt: skip
         if value is not None and not (math.isfinite(value) and value > 0.0):
             raise WashbenchError(f"{flag}: expected a positive number, got {value:g}")
+    if not 0 < opts.rref_hz <= 10000:
+        raise WashbenchError(f"--rref-hz: expected 1..10000 Hz, got {opts.rref_hz}")
     specs = select_washouts(washouts, variants, params_path)
     names = [w.name for w in specs]
     check_filter_start(opts.filter_start)
