@@ -217,7 +217,75 @@ def build_parser() -> argparse.ArgumentParser:
         "recording", type=Path, nargs="+", help=".rrd file(s) from washbench run or suite: one, or two to compare"
     )
     p.add_argument("--web", action="store_true", help="always use the web viewer")
+    _live_parsers(sub)
     return parser
+
+
+def _live_parsers(sub: Any) -> None:
+    """``washbench live`` and ``washbench send`` (docs/live.md)."""
+    from washbench.live import FORMATS
+
+    p = sub.add_parser("live", help="run the washouts live on a flight simulator's UDP output; drive a platform")
+    p.add_argument("--listen", metavar="HOST:PORT", help="where to receive the simulator's datagrams")
+    p.add_argument("--format", choices=FORMATS, help="what the simulator sends (docs/live.md)")
+    p.add_argument("--out", type=Path, help="output folder: the result folder of washbench cue on the saved input")
+    p.add_argument("--sink", metavar="udp://HOST:PORT", help="send the platform commands there (default: nowhere)")
+    p.add_argument("--sink-format", choices=("binary", "json"), default="binary", help="command packets (docs/live.md)")
+    p.add_argument("--duration", type=float, metavar="S", help="stop after S seconds")
+    p.add_argument("--idle-timeout", type=float, metavar="S", help="stop when the source is quiet for S seconds")
+    p.add_argument("--rate-hz", type=float, metavar="HZ", help="the source's rate (default: measured)")
+    p.add_argument("--resample", type=float, metavar="HZ", help="cue the saved input at HZ (default: only if needed)")
+    p.add_argument("--xplane", metavar="HOST:PORT", default="127.0.0.1:49000", help="X-Plane's address for RREF")
+    p.add_argument("--rref-hz", type=int, default=60, metavar="HZ", help="RREF subscription rate (default 60)")
+    p.add_argument("--no-viewer", action="store_true", help="no live rerun viewer")
+    p.add_argument("--realtime", action="store_true", help="SCHED_FIFO priority while receiving (root/CAP_SYS_NICE)")
+    p.add_argument("--filter-start", choices=("steady", "rest"), default="steady", help="filters' start state")
+    p.add_argument("--print-flightgear-protocol", action="store_true", help="print FlightGear's protocol file, exit")
+    _washout_options(p)
+    p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
+    p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
+    _output_options(p)
+
+    p = sub.add_parser("send", help="send a recorded file or a JSBSim flight over UDP as a flight simulator would")
+    p.add_argument("file", type=Path, nargs="?", help="any washbench cue input")
+    p.add_argument("--fly", type=Path, metavar="MANOEUVRE", help="fly this manoeuvre with JSBSim and send it")
+    p.add_argument("--to", metavar="HOST:PORT", help="where washbench live listens")
+    p.add_argument("--format", choices=FORMATS, default="washbench", help="what to send as (default washbench)")
+    p.add_argument("--speed", type=float, default=1.0, help="times real time (default 1)")
+    p.add_argument("--listen", metavar="HOST:PORT", help="xplane-rref: where to take subscriptions (X-Plane's 49000)")
+    _aircraft_dir_option(p)
+
+
+def _live(args: argparse.Namespace) -> int:
+    from washbench.live.endpoints import parse_address
+    from washbench.runs.live import LiveOptions, run_live
+
+    if args.print_flightgear_protocol:
+        from washbench.live.packets import flightgear_protocol
+
+        print(flightgear_protocol(), end="")
+        return 0
+    for flag, value in (("--listen", args.listen), ("--format", args.format), ("--out", args.out)):
+        if value is None:
+            raise WashbenchError(f"{flag} is required")
+    opts = LiveOptions(
+        listen=parse_address(args.listen, "--listen"), fmt=args.format, out=args.out,
+        sink=parse_address(args.sink, "--sink") if args.sink else None, sink_format=args.sink_format,
+        duration_s=args.duration, idle_timeout_s=args.idle_timeout, rate_hz=args.rate_hz, resample_hz=args.resample,
+        xplane=parse_address(args.xplane, "--xplane"), rref_hz=args.rref_hz, viewer=not args.no_viewer,
+        recording=not args.no_recording, figures=not args.no_figures, filter_start=args.filter_start,
+        realtime=args.realtime,
+    )  # fmt: skip
+    return run_live(opts, args.washout, args.params, args.platform, args.variant)
+
+
+def _send(args: argparse.Namespace) -> int:
+    from washbench.live.endpoints import parse_address
+    from washbench.runs.send import run_send
+
+    to = parse_address(args.to, "--to") if args.to else None
+    listen = parse_address(args.listen, "--listen") if args.listen else None
+    return run_send(args.format, to, args.file, args.fly, args.speed, listen, tuple(args.aircraft_dir))
 
 
 def _cue_input_options(p: argparse.ArgumentParser) -> None:
@@ -405,6 +473,8 @@ def _dispatch(args: argparse.Namespace) -> int:
         from washbench.review.report import report_command
 
         return report_command(args.results)
+    if args.command in ("live", "send"):
+        return _live(args) if args.command == "live" else _send(args)
     if args.command == "replay":
         from washbench.review.replay import replay_command
 
