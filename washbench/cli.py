@@ -14,6 +14,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from washbench.cli_examples import add_examples
 from washbench.cueing.params import WASHOUT_KINDS
 from washbench.errors import Terminated, WashbenchError
 
@@ -143,7 +144,7 @@ def build_parser() -> argparse.ArgumentParser:
     _washout_options(p)
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
-    p.add_argument("--boundaries", type=Path, help="gain/phase boundaries YAML, drawn and checked (README)")
+    p.add_argument("--boundaries", type=Path, help="gain/phase boundaries YAML, drawn and checked (docs: OMCT)")
     p.add_argument("--rate-hz", type=float, default=120.0, help="washout sample rate (default 120)")
     p.add_argument("--amplitude-scale", type=float, default=1.0, help="multiply every input amplitude (default 1)")
 
@@ -151,7 +152,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("kind", help="signal shape: sine, step, pulse, doublet, chirp, multisine")
     p.add_argument("--axis", required=True, help="body axis: f_x, f_y, f_z (specific force), roll, pitch, yaw")
     p.add_argument("--amplitude", type=float, required=True, help="m/s^2 (f_x, f_y, f_z) or deg/s (rotations)")
-    p.add_argument("--frequency-hz", type=float, help="frequency (every kind but step; see README)")
+    p.add_argument("--frequency-hz", type=float, help="frequency (every kind but step; see docs/how-to/omct.md)")
     p.add_argument("--duration-s", type=float, default=20.0, help="length (default 20 s)")
     p.add_argument("--rate-hz", type=float, default=120.0, help="sample rate (default 120 Hz)")
     p.add_argument("--start-s", type=float, default=1.0, help="onset of step, pulse, doublet, chirp (default 1 s)")
@@ -204,6 +205,7 @@ def build_parser() -> argparse.ArgumentParser:
         "recording", type=Path, nargs="+", help=".rrd file(s) from washbench run or suite: one, or two to compare"
     )
     p.add_argument("--web", action="store_true", help="always use the web viewer")
+    add_examples(parser)  # the docs named at the top level, examples at the end of each command's help
     return parser
 
 
