@@ -14,9 +14,10 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from washbench.cli_examples import add_examples
+from washbench.cli_examples import add_examples, subcommands
 from washbench.cueing.params import WASHOUT_KINDS
 from washbench.errors import Terminated, WashbenchError
+from washbench.io import config as project_config
 
 _VARIANT_HELP = "add a washout NAME of KIND with dotted-key overrides of the parameter file, repeatable"
 
@@ -450,7 +451,22 @@ def main(argv: list[str] | None = None) -> int:
     SIGINT and SIGTERM stop the command at once: cleanup code runs (half-built results are removed, worker
     processes and viewers stopped), one line is printed and the status is 130 or 143.
     """
-    args = build_parser().parse_args(argv)
+    try:  # the project configuration file (washbench.toml or [tool.washbench]) gives defaults; a flag wins
+        config = project_config.discover()
+    except WashbenchError as exc:
+        if not {"-h", "--help", "--version"} & set(sys.argv[1:] if argv is None else argv):
+            print(f"washbench: error: {exc}", file=sys.stderr)
+            return 2
+        config = None
+    parser = build_parser()
+    if config is not None:
+        _config_defaults(parser, config)
+    args = parser.parse_args(argv)
+    if config is not None and getattr(args, "aircraft_dir", None) == []:
+        args.aircraft_dir = list(config.aircraft_dirs)  # a --aircraft-dir given at all replaces the file's list
+    env_before = os.environ.pop(project_config.CONFIG_USED_ENV, None)
+    if config is not None:  # recorded in the provenance, also by worker processes
+        os.environ[project_config.CONFIG_USED_ENV] = str(config.path)
     signal.signal(signal.SIGTERM, _terminate)
     try:
         try:
@@ -474,6 +490,20 @@ def main(argv: list[str] | None = None) -> int:
         return 143
     finally:
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        os.environ.pop(project_config.CONFIG_USED_ENV, None)
+        if env_before is not None:
+            os.environ[project_config.CONFIG_USED_ENV] = env_before
+
+
+def _config_defaults(parser: argparse.ArgumentParser, config: project_config.ProjectConfig) -> None:
+    """The configuration file's values as each command's defaults (a required --out is then optional)."""
+    for name, sub in subcommands(parser).items():
+        defaults = project_config.defaults_for(config, name, [a.dest for a in sub._actions])
+        defaults.pop("aircraft_dir", None)  # appended to by --aircraft-dir, so applied after parsing instead
+        for action in sub._actions:
+            if action.dest in defaults:
+                action.default = defaults[action.dest]
+                action.required = False
 
 
 if __name__ == "__main__":
