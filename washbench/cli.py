@@ -46,7 +46,7 @@ def _study_options(p: argparse.ArgumentParser) -> None:
         metavar="RESULTS_DIR",
         help="read RESULTS_DIR/<aircraft>/<manoeuvre>/flight.parquet instead of flying",
     )
-    p.add_argument("--jobs", type=_jobs, help="parallel processes for the flights (default: number of cores)")
+    p.add_argument("--jobs", type=_jobs, help="processes for the flights (default: the CPUs this process may use)")
     p.add_argument("--dask", metavar="ADDRESS", help="send the work to this Dask scheduler (washbench[cluster])")
     p.add_argument("--quiet", action="store_true", help="no progress display")
     _aircraft_dir_option(p)
@@ -132,7 +132,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--max-time-s", type=float, metavar="S", help="JSBSim scripts: stop each after S s simulated")
     p.add_argument("--out", type=Path, required=True, help="results folder")
     _aircraft_dir_option(p)
-    p.add_argument("--jobs", type=_jobs, help="parallel processes (default: number of cores)")
+    p.add_argument("--jobs", type=_jobs, help="parallel processes (default: the CPUs this process may use)")
     _washout_options(p)
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
