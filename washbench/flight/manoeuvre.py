@@ -633,7 +633,7 @@ def _check_semantics(m: Manoeuvre, where: _Where, aircraft_dirs: Sequence[Path] 
         base = ("checks", j)
         if check.signal not in COLUMN_NAMES and check.signal != "sink_fps":
             close = difflib.get_close_matches(check.signal, [*COLUMN_NAMES, "sink_fps"], n=1, cutoff=0.7)
-            hint = f"did you mean '{close[0]}'?" if close else "a signal is a flight.parquet column, see docs/reference/outputs.md"
+            hint = f"did you mean '{close[0]}'?" if close else "a signal is a flight.parquet column, e.g. phi_deg"
             where.add((*base, "signal"), f"unknown signal '{check.signal}' ({hint})")
         if check.signal == "sink_fps" and check.stat not in EVENT_STATS:
             where.add((*base, "stat"), "sink_fps is measured at an event: use at_touchdown or at_liftoff")

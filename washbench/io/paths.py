@@ -20,7 +20,8 @@ order:
 A pilot profile is, in this order: the file named by the manoeuvre's ``pilot_profile`` key (relative to the
 manoeuvre file); ``<folder>/<name>/pilot.yaml`` in the same folders as above, in the same order (so a profile
 can sit next to the user's copy of an aircraft, or alone in ``aircraft/<name>/pilot.yaml`` for a JSBSim model);
-the bundled profiles are the ``pilot.yaml`` files of the bundled aircraft folders (``aircraft/<name>/pilot.yaml``). Errors for an unknown aircraft or a missing profile list every place searched.
+the bundled profiles are the ``pilot.yaml`` files of the bundled aircraft folders (``aircraft/<name>/pilot.yaml``).
+Errors for an unknown aircraft or a missing profile list every place searched.
 """
 
 from __future__ import annotations
