@@ -392,7 +392,7 @@ def _dispatch(args: argparse.Namespace) -> int:
 
         return copy_examples(args.folder)
     if args.command == "report":
-        from washbench.review.report import report_command
+        from washbench.review.report_command import report_command
 
         return report_command(args.results)
     if args.command == "replay":

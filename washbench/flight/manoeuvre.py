@@ -793,7 +793,7 @@ def _check_properties(m: Manoeuvre, where: _Where) -> None:
 
     import jsbsim
 
-    from washbench.flight.fdm import quiet_stdout  # here: fdm imports this module
+    from washbench.flight.console import quiet_stdout
 
     os.environ["JSBSIM_DEBUG"] = "0"
     fdm = jsbsim.FGFDMExec(str(jsbsim_root()), None)
