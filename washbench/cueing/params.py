@@ -139,17 +139,6 @@ class WashoutParams(StrictModel):
     free_fall_threshold_mps2: Annotated[float, Field(gt=0.0, le=100.0, allow_inf_nan=False)]
 
 
-def load_washout_params(path: Path | None = None) -> WashoutParams:
-    """Load a washout parameter YAML file (``None``: the bundled CW1 set, ``washbench/data/cw1.yaml``).
-
-    A ``variants:`` section is checked and left out (:func:`washbench.cueing.variants.load_param_file` reads it).
-    Raises :class:`washbench.errors.WashbenchError` with ``file:line: field: problem`` on bad input.
-    """
-    from washbench.cueing.variants import load_param_file
-
-    return load_param_file(path)[0]
-
-
 def load_base_params(path: Path, data: Any, lines: dict[Any, int]) -> WashoutParams:
     """Validate parsed YAML ``data`` (without its ``variants:`` section) into a WashoutParams."""
     return validate_data(path, data, lines, WashoutParams)

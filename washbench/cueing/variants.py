@@ -31,7 +31,13 @@ from typing import Any
 import pydantic
 from pydantic import BaseModel
 
-from washbench.cueing.params import DEFAULT_PARAMS_PATH, WASHOUT_KINDS, WashoutParams, check_washouts
+from washbench.cueing.params import (
+    DEFAULT_PARAMS_PATH,
+    WASHOUT_KINDS,
+    WashoutParams,
+    check_washouts,
+    load_base_params,
+)
 from washbench.errors import WashbenchError, located
 from washbench.io.names import identifier_problem
 from washbench.io.yamlio import Loc, line_of, read_yaml, validate_data
@@ -222,10 +228,17 @@ def _file_variants(path: Path, data: Any, lines: dict[Loc, int], base: WashoutPa
     return tuple(out)
 
 
+def load_washout_params(path: Path | None = None) -> WashoutParams:
+    """Load a washout parameter YAML file (``None``: the bundled CW1 set, ``washbench/data/cw1.yaml``).
+
+    A ``variants:`` section is checked and left out (:func:`load_param_file` reads it).
+    Raises :class:`washbench.errors.WashbenchError` with ``file:line: field: problem`` on bad input.
+    """
+    return load_param_file(path)[0]
+
+
 def load_param_file(path: Path | None = None) -> tuple[WashoutParams, tuple[Washout, ...]]:
     """A parameter file's base set and its ``variants:`` section (``None``: the bundled CW1, no variants)."""
-    from washbench.cueing.params import load_base_params
-
     path = DEFAULT_PARAMS_PATH if path is None else Path(path)
     data, lines = read_yaml(path)
     if not isinstance(data, dict):
