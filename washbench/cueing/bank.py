@@ -21,7 +21,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from washbench.cueing import filters
-from washbench.cueing.jitcache import announce_compile
 from washbench.cueing.kernel import (
     C_ALPHA,
     C_AMAX,
@@ -78,6 +77,7 @@ from washbench.cueing.params import WashoutParams
 from washbench.cueing.variants import Washout, as_washouts
 from washbench.errors import WashbenchError
 from washbench.io.results import DT_RANGE_S
+from washbench.numerics.jitcache import announce_compile
 from washbench.platform.limits import PlatformLimits, wheel_jacobian
 
 _KINDS = {"small-angle": KIND_SMALL, "large-angle": KIND_LARGE, "unrestricted": KIND_UNRESTRICTED}

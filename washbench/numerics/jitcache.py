@@ -35,7 +35,7 @@ def configure_cache() -> None:
     """
     if os.environ.get("NUMBA_CACHE_DIR"):
         return
-    if all(_writable(_PACKAGE_DIR / sub) for sub in ("cueing", "platform", "perception", "analysis")):
+    if all(_writable(_PACKAGE_DIR / sub) for sub in ("numerics", "cueing", "platform", "perception", "analysis")):
         return
     import platformdirs
 
