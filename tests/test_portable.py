@@ -32,7 +32,7 @@ def test_numba_cache_goes_to_the_user_cache_folder_when_the_package_is_read_only
     """In a fresh interpreter with the package folders reported read-only, NUMBA_CACHE_DIR points at the user cache
     (XDG_CACHE_HOME here) and numba writes the kernel's cache there."""
     code = (
-        "import os, washbench.cueing.jitcache as j\n"
+        "import os, washbench.numerics.jitcache as j\n"
         "j._writable = lambda folder: False\n"
         "j.configure_cache()\n"
         "print(os.environ['NUMBA_CACHE_DIR'])\n"

@@ -14,8 +14,10 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from washbench.cli_examples import add_examples, subcommands
 from washbench.cueing.params import WASHOUT_KINDS
 from washbench.errors import Terminated, WashbenchError
+from washbench.io import config as project_config
 
 _VARIANT_HELP = "add a washout NAME of KIND with dotted-key overrides of the parameter file, repeatable"
 
@@ -57,7 +59,7 @@ def _study_options(p: argparse.ArgumentParser) -> None:
         metavar="RESULTS_DIR",
         help="read RESULTS_DIR/<aircraft>/<manoeuvre>/flight.parquet instead of flying",
     )
-    p.add_argument("--jobs", type=_jobs, help="parallel processes for the flights (default: number of cores)")
+    p.add_argument("--jobs", type=_jobs, help="processes for the flights (default: the CPUs this process may use)")
     p.add_argument("--dask", metavar="ADDRESS", help="send the work to this Dask scheduler (washbench[cluster])")
     p.add_argument("--quiet", action="store_true", help="no progress display")
     _aircraft_dir_option(p)
@@ -143,7 +145,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--max-time-s", type=float, metavar="S", help="JSBSim scripts: stop each after S s simulated")
     p.add_argument("--out", type=Path, required=True, help="results folder")
     _aircraft_dir_option(p)
-    p.add_argument("--jobs", type=_jobs, help="parallel processes (default: number of cores)")
+    p.add_argument("--jobs", type=_jobs, help="parallel processes (default: the CPUs this process may use)")
     _washout_options(p)
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
@@ -156,7 +158,7 @@ def build_parser() -> argparse.ArgumentParser:
     _washout_options(p)
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
-    p.add_argument("--boundaries", type=Path, help="gain/phase boundaries YAML, drawn and checked (README)")
+    p.add_argument("--boundaries", type=Path, help="gain/phase boundaries YAML, drawn and checked (docs: OMCT)")
     p.add_argument("--rate-hz", type=float, default=120.0, help="washout sample rate (default 120)")
     p.add_argument("--amplitude-scale", type=float, default=1.0, help="multiply every input amplitude (default 1)")
 
@@ -164,7 +166,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("kind", help="signal shape: sine, step, pulse, doublet, chirp, multisine")
     p.add_argument("--axis", required=True, help="body axis: f_x, f_y, f_z (specific force), roll, pitch, yaw")
     p.add_argument("--amplitude", type=float, required=True, help="m/s^2 (f_x, f_y, f_z) or deg/s (rotations)")
-    p.add_argument("--frequency-hz", type=float, help="frequency (every kind but step; see README)")
+    p.add_argument("--frequency-hz", type=float, help="frequency (every kind but step; see docs/how-to/omct.md)")
     p.add_argument("--duration-s", type=float, default=20.0, help="length (default 20 s)")
     p.add_argument("--rate-hz", type=float, default=120.0, help="sample rate (default 120 Hz)")
     p.add_argument("--start-s", type=float, default=1.0, help="onset of step, pulse, doublet, chirp (default 1 s)")
@@ -218,6 +220,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--web", action="store_true", help="always use the web viewer")
     _live_parsers(sub)
+    add_examples(parser)  # the docs named at the top level, examples at the end of each command's help
     return parser
 
 
@@ -470,7 +473,7 @@ def _dispatch(args: argparse.Namespace) -> int:
 
         return copy_examples(args.folder)
     if args.command == "report":
-        from washbench.review.report import report_command
+        from washbench.review.report_command import report_command
 
         return report_command(args.results)
     if args.command in ("live", "send"):
@@ -541,7 +544,22 @@ def main(argv: list[str] | None = None) -> int:
     SIGINT and SIGTERM stop the command at once: cleanup code runs (half-built results are removed, worker
     processes and viewers stopped), one line is printed and the status is 130 or 143.
     """
-    args = build_parser().parse_args(argv)
+    try:  # the project configuration file (washbench.toml or [tool.washbench]) gives defaults; a flag wins
+        config = project_config.discover()
+    except WashbenchError as exc:
+        if not {"-h", "--help", "--version"} & set(sys.argv[1:] if argv is None else argv):
+            print(f"washbench: error: {exc}", file=sys.stderr)
+            return 2
+        config = None
+    parser = build_parser()
+    if config is not None:
+        _config_defaults(parser, config)
+    args = parser.parse_args(argv)
+    if config is not None and getattr(args, "aircraft_dir", None) == []:
+        args.aircraft_dir = list(config.aircraft_dirs)  # a --aircraft-dir given at all replaces the file's list
+    env_before = os.environ.pop(project_config.CONFIG_USED_ENV, None)
+    if config is not None:  # recorded in the provenance, also by worker processes
+        os.environ[project_config.CONFIG_USED_ENV] = str(config.path)
     signal.signal(signal.SIGTERM, _terminate)
     try:
         try:
@@ -566,6 +584,20 @@ def main(argv: list[str] | None = None) -> int:
         return 143
     finally:
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        os.environ.pop(project_config.CONFIG_USED_ENV, None)
+        if env_before is not None:
+            os.environ[project_config.CONFIG_USED_ENV] = env_before
+
+
+def _config_defaults(parser: argparse.ArgumentParser, config: project_config.ProjectConfig) -> None:
+    """The configuration file's values as each command's defaults (a required --out is then optional)."""
+    for name, sub in subcommands(parser).items():
+        defaults = project_config.defaults_for(config, name, [a.dest for a in sub._actions])
+        defaults.pop("aircraft_dir", None)  # appended to by --aircraft-dir, so applied after parsing instead
+        for action in sub._actions:
+            if action.dest in defaults:
+                action.default = defaults[action.dest]
+                action.required = False
 
 
 if __name__ == "__main__":

@@ -5,10 +5,12 @@ simulator pilot's perceived signal ``y`` sampled on the same uniform grid:
 
 * ``npc``: normalized Pearson correlation, Eqs. 20-21 with K = 1:
   ``NPC = K / (1 + PC) + 1 - K / 2``. 1.0 for perfect correlation, 1.5 for none, larger is worse.
+
   - PC = -1 (perfectly anti-correlated, to within 1e-12): NPC is reported as ``inf`` (the limit of
     Eq. 21; written as ``inf`` in CSV, read back as ``float('inf')``).
   - a flat signal (standard deviation at most 1e-9 of its own peak magnitude, or exactly zero)
     leaves PC undefined: NPC is ``nan`` (an empty field in CSV), never a made-up number.
+
 * ``integral_error``: Eq. 22, ``integral |x - y| dt`` by the trapezoid rule on the uniform grid,
   from the first to the last sample.
 * ``max_error``: ``max |x - y|``.

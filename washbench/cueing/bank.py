@@ -21,7 +21,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from washbench.cueing import filters
-from washbench.cueing.jitcache import announce_compile
 from washbench.cueing.kernel import (
     C_ADAPT,
     C_ALPHA,
@@ -103,6 +102,7 @@ from washbench.cueing.setpoints import SetPointSource
 from washbench.cueing.variants import Washout, as_washouts
 from washbench.errors import WashbenchError
 from washbench.io.results import DT_RANGE_S
+from washbench.numerics.jitcache import announce_compile
 from washbench.platform.limits import PlatformLimits, wheel_jacobian
 
 _KINDS = {

@@ -21,7 +21,7 @@ import importlib
 import importlib.metadata
 import importlib.util
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -172,6 +172,20 @@ def plugin_specs() -> tuple[str, ...]:
     return tuple(_PLUGIN_SPECS.values())
 
 
+def check_washouts(washouts: Sequence[str]) -> tuple[str, ...]:
+    """Built-in or registered washout names as a tuple; WashbenchError if none, one is unknown or one is listed
+    twice."""
+    names = tuple(washouts)
+    if not names:
+        raise WashbenchError("no washout selected")
+    for name in names:
+        if name not in known_kinds():
+            raise WashbenchError(f"unknown washout {name!r} (valid: {', '.join(known_kinds())})")
+    if len(set(names)) != len(names):
+        raise WashbenchError(f"washout listed twice: {', '.join(names)}")
+    return names
+
+
 def get(kind: str, spec: str | None = None) -> Algorithm:
     """The Python algorithm ``kind`` (loading ``spec`` = ``FILE.py:NAME`` first if it is not loaded here)."""
     if kind in _LOADED:
@@ -203,6 +217,7 @@ __all__ = [
     "BUILTIN_PYTHON",
     "ENTRY_POINT_GROUP",
     "Algorithm",
+    "check_washouts",
     "get",
     "is_python",
     "known_kinds",

@@ -12,7 +12,9 @@ One JSON-able dict (:func:`build_provenance`) records
   and SHA-256 of the file actually used (the bundled ``cw1.yaml`` / ``atlas.yaml`` when none was given) and the
   values read from it (so a result can be re-examined without the file);
 - ``washouts``: the washouts that ran, name and kind, and a variant's own parameter values;
-- ``turbulence``: severity and seed of the manoeuvre's turbulence (``None`` without turbulence).
+- ``turbulence``: severity and seed of the manoeuvre's turbulence (``None`` without turbulence);
+- ``config``: the project configuration file the command found (``washbench.toml`` or a ``pyproject.toml`` with
+  ``[tool.washbench]``, see :mod:`washbench.io.config`), its path and SHA-256; left out when there was none.
 
 It goes into ``run.json`` (``"provenance"``, with the date ``"created_utc"`` beside it), the key-value metadata of
 ``traces.parquet`` and ``flight.parquet`` (key ``washbench.provenance``, JSON) and the report header. The date is
@@ -26,11 +28,14 @@ import functools
 import hashlib
 import importlib.metadata
 import json
+import os
 import platform as _platform
 import subprocess
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
+
+from washbench.io.config import CONFIG_USED_ENV
 
 PARQUET_KEY = b"washbench.provenance"
 """Key of the provenance JSON in a Parquet file's key-value metadata."""
@@ -146,6 +151,9 @@ def build_provenance(
         prov["platform"] = file_record(platform_path, platform.name, platform.model_dump(mode="json"))
     if manoeuvre_path is not None:
         prov["turbulence"] = turbulence_record(turbulence)
+    config_used = os.environ.get(CONFIG_USED_ENV)
+    if config_used and Path(config_used).is_file():
+        prov["config"] = file_record(config_used)
     return prov
 
 

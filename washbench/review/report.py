@@ -25,10 +25,9 @@ import numpy as np
 
 from washbench.analysis.metrics import DOFS
 from washbench.analysis.ranking import METRICS, RankRow, compare, rank, reference_washout
-from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
 from washbench.review.numbers import pct, sig
-from washbench.review.result_data import ResultData, is_result_folder, load_result
+from washbench.review.result_data import ResultData, load_result
 
 REPORT_FILE = "report.md"
 FIGURES_DIR = "figures"
@@ -353,19 +352,3 @@ def write_result_report(
     path = data.folder / REPORT_FILE
     write_text_atomic(path, "\n".join(lines).rstrip() + "\n")
     return path
-
-
-def report_command(results_dir: Path) -> int:
-    """``washbench report DIR``: write report.md and the figures (PNG and PDF) again from a result or suite folder's
-    files."""
-    folder = Path(results_dir)
-    if not folder.is_dir():
-        raise WashbenchError(located(folder, "no such folder"))
-    if is_result_folder(folder) and not (folder / SUITE_FILE).exists():
-        path = write_result_report(folder, pdf=True)
-    else:
-        from washbench.review.suite_report import write_suite_report
-
-        path = write_suite_report(folder, regenerate_results=True)
-    print(f"report: {path}")
-    return 0

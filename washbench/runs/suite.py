@@ -55,6 +55,7 @@ from washbench.analysis.ranking import (
 )
 from washbench.errors import Terminated, WashbenchError, located
 from washbench.io.atomic import write_text_atomic
+from washbench.io.cpus import usable_cpus
 from washbench.io.lock import LOCK_NAME, output_lock
 from washbench.io.paths import MANOEUVRES_DIR, bundled_names, resolve_manoeuvre
 from washbench.io.publish import clean_partials, is_leftover, is_washbench_result, read_marker
@@ -270,7 +271,7 @@ def run_suite(
     On any exception (KeyboardInterrupt and :class:`washbench.errors.Terminated` included) the local workers are
     stopped before it propagates, so no worker writes anything afterwards.
     """
-    jobs = max(1, min(jobs or os.cpu_count() or 1, len(files)))
+    jobs = max(1, min(jobs or usable_cpus(), len(files)))
     out_dir.mkdir(parents=True, exist_ok=True)
     dirs = tuple(str(d) for d in aircraft_dirs)
     params = str(params_path) if params_path else None
