@@ -206,11 +206,14 @@ def analyse(
 
 def _metric_rows(perceived: Mapping[str, Perceived], dt_s: float) -> list[MetricRow]:
     """Six metric rows per washout: each simulator pilot's perceived motion against the aircraft pilot's."""
+    from washbench.analysis.cues import classified_rows
+
     ac = perceived[AIRCRAFT]
     rows: list[MetricRow] = []
     for name, p in perceived.items():
         if name != AIRCRAFT:
-            rows += dof_metrics(name, ac.f_mps2, ac.omega_radps, p.f_mps2, p.omega_radps, dt_s)
+            base = dof_metrics(name, ac.f_mps2, ac.omega_radps, p.f_mps2, p.omega_radps, dt_s)
+            rows += classified_rows(base, ac.f_mps2, ac.omega_radps, p.f_mps2, p.omega_radps, dt_s)
     return rows
 
 

@@ -347,20 +347,13 @@ def _runs_with_metrics(outcomes: Sequence[Outcome]) -> list[Outcome]:
 
 def metrics_table(outcomes: Sequence[Outcome]) -> str:
     """``metrics.csv`` of the suite (every run that produced metrics, failed checks included)."""
-    rows = [["aircraft", "manoeuvre", "washout", "dof", "npc", "integral_error", "max_error"]]
+    from washbench.io.results import METRICS_COLUMNS
+
+    rows = [["aircraft", "manoeuvre", *METRICS_COLUMNS]]
     for o in _runs_with_metrics(outcomes):
         for m in o.run.metrics:
-            rows.append(
-                [
-                    o.run.aircraft,
-                    o.run.manoeuvre,
-                    m.washout,
-                    m.dof,
-                    csv_number(m.npc),
-                    csv_number(m.integral_error),
-                    csv_number(m.max_error),
-                ]
-            )
+            nums = [csv_number(getattr(m, c)) for c in METRICS_COLUMNS[2:-1]]
+            rows.append([o.run.aircraft, o.run.manoeuvre, m.washout, m.dof, *nums, m.false_cue_events])
     return _csv(rows)
 
 
