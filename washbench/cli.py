@@ -33,6 +33,13 @@ def _washout_options(p: argparse.ArgumentParser, variants: bool = True) -> None:
         p.add_argument("--variant", action="append", default=[], metavar="NAME=KIND[,KEY=VALUE...]", help=_VARIANT_HELP)
 
 
+def _rank_option(p: argparse.ArgumentParser) -> None:
+    """--rank-by (cue, run, suite): the ranking rule, recorded in the provenance (docs/fidelity.md)."""
+    p.add_argument("--rank-by", choices=("score", "false-cue", "weighted"),
+                   help="ranking rule (default: the parameter file's ranking: section, else score); weighted uses "
+                   "its ranking.dof_weights")  # fmt: skip
+
+
 def _study_options(p: argparse.ArgumentParser) -> None:
     """What sweep and tune share."""
     p.add_argument("--params", type=Path, help="base washout parameter YAML (default: bundled CW1)")
@@ -88,6 +95,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", type=Path, required=True, help="output folder (a run result folder's files)")
     _cue_input_options(p)
     _washout_options(p)
+    _rank_option(p)
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
 
@@ -110,6 +118,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--out", type=Path, required=True, help="results folder; writes OUT/<aircraft>/<manoeuvre>/")
     _washout_options(p)
+    _rank_option(p)
     _aircraft_dir_option(p)
     p.add_argument("--max-time-s", type=float, metavar="S", help="JSBSim script: stop after S s simulated")
     p.add_argument("--filter-start", choices=("steady", "rest"), default="steady", help="filters' start state")
@@ -132,6 +141,7 @@ def build_parser() -> argparse.ArgumentParser:
     _aircraft_dir_option(p)
     p.add_argument("--jobs", type=_jobs, help="parallel processes (default: number of cores)")
     _washout_options(p)
+    _rank_option(p)
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
     p.add_argument("--dask", metavar="ADDRESS", help="run on this Dask scheduler instead of local processes")
@@ -257,6 +267,7 @@ def _cue(args: argparse.Namespace) -> int:
         strict=args.strict,
         recording=not args.no_recording,
         figures=not args.no_figures,
+        rank_by=args.rank_by,
     )
     return run_cue(
         args.input,
@@ -336,6 +347,7 @@ def _dispatch(args: argparse.Namespace) -> int:
             washouts=args.washout,
             variants=args.variant,
             aircraft_dirs=args.aircraft_dir,
+            rank_by=args.rank_by,
         )
     if args.command == "suite":
         from washbench.runs.suite import suite_command
@@ -354,6 +366,7 @@ def _dispatch(args: argparse.Namespace) -> int:
             washouts=args.washout,
             variants=args.variant,
             dask=args.dask,
+            rank_by=args.rank_by,
         )
     if args.command == "omct":
         from washbench.runs.omct import run_omct

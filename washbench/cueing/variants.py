@@ -231,6 +231,7 @@ def load_param_file(path: Path | None = None) -> tuple[WashoutParams, tuple[Wash
     if not isinstance(data, dict):
         return validate_data(path, data, lines, WashoutParams), ()
     variants = data.pop("variants", None)
+    data.pop("ranking", None)  # the ranking rule's section (washbench.runs.rank_rule)
     base = load_base_params(path, data, lines)
     return base, (() if variants is None else _file_variants(path, variants, lines, base))
 

@@ -116,6 +116,7 @@ def build_provenance(
     turbulence: Any = None,
     aircraft_files: Any = None,
     washouts: Sequence[Any] = (),
+    ranking: Mapping[str, Any] | None = None,
 ) -> dict[str, Any]:
     """The provenance of one result (module docstring); no date in it.
 
@@ -125,7 +126,8 @@ def build_provenance(
     where the manoeuvre's aircraft was found) adds the JSBSim model file ``<name>/<name>.xml`` and the pilot profile,
     each with its path and SHA-256 (the model's own file only: engines and systems it includes are not hashed).
     ``washouts`` (``washbench.cueing.variants.Washout``: name, kind, params) lists what ran; a variant's complete
-    parameter values are recorded where they differ from the file's base set.
+    parameter values are recorded where they differ from the file's base set. ``ranking``: the ranking rule
+    (:meth:`washbench.analysis.ranking.RankRule.record`).
     """
     prov: dict[str, Any] = {"software": software_versions()}
     if manoeuvre_path is not None:
@@ -146,6 +148,8 @@ def build_provenance(
         prov["platform"] = file_record(platform_path, platform.name, platform.model_dump(mode="json"))
     if manoeuvre_path is not None:
         prov["turbulence"] = turbulence_record(turbulence)
+    if ranking is not None:
+        prov["ranking"] = dict(ranking)
     return prov
 
 

@@ -24,7 +24,17 @@ from typing import Any
 import numpy as np
 
 from washbench.analysis.metrics import DOFS
-from washbench.analysis.ranking import METRICS, RankRow, compare, rank, reference_washout
+from washbench.analysis.ranking import (
+    DEFAULT_RULE,
+    METRICS,
+    RankRow,
+    RankRule,
+    compare,
+    rank,
+    reference_washout,
+    rule_from_record,
+    undecided,
+)
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
 from washbench.review.numbers import pct, sig
@@ -118,21 +128,41 @@ def _score_cell(score: float, best: bool) -> str:
     return f"{text} {FLAG}" if score > 1.0 else text
 
 
-def ranking_lines(data: ResultData, ranking: list[RankRow]) -> list[str]:
-    """Ranking table (rank, washout, score) and the DOF weights used."""
+def result_rule(data: ResultData) -> RankRule:
+    """The ranking rule a result was written with (its provenance's ``ranking``; the default before rules)."""
+    prov = data.provenance
+    return rule_from_record(prov.get("ranking") if isinstance(prov, dict) else None)
+
+
+def rank_cell(r: RankRow) -> str:
+    """A rank as shown: ``1`` or, when shared (a tie within the margin), ``1 (tie)``."""
+    return f"{r.rank} (tie)" if r.tied else str(r.rank)
+
+
+def ranking_lines(data: ResultData, ranking: list[RankRow], rule: RankRule = DEFAULT_RULE) -> list[str]:
+    """Ranking table (rank, washout, the rule's value), the rule with its tie margin and the DOF weights used."""
     if not ranking:
         return []
-    lines = ["| rank | washout | score (-) |", "|---|---|---|"]
-    lines += [f"| {r.rank} | {r.washout} | {_score_cell(r.score, r.rank == 1)} |" for r in ranking]
-    weights = ranking[0].weights
+    unit = "false-cue time (DOF lengths)" if rule.by == "false-cue" else "score (-)"
+    lines = [f"| rank | washout | {unit} |", "|---|---|---|"]
+    flag = rule.by != "false-cue"
     lines += [
-        "",
-        "Score: sum over DOFs of weight x integral error / the aircraft pilot's own perceived motion in that DOF (0 "
-        "perfect, 1 no better than standing still). Weights: "
-        + ", ".join(f"{d} {sig(weights[d], 2)}" for d in DOFS)
-        + ".",
+        f"| {rank_cell(r)} | {r.washout} | {_score_cell(r.score, r.rank == 1) if flag else sig(r.score)} |"
+        for r in ranking
     ]
-    if any(r.score > 1.0 for r in ranking):
+    weights = ranking[0].weights
+    lines += ["", f"Ranked by {rule.label()}."]
+    if undecided(ranking):
+        lines += ["", "**The first place is a tie**: the best values differ by less than the tie margin."]
+    if rule.by != "false-cue":
+        lines += [
+            "",
+            "Score: sum over DOFs of weight x integral error / the aircraft pilot's own perceived motion in that DOF "
+            "(0 perfect, 1 no better than standing still). Weights: "
+            + ", ".join(f"{d} {sig(weights[d], 2)}" for d in DOFS)
+            + ".",
+        ]
+    if flag and any(r.score > 1.0 for r in ranking):
         lines += ["", SCORE_NOTE]
     return [*lines, ""]
 
@@ -289,8 +319,9 @@ def result_sections(
     """
     h = "#" * level
     lines: list[str] = []
-    ranking = rank(data.metrics, data.motion) if data.metrics else []
-    lines += [f"{h} Ranking", "", *ranking_lines(data, ranking)]
+    rule = result_rule(data)
+    ranking = rank(data.metrics, data.motion, rule) if data.metrics else []
+    lines += [f"{h} Ranking", "", *ranking_lines(data, ranking, rule)]
     lines += [f"{h} Perceived motion", ""]
     lines += [
         "Aircraft pilot (magenta, wide) against each washout's simulator pilot; dashed: perception thresholds "

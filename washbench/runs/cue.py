@@ -427,6 +427,7 @@ class CueOptions:
     strict: bool = False
     recording: bool = True
     figures: bool = True
+    rank_by: str | None = None  # the ranking rule (--rank-by; None: the parameter file's)
 
 
 @dataclass(frozen=True, eq=False)
@@ -620,7 +621,7 @@ def run_cue(
         from washbench.io.provenance import file_record, read_parquet_provenance
         from washbench.runs.pipeline import run_provenance
 
-        prov = run_provenance(params_path, platform_path, specs, limits)
+        prov = run_provenance(params_path, platform_path, specs, limits, rank_by=opts.rank_by)
         prov["input"] = file_record(input_path)
         is_parquet = input_path.suffix.lower() in (".parquet", ".pq")
         input_prov = read_parquet_provenance(input_path) if is_parquet else None
