@@ -215,6 +215,37 @@ def metric_tables(data: ResultData) -> list[str]:
     return lines
 
 
+def cue_lines(data: ResultData) -> list[str]:
+    """Time fractions of correct, scaled, false and missing cues per washout and DOF, and the false-cue events."""
+    from washbench.analysis.cues import SCALE_BAND, parse_events
+
+    rows = [m for m in data.metrics if not math.isnan(m.cue_false_frac)]
+    if not rows:
+        return ["_This result was written before the cue classification: `washbench cue` it again for it._", ""]
+    lines = [
+        "Percent of the manoeuvre's time (docs/fidelity.md): a cue is correct when both pilots feel the DOF (above "
+        f"the Zacharias threshold) in the same direction with a magnitude ratio within {SCALE_BAND[0]:g}-"
+        f"{SCALE_BAND[1]:g}, scaled outside that ratio, false when the simulator pilot feels motion the aircraft "
+        "pilot does not or in the opposite direction, missing when the aircraft pilot feels motion the simulator "
+        "pilot does not.",
+        "",
+        "| washout | DOF | correct (%) | scaled (%) | false (%) | missing (%) | false-cue events |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for m in rows:
+        events = parse_events(m.false_cue_events, m.dof)
+        longest = max(events, key=lambda e: e.end_s - e.start_s, default=None)
+        ev = f"{len(events)}" + (f" (longest {sig(longest.start_s)}-{sig(longest.end_s)} s, peak "
+                                 f"{sig(longest.peak)} {_unit('max_error', m.dof)})" if longest else "")  # fmt: skip
+        cells = (m.cue_correct_frac, m.cue_scaled_frac, m.cue_false_frac, m.cue_missing_frac)
+        lines.append(f"| {m.washout} | {m.dof} | " + " | ".join(sig(100.0 * c) for c in cells) + f" | {ev} |")
+    washouts = dict.fromkeys(r.washout for r in rows)
+    false_time = {w: sum(m.cue_false_frac for m in rows if m.washout == w) for w in washouts}
+    lines += ["", "False-cue time (sum over DOFs, manoeuvre lengths): "
+              + ", ".join(f"{w} {sig(v)}" for w, v in false_time.items()) + ".", ""]  # fmt: skip
+    return lines
+
+
 def saturation_lines(data: ResultData) -> list[str]:
     """Time at each limit per washout, in seconds and percent of the manoeuvre."""
     from washbench.review.figures import SATURATION_LABELS
@@ -276,7 +307,7 @@ def result_figures(data: ResultData, pdf: bool = False) -> dict[str, Path]:
     fig_dir.mkdir(exist_ok=True)
     formats = ("png", "pdf") if pdf else ("png",)
     if not pdf:
-        for stem in ("perceived", "envelope"):
+        for stem in ("perceived", "envelope", "cues"):
             (fig_dir / f"{stem}.pdf").unlink(missing_ok=True)
     thresholds, rest = perception_thresholds()
     out = {}
@@ -290,6 +321,11 @@ def result_figures(data: ResultData, pdf: bool = False) -> dict[str, Path]:
         rest=rest,
         formats=formats,
     )[0]
+    if data.washouts and all(w in data.perceived for w in data.washouts):
+        from washbench.review.cue_figures import cue_classes, cue_lane_figure
+
+        classes = cue_classes(data.perceived, data.washouts)
+        out["cues"] = cue_lane_figure(fig_dir / "cues", data.title, data.t_s, classes, formats=formats)[0]
     if data.usage:
         out["envelope"] = envelope_figure(
             fig_dir / "envelope", data.title, data.t_s, data.usage, data.saturated, phases=data.phases, formats=formats
@@ -329,6 +365,9 @@ def result_sections(
         "",
     ]
     lines += _image(figures["perceived"], start, "perceived motion") if "perceived" in figures else [NO_FIGURES, ""]
+    lines += [f"{h} Cues: correct, scaled, false, missing", "", *cue_lines(data)]
+    if "cues" in figures:
+        lines += _image(figures["cues"], start, "false and missing cues")
     lines += [f"{h} Metrics", "", *metric_tables(data)]
     lines += [f"{h} Platform", ""]
     if brief:

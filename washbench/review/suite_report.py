@@ -226,7 +226,7 @@ def _existing_figures(d: ResultData) -> dict[str, Path]:
     """The result's figures as its report links them (drawn again when missing)."""
     from washbench.review.report import result_figures
 
-    found = {name: d.folder / FIGURES_DIR / f"{name}.png" for name in ("perceived", "envelope")}
+    found = {name: d.folder / FIGURES_DIR / f"{name}.png" for name in ("perceived", "envelope", "cues")}
     found = {k: p for k, p in found.items() if p.is_file()}
     if "perceived" not in found:
         return result_figures(load_result(d.folder))  # with every series (the suite's tables read only a few)
