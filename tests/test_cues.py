@@ -73,7 +73,7 @@ def test_short_runs_merge_and_tiny_events_are_not_listed():
 def test_metrics_csv_round_trip_with_cue_columns(tmp_path):
     _, a, b = _signals()
     s = cues.summarise(a, b, 0.2, DT, "surge")
-    row = MetricRow("w", "surge", 1.2, 3.4, 5.6, *s.fractions[1:], cues.events_text(s.events))
+    row = MetricRow("w", "surge", 1.2, 3.4, 5.6, *s.fractions[1:], false_cue_events=cues.events_text(s.events))
     path = tmp_path / "metrics.csv"
     write_metrics_csv(path, [row])
     (back,) = read_metrics_csv(path)

@@ -18,13 +18,13 @@ DT = 1 / 120
 
 
 def _input(path: Path) -> Path:
-    """10 s at 120 Hz: a 2 m/s^2 surge step 1-4 s and a +-20 deg/s roll doublet 5-7 s."""
+    """10 s at 120 Hz: a 2 m/s^2 surge step 1-4 s, a +-20 deg/s roll doublet 5-7 s, a 0.5 m/s^2 heave sine."""
     t = np.arange(10 * 120 + 1) * DT
     cols = {
         "t_s": t,
         "f_x_mps2": np.where((t >= 1.0) & (t < 4.0), 2.0, 0.0),
         "f_y_mps2": np.zeros_like(t),
-        "f_z_mps2": np.full_like(t, -G),
+        "f_z_mps2": -G + 0.5 * np.sin(2 * np.pi * 0.2 * t),
         "omega_x_degps": np.where((t >= 5.0) & (t < 6.0), 20.0, 0.0) - np.where((t >= 6.0) & (t < 7.0), 20.0, 0.0),
         "omega_y_degps": np.zeros_like(t),
         "omega_z_degps": np.zeros_like(t),
@@ -99,3 +99,26 @@ def test_bad_ranking_section_is_one_line_exit_2(trace: Path, tmp_path: Path) -> 
     params = _params(tmp_path / "noweights.yaml", "ranking:\n  by: weighted\n")
     res = cue(trace, "--out", tmp_path / "y", "--params", params)
     assert res.returncode == 2 and "dof_weights" in res.stderr and "Traceback" not in res.stderr
+
+
+def test_msdv_on_the_heave_rows_equals_an_independent_analogue_simulation(trace: Path, tmp_path: Path) -> None:
+    """The aircraft pilot's MSDV: the analogue Wf simulated by scipy.signal.lsim on the input's vertical motion."""
+    import math
+
+    from scipy import signal
+
+    from washbench.perception.sickness import wf_tf
+
+    res = cue(trace, "--out", tmp_path / "m")
+    assert res.returncode == 0, res.stderr
+    rows = read_metrics_csv(tmp_path / "m" / "metrics.csv")
+    heave = [r for r in rows if r.dof == "heave"]
+    assert len(heave) == 3 and all(r.msdv_mps15 > 0.0 for r in heave)
+    assert all(math.isnan(r.msdv_mps15) for r in rows if r.dof != "heave")
+    data = np.loadtxt(trace, delimiter=",", skiprows=1)
+    t, f_z = data[:, 0], data[:, 3]
+    _, aw, _ = signal.lsim(signal.lti(*wf_tf()), -(f_z + G), t)
+    expected = math.sqrt(float(np.sum(aw * aw)) * DT)
+    assert expected > 0.3  # 0.5 m/s^2 at 0.2 Hz (Wf 0.99) for 10 s, less the filter's start: about 1.1
+    assert heave[0].msdv_aircraft_mps15 == pytest.approx(expected, rel=1e-3)
+    assert "## Motion sickness dose" in (tmp_path / "m" / "report.md").read_text()

@@ -92,7 +92,9 @@ class MetricRow:
     """One row of ``metrics.csv``: a washout's metrics for one DOF (units: see module docstring).
 
     The cue classification (:mod:`washbench.analysis.cues`): time fractions ``cue_*_frac`` (NaN where not
-    classified, e.g. a study's evaluation) and the false-cue events as ``start-end@peak;...`` text.
+    classified, e.g. a study's evaluation) and the false-cue events as ``start-end@peak;...`` text. On the heave row,
+    the motion sickness dose values (MSDV, m/s^1.5, ISO 2631-1 Wf) of the simulator pilot and of the aircraft pilot
+    (NaN on the other rows).
     """
 
     washout: str
@@ -104,6 +106,8 @@ class MetricRow:
     cue_scaled_frac: float = math.nan
     cue_false_frac: float = math.nan
     cue_missing_frac: float = math.nan
+    msdv_mps15: float = math.nan
+    msdv_aircraft_mps15: float = math.nan
     false_cue_events: str = ""
 
 

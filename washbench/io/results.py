@@ -24,7 +24,9 @@ unchanged to ``traces.parquet`` (e.g. the flight pipeline's state columns).
 
 ``DIR/metrics.csv``: ``washout,dof,npc,integral_error,max_error`` then the cue classification
 (:mod:`washbench.analysis.cues`) ``cue_correct_frac,cue_scaled_frac,cue_false_frac,cue_missing_frac`` (time
-fractions) and ``false_cue_events`` (``start_s-end_s@peak`` joined by ``;``), one row per washout and DOF
+fractions), on the heave row the motion sickness dose values ``msdv_mps15,msdv_aircraft_mps15`` (ISO 2631-1 Wf,
+m/s^1.5: the simulator pilot's and the aircraft pilot's, :mod:`washbench.perception.sickness`) and
+``false_cue_events`` (``start_s-end_s@peak`` joined by ``;``), one row per washout and DOF
 (surge, sway, heave, roll, pitch, yaw). Floats are written with ``repr`` (exact round trip); an
 undefined NPC (flat signal) is an empty field; PC = -1 gives ``inf``.
 """
@@ -58,9 +60,11 @@ AIRCRAFT = "aircraft"
 
 METRICS_COLUMNS = (
     "washout", "dof", "npc", "integral_error", "max_error",
-    "cue_correct_frac", "cue_scaled_frac", "cue_false_frac", "cue_missing_frac", "false_cue_events",
+    "cue_correct_frac", "cue_scaled_frac", "cue_false_frac", "cue_missing_frac",
+    "msdv_mps15", "msdv_aircraft_mps15", "false_cue_events",
 )  # fmt: skip
 """metrics.csv columns; files written before the cue classification have the first five only (still read)."""
+METRICS_TEXT_COLUMNS = ("washout", "dof", "false_cue_events")
 N_BASE_METRICS_COLUMNS = 5
 
 #: Time steps an input motion may have, s: beyond, the filters cannot be discretised (a subnormal step, or one of
@@ -310,7 +314,7 @@ def metrics_csv_text(rows: Iterable[MetricRow]) -> str:
     w.writerow(METRICS_COLUMNS)
     for r in rows:
         w.writerow(
-            [r.washout, r.dof, *(csv_number(getattr(r, c)) for c in METRICS_COLUMNS[2:-1]), r.false_cue_events]
+            [getattr(r, c) if c in METRICS_TEXT_COLUMNS else csv_number(getattr(r, c)) for c in METRICS_COLUMNS]
         )
     return buf.getvalue()
 
@@ -337,9 +341,9 @@ def read_metrics_csv(path: str | Path) -> list[MetricRow]:
         if len(rec) != ncol:
             raise WashbenchError(located(path, f"expected {ncol} fields, got {len(rec)}", line=line))
         try:
-            nums = [math.nan if v == "" else float(v) for v in rec[2 : min(ncol, len(METRICS_COLUMNS) - 1)]]
+            values = {c: v if c in METRICS_TEXT_COLUMNS else (math.nan if v == "" else float(v))
+                      for c, v in zip(header, rec, strict=True)}  # fmt: skip
         except ValueError as exc:
             raise WashbenchError(located(path, f"not a number: {exc}", line=line)) from None
-        events = rec[-1] if ncol == len(METRICS_COLUMNS) else ""
-        rows.append(MetricRow(rec[0], rec[1], *nums, false_cue_events=events))
+        rows.append(MetricRow(**values))
     return rows

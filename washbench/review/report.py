@@ -246,6 +246,24 @@ def cue_lines(data: ResultData) -> list[str]:
     return lines
 
 
+def sickness_lines(data: ResultData) -> list[str]:
+    """MSDV (ISO 2631-1 Wf) of the vertical motion at each pilot's head (the heave rows of metrics.csv)."""
+    heave = [m for m in data.metrics if m.dof == "heave" and not math.isnan(m.msdv_mps15)]
+    if not heave:
+        return ["_This result was written before the motion sickness dose: `washbench cue` it again for it._", ""]
+    lines = [
+        "Motion sickness dose value MSDV = sqrt(integral a_w^2 dt) of the vertical acceleration at the head, "
+        "weighted by ISO 2631-1 Wf (peak near 0.16 Hz), over the manoeuvre (docs/fidelity.md). Lower is better; "
+        "a simulator pilot above the aircraft pilot gets more vertical low-frequency motion than the flight had.",
+        "",
+        "| pilot | MSDV (m/s^1.5) |",
+        "|---|---|",
+        f"| aircraft | {sig(heave[0].msdv_aircraft_mps15)} |",
+    ]
+    lines += [f"| {m.washout} | {sig(m.msdv_mps15)} |" for m in heave]
+    return [*lines, ""]
+
+
 def saturation_lines(data: ResultData) -> list[str]:
     """Time at each limit per washout, in seconds and percent of the manoeuvre."""
     from washbench.review.figures import SATURATION_LABELS
@@ -368,6 +386,7 @@ def result_sections(
     lines += [f"{h} Cues: correct, scaled, false, missing", "", *cue_lines(data)]
     if "cues" in figures:
         lines += _image(figures["cues"], start, "false and missing cues")
+    lines += [f"{h} Motion sickness dose", "", *sickness_lines(data)]
     lines += [f"{h} Metrics", "", *metric_tables(data)]
     lines += [f"{h} Platform", ""]
     if brief:

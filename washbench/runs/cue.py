@@ -198,22 +198,35 @@ def analyse(
                 raise ValueError(f"washout {name!r}: saturated[{kind!r}] has shape {np.shape(flags)}, expected ({n},)")
         perceived[name] = model.perceive(arr["head_f_mps2"], arr["head_omega_radps"], filter_start)
         checked[name] = arr
-    rows = _metric_rows(perceived, motion.dt_s)
+    vertical = {AIRCRAFT: motion.f_mps2[:, 2], **{w: a["head_f_mps2"][:, 2] for w, a in checked.items()}}
+    rows = _metric_rows(perceived, motion.dt_s, vertical)
     result = CueResult(motion=motion, traces=dict(traces), perceived=perceived, metrics=rows, arrays=checked)
     result.columns(0, 0)  # an input column that clashes with a result column fails now, before anything is written
     return result
 
 
-def _metric_rows(perceived: Mapping[str, Perceived], dt_s: float) -> list[MetricRow]:
-    """Six metric rows per washout: each simulator pilot's perceived motion against the aircraft pilot's."""
+def _metric_rows(
+    perceived: Mapping[str, Perceived], dt_s: float, vertical: Mapping[str, np.ndarray]
+) -> list[MetricRow]:
+    """Six metric rows per washout: each simulator pilot's perceived motion against the aircraft pilot's, the cue
+    classification, and on the heave row the MSDV of each pilot's head (``vertical``: pilot -> body-z specific
+    force (N,), m/s^2)."""
+    import dataclasses
+
     from washbench.analysis.cues import classified_rows
+    from washbench.perception.sickness import head_msdv
 
     ac = perceived[AIRCRAFT]
+    msdv_ac = head_msdv(vertical[AIRCRAFT], dt_s)
     rows: list[MetricRow] = []
     for name, p in perceived.items():
         if name != AIRCRAFT:
             base = dof_metrics(name, ac.f_mps2, ac.omega_radps, p.f_mps2, p.omega_radps, dt_s)
-            rows += classified_rows(base, ac.f_mps2, ac.omega_radps, p.f_mps2, p.omega_radps, dt_s)
+            msdv = head_msdv(vertical[name], dt_s)
+            rows += [
+                dataclasses.replace(r, msdv_mps15=msdv, msdv_aircraft_mps15=msdv_ac) if r.dof == "heave" else r
+                for r in classified_rows(base, ac.f_mps2, ac.omega_radps, p.f_mps2, p.omega_radps, dt_s)
+            ]
     return rows
 
 
@@ -351,6 +364,7 @@ def stream_cue(
     model = VestibularModel(motion.dt_s)
     streams = {p: PerceptionStream(model, filter_start) for p in (AIRCRAFT, *names)}
     felt = {p: Perceived(np.empty((n, 3)), np.empty((n, 3))) for p in streams}
+    vertical = {p: np.empty(n) for p in streams}  # body-z specific force at each pilot's head (MSDV)
     keep = (_REVIEW_FIELDS if figures or recording else ()) + (_RECORDING_FIELDS if recording else ())
     kept = {w: {f: np.empty((n, _TRACE_FIELDS[f])) for f in keep} for w in names}
     flags: dict[str, dict[str, np.ndarray]] = {w: {} for w in names}
@@ -370,6 +384,7 @@ def stream_cue(
                 fields[w] = {f: getattr(tr, f) for f in _TRACE_FIELDS} if finite else _checked_trace(w, tr, b - a, a)
                 saturated[w] = tr.saturated
                 perceived[w] = streams[w].perceive(fields[w]["head_f_mps2"], fields[w]["head_omega_radps"])
+                vertical[w][rows] = fields[w]["head_f_mps2"][:, 2]
                 for f in keep:
                     kept[w][f][rows] = fields[w][f]
                 for k, v in tr.saturated.items():
@@ -382,7 +397,8 @@ def stream_cue(
                 progress.update(b)
 
     write_trace_chunks(traces_path, tables(), metadata)
-    metrics = _metric_rows(felt, motion.dt_s)
+    vertical[AIRCRAFT][:] = motion.f_mps2[:, 2]
+    metrics = _metric_rows(felt, motion.dt_s, vertical)
     counts = bank.saturation_counts()
     traces = {w: SimpleNamespace(**kept[w], saturated=flags[w], saturation_counts=counts[w]) for w in names}
     return CueResult(motion=motion, traces=traces, perceived=felt, metrics=metrics)

@@ -352,13 +352,13 @@ def _runs_with_metrics(outcomes: Sequence[Outcome]) -> list[Outcome]:
 
 def metrics_table(outcomes: Sequence[Outcome]) -> str:
     """``metrics.csv`` of the suite (every run that produced metrics, failed checks included)."""
-    from washbench.io.results import METRICS_COLUMNS
+    from washbench.io.results import METRICS_COLUMNS, METRICS_TEXT_COLUMNS
 
     rows = [["aircraft", "manoeuvre", *METRICS_COLUMNS]]
     for o in _runs_with_metrics(outcomes):
         for m in o.run.metrics:
-            nums = [csv_number(getattr(m, c)) for c in METRICS_COLUMNS[2:-1]]
-            rows.append([o.run.aircraft, o.run.manoeuvre, m.washout, m.dof, *nums, m.false_cue_events])
+            cells = [getattr(m, c) if c in METRICS_TEXT_COLUMNS else csv_number(getattr(m, c)) for c in METRICS_COLUMNS]
+            rows.append([o.run.aircraft, o.run.manoeuvre, *cells])
     return _csv(rows)
 
 
