@@ -122,3 +122,30 @@ def test_msdv_on_the_heave_rows_equals_an_independent_analogue_simulation(trace:
     assert expected > 0.3  # 0.5 m/s^2 at 0.2 Hz (Wf 0.99) for 10 s, less the filter's start: about 1.1
     assert heave[0].msdv_aircraft_mps15 == pytest.approx(expected, rel=1e-3)
     assert "## Motion sickness dose" in (tmp_path / "m" / "report.md").read_text()
+
+
+def test_vestibular_choice_changes_the_perception_and_is_recorded(trace: Path, tmp_path: Path) -> None:
+    """--vestibular telban-cardullo: the aircraft pilot's perceived roll rate is the Telban-Cardullo canal model's
+    (scipy lsim of its transfer function on the input), the choice is in the provenance and the report."""
+    import pyarrow.parquet as pq
+    from scipy import signal
+
+    from washbench.perception.vestibular import MODELS, canal_tf
+
+    res = cue(trace, "--out", tmp_path / "tc", "--vestibular", "telban-cardullo")
+    assert res.returncode == 0, res.stderr
+    prov = json.loads((tmp_path / "tc" / "run.json").read_text())["provenance"]
+    assert prov["vestibular"]["model"] == "telban-cardullo"
+    assert prov["vestibular"]["values"]["canals"]["T_N_s"] == 0.06
+    assert "Telban-Cardullo otolith and canals" in (tmp_path / "tc" / "report.md").read_text()
+    table = pq.read_table(tmp_path / "tc" / "traces.parquet")
+    t = table.column("t_s").to_numpy()
+    p = table.column("aircraft.perceived_omega_x_degps").to_numpy()
+    u = np.loadtxt(trace, delimiter=",", skiprows=1)[:, 4]  # omega_x_degps of the input
+    _, y, _ = signal.lsim(signal.lti(*canal_tf(MODELS["telban-cardullo"].canals)), u, t)
+    np.testing.assert_allclose(p, y, atol=1e-6 * 20.0 * 12.0)
+    default = cue(trace, "--out", tmp_path / "ym")
+    assert default.returncode == 0
+    p_ym = pq.read_table(tmp_path / "ym" / "traces.parquet").column("aircraft.perceived_omega_x_degps").to_numpy()
+    assert np.max(np.abs(p_ym - p)) > 1.0  # a different model, a different perception
+    assert json.loads((tmp_path / "ym" / "run.json").read_text())["provenance"]["vestibular"]["model"] == "young-meiry"

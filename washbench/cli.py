@@ -34,10 +34,12 @@ def _washout_options(p: argparse.ArgumentParser, variants: bool = True) -> None:
 
 
 def _rank_option(p: argparse.ArgumentParser) -> None:
-    """--rank-by (cue, run, suite): the ranking rule, recorded in the provenance (docs/fidelity.md)."""
+    """--rank-by and --vestibular (cue, run, suite), recorded in the provenance (docs/fidelity.md)."""
     p.add_argument("--rank-by", choices=("score", "false-cue", "weighted"),
                    help="ranking rule (default: the parameter file's ranking: section, else score); weighted uses "
                    "its ranking.dof_weights")  # fmt: skip
+    p.add_argument("--vestibular", choices=("young-meiry", "telban-cardullo"),
+                   help="vestibular models (default young-meiry: Meiry-Young otolith, Young-Oman canals)")
 
 
 def _study_options(p: argparse.ArgumentParser) -> None:
@@ -268,6 +270,7 @@ def _cue(args: argparse.Namespace) -> int:
         recording=not args.no_recording,
         figures=not args.no_figures,
         rank_by=args.rank_by,
+        vestibular=args.vestibular,
     )
     return run_cue(
         args.input,
@@ -348,6 +351,7 @@ def _dispatch(args: argparse.Namespace) -> int:
             variants=args.variant,
             aircraft_dirs=args.aircraft_dir,
             rank_by=args.rank_by,
+            vestibular=args.vestibular,
         )
     if args.command == "suite":
         from washbench.runs.suite import suite_command
@@ -367,6 +371,7 @@ def _dispatch(args: argparse.Namespace) -> int:
             variants=args.variant,
             dask=args.dask,
             rank_by=args.rank_by,
+            vestibular=args.vestibular,
         )
     if args.command == "omct":
         from washbench.runs.omct import run_omct

@@ -98,6 +98,14 @@ def provenance_lines(prov: dict[str, Any] | None, created_utc: str | None) -> li
         ]  # fmt: skip
         rows.append(("washouts", ", ".join(runs)))
     file_row("platform", prov.get("platform"))
+    vest = prov.get("vestibular")
+    if isinstance(vest, dict) and vest.get("model"):
+        names = {"young-meiry": "Meiry-Young otolith, Young-Oman canals (the paper's)",
+                 "telban-cardullo": "Telban-Cardullo otolith and canals (NASA CR-2005-213747)"}  # fmt: skip
+        rows.append(("vestibular models", names.get(vest["model"], str(vest["model"]))))
+    ranking = prov.get("ranking")
+    if isinstance(ranking, dict) and ranking.get("by"):
+        rows.append(("ranking rule", f"`--rank-by {ranking['by']}`"))
     if "turbulence" in prov or (inp and "turbulence" in inp.get("provenance", {})):
         turb = prov.get("turbulence", inp.get("provenance", {}).get("turbulence") if inp else None)
         rows.append(("turbulence", f"{turb['severity']}, seed {turb['seed']}" if turb else "none"))

@@ -56,7 +56,7 @@ from washbench.io.results import (
     write_metrics_csv,
     write_traces,
 )
-from washbench.perception.vestibular import Perceived, VestibularModel, VestibularParams
+from washbench.perception.vestibular import Perceived, VestibularModel, VestibularParams, model_params
 
 TRACES_FILE = "traces.parquet"
 METRICS_FILE = "metrics.csv"
@@ -339,6 +339,7 @@ def stream_cue(
     figures: bool = True,
     chunk_rows: int = CHUNK_ROWS,
     progress: Progress | None = None,
+    vestibular: VestibularParams | None = None,
 ) -> CueResult:
     """:func:`cue_motion` and the traces.parquet of :func:`write_results` in one pass, ``chunk_rows`` samples at a
     time (washouts, vestibular models, one Parquet row group per chunk): the same columns and metrics, bit for bit.
@@ -361,7 +362,7 @@ def stream_cue(
         raise WashbenchError("nothing to cue: the input has no rows")
     bank = CueingBank(washouts, None, limits, motion.dt_s, filter_start)
     names = bank.washouts
-    model = VestibularModel(motion.dt_s)
+    model = VestibularModel(motion.dt_s, vestibular)
     streams = {p: PerceptionStream(model, filter_start) for p in (AIRCRAFT, *names)}
     felt = {p: Perceived(np.empty((n, 3)), np.empty((n, 3))) for p in streams}
     vertical = {p: np.empty(n) for p in streams}  # body-z specific force at each pilot's head (MSDV)
@@ -444,6 +445,7 @@ class CueOptions:
     recording: bool = True
     figures: bool = True
     rank_by: str | None = None  # the ranking rule (--rank-by; None: the parameter file's)
+    vestibular: str | None = None  # the vestibular model (--vestibular; None: young-meiry)
 
 
 @dataclass(frozen=True, eq=False)
@@ -567,6 +569,7 @@ def write_outputs(
                 result = stream_cue(
                     seg.motion, washouts, limits, tmp[TRACES_FILE], meta,
                     filter_start=opts.filter_start, recording=opts.recording, figures=opts.figures, progress=shown,
+                    vestibular=model_params(opts.vestibular),
                 )  # fmt: skip
                 offset += seg.motion.n
                 summary = segment_summary(input_path, seg, result, folder)
@@ -637,7 +640,8 @@ def run_cue(
         from washbench.io.provenance import file_record, read_parquet_provenance
         from washbench.runs.pipeline import run_provenance
 
-        prov = run_provenance(params_path, platform_path, specs, limits, rank_by=opts.rank_by)
+        prov = run_provenance(params_path, platform_path, specs, limits, rank_by=opts.rank_by,
+                              vestibular=opts.vestibular)  # fmt: skip
         prov["input"] = file_record(input_path)
         is_parquet = input_path.suffix.lower() in (".parquet", ".pq")
         input_prov = read_parquet_provenance(input_path) if is_parquet else None

@@ -185,6 +185,7 @@ def _run_one(
     max_time_s: float | None = None,
     outputs: Outputs = DEFAULT_OUTPUTS,
     rank_by: str | None = None,
+    vestibular: str | None = None,
 ) -> list[Outcome]:
     """Worker: run one manoeuvre or JSBSim script (one outcome per run segment); never raises (failures
     come back as an Outcome)."""
@@ -198,6 +199,7 @@ def _run_one(
         dirs = [Path(d) for d in aircraft_dirs]
         common = {"params_path": params, "platform_path": platform, "aircraft_dirs": dirs}
         common |= {"washouts": washouts, "variants": variants, "outputs": outputs, "rank_by": rank_by}
+        common |= {"vestibular": vestibular}
         if is_script(Path(path)):
             runs = run_script(Path(path), Path(out_dir), max_time_s=max_time_s, **common)
         else:
@@ -262,6 +264,7 @@ def run_suite(
     max_time_s: float | None = None,
     outputs: Outputs = DEFAULT_OUTPUTS,
     rank_by: str | None = None,
+    vestibular: str | None = None,
 ) -> list[Outcome]:
     """Run every file in parallel processes (or on the Dask cluster at ``dask``); outcomes in the order of ``files``
     (a JSBSim script that resets gives one outcome per run segment, in order). ``outputs``: whether the
@@ -276,8 +279,8 @@ def run_suite(
     params = str(params_path) if params_path else None
     platform = str(platform_path) if platform_path else None
     chosen = tuple(washouts) if washouts else None
-    args = [(str(f), str(out_dir), params, platform, chosen, tuple(variants), dirs, max_time_s, outputs, rank_by)
-            for f in files]
+    args = [(str(f), str(out_dir), params, platform, chosen, tuple(variants), dirs, max_time_s, outputs, rank_by,
+             vestibular) for f in files]  # fmt: skip
     outcomes: dict[str, list[Outcome]] = {}
     start = time.perf_counter()
     if progress:
@@ -548,6 +551,7 @@ def suite_command(
     max_time_s: float | None = None,
     outputs: Outputs = DEFAULT_OUTPUTS,
     rank_by: str | None = None,
+    vestibular: str | None = None,
 ) -> int:
     """CLI entry: run the suite, write its results, print where they are; 0 if all succeeded, else 1.
 
@@ -578,6 +582,7 @@ def suite_command(
         platform_path=platform_path or DEFAULT_LIMITS_PATH,
         platform=load_platform_limits(platform_path),
         ranking=load_rank_rule(params_path, rank_by).record(),
+        vestibular=vestibular or "young-meiry",
     )
     check_unique_names(files, aircraft_dirs)
     start = time.perf_counter()
@@ -604,6 +609,7 @@ def suite_command(
                 max_time_s=max_time_s,
                 outputs=outputs,
                 rank_by=rank_by,
+                vestibular=vestibular,
             )
             write_suite_results(outcomes, stage, provenance, outputs.figures)
             _swap_in(stage, out_dir, previous)
