@@ -117,7 +117,7 @@ def build_provenance(
     aircraft_files: Any = None,
     washouts: Sequence[Any] = (),
     ranking: Mapping[str, Any] | None = None,
-    vestibular: str | None = None,
+    vestibular: Mapping[str, Any] | None = None,
 ) -> dict[str, Any]:
     """The provenance of one result (module docstring); no date in it.
 
@@ -128,8 +128,8 @@ def build_provenance(
     each with its path and SHA-256 (the model's own file only: engines and systems it includes are not hashed).
     ``washouts`` (``washbench.cueing.variants.Washout``: name, kind, params) lists what ran; a variant's complete
     parameter values are recorded where they differ from the file's base set. ``ranking``: the ranking rule
-    (:meth:`washbench.analysis.ranking.RankRule.record`); ``vestibular``: the vestibular model's name
-    (:data:`washbench.perception.vestibular.MODELS`), recorded with its values.
+    (:meth:`washbench.analysis.ranking.RankRule.record`); ``vestibular``: the vestibular model
+    (:func:`washbench.perception.vestibular.model_record`: its name and values).
     """
     prov: dict[str, Any] = {"software": software_versions()}
     if manoeuvre_path is not None:
@@ -153,9 +153,7 @@ def build_provenance(
     if ranking is not None:
         prov["ranking"] = dict(ranking)
     if vestibular is not None:
-        from washbench.perception.vestibular import model_params
-
-        prov["vestibular"] = {"model": vestibular, "values": model_params(vestibular).model_dump(mode="json")}
+        prov["vestibular"] = dict(vestibular)
     return prov
 
 

@@ -100,6 +100,12 @@ otolith and Young-Oman canals, the default) and ``telban-cardullo``."""
 DEFAULT_MODEL = "young-meiry"
 
 
+def model_record(name: str | None) -> dict[str, object]:
+    """The provenance record of a model of :data:`MODELS`: ``{"model": name, "values": its parameters}``."""
+    key = DEFAULT_MODEL if name is None else name
+    return {"model": key, "values": model_params(key).model_dump(mode="json")}
+
+
 def model_params(name: str | None) -> VestibularParams:
     """The parameters of a model of :data:`MODELS` (None: the default); ValueError naming the valid ones."""
     key = DEFAULT_MODEL if name is None else name

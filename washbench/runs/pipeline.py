@@ -227,6 +227,7 @@ def run_provenance(
     the ranking rule (:func:`washbench.runs.rank_rule.load_rank_rule`)."""
     from washbench.cueing import load_washout_params
     from washbench.cueing.params import DEFAULT_PARAMS_PATH
+    from washbench.perception.vestibular import model_record
     from washbench.platform.limits import DEFAULT_LIMITS_PATH
     from washbench.runs.rank_rule import load_rank_rule
 
@@ -240,7 +241,7 @@ def run_provenance(
         platform_path=platform_path or DEFAULT_LIMITS_PATH,
         platform=limits,
         ranking=load_rank_rule(params_path, rank_by).record(),
-        vestibular=vestibular or "young-meiry",
+        vestibular=model_record(vestibular),
     )
 
 

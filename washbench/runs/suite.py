@@ -571,6 +571,7 @@ def suite_command(
     from washbench.cueing.params import DEFAULT_PARAMS_PATH
     from washbench.cueing.variants import select_washouts
     from washbench.io.provenance import build_provenance
+    from washbench.perception.vestibular import model_record
     from washbench.platform import load_platform_limits
     from washbench.platform.limits import DEFAULT_LIMITS_PATH
     from washbench.runs.rank_rule import load_rank_rule
@@ -582,7 +583,7 @@ def suite_command(
         platform_path=platform_path or DEFAULT_LIMITS_PATH,
         platform=load_platform_limits(platform_path),
         ranking=load_rank_rule(params_path, rank_by).record(),
-        vestibular=vestibular or "young-meiry",
+        vestibular=model_record(vestibular),
     )
     check_unique_names(files, aircraft_dirs)
     start = time.perf_counter()
