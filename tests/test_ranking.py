@@ -84,8 +84,8 @@ def test_rank_marks_ties_and_counts_undecided_first_places() -> None:
     b = rows_for("large-angle", {"surge": 0.595})
     c = rows_for("unrestricted", {"surge": 0.9})
     ranking = rank(a + b + c, motion)
-    assert [(r.washout, r.rank, r.tied) for r in ranking] == [
-        ("small-angle", 1, True), ("large-angle", 1, True), ("unrestricted", 3, False)
+    assert [(r.washout, r.rank, r.tied) for r in ranking] == [  # within the tie by value
+        ("large-angle", 1, True), ("small-angle", 1, True), ("unrestricted", 3, False)
     ]
     assert undecided(ranking)
     assert wins([ranking]) == {"small-angle": 1, "large-angle": 1, "unrestricted": 0}

@@ -60,3 +60,18 @@ def test_msdv_of_a_sinusoid_is_its_closed_form() -> None:
     # and from the head's specific force: level flight (f_z = -g) plus the same motion gives the same dose
     assert sickness.head_msdv(-9.80665 - a, dt) == pytest.approx(math.sqrt(m_long), rel=1e-9)
     assert sickness.head_msdv(np.full(1000, -9.80665), dt) == 0.0
+
+
+def test_hand_bilinear_and_filter_equal_scipy() -> None:
+    """wf_sos (bilinear by hand, per factor) and sos_filter against scipy's bilinear_zpk and sosfilt."""
+    dt = 1 / 120
+    num, den = sickness.wf_tf()
+    z, p, k = signal.tf2zpk(num, den)
+    ref_sos = signal.zpk2sos(*signal.bilinear_zpk(z, p, k, 1 / dt))
+    w = np.linspace(0.001, 3.0, 50)
+    _, h_mine = signal.sosfreqz(sickness.wf_sos(dt), worN=w, fs=1 / dt)
+    _, h_ref = signal.sosfreqz(ref_sos, worN=w, fs=1 / dt)
+    np.testing.assert_allclose(h_mine, h_ref, rtol=1e-8, atol=1e-12)
+    x = np.random.default_rng(3).normal(size=5000)
+    sos = sickness.wf_sos(dt)
+    np.testing.assert_allclose(sickness.sos_filter(sos, x), signal.sosfilt(sos, x), rtol=1e-10, atol=1e-13)

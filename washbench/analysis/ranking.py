@@ -39,8 +39,8 @@ Other rules (:class:`RankRule`, ``--rank-by`` and the parameter file's ``ranking
 **Ties** (honest ranks). Values are sorted (lower first); a tie group starts at the best value ``v0`` not yet
 ranked and takes every further value ``v`` with ``v - v0 <= max(TIE_RELATIVE * |v0|, TIE_ABSOLUTE)`` (measured
 from the group's best, so a group never chains beyond the margin). Every washout of a group gets the same rank,
-one more than the number of washouts ranked before the group ("1, 1, 3"), and is marked ``tied``. Within a
-group, and for the order of the rows, washouts keep the order they were listed in. The margins are CHOSEN
+one more than the number of washouts ranked before the group ("1, 1, 3"), and is marked ``tied``. Rows are
+ordered by rank, then value, then the order the washouts were listed in. The margins are CHOSEN
 (docs/fidelity.md): 3 % of the score (0.605 against 0.595 is a tie) or 0.005, whichever is larger.
 """
 
@@ -260,13 +260,18 @@ def rule_values(
 def rank(rows: Sequence[MetricRow], motion: Mapping[str, float], rule: RankRule = DEFAULT_RULE) -> list[RankRow]:
     """Rank the washouts of one manoeuvre by ``rule`` with honest ties (module doc gives the rules).
 
-    Rows come best first; within a tie, in the order the washouts were listed.
+    Rows come best first; within a tie by value (the shared rank says the order is not a verdict), equal values
+    in the order the washouts were listed.
     """
     washouts = washout_order(rows)
     values, weights = rule_values(rows, motion, rule)
     ranks = tie_groups([values[w] for w in washouts], rule.tie_relative, rule.tie_absolute)
     share = {r: ranks.count(r) for r in ranks}
-    ordered = sorted(range(len(washouts)), key=lambda i: (ranks[i], i))
+    def value(i: int) -> float:
+        v = values[washouts[i]]
+        return math.inf if math.isnan(v) else v
+
+    ordered = sorted(range(len(washouts)), key=lambda i: (ranks[i], value(i), i))
     return [
         RankRow(washout=washouts[i], score=values[washouts[i]], rank=ranks[i], weights=weights,
                 tied=share[ranks[i]] > 1)

@@ -32,6 +32,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba import njit
 
 from washbench.io.units import G0_MPS2
 
@@ -57,16 +58,56 @@ def wf_tf() -> tuple[np.ndarray, np.ndarray]:
     return num, den
 
 
-def wf_sos(dt_s: float) -> np.ndarray:
-    """Wf discretised by the bilinear transform at step ``dt_s`` [s], as scipy second-order sections."""
-    from scipy import signal
+def wf_factors() -> list[tuple[tuple[float, float, float], tuple[float, float, float]]]:
+    """The four analogue factors of Wf as ((b2, b1, b0), (a2, a1, a0)): ``(b2 s^2 + b1 s + b0) / (a2 s^2 + ...)``."""
+    p = WF_PARAMS
+    w1, w2, w4, w5, w6 = (2.0 * math.pi * p[k] for k in ("f1_hz", "f2_hz", "f4_hz", "f5_hz", "f6_hz"))
+    return [
+        ((1.0, 0.0, 0.0), (1.0, w1 / p["q1"], w1 * w1)),
+        ((0.0, 0.0, w2 * w2), (1.0, w2 / p["q2"], w2 * w2)),
+        ((0.0, 0.0, w4 * w4), (1.0, w4 / p["q4"], w4 * w4)),
+        ((1.0, w5 / p["q5"], w5 * w5), (1.0, w6 / p["q6"], w6 * w6)),
+    ]
 
+
+def wf_sos(dt_s: float) -> np.ndarray:
+    """Wf discretised by the bilinear transform at step ``dt_s`` [s]: second-order sections (4, 6) in scipy's
+    layout ``[b0, b1, b2, 1, a1, a2]`` (coefficients of z^0, z^-1, z^-2), one per analogue factor.
+
+    ``s = K (1 - z^-1) / (1 + z^-1)``, ``K = 2 / dt``, applied to each factor by hand (no scipy import at run time).
+    """
     if not (math.isfinite(dt_s) and dt_s > 0.0):
         raise ValueError(f"dt must be a positive number of seconds, got {dt_s!r}")
-    num, den = wf_tf()
-    z, p, k = signal.tf2zpk(num, den)
-    zd, pd, kd = signal.bilinear_zpk(z, p, k, 1.0 / dt_s)
-    return signal.zpk2sos(zd, pd, kd)
+    k = 2.0 / dt_s
+    rows = []
+    for (b2, b1, b0), (a2, a1, a0) in wf_factors():
+        nb = (b2 * k * k + b1 * k + b0, 2.0 * (b0 - b2 * k * k), b2 * k * k - b1 * k + b0)
+        na = (a2 * k * k + a1 * k + a0, 2.0 * (a0 - a2 * k * k), a2 * k * k - a1 * k + a0)
+        rows.append([nb[0] / na[0], nb[1] / na[0], nb[2] / na[0], 1.0, na[1] / na[0], na[2] / na[0]])
+    return np.array(rows)
+
+
+def sos_filter(sos: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Filter ``x`` (N,) through second-order sections (S, 6) from rest (direct form II transposed), as
+    ``scipy.signal.sosfilt`` does, without importing scipy."""
+    y = np.asarray(x, dtype=np.float64).copy()
+    for b0, b1, b2, _, a1, a2 in np.asarray(sos, dtype=np.float64):
+        y = _biquad(float(b0), float(b1), float(b2), float(a1), float(a2), y)
+    return y
+
+
+@njit(cache=True)
+def _biquad(b0: float, b1: float, b2: float, a1: float, a2: float, x: np.ndarray) -> np.ndarray:
+    y = np.empty_like(x)
+    z1 = 0.0
+    z2 = 0.0
+    for i in range(x.shape[0]):
+        xi = x[i]
+        yi = b0 * xi + z1
+        z1 = b1 * xi - a1 * yi + z2
+        z2 = b2 * xi - a2 * yi
+        y[i] = yi
+    return y
 
 
 def vertical_acceleration(f_z_mps2: np.ndarray) -> np.ndarray:
@@ -76,9 +117,7 @@ def vertical_acceleration(f_z_mps2: np.ndarray) -> np.ndarray:
 
 def wf_weighted(a_mps2: np.ndarray, dt_s: float) -> np.ndarray:
     """The Wf-weighted acceleration (N,) of ``a_mps2`` (N,), filter starting at rest."""
-    from scipy import signal
-
-    return signal.sosfilt(wf_sos(dt_s), np.asarray(a_mps2, dtype=np.float64))
+    return sos_filter(wf_sos(dt_s), a_mps2)
 
 
 def msdv(a_mps2: np.ndarray, dt_s: float) -> float:
