@@ -234,5 +234,5 @@ def _existing_figures(d: ResultData) -> dict[str, Path]:
 
 
 def _tie_label(ranking: Sequence[RankRow]) -> str:
-    """Row-label suffix of the score figure naming a shared first place (`` (tie: a = b)``), else empty."""
-    return " (tie: " + " = ".join(r.washout for r in ranking if r.rank == 1) + ")" if undecided(ranking) else ""
+    """Row-label suffix of the score figure naming a shared first place (a second line ``tie: a = b``), else empty."""
+    return "\ntie: " + " = ".join(r.washout for r in ranking if r.rank == 1) if undecided(ranking) else ""
