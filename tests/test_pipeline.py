@@ -59,7 +59,7 @@ def test_run_writes_every_file_and_nothing_else(run_dir: Path) -> None:
         ]
     )
     assert sorted(p.name for p in (run_dir / "figures").iterdir()) == [
-        "envelope.png", "perceived.png"
+        "cues.png", "envelope.png", "perceived.png"
     ]  # PNG only: `washbench report` adds the PDFs
     assert not list(run_dir.parent.glob(".*")), "temporary folders left behind"
     flight = json.loads((run_dir / "flight.json").read_text())

@@ -126,12 +126,13 @@ def test_report_header_names_the_inputs_and_versions(run_dir: Path, inputs: dict
 
 
 def test_every_linked_figure_exists_and_is_an_image(run_dir: Path) -> None:
-    assert check_images(run_dir / "report.md") == 2  # perceived motion, platform envelope
+    assert check_images(run_dir / "report.md") == 3  # perceived motion, false and missing cues, platform envelope
 
 
 def test_every_table_is_well_formed(run_dir: Path) -> None:
-    # provenance, ranking, three metric tables, time at a limit, checks, phases
-    assert check_tables(run_dir / "report.md") == 8
+    # provenance, ranking, cue classification, motion sickness dose, three metric tables, time at a limit, checks,
+    # phases
+    assert check_tables(run_dir / "report.md") == 10
 
 
 def test_report_reads_like_a_table(run_dir: Path) -> None:
@@ -180,8 +181,8 @@ def test_report_is_regenerated_from_the_files_alone(run_dir: Path, inputs: dict[
     assert proc.returncode == 0, proc.stderr
     # the same report, with the PDF versions the run left to `washbench report` now linked
     assert without_pdf_links((copy / "report.md").read_text()) == (run_dir / "report.md").read_text()
-    assert check_images(copy / "report.md", vector=True) == 2
-    for name in ("perceived.png", "envelope.png"):
+    assert check_images(copy / "report.md", vector=True) == 3
+    for name in ("perceived.png", "envelope.png", "cues.png"):
         assert (copy / "figures" / name).read_bytes() == (run_dir / "figures" / name).read_bytes(), name
 
 
@@ -202,7 +203,7 @@ def test_cue_results_get_the_same_report(run_dir: Path, tmp_path: Path) -> None:
     assert sha256(run_dir / "flight.parquet") in text and flown["manoeuvre"]["sha256"] in text
     assert "| sa_slow_tilt |" in text and "sa_slow_tilt vs small-angle (% better)" in text
     assert "| washouts | small-angle, sa_slow_tilt (small-angle) with its own values |" in text
-    assert check_images(out / "report.md") == 2
+    assert check_images(out / "report.md") == 3
 
 
 def test_no_figures_then_report_draws_them_with_their_pdfs(run_dir: Path, tmp_path: Path) -> None:
@@ -222,8 +223,8 @@ def test_no_figures_then_report_draws_them_with_their_pdfs(run_dir: Path, tmp_pa
     assert rows(text) == rows((full / "report.md").read_text())
     proc = washbench("report", out)
     assert proc.returncode == 0, proc.stderr
-    assert check_images(out / "report.md", vector=True) == 2
-    for name in ("perceived.png", "envelope.png"):  # drawn from the files = drawn by the cue from memory
+    assert check_images(out / "report.md", vector=True) == 3
+    for name in ("perceived.png", "envelope.png", "cues.png"):  # drawn from the files = drawn by the cue from memory
         assert (out / "figures" / name).read_bytes() == (full / "figures" / name).read_bytes(), name
 
 

@@ -47,6 +47,15 @@ def _washout_options(p: argparse.ArgumentParser, variants: bool = True) -> None:
     _plugin_option(p)
 
 
+def _rank_option(p: argparse.ArgumentParser) -> None:
+    """--rank-by and --vestibular (cue, run, suite), recorded in the provenance (docs/fidelity.md)."""
+    p.add_argument("--rank-by", choices=("score", "false-cue", "weighted"),
+                   help="ranking rule (default: the parameter file's ranking: section, else score); weighted uses "
+                   "its ranking.dof_weights")  # fmt: skip
+    p.add_argument("--vestibular", choices=("young-meiry", "telban-cardullo"),
+                   help="vestibular models (default young-meiry: Meiry-Young otolith, Young-Oman canals)")
+
+
 def _study_options(p: argparse.ArgumentParser) -> None:
     """What sweep and tune share."""
     _plugin_option(p)
@@ -103,6 +112,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", type=Path, required=True, help="output folder (a run result folder's files)")
     _cue_input_options(p)
     _washout_options(p)
+    _rank_option(p)
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
 
@@ -125,6 +135,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--out", type=Path, required=True, help="results folder; writes OUT/<aircraft>/<manoeuvre>/")
     _washout_options(p)
+    _rank_option(p)
     _aircraft_dir_option(p)
     p.add_argument("--max-time-s", type=float, metavar="S", help="JSBSim script: stop after S s simulated")
     p.add_argument("--filter-start", choices=("steady", "rest"), default="steady", help="filters' start state")
@@ -147,6 +158,7 @@ def build_parser() -> argparse.ArgumentParser:
     _aircraft_dir_option(p)
     p.add_argument("--jobs", type=_jobs, help="parallel processes (default: the CPUs this process may use)")
     _washout_options(p)
+    _rank_option(p)
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
     p.add_argument("--dask", metavar="ADDRESS", help="run on this Dask scheduler instead of local processes")
@@ -341,6 +353,8 @@ def _cue(args: argparse.Namespace) -> int:
         strict=args.strict,
         recording=not args.no_recording,
         figures=not args.no_figures,
+        rank_by=args.rank_by,
+        vestibular=args.vestibular,
     )
     return run_cue(
         args.input,
@@ -420,6 +434,8 @@ def _dispatch(args: argparse.Namespace) -> int:
             washouts=args.washout,
             variants=args.variant,
             aircraft_dirs=args.aircraft_dir,
+            rank_by=args.rank_by,
+            vestibular=args.vestibular,
         )
     if args.command == "suite":
         from washbench.runs.suite import suite_command
@@ -438,6 +454,8 @@ def _dispatch(args: argparse.Namespace) -> int:
             washouts=args.washout,
             variants=args.variant,
             dask=args.dask,
+            rank_by=args.rank_by,
+            vestibular=args.vestibular,
         )
     if args.command == "omct":
         from washbench.runs.omct import run_omct

@@ -269,6 +269,7 @@ def load_param_file(path: Path | None = None) -> tuple[WashoutParams, tuple[Wash
     if not isinstance(data, dict):
         return validate_data(path, data, lines, WashoutParams), ()
     variants = data.pop("variants", None)
+    data.pop("ranking", None)  # the ranking rule's section (washbench.runs.rank_rule)
     kinds = registry.python_kinds()
     sections = {k: data.pop(k) for k in list(data) if k in kinds}
     for kind, section in sections.items():  # each validated now, so its errors name the file and line

@@ -121,6 +121,8 @@ def build_provenance(
     turbulence: Any = None,
     aircraft_files: Any = None,
     washouts: Sequence[Any] = (),
+    ranking: Mapping[str, Any] | None = None,
+    vestibular: Mapping[str, Any] | None = None,
 ) -> dict[str, Any]:
     """The provenance of one result (module docstring); no date in it.
 
@@ -130,7 +132,9 @@ def build_provenance(
     where the manoeuvre's aircraft was found) adds the JSBSim model file ``<name>/<name>.xml`` and the pilot profile,
     each with its path and SHA-256 (the model's own file only: engines and systems it includes are not hashed).
     ``washouts`` (``washbench.cueing.variants.Washout``: name, kind, params) lists what ran; a variant's complete
-    parameter values are recorded where they differ from the file's base set.
+    parameter values are recorded where they differ from the file's base set. ``ranking``: the ranking rule
+    (:meth:`washbench.analysis.ranking.RankRule.record`); ``vestibular``: the vestibular model
+    (:func:`washbench.perception.vestibular.model_record`: its name and values).
     """
     prov: dict[str, Any] = {"software": software_versions()}
     if manoeuvre_path is not None:
@@ -154,6 +158,10 @@ def build_provenance(
     config_used = os.environ.get(CONFIG_USED_ENV)
     if config_used and Path(config_used).is_file():
         prov["config"] = file_record(config_used)
+    if ranking is not None:
+        prov["ranking"] = dict(ranking)
+    if vestibular is not None:
+        prov["vestibular"] = dict(vestibular)
     return prov
 
 

@@ -24,7 +24,17 @@ from typing import Any
 import numpy as np
 
 from washbench.analysis.metrics import DOFS
-from washbench.analysis.ranking import METRICS, RankRow, compare, rank, reference_washout
+from washbench.analysis.ranking import (
+    DEFAULT_RULE,
+    METRICS,
+    RankRow,
+    RankRule,
+    compare,
+    rank,
+    reference_washout,
+    rule_from_record,
+    undecided,
+)
 from washbench.io.atomic import write_text_atomic
 from washbench.review.numbers import pct, sig
 from washbench.review.result_data import ResultData, load_result
@@ -87,6 +97,14 @@ def provenance_lines(prov: dict[str, Any] | None, created_utc: str | None) -> li
         ]  # fmt: skip
         rows.append(("washouts", ", ".join(runs)))
     file_row("platform", prov.get("platform"))
+    vest = prov.get("vestibular")
+    if isinstance(vest, dict) and vest.get("model"):
+        names = {"young-meiry": "Meiry-Young otolith, Young-Oman canals (the paper's)",
+                 "telban-cardullo": "Telban-Cardullo otolith and canals (NASA CR-2005-213747)"}  # fmt: skip
+        rows.append(("vestibular models", names.get(vest["model"], str(vest["model"]))))
+    ranking = prov.get("ranking")
+    if isinstance(ranking, dict) and ranking.get("by"):
+        rows.append(("ranking rule", f"`--rank-by {ranking['by']}`"))
     if "turbulence" in prov or (inp and "turbulence" in inp.get("provenance", {})):
         turb = prov.get("turbulence", inp.get("provenance", {}).get("turbulence") if inp else None)
         rows.append(("turbulence", f"{turb['severity']}, seed {turb['seed']}" if turb else "none"))
@@ -117,21 +135,41 @@ def _score_cell(score: float, best: bool) -> str:
     return f"{text} {FLAG}" if score > 1.0 else text
 
 
-def ranking_lines(data: ResultData, ranking: list[RankRow]) -> list[str]:
-    """Ranking table (rank, washout, score) and the DOF weights used."""
+def result_rule(data: ResultData) -> RankRule:
+    """The ranking rule a result was written with (its provenance's ``ranking``; the default before rules)."""
+    prov = data.provenance
+    return rule_from_record(prov.get("ranking") if isinstance(prov, dict) else None)
+
+
+def rank_cell(r: RankRow) -> str:
+    """A rank as shown: ``1`` or, when shared (a tie within the margin), ``1 (tie)``."""
+    return f"{r.rank} (tie)" if r.tied else str(r.rank)
+
+
+def ranking_lines(data: ResultData, ranking: list[RankRow], rule: RankRule = DEFAULT_RULE) -> list[str]:
+    """Ranking table (rank, washout, the rule's value), the rule with its tie margin and the DOF weights used."""
     if not ranking:
         return []
-    lines = ["| rank | washout | score (-) |", "|---|---|---|"]
-    lines += [f"| {r.rank} | {r.washout} | {_score_cell(r.score, r.rank == 1)} |" for r in ranking]
-    weights = ranking[0].weights
+    unit = "false-cue time (DOF lengths)" if rule.by == "false-cue" else "score (-)"
+    lines = [f"| rank | washout | {unit} |", "|---|---|---|"]
+    flag = rule.by != "false-cue"
     lines += [
-        "",
-        "Score: sum over DOFs of weight x integral error / the aircraft pilot's own perceived motion in that DOF (0 "
-        "perfect, 1 no better than standing still). Weights: "
-        + ", ".join(f"{d} {sig(weights[d], 2)}" for d in DOFS)
-        + ".",
+        f"| {rank_cell(r)} | {r.washout} | {_score_cell(r.score, r.rank == 1) if flag else sig(r.score)} |"
+        for r in ranking
     ]
-    if any(r.score > 1.0 for r in ranking):
+    weights = ranking[0].weights
+    lines += ["", f"Ranked by {rule.label()}."]
+    if undecided(ranking):
+        lines += ["", "**The first place is a tie**: the best values differ by less than the tie margin."]
+    if rule.by != "false-cue":
+        lines += [
+            "",
+            "Score: sum over DOFs of weight x integral error / the aircraft pilot's own perceived motion in that DOF "
+            "(0 perfect, 1 no better than standing still). Weights: "
+            + ", ".join(f"{d} {sig(weights[d], 2)}" for d in DOFS)
+            + ".",
+        ]
+    if flag and any(r.score > 1.0 for r in ranking):
         lines += ["", SCORE_NOTE]
     return [*lines, ""]
 
@@ -182,6 +220,55 @@ def metric_tables(data: ResultData) -> list[str]:
             )
         lines.append("")
     return lines
+
+
+def cue_lines(data: ResultData) -> list[str]:
+    """Time fractions of correct, scaled, false and missing cues per washout and DOF, and the false-cue events."""
+    from washbench.analysis.cues import SCALE_BAND, parse_events
+
+    rows = [m for m in data.metrics if not math.isnan(m.cue_false_frac)]
+    if not rows:
+        return ["_This result was written before the cue classification: `washbench cue` it again for it._", ""]
+    lines = [
+        "Percent of the manoeuvre's time (docs/fidelity.md): a cue is correct when both pilots feel the DOF (above "
+        f"the Zacharias threshold) in the same direction with a magnitude ratio within {SCALE_BAND[0]:g}-"
+        f"{SCALE_BAND[1]:g}, scaled outside that ratio, false when the simulator pilot feels motion the aircraft "
+        "pilot does not or in the opposite direction, missing when the aircraft pilot feels motion the simulator "
+        "pilot does not.",
+        "",
+        "| washout | DOF | correct (%) | scaled (%) | false (%) | missing (%) | false-cue events |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for m in rows:
+        events = parse_events(m.false_cue_events, m.dof)
+        longest = max(events, key=lambda e: e.end_s - e.start_s, default=None)
+        ev = f"{len(events)}" + (f" (longest {sig(longest.start_s)}-{sig(longest.end_s)} s, peak "
+                                 f"{sig(longest.peak)} {_unit('max_error', m.dof)})" if longest else "")  # fmt: skip
+        cells = (m.cue_correct_frac, m.cue_scaled_frac, m.cue_false_frac, m.cue_missing_frac)
+        lines.append(f"| {m.washout} | {m.dof} | " + " | ".join(sig(100.0 * c) for c in cells) + f" | {ev} |")
+    washouts = dict.fromkeys(r.washout for r in rows)
+    false_time = {w: sum(m.cue_false_frac for m in rows if m.washout == w) for w in washouts}
+    lines += ["", "False-cue time (sum over DOFs, manoeuvre lengths): "
+              + ", ".join(f"{w} {sig(v)}" for w, v in false_time.items()) + ".", ""]  # fmt: skip
+    return lines
+
+
+def sickness_lines(data: ResultData) -> list[str]:
+    """MSDV (ISO 2631-1 Wf) of the vertical motion at each pilot's head (the heave rows of metrics.csv)."""
+    heave = [m for m in data.metrics if m.dof == "heave" and not math.isnan(m.msdv_mps15)]
+    if not heave:
+        return ["_This result was written before the motion sickness dose: `washbench cue` it again for it._", ""]
+    lines = [
+        "Motion sickness dose value MSDV = sqrt(integral a_w^2 dt) of the vertical acceleration at the head, "
+        "weighted by ISO 2631-1 Wf (peak near 0.16 Hz), over the manoeuvre (docs/fidelity.md). Lower is better; "
+        "a simulator pilot above the aircraft pilot gets more vertical low-frequency motion than the flight had.",
+        "",
+        "| pilot | MSDV (m/s^1.5) |",
+        "|---|---|",
+        f"| aircraft | {sig(heave[0].msdv_aircraft_mps15)} |",
+    ]
+    lines += [f"| {m.washout} | {sig(m.msdv_mps15)} |" for m in heave]
+    return [*lines, ""]
 
 
 def saturation_lines(data: ResultData) -> list[str]:
@@ -245,7 +332,7 @@ def result_figures(data: ResultData, pdf: bool = False) -> dict[str, Path]:
     fig_dir.mkdir(exist_ok=True)
     formats = ("png", "pdf") if pdf else ("png",)
     if not pdf:
-        for stem in ("perceived", "envelope"):
+        for stem in ("perceived", "envelope", "cues"):
             (fig_dir / f"{stem}.pdf").unlink(missing_ok=True)
     thresholds, rest = perception_thresholds()
     out = {}
@@ -259,6 +346,11 @@ def result_figures(data: ResultData, pdf: bool = False) -> dict[str, Path]:
         rest=rest,
         formats=formats,
     )[0]
+    if data.washouts and all(w in data.perceived for w in data.washouts):
+        from washbench.review.cue_figures import cue_classes, cue_lane_figure
+
+        classes = cue_classes(data.perceived, data.washouts)
+        out["cues"] = cue_lane_figure(fig_dir / "cues", data.title, data.t_s, classes, formats=formats)[0]
     if data.usage:
         out["envelope"] = envelope_figure(
             fig_dir / "envelope", data.title, data.t_s, data.usage, data.saturated, phases=data.phases, formats=formats
@@ -288,8 +380,9 @@ def result_sections(
     """
     h = "#" * level
     lines: list[str] = []
-    ranking = rank(data.metrics, data.motion) if data.metrics else []
-    lines += [f"{h} Ranking", "", *ranking_lines(data, ranking)]
+    rule = result_rule(data)
+    ranking = rank(data.metrics, data.motion, rule) if data.metrics else []
+    lines += [f"{h} Ranking", "", *ranking_lines(data, ranking, rule)]
     lines += [f"{h} Perceived motion", ""]
     lines += [
         "Aircraft pilot (magenta, wide) against each washout's simulator pilot; dashed: perception thresholds "
@@ -297,6 +390,10 @@ def result_sections(
         "",
     ]
     lines += _image(figures["perceived"], start, "perceived motion") if "perceived" in figures else [NO_FIGURES, ""]
+    lines += [f"{h} Cues: correct, scaled, false, missing", "", *cue_lines(data)]
+    if "cues" in figures:
+        lines += _image(figures["cues"], start, "false and missing cues")
+    lines += [f"{h} Motion sickness dose", "", *sickness_lines(data)]
     lines += [f"{h} Metrics", "", *metric_tables(data)]
     lines += [f"{h} Platform", ""]
     if brief:

@@ -46,12 +46,15 @@ from pathlib import Path
 from typing import Any
 
 from washbench.analysis.ranking import (
+    DEFAULT_RULE,
     DOFS,
     METRICS,
     RankRow,
+    RankRule,
     compare,
     rank,
     reference_washout,
+    rule_from_record,
 )
 from washbench.errors import Terminated, WashbenchError, located
 from washbench.io.atomic import write_text_atomic
@@ -182,6 +185,8 @@ def _run_one(
     aircraft_dirs: tuple[str, ...] = (),
     max_time_s: float | None = None,
     outputs: Outputs = DEFAULT_OUTPUTS,
+    rank_by: str | None = None,
+    vestibular: str | None = None,
     plugins: tuple[str, ...] = (),
 ) -> list[Outcome]:
     """Worker: run one manoeuvre or JSBSim script (one outcome per run segment); never raises (failures
@@ -199,7 +204,8 @@ def _run_one(
             registry.load_plugin(spec)
         dirs = [Path(d) for d in aircraft_dirs]
         common = {"params_path": params, "platform_path": platform, "aircraft_dirs": dirs}
-        common |= {"washouts": washouts, "variants": variants, "outputs": outputs}
+        common |= {"washouts": washouts, "variants": variants, "outputs": outputs, "rank_by": rank_by}
+        common |= {"vestibular": vestibular}
         if is_script(Path(path)):
             runs = run_script(Path(path), Path(out_dir), max_time_s=max_time_s, **common)
         else:
@@ -263,6 +269,8 @@ def run_suite(
     aircraft_dirs: Sequence[Path] = (),
     max_time_s: float | None = None,
     outputs: Outputs = DEFAULT_OUTPUTS,
+    rank_by: str | None = None,
+    vestibular: str | None = None,
 ) -> list[Outcome]:
     """Run every file in parallel processes (or on the Dask cluster at ``dask``); outcomes in the order of ``files``
     (a JSBSim script that resets gives one outcome per run segment, in order). ``outputs``: whether the
@@ -280,8 +288,8 @@ def run_suite(
     from washbench.cueing import registry
 
     plugins = registry.plugin_specs()
-    args = [(str(f), str(out_dir), params, platform, chosen, tuple(variants), dirs, max_time_s, outputs, plugins)
-            for f in files]
+    args = [(str(f), str(out_dir), params, platform, chosen, tuple(variants), dirs, max_time_s, outputs, rank_by,
+             vestibular, plugins) for f in files]  # fmt: skip
     outcomes: dict[str, list[Outcome]] = {}
     start = time.perf_counter()
     if progress:
@@ -356,20 +364,13 @@ def _runs_with_metrics(outcomes: Sequence[Outcome]) -> list[Outcome]:
 
 def metrics_table(outcomes: Sequence[Outcome]) -> str:
     """``metrics.csv`` of the suite (every run that produced metrics, failed checks included)."""
-    rows = [["aircraft", "manoeuvre", "washout", "dof", "npc", "integral_error", "max_error"]]
+    from washbench.io.results import METRICS_COLUMNS, METRICS_TEXT_COLUMNS
+
+    rows = [["aircraft", "manoeuvre", *METRICS_COLUMNS]]
     for o in _runs_with_metrics(outcomes):
         for m in o.run.metrics:
-            rows.append(
-                [
-                    o.run.aircraft,
-                    o.run.manoeuvre,
-                    m.washout,
-                    m.dof,
-                    csv_number(m.npc),
-                    csv_number(m.integral_error),
-                    csv_number(m.max_error),
-                ]
-            )
+            cells = [getattr(m, c) if c in METRICS_TEXT_COLUMNS else csv_number(getattr(m, c)) for c in METRICS_COLUMNS]
+            rows.append([o.run.aircraft, o.run.manoeuvre, *cells])
     return _csv(rows)
 
 
@@ -391,12 +392,14 @@ def comparison_table(outcomes: Sequence[Outcome]) -> str:
     return _csv(rows)
 
 
-def ranking_table(rankings: dict[tuple[str, str], list[RankRow]]) -> str:
-    """``ranking.csv``: rank, washout and score (lower is better) per manoeuvre."""
-    rows = [["aircraft", "manoeuvre", "rank", "washout", "score"]]
+def ranking_table(rankings: dict[tuple[str, str], list[RankRow]], rule: RankRule = DEFAULT_RULE) -> str:
+    """``ranking.csv``: rank, washout and the rule's value (``score``, lower is better) per manoeuvre; ``tied``
+    (true when the rank is shared: values within the tie margin) and ``rule`` (``--rank-by``)."""
+    rows = [["aircraft", "manoeuvre", "rank", "washout", "score", "tied", "rule"]]
     for (aircraft, manoeuvre), ranking in rankings.items():
         for r in ranking:
-            rows.append([aircraft, manoeuvre, str(r.rank), r.washout, csv_number(r.score)])
+            tied = "true" if r.tied else "false"
+            rows.append([aircraft, manoeuvre, str(r.rank), r.washout, csv_number(r.score), tied, rule.by])
     return _csv(rows)
 
 
@@ -416,12 +419,14 @@ def write_suite_results(
     from washbench.io.provenance import utc_now
     from washbench.review.suite_report import write_suite_json, write_suite_report
 
+    rule = rule_from_record((provenance or {}).get("ranking"))
     rankings = {
-        (o.run.aircraft, o.run.manoeuvre): rank(o.run.metrics, o.run.motion) for o in _runs_with_metrics(outcomes)
+        (o.run.aircraft, o.run.manoeuvre): rank(o.run.metrics, o.run.motion, rule)
+        for o in _runs_with_metrics(outcomes)
     }
     write_text_atomic(out_dir / "metrics.csv", metrics_table(outcomes))
     write_text_atomic(out_dir / "comparison.csv", comparison_table(outcomes))
-    write_text_atomic(out_dir / "ranking.csv", ranking_table(rankings))
+    write_text_atomic(out_dir / "ranking.csv", ranking_table(rankings, rule))
     entries = [
         {
             "file": _short(o.path),
@@ -530,8 +535,12 @@ def write_run_review(
     """
     from washbench.review.report import write_result_report
 
-    rankings = {(summary.aircraft, summary.manoeuvre): rank(summary.metrics, summary.motion)} if summary.metrics else {}
-    write_text_atomic(run_dir / "ranking.csv", ranking_table(rankings))
+    prov = (read_marker(run_dir, RUN_MARKER) or {}).get("provenance")
+    rule = rule_from_record(prov.get("ranking") if isinstance(prov, dict) else None)
+    rankings = (
+        {(summary.aircraft, summary.manoeuvre): rank(summary.metrics, summary.motion, rule)} if summary.metrics else {}
+    )
+    write_text_atomic(run_dir / "ranking.csv", ranking_table(rankings, rule))
     write_result_report(run_dir, table, figures=figures)
 
 
@@ -550,6 +559,8 @@ def suite_command(
     jsbsim_scripts: Sequence[str] = (),
     max_time_s: float | None = None,
     outputs: Outputs = DEFAULT_OUTPUTS,
+    rank_by: str | None = None,
+    vestibular: str | None = None,
 ) -> int:
     """CLI entry: run the suite, write its results, print where they are; 0 if all succeeded, else 1.
 
@@ -569,8 +580,10 @@ def suite_command(
     from washbench.cueing.params import DEFAULT_PARAMS_PATH
     from washbench.cueing.variants import select_washouts
     from washbench.io.provenance import build_provenance
+    from washbench.perception.vestibular import model_record
     from washbench.platform import load_platform_limits
     from washbench.platform.limits import DEFAULT_LIMITS_PATH
+    from washbench.runs.rank_rule import load_rank_rule
 
     provenance = build_provenance(
         params_path=params_path or DEFAULT_PARAMS_PATH,
@@ -578,6 +591,8 @@ def suite_command(
         washouts=select_washouts(washouts, variants, params_path),
         platform_path=platform_path or DEFAULT_LIMITS_PATH,
         platform=load_platform_limits(platform_path),
+        ranking=load_rank_rule(params_path, rank_by).record(),
+        vestibular=model_record(vestibular),
     )
     check_unique_names(files, aircraft_dirs)
     start = time.perf_counter()
@@ -603,6 +618,8 @@ def suite_command(
                 aircraft_dirs=aircraft_dirs,
                 max_time_s=max_time_s,
                 outputs=outputs,
+                rank_by=rank_by,
+                vestibular=vestibular,
             )
             write_suite_results(outcomes, stage, provenance, outputs.figures)
             _swap_in(stage, out_dir, previous)
