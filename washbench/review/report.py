@@ -45,7 +45,9 @@ _UNITS = {
     "max_error": ("m/s²", "deg/s"),
 }
 _METRIC_TITLES = {
-    "npc": "Normalized Pearson correlation (NPC: 1 is perfect, 1.5 uncorrelated, lower is better; - where flat)",
+    "npc": "Normalized Pearson correlation (NPC, lower is better: 1 perfect, 1.5 uncorrelated, above 1.5 "
+    "anti-correlated, i.e. the cue moves against the aircraft's: 2.5 at a correlation of -0.5, infinite at -1; "
+    "- where flat)",
     "integral_error": "Integral of |perceived error| (lower is better)",
     "max_error": "Maximum |perceived error| (lower is better)",
 }
@@ -217,26 +219,35 @@ def check_lines(data: ResultData) -> list[str]:
     return [*lines, ""]
 
 
-def perception_thresholds() -> tuple[tuple[float, ...], tuple[float, ...]]:
-    """Zacharias thresholds and the resting values they are taken around, per DOF (m/s^2, deg/s)."""
-    from washbench.perception.thresholds import STANDARD_GRAVITY_MPS2, ZACHARIAS
+def perception_thresholds(data: ResultData) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """Zacharias thresholds and the resting values they are taken around, per DOF (m/s^2, deg/s).
+
+    The resting value is what the aircraft pilot perceives at the first sample (trimmed flight, or standing on the
+    runway): a steady cue the pilot has been exposed to is not a change felt, so the band "not felt" lies around it
+    (for a level start about (0, 0, -g, 0, 0, 0); a descent or a climb starts with its own surge).
+    """
+    from washbench.perception.thresholds import ZACHARIAS
 
     th = ZACHARIAS
     thresholds = (th.f_x_mps2, th.f_y_mps2, th.f_z_mps2, th.omega_x_degps, th.omega_y_degps, th.omega_z_degps)
-    return thresholds, (0.0, 0.0, -STANDARD_GRAVITY_MPS2, 0.0, 0.0, 0.0)
+    rest = tuple(float(v) for v in data.perceived["aircraft"][0])
+    return thresholds, rest
 
 
 def time_above_threshold(data: ResultData) -> dict[str, float]:
-    """Per DOF, how long the aircraft pilot's perceived motion lies beyond the perception threshold [s]."""
-    thresholds, rest = perception_thresholds()
+    """Per DOF, how long the aircraft pilot's perceived motion lies beyond the perception threshold around its
+    resting value (:func:`perception_thresholds`) [s]."""
+    thresholds, rest = perception_thresholds(data)
     p = data.perceived["aircraft"]
     return {
         d: float(np.count_nonzero(np.abs(p[:, i] - rest[i]) > thresholds[i])) * data.dt_s for i, d in enumerate(DOFS)
     }
 
 
-def result_figures(data: ResultData, pdf: bool = False) -> dict[str, Path]:
+def result_figures(data: ResultData, pdf: bool = False, palette: str | None = None) -> dict[str, Path]:
     """Draw the result's figures into ``folder/figures/`` (PNG, and PDF with ``pdf``); figure name -> PNG path.
+
+    ``palette``: :data:`washbench.review.palette.PALETTES` (None: ``$WASHBENCH_PALETTE`` or the default).
 
     A PDF left from an earlier ``washbench report`` is removed when none is drawn (it would show other data).
     """
@@ -248,7 +259,7 @@ def result_figures(data: ResultData, pdf: bool = False) -> dict[str, Path]:
     if not pdf:
         for stem in ("perceived", "envelope"):
             (fig_dir / f"{stem}.pdf").unlink(missing_ok=True)
-    thresholds, rest = perception_thresholds()
+    thresholds, rest = perception_thresholds(data)
     out = {}
     out["perceived"] = perceived_figure(
         fig_dir / "perceived",
@@ -259,10 +270,12 @@ def result_figures(data: ResultData, pdf: bool = False) -> dict[str, Path]:
         thresholds=thresholds,
         rest=rest,
         formats=formats,
+        palette=palette,
     )[0]
     if data.usage:
         out["envelope"] = envelope_figure(
-            fig_dir / "envelope", data.title, data.t_s, data.usage, data.saturated, phases=data.phases, formats=formats
+            fig_dir / "envelope", data.title, data.t_s, data.usage, data.saturated, phases=data.phases, formats=formats,
+            palette=palette,
         )[0]
     return out
 
@@ -293,8 +306,9 @@ def result_sections(
     lines += [f"{h} Ranking", "", *ranking_lines(data, ranking)]
     lines += [f"{h} Perceived motion", ""]
     lines += [
-        "Aircraft pilot (magenta, wide) against each washout's simulator pilot; dashed: perception thresholds "
-        "(Zacharias 1978) around the resting value, what lies between them is not felt; shaded: the phases.",
+        "Aircraft pilot (wide solid line) against each washout's simulator pilot (each its own colour and dash); "
+        "grey band: the perception thresholds (Zacharias 1978) around the pilot's resting value (what was perceived "
+        "at the start), what lies inside it is not felt; shaded: the phases.",
         "",
     ]
     lines += _image(figures["perceived"], start, "perceived motion") if "perceived" in figures else [NO_FIGURES, ""]
