@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from washbench.errors import WashbenchError
 from washbench.review.figures import envelope_figure, perceived_figure, phase_label
 from washbench.review.palette import (
     CB_WASHOUT_COLORS,
@@ -62,7 +63,7 @@ def test_palette_from_the_environment_and_unknown_names(monkeypatch: pytest.Monk
     monkeypatch.setenv("WASHBENCH_PALETTE", "colorblind")
     assert palette_name() == "colorblind" and palette_name("default") == "default"
     monkeypatch.setenv("WASHBENCH_PALETTE", "pastel")
-    with pytest.raises(ValueError, match="WASHBENCH_PALETTE"):
+    with pytest.raises(WashbenchError, match="WASHBENCH_PALETTE"):
         palette_name()
 
 
@@ -77,3 +78,29 @@ def test_palette_from_the_environment_and_unknown_names(monkeypatch: pytest.Monk
 )
 def test_phase_labels_wrap_before_they_are_cut(name: str, width_in: float, expected: str) -> None:
     assert phase_label(name, width_in) == expected
+
+
+def test_swept_keys_carry_the_unit_of_their_name() -> None:
+    from washbench.review.study_figures import key_label
+
+    assert key_label("translational_highpass_wn_radps.x") == "translational_highpass_wn_radps.x (rad/s)"
+    assert key_label("tilt.gain_per_s") == "tilt.gain_per_s (1/s)"
+    assert key_label("rotational.saturation_degps") == "rotational.saturation_degps (deg/s)"
+    assert key_label("scale.specific_force") == "scale.specific_force (-)"
+    assert key_label("tilt.rate_limit_mode") == "tilt.rate_limit_mode"
+
+
+def test_the_report_names_an_end_stop_next_to_the_score_it_dominates() -> None:
+    from washbench.review.report import END_STOP_SHARE, end_stop_note
+    from washbench.review.result_data import ResultData
+
+    n = 1000
+    pos = np.zeros(n, bool)
+    pos[:540] = True
+    below = np.arange(n) < END_STOP_SHARE * n - 1
+    data = ResultData(folder=Path("."), title="t", washouts=["a", "b", "c"], metrics=[], t_s=np.arange(n) / 100.0,
+                      dt_s=0.01, perceived={}, usage={}, motion={},
+                      saturated={"a": {"pos": pos}, "b": {"pos": below}, "c": {}})  # fmt: skip
+    note = end_stop_note(data, "a")
+    assert note == "end stop: stage at its position limit for 5.40 s (54 %), the score reflects its hard stops"
+    assert end_stop_note(data, "b") == "" and end_stop_note(data, "c") == ""

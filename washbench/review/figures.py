@@ -32,6 +32,7 @@ from typing import Any
 
 import numpy as np
 
+from washbench.review.numbers import SCORE_FLAG
 from washbench.review.palette import aircraft_color, mpl, palette_name, washout_colors, washout_dashes
 
 FIGURE_FORMATS = ("png", "pdf")
@@ -146,7 +147,7 @@ def _auto_formatter() -> Any:
 
 def _plot_width_px(size_in: tuple[float, float], margins_in: tuple[float, float, float, float]) -> int:
     """Width of the panels in PNG pixels (the resolution a trace is drawn at)."""
-    return max(int(math.ceil((size_in[0] - margins_in[0] - margins_in[1]) * PNG_DPI)), 16)
+    return max(math.ceil((size_in[0] - margins_in[0] - margins_in[1]) * PNG_DPI), 16)
 
 
 def _top_legend(fig: Any, handles: list[Any]) -> None:
@@ -421,7 +422,7 @@ def score_heatmap(
         best = np.nanmin(row) if np.isfinite(row).any() else math.nan
         for c in range(len(washouts)):
             v = row[c]
-            text = "-" if not math.isfinite(v) else _sig(v) + (" !" if v > 1.0 else "")
+            text = "-" if not math.isfinite(v) else _sig(v) + (f" {SCORE_FLAG}" if v > 1.0 else "")
             is_best = math.isfinite(v) and v == best
             ax.text(c, r, text, ha="center", va="center", fontsize=8, fontweight="bold" if is_best else "normal")
             if is_best:
@@ -432,7 +433,8 @@ def score_heatmap(
     bar = fig.colorbar(image, ax=ax, shrink=0.8, pad=0.02)
     bar.set_label("score (lower is better)", fontsize=7.5)
     bar.ax.tick_params(labelsize=7)
-    ax.set_title(f"{title}: best per manoeuvre framed;\n! above 1 = worse than a simulator standing still", fontsize=9)
+    ax.set_title(f"{title}: best per manoeuvre framed;\n{SCORE_FLAG} above 1 = worse than a simulator standing still",
+                 fontsize=9)  # fmt: skip
     return save_figure(fig, stem, formats)
 
 
@@ -449,19 +451,26 @@ def table4_figure(
 
     ``better_pct``: washout -> (R, len(metrics) * len(dofs)) array of 100 * (reference - washout) / reference, columns
     grouped by metric, then DOF; positive means better than the reference. NaN where undefined. Returns the paths.
+
+    The colours follow a symmetric logarithmic scale (linear within +-10 %, then one step per decade) up to the
+    largest magnitude in the table, so -1273 % is redder than -150 %, which is redder than -20 %; every cell prints
+    its value.
     """
-    from matplotlib.colors import Normalize
+    from matplotlib.colors import SymLogNorm
 
     others = list(better_pct)
     ncol = len(metrics) * len(dofs)
     fig = _new_figure(2.2 + 0.42 * ncol, 0.9 + len(others) * (0.85 + 0.3 * len(rows)))
     axes = np.atleast_1d(fig.subplots(len(others), 1, squeeze=False)[:, 0])
     cmap = _diverging_cmap()
-    norm = Normalize(vmin=-100.0, vmax=100.0)
+    values_of = {w: np.asarray(better_pct[w], dtype=np.float64).reshape(len(rows), ncol) for w in others}
+    finite = np.concatenate([np.abs(v[np.isfinite(v)]) for v in values_of.values()] + [np.zeros(1)])
+    vmax = max(100.0, float(finite.max()))
+    norm = SymLogNorm(linthresh=10.0, linscale=1.0, vmin=-vmax, vmax=vmax, base=10)
     image = None
     for ax, w in zip(axes, others, strict=True):
-        values = np.asarray(better_pct[w], dtype=np.float64).reshape(len(rows), ncol)
-        image = ax.imshow(np.ma.masked_invalid(np.clip(values, -100, 100)), cmap=cmap, norm=norm, aspect="auto")
+        values = values_of[w]
+        image = ax.imshow(np.ma.masked_invalid(values), cmap=cmap, norm=norm, aspect="auto")
         for r in range(len(rows)):
             for c in range(ncol):
                 v = values[r, c]
@@ -478,7 +487,10 @@ def table4_figure(
         ax.set_title(f"{w} better than {reference} (% of {reference}'s value)", fontsize=9)
     if image is not None:
         bar = fig.colorbar(image, ax=list(axes), shrink=0.6, pad=0.01)
-        bar.set_label("% better (green) / worse (red)", fontsize=7.5)
+        decades = [10.0**k for k in range(1, math.floor(math.log10(vmax)) + 1)]
+        ticks = [-d for d in reversed(decades)] + [0.0] + decades
+        bar.set_ticks(ticks, labels=[f"{t:+.0f}" if t else "0" for t in ticks])
+        bar.set_label("% better (green) / worse (red), log scale beyond +-10", fontsize=7.5)
         bar.ax.tick_params(labelsize=7)
     return save_figure(fig, stem, formats)
 

@@ -72,12 +72,15 @@ AIRCRAFT_DASH: Dash = (0, None)
 def palette_name(name: str | None = None) -> str:
     """The palette to draw with: ``name`` if given, else ``$WASHBENCH_PALETTE``, else ``default``.
 
-    Raises ValueError naming the choices for an unknown name.
+    Raises :class:`washbench.errors.WashbenchError` (a ValueError's one-line message) naming the choices for an
+    unknown name.
     """
+    from washbench.errors import WashbenchError
+
     chosen = name or os.environ.get(PALETTE_ENV, "").strip() or "default"
     if chosen not in PALETTES:
         source = "" if name else f" (from ${PALETTE_ENV})"
-        raise ValueError(f"unknown palette {chosen!r}{source}: choose {' or '.join(PALETTES)}")
+        raise WashbenchError(f"unknown palette {chosen!r}{source}: choose {' or '.join(PALETTES)}")
     return chosen
 
 

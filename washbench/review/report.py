@@ -27,14 +27,14 @@ from washbench.analysis.metrics import DOFS
 from washbench.analysis.ranking import METRICS, RankRow, compare, rank, reference_washout
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
-from washbench.review.numbers import pct, sig
+from washbench.review.numbers import SCORE_FLAG, pct, sig
 from washbench.review.result_data import ResultData, is_result_folder, load_result
 
 REPORT_FILE = "report.md"
 FIGURES_DIR = "figures"
 SUITE_FILE = "suite.json"
 
-FLAG = "⚠"
+FLAG = SCORE_FLAG
 SCORE_NOTE = (
     f"{FLAG} a score above 1: the washout's perceived error is larger than that of a simulator that stands still, "
     "i.e. it gives more false cues than it gives true ones on this manoeuvre."
@@ -120,12 +120,35 @@ def _score_cell(score: float, best: bool) -> str:
     return f"{text} {FLAG}" if score > 1.0 else text
 
 
+END_STOP_SHARE = 0.05
+"""Share of the manoeuvre at a stage position limit (an end stop) from which the report says, next to the score,
+that the score reflects the end stop: the stage then stops hard, and the steps it makes in the simulator pilot's
+specific force (up to the 1 g acceleration limit) are perceived errors the washout's filters did not make."""
+
+
+def end_stop_note(data: ResultData, washout: str) -> str:
+    """``end stop: stage at its position limit for 32.8 s (54 %)`` when that share reaches :data:`END_STOP_SHARE`,
+    else empty."""
+    flags = data.saturated.get(washout, {}).get("pos")
+    steps = int(np.count_nonzero(flags)) if flags is not None else 0
+    if not steps or steps < END_STOP_SHARE * data.n:
+        return ""
+    return (f"end stop: stage at its position limit for {sig(steps * data.dt_s)} s "
+            f"({pct(100.0 * steps / data.n, False)}), the score reflects its hard stops")  # fmt: skip
+
+
 def ranking_lines(data: ResultData, ranking: list[RankRow]) -> list[str]:
-    """Ranking table (rank, washout, score) and the DOF weights used."""
+    """Ranking table (rank, washout, score, and a note where end stops dominate) and the DOF weights used."""
     if not ranking:
         return []
-    lines = ["| rank | washout | score (-) |", "|---|---|---|"]
-    lines += [f"| {r.rank} | {r.washout} | {_score_cell(r.score, r.rank == 1)} |" for r in ranking]
+    notes = {r.washout: end_stop_note(data, r.washout) for r in ranking}
+    if any(notes.values()):
+        lines = ["| rank | washout | score (-) | note |", "|---|---|---|---|"]
+        lines += [f"| {r.rank} | {r.washout} | {_score_cell(r.score, r.rank == 1)} | {notes[r.washout]} |"
+                  for r in ranking]  # fmt: skip
+    else:
+        lines = ["| rank | washout | score (-) |", "|---|---|---|"]
+        lines += [f"| {r.rank} | {r.washout} | {_score_cell(r.score, r.rank == 1)} |" for r in ranking]
     weights = ranking[0].weights
     lines += [
         "",
@@ -369,9 +392,14 @@ def write_result_report(
     return path
 
 
-def report_command(results_dir: Path) -> int:
+def report_command(results_dir: Path, palette: str | None = None) -> int:
     """``washbench report DIR``: write report.md and the figures (PNG and PDF) again from a result or suite folder's
-    files."""
+    files. ``palette`` (:data:`washbench.review.palette.PALETTES`) is set for this process as
+    ``$WASHBENCH_PALETTE`` would be (every figure of a suite is drawn with it)."""
+    from washbench.review.palette import PALETTE_ENV, palette_name
+
+    if palette is not None:
+        os.environ[PALETTE_ENV] = palette_name(palette)
     folder = Path(results_dir)
     if not folder.is_dir():
         raise WashbenchError(located(folder, "no such folder"))
