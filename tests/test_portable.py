@@ -60,3 +60,23 @@ def test_numba_cache_goes_to_the_user_cache_folder_when_the_package_is_read_only
 )
 def test_native_viewer_on_desktops(platform: str, environ: dict[str, str], native: bool) -> None:
     assert _has_display(platform, environ) is native
+
+
+def test_a_first_compile_is_announced_in_one_line_and_a_cached_one_not(tmp_path: Path) -> None:
+    """Two kernels compiled in one process (a fresh numba cache): one line; the same again from the cache: none."""
+    code = (
+        "import numpy as np\n"
+        "from washbench.review.thinning import keep_changes, keep_samples\n"
+        "v = np.cumsum(np.ones((50, 2)), axis=0)\n"
+        "keep_samples(np.arange(50.0), v, 0.1, 10.0)\n"
+        "keep_changes(v, 0.1, 10)\n"
+        "keep_samples(np.arange(50.0), v, 0.1, 10.0)\n"
+    )
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "numba")}
+    first, again = (subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=300)
+                    for _ in range(2))  # fmt: skip
+    assert first.returncode == 0 and again.returncode == 0, first.stderr + again.stderr
+    lines = first.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("washbench: compiling"), first.stderr
+    assert str(tmp_path / "numba") in lines[0]
+    assert again.stderr.strip() == ""
