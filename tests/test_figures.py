@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from washbench.errors import WashbenchError
-from washbench.review.figures import envelope_figure, perceived_figure, phase_label, warm_up
+from washbench.review.figures import envelope_figure, perceived_figure, phase_label
 from washbench.review.palette import (
     CB_WASHOUT_COLORS,
     PALETTES,
@@ -47,8 +47,6 @@ def test_a_reused_layout_draws_the_same_pixels_as_a_fresh_one(tmp_path: Path) ->
     again = draw(tmp_path, seed=1)
     assert first == again
     assert other != first
-    warm_up()  # what the suite's process server draws before it forks its workers
-    assert draw(tmp_path, seed=1) == first
 
 
 def test_every_washout_has_its_own_colour_and_line_style_in_each_palette() -> None:

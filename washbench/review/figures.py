@@ -309,33 +309,6 @@ def perceived_figure(
     return save_figure(fig, stem, formats)
 
 
-def warm_up() -> None:
-    """Lay out and draw the perceived-motion figure once on made-up data, without writing a file: a process that
-    forks workers (the suite's process server) calls it so that each worker's first figure reuses a layout already
-    built, with its fonts loaded (:func:`_stacked_layout`)."""
-    import io
-
-    n = 240
-    t = np.arange(n) / 120.0
-    traces = {"aircraft": np.zeros((n, 6)), "small-angle": np.ones((n, 6))}
-    for phases in ([("a", 0.0, 1.0), ("b", 1.0, t[-1])], []):
-        ratios = (0.35, *[1.0] * 6) if phases else (1.0,) * 6
-        fig, axes = _stacked_layout(("perceived", ratios), PERCEIVED_SIZE_IN, PERCEIVED_MARGINS_IN, ratios)
-        panels = axes[1:] if phases else axes
-        if phases:
-            _phase_lane(axes[0], phases, 0.0, float(t[-1]), 1.0)
-        for i, ax in enumerate(panels):
-            ax.plot(t, traces["small-angle"][:, i], lw=1.0)
-            ax.plot(t, traces["aircraft"][:, i], lw=1.7)
-            ax.set_ylabel("warm\n(up)", fontsize=9)
-            ax.tick_params(labelsize=8)
-            ax.grid(True, color=(0.9, 0.9, 0.9), lw=0.5)
-        panels[-1].set_xlabel("time (s)", fontsize=9)
-        _top_legend(fig, list(panels[0].lines))
-        axes[0].set_title("warm up", fontsize=11)
-        fig.savefig(io.BytesIO(), format="png", dpi=PNG_DPI)
-
-
 def _runs(flags: np.ndarray) -> list[tuple[int, int]]:
     """(start, end) index pairs of the runs of True in a boolean array (end exclusive)."""
     f = np.concatenate([[False], np.asarray(flags, dtype=bool), [False]])

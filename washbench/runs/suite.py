@@ -215,7 +215,7 @@ def _preload() -> None:
 
 _QUIET_TRACKER = "ignore:resource_tracker:UserWarning"
 
-FIGURE_MODULES = ("matplotlib.figure", "matplotlib.backends.backend_agg", "washbench.runs.preload_figures")
+FIGURE_MODULES = ("matplotlib.figure", "matplotlib.backends.backend_agg")
 """Preloaded by the process server besides :mod:`washbench.runs.preload` when the runs draw figures."""
 
 
