@@ -205,7 +205,7 @@ def test_omct_equals_cue_traces_of_a_signal_sine(omct_run: tuple[Path, list[dict
         args += ["--frequency-hz", repr(w / (2 * math.pi)), "--duration-s", repr(tm.duration_s), "--out", str(sig_file)]
         assert main(args) == 0
         cue_out = tmp_path / f"cue_{test_name}"
-        assert main(["cue", str(sig_file), "--out", str(cue_out)]) == 0
+        assert main(["cue", str(sig_file), "--out", str(cue_out), "--no-figures", "--no-recording"]) == 0
         tr = read_traces(cue_out / "traces.parquet")
         dt = float(tr["t_s"][1] - tr["t_s"][0])
 

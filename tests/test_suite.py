@@ -131,35 +131,30 @@ def test_ranking_and_comparison_tables(first: tuple[Path, subprocess.CompletedPr
                 assert float(row[f"{w}_better_by"]) == pytest.approx(diff)
 
 
-def test_same_suite_twice_gives_identical_metrics(
+def test_same_suite_twice_gives_identical_metrics_and_lean_outputs(
     inputs: Path, first: tuple[Path, subprocess.CompletedProcess[str]], tmp_path: Path
 ) -> None:
-    # the second time in one process and without recordings: the same numbers, and no .rrd anywhere
+    # the second time in one process, without recordings and figures: the same numbers, no .rrd and no figure
     out, _ = first
-    again = suite(inputs, "--out", tmp_path, "--jobs", "1", "--quiet", "--no-recording")
+    again = suite(inputs, "--out", tmp_path, "--jobs", "1", "--quiet", "--no-recording", "--no-figures")
     assert again.returncode == 1
     for name in ("metrics.csv", "comparison.csv", "ranking.csv"):
         assert (tmp_path / name).read_bytes() == (out / name).read_bytes(), name
     for name in ("coordinated_turn", "stall_recovery"):
         run = tmp_path / "c172p" / name
         recorded = {p.name for p in (out / "c172p" / name).iterdir()}
-        assert "recording.rrd" in recorded and {p.name for p in run.iterdir()} == recorded - {"recording.rrd"}
+        assert "recording.rrd" in recorded and "figures" in recorded
+        assert {p.name for p in run.iterdir()} == recorded - {"recording.rrd", "figures"}
         assert (run / "traces.parquet").read_bytes() == (out / "c172p" / name / "traces.parquet").read_bytes()
+        assert NO_FIGURES in (run / "report.md").read_text()
     assert "recording.rrd" not in (tmp_path / "report.md").read_text()
+    assert not list(tmp_path.rglob("figures")) and not list(tmp_path.rglob("*.png"))
+    assert not list(tmp_path.rglob("*.rrd"))
+    text = (tmp_path / "report.md").read_text()
+    assert NO_FIGURES in text and "## Summary" in text and check_tables(tmp_path / "report.md") >= 2
 
 
 def test_bad_arguments_are_one_line(tmp_path: Path) -> None:
     proc = suite(tmp_path / "nope", "--out", tmp_path / "o")
     assert proc.returncode == 2
     assert proc.stderr.strip().count("\n") == 0 and "no such file or folder" in proc.stderr
-
-
-def test_suite_without_figures_or_recordings(tmp_path: Path) -> None:
-    out = tmp_path / "lean"
-    proc = suite(GOOD[0], "--out", out, "--jobs", "1", "--no-figures", "--no-recording")
-    assert proc.returncode == 0, proc.stderr
-    assert not list(out.rglob("figures")) and not list(out.rglob("*.png")) and not list(out.rglob("*.rrd"))
-    text = (out / "report.md").read_text()
-    assert NO_FIGURES in text and "## Summary" in text and check_tables(out / "report.md") >= 2
-    (run,) = [p.parent for p in out.rglob("run.json")]
-    assert NO_FIGURES in (run / "report.md").read_text()

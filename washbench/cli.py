@@ -225,6 +225,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("report", help="write report.md and its figures (PNG and PDF) again from existing results")
     p.add_argument("results", type=Path, help="a result folder (washbench run / cue) or a suite folder")
+    p.add_argument("--palette", choices=("default", "colorblind"), default=None,
+                   help="figure colours: default, or colorblind (Okabe-Ito); also $WASHBENCH_PALETTE")  # fmt: skip
 
     p = sub.add_parser("replay", help="open a recording (or compare two) in the rerun viewer")
     p.add_argument(
@@ -493,7 +495,7 @@ def _dispatch(args: argparse.Namespace) -> int:
     if args.command == "report":
         from washbench.review.report_command import report_command
 
-        return report_command(args.results)
+        return report_command(args.results, args.palette)
     if args.command in ("live", "send"):
         return _live(args) if args.command == "live" else _send(args)
     if args.command == "replay":

@@ -31,6 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from washbench.analysis.metric_sums import FLAT_RTOL, signal_metrics
+from washbench.numerics.jitcache import announce_compile
 
 NPC_K = 1.0
 """The K of Eq. 21 used in the paper."""
@@ -60,6 +61,7 @@ def is_flat(x: np.ndarray, rtol: float = FLAT_RTOL) -> bool:
 def pearson(x: np.ndarray, y: np.ndarray) -> float:
     """Pearson correlation PC (Eq. 20) in [-1, 1]; ``nan`` if either signal is flat (see :func:`is_flat`)."""
     x, y = _as_pair(x, y)
+    announce_compile(signal_metrics)
     return float(signal_metrics(x, y, 1.0)[0])
 
 
@@ -80,12 +82,14 @@ def npc(x: np.ndarray, y: np.ndarray, k: float = NPC_K) -> float:
 def integral_abs_error(x: np.ndarray, y: np.ndarray, dt_s: float) -> float:
     """Eq. 22: ``integral |x - y| dt`` over the trace, trapezoid rule on a uniform grid of step ``dt_s`` [s]."""
     x, y = _as_pair(x, y)
+    announce_compile(signal_metrics)
     return float(signal_metrics(x, y, float(dt_s))[1])
 
 
 def max_abs_error(x: np.ndarray, y: np.ndarray) -> float:
     """``max |x - y|`` over the trace."""
     x, y = _as_pair(x, y)
+    announce_compile(signal_metrics)
     return float(signal_metrics(x, y, 1.0)[2])
 
 
@@ -133,6 +137,7 @@ def dof_metrics(
         a = np.ascontiguousarray(np.asarray(a, dtype=np.float64).T) * scale  # (3, N): contiguous per axis
         s = np.ascontiguousarray(np.asarray(s, dtype=np.float64).T) * scale
         for axis in range(3):
+            announce_compile(signal_metrics)
             pc, integral, max_error = signal_metrics(*_as_pair(a[axis], s[axis]), float(dt_s))
             rows.append(
                 MetricRow(

@@ -431,6 +431,7 @@ class CueingBank:
             out = np.empty(shape)
         elif out.shape != shape or out.dtype != np.float64 or not out.flags.c_contiguous:
             raise ValueError(f"out must be a C-contiguous float64 array of shape {shape}")
+        announce_compile(bank_block)
         bank_block(f, w, self._cfg, self._coef, self._state, self._counts, out)
         if self._py and f.shape[0]:
             if not self._started:

@@ -7,8 +7,12 @@
 - Stale: numba keys a cached function on its own source file only: when a jitted function inlines jitted
   helpers from another file and that file changes, the stale machine code would still be loaded. Each module
   that compiles in helpers from elsewhere calls :func:`drop_stale_cache` at import, before anything is compiled.
-- Saying so: the first run after an install or upgrade compiles the kernel (10-15 s). :func:`announce_compile`
-  prints one line about it, once per process, when the cache holds nothing for a function about to run.
+- Saying so: the first command after an install or upgrade that needs a compiled function compiles it (the
+  washout kernel 10-20 s; the perception and metric sums, the recording's thinning a few seconds each).
+  :func:`announce_compile` is called before every compiled call a command makes from Python (it costs a flag test
+  once it has looked) and prints one line to stderr, once per command, when the cache holds nothing for a function
+  about to run: the suite's process server looks at every kernel its workers will run before it forks them
+  (:mod:`washbench.runs.preload`), so a suite says it once, not once per worker.
 """
 
 from __future__ import annotations
@@ -81,25 +85,34 @@ def drop_stale_cache(module_file: str, deps: list[Path]) -> None:
         pass
 
 
+def _needs_compile(dispatcher: object) -> tuple[bool, str | None]:
+    """(compiles now, the cache folder) for a jitted function: no signature in memory and no index file on disk."""
+    if getattr(dispatcher, "signatures", None):
+        return False, None
+    cache = getattr(dispatcher, "_cache", None)
+    index = getattr(getattr(cache, "_cache_file", None), "_index_path", None)
+    if index is None or not os.path.exists(index):
+        return True, str(Path(index).parent) if index else None
+    return False, None
+
+
 def announce_compile(*dispatchers: object) -> None:
     """Print one line to stderr, once per process, if any of these jitted functions is about to be compiled.
 
     A function with no compiled signature in memory and no index file in its on-disk cache will compile
-    now; one whose cache exists is loaded in well under a second and is not announced.
+    now; one whose cache exists is loaded in well under a second and is not announced. Forked workers inherit
+    the "said" state of the process they fork from.
     """
     global _announced
     if _announced:
         return
     for d in dispatchers:
-        if getattr(d, "signatures", None):
-            continue
-        cache = getattr(d, "_cache", None)
-        index = getattr(getattr(cache, "_cache_file", None), "_index_path", None)
-        if index is None or not os.path.exists(index):
+        compiles, folder = _needs_compile(d)
+        if compiles:
             _announced = True
             print(
-                "washbench: compiling the washout kernel (once after install or upgrade, 10-20 s; cached in "
-                f"{Path(index).parent if index else 'memory only'})",
+                "washbench: compiling the numerical kernels for this machine (first use after an install or upgrade, "
+                f"10-30 s; kept in {folder or 'memory only'} for later commands)",
                 file=sys.stderr,
                 flush=True,
             )

@@ -234,8 +234,10 @@ class DiscreteModel:
 
         The same compiled step as :meth:`apply`: feeding a trace in chunks gives the same bits as feeding it whole.
         """
+        from washbench.numerics.jitcache import announce_compile
         from washbench.perception.sections import sections_run
 
+        announce_compile(sections_run)
         b, phi, _ = self.arrays()
         x, u_prev = state
         return sections_run(b, phi, x, u_prev, np.ascontiguousarray(u, dtype=np.float64))
@@ -246,8 +248,10 @@ class DiscreteModel:
         Returns float64 of the same shape. One compiled pass per column (:mod:`washbench.perception.sections`),
         the same step the studies' evaluation kernel takes per sample.
         """
+        from washbench.numerics.jitcache import announce_compile
         from washbench.perception.sections import sections_apply, sections_apply_from
 
+        announce_compile(sections_apply if start is None else sections_apply_from)
         u = np.asarray(u, dtype=np.float64)
         if u.ndim not in (1, 2) or u.shape[0] == 0:
             raise ValueError(f"expected a non-empty (N,) or (N, m) array, got shape {u.shape}")

@@ -36,14 +36,14 @@ from washbench.analysis.ranking import (
     undecided,
 )
 from washbench.io.atomic import write_text_atomic
-from washbench.review.numbers import pct, sig
+from washbench.review.numbers import SCORE_FLAG, pct, sig
 from washbench.review.result_data import ResultData, load_result
 
 REPORT_FILE = "report.md"
 FIGURES_DIR = "figures"
 SUITE_FILE = "suite.json"
 
-FLAG = "⚠"
+FLAG = SCORE_FLAG
 SCORE_NOTE = (
     f"{FLAG} a score above 1: the washout's perceived error is larger than that of a simulator that stands still, "
     "i.e. it gives more false cues than it gives true ones on this manoeuvre."
@@ -54,7 +54,9 @@ _UNITS = {
     "max_error": ("m/s²", "deg/s"),
 }
 _METRIC_TITLES = {
-    "npc": "Normalized Pearson correlation (NPC: 1 is perfect, 1.5 uncorrelated, lower is better; - where flat)",
+    "npc": "Normalized Pearson correlation (NPC, lower is better: 1 perfect, 1.5 uncorrelated, above 1.5 "
+    "anti-correlated, i.e. the cue moves against the aircraft's: 2.5 at a correlation of -0.5, infinite at -1; "
+    "- where flat)",
     "integral_error": "Integral of |perceived error| (lower is better)",
     "max_error": "Maximum |perceived error| (lower is better)",
 }
@@ -146,17 +148,41 @@ def rank_cell(r: RankRow) -> str:
     return f"{r.rank} (tie)" if r.tied else str(r.rank)
 
 
+END_STOP_SHARE = 0.05
+"""Share of the manoeuvre at a stage position limit (an end stop) from which the report says, next to the score,
+that the score reflects the end stop: the stage then stops hard, and the steps it makes in the simulator pilot's
+specific force (up to the 1 g acceleration limit) are perceived errors the washout's filters did not make."""
+
+
+def end_stop_note(data: ResultData, washout: str) -> str:
+    """``end stop: stage at its position limit for 32.8 s (54 %)`` when that share reaches :data:`END_STOP_SHARE`,
+    else empty."""
+    flags = data.saturated.get(washout, {}).get("pos")
+    steps = int(np.count_nonzero(flags)) if flags is not None else 0
+    if not steps or steps < END_STOP_SHARE * data.n:
+        return ""
+    return (f"end stop: stage at its position limit for {sig(steps * data.dt_s)} s "
+            f"({pct(100.0 * steps / data.n, False)}), the score reflects its hard stops")  # fmt: skip
+
+
 def ranking_lines(data: ResultData, ranking: list[RankRow], rule: RankRule = DEFAULT_RULE) -> list[str]:
-    """Ranking table (rank, washout, the rule's value), the rule with its tie margin and the DOF weights used."""
+    """Ranking table (rank, washout, the rule's value, and a note where end stops dominate), the rule with its tie
+    margin and the DOF weights used."""
     if not ranking:
         return []
     unit = "false-cue time (DOF lengths)" if rule.by == "false-cue" else "score (-)"
-    lines = [f"| rank | washout | {unit} |", "|---|---|---|"]
     flag = rule.by != "false-cue"
-    lines += [
-        f"| {rank_cell(r)} | {r.washout} | {_score_cell(r.score, r.rank == 1) if flag else sig(r.score)} |"
-        for r in ranking
-    ]
+    notes = {r.washout: end_stop_note(data, r.washout) for r in ranking}
+
+    def value(r: RankRow) -> str:
+        return _score_cell(r.score, r.rank == 1) if flag else sig(r.score)
+
+    if any(notes.values()):
+        lines = [f"| rank | washout | {unit} | note |", "|---|---|---|---|"]
+        lines += [f"| {rank_cell(r)} | {r.washout} | {value(r)} | {notes[r.washout]} |" for r in ranking]
+    else:
+        lines = [f"| rank | washout | {unit} |", "|---|---|---|"]
+        lines += [f"| {rank_cell(r)} | {r.washout} | {value(r)} |" for r in ranking]
     weights = ranking[0].weights
     lines += ["", f"Ranked by {rule.label()}."]
     if undecided(ranking):
@@ -303,26 +329,35 @@ def check_lines(data: ResultData) -> list[str]:
     return [*lines, ""]
 
 
-def perception_thresholds() -> tuple[tuple[float, ...], tuple[float, ...]]:
-    """Zacharias thresholds and the resting values they are taken around, per DOF (m/s^2, deg/s)."""
-    from washbench.perception.thresholds import STANDARD_GRAVITY_MPS2, ZACHARIAS
+def perception_thresholds(data: ResultData) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """Zacharias thresholds and the resting values they are taken around, per DOF (m/s^2, deg/s).
+
+    The resting value is what the aircraft pilot perceives at the first sample (trimmed flight, or standing on the
+    runway): a steady cue the pilot has been exposed to is not a change felt, so the band "not felt" lies around it
+    (for a level start about (0, 0, -g, 0, 0, 0); a descent or a climb starts with its own surge).
+    """
+    from washbench.perception.thresholds import ZACHARIAS
 
     th = ZACHARIAS
     thresholds = (th.f_x_mps2, th.f_y_mps2, th.f_z_mps2, th.omega_x_degps, th.omega_y_degps, th.omega_z_degps)
-    return thresholds, (0.0, 0.0, -STANDARD_GRAVITY_MPS2, 0.0, 0.0, 0.0)
+    rest = tuple(float(v) for v in data.perceived["aircraft"][0])
+    return thresholds, rest
 
 
 def time_above_threshold(data: ResultData) -> dict[str, float]:
-    """Per DOF, how long the aircraft pilot's perceived motion lies beyond the perception threshold [s]."""
-    thresholds, rest = perception_thresholds()
+    """Per DOF, how long the aircraft pilot's perceived motion lies beyond the perception threshold around its
+    resting value (:func:`perception_thresholds`) [s]."""
+    thresholds, rest = perception_thresholds(data)
     p = data.perceived["aircraft"]
     return {
         d: float(np.count_nonzero(np.abs(p[:, i] - rest[i]) > thresholds[i])) * data.dt_s for i, d in enumerate(DOFS)
     }
 
 
-def result_figures(data: ResultData, pdf: bool = False) -> dict[str, Path]:
+def result_figures(data: ResultData, pdf: bool = False, palette: str | None = None) -> dict[str, Path]:
     """Draw the result's figures into ``folder/figures/`` (PNG, and PDF with ``pdf``); figure name -> PNG path.
+
+    ``palette``: :data:`washbench.review.palette.PALETTES` (None: ``$WASHBENCH_PALETTE`` or the default).
 
     A PDF left from an earlier ``washbench report`` is removed when none is drawn (it would show other data).
     """
@@ -334,7 +369,7 @@ def result_figures(data: ResultData, pdf: bool = False) -> dict[str, Path]:
     if not pdf:
         for stem in ("perceived", "envelope", "cues"):
             (fig_dir / f"{stem}.pdf").unlink(missing_ok=True)
-    thresholds, rest = perception_thresholds()
+    thresholds, rest = perception_thresholds(data)
     out = {}
     out["perceived"] = perceived_figure(
         fig_dir / "perceived",
@@ -345,6 +380,7 @@ def result_figures(data: ResultData, pdf: bool = False) -> dict[str, Path]:
         thresholds=thresholds,
         rest=rest,
         formats=formats,
+        palette=palette,
     )[0]
     if data.washouts and all(w in data.perceived for w in data.washouts):
         from washbench.review.cue_figures import cue_classes, cue_lane_figure
@@ -353,7 +389,8 @@ def result_figures(data: ResultData, pdf: bool = False) -> dict[str, Path]:
         out["cues"] = cue_lane_figure(fig_dir / "cues", data.title, data.t_s, classes, formats=formats)[0]
     if data.usage:
         out["envelope"] = envelope_figure(
-            fig_dir / "envelope", data.title, data.t_s, data.usage, data.saturated, phases=data.phases, formats=formats
+            fig_dir / "envelope", data.title, data.t_s, data.usage, data.saturated, phases=data.phases, formats=formats,
+            palette=palette,
         )[0]
     return out
 
@@ -385,8 +422,9 @@ def result_sections(
     lines += [f"{h} Ranking", "", *ranking_lines(data, ranking, rule)]
     lines += [f"{h} Perceived motion", ""]
     lines += [
-        "Aircraft pilot (magenta, wide) against each washout's simulator pilot; dashed: perception thresholds "
-        "(Zacharias 1978) around the resting value, what lies between them is not felt; shaded: the phases.",
+        "Aircraft pilot (wide solid line) against each washout's simulator pilot (each its own colour and dash); "
+        "grey band: the perception thresholds (Zacharias 1978) around the pilot's resting value (what was perceived "
+        "at the start), what lies inside it is not felt; shaded: the phases.",
         "",
     ]
     lines += _image(figures["perceived"], start, "perceived motion") if "perceived" in figures else [NO_FIGURES, ""]

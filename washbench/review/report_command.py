@@ -6,6 +6,7 @@ from the same pieces) because it chooses between the two.
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 from washbench.errors import WashbenchError, located
@@ -14,9 +15,14 @@ from washbench.review.result_data import is_result_folder
 from washbench.review.suite_report import write_suite_report
 
 
-def report_command(results_dir: Path) -> int:
+def report_command(results_dir: Path, palette: str | None = None) -> int:
     """``washbench report DIR``: write report.md and the figures (PNG and PDF) again from a result or suite folder's
-    files."""
+    files. ``palette`` (:data:`washbench.review.palette.PALETTES`) is set for this process as
+    ``$WASHBENCH_PALETTE`` would be (every figure of a suite is drawn with it)."""
+    from washbench.review.palette import PALETTE_ENV, palette_name
+
+    if palette is not None:
+        os.environ[PALETTE_ENV] = palette_name(palette)
     folder = Path(results_dir)
     if not folder.is_dir():
         raise WashbenchError(located(folder, "no such folder"))

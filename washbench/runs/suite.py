@@ -295,7 +295,7 @@ def run_suite(
     if progress:
         print(
             f"suite: {len(files)} manoeuvres on {jobs} process{'es' if jobs > 1 else ''} -> {_destination(out_dir)}\n"
-            "suite: loading JSBSim, rerun and the washout kernel (compiled once after install: a few seconds)",
+            "suite: loading JSBSim, rerun and the compiled kernels",
             file=sys.stderr,
         )
     if dask:
