@@ -157,10 +157,18 @@ def _plot_width_px(size_in: tuple[float, float], margins_in: tuple[float, float,
     return max(math.ceil((size_in[0] - margins_in[0] - margins_in[1]) * PNG_DPI), 16)
 
 
+_LEGEND_ROW = 6
+"""Entries in one legend row; more (the aircraft and six or more washouts) go on two rows in a smaller font."""
+
+
 def _top_legend(fig: Any, handles: list[Any]) -> None:
-    """The legend in one row above the panels (under the figure's top edge)."""
-    fig.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, 1.0 - 0.04 / fig.get_figheight()),
-               ncol=len(handles), fontsize=8.5, frameon=False, handlelength=3.2)  # fmt: skip
+    """The legend above the panels (under the figure's top edge): one row, or two when there are more than
+    :data:`_LEGEND_ROW` entries (so that every name stays inside the picture)."""
+    two = len(handles) > _LEGEND_ROW
+    fig.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, 1.0 - 0.02 / fig.get_figheight()),
+               ncol=math.ceil(len(handles) / 2) if two else len(handles), fontsize=7.0 if two else 8.5,
+               frameon=False, handlelength=3.2, borderaxespad=0.0,
+               labelspacing=0.15, columnspacing=1.2)  # fmt: skip
 
 
 def save_figure(fig: Any, stem: Path, formats: Sequence[str] = ("png",)) -> list[Path]:
