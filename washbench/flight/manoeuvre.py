@@ -753,6 +753,8 @@ def _check_inputs(phase: Phase, loc: Loc, profile: PilotProfile, where: _Where) 
                 )
         amplitude = ci.amplitude_norm if ci.amplitude_norm is not None else ci.amplitude_deg
         _check_signal(ci, amplitude, at, "amplitude_norm or amplitude_deg", phase, where)
+        if ci.amplitude_deg is not None and ci.shape is not None and profile.surfaces is not None:
+            _check_travel(ci, getattr(profile.surfaces, axis), phase, at, where)
         released = ci.free or ci.fixed_norm is not None or ci.fixed_deg is not None
         if not released and ci.shape is None:
             raise where.error(at, "does nothing: give a 'shape', 'free: true' or a fixed value")
@@ -777,6 +779,34 @@ def _check_inputs(phase: Phase, loc: Loc, profile: PilotProfile, where: _Where) 
         _check_signal(pi, pi.amplitude, at, "amplitude", phase, where)
         if pi.shape is None and pi.fixed is None:
             raise where.error(at, "does nothing: give a 'shape' or a 'fixed' value")
+
+
+def _check_travel(ci: ControlInput, travel: Any, phase: Phase, at: Loc, where: _Where) -> None:
+    """An ``amplitude_deg`` signal fits the surface travel (from the model's flight-control system, copied into the
+    pilot profile): from a ``fixed_deg`` base exactly; from any other base (the command at the phase start or the
+    pilot's, known only in flight) its swing, highest minus lowest deflection asked, must fit the whole travel.
+    Where it fits only from some bases, a flight reports the time clipped at a stop (:mod:`washbench.flight.openloop`).
+    """
+    from washbench.flight.inputs import shape_extent
+
+    lo, hi = shape_extent(ci.shape, ci.start_s, ci.duration_s, ci.period_s, ci.start_hz, ci.end_hz, ci.sweep,
+                          phase.until.duration_s)  # fmt: skip
+    a = float(ci.amplitude_deg or 0.0)
+    low, high = sorted((a * lo, a * hi))
+    span = f"{travel.min_deg:g}..{travel.max_deg:g} deg"
+    if ci.fixed_deg is not None:
+        if ci.fixed_deg + low < travel.min_deg - 1e-9 or ci.fixed_deg + high > travel.max_deg + 1e-9:
+            raise where.error(
+                (*at, "amplitude_deg"),
+                f"from fixed_deg {ci.fixed_deg:g} the {ci.shape} asks {ci.fixed_deg + low:g}..{ci.fixed_deg + high:g} "
+                f"deg, beyond the surface travel {span} (it would stop at the limit)",
+            )
+    elif high - low > travel.max_deg - travel.min_deg + 1e-9:
+        raise where.error(
+            (*at, "amplitude_deg"),
+            f"the {ci.shape} swings {high - low:g} deg, more than the whole surface travel {span} (it would stop at "
+            "the limits)",
+        )
 
 
 def _check_properties(m: Manoeuvre, where: _Where) -> None:

@@ -312,15 +312,16 @@ def signal_command(
     out: Path,
 ) -> int:
     """The ``washbench signal`` command: generate a test signal and write it as a ``washbench cue`` input."""
-    from washbench.analysis.signals import SignalSpec, amplitude_unit
+    from washbench.analysis.signals import SignalSpec, amplitude_unit, canonical_axis
     from washbench.io.motion_file import write_motion
 
+    given, axis = axis, canonical_axis(axis)  # surge/sway/heave (the metrics' names) or f_x/f_y/f_z
     spec = SignalSpec(kind, axis, amplitude, frequency_hz, duration_s, rate_hz, start_s)
     sig = generate(spec)
     write_motion(out, sig.t_s, sig.f_mps2, sig.omega_radps)
     freq = "" if frequency_hz is None or kind == "step" else f" at {frequency_hz:g} Hz"
     print(
-        f"wrote {out}: {kind} on {axis}, amplitude {amplitude:g} {amplitude_unit(axis)}{freq}, "
+        f"wrote {out}: {kind} on {axis if given == axis else f'{given} ({axis})'}, amplitude {amplitude:g} {amplitude_unit(axis)}{freq}, "
         f"{sig.t_s.shape[0]} samples at {rate_hz:g} Hz"
     )
     return 0

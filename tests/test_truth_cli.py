@@ -1,0 +1,29 @@
+"""Issue 26, the command line: what a user types that was refused or answered wrongly, driven through ``main``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from washbench.cli import main
+
+G0 = 9.80665
+
+
+def test_signal_accepts_the_metrics_axis_names(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """``--axis heave`` is f_z (metrics call the body z specific force heave): the same file, bit for bit, and a
+    step of +1 m/s^2 on f = [0, 0, -g] from 1 s on."""
+    a, b = tmp_path / "heave.csv", tmp_path / "fz.csv"
+    assert main(["signal", "step", "--axis", "heave", "--amplitude", "1", "--duration-s", "2", "--out", str(a)]) == 0
+    assert "step on heave (f_z)" in capsys.readouterr().out
+    assert main(["signal", "step", "--axis", "f_z", "--amplitude", "1", "--duration-s", "2", "--out", str(b)]) == 0
+    assert a.read_bytes() == b.read_bytes()
+    data = np.genfromtxt(a, delimiter=",", names=True)
+    late = data["t_s"] >= 1.0
+    np.testing.assert_allclose(data["f_z_mps2"][late], -G0 + 1.0, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(data["f_z_mps2"][~late], -G0, rtol=0, atol=1e-9)
+    assert main(["signal", "step", "--axis", "Surge", "--amplitude", "1", "--out", str(tmp_path / "s.csv")]) == 0
+    assert main(["signal", "step", "--axis", "bob", "--amplitude", "1", "--out", str(tmp_path / "x.csv")]) == 2
+    assert "unknown axis 'bob' (valid: f_x, f_y, f_z, roll, pitch, yaw, or surge, sway, heave" in capsys.readouterr().err
