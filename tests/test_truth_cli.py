@@ -26,4 +26,5 @@ def test_signal_accepts_the_metrics_axis_names(tmp_path: Path, capsys: pytest.Ca
     np.testing.assert_allclose(data["f_z_mps2"][~late], -G0, rtol=0, atol=1e-9)
     assert main(["signal", "step", "--axis", "Surge", "--amplitude", "1", "--out", str(tmp_path / "s.csv")]) == 0
     assert main(["signal", "step", "--axis", "bob", "--amplitude", "1", "--out", str(tmp_path / "x.csv")]) == 2
-    assert "unknown axis 'bob' (valid: f_x, f_y, f_z, roll, pitch, yaw, or surge, sway, heave" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "unknown axis 'bob' (valid: f_x, f_y, f_z, roll, pitch, yaw, or surge, sway, heave" in err

@@ -64,7 +64,8 @@ def test_a_step_within_the_travel_is_flown_as_asked(tmp_path: Path) -> None:
 
 
 def test_a_number_where_text_is_expected_gets_the_hint_to_quote_it(tmp_path: Path, capsys) -> None:
-    f = write(tmp_path, "m.yaml", RUDDER.format(shape="step", amp=10, extra="").replace("aircraft: c172p", "aircraft: 737"))
+    text = RUDDER.format(shape="step", amp=10, extra="").replace("aircraft: c172p", "aircraft: 737")
+    f = write(tmp_path, "m.yaml", text)
     assert main(["validate", str(f)]) == 2
     err = capsys.readouterr().err
     assert "m.yaml:2: aircraft: expected text, got 737 (write it in quotes: '737')" in err

@@ -149,8 +149,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("signal", help="write a test signal on one axis as a washbench cue input")
     p.add_argument("kind", help="signal shape: sine, step, pulse, doublet, chirp, multisine")
-    p.add_argument("--axis", required=True,
-                   help="body axis: f_x, f_y, f_z (specific force; or surge, sway, heave), roll, pitch, yaw")  # fmt: skip
+    p.add_argument(
+        "--axis", required=True, help="f_x, f_y, f_z (specific force, or surge, sway, heave), roll, pitch, yaw"
+    )
     p.add_argument("--amplitude", type=float, required=True, help="m/s^2 (f_x, f_y, f_z) or deg/s (rotations)")
     p.add_argument("--frequency-hz", type=float, help="frequency (every kind but step; see README)")
     p.add_argument("--duration-s", type=float, default=20.0, help="length (default 20 s)")

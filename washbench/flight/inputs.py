@@ -138,7 +138,7 @@ def shape_extent(
     length = duration_s
     if length is None:
         length = (phase_s - start_s) if phase_s is not None else _need(period_s)
-    n = max(int(math.ceil(length / 1e-3)), 1)
+    n = max(math.ceil(length / 1e-3), 1)
     lo = hi = 0.0
     for k in range(n):
         v = unit_shape(shape, start_s + k * 1e-3, start_s, duration_s, period_s, start_hz, end_hz, sweep)

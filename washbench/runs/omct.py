@@ -320,8 +320,9 @@ def signal_command(
     sig = generate(spec)
     write_motion(out, sig.t_s, sig.f_mps2, sig.omega_radps)
     freq = "" if frequency_hz is None or kind == "step" else f" at {frequency_hz:g} Hz"
+    named = axis if given == axis else f"{given} ({axis})"
     print(
-        f"wrote {out}: {kind} on {axis if given == axis else f'{given} ({axis})'}, amplitude {amplitude:g} {amplitude_unit(axis)}{freq}, "
+        f"wrote {out}: {kind} on {named}, amplitude {amplitude:g} {amplitude_unit(axis)}{freq}, "
         f"{sig.t_s.shape[0]} samples at {rate_hz:g} Hz"
     )
     return 0
