@@ -146,6 +146,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--boundaries", type=Path, help="gain/phase boundaries YAML, drawn and checked (README)")
     p.add_argument("--rate-hz", type=float, default=120.0, help="washout sample rate (default 120)")
     p.add_argument("--amplitude-scale", type=float, default=1.0, help="multiply every input amplitude (default 1)")
+    p.add_argument("--quiet", action="store_true", help="no progress display")
 
     p = sub.add_parser("signal", help="write a test signal on one axis as a washbench cue input")
     p.add_argument("kind", help="signal shape: sine, step, pulse, doublet, chirp, multisine")
@@ -228,6 +229,7 @@ def _cue_input_options(p: argparse.ArgumentParser) -> None:
                    help="filters start in the first sample's steady state (default) or at rest")  # fmt: skip
     g = p.add_argument_group("checks and outputs")
     g.add_argument("--strict", action="store_true", help="plausibility warnings are errors")
+    g.add_argument("--quiet", action="store_true", help="no progress display")
     _output_options(g)
 
 
@@ -259,6 +261,7 @@ def _cue(args: argparse.Namespace) -> int:
         strict=args.strict,
         recording=not args.no_recording,
         figures=not args.no_figures,
+        progress=not args.quiet,
     )
     return run_cue(
         args.input,
@@ -369,6 +372,7 @@ def _dispatch(args: argparse.Namespace) -> int:
             rate_hz=args.rate_hz,
             amplitude_scale=args.amplitude_scale,
             variants=args.variant,
+            progress=not args.quiet,
         )
         return 0
     if args.command == "signal":

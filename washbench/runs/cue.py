@@ -33,6 +33,7 @@ from washbench.io.atomic import atomic_path
 from washbench.io.input_format import InputFormat
 from washbench.io.names import check_identifier
 from washbench.io.plausibility import Finding, check_motion
+from washbench.io.progress import Progress
 from washbench.io.publish import result_path
 from washbench.io.readers import Samples, read_samples
 from washbench.io.resample import check_gaps, resample, split_resets, to_motion, window
@@ -284,33 +285,6 @@ _RECORDING_FIELDS = ("head_f_mps2", "head_omega_radps", "q")
 """... and for the recording (the simulator pilot's raw motion, the sphere's attitude in the 3D view)."""
 
 
-class Progress:
-    """``cue: 45% (97,000 of 216,000 rows)`` on stderr: in place on a terminal, else a line every ``every_s``
-    (nothing for work done in less); :meth:`close` ends the line on a terminal."""
-
-    def __init__(self, label: str, total: int, every_s: float = 5.0) -> None:
-        self.label, self.total, self.every_s = label, total, every_s
-        self.offset = 0  # rows done before the part now being counted (``update`` counts from here)
-        self.tty = sys.stderr.isatty()
-        self._last = time.monotonic()
-        self._shown = False
-
-    def update(self, done: int) -> None:
-        now = time.monotonic()
-        if now - self._last < (0.2 if self.tty else self.every_s):
-            return
-        self._last = now
-        done += self.offset
-        pct = 100.0 * done / max(self.total, 1)
-        line = f"{self.label}: {pct:3.0f}% ({done:,} of {self.total:,} rows)"
-        print(f"\r{line}" if self.tty else line, end="" if self.tty else "\n", file=sys.stderr, flush=True)
-        self._shown = True
-
-    def close(self) -> None:
-        if self.tty and self._shown:
-            print(file=sys.stderr, flush=True)
-
-
 def stream_cue(
     motion: Motion,
     washouts: Sequence[Any],
@@ -424,6 +398,7 @@ class CueOptions:
     strict: bool = False
     recording: bool = True
     figures: bool = True
+    progress: bool = True
 
 
 @dataclass(frozen=True, eq=False)
@@ -623,7 +598,7 @@ def run_cue(
         input_prov = read_parquet_provenance(input_path) if is_parquet else None
         if input_prov:
             prov["input"]["provenance"] = input_prov
-        done = write_outputs(out_dir, input_path, segments, specs, limits, opts, start, prov, progress=True)
+        done = write_outputs(out_dir, input_path, segments, specs, limits, opts, start, prov, progress=opts.progress)
     for seg, (summary, result) in zip(segments, done, strict=True):
         m = seg.motion
         label = f"{input_path}{f' {seg.name}' if seg.name else ''}"

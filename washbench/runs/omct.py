@@ -29,6 +29,7 @@ from washbench.analysis.signals import amplitude_unit, generate
 from washbench.cueing.variants import Washout
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
+from washbench.io.progress import Progress
 from washbench.io.results import csv_number
 from washbench.io.yamlio import load_yaml_model
 from washbench.perception.vestibular import VestibularModel, VestibularParams
@@ -114,8 +115,11 @@ def measure(
     boundaries: dict[str, omct.Bounds] | None = None,
     vestibular: VestibularParams | None = None,
     amplitude_scale: float = 1.0,
+    progress: bool = False,
 ) -> tuple[list[OmctPoint], OmctSettings]:
     """Run every test at every frequency for every washout; points ordered washout, test, frequency.
+
+    ``progress``: show the test points done and the expected end on standard error (:mod:`washbench.io.progress`).
 
     ``amplitude_scale`` multiplies every input amplitude (1: the amplitudes of :func:`omct.amplitude`), to
     probe where a washout stops being linear.
@@ -135,21 +139,25 @@ def measure(
     sigma = slowest_decay(entries)
     model = VestibularModel(dt, vestibular)
     raw: dict[tuple[str, str], list[tuple[float, float, str, complex, float, tuple[str, ...], complex]]] = {}
-    for test in tests:
-        for w in frequencies_radps:
-            tm = omct.timing(w, sigma)
-            spec = omct.input_spec(test, w, rate_hz, tm.duration_s, amplitude_scale)
-            sig = generate(spec)
-            ref = omct.reference_fit(test, sig.f_mps2, sig.omega_radps, dt, w, tm.periods)
-            aircraft = omct.response(test, ref, sig.f_mps2, sig.omega_radps, dt, w, tm.periods, _g(entries[0]))
-            traces = cue_trace(sig.f_mps2, sig.omega_radps, dt, entries, None, limits)
-            for m in entries:
-                tr = traces[m.name]
-                r = omct.response(test, ref, tr.head_f_mps2, tr.head_omega_radps, dt, w, tm.periods, _g(m))
-                sat = omct.saturated_kinds(tr.saturation_counts)
-                raw.setdefault((m.name, test.name), []).append(
-                    (w, spec.amplitude, amplitude_unit(test.input_axis), r.h, r.distortion, sat, aircraft.h)
-                )
+    shown = Progress("omct", len(tests) * len(frequencies_radps), "test points") if progress else None
+    for i, (test, w) in enumerate((t, w) for t in tests for w in frequencies_radps):
+        tm = omct.timing(w, sigma)
+        spec = omct.input_spec(test, w, rate_hz, tm.duration_s, amplitude_scale)
+        sig = generate(spec)
+        ref = omct.reference_fit(test, sig.f_mps2, sig.omega_radps, dt, w, tm.periods)
+        aircraft = omct.response(test, ref, sig.f_mps2, sig.omega_radps, dt, w, tm.periods, _g(entries[0]))
+        traces = cue_trace(sig.f_mps2, sig.omega_radps, dt, entries, None, limits)
+        for m in entries:
+            tr = traces[m.name]
+            r = omct.response(test, ref, tr.head_f_mps2, tr.head_omega_radps, dt, w, tm.periods, _g(m))
+            sat = omct.saturated_kinds(tr.saturation_counts)
+            raw.setdefault((m.name, test.name), []).append(
+                (w, spec.amplitude, amplitude_unit(test.input_axis), r.h, r.distortion, sat, aircraft.h)
+            )
+        if shown is not None:
+            shown.update(i + 1, test.name)
+    if shown is not None:
+        shown.close()
     points: list[OmctPoint] = []
     for e in entries:
         for test in tests:
@@ -244,6 +252,7 @@ def run_omct(
     amplitude_scale: float = 1.0,
     plots: bool = True,
     variants: Sequence[str] = (),
+    progress: bool = False,
 ) -> list[OmctPoint]:
     """The ``washbench omct`` command: the washouts of ``--washout``, ``--variant`` and ``--params``.
 
@@ -258,8 +267,9 @@ def run_omct(
     limits = load_platform_limits(platform_path)
     boundary = load_boundaries(boundaries_path) if boundaries_path is not None else None
     return run_entries(
-        out_dir, entries, limits, boundary, rate_hz=rate_hz, amplitude_scale=amplitude_scale, plots=plots
-    )
+        out_dir, entries, limits, boundary, rate_hz=rate_hz, amplitude_scale=amplitude_scale, plots=plots,
+        progress=progress,
+    )  # fmt: skip
 
 
 def run_entries(
@@ -270,13 +280,16 @@ def run_entries(
     rate_hz: float = 120.0,
     amplitude_scale: float = 1.0,
     plots: bool = True,
+    progress: bool = False,
 ) -> list[OmctPoint]:
     """Measure ``entries`` and write the results (the part of :func:`run_omct` a variant list can call)."""
     out_dir = Path(out_dir)
     if out_dir.exists() and not out_dir.is_dir():
         raise WashbenchError(located(out_dir, "output path exists and is not a folder"))
     bounds = boundary.bounds() if boundary else None
-    points, settings = measure(entries, limits, rate_hz=rate_hz, boundaries=bounds, amplitude_scale=amplitude_scale)
+    points, settings = measure(
+        entries, limits, rate_hz=rate_hz, boundaries=bounds, amplitude_scale=amplitude_scale, progress=progress
+    )
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
         files: dict[str, str] = {}

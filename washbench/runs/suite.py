@@ -57,6 +57,7 @@ from washbench.errors import Terminated, WashbenchError, located
 from washbench.io.atomic import write_text_atomic
 from washbench.io.lock import LOCK_NAME, output_lock
 from washbench.io.paths import MANOEUVRES_DIR, bundled_names, resolve_manoeuvre
+from washbench.io.progress import Progress
 from washbench.io.publish import clean_partials, is_leftover, is_washbench_result, read_marker
 from washbench.io.results import csv_number
 from washbench.runs.outputs import DEFAULT_OUTPUTS, Outputs
@@ -275,34 +276,41 @@ def run_suite(
             for f in files]
     outcomes: dict[str, list[Outcome]] = {}
     start = time.perf_counter()
+    shown = Progress("suite", len(files), "manoeuvres") if progress else None
     if progress:
         print(
             f"suite: {len(files)} manoeuvres on {jobs} process{'es' if jobs > 1 else ''} -> {_destination(out_dir)}\n"
             "suite: loading JSBSim, rerun and the washout kernel (compiled once after install: a few seconds)",
             file=sys.stderr,
         )
-    if dask:
-        from washbench.runs.cluster import dask_map
+    try:
+        if dask:
+            from washbench.runs.cluster import dask_map
 
-        for runs in dask_map(dask, _run_one, args):
-            outcomes[runs[0].path] = _report(runs, len(outcomes) + 1, len(files), start, progress)
-    elif jobs == 1:
-        for a in args:
-            outcomes[a[0]] = _report(_run_one(*a), len(outcomes) + 1, len(files), start, progress)
-    else:
-        ctx, initializer = pool_context(outputs.recording, main_stops_workers=True, figures=outputs.figures)
-        pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_init, initargs=(initializer,))
-        try:
-            with _signals_deferred():  # submitting starts the workers (up to ``jobs``)
-                futures = [pool.submit(_run_one, *a) for a in args]
-            for fut in as_completed(futures):
-                runs = fut.result()
-                outcomes[runs[0].path] = _report(runs, len(outcomes) + 1, len(files), start, progress)
-        except BaseException:
-            with _signals_held():
-                _stop_pool(pool)
-            raise
-        pool.shutdown(wait=True)
+            for runs in dask_map(dask, _run_one, args):
+                outcomes[runs[0].path] = _report(runs, len(outcomes) + 1, len(files), start, shown)
+        elif jobs == 1:
+            for a in args:
+                outcomes[a[0]] = _report(_run_one(*a), len(outcomes) + 1, len(files), start, shown)
+        else:
+            ctx, initializer = pool_context(outputs.recording, main_stops_workers=True, figures=outputs.figures)
+            pool = ProcessPoolExecutor(
+                max_workers=jobs, mp_context=ctx, initializer=_worker_init, initargs=(initializer,)
+            )
+            try:
+                with _signals_deferred():  # submitting starts the workers (up to ``jobs``)
+                    futures = [pool.submit(_run_one, *a) for a in args]
+                for fut in as_completed(futures):
+                    runs = fut.result()
+                    outcomes[runs[0].path] = _report(runs, len(outcomes) + 1, len(files), start, shown)
+            except BaseException:
+                with _signals_held():
+                    _stop_pool(pool)
+                raise
+            pool.shutdown(wait=True)
+    finally:
+        if shown is not None:
+            shown.close()
     return [o for a in args for o in outcomes[a[0]]]
 
 
@@ -311,21 +319,23 @@ def _destination(out_dir: Path) -> Path:
     return out_dir.parent if is_leftover(out_dir.name) else out_dir
 
 
-def _report(runs: list[Outcome], done: int, total: int, start: float, progress: bool) -> list[Outcome]:
+def _report(runs: list[Outcome], done: int, total: int, start: float, progress: Progress | None) -> list[Outcome]:
     for outcome in runs:
         _report_one(outcome, done, total, start, progress)
+    if progress is not None:
+        progress.update(done)
     return runs
 
 
-def _report_one(outcome: Outcome, done: int, total: int, start: float, progress: bool) -> None:
-    if progress:
+def _report_one(outcome: Outcome, done: int, total: int, start: float, progress: Progress | None) -> None:
+    if progress is not None:
         name = f"{outcome.run.aircraft}/{outcome.run.manoeuvre}" if outcome.run.aircraft else _short(outcome.path)
         state = "ok  " if outcome.run.ok else "FAIL"
         extra = f"checks {outcome.run.checks_passed}/{outcome.run.checks_total}" if outcome.run.checks_total else ""
         line = f"[{done:>2}/{total}] {state} {name:<40} {outcome.wall_s:6.1f} s  {extra}"
         if not outcome.run.ok:
             line += f"\n        {outcome.run.reason}"
-        print(f"{line}   (elapsed {time.perf_counter() - start:.0f} s)", file=sys.stderr, flush=True)
+        progress.message(f"{line}   (elapsed {time.perf_counter() - start:.0f} s)")
 
 
 def _short(path: str) -> str:
