@@ -213,7 +213,7 @@ def test_jsbsim_own_csv_output_matches_the_recorder(trace: dict[str, np.ndarray]
     from washbench.io.readers import read_samples
 
     s = read_samples(csv_path)
-    assert s.kind == "jsbsim" and any("one-frame lag" in n for n in s.notes)
+    assert s.kind == "jsbsim" and any("shifted back one frame of 0.00833333 s = one row" in n for n in s.notes)
     n = s.n
     ref_f = np.column_stack([trace[f"f_{a}_mps2"] for a in "xyz"])[:n]
     ref_w = np.column_stack([trace[f"omega_{a}_degps"] for a in "xyz"])[:n]

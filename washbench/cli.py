@@ -219,6 +219,8 @@ def _cue_input_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--input-format", type=Path, metavar="FILE", help="YAML: format, delimiter, axes, columns")
     g.add_argument("--axes", metavar="XYZ", help="sensor axes as body directions, e.g. flu (z up, y left); default frd")
     g.add_argument("--delimiter", metavar="D", help="CSV delimiter (default: detected): , ; tab | or a character")
+    g.add_argument("--decimal", choices=(".", ","), help="decimal mark of the numbers (default .)")
+    g.add_argument("--jsbsim-dt", type=float, metavar="S", help="JSBSim CSV: the simulation frame time (script dt)")
     g = p.add_argument_group("time")
     g.add_argument("--resample", type=float, metavar="HZ", help="interpolate onto a uniform grid at HZ (anti-alias)")
     g.add_argument("--max-gap-s", type=float, metavar="S", help="largest allowed time step (default: 5 median steps)")
@@ -251,7 +253,7 @@ def _cue(args: argparse.Namespace) -> int:
     from washbench.runs.cue import CueOptions, run_cue
 
     opts = CueOptions(
-        fmt=input_format(args.columns, args.input_format, args.axes, args.delimiter),
+        fmt=input_format(args.columns, args.input_format, args.axes, args.delimiter, args.decimal, args.jsbsim_dt),
         resample_hz=args.resample,
         max_gap_s=args.max_gap_s,
         split=not args.no_split,

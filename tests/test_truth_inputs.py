@@ -1,0 +1,122 @@
+"""Issue 26, recorded inputs through ``washbench cue`` (the command's entry, ``main``), with logs written here:
+
+- JSBSim's own CSV logged below the simulation rate: the pilot accelerations are moved back one simulation
+  frame, not one row; against the same flight as washbench records it (one-frame lag removed, 120 Hz);
+- decimal-comma files: the hint, and ``--decimal ,`` reading them.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import jsbsim
+import numpy as np
+import pyarrow.csv as pacsv
+import pyarrow.parquet as pq
+import pytest
+
+from washbench.cli import main
+from washbench.flight.scripts import bundled_script, fly_script
+
+SCRIPT = "c172_cruise_8K"
+SECONDS = 14.0
+START_S = 2.0  # the script starts untrimmed: its first second is a transient no 10 Hz log can follow
+G0 = 9.80665
+
+
+@pytest.fixture(scope="module")
+def flown(tmp_path_factory: pytest.TempPathFactory) -> dict:
+    """The script flown by washbench (reference: lag removed, every 120 Hz frame) and by JSBSim with its own CSV
+    output at 120 Hz and at 10 Hz (every 12th frame)."""
+    d = tmp_path_factory.mktemp("jsbsim_logs")
+    (seg,) = fly_script(bundled_script(SCRIPT), max_time_s=SECONDS).segments
+    logs = {}
+    for rate in (120, 10):
+        csv_path = d / f"log_{rate}.csv"
+        directive = d / f"out_{rate}.xml"
+        directive.write_text(
+            f'<?xml version="1.0"?>\n<output name="{csv_path}" type="CSV" rate="{rate}">\n  <rates> ON </rates>\n'
+            + "".join(f"  <property> accelerations/a-pilot-{a}-ft_sec2 </property>\n" for a in "xyz")
+            + "</output>\n"
+        )
+        fdm = jsbsim.FGFDMExec(jsbsim.get_default_root_dir(), None)
+        fdm.set_debug_level(0)
+        fdm.set_output_path(str(d))
+        fdm.load_script(str(bundled_script(SCRIPT)))
+        fdm.set_output_directive(str(directive))
+        fdm.run_ic()
+        while fdm.get_sim_time() < SECONDS:
+            fdm.run()
+        del fdm
+        logs[rate] = csv_path
+    return {"ref": seg.columns, "logs": logs, "dir": d}
+
+
+def cue_f(path: Path, out: Path, *extra: str) -> tuple[np.ndarray, np.ndarray]:
+    argv = ["cue", str(path), "--out", str(out), "--washout", "large-angle", "--no-recording", "--no-figures"]
+    assert main([*argv, "--quiet", *extra]) in (0, 1)
+    t = pq.read_table(out / "traces.parquet")
+    return t["t_s"].to_numpy(), np.column_stack([t[f"aircraft.f_{a}_mps2"].to_numpy() for a in "xyz"])
+
+
+def reference_at(flown: dict, t: np.ndarray) -> np.ndarray:
+    ref = flown["ref"]
+    return np.column_stack([np.interp(t, ref["t_s"], ref[f"f_{a}_mps2"]) for a in "xyz"])
+
+
+def test_a_10hz_jsbsim_log_is_shifted_one_frame_not_one_row(flown: dict, tmp_path: Path, capsys) -> None:
+    """With the frame time given, the 10 Hz log's specific force matches the 120 Hz recording at its rows (within
+    the linear interpolation over a twelfth of a row); shifted by a row it would be 11 frames early: many times
+    further off."""
+    t, f = cue_f(flown["logs"][10], tmp_path / "a", "--jsbsim-dt", str(1 / 120), "--start-s", str(START_S))
+    out = capsys.readouterr().out
+    assert "shifted back one frame of 0.00833333 s (frame from --jsbsim-dt), interpolated between rows 0.0999996 s apart" in out
+    ref = reference_at(flown, t)
+    ref_next_row = reference_at(flown, t + 0.1 - 1 / 120)  # what the row shift gave: 11 frames ahead
+
+    def rms(x: np.ndarray) -> float:
+        return float(np.sqrt(np.mean(np.sum(x**2, axis=1))))
+
+    err, row_err = rms(f - ref), rms(ref_next_row - ref)
+    assert err < 0.02 and row_err > 5 * err, (err, row_err)  # measured 0.013 and 0.10 m/s^2
+    # worst: the autopilot's step at 5.008 s, which no 10 Hz log resolves (measured 0.10 against 0.78 m/s^2)
+    assert np.abs(f - ref).max() < 0.2 * np.abs(ref_next_row - ref).max()
+
+
+def test_a_10hz_jsbsim_log_without_its_frame_time_is_not_shifted_and_says_so(flown: dict, tmp_path: Path,
+                                                                              capsys) -> None:  # fmt: skip
+    t, f = cue_f(flown["logs"][10], tmp_path / "b")
+    out = capsys.readouterr().out
+    assert "lag the other columns by one simulation frame, but the log's rows are 0.0999996 s apart" in out
+    assert "NOT shifted (give the script's <run dt> with --jsbsim-dt S" in out
+    logged = pacsv.read_csv(flown["logs"][10])["/fdm/jsbsim/accelerations/a-pilot-z-ft_sec2"].to_numpy()
+    np.testing.assert_allclose(f[:, 2], logged[: len(t)] * 0.3048, rtol=1e-12)  # the rows as logged
+
+
+def test_a_120hz_jsbsim_log_is_shifted_one_row(flown: dict, tmp_path: Path, capsys) -> None:
+    t, f = cue_f(flown["logs"][120], tmp_path / "c")
+    assert "shifted back one frame of 0.00833333 s = one row (frame from JSBSim's default" in capsys.readouterr().out
+    inside = t < flown["ref"]["t_s"][-1]  # the recorder's last sample has no next frame to take its value from
+    np.testing.assert_allclose(f[inside], reference_at(flown, t[inside]), rtol=0, atol=1e-9)
+
+
+def test_a_decimal_comma_file_gets_the_hint_and_reads_with_decimal_comma(tmp_path: Path, capsys) -> None:
+    """A semicolon CSV with decimal commas (as a German or French spreadsheet writes it): refused with the hint,
+    then read with ``--decimal ,`` to the same metrics as the same numbers written with decimal points."""
+    dot = tmp_path / "dot.csv"
+    assert main(["signal", "sine", "--axis", "heave", "--amplitude", "1.5", "--frequency-hz", "0.5", "--duration-s",
+                 "6", "--out", str(dot)]) == 0  # fmt: skip
+    lines = dot.read_text().splitlines()
+    comma = tmp_path / "comma.csv"
+    comma.write_text("\n".join([lines[0].replace(",", ";")] + [ln.replace(",", ";").replace(".", ",")
+                                                               for ln in lines[1:]]) + "\n")  # fmt: skip
+    capsys.readouterr()
+    base = ["--washout", "large-angle", "--no-recording", "--no-figures", "--quiet"]
+    assert main(["cue", str(comma), "--out", str(tmp_path / "x"), *base]) == 2
+    err = capsys.readouterr().err
+    assert "comma.csv:2: t_s: not a number: '0,0' (a decimal comma? read the file with --decimal ,)" in err, err
+    assert main(["cue", str(comma), "--out", str(tmp_path / "c"), "--decimal", ",", *base]) == 0
+    assert main(["cue", str(dot), "--out", str(tmp_path / "d"), *base]) == 0
+    assert (tmp_path / "c" / "metrics.csv").read_text() == (tmp_path / "d" / "metrics.csv").read_text()
+    assert main(["cue", str(dot), "--out", str(tmp_path / "e"), "--decimal", ",", "--delimiter", ",", *base]) == 2
+    assert "--decimal ,: the delimiter is ',' too" in capsys.readouterr().err
