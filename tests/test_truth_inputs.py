@@ -120,3 +120,81 @@ def test_a_decimal_comma_file_gets_the_hint_and_reads_with_decimal_comma(tmp_pat
     assert (tmp_path / "c" / "metrics.csv").read_text() == (tmp_path / "d" / "metrics.csv").read_text()
     assert main(["cue", str(dot), "--out", str(tmp_path / "e"), "--decimal", ",", "--delimiter", ",", *base]) == 2
     assert "--decimal ,: the delimiter is ',' too" in capsys.readouterr().err
+
+
+def write_log(path: Path, t: np.ndarray, f: np.ndarray, w: np.ndarray, names: str = "t,ax,ay,az,p,q,r") -> Path:
+    """A hand-made log: time, three specific forces, three rates, in the units the caller chose."""
+    rows = np.column_stack([t, f, w])
+    path.write_text(names + "\n" + "\n".join(",".join(f"{v:.9g}" for v in r) for r in rows) + "\n")
+    return path
+
+
+def turning_flight(n: int, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A gentle S-turn: f about -g with swings up to 1.5 m/s^2, rates up to 10 deg/s (SI and deg/s)."""
+    t = np.arange(n) * dt
+    s = np.sin(2 * np.pi * 0.2 * t)
+    f = np.column_stack([0.5 * s, 1.5 * s, -G0 + 0.3 * s])
+    w = np.column_stack([10.0 * s, 2.0 * s, 5.0 * s])
+    return t, f, w
+
+
+def test_resample_checks_plausibility_first_and_refuses_a_1000_fold_growth(tmp_path: Path, capsys) -> None:
+    """Time in ms declared as s (0.01 Hz apparent; item 2 of issue 26): the same warning with --resample as without
+    (it was skipped), and the 10,000-fold growth refused before anything is written; --force resamples a real
+    2 Hz log 195-fold."""
+    t, f, w = turning_flight(600, 0.1)
+    log = write_log(tmp_path / "ms.csv", t * 1000.0, f, w)
+    cols = ["--columns", "t=t,f_x=ax,f_y=ay,f_z=az,omega_x=p,omega_y=q,omega_z=r"]
+    base = ["--washout", "large-angle", "--no-recording", "--no-figures", "--quiet", *cols]
+    out = tmp_path / "out"
+    warning = "sample rate 0.01 Hz is outside 10 Hz .. 10000 Hz: is the time in ms? (read as s now; give the unit " \
+              "with --columns t=COLUMN:ms,...)"  # fmt: skip
+    assert main(["cue", str(log), "--out", str(tmp_path / "plain"), *base]) == 0
+    assert warning in capsys.readouterr().err
+    assert main(["cue", str(log), "--out", str(out), "--resample", "100", *base]) == 2
+    err = capsys.readouterr().err
+    assert warning in err and "--resample 100 would make 5,990,001 rows of 600 (9983 times" in err, err
+    assert not out.exists()
+    slow = write_log(tmp_path / "slow.csv", *turning_flight(40, 0.5))  # 2 Hz, 20 s: at 400 Hz 8001 rows
+    assert main(["cue", str(slow), "--out", str(out), "--resample", "400", *base]) == 2
+    err = capsys.readouterr().err
+    assert "--resample 400 would make 7,801 rows of 40 (195 times): sample rate 2 Hz is outside" in err, err
+    assert not out.exists()
+    assert main(["cue", str(slow), "--out", str(out), "--resample", "400", "--force", *base]) == 0
+    assert pq.read_metadata(out / "traces.parquet").num_rows == 7801
+
+
+@pytest.mark.parametrize(
+    ("unit", "scale", "expected"),
+    [
+        ("radps", 1.0, "or rates in degps? (read as radps now; give the unit with --columns omega_x=COLUMN:degps"),
+        ("degps", np.pi / 180, "are the rates in radps? (read as degps now; give the unit with --columns "
+                               "omega_x=COLUMN:radps"),
+        ("radps", np.pi / 180 / 1000, "they are read as radps already: is a wrong column mapped?"),
+    ],
+)
+def test_rate_unit_hints_follow_from_what_was_declared(tmp_path: Path, capsys, unit: str, scale: float,
+                                                       expected: str) -> None:  # fmt: skip
+    """Rates written in deg/s but declared :radps reach 10 * 57.3 * ... deg/s: the hint says they look like deg/s
+    (item 4 of issue 26 found the opposite advice, 'use :radps', which was what had been written)."""
+    t, f, w = turning_flight(1200, 1 / 120)
+    w = w * 30.0 if unit == "radps" and scale == 1.0 else w  # 300 deg/s read as rad/s: 17,000 deg/s
+    log = write_log(tmp_path / "r.csv", t, f, w * scale)
+    cols = f"t=t,f_x=ax,f_y=ay,f_z=az,omega_x=p:{unit},omega_y=q:{unit},omega_z=r:{unit}"
+    main(["cue", str(log), "--out", str(tmp_path / "o"), "--columns", cols, "--washout", "large-angle",
+          "--no-recording", "--no-figures", "--quiet"])  # fmt: skip
+    err = capsys.readouterr().err
+    assert expected in err, err
+    if unit == "radps":
+        assert "(use :radps)" not in err and "COLUMN:radps" not in err
+
+
+def test_force_unit_hint_names_the_unit_that_fits(tmp_path: Path, capsys) -> None:
+    """Specific force written in g but declared in ft/s^2: the hint is g (read as ftps2, |f| is 0.3 m/s^2)."""
+    t, f, w = turning_flight(1200, 1 / 120)
+    log = write_log(tmp_path / "g.csv", t, f / G0, w)
+    cols = "t=t,f_x=ax:ftps2,f_y=ay:ftps2,f_z=az:ftps2,omega_x=p,omega_y=q,omega_z=r"
+    main(["cue", str(log), "--out", str(tmp_path / "o"), "--columns", cols, "--washout", "large-angle",
+          "--no-recording", "--no-figures", "--quiet"])  # fmt: skip
+    err = capsys.readouterr().err
+    assert "far from g: is it in g? (read as ftps2 now; give the unit with --columns f_x=COLUMN:g,...)" in err

@@ -223,6 +223,7 @@ def _cue_input_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--jsbsim-dt", type=float, metavar="S", help="JSBSim CSV: the simulation frame time (script dt)")
     g = p.add_argument_group("time")
     g.add_argument("--resample", type=float, metavar="HZ", help="interpolate onto a uniform grid at HZ (anti-alias)")
+    g.add_argument("--force", action="store_true", help="resample even to more than 100 times the rows read")
     g.add_argument("--max-gap-s", type=float, metavar="S", help="largest allowed time step (default: 5 median steps)")
     g.add_argument("--no-split", action="store_true", help="refuse a time reset instead of cueing each part")
     g.add_argument("--start-s", type=float, metavar="S", help="cue from this time on (input time, s)")
@@ -264,6 +265,7 @@ def _cue(args: argparse.Namespace) -> int:
         recording=not args.no_recording,
         figures=not args.no_figures,
         progress=not args.quiet,
+        force=args.force,
     )
     return run_cue(
         args.input,

@@ -23,7 +23,8 @@ so a ``washbench fly`` trace is read back bit for bit.
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -56,6 +57,10 @@ class Samples:
     lines: np.ndarray | None
     notes: tuple[str, ...] = ()
     time_column: str = "t_s"
+    declared: Mapping[str, str] = field(default_factory=dict)
+    """The units the columns were read in: ``t`` (time), ``f`` (specific force), ``omega`` (angular velocity)."""
+    sources: Mapping[str, str] = field(default_factory=dict)
+    """Per motion field (``t``, ``f_x`` ...) the source column, unit and sign it came from (``-ax:g``)."""
 
     @property
     def n(self) -> int:
@@ -79,6 +84,8 @@ class Samples:
             lines=None if self.lines is None else self.lines[index],
             notes=self.notes + notes,
             time_column=self.time_column,
+            declared=self.declared,
+            sources=self.sources,
         )
 
 
@@ -201,6 +208,8 @@ def convert(src: SourceTable, fmt: InputFormat) -> Samples:
         lines=src.lines,
         notes=tuple(notes),
         time_column=t_src.column,
+        declared={"t": units.normalise_unit(t_src.unit), "f": mapping["f_x"].unit, "omega": mapping["omega_x"].unit},
+        sources={f: s.describe() for f, s in mapping.items()},
     )
     if src.kind == "jsbsim":
         samples = shift_jsbsim_lag(samples, fmt.jsbsim_dt_s)
@@ -270,7 +279,7 @@ def shift_jsbsim_lag(s: Samples, frame_s: float | None = None) -> Samples:
             f"interpolated between rows {float(np.median(steps)):.6g} s apart"
         )
         out = s.take(slice(0, keep), (note,))
-    return Samples(out.path, out.kind, out.t_s, f, out.omega_degps, out.extra, out.lines, out.notes, out.time_column)
+    return replace(out, f_mps2=f)
 
 
 def _time_column(src: SourceTable, s: ColumnSource, notes: list[str]) -> np.ndarray:

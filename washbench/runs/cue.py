@@ -32,11 +32,11 @@ from washbench.errors import WashbenchError, located
 from washbench.io.atomic import atomic_path
 from washbench.io.input_format import InputFormat
 from washbench.io.names import check_identifier
-from washbench.io.plausibility import Finding, check_motion
+from washbench.io.plausibility import Finding, check_arrays
 from washbench.io.progress import Progress
 from washbench.io.publish import result_path
 from washbench.io.readers import Samples, read_samples
-from washbench.io.resample import check_gaps, resample, split_resets, to_motion, window
+from washbench.io.resample import check_gaps, check_step, resample, split_resets, to_motion, window
 from washbench.io.results import (
     AIRCRAFT,
     TIME_COLUMN,
@@ -399,6 +399,13 @@ class CueOptions:
     recording: bool = True
     figures: bool = True
     progress: bool = True
+    force: bool = False
+    """Resample even when that makes more than :data:`MAX_GROWTH` times the input's rows."""
+
+
+MAX_GROWTH = 100
+"""``--resample`` refuses (without ``--force``) to make more than this many times the input's rows: such a factor
+is a time column in the wrong unit far more often than a wish (a 0.1 Hz 'log' at 100 Hz: 1000 times)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -424,8 +431,12 @@ def read_input(path: Path, fmt: InputFormat) -> Samples:
 
 
 def prepare_segments(samples: Samples, opts: CueOptions) -> list[Segment]:
-    """Window and segments: split at time resets, cut the window, check gaps, put on a uniform grid
-    (``--resample``, else the grid check), then the plausibility checks (errors with ``--strict``)."""
+    """Window and segments: split at time resets, cut the window, check gaps, the plausibility checks on the data
+    as read (errors with ``--strict``), then put on a uniform grid (``--resample``, else the grid check).
+
+    Resampling is held to what the grid check holds the data to (a step of 1 Hz .. 10 kHz, the median step
+    here), and to at most :data:`MAX_GROWTH` times the rows read unless ``opts.force``.
+    """
     parts = split_resets(samples, split=opts.split)
     out = []
     for i, part in enumerate(parts):
@@ -433,15 +444,29 @@ def prepare_segments(samples: Samples, opts: CueOptions) -> list[Segment]:
         part = window(part, opts.start_s, opts.end_s)
         check_gaps(part, opts.max_gap_s)
         notes = list(part.notes)
+        step = float(np.median(np.diff(part.t_s)))
+        findings = tuple(check_arrays(part.t_s, step, part.f_mps2, part.omega_degps, part.declared))
+        if opts.strict and findings:
+            where = f" ({name})" if name else ""
+            raise WashbenchError(located(samples.path, f"{findings[0].text}{where} [--strict]"))
         if opts.resample_hz is not None:
+            check_step(part, step)
+            rows = math.floor((part.t_s[-1] - part.t_s[0]) * opts.resample_hz + 1e-9) + 1
+            if rows > MAX_GROWTH * part.n and not opts.force:
+                why = next((f.text for f in findings if f.text.startswith("sample rate")), "")
+                why = why or f"the data's own rate is {1.0 / step:.4g} Hz: is the time in another unit?"
+                raise WashbenchError(
+                    located(
+                        samples.path,
+                        f"--resample {opts.resample_hz:g} would make {rows:,} rows of {part.n:,} ({rows / part.n:.0f} "
+                        f"times): {why}; --force resamples anyway",
+                        field=part.time_column,
+                    )
+                )
             motion, note = resample(part, opts.resample_hz)
             notes.append(note)
         else:
             motion = to_motion(part)
-        findings = tuple(check_motion(motion))
-        if opts.strict and findings:
-            where = f" ({name})" if name else ""
-            raise WashbenchError(located(samples.path, f"{findings[0].text}{where} [--strict]"))
         out.append(Segment(name=name, motion=motion, notes=tuple(notes), findings=findings))
     return out
 
