@@ -111,7 +111,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", type=Path, required=True, help="results folder; writes OUT/<aircraft>/<manoeuvre>/")
     _washout_options(p)
     _aircraft_dir_option(p)
-    p.add_argument("--max-time-s", type=float, metavar="S", help="JSBSim script: stop after S s simulated")
+    p.add_argument("--max-time-s", type=float, metavar="S", help="JSBSim script: stop after S s (default 1200)")
     p.add_argument("--filter-start", choices=("steady", "rest"), default="steady", help="filters' start state")
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
@@ -127,7 +127,7 @@ def build_parser() -> argparse.ArgumentParser:
         "default: all bundled",
     )
     p.add_argument("--jsbsim-scripts", nargs="+", default=[], metavar="NAME", help="scripts shipped with JSBSim")
-    p.add_argument("--max-time-s", type=float, metavar="S", help="JSBSim scripts: stop each after S s simulated")
+    p.add_argument("--max-time-s", type=float, metavar="S", help="JSBSim scripts: stop each after S s (default 1200)")
     p.add_argument("--out", type=Path, required=True, help="results folder")
     _aircraft_dir_option(p)
     p.add_argument("--jobs", type=_jobs, help="parallel processes (default: number of cores)")

@@ -581,6 +581,12 @@ def suite_command(
         platform=load_platform_limits(platform_path),
     )
     check_unique_names(files, aircraft_dirs)
+    from washbench.flight.scripts import is_script
+    from washbench.runs.pipeline import announce_script
+
+    for f in files:
+        if is_script(f):
+            announce_script(f, max_time_s, aircraft_dirs, washouts, variants, params_path, outputs)
     start = time.perf_counter()
     with output_lock(out_dir):
         clean_partials(out_dir, only_dead=False)  # under the lock every leftover is stale
