@@ -15,6 +15,7 @@ import pytest
 from flight_helpers import write
 
 from washbench.cli import main
+from washbench.flight.scripts import bundled_script
 
 RUDDER = """\
     name: rudder_kick
@@ -69,3 +70,37 @@ def test_a_number_where_text_is_expected_gets_the_hint_to_quote_it(tmp_path: Pat
     assert main(["validate", str(f)]) == 2
     err = capsys.readouterr().err
     assert "m.yaml:2: aircraft: expected text, got 737 (write it in quotes: '737')" in err
+
+
+def test_validate_takes_what_suite_takes_and_reports_every_independent_mistake(tmp_path: Path, capsys) -> None:
+    """A folder holding a good manoeuvre, a JSBSim script (read as a script, not as YAML) and a manoeuvre with three
+    independent mistakes in two phases and a check: every file checked, every mistake reported with its line."""
+    folder = tmp_path / "mine"
+    folder.mkdir()
+    write(folder, "good.yaml", RUDDER.format(shape="step", amp=10, extra=""))
+    bad = RUDDER.format(shape="doublet", amp=3, extra="") + """\
+      - name: again
+        hold: {altitude_ft: 4000, airspeed_kts: 95}
+        inputs:
+          aileron: {shape: pulse, amplitude_deg: 2, free: true}
+        until: {duration_s: 2}
+    checks:
+      - {name: yaw, signal: omega_r_degps, stat: max, max: 5}
+    """
+    write(folder, "bad.yaml", bad)
+    (folder / "cruise.xml").write_text(bundled_script("c172_cruise_8K").read_text())
+    (folder / "notes.xml").write_text("<notes>not a script: skipped in a folder</notes>\n")
+    assert main(["validate", str(folder)]) == 2
+    out, err = capsys.readouterr()
+    assert sorted(out.splitlines()) == sorted([f"{folder / 'cruise.xml'}: OK", f"{folder / 'good.yaml'}: OK"])
+    problems = [ln for ln in err.splitlines() if ln.startswith("washbench: error:")]
+    assert len(problems) == 3, err
+    assert "bad.yaml:12: phases[1].inputs.rudder.shape: a doublet needs 'duration_s'" in problems[0]
+    assert "bad.yaml:17: phases[2].inputs.aileron.shape: a pulse needs 'duration_s'" in problems[1]
+    assert "bad.yaml:20: checks[0].signal: unknown signal 'omega_r_degps' (did you mean 'omega_z_" in problems[2]
+    assert main(["validate", str(folder / "cruise.xml")]) == 0  # a script named directly: not read as YAML
+    broken = folder / "broken.xml"
+    broken.write_text("<runscript>\n  <use aircraft='c172x'/>\n</runscript>\n")
+    assert main(["validate", str(broken)]) == 2
+    assert "broken.xml: <run> is missing" in capsys.readouterr().err
+

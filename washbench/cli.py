@@ -97,8 +97,8 @@ def build_parser() -> argparse.ArgumentParser:
     _aircraft_dir_option(p)
     p.add_argument("--quiet", action="store_true", help="no progress display")
 
-    p = sub.add_parser("validate", help="check manoeuvre files without flying them")
-    p.add_argument("manoeuvres", type=Path, nargs="+", help="manoeuvre YAML files")
+    p = sub.add_parser("validate", help="check manoeuvre files and JSBSim scripts without flying them")
+    p.add_argument("manoeuvres", type=Path, nargs="+", help="manoeuvre files, JSBSim scripts, folders or bundled names")
     _aircraft_dir_option(p)
 
     p = sub.add_parser("schema", help="print the manoeuvre file JSON Schema")
@@ -323,7 +323,7 @@ def _dispatch(args: argparse.Namespace) -> int:
 
         return fly_command(args.manoeuvre, args.out, progress=not args.quiet, aircraft_dirs=args.aircraft_dir)
     if args.command == "validate":
-        from washbench.flight.manoeuvre import validate_command
+        from washbench.flight.validate import validate_command
 
         return validate_command(args.manoeuvres, aircraft_dirs=args.aircraft_dir)
     if args.command == "schema":

@@ -190,19 +190,19 @@ def scripts_dir() -> Path:
     return jsbsim_root() / "scripts"
 
 
-def _is_runscript(path: Path) -> bool:
-    """Whether ``path`` is a JSBSim script (root element ``<runscript>``), not another XML file in the folder."""
+def is_runscript(path: Path) -> bool:
+    """True for an XML file whose root element is a JSBSim ``<runscript>`` (cheap: reads the first element)."""
     try:
-        with open(path, encoding="utf-8", errors="replace") as fh:
-            head = fh.read(4096)
-    except OSError:
+        for _, elem in ET.iterparse(path, events=("start",)):
+            return elem.tag == "runscript"
+    except (ET.ParseError, OSError):
         return False
-    return re.search(r"<runscript[\s>]", head) is not None
+    return False
 
 
 def bundled_scripts() -> list[str]:
     """The names of the scripts shipped with JSBSim (files whose root element is ``<runscript>``)."""
-    return sorted(p.stem for p in scripts_dir().glob("*.xml") if _is_runscript(p))
+    return sorted(p.stem for p in scripts_dir().glob("*.xml") if is_runscript(p))
 
 
 def bundled_script(name: str) -> Path:
@@ -210,7 +210,7 @@ def bundled_script(name: str) -> Path:
     all of them) if unknown or not a script."""
     stem = name[:-4] if name.endswith(".xml") else name
     path = scripts_dir() / f"{stem}.xml"
-    if not path.is_file() or not _is_runscript(path):
+    if not path.is_file() or not is_runscript(path):
         import difflib
 
         known = bundled_scripts()

@@ -77,29 +77,19 @@ class Outcome:
     run: RunSummary
 
 
-def _is_runscript(path: Path) -> bool:
-    """True for an XML file whose root element is a JSBSim ``<runscript>`` (cheap: reads the first element)."""
-    import xml.etree.ElementTree as ET
-
-    try:
-        for _, elem in ET.iterparse(path, events=("start",)):
-            return elem.tag == "runscript"
-    except (ET.ParseError, OSError):
-        return False
-    return False
-
-
 def find_manoeuvres(inputs: Sequence[Path], scripts: Sequence[Path] = ()) -> list[Path]:
     """Manoeuvre files and JSBSim scripts from files and folders (folders are searched recursively for
     ``*.yaml`` manoeuvres and ``*.xml`` JSBSim scripts), then ``scripts``; no inputs at all: the bundled
     manoeuvres."""
+    from washbench.flight.scripts import is_runscript
+
     if not inputs and not scripts:
         inputs = [MANOEUVRES_DIR]
     found: list[Path] = []
     for item in map(resolve_manoeuvre, inputs):
         if item.is_dir():
             found.extend(sorted(p for p in item.rglob("*.yaml") if p.is_file()))
-            found.extend(sorted(p for p in item.rglob("*.xml") if p.is_file() and _is_runscript(p)))
+            found.extend(sorted(p for p in item.rglob("*.xml") if p.is_file() and is_runscript(p)))
         elif item.is_file():
             found.append(item)
         else:
