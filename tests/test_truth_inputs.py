@@ -198,3 +198,40 @@ def test_force_unit_hint_names_the_unit_that_fits(tmp_path: Path, capsys) -> Non
           "--no-recording", "--no-figures", "--quiet"])  # fmt: skip
     err = capsys.readouterr().err
     assert "far from g: is it in g? (read as ftps2 now; give the unit with --columns f_x=COLUMN:g,...)" in err
+
+
+def test_cue_draws_the_input_as_read_and_links_it_first(tmp_path: Path) -> None:
+    """A z-up, y-left sensor (--axes flu) logging g and rad/s, its roll rate column negated in the mapping: the
+    input figure's legends say where each body signal came from, and report.md shows it first."""
+    t, f, w = turning_flight(1200, 1 / 120)
+    sensor_f = np.column_stack([f[:, 0], -f[:, 1], -f[:, 2]]) / G0  # body frd -> sensor flu, in g
+    sensor_w = np.radians(np.column_stack([-w[:, 0], -w[:, 1], -w[:, 2]]))  # flu, rad/s; x stored negated
+    log = write_log(tmp_path / "imu.csv", t, sensor_f, sensor_w)
+    cols = "t=t,f_x=ax:g,f_y=ay:g,f_z=az:g,omega_x=-p:radps,omega_y=q:radps,omega_z=r:radps"
+    out = tmp_path / "out"
+    assert main(["cue", str(log), "--out", str(out), "--columns", cols, "--axes", "flu", "--washout", "large-angle",
+                 "--no-recording", "--quiet"]) == 0  # fmt: skip
+    png = out / "figures" / "input.png"
+    assert png.read_bytes()[:4] == b"\x89PNG"
+    report = (out / "report.md").read_text()
+    first_section = report.split("\n## ")[1]
+    assert first_section.startswith("Input as read") and "![input as read](figures/input.png)" in first_section
+    traces = pq.read_table(out / "traces.parquet")
+    got = np.column_stack([traces[f"aircraft.f_{a}_mps2"].to_numpy() for a in "xyz"])
+    np.testing.assert_allclose(got, f, rtol=1e-6, atol=1e-6)  # what the figure shows: the body-frame input
+
+    from washbench.io.input_format import input_format
+    from washbench.review.input_figure import input_labels
+
+    fmt = input_format(cols, None, "flu")
+    from washbench.io.readers import read_samples
+
+    labels = input_labels(read_samples(log, fmt).sources, "flu", tuple(fmt.columns), fmt.origin)
+    assert labels == [
+        "f_x ← +'ax' (g); sign: --axes flu: sensor x [m/s²]",
+        "f_y ← −'ay' (g); sign: --axes flu: sensor y reversed [m/s²]",
+        "f_z ← −'az' (g); sign: --axes flu: sensor z reversed [m/s²]",
+        "omega_x ← −'p' (rad/s); sign: '-' in --columns, --axes flu: sensor x [deg/s]",
+        "omega_y ← −'q' (rad/s); sign: --axes flu: sensor y reversed [deg/s]",
+        "omega_z ← −'r' (rad/s); sign: --axes flu: sensor z reversed [deg/s]",
+    ]

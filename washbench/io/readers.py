@@ -59,8 +59,8 @@ class Samples:
     time_column: str = "t_s"
     declared: Mapping[str, str] = field(default_factory=dict)
     """The units the columns were read in: ``t`` (time), ``f`` (specific force), ``omega`` (angular velocity)."""
-    sources: Mapping[str, str] = field(default_factory=dict)
-    """Per motion field (``t``, ``f_x`` ...) the source column, unit and sign it came from (``-ax:g``)."""
+    sources: Mapping[str, ColumnSource] = field(default_factory=dict)
+    """Per motion field (``t``, ``f_x`` ...) the source column, unit and sign it came from."""
 
     @property
     def n(self) -> int:
@@ -209,7 +209,7 @@ def convert(src: SourceTable, fmt: InputFormat) -> Samples:
         notes=tuple(notes),
         time_column=t_src.column,
         declared={"t": units.normalise_unit(t_src.unit), "f": mapping["f_x"].unit, "omega": mapping["omega_x"].unit},
-        sources={f: s.describe() for f, s in mapping.items()},
+        sources=dict(mapping),
     )
     if src.kind == "jsbsim":
         samples = shift_jsbsim_lag(samples, fmt.jsbsim_dt_s)

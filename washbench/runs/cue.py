@@ -418,6 +418,8 @@ class Segment:
     motion: Motion
     notes: tuple[str, ...]
     findings: tuple[Finding, ...]
+    labels: tuple[str, ...] = ()
+    """Where each of the six signals came from (:func:`washbench.review.input_figure.input_labels`)."""
 
 
 def check_segment_name(name: str) -> str:
@@ -437,7 +439,11 @@ def prepare_segments(samples: Samples, opts: CueOptions) -> list[Segment]:
     Resampling is held to what the grid check holds the data to (a step of 1 Hz .. 10 kHz, the median step
     here), and to at most :data:`MAX_GROWTH` times the rows read unless ``opts.force``.
     """
+    from washbench.review.input_figure import input_labels
+
     parts = split_resets(samples, split=opts.split)
+    fmt = opts.fmt
+    labels = tuple(input_labels(samples.sources, fmt.axes, tuple(fmt.columns), fmt.origin)) if samples.sources else ()
     out = []
     for i, part in enumerate(parts):
         name = check_segment_name(f"segment_{i + 1}") if len(parts) > 1 else ""
@@ -467,7 +473,7 @@ def prepare_segments(samples: Samples, opts: CueOptions) -> list[Segment]:
             notes.append(note)
         else:
             motion = to_motion(part)
-        out.append(Segment(name=name, motion=motion, notes=tuple(notes), findings=findings))
+        out.append(Segment(name=name, motion=motion, notes=tuple(notes), findings=findings, labels=labels))
     return out
 
 
@@ -569,9 +575,14 @@ def write_outputs(
                     props = flat_strings(provenance, created) if provenance else None
                     write_run_recording(tmp[RECORDING_FILE], title, seg.motion, result, limits, q, [], props)
                 done.append((summary, result))
-        for summary, result in done:  # last, as a suite's report: each written atomically once the rest is in
-            if not opts.recording:  # place; a recording of an earlier run would not show these results
+        for seg, (summary, result) in zip(segments, done, strict=True):  # last, as a suite's report: each written
+            if not opts.recording:  # atomically once the rest is in place; an earlier recording would mislead
                 (summary.run_dir / RECORDING_FILE).unlink(missing_ok=True)
+            if opts.figures and seg.labels:  # what was read, linked first in the report
+                from washbench.review.input_figure import draw_for_result
+
+                title = f"{input_path.name}{f' {seg.name}' if seg.name else ''}"
+                draw_for_result(summary.run_dir, title, seg.motion, seg.labels, seg.notes)
             write_run_review(summary.run_dir, summary, str(input_path), result.review_table(), opts.figures)
     except OSError as exc:
         raise WashbenchError(located(out_dir, f"cannot write results: {exc.strerror or exc}")) from None
