@@ -132,10 +132,11 @@ BYTES_PER_STEP_WASHOUT = 290.0
 BYTES_PER_STEP_WASHOUT_RECORDING = 160.0
 """Result size per recorded step, at most: flight.parquet and the aircraft's traces, then per washout its traces and
 its part of recording.rrd. Measured on ``c172_cruise_8K.xml`` for 20 s (2,400 steps, three washouts, a gust:
-4.0 MB, 1,650 bytes a step); smooth flights compress better (``ball.xml``, 60 s: 657 bytes a step)."""
-STEPS_PER_S = 900.0
-"""Steps flown, cued and written per second of wall time with three washouts and a recording, measured on this
-project's 2-core machine under load (``ball.xml``, 60 s: 8.1 s): an estimate for the announcement only."""
+4.0 MB, 1,650 bytes a step); smooth flights compress better (``ball.xml``, 60 s at 100 Hz: 790 bytes a step)."""
+STEPS_PER_S = 750.0
+"""Steps flown, cued and written per second of wall time with three washouts and a recording, start-up included,
+measured on this project's 2-core machine under load (``ball.xml``, 6,000 steps: 8.1 s): an order of magnitude for
+the announcement only."""
 
 
 @dataclass(frozen=True)
@@ -161,7 +162,7 @@ class ScriptPlan:
         mb = self.size_bytes / 1e6
         line = (
             f"{self.info.name}: flying {duration_text(self.time_s)} simulated ({self.steps:,} steps of "
-            f"{self.info.dt_s:.6g} s): up to about {mb:,.3g} MB of results and {duration_text(self.wall_s)} "
+            f"{self.info.dt_s:.6g} s): up to about {_mb(mb)} MB of results and {duration_text(self.wall_s)} "
             "(estimated)"
         )
         if self.capped:
@@ -169,9 +170,14 @@ class ScriptPlan:
             line += (
                 f"; the script runs {duration_text(whole)} ({whole:g} s): stopped at the default cap of "
                 f"{DEFAULT_MAX_TIME_S:g} s, --max-time-s {whole:g} flies it all (up to about "
-                f"{self.size_bytes * whole / self.time_s / 1e6:,.3g} MB)"
+                f"{_mb(self.size_bytes * whole / self.time_s / 1e6)} MB)"
             )
         return line
+
+
+def _mb(x: float) -> str:
+    """Megabytes to two significant digits below 10, whole (with thousands separators) above."""
+    return f"{x:.2g}" if x < 10 else f"{x:,.0f}"
 
 
 def script_plan(info: ScriptInfo, max_time_s: float | None, washouts: int = 3, recording: bool = True) -> ScriptPlan:
