@@ -28,3 +28,32 @@ def test_signal_accepts_the_metrics_axis_names(tmp_path: Path, capsys: pytest.Ca
     assert main(["signal", "step", "--axis", "bob", "--amplitude", "1", "--out", str(tmp_path / "x.csv")]) == 2
     err = capsys.readouterr().err
     assert "unknown axis 'bob' (valid: f_x, f_y, f_z, roll, pitch, yaw, or surge, sway, heave" in err
+
+
+@pytest.mark.parametrize("command", ["cue", "run", "suite", "fly", "omct", "sweep", "tune"])
+def test_every_long_command_takes_quiet(command: str) -> None:
+    """The README says run, suite and cue take --quiet; omct, sweep and tune are as long (issue 26 item 7)."""
+    from washbench.cli import build_parser
+
+    positional = {"cue": ["in.csv"], "run": ["m.yaml"], "fly": ["m.yaml"], "sweep": ["m.yaml"], "tune": ["m.yaml"]}
+    extra = {"tune": ["--washout", "large-angle"]}
+    args = build_parser().parse_args([command, *positional.get(command, []), "--out", "o", *extra.get(command, []),
+                                      "--quiet"])  # fmt: skip
+    assert args.quiet is True
+
+
+def test_omct_shows_its_progress_unless_quiet(capsys: pytest.CaptureFixture[str], monkeypatch) -> None:
+    from washbench.analysis import omct
+    from washbench.cueing.variants import select_washouts
+    from washbench.platform import load_platform_limits
+    from washbench.runs.omct import measure
+
+    monkeypatch.setattr("washbench.io.progress.QUIET_FOR_S", 0.0)
+    entries, limits = select_washouts(["large-angle"], (), None), load_platform_limits(None)
+    measure(entries, limits, tests=omct.TESTS[:1], frequencies_radps=[1.0, 2.0], progress=True)
+    lines = capsys.readouterr().err.splitlines()
+    assert lines[0].startswith("omct:  50% (1 of 2 test points), expected end ")
+    assert lines[0].endswith(omct.TESTS[0].name)
+    assert lines[1].startswith("omct: 100% (2 of 2 test points), done in ")
+    measure(entries, limits, tests=omct.TESTS[:1], frequencies_radps=[1.0, 2.0], progress=False)
+    assert capsys.readouterr().err == ""

@@ -216,6 +216,9 @@ def test_cue_draws_the_input_as_read_and_links_it_first(tmp_path: Path) -> None:
     report = (out / "report.md").read_text()
     first_section = report.split("\n## ")[1]
     assert first_section.startswith("Input as read") and "![input as read](figures/input.png)" in first_section
+    assert main(["report", str(out)]) == 0  # drawn again from the result's files, with its PDF
+    assert (out / "figures" / "input.pdf").read_bytes()[:5] == b"%PDF-"
+    assert "[input.pdf](figures/input.pdf)" in (out / "report.md").read_text().split("\n## ")[1]
     traces = pq.read_table(out / "traces.parquet")
     got = np.column_stack([traces[f"aircraft.f_{a}_mps2"].to_numpy() for a in "xyz"])
     np.testing.assert_allclose(got, f, rtol=1e-6, atol=1e-6)  # what the figure shows: the body-frame input

@@ -6,12 +6,13 @@ each panel's legend naming where the signal came from (:func:`input_labels`): th
 read in and the sign, with where the sign came from (a ``-`` in the column mapping, the ``--axes`` of the sensor).
 Dashed grey guides mark what a level, unaccelerated aircraft would show (f = [0, 0, -g], omega = 0): a specific
 force in g, a z axis up or a rate in rad/s is then off its guide at a glance. The figure is ``figures/input.png``
-of a cue result, and :func:`input_lines` links it first in the report.
+of a cue result (legends and notes kept in run.json, so ``washbench report`` draws it again, with its PDF), and
+:func:`input_section` links it first in the report.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -67,8 +68,10 @@ def input_figure(
     omega_degps: np.ndarray,
     labels: Sequence[str],
     notes: Sequence[str] = (),
+    formats: Sequence[str] = ("png",),
 ) -> Path:
-    """Draw the six input signals into ``stem.png`` (atomically, deterministically); return its path.
+    """Draw the six input signals into ``stem.png`` (and the other ``formats``: ``pdf``), atomically and
+    deterministically; return the PNG's path.
 
     ``t_s`` (N,) [s]; ``f_mps2`` (N, 3) [m/s^2]; ``omega_degps`` (N, 3) [deg/s] as the washouts receive them;
     ``labels``: the six legends (:func:`input_labels`); ``notes``: what the reading did (units, resampling),
@@ -104,34 +107,64 @@ def input_figure(
     fig.suptitle(f"{title}: the input as the washouts receive it", fontsize=11, y=0.985)
     for k, note in enumerate(notes[:4]):
         fig.text(0.5, 0.955 - 0.018 * k, _short(note, 150), ha="center", fontsize=7.5, color=(0.3, 0.3, 0.3))
-    return save_figure(fig, stem, ("png",))[0]
+    return save_figure(fig, stem, formats)[0]
 
 
 def _short(text: str, n: int) -> str:
     return text if len(text) <= n else text[: n - 1] + "…"
 
 
-def input_lines(folder: Path, start: Path, level: int = 2) -> list[str]:
-    """The report's first section when the result has an input figure (a ``cue`` result), else nothing."""
+def input_section(folder: Path, pdf: bool, image: Callable[[Path, Path, str], list[str]]) -> list[str]:
+    """The report's first section when the result has an input figure (a ``cue`` result), else nothing.
+
+    ``pdf`` (``washbench report``): the figure is drawn again, PNG and PDF, from the result's files
+    (:func:`redraw`); ``image``: the report's way of embedding a figure and linking its PDF.
+    """
     png = folder / "figures" / f"{INPUT_STEM}.png"
     if not png.is_file():
         return []
-    rel = png.relative_to(start).as_posix() if png.is_relative_to(start) else str(png)
+    if pdf:
+        png = redraw(folder, ("png", "pdf")) or png
     return [
-        f"{'#' * level} Input as read",
+        "## Input as read",
         "",
         "The six signals the washouts received, after the units, axes and resampling were applied; each legend "
         "names the column, unit and sign they came from, the dashed line level flight. Check them before the "
         "results: a unit or sign mistake shows here.",
         "",
-        f"![input as read]({rel})",
-        "",
+        *image(png, folder, "input as read"),
     ]
 
 
+def redraw(folder: Path, formats: Sequence[str]) -> Path | None:
+    """Draw ``folder/figures/input.*`` again from the result's files: the input columns of traces.parquet and the
+    legends and notes run.json keeps (``input_labels``, ``conversions``); None when run.json has no legends."""
+    import json
+
+    import pyarrow.parquet as pq
+
+    from washbench.io.results import AIRCRAFT, TIME_COLUMN, f_columns, omega_columns
+
+    try:
+        doc = json.loads((folder / "run.json").read_text())
+    except (OSError, ValueError):
+        return None
+    labels = doc.get("input_labels")
+    if not isinstance(labels, list) or len(labels) != 6:
+        return None
+    cols = [TIME_COLUMN, *f_columns(AIRCRAFT), *omega_columns(AIRCRAFT)]
+    table = pq.read_table(folder / "traces.parquet", columns=cols)
+    arr = np.column_stack([table[c].to_numpy() for c in cols])
+    title = f"{Path(str(doc.get('input', 'input'))).name} {doc.get('segment', '')}".strip()
+    return input_figure(folder / "figures" / INPUT_STEM, title, arr[:, 0], arr[:, 1:4], arr[:, 4:7], labels,
+                        doc.get("conversions", ()), formats)  # fmt: skip
+
+
 def draw_for_result(folder: Path, title: str, motion: Any, labels: Sequence[str], notes: Sequence[str]) -> Path:
-    """``folder/figures/input.png`` of a cued segment (``motion``: :class:`washbench.io.results.Motion`)."""
+    """``folder/figures/input.png`` of a cued segment (``motion``: :class:`washbench.io.results.Motion`); a PDF of an
+    earlier ``washbench report`` is removed (it would show other data)."""
     fig_dir = folder / "figures"
     fig_dir.mkdir(parents=True, exist_ok=True)
+    (fig_dir / f"{INPUT_STEM}.pdf").unlink(missing_ok=True)
     w = motion.omega_degps if motion.omega_degps is not None else np.degrees(motion.omega_radps)
     return input_figure(fig_dir / INPUT_STEM, title, motion.t_s, motion.f_mps2, w, labels, notes)

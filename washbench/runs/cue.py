@@ -564,6 +564,7 @@ def write_outputs(
                     "t_end_s": float(seg.motion.t_s[-1]),
                     "filter_start": opts.filter_start,
                     "conversions": list(seg.notes),
+                    "input_labels": list(seg.labels),
                     "warnings": [f.text for f in seg.findings],
                 }
                 if provenance:
