@@ -57,3 +57,17 @@ def test_omct_shows_its_progress_unless_quiet(capsys: pytest.CaptureFixture[str]
     assert lines[1].startswith("omct: 100% (2 of 2 test points), done in ")
     measure(entries, limits, tests=omct.TESTS[:1], frequencies_radps=[1.0, 2.0], progress=False)
     assert capsys.readouterr().err == ""
+
+
+def test_omct_boundary_files_accept_the_metrics_axis_names(tmp_path: Path) -> None:
+    from washbench.errors import WashbenchError
+    from washbench.runs.omct import load_boundaries
+
+    f = tmp_path / "b.yaml"
+    f.write_text("name: mine\nsource: test\ntests:\n  heave_to_heave: {frequency_radps: [1.0], gain_min: [0.5]}\n"
+                 "  surge_to_pitch: {frequency_radps: [1.0], gain_max: [2.0]}\n")  # fmt: skip
+    assert sorted(load_boundaries(f).tests) == ["f_x_to_pitch", "f_z_to_f_z"]
+    f.write_text("name: mine\nsource: test\ntests:\n  heave_to_heave: {frequency_radps: [1.0], gain_min: [0.5]}\n"
+                 "  f_z_to_f_z: {frequency_radps: [1.0], gain_max: [2.0]}\n")  # fmt: skip
+    with pytest.raises(WashbenchError, match="test 'f_z_to_f_z' is given twice"):
+        load_boundaries(f)
