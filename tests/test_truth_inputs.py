@@ -238,3 +238,13 @@ def test_cue_draws_the_input_as_read_and_links_it_first(tmp_path: Path) -> None:
         "omega_y ← −'q' (rad/s); sign: --axes flu: sensor y reversed [deg/s]",
         "omega_z ← −'r' (rad/s); sign: --axes flu: sensor z reversed [deg/s]",
     ]
+
+
+def test_the_frame_time_can_come_from_an_input_format_file(flown: dict, tmp_path: Path) -> None:
+    spec = tmp_path / "jsbsim.yaml"
+    spec.write_text("format: jsbsim\njsbsim_dt_s: 0.0083333333\n")
+    t1, f1 = cue_f(flown["logs"][10], tmp_path / "a", "--input-format", str(spec))
+    t2, f2 = cue_f(flown["logs"][10], tmp_path / "b", "--jsbsim-dt", "0.0083333333")
+    assert np.array_equal(t1, t2) and np.array_equal(f1, f2)
+    spec.write_text("format: jsbsim\njsbsim_dt_s: -1\n")
+    assert main(["cue", str(flown["logs"][10]), "--out", str(tmp_path / "c"), "--input-format", str(spec)]) == 2
