@@ -214,7 +214,7 @@ def test_jsbsim_own_csv_output_matches_the_recorder(trace: dict[str, np.ndarray]
     from washbench.io.readers import read_samples
 
     s = read_samples(csv_path)
-    assert s.kind == "jsbsim" and any("one-frame lag" in n for n in s.notes)
+    assert s.kind == "jsbsim" and any("shifted back one frame of 0.00833333 s = one row" in n for n in s.notes)
     n = s.n
     ref_f = np.column_stack([trace[f"f_{a}_mps2"] for a in "xyz"])[:n]
     ref_w = np.column_stack([trace[f"omega_{a}_degps"] for a in "xyz"])[:n]
@@ -243,11 +243,11 @@ def warnings_of(cols: dict[str, np.ndarray], tmp_path: Path, capsys: pytest.Capt
     ("case", "expected"),
     [
         ("time in ms", "sample rate 0.12 Hz is outside 10 Hz .. 10000 Hz: is the time in ms"),
-        ("time in ns", "is outside 10 Hz .. 10000 Hz: is the time in ms or ns?"),
-        ("force in g", "far from g: is the specific force in g or ft/s^2?"),
-        ("force in ft/s^2", "far from g: is the specific force in g or ft/s^2?"),
+        ("time in ns", "is outside 10 Hz .. 10000 Hz: is the time in ns?"),
+        ("force in g", "far from g: is it in g? (read as mps2 now; give the unit with --columns f_x=COLUMN:g"),
+        ("force in ft/s^2", "far from g: is it in ftps2? (read as mps2 now"),
         ("z up", "above zero: is the sensor's z axis up?"),
-        ("rates in rad/s", "are the rates in rad/s?"),
+        ("rates in rad/s", "are the rates in radps? (read as degps now"),
         ("crash spike", "above 10 g: a crash or a spike?"),
         ("all zero", "the motion is all zero throughout"),
     ],

@@ -129,7 +129,8 @@ def test_web_viewer_serves_on_loopback(recording):
 
 
 def test_cli_without_display_serves_the_web_viewer_until_interrupted(recording):
-    """``washbench replay FILE`` with no DISPLAY: prints the address, serves it, stops cleanly on Ctrl-C (SIGINT)."""
+    """``washbench replay FILE`` with no DISPLAY: prints the address, serves it, stops cleanly on Ctrl-C (SIGINT),
+    saying so, with status 130."""
     env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
     proc = subprocess.Popen(
         [sys.executable, "-m", "washbench", "replay", str(recording)],
@@ -155,7 +156,8 @@ def test_cli_without_display_serves_the_web_viewer_until_interrupted(recording):
         status, _ = http_get(url + "/")
         assert status == 200
         proc.send_signal(signal.SIGINT)
-        assert proc.wait(timeout=30) == 0
+        assert proc.wait(timeout=30) == 130  # as every command after Ctrl-C (issue 26, item 8)
+        assert "washbench: interrupted" in proc.stderr.read()
         with pytest.raises((urllib.error.URLError, ConnectionError)):
             http_get(url + "/")  # the viewer went down with the command
     finally:

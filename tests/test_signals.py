@@ -101,7 +101,7 @@ def test_signal_command_writes_a_cue_input(tmp_path: Path, capsys: pytest.Captur
         (["step", "--axis", "f_x", "--amplitude", "1", "--duration-s", "0"], "--duration-s must be a positive"),
         (["step", "--axis", "f_x", "--amplitude", "1", "--ext", "x"], "unrecognized arguments"),
         (["sawtooth", "--axis", "f_x", "--amplitude", "1"], "unknown signal kind 'sawtooth' (valid: sine, step"),
-        (["step", "--axis", "surge", "--amplitude", "1"], "unknown axis 'surge' (valid: f_x, f_y, f_z, roll"),
+        (["step", "--axis", "bob", "--amplitude", "1"], "unknown axis 'bob' (valid: f_x, f_y, f_z, roll"),
     ],
 )
 def test_signal_bad_input(tmp_path: Path, capsys: pytest.CaptureFixture[str], args: list[str], message: str) -> None:

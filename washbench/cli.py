@@ -122,8 +122,8 @@ def build_parser() -> argparse.ArgumentParser:
     _aircraft_dir_option(p)
     p.add_argument("--quiet", action="store_true", help="no progress display")
 
-    p = sub.add_parser("validate", help="check manoeuvre files without flying them")
-    p.add_argument("manoeuvres", type=Path, nargs="+", help="manoeuvre YAML files")
+    p = sub.add_parser("validate", help="check manoeuvre files and JSBSim scripts without flying them")
+    p.add_argument("manoeuvres", type=Path, nargs="+", help="manoeuvre files, JSBSim scripts, folders or bundled names")
     _aircraft_dir_option(p)
 
     p = sub.add_parser("schema", help="print the manoeuvre file JSON Schema")
@@ -137,7 +137,7 @@ def build_parser() -> argparse.ArgumentParser:
     _washout_options(p)
     _rank_option(p)
     _aircraft_dir_option(p)
-    p.add_argument("--max-time-s", type=float, metavar="S", help="JSBSim script: stop after S s simulated")
+    p.add_argument("--max-time-s", type=float, metavar="S", help="JSBSim script: stop after S s (default 1200)")
     p.add_argument("--filter-start", choices=("steady", "rest"), default="steady", help="filters' start state")
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
@@ -153,7 +153,7 @@ def build_parser() -> argparse.ArgumentParser:
         "default: all bundled",
     )
     p.add_argument("--jsbsim-scripts", nargs="+", default=[], metavar="NAME", help="scripts shipped with JSBSim")
-    p.add_argument("--max-time-s", type=float, metavar="S", help="JSBSim scripts: stop each after S s simulated")
+    p.add_argument("--max-time-s", type=float, metavar="S", help="JSBSim scripts: stop each after S s (default 1200)")
     p.add_argument("--out", type=Path, required=True, help="results folder")
     _aircraft_dir_option(p)
     p.add_argument("--jobs", type=_jobs, help="parallel processes (default: the CPUs this process may use)")
@@ -173,10 +173,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--boundaries", type=Path, help="gain/phase boundaries YAML, drawn and checked (docs: OMCT)")
     p.add_argument("--rate-hz", type=float, default=120.0, help="washout sample rate (default 120)")
     p.add_argument("--amplitude-scale", type=float, default=1.0, help="multiply every input amplitude (default 1)")
+    p.add_argument("--quiet", action="store_true", help="no progress display")
 
     p = sub.add_parser("signal", help="write a test signal on one axis as a washbench cue input")
     p.add_argument("kind", help="signal shape: sine, step, pulse, doublet, chirp, multisine")
-    p.add_argument("--axis", required=True, help="body axis: f_x, f_y, f_z (specific force), roll, pitch, yaw")
+    p.add_argument(
+        "--axis", required=True, help="f_x, f_y, f_z (specific force, or surge, sway, heave), roll, pitch, yaw"
+    )
     p.add_argument("--amplitude", type=float, required=True, help="m/s^2 (f_x, f_y, f_z) or deg/s (rotations)")
     p.add_argument("--frequency-hz", type=float, help="frequency (every kind but step; see docs/how-to/omct.md)")
     p.add_argument("--duration-s", type=float, default=20.0, help="length (default 20 s)")
@@ -314,8 +317,11 @@ def _cue_input_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--input-format", type=Path, metavar="FILE", help="YAML: format, delimiter, axes, columns")
     g.add_argument("--axes", metavar="XYZ", help="sensor axes as body directions, e.g. flu (z up, y left); default frd")
     g.add_argument("--delimiter", metavar="D", help="CSV delimiter (default: detected): , ; tab | or a character")
+    g.add_argument("--decimal", choices=(".", ","), help="decimal mark of the numbers (default .)")
+    g.add_argument("--jsbsim-dt", type=float, metavar="S", help="JSBSim CSV: the simulation frame time (script dt)")
     g = p.add_argument_group("time")
     g.add_argument("--resample", type=float, metavar="HZ", help="interpolate onto a uniform grid at HZ (anti-alias)")
+    g.add_argument("--force", action="store_true", help="resample even to more than 100 times the rows read")
     g.add_argument("--max-gap-s", type=float, metavar="S", help="largest allowed time step (default: 5 median steps)")
     g.add_argument("--no-split", action="store_true", help="refuse a time reset instead of cueing each part")
     g.add_argument("--start-s", type=float, metavar="S", help="cue from this time on (input time, s)")
@@ -324,6 +330,7 @@ def _cue_input_options(p: argparse.ArgumentParser) -> None:
                    help="filters start in the first sample's steady state (default) or at rest")  # fmt: skip
     g = p.add_argument_group("checks and outputs")
     g.add_argument("--strict", action="store_true", help="plausibility warnings are errors")
+    g.add_argument("--quiet", action="store_true", help="no progress display")
     _output_options(g)
 
 
@@ -345,7 +352,7 @@ def _cue(args: argparse.Namespace) -> int:
     from washbench.runs.cue import CueOptions, run_cue
 
     opts = CueOptions(
-        fmt=input_format(args.columns, args.input_format, args.axes, args.delimiter),
+        fmt=input_format(args.columns, args.input_format, args.axes, args.delimiter, args.decimal, args.jsbsim_dt),
         resample_hz=args.resample,
         max_gap_s=args.max_gap_s,
         split=not args.no_split,
@@ -357,6 +364,8 @@ def _cue(args: argparse.Namespace) -> int:
         figures=not args.no_figures,
         rank_by=args.rank_by,
         vestibular=args.vestibular,
+        progress=not args.quiet,
+        force=args.force,
     )
     return run_cue(
         args.input,
@@ -414,7 +423,7 @@ def _dispatch(args: argparse.Namespace) -> int:
 
         return fly_command(args.manoeuvre, args.out, progress=not args.quiet, aircraft_dirs=args.aircraft_dir)
     if args.command == "validate":
-        from washbench.flight.manoeuvre import validate_command
+        from washbench.flight.validate import validate_command
 
         return validate_command(args.manoeuvres, aircraft_dirs=args.aircraft_dir)
     if args.command == "schema":
@@ -471,6 +480,7 @@ def _dispatch(args: argparse.Namespace) -> int:
             rate_hz=args.rate_hz,
             amplitude_scale=args.amplitude_scale,
             variants=args.variant,
+            progress=not args.quiet,
         )
         return 0
     if args.command == "signal":

@@ -31,6 +31,7 @@ from pydantic import Field, field_validator, model_validator
 from washbench.analysis.omct import TEST_NAMES, Bounds
 from washbench.io.yamlio import StrictModel
 
+_DOF_AXES = {"surge": "f_x", "sway": "f_y", "heave": "f_z"}
 PositiveFloat = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
 FiniteFloat = Annotated[float, Field(allow_inf_nan=False)]
 
@@ -84,10 +85,20 @@ class BoundaryFile(StrictModel):
     @field_validator("tests")
     @classmethod
     def _known_tests(cls, tests: dict[str, TestBoundary]) -> dict[str, TestBoundary]:
-        for name in tests:
-            if name not in TEST_NAMES:
-                raise ValueError(f"unknown test {name!r} (valid: {', '.join(TEST_NAMES)})")
-        return tests
+        """Test names as :data:`TEST_NAMES` spell them; the metrics' names surge, sway, heave are accepted for f_x,
+        f_y, f_z (``surge_to_pitch`` is ``f_x_to_pitch``)."""
+        out: dict[str, TestBoundary] = {}
+        for name, tb in tests.items():
+            parts = name.split("_to_")
+            canonical = "_to_".join(_DOF_AXES.get(p, p) for p in parts) if len(parts) == 2 else name
+            if canonical not in TEST_NAMES:
+                raise ValueError(
+                    f"unknown test {name!r} (valid: {', '.join(TEST_NAMES)}; surge, sway, heave name f_x, f_y, f_z)"
+                )
+            if canonical in out:
+                raise ValueError(f"test {canonical!r} is given twice (as {name!r})")
+            out[canonical] = tb
+        return out
 
     def bounds(self) -> dict[str, Bounds]:
         """test name -> bounds."""

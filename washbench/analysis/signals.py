@@ -46,6 +46,21 @@ ROTATIONAL_AXES: tuple[str, ...] = ("roll", "pitch", "yaw")
 KINDS: tuple[str, ...] = ("sine", "step", "pulse", "doublet", "chirp", "multisine")
 NEEDS_FREQUENCY: frozenset[str] = frozenset({"sine", "pulse", "doublet", "chirp", "multisine"})
 AXIS_INDEX = {"f_x": 0, "f_y": 1, "f_z": 2, "roll": 0, "pitch": 1, "yaw": 2}
+AXIS_ALIASES = {"surge": "f_x", "sway": "f_y", "heave": "f_z", "x": "f_x", "y": "f_y", "z": "f_z",
+                "p": "roll", "q": "pitch", "r": "yaw"}  # fmt: skip
+"""The metrics' DOF names (surge, sway, heave) and the body-axis letters, accepted for the signal axes."""
+
+
+def canonical_axis(name: str) -> str:
+    """The axis ``name`` as :data:`AXES` spells it (``heave`` -> ``f_z``; case and ``-``/``_`` ignored); an unknown
+    name is a WashbenchError listing both namings."""
+    key = name.strip().lower().replace("-", "_")
+    key = AXIS_ALIASES.get(key, key)
+    if key not in AXES:
+        raise WashbenchError(
+            f"unknown axis {name!r} (valid: {', '.join(AXES)}, or surge, sway, heave for f_x, f_y, f_z)"
+        )
+    return key
 MULTISINE_N = 6
 CHIRP_DECADES = 2.0
 _REFINE = 8  # chirp attitude: Simpson sub-steps per sample
@@ -99,7 +114,8 @@ def check_spec(spec: SignalSpec) -> SignalSpec:
     if spec.kind not in KINDS:
         raise WashbenchError(f"unknown signal kind {spec.kind!r} (valid: {', '.join(KINDS)})")
     if spec.axis not in AXES:
-        raise WashbenchError(f"unknown axis {spec.axis!r} (valid: {', '.join(AXES)})")
+        canonical_axis(spec.axis)  # the error naming both namings
+        raise WashbenchError(f"axis {spec.axis!r}: give it as {canonical_axis(spec.axis)!r} in a SignalSpec")
     if not math.isfinite(spec.amplitude):
         raise WashbenchError(f"--amplitude must be a finite number, got {spec.amplitude!r}")
     rate = _positive("--rate-hz", spec.rate_hz)

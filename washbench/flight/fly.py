@@ -325,7 +325,7 @@ def fly(
                 turned = rolled = pitched = 0.0
                 phase_events = set()
                 pilot.begin_phase(phase.hold, theta, thr_w.get_double_value(), flap_get())
-                openloop.begin_phase(phase.inputs)
+                openloop.begin_phase(phase.inputs, phase.name)
                 flapc_w.set_double_value(pilot.flaps_cmd)
                 lbrk_w.set_double_value(pilot.brakes)
                 rbrk_w.set_double_value(pilot.brakes)
@@ -384,12 +384,18 @@ def fly(
     columns = _columns(np.frombuffer(rows, dtype=np.float64).reshape(-1, ncol), dt)
     results = evaluate(list(m.checks), columns, phases_out, events, dt) if not reason else []
     checks = [(c.name, c.measured, c.limit, c.passed) for c in results]
+    for (phase_name, axis), steps in openloop.clipped.items():  # asked beyond the surface travel: not flown as asked
+        checks.append((f"{axis} input within its travel in '{phase_name}'", steps * dt, "0 s clipped", False))
     status = "ok"
     if reason:
         status = "failed"
-    elif not all(c.passed for c in results):
+    elif not all(c[3] for c in checks):
         status = "failed"
-        reason = "checks failed: " + ", ".join(c.name for c in results if not c.passed)
+        reason = "checks failed: " + ", ".join(
+            f"{c[0]}" + (f" ({c[1]:.3g} s clipped at the stop)" if c[2] == "0 s clipped" else "")
+            for c in checks
+            if not c[3]
+        )
     probed = {name: np.array(v) for name, v in zip(probes, probe_rows, strict=True)}
     return FlightResult(m.name, m.aircraft, dt, columns, phases_out, checks, status, reason, events, probed)
 
@@ -498,7 +504,7 @@ def fly_command(manoeuvre_path: Path, out_dir: Path, progress: bool = True, airc
         write_flight(out_dir, result, str(manoeuvre_path), prov)
     passed = sum(1 for c in result.checks if c[3])
     line = (
-        f"{m.name} ({m.aircraft}): {result.status}, {passed}/{len(m.checks)} checks passed, "
+        f"{m.name} ({m.aircraft}): {result.status}, {passed}/{len(result.checks)} checks passed, "
         f"{result.duration_s:.1f} s flown in {wall:.1f} s -> {out_dir}"
     )
     if not result.ok:

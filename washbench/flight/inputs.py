@@ -116,6 +116,36 @@ def unit_shape(
     raise ValueError(f"unknown input shape {shape!r} (one of {', '.join(SHAPES)})")
 
 
+def shape_extent(
+    shape: str,
+    start_s: float = 0.0,
+    duration_s: float | None = None,
+    period_s: float | None = None,
+    start_hz: float | None = None,
+    end_hz: float | None = None,
+    sweep: str = "linear",
+    phase_s: float | None = None,
+) -> tuple[float, float]:
+    """(lowest, highest) unit value of ``shape`` over its window (0 before it included), sampled every 1 ms.
+
+    A sine without ``duration_s`` runs to the phase end ``phase_s`` (one period when that is not known). Sampling
+    can only miss a peak by a little, never invent one: the extent is never wider than the signal's.
+    """
+    if shape in ("step", "pulse"):
+        return 0.0, 1.0
+    if shape in ("doublet", "3211"):
+        return -1.0, 1.0
+    length = duration_s
+    if length is None:
+        length = (phase_s - start_s) if phase_s is not None else _need(period_s)
+    n = max(math.ceil(length / 1e-3), 1)
+    lo = hi = 0.0
+    for k in range(n):
+        v = unit_shape(shape, start_s + k * 1e-3, start_s, duration_s, period_s, start_hz, end_hz, sweep)
+        lo, hi = min(lo, v), max(hi, v)
+    return lo, hi
+
+
 def _need(x: float | None) -> float:
     if x is None:
         raise ValueError("missing parameter for the input shape")

@@ -690,38 +690,46 @@ PILOT_PROPERTIES = (
 )
 
 
-def _check_signal(sig: Signal, amplitude: float | None, loc: Loc, amp_key: str, phase: Phase, where: _Where) -> None:
-    """A signal's keys fit its shape, it has an amplitude, and it ends within a fixed-length phase."""
+def _add(where: _Where, loc: Loc, problem: str) -> bool:
+    """Add a problem to ``where``; False (for ``return _add(...)``: the check failed)."""
+    where.add(loc, problem)
+    return False
+
+
+def _check_signal(sig: Signal, amplitude: float | None, loc: Loc, amp_key: str, phase: Phase, where: _Where) -> bool:
+    """A signal's keys fit its shape, it has an amplitude, and it ends within a fixed-length phase; False (the
+    problem added to ``where``) if not."""
     if sig.shape is None:
         stray = [k for k in (*_SHAPE_PARAMS, "start_s") if k in sig.model_fields_set]
         if amplitude is not None:
             keys = ("amplitude_norm", "amplitude_deg", "amplitude")
             given = next(k for k in keys if getattr(sig, k, None) is not None)
-            raise where.error((*loc, given), "an amplitude needs a 'shape'")
+            return _add(where, (*loc, given), "an amplitude needs a 'shape'")
         if stray:
-            raise where.error((*loc, stray[0]), "needs a 'shape'")
-        return
+            return _add(where, (*loc, stray[0]), "needs a 'shape'")
+        return True
     if amplitude is None:
-        raise where.error((*loc, "shape"), f"a {sig.shape} needs an amplitude ({amp_key})")
+        return _add(where, (*loc, "shape"), f"a {sig.shape} needs an amplitude ({amp_key})")
     required, optional = SHAPE_KEYS[sig.shape]
     for key in required:
         if getattr(sig, key) is None:
-            raise where.error((*loc, "shape"), f"a {sig.shape} needs '{key}'")
+            return _add(where, (*loc, "shape"), f"a {sig.shape} needs '{key}'")
     for key in (*_SHAPE_PARAMS, "sweep"):
         if key in sig.model_fields_set and key not in required and key not in optional:
-            raise where.error((*loc, key), f"not used by a {sig.shape}")
+            return _add(where, (*loc, key), f"not used by a {sig.shape}")
     if sig.shape == "chirp" and sig.sweep == "logarithmic" and sig.start_hz == sig.end_hz:
-        raise where.error((*loc, "end_hz"), "a logarithmic sweep needs end_hz different from start_hz")
+        return _add(where, (*loc, "end_hz"), "a logarithmic sweep needs end_hz different from start_hz")
     end = sig.start_s + (sig.duration_s or 0.0)
     limit = phase.until.duration_s
     if limit is not None and end > limit + 1e-9:
-        raise where.error(
-            (*loc, "start_s"), f"the {sig.shape} runs to {end:g} s, past the phase's duration_s of {limit:g} s"
-        )
+        problem = f"the {sig.shape} runs to {end:g} s, past the phase's duration_s of {limit:g} s"
+        return _add(where, (*loc, "start_s"), problem)
+    return True
 
 
 def _check_inputs(phase: Phase, loc: Loc, profile: PilotProfile, where: _Where) -> None:
-    """The open-loop inputs of a phase are complete, consistent with the hold, and in range."""
+    """The open-loop inputs of a phase are complete, consistent with the hold, and in range: the first problem of
+    each input is added to ``where`` (its other checks would only repeat it), and the next input is checked."""
     inputs = phase.inputs
     if inputs is None:
         return
@@ -732,51 +740,93 @@ def _check_inputs(phase: Phase, loc: Loc, profile: PilotProfile, where: _Where) 
             continue
         at: Loc = (*loc, axis)
         if ci.fixed_norm is not None and ci.fixed_deg is not None:
-            raise where.error((*at, "fixed_deg"), "give either fixed_norm or fixed_deg")
+            where.add((*at, "fixed_deg"), "give either fixed_norm or fixed_deg")
+            continue
         if ci.amplitude_norm is not None and ci.amplitude_deg is not None:
-            raise where.error((*at, "amplitude_deg"), "give either amplitude_norm or amplitude_deg")
+            where.add((*at, "amplitude_deg"), "give either amplitude_norm or amplitude_deg")
+            continue
         uses_deg = ci.fixed_deg is not None or ci.amplitude_deg is not None
         key = "fixed_deg" if ci.fixed_deg is not None else "amplitude_deg"
         if uses_deg and axis == "throttle":
-            raise where.error((*at, key), "the throttle has no surface: use the _norm keys")
+            where.add((*at, key), "the throttle has no surface: use the _norm keys")
+            continue
         if uses_deg and profile.surfaces is None:
-            raise where.error((*at, key), f"the pilot profile of '{profile.aircraft}' gives no surface travel")
+            where.add((*at, key), f"the pilot profile of '{profile.aircraft}' gives no surface travel")
+            continue
         if ci.fixed_norm is not None:
             lo = 0.0 if axis == "throttle" else -1.0
             if not lo <= ci.fixed_norm <= 1.0:
-                raise where.error((*at, "fixed_norm"), f"outside the command range {lo:g}..1")
+                where.add((*at, "fixed_norm"), f"outside the command range {lo:g}..1")
+                continue
         if ci.fixed_deg is not None and profile.surfaces is not None:
             travel = getattr(profile.surfaces, axis)
             if not travel.min_deg <= ci.fixed_deg <= travel.max_deg:
-                raise where.error(
-                    (*at, "fixed_deg"), f"outside the surface travel {travel.min_deg:g}..{travel.max_deg:g} deg"
-                )
+                where.add((*at, "fixed_deg"), f"outside the surface travel {travel.min_deg:g}..{travel.max_deg:g} deg")
+                continue
         amplitude = ci.amplitude_norm if ci.amplitude_norm is not None else ci.amplitude_deg
-        _check_signal(ci, amplitude, at, "amplitude_norm or amplitude_deg", phase, where)
+        if not _check_signal(ci, amplitude, at, "amplitude_norm or amplitude_deg", phase, where):
+            continue
+        if ci.amplitude_deg is not None and ci.shape is not None and profile.surfaces is not None:
+            _check_travel(ci, getattr(profile.surfaces, axis), phase, at, where)
         released = ci.free or ci.fixed_norm is not None or ci.fixed_deg is not None
         if not released and ci.shape is None:
-            raise where.error(at, "does nothing: give a 'shape', 'free: true' or a fixed value")
+            where.add(at, "does nothing: give a 'shape', 'free: true' or a fixed value")
+            continue
         if released:
             taken = _set_fields(hold, _AXIS_TARGETS[axis])
             if taken:
-                raise where.error(
-                    (*at,), f"the {axis} is released, which contradicts 'hold.{taken[0]}' (the {axis} is its control)"
-                )
+                contradicted = f"'hold.{taken[0]}' (the {axis} is its control)"
+                where.add((*at,), f"the {axis} is released, which contradicts {contradicted}")
+                continue
             if axis == "throttle" and hold.airspeed_kts is not None:  # without a fixed throttle it holds the speed
-                raise where.error(at, "the throttle is released, which contradicts 'hold.airspeed_kts' (held with it)")
+                where.add(at, "the throttle is released, which contradicts 'hold.airspeed_kts' (held with it)")
+                continue
             if axis == "elevator" and hold.airspeed_kts is not None and hold.throttle is not None:
-                raise where.error(at, "the elevator is released, which contradicts 'hold.airspeed_kts' (held with it)")
+                where.add(at, "the elevator is released, which contradicts 'hold.airspeed_kts' (held with it)")
+                continue
     seen: set[str] = set()
     for j, pi in enumerate(inputs.properties):
         at = (*loc, "properties", j)
         if pi.property in PILOT_PROPERTIES:
-            raise where.error((*at, "property"), f"'{pi.property}' is written by the pilot: use the axis keys")
+            where.add((*at, "property"), f"'{pi.property}' is written by the pilot: use the axis keys")
+            continue
         if pi.property in seen:
-            raise where.error((*at, "property"), f"'{pi.property}' is given twice in this phase")
+            where.add((*at, "property"), f"'{pi.property}' is given twice in this phase")
+            continue
         seen.add(pi.property)
-        _check_signal(pi, pi.amplitude, at, "amplitude", phase, where)
+        if not _check_signal(pi, pi.amplitude, at, "amplitude", phase, where):
+            continue
         if pi.shape is None and pi.fixed is None:
-            raise where.error(at, "does nothing: give a 'shape' or a 'fixed' value")
+            where.add(at, "does nothing: give a 'shape' or a 'fixed' value")
+            continue
+
+
+def _check_travel(ci: ControlInput, travel: Any, phase: Phase, at: Loc, where: _Where) -> None:
+    """An ``amplitude_deg`` signal fits the surface travel (from the model's flight-control system, copied into the
+    pilot profile): from a ``fixed_deg`` base exactly; from any other base (the command at the phase start or the
+    pilot's, known only in flight) its swing, highest minus lowest deflection asked, must fit the whole travel.
+    Where it fits only from some bases, a flight reports the time clipped at a stop (:mod:`washbench.flight.openloop`).
+    """
+    from washbench.flight.inputs import shape_extent
+
+    lo, hi = shape_extent(ci.shape, ci.start_s, ci.duration_s, ci.period_s, ci.start_hz, ci.end_hz, ci.sweep,
+                          phase.until.duration_s)  # fmt: skip
+    a = float(ci.amplitude_deg or 0.0)
+    low, high = sorted((a * lo, a * hi))
+    span = f"{travel.min_deg:g}..{travel.max_deg:g} deg"
+    if ci.fixed_deg is not None:
+        if ci.fixed_deg + low < travel.min_deg - 1e-9 or ci.fixed_deg + high > travel.max_deg + 1e-9:
+            where.add(
+                (*at, "amplitude_deg"),
+                f"from fixed_deg {ci.fixed_deg:g} the {ci.shape} asks {ci.fixed_deg + low:g}..{ci.fixed_deg + high:g} "
+                f"deg, beyond the surface travel {span} (it would stop at the limit)",
+            )
+    elif high - low > travel.max_deg - travel.min_deg + 1e-9:
+        where.add(
+            (*at, "amplitude_deg"),
+            f"the {ci.shape} swings {high - low:g} deg, more than the whole surface travel {span} (it would stop at "
+            "the limits)",
+        )
 
 
 def _check_properties(m: Manoeuvre, where: _Where) -> None:
@@ -805,7 +855,7 @@ def _check_properties(m: Manoeuvre, where: _Where) -> None:
     pm = fdm.get_property_manager()
     for loc, name in wanted:
         if not pm.hasNode(name):
-            raise where.error(loc, f"unknown JSBSim property '{name}' (not in the {m.aircraft} model)")
+            where.add(loc, f"unknown JSBSim property '{name}' (not in the {m.aircraft} model)")
 
 
 def _never_reason(
@@ -866,21 +916,6 @@ def load_manoeuvre(path: str | Path, aircraft_dirs: Sequence[Path] = ()) -> Mano
     data, lines = read_yaml(path)
     context = {"source": path, "lines": lines, "aircraft_dirs": tuple(aircraft_dirs)}
     return validate_data(path, data, lines, Manoeuvre, context=context)
-
-
-def validate_command(paths: Sequence[Path], aircraft_dirs: Sequence[Path] = ()) -> int:
-    """``washbench validate FILE...``: print ``FILE: OK`` or the error line per file; 2 if any is bad."""
-    bad = 0
-    for path in paths:
-        try:
-            load_manoeuvre(path, aircraft_dirs)
-        except WashbenchError as exc:
-            for problem in exc.problems:
-                print(f"washbench: error: {problem}", file=sys.stderr)
-            bad += 1
-        else:
-            print(f"{path}: OK")
-    return 2 if bad else 0
 
 
 def manoeuvre_json_schema() -> dict[str, Any]:

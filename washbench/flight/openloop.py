@@ -11,7 +11,10 @@ Per axis (elevator, aileron, rudder, throttle) the command sent to JSBSim is
 A signal in degrees (``amplitude_deg``, ``fixed_deg``) is added to the surface deflection and
 mapped back through the profile's surface travel, trim included: the command is
 ``surface_norm(surface_deg(base + trim) + a s(t)) - trim``, so the surface moves by exactly
-``a s(t)`` degrees (within its travel). Open-loop signals bypass the pilot's surface rate limit
+``a s(t)`` degrees within its travel. Beyond it the surface stops at the limit: a manoeuvre file is refused
+where that cannot be avoided (:func:`washbench.flight.manoeuvre.load_manoeuvre`), and otherwise the steps
+clipped are counted per phase and axis (:attr:`OpenLoop.clipped`) and the flight fails a check saying for how
+long. Open-loop signals bypass the pilot's surface rate limit
 (a step is a step). When a free axis is given back to the pilot in a later phase, its loop starts
 from the command it finds (bumpless). A property input writes ``fixed`` (else the value at the
 phase start) plus the signal; after the phase the property keeps the last value written.
@@ -30,6 +33,7 @@ from washbench.flight.pilot import Pilot
 from washbench.flight.profile import PilotProfile, Surface
 
 AXES = ("aileron", "elevator", "rudder", "throttle")
+_TRAVEL_SLACK_DEG = 1e-6  # a deflection asked this far past a stop is rounding, not a clipped input
 AXIS_PROPERTIES = ("fcs/aileron-cmd-norm", "fcs/elevator-cmd-norm", "fcs/rudder-cmd-norm", "fcs/throttle-cmd-norm")
 
 
@@ -57,14 +61,17 @@ class _Plan:
         return self.amplitude * unit_shape(s.shape, t, s.start_s, s.duration_s, s.period_s, s.start_hz, s.end_hz,
                                            s.sweep)  # fmt: skip
 
-    def command(self, t: float, pilot_command: float) -> float:
+    def command(self, t: float, pilot_command: float) -> tuple[float, bool]:
+        """(the command, True when the deflection asked in degrees lies beyond the travel and was clipped)."""
         base = self.base if self.free else pilot_command
         if self.deg:
             lo_deg, hi_deg = self.travel
             base_deg = base if self.free else surface_deg(base + self.trim, lo_deg, hi_deg)
-            return surface_norm(base_deg + self.shape(t), lo_deg, hi_deg) - self.trim
+            want = base_deg + self.shape(t)
+            clipped = want < lo_deg - _TRAVEL_SLACK_DEG or want > hi_deg + _TRAVEL_SLACK_DEG
+            return surface_norm(want, lo_deg, hi_deg) - self.trim, clipped
         u = base + self.shape(t)
-        return self.lo if u < self.lo else self.hi if u > self.hi else u
+        return (self.lo if u < self.lo else self.hi if u > self.hi else u), False
 
 
 class OpenLoop:
@@ -78,9 +85,13 @@ class OpenLoop:
         self.plans: list[_Plan | None] = [None] * 4
         self.props: list[_Plan] = []
         self.active = False
+        self.phase = ""
+        self.clipped: dict[tuple[str, str], int] = {}
+        """(phase, axis) -> steps at which the deflection asked in degrees lay beyond the surface travel."""
 
-    def begin_phase(self, inputs: Inputs | None) -> None:
+    def begin_phase(self, inputs: Inputs | None, phase: str = "") -> None:
         """Resolve the inputs of a new phase from the present commands; give freed axes back to the pilot."""
+        self.phase = phase
         previous = self.plans
         self.plans = [None] * 4
         self.props = []
@@ -89,7 +100,7 @@ class OpenLoop:
                 ci: ControlInput | None = getattr(inputs, axis)
                 if ci is not None:
                     before = previous[i]
-                    carried = before.command(-1.0, 0.0) if before is not None and before.free else None
+                    carried = before.command(-1.0, 0.0)[0] if before is not None and before.free else None
                     self.plans[i] = self._axis_plan(i, ci, carried)
             self.props = [self._property_plan(pi) for pi in inputs.properties]
         for i, plan in enumerate(previous):
@@ -131,7 +142,10 @@ class OpenLoop:
         out = [aileron, elevator, rudder, throttle]
         for i, plan in enumerate(self.plans):
             if plan is not None:
-                out[i] = plan.command(t, out[i])
+                out[i], clipped = plan.command(t, out[i])
+                if clipped:
+                    key = (self.phase, AXES[i])
+                    self.clipped[key] = self.clipped.get(key, 0) + 1
         for plan in self.props:
             plan.node.set_double_value(plan.base + plan.shape(t))
         return tuple(out)

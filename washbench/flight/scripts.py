@@ -121,18 +121,111 @@ class ScriptFlight:
     stopped_by_limit: bool = False
 
 
+DEFAULT_MAX_TIME_S = 1200.0
+"""A JSBSim script is flown for at most this much simulated time [s] unless ``--max-time-s`` says otherwise: 20 min
+(144,000 steps at 120 Hz, up to about 230 MB of results with three washouts) covers the aircraft tests among JSBSim's
+scripts; the orbits and balloon flights (3 h and more, up to 600,000 s) would write gigabytes."""
+LONG_RUN_S = 120.0
+"""A script flown for longer than this [s] is announced with its expected size and duration before it starts."""
+BYTES_PER_STEP = 260.0
+BYTES_PER_STEP_WASHOUT = 290.0
+BYTES_PER_STEP_WASHOUT_RECORDING = 160.0
+"""Result size per recorded step, at most: flight.parquet and the aircraft's traces, then per washout its traces and
+its part of recording.rrd. Measured on ``c172_cruise_8K.xml`` for 20 s (2,400 steps, three washouts, a gust:
+4.0 MB, 1,650 bytes a step); smooth flights compress better (``ball.xml``, 60 s at 100 Hz: 790 bytes a step)."""
+STEPS_PER_S = 750.0
+"""Steps flown, cued and written per second of wall time with three washouts and a recording, start-up included,
+measured on this project's 2-core machine under load (``ball.xml``, 6,000 steps: 8.1 s): an order of magnitude for
+the announcement only."""
+
+
+@dataclass(frozen=True)
+class ScriptPlan:
+    """What flying a script will take: ``time_s`` simulated (its ``<run end>`` or the cap), ``steps``,
+    ``size_bytes`` of results (estimated), ``wall_s`` (estimated) and whether the cap cut the script short."""
+
+    info: ScriptInfo
+    time_s: float
+    steps: int
+    size_bytes: float
+    wall_s: float
+    capped: bool
+
+    @property
+    def long(self) -> bool:
+        return self.capped or self.time_s > LONG_RUN_S
+
+    def text(self) -> str:
+        """One line: what will be flown, how big and how long, and how to change it."""
+        from washbench.io.progress import duration_text
+
+        mb = self.size_bytes / 1e6
+        line = (
+            f"{self.info.name}: flying {duration_text(self.time_s)} simulated ({self.steps:,} steps of "
+            f"{self.info.dt_s:.6g} s): up to about {_mb(mb)} MB of results and {duration_text(self.wall_s)} "
+            "(estimated)"
+        )
+        if self.capped:
+            whole = self.info.end_s
+            line += (
+                f"; the script runs {duration_text(whole)} ({whole:g} s): stopped at the default cap of "
+                f"{DEFAULT_MAX_TIME_S:g} s, --max-time-s {whole:g} flies it all (up to about "
+                f"{_mb(self.size_bytes * whole / self.time_s / 1e6)} MB)"
+            )
+        return line
+
+
+def _mb(x: float) -> str:
+    """Megabytes to two significant digits below 10, whole (with thousands separators) above."""
+    return f"{x:.2g}" if x < 10 else f"{x:,.0f}"
+
+
+def script_plan(info: ScriptInfo, max_time_s: float | None, washouts: int = 3, recording: bool = True) -> ScriptPlan:
+    """The plan of flying ``info`` with ``--max-time-s`` ``max_time_s`` (None: up to :data:`DEFAULT_MAX_TIME_S`)."""
+    capped = max_time_s is None and info.end_s > DEFAULT_MAX_TIME_S
+    limit = DEFAULT_MAX_TIME_S if max_time_s is None else max_time_s
+    time_s = min(info.end_s, limit)
+    steps = round(time_s / info.dt_s)
+    per_washout = BYTES_PER_STEP_WASHOUT + (BYTES_PER_STEP_WASHOUT_RECORDING if recording else 0.0)
+    per_step = BYTES_PER_STEP + washouts * per_washout
+    return ScriptPlan(info, time_s, steps, steps * per_step, steps * washouts / 3.0 / STEPS_PER_S, capped)
+
+
 def scripts_dir() -> Path:
     """The scripts shipped in the jsbsim package."""
     return jsbsim_root() / "scripts"
 
 
+def is_runscript(path: Path) -> bool:
+    """True for an XML file whose root element is a JSBSim ``<runscript>`` (cheap: reads the first element)."""
+    try:
+        for _, elem in ET.iterparse(path, events=("start",)):
+            return elem.tag == "runscript"
+    except (ET.ParseError, OSError):
+        return False
+    return False
+
+
+def bundled_scripts() -> list[str]:
+    """The names of the scripts shipped with JSBSim (files whose root element is ``<runscript>``)."""
+    return sorted(p.stem for p in scripts_dir().glob("*.xml") if is_runscript(p))
+
+
 def bundled_script(name: str) -> Path:
-    """A script shipped with JSBSim by name (``c1723`` or ``c1723.xml``); WashbenchError listing them if unknown."""
+    """A script shipped with JSBSim by name (``c1723`` or ``c1723.xml``); WashbenchError with the closest names (or
+    all of them) if unknown or not a script."""
     stem = name[:-4] if name.endswith(".xml") else name
     path = scripts_dir() / f"{stem}.xml"
-    if not path.is_file():
-        known = sorted(p.stem for p in scripts_dir().glob("*.xml"))
-        raise WashbenchError(f"--jsbsim-scripts: no script {name!r} ships with JSBSim (known: {', '.join(known)})")
+    if not path.is_file() or not is_runscript(path):
+        import difflib
+
+        known = bundled_scripts()
+        close = difflib.get_close_matches(stem, known, n=3, cutoff=0.6)
+        hint = f"did you mean {', '.join(close)}?" if close else f"the {len(known)} scripts: {', '.join(known)}"
+        if path.is_file():
+            raise WashbenchError(f"--jsbsim-scripts: {name!r} ships with JSBSim but is not a script (no <runscript>); "
+                                 f"{hint}")  # fmt: skip
+        raise WashbenchError(f"--jsbsim-scripts: no script {name!r} ships with JSBSim; {hint}")
     return path
 
 

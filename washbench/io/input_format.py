@@ -58,6 +58,10 @@ class InputFormat:
     columns: Mapping[str, ColumnSource] = field(default_factory=dict)
     axes: str = "frd"
     origin: str = "--columns"
+    decimal: str = "."
+    """The decimal mark of a text file's numbers: ``.`` or ``,`` (``--decimal``)."""
+    jsbsim_dt_s: float | None = None
+    """A JSBSim CSV log's simulation frame time [s] (``--jsbsim-dt``): its pilot accelerations lag one frame."""
 
 
 # --------------------------------------------------------------------------- the mapping option
@@ -129,6 +133,8 @@ class InputFormatFile(StrictModel):
     format: csv              # auto (default) | csv | parquet | xplane | jsbsim
     delimiter: ";"           # or comma, semicolon, tab, pipe; default: detected
     axes: flu                # sensor axes (see washbench.io.units); default frd
+    decimal: ","             # decimal mark of the numbers, "." (default) or ","
+    jsbsim_dt_s: 0.0083333   # JSBSim CSV: the simulation's frame time (the script's <run dt>)
     columns:                 # FIELD: "[-]COLUMN[:UNIT]" (column names may hold commas here)
       t: "Time:ms"
       f_x: "ax:g"
@@ -138,6 +144,8 @@ class InputFormatFile(StrictModel):
     format: Literal["auto", "csv", "parquet", "xplane", "jsbsim"] = "auto"
     delimiter: str | None = None
     axes: str = "frd"
+    decimal: Literal[".", ","] = "."
+    jsbsim_dt_s: float | None = Field(default=None, gt=0.0, allow_inf_nan=False)
     columns: dict[str, str] = Field(default_factory=dict)
 
 
@@ -157,7 +165,12 @@ def load_input_format(path: str | Path) -> InputFormat:
     except ValueError as exc:
         raise WashbenchError(f"{where}: {exc}") from None
     delim = check_delimiter(doc.delimiter, f"{path}:{line_of(lines, ('delimiter',)) or 1}: delimiter")
-    return InputFormat(kind=doc.format, delimiter=delim, columns=columns, axes=doc.axes, origin=str(path))
+    if delim == doc.decimal:
+        raise WashbenchError(f"{path}:{line_of(lines, ('decimal',)) or 1}: decimal: the delimiter is {delim!r} too")
+    return InputFormat(
+        kind=doc.format, delimiter=delim, columns=columns, axes=doc.axes, origin=str(path), decimal=doc.decimal,
+        jsbsim_dt_s=doc.jsbsim_dt_s,
+    )  # fmt: skip
 
 
 def input_format(
@@ -165,9 +178,11 @@ def input_format(
     format_file: str | Path | None = None,
     axes: str | None = None,
     delimiter: str | None = None,
+    decimal: str | None = None,
+    jsbsim_dt_s: float | None = None,
 ) -> InputFormat:
     """The input format from the command line: ``--input-format FILE`` first, then ``--columns`` (field by
-    field), ``--axes`` and ``--delimiter`` over it."""
+    field), ``--axes``, ``--delimiter``, ``--decimal`` and ``--jsbsim-dt`` over it."""
     fmt = load_input_format(format_file) if format_file is not None else InputFormat()
     cols = dict(fmt.columns)
     origin = fmt.origin
@@ -179,10 +194,20 @@ def input_format(
             units.axes_matrix(axes)
         except ValueError as exc:
             raise WashbenchError(f"--axes: {exc}") from None
+    if decimal is not None and decimal not in (".", ","):
+        raise WashbenchError(f"--decimal: expected '.' or ',', got {decimal!r}")
+    if jsbsim_dt_s is not None and not (0.0 < jsbsim_dt_s < 1.0):
+        raise WashbenchError(f"--jsbsim-dt: expected a frame time in seconds (0 .. 1), got {jsbsim_dt_s!r}")
+    delim = check_delimiter(delimiter, "--delimiter") if delimiter is not None else fmt.delimiter
+    mark = decimal if decimal is not None else fmt.decimal
+    if delim == mark:
+        raise WashbenchError(f"--decimal {mark}: the delimiter is {mark!r} too (give --delimiter ';' or tab)")
     return InputFormat(
         kind=fmt.kind,
-        delimiter=check_delimiter(delimiter, "--delimiter") if delimiter is not None else fmt.delimiter,
+        delimiter=delim,
         columns=cols,
         axes=axes if axes is not None else fmt.axes,
         origin=origin,
+        decimal=mark,
+        jsbsim_dt_s=jsbsim_dt_s if jsbsim_dt_s is not None else fmt.jsbsim_dt_s,
     )

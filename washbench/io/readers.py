@@ -9,8 +9,9 @@ Files (chosen by extension, then by the header):
 - X-Plane's Data Output file ``Data.txt`` (:mod:`washbench.io.xplane`): pipe-separated, padded headers.
 - JSBSim's own CSV output (header ``Time, ..., accelerations/a-pilot-x-ft_sec2, ...``): the eyepoint
   specific force (ft/s^2) and the body rates (``velocities/p-rad_sec`` ... or the ``<rates>`` group's
-  ``P (deg/s)``); JSBSim's pilot accelerations lag its other outputs by one frame, so they are shifted
-  back by one row (the last row, which has none, is dropped).
+  ``P (deg/s)``); JSBSim's pilot accelerations lag its other outputs by one simulation frame, so they are
+  shifted back by one frame (:func:`shift_jsbsim_lag`: one row of a log written every frame, interpolated in a
+  log written every few frames, not at all where the frame time cannot be known).
 
 Every reader ends in the same conversion (:func:`convert`): the format's column mapping, overridden
 field by field by the user's (``--columns`` or ``--input-format FILE``), picks one source column per
@@ -21,7 +22,9 @@ so a ``washbench fly`` trace is read back bit for bit.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -54,6 +57,10 @@ class Samples:
     lines: np.ndarray | None
     notes: tuple[str, ...] = ()
     time_column: str = "t_s"
+    declared: Mapping[str, str] = field(default_factory=dict)
+    """The units the columns were read in: ``t`` (time), ``f`` (specific force), ``omega`` (angular velocity)."""
+    sources: Mapping[str, ColumnSource] = field(default_factory=dict)
+    """Per motion field (``t``, ``f_x`` ...) the source column, unit and sign it came from."""
 
     @property
     def n(self) -> int:
@@ -77,6 +84,8 @@ class Samples:
             lines=None if self.lines is None else self.lines[index],
             notes=self.notes + notes,
             time_column=self.time_column,
+            declared=self.declared,
+            sources=self.sources,
         )
 
 
@@ -130,8 +139,8 @@ def read_samples(path: str | Path, fmt: InputFormat | None = None) -> Samples:
     else:
         _, names, delim = header(path, delim)
         mapping = default_mapping(kind, names) | dict(fmt.columns)
-        src = read_text_table(path, delim, {s.column for s in mapping.values()})
-        src = SourceTable(path=src.path, kind=kind, table=src.table, lines=src.lines)
+        src = read_text_table(path, delim, {s.column for s in mapping.values()}, fmt.decimal)
+        src = SourceTable(path=src.path, kind=kind, table=src.table, lines=src.lines, decimal=src.decimal)
     return convert(src, fmt)
 
 
@@ -199,18 +208,78 @@ def convert(src: SourceTable, fmt: InputFormat) -> Samples:
         lines=src.lines,
         notes=tuple(notes),
         time_column=t_src.column,
+        declared={"t": units.normalise_unit(t_src.unit), "f": mapping["f_x"].unit, "omega": mapping["omega_x"].unit},
+        sources=dict(mapping),
     )
     if src.kind == "jsbsim":
-        samples = shift_jsbsim_lag(samples)
+        samples = shift_jsbsim_lag(samples, fmt.jsbsim_dt_s)
     return samples
 
 
-def shift_jsbsim_lag(s: Samples) -> Samples:
-    """JSBSim logs ``a-pilot`` one frame late: row k + 1 holds sample k's value. Shift it back, drop the last row."""
+JSBSIM_DEFAULT_DT_S = 1.0 / 120.0
+"""JSBSim's frame time when a script's ``<run>`` gives no ``dt`` [s]."""
+JSBSIM_DT_COLUMNS = ("simulation/dt", "/fdm/jsbsim/simulation/dt")
+"""A logged ``simulation/dt`` property: the frame time, read from the log itself."""
+
+
+def jsbsim_frame_s(s: Samples, given_s: float | None) -> tuple[float | None, str]:
+    """(the simulation frame time of a JSBSim log [s] or None where it cannot be known; where it came from).
+
+    Given (``--jsbsim-dt``), or a logged ``simulation/dt`` column, or, for a log whose rows are JSBSim's default
+    frame (1/120 s) apart, that frame: a script that sets no ``dt`` and logs every frame (a log at 120 Hz of a
+    240 Hz simulation is told apart only by ``--jsbsim-dt``).
+    """
+    if given_s is not None:
+        return float(given_s), "--jsbsim-dt"
+    for c in JSBSIM_DT_COLUMNS:
+        if c in s.extra and s.extra[c].dtype.kind in "fi" and np.ptp(s.extra[c]) == 0.0:
+            return float(s.extra[c][0]), f"its {c} column"
+    steps = np.diff(s.t_s)
+    if steps.size and np.all(np.abs(steps - JSBSIM_DEFAULT_DT_S) <= 1e-3 * JSBSIM_DEFAULT_DT_S):
+        return JSBSIM_DEFAULT_DT_S, "JSBSim's default, one row per frame at 120 Hz"
+    return None, ""
+
+
+def shift_jsbsim_lag(s: Samples, frame_s: float | None = None) -> Samples:
+    """JSBSim logs ``a-pilot`` one simulation frame late: the value logged at time t is the one of t - frame.
+
+    The accelerations are moved back by one frame, ``f(t_k) = f_logged(t_k + frame)``: for a log with a row per
+    frame that is the next row exactly; for a log written every few frames (``<output rate>`` below the
+    simulation's) it is interpolated linearly between the rows around ``t_k + frame``. Rows with no logged value
+    one frame later (the last) are dropped. Where the frame time cannot be known (:func:`jsbsim_frame_s`) nothing
+    is shifted and the note says so: shifting by a row of a sub-sampled log would move the accelerations by a
+    whole row, many frames.
+    """
+    frame, origin = jsbsim_frame_s(s, frame_s)
     n = s.n
-    f = np.ascontiguousarray(s.f_mps2[1:])
-    out = s.take(slice(0, n - 1), ("JSBSim's pilot accelerations shifted back one row (their one-frame lag)",))
-    return Samples(out.path, out.kind, out.t_s, f, out.omega_degps, out.extra, out.lines, out.notes, out.time_column)
+    t = s.t_s
+    steps = np.diff(t)
+    if frame is None:
+        note = (
+            f"JSBSim's pilot accelerations lag the other columns by one simulation frame, but the log's rows are "
+            f"{float(np.median(steps)):.6g} s apart and its frame time is not in the file: NOT shifted (give the "
+            "script's <run dt> with --jsbsim-dt S, or log simulation/dt)"
+        )
+        return s.take(slice(0, n), (note,))
+    if np.all(np.abs(steps - frame) <= 1e-3 * frame):
+        f = np.ascontiguousarray(s.f_mps2[1:])
+        note = f"JSBSim's pilot accelerations shifted back one frame of {frame:.6g} s = one row (frame from {origin})"
+        out = s.take(slice(0, n - 1), (note,))
+    else:
+        if not np.all(steps > 0.0):
+            raise WashbenchError(located(s.path, "JSBSim log: time does not increase, cannot undo the one-frame lag"))
+        if np.any(steps < frame * (1.0 - 1e-3)):
+            raise WashbenchError(
+                located(s.path, f"JSBSim log: rows closer than the frame time {frame:.6g} s (from {origin})")
+            )
+        keep = int(np.searchsorted(t, t[-1] - frame, side="right"))
+        f = np.column_stack([np.interp(t[:keep] + frame, t, s.f_mps2[:, j]) for j in range(3)])
+        note = (
+            f"JSBSim's pilot accelerations shifted back one frame of {frame:.6g} s (frame from {origin}), "
+            f"interpolated between rows {float(np.median(steps)):.6g} s apart"
+        )
+        out = s.take(slice(0, keep), (note,))
+    return replace(out, f_mps2=f)
 
 
 def _time_column(src: SourceTable, s: ColumnSource, notes: list[str]) -> np.ndarray:
@@ -267,12 +336,18 @@ def _check_nulls(src: SourceTable, name: str, col: pa.ChunkedArray) -> None:
         raise WashbenchError(located(src.path, f"{row}missing value", line=line, field=name))
 
 
+_DECIMAL_COMMA = re.compile(r"^[+-]?\d*,\d+([eE][+-]?\d+)?$")
+"""A number written with a decimal comma (``0,000000``, ``-1,5e-3``)."""
+
+
 def numeric_column(src: SourceTable, name: str, label: str | None = None) -> np.ndarray:
     """Column ``name`` as float64, checked: no missing, non-numeric, NaN or infinite values."""
     col = src.table.column(name)
     _check_nulls(src, name, col)
     if pa.types.is_string(col.type) or pa.types.is_large_string(col.type):
         stripped = pc.utf8_trim_whitespace(col)
+        if src.decimal == ",":
+            stripped = pc.replace_substring(stripped, ",", ".")
         try:
             col = pc.cast(stripped, pa.float64())
         except pa.ArrowInvalid:
@@ -281,8 +356,11 @@ def numeric_column(src: SourceTable, name: str, label: str | None = None) -> np.
                     float(v)
                 except ValueError:
                     line, row = _where(src, i)
+                    hint = ""
+                    if src.decimal == "." and _DECIMAL_COMMA.match(v):
+                        hint = " (a decimal comma? read the file with --decimal ,)"
                     raise WashbenchError(
-                        located(src.path, f"{row}not a number: {v!r}", line=line, field=name)
+                        located(src.path, f"{row}not a number: {v!r}{hint}", line=line, field=name)
                     ) from None
             raise WashbenchError(located(src.path, "column is not numeric", field=name)) from None
     elif pa.types.is_integer(col.type) or pa.types.is_floating(col.type):

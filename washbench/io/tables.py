@@ -31,6 +31,7 @@ class SourceTable:
     kind: str
     table: pa.Table
     lines: np.ndarray | None
+    decimal: str = "."
 
 
 def file_kind(path: Path) -> str:
@@ -88,10 +89,11 @@ def header(path: Path, delimiter: str | None) -> tuple[int, list[str], str]:
     raise WashbenchError(located(path, "the file is empty" if not lines else "no header line (only comments)"))
 
 
-def read_text_table(path: Path, delimiter: str | None, string_columns: set[str]) -> SourceTable:
+def read_text_table(path: Path, delimiter: str | None, string_columns: set[str], decimal: str = ".") -> SourceTable:
     """A CSV-like text file with pyarrow: header and delimiter sniffed, ``#`` lines skipped, names trimmed.
 
-    ``string_columns`` are read as text (converted later with errors that name the line and value).
+    ``string_columns`` are read as text (converted later with errors that name the line and value); the other
+    numbers are read with the decimal mark ``decimal``.
     """
     try:
         size = path.stat().st_size
@@ -123,6 +125,7 @@ def read_text_table(path: Path, delimiter: str | None, string_columns: set[str])
     convert = pacsv.ConvertOptions(
         null_values=[""],
         strings_can_be_null=True,
+        decimal_point=decimal,
         column_types={c: pa.string() for c in names if c in string_columns},
     )
     try:
@@ -148,7 +151,7 @@ def read_text_table(path: Path, delimiter: str | None, string_columns: set[str])
         skip = np.asarray(sorted(skipped), dtype=np.int64)
         for s in skip:
             lines[lines >= s] += 1
-    return SourceTable(path=path, kind="csv", table=table, lines=lines)
+    return SourceTable(path=path, kind="csv", table=table, lines=lines, decimal=decimal)
 
 
 def read_parquet_table(path: Path) -> SourceTable:

@@ -277,7 +277,9 @@ def _problem(err: dict[str, Any], model: type[BaseModel], loc: Loc) -> str:
     if kind in {"bool_type", "bool_parsing"}:
         return f"expected true or false, got {_describe(value)}"
     if kind in {"string_type"}:
-        return f"expected text, got {_describe(value)}"
+        number = isinstance(value, int | float) and not isinstance(value, bool)
+        hint = f" (write it in quotes: '{value}')" if number else ""
+        return f"expected text, got {_describe(value)}{hint}"
     if kind in {"list_type", "tuple_type"}:
         return f"expected a list, got {_describe(value)}"
     if kind in {"dict_type", "model_type", "model_attributes_type"}:

@@ -176,9 +176,9 @@ def replay_command(paths: Path | list[Path], web: bool) -> int:
 
     The native viewer where a display exists (a macOS or Windows desktop, or DISPLAY / WAYLAND_DISPLAY set) and
     ``web`` is false; otherwise the web viewer on 127.0.0.1 with system-chosen ports, whose address is printed; it
-    runs until Ctrl-C (status 0). Returns the exit status. The comparison recording lives in a temporary folder
-    removed when the viewer stops. SIGTERM stops the viewer too (status 143), and a viewer outlives washbench in no
-    case (Linux: not even a SIGKILL of washbench, through the parent-death signal).
+    runs until Ctrl-C (status 130, as any command). Returns the exit status. The comparison recording lives in a
+    temporary folder removed when the viewer stops. SIGTERM stops the viewer too (status 143), and a viewer
+    outlives washbench in no case (Linux: not even a SIGKILL of washbench, through the parent-death signal).
     """
     files = [Path(p) for p in (paths if isinstance(paths, list) else [paths])]
     if len(files) not in (1, 2):
@@ -207,9 +207,7 @@ def _replay(path: Path, web: bool) -> int:
     try:
         while proc.poll() is None:
             time.sleep(0.2)
-    except KeyboardInterrupt:
-        return 0
-    finally:
+    finally:  # Ctrl-C goes on to the command's handler: "washbench: interrupted", status 130
         with contextlib.suppress(ProcessLookupError):
             stop_viewer(proc)
     return proc.returncode

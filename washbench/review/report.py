@@ -482,6 +482,9 @@ def write_result_report(
         f"washouts: {', '.join(data.washouts)}.",
         "",
     ]
+    from washbench.review.input_figure import input_section
+
+    lines += input_section(data.folder, pdf, _image) if figures else []  # a cue result: the input as read, first
     lines += provenance_lines(data.provenance, data.created_utc)
     lines += result_sections(data, drawn, data.folder, 2)
     path = data.folder / REPORT_FILE

@@ -32,10 +32,11 @@ from washbench.errors import WashbenchError, located
 from washbench.io.atomic import atomic_path
 from washbench.io.input_format import InputFormat
 from washbench.io.names import check_identifier
-from washbench.io.plausibility import Finding, check_motion
+from washbench.io.plausibility import Finding, check_arrays
+from washbench.io.progress import Progress
 from washbench.io.publish import result_path
 from washbench.io.readers import Samples, read_samples
-from washbench.io.resample import check_gaps, resample, split_resets, to_motion, window
+from washbench.io.resample import check_gaps, check_step, resample, split_resets, to_motion, window
 from washbench.io.results import (
     AIRCRAFT,
     TIME_COLUMN,
@@ -300,33 +301,6 @@ _RECORDING_FIELDS = ("head_f_mps2", "head_omega_radps", "q")
 """... and for the recording (the simulator pilot's raw motion, the sphere's attitude in the 3D view)."""
 
 
-class Progress:
-    """``cue: 45% (97,000 of 216,000 rows)`` on stderr: in place on a terminal, else a line every ``every_s``
-    (nothing for work done in less); :meth:`close` ends the line on a terminal."""
-
-    def __init__(self, label: str, total: int, every_s: float = 5.0) -> None:
-        self.label, self.total, self.every_s = label, total, every_s
-        self.offset = 0  # rows done before the part now being counted (``update`` counts from here)
-        self.tty = sys.stderr.isatty()
-        self._last = time.monotonic()
-        self._shown = False
-
-    def update(self, done: int) -> None:
-        now = time.monotonic()
-        if now - self._last < (0.2 if self.tty else self.every_s):
-            return
-        self._last = now
-        done += self.offset
-        pct = 100.0 * done / max(self.total, 1)
-        line = f"{self.label}: {pct:3.0f}% ({done:,} of {self.total:,} rows)"
-        print(f"\r{line}" if self.tty else line, end="" if self.tty else "\n", file=sys.stderr, flush=True)
-        self._shown = True
-
-    def close(self) -> None:
-        if self.tty and self._shown:
-            print(file=sys.stderr, flush=True)
-
-
 def stream_cue(
     motion: Motion,
     washouts: Sequence[Any],
@@ -446,6 +420,14 @@ class CueOptions:
     figures: bool = True
     rank_by: str | None = None  # the ranking rule (--rank-by; None: the parameter file's)
     vestibular: str | None = None  # the vestibular model (--vestibular; None: young-meiry)
+    progress: bool = True
+    force: bool = False
+    """Resample even when that makes more than :data:`MAX_GROWTH` times the input's rows."""
+
+
+MAX_GROWTH = 100
+"""``--resample`` refuses (without ``--force``) to make more than this many times the input's rows: such a factor
+is a time column in the wrong unit far more often than a wish (a 0.1 Hz 'log' at 100 Hz: 1000 times)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -458,6 +440,8 @@ class Segment:
     motion: Motion
     notes: tuple[str, ...]
     findings: tuple[Finding, ...]
+    labels: tuple[str, ...] = ()
+    """Where each of the six signals came from (:func:`washbench.review.input_figure.input_labels`)."""
 
 
 def check_segment_name(name: str) -> str:
@@ -471,25 +455,47 @@ def read_input(path: Path, fmt: InputFormat) -> Samples:
 
 
 def prepare_segments(samples: Samples, opts: CueOptions) -> list[Segment]:
-    """Window and segments: split at time resets, cut the window, check gaps, put on a uniform grid
-    (``--resample``, else the grid check), then the plausibility checks (errors with ``--strict``)."""
+    """Window and segments: split at time resets, cut the window, check gaps, the plausibility checks on the data
+    as read (errors with ``--strict``), then put on a uniform grid (``--resample``, else the grid check).
+
+    Resampling is held to what the grid check holds the data to (a step of 1 Hz .. 10 kHz, the median step
+    here), and to at most :data:`MAX_GROWTH` times the rows read unless ``opts.force``.
+    """
+    from washbench.review.input_figure import input_labels
+
     parts = split_resets(samples, split=opts.split)
+    fmt = opts.fmt
+    labels = tuple(input_labels(samples.sources, fmt.axes, tuple(fmt.columns), fmt.origin)) if samples.sources else ()
     out = []
     for i, part in enumerate(parts):
         name = check_segment_name(f"segment_{i + 1}") if len(parts) > 1 else ""
         part = window(part, opts.start_s, opts.end_s)
         check_gaps(part, opts.max_gap_s)
         notes = list(part.notes)
+        step = float(np.median(np.diff(part.t_s)))
+        findings = tuple(check_arrays(part.t_s, step, part.f_mps2, part.omega_degps, part.declared))
+        if opts.strict and findings:
+            where = f" ({name})" if name else ""
+            raise WashbenchError(located(samples.path, f"{findings[0].text}{where} [--strict]"))
         if opts.resample_hz is not None:
+            check_step(part, step)
+            rows = math.floor((part.t_s[-1] - part.t_s[0]) * opts.resample_hz + 1e-9) + 1
+            if rows > MAX_GROWTH * part.n and not opts.force:
+                why = next((f.text for f in findings if f.text.startswith("sample rate")), "")
+                why = why or f"the data's own rate is {1.0 / step:.4g} Hz: is the time in another unit?"
+                raise WashbenchError(
+                    located(
+                        samples.path,
+                        f"--resample {opts.resample_hz:g} would make {rows:,} rows of {part.n:,} ({rows / part.n:.0f} "
+                        f"times): {why}; --force resamples anyway",
+                        field=part.time_column,
+                    )
+                )
             motion, note = resample(part, opts.resample_hz)
             notes.append(note)
         else:
             motion = to_motion(part)
-        findings = tuple(check_motion(motion))
-        if opts.strict and findings:
-            where = f" ({name})" if name else ""
-            raise WashbenchError(located(samples.path, f"{findings[0].text}{where} [--strict]"))
-        out.append(Segment(name=name, motion=motion, notes=tuple(notes), findings=findings))
+        out.append(Segment(name=name, motion=motion, notes=tuple(notes), findings=findings, labels=labels))
     return out
 
 
@@ -581,6 +587,7 @@ def write_outputs(
                     "t_end_s": float(seg.motion.t_s[-1]),
                     "filter_start": opts.filter_start,
                     "conversions": list(seg.notes),
+                    "input_labels": list(seg.labels),
                     "warnings": [f.text for f in seg.findings],
                 }
                 if provenance:
@@ -592,9 +599,14 @@ def write_outputs(
                     props = flat_strings(provenance, created) if provenance else None
                     write_run_recording(tmp[RECORDING_FILE], title, seg.motion, result, limits, q, [], props)
                 done.append((summary, result))
-        for summary, result in done:  # last, as a suite's report: each written atomically once the rest is in
-            if not opts.recording:  # place; a recording of an earlier run would not show these results
+        for seg, (summary, result) in zip(segments, done, strict=True):  # last, as a suite's report: each written
+            if not opts.recording:  # atomically once the rest is in place; an earlier recording would mislead
                 (summary.run_dir / RECORDING_FILE).unlink(missing_ok=True)
+            if opts.figures and seg.labels:  # what was read, linked first in the report
+                from washbench.review.input_figure import draw_for_result
+
+                title = f"{input_path.name}{f' {seg.name}' if seg.name else ''}"
+                draw_for_result(summary.run_dir, title, seg.motion, seg.labels, seg.notes)
             write_run_review(summary.run_dir, summary, str(input_path), result.review_table(), opts.figures)
     except OSError as exc:
         raise WashbenchError(located(out_dir, f"cannot write results: {exc.strerror or exc}")) from None
@@ -647,7 +659,7 @@ def run_cue(
         input_prov = read_parquet_provenance(input_path) if is_parquet else None
         if input_prov:
             prov["input"]["provenance"] = input_prov
-        done = write_outputs(out_dir, input_path, segments, specs, limits, opts, start, prov, progress=True)
+        done = write_outputs(out_dir, input_path, segments, specs, limits, opts, start, prov, progress=opts.progress)
     for seg, (summary, result) in zip(segments, done, strict=True):
         m = seg.motion
         label = f"{input_path}{f' {seg.name}' if seg.name else ''}"

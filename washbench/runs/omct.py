@@ -29,6 +29,7 @@ from washbench.analysis.signals import amplitude_unit, generate
 from washbench.cueing.variants import Washout
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
+from washbench.io.progress import Progress
 from washbench.io.results import csv_number
 from washbench.io.yamlio import load_yaml_model
 from washbench.perception.vestibular import VestibularModel, VestibularParams
@@ -121,8 +122,11 @@ def measure(
     boundaries: dict[str, omct.Bounds] | None = None,
     vestibular: VestibularParams | None = None,
     amplitude_scale: float = 1.0,
+    progress: bool = False,
 ) -> tuple[list[OmctPoint], OmctSettings]:
     """Run every test at every frequency for every washout; points ordered washout, test, frequency.
+
+    ``progress``: show the test points done and the expected end on standard error (:mod:`washbench.io.progress`).
 
     ``amplitude_scale`` multiplies every input amplitude (1: the amplitudes of :func:`omct.amplitude`), to
     probe where a washout stops being linear.
@@ -142,23 +146,27 @@ def measure(
     sigma = slowest_decay(entries)
     model = VestibularModel(dt, vestibular)
     raw: dict[tuple[str, str], list[tuple[float, float, str, complex, float, tuple[str, ...], complex, complex]]] = {}
-    for test in tests:
-        for w in frequencies_radps:
-            tm = omct.timing(w, sigma)
-            spec = omct.input_spec(test, w, rate_hz, tm.duration_s, amplitude_scale)
-            sig = generate(spec)
-            ref = omct.reference_fit(test, sig.f_mps2, sig.omega_radps, dt, w, tm.periods)
-            aircraft = omct.response(test, ref, sig.f_mps2, sig.omega_radps, dt, w, tm.periods, _g(entries[0]))
-            traces = cue_trace(sig.f_mps2, sig.omega_radps, dt, entries, None, limits)
-            for m in entries:
-                tr = traces[m.name]
-                head = omct.platform_head_motion(tr.pos_m, tr.q, tr.omega_radps, m.params.head.offset_m, dt, _g(m))
-                r = omct.platform_response(test, ref, head, dt, w, tm.periods, _g(m))
-                est = omct.response(test, ref, tr.head_f_mps2, tr.head_omega_radps, dt, w, tm.periods, _g(m))
-                sat = omct.saturated_kinds(tr.saturation_counts)
-                raw.setdefault((m.name, test.name), []).append(
-                    (w, spec.amplitude, amplitude_unit(test.input_axis), r.h, r.distortion, sat, aircraft.h, est.h)
-                )
+    shown = Progress("omct", len(tests) * len(frequencies_radps), "test points") if progress else None
+    for i, (test, w) in enumerate((t, w) for t in tests for w in frequencies_radps):
+        tm = omct.timing(w, sigma)
+        spec = omct.input_spec(test, w, rate_hz, tm.duration_s, amplitude_scale)
+        sig = generate(spec)
+        ref = omct.reference_fit(test, sig.f_mps2, sig.omega_radps, dt, w, tm.periods)
+        aircraft = omct.response(test, ref, sig.f_mps2, sig.omega_radps, dt, w, tm.periods, _g(entries[0]))
+        traces = cue_trace(sig.f_mps2, sig.omega_radps, dt, entries, None, limits)
+        for m in entries:
+            tr = traces[m.name]
+            head = omct.platform_head_motion(tr.pos_m, tr.q, tr.omega_radps, m.params.head.offset_m, dt, _g(m))
+            r = omct.platform_response(test, ref, head, dt, w, tm.periods, _g(m))
+            est = omct.response(test, ref, tr.head_f_mps2, tr.head_omega_radps, dt, w, tm.periods, _g(m))
+            sat = omct.saturated_kinds(tr.saturation_counts)
+            raw.setdefault((m.name, test.name), []).append(
+                (w, spec.amplitude, amplitude_unit(test.input_axis), r.h, r.distortion, sat, aircraft.h, est.h)
+            )
+        if shown is not None:
+            shown.update(i + 1, test.name)
+    if shown is not None:
+        shown.close()
     points: list[OmctPoint] = []
     for e in entries:
         for test in tests:
@@ -257,6 +265,7 @@ def run_omct(
     amplitude_scale: float = 1.0,
     plots: bool = True,
     variants: Sequence[str] = (),
+    progress: bool = False,
 ) -> list[OmctPoint]:
     """The ``washbench omct`` command: the washouts of ``--washout``, ``--variant`` and ``--params``.
 
@@ -271,8 +280,9 @@ def run_omct(
     limits = load_platform_limits(platform_path)
     boundary = load_boundaries(boundaries_path) if boundaries_path is not None else None
     return run_entries(
-        out_dir, entries, limits, boundary, rate_hz=rate_hz, amplitude_scale=amplitude_scale, plots=plots
-    )
+        out_dir, entries, limits, boundary, rate_hz=rate_hz, amplitude_scale=amplitude_scale, plots=plots,
+        progress=progress,
+    )  # fmt: skip
 
 
 def run_entries(
@@ -283,13 +293,16 @@ def run_entries(
     rate_hz: float = 120.0,
     amplitude_scale: float = 1.0,
     plots: bool = True,
+    progress: bool = False,
 ) -> list[OmctPoint]:
     """Measure ``entries`` and write the results (the part of :func:`run_omct` a variant list can call)."""
     out_dir = Path(out_dir)
     if out_dir.exists() and not out_dir.is_dir():
         raise WashbenchError(located(out_dir, "output path exists and is not a folder"))
     bounds = boundary.bounds() if boundary else None
-    points, settings = measure(entries, limits, rate_hz=rate_hz, boundaries=bounds, amplitude_scale=amplitude_scale)
+    points, settings = measure(
+        entries, limits, rate_hz=rate_hz, boundaries=bounds, amplitude_scale=amplitude_scale, progress=progress
+    )
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
         files: dict[str, str] = {}
@@ -325,15 +338,17 @@ def signal_command(
     out: Path,
 ) -> int:
     """The ``washbench signal`` command: generate a test signal and write it as a ``washbench cue`` input."""
-    from washbench.analysis.signals import SignalSpec, amplitude_unit
+    from washbench.analysis.signals import SignalSpec, amplitude_unit, canonical_axis
     from washbench.io.motion_file import write_motion
 
+    given, axis = axis, canonical_axis(axis)  # surge/sway/heave (the metrics' names) or f_x/f_y/f_z
     spec = SignalSpec(kind, axis, amplitude, frequency_hz, duration_s, rate_hz, start_s)
     sig = generate(spec)
     write_motion(out, sig.t_s, sig.f_mps2, sig.omega_radps)
     freq = "" if frequency_hz is None or kind == "step" else f" at {frequency_hz:g} Hz"
+    named = axis if given == axis else f"{given} ({axis})"
     print(
-        f"wrote {out}: {kind} on {axis}, amplitude {amplitude:g} {amplitude_unit(axis)}{freq}, "
+        f"wrote {out}: {kind} on {named}, amplitude {amplitude:g} {amplitude_unit(axis)}{freq}, "
         f"{sig.t_s.shape[0]} samples at {rate_hz:g} Hz"
     )
     return 0

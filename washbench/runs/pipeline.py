@@ -388,12 +388,14 @@ def run_script(
     """
     from washbench.cueing.bank import check_filter_start
     from washbench.cueing.variants import select_washouts
-    from washbench.flight.scripts import fly_script, load_script_info, write_script_flight
+    from washbench.flight.scripts import DEFAULT_MAX_TIME_S, fly_script, load_script_info, write_script_flight
     from washbench.platform import load_platform_limits
 
     info = load_script_info(script_path, aircraft_dirs)
     check_filter_start(filter_start)
     check_max_time(max_time_s)
+    if max_time_s is None and info.end_s > DEFAULT_MAX_TIME_S:  # announced by the commands (script_plan)
+        max_time_s = DEFAULT_MAX_TIME_S
     specs = select_washouts(washouts, variants, params_path)
     limits = load_platform_limits(platform_path)
     prov = run_provenance(params_path, platform_path, specs, limits, script_path, rank_by=rank_by,
@@ -537,6 +539,27 @@ def platform_envelope(limits: PlatformLimits) -> PlatformEnvelope:
     )
 
 
+def announce_script(
+    path: Path,
+    max_time_s: float | None,
+    aircraft_dirs: Sequence[Path],
+    washouts: Sequence[str] | None,
+    variants: Sequence[str],
+    params_path: Path | None,
+    outputs: Outputs,
+) -> None:
+    """Before a long JSBSim script run (or one the default cap cuts short): one line on standard error with the
+    simulated time, the steps, the expected size and wall time, and the cap (:func:`washbench.flight.scripts.
+    script_plan`)."""
+    from washbench.cueing.variants import select_washouts
+    from washbench.flight.scripts import load_script_info, script_plan
+
+    n = len(select_washouts(washouts, variants, params_path))
+    plan = script_plan(load_script_info(path, aircraft_dirs), max_time_s, n, outputs.recording)
+    if plan.long:
+        print(f"washbench: {plan.text()}", file=sys.stderr, flush=True)
+
+
 def run_command(
     manoeuvre_path: Path,
     out_root: Path,
@@ -567,6 +590,7 @@ def run_command(
     start = time.perf_counter()
     with output_lock(out_root):  # held while it runs: a second writer gets one line at once
         if is_script(manoeuvre_path):
+            announce_script(manoeuvre_path, max_time_s, aircraft_dirs, washouts, variants, params_path, outputs)
             runs = run_script(
                 manoeuvre_path,
                 out_root,

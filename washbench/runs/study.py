@@ -23,6 +23,7 @@ from washbench.analysis.evaluate import Evaluation, FlightEvaluator
 from washbench.cueing.variants import Washout
 from washbench.errors import WashbenchError, located
 from washbench.io.cpus import usable_cpus
+from washbench.io.progress import Progress
 
 FLIGHTS_DIR = "flights"
 
@@ -135,9 +136,14 @@ def _concat(parts: Sequence[Evaluation]) -> Evaluation:
 
 
 def evaluate(
-    flights: Sequence[StudyFlight], candidates: Sequence[Washout], dask: str | None = None
+    flights: Sequence[StudyFlight],
+    candidates: Sequence[Washout],
+    dask: str | None = None,
+    progress: Progress | None = None,
 ) -> list[Evaluation]:
     """Every candidate on every flight: one Evaluation (M candidates) per flight, in flight order.
+
+    ``progress`` (:mod:`washbench.io.progress`) is told the steps done (samples x candidates) after each flight.
 
     Locally one compiled call per flight uses every core (threads over candidates); with ``dask`` the batches go
     to the cluster as tasks (each flight sent to every worker once) and give the same numbers.
@@ -145,7 +151,13 @@ def evaluate(
     if not candidates:
         raise WashbenchError("no candidate to evaluate")
     if not dask:
-        return [f.evaluator.evaluate(candidates) for f in flights]
+        out, steps = [], 0
+        for f in flights:
+            out.append(f.evaluator.evaluate(candidates))
+            steps += f.evaluator.n * len(candidates)
+            if progress is not None:
+                progress.update(steps)
+        return out
     from washbench.runs.cluster import client
 
     c = client(dask)
@@ -170,4 +182,10 @@ def evaluate(
                 for i in range(0, len(candidates), chunk)
             ]
         )
-    return [_concat(c.gather(fs)) for fs in futures]
+    out, steps = [], 0
+    for f, fs in zip(flights, futures, strict=True):
+        out.append(_concat(c.gather(fs)))
+        steps += f.evaluator.n * len(candidates)
+        if progress is not None:
+            progress.update(steps)
+    return out

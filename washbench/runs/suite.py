@@ -61,6 +61,7 @@ from washbench.io.atomic import write_text_atomic
 from washbench.io.cpus import usable_cpus
 from washbench.io.lock import LOCK_NAME, output_lock
 from washbench.io.paths import MANOEUVRES_DIR, bundled_names, resolve_manoeuvre
+from washbench.io.progress import Progress
 from washbench.io.publish import clean_partials, is_leftover, is_washbench_result, read_marker
 from washbench.io.results import csv_number
 from washbench.runs.outputs import DEFAULT_OUTPUTS, Outputs
@@ -80,29 +81,19 @@ class Outcome:
     run: RunSummary
 
 
-def _is_runscript(path: Path) -> bool:
-    """True for an XML file whose root element is a JSBSim ``<runscript>`` (cheap: reads the first element)."""
-    import xml.etree.ElementTree as ET
-
-    try:
-        for _, elem in ET.iterparse(path, events=("start",)):
-            return elem.tag == "runscript"
-    except (ET.ParseError, OSError):
-        return False
-    return False
-
-
 def find_manoeuvres(inputs: Sequence[Path], scripts: Sequence[Path] = ()) -> list[Path]:
     """Manoeuvre files and JSBSim scripts from files and folders (folders are searched recursively for
     ``*.yaml`` manoeuvres and ``*.xml`` JSBSim scripts), then ``scripts``; no inputs at all: the bundled
     manoeuvres."""
+    from washbench.flight.scripts import is_runscript
+
     if not inputs and not scripts:
         inputs = [MANOEUVRES_DIR]
     found: list[Path] = []
     for item in map(resolve_manoeuvre, inputs):
         if item.is_dir():
             found.extend(sorted(p for p in item.rglob("*.yaml") if p.is_file()))
-            found.extend(sorted(p for p in item.rglob("*.xml") if p.is_file() and _is_runscript(p)))
+            found.extend(sorted(p for p in item.rglob("*.xml") if p.is_file() and is_runscript(p)))
         elif item.is_file():
             found.append(item)
         else:
@@ -292,34 +283,41 @@ def run_suite(
              vestibular, plugins) for f in files]  # fmt: skip
     outcomes: dict[str, list[Outcome]] = {}
     start = time.perf_counter()
+    shown = Progress("suite", len(files), "manoeuvres") if progress else None
     if progress:
         print(
             f"suite: {len(files)} manoeuvres on {jobs} process{'es' if jobs > 1 else ''} -> {_destination(out_dir)}\n"
             "suite: loading JSBSim, rerun and the compiled kernels",
             file=sys.stderr,
         )
-    if dask:
-        from washbench.runs.cluster import dask_map
+    try:
+        if dask:
+            from washbench.runs.cluster import dask_map
 
-        for runs in dask_map(dask, _run_one, args):
-            outcomes[runs[0].path] = _report(runs, len(outcomes) + 1, len(files), start, progress)
-    elif jobs == 1:
-        for a in args:
-            outcomes[a[0]] = _report(_run_one(*a), len(outcomes) + 1, len(files), start, progress)
-    else:
-        ctx, initializer = pool_context(outputs.recording, main_stops_workers=True, figures=outputs.figures)
-        pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_init, initargs=(initializer,))
-        try:
-            with _signals_deferred():  # submitting starts the workers (up to ``jobs``)
-                futures = [pool.submit(_run_one, *a) for a in args]
-            for fut in as_completed(futures):
-                runs = fut.result()
-                outcomes[runs[0].path] = _report(runs, len(outcomes) + 1, len(files), start, progress)
-        except BaseException:
-            with _signals_held():
-                _stop_pool(pool)
-            raise
-        pool.shutdown(wait=True)
+            for runs in dask_map(dask, _run_one, args):
+                outcomes[runs[0].path] = _report(runs, len(outcomes) + 1, len(files), start, shown)
+        elif jobs == 1:
+            for a in args:
+                outcomes[a[0]] = _report(_run_one(*a), len(outcomes) + 1, len(files), start, shown)
+        else:
+            ctx, initializer = pool_context(outputs.recording, main_stops_workers=True, figures=outputs.figures)
+            pool = ProcessPoolExecutor(
+                max_workers=jobs, mp_context=ctx, initializer=_worker_init, initargs=(initializer,)
+            )
+            try:
+                with _signals_deferred():  # submitting starts the workers (up to ``jobs``)
+                    futures = [pool.submit(_run_one, *a) for a in args]
+                for fut in as_completed(futures):
+                    runs = fut.result()
+                    outcomes[runs[0].path] = _report(runs, len(outcomes) + 1, len(files), start, shown)
+            except BaseException:
+                with _signals_held():
+                    _stop_pool(pool)
+                raise
+            pool.shutdown(wait=True)
+    finally:
+        if shown is not None:
+            shown.close()
     return [o for a in args for o in outcomes[a[0]]]
 
 
@@ -328,21 +326,23 @@ def _destination(out_dir: Path) -> Path:
     return out_dir.parent if is_leftover(out_dir.name) else out_dir
 
 
-def _report(runs: list[Outcome], done: int, total: int, start: float, progress: bool) -> list[Outcome]:
+def _report(runs: list[Outcome], done: int, total: int, start: float, progress: Progress | None) -> list[Outcome]:
     for outcome in runs:
         _report_one(outcome, done, total, start, progress)
+    if progress is not None:
+        progress.update(done)
     return runs
 
 
-def _report_one(outcome: Outcome, done: int, total: int, start: float, progress: bool) -> None:
-    if progress:
+def _report_one(outcome: Outcome, done: int, total: int, start: float, progress: Progress | None) -> None:
+    if progress is not None:
         name = f"{outcome.run.aircraft}/{outcome.run.manoeuvre}" if outcome.run.aircraft else _short(outcome.path)
         state = "ok  " if outcome.run.ok else "FAIL"
         extra = f"checks {outcome.run.checks_passed}/{outcome.run.checks_total}" if outcome.run.checks_total else ""
         line = f"[{done:>2}/{total}] {state} {name:<40} {outcome.wall_s:6.1f} s  {extra}"
         if not outcome.run.ok:
             line += f"\n        {outcome.run.reason}"
-        print(f"{line}   (elapsed {time.perf_counter() - start:.0f} s)", file=sys.stderr, flush=True)
+        progress.message(f"{line}   (elapsed {time.perf_counter() - start:.0f} s)")
 
 
 def _short(path: str) -> str:
@@ -595,6 +595,12 @@ def suite_command(
         vestibular=model_record(vestibular),
     )
     check_unique_names(files, aircraft_dirs)
+    from washbench.flight.scripts import is_script
+    from washbench.runs.pipeline import announce_script
+
+    for f in files:
+        if is_script(f):
+            announce_script(f, max_time_s, aircraft_dirs, washouts, variants, params_path, outputs)
     start = time.perf_counter()
     with output_lock(out_dir):
         clean_partials(out_dir, only_dead=False)  # under the lock every leftover is stale

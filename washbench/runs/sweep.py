@@ -24,6 +24,7 @@ from washbench.analysis.sweep import SweepRow, grid, parse_set, point_washouts, 
 from washbench.cueing.params import WASHOUT_NAMES
 from washbench.errors import WashbenchError
 from washbench.io.atomic import write_text_atomic
+from washbench.io.progress import Progress
 
 
 def _csv(rows: list[list[str]]) -> str:
@@ -67,7 +68,13 @@ def sweep_command(
         aircraft_dirs=aircraft_dirs,
     )
     t_eval = time.perf_counter()
-    results = evaluate(flights, candidates, dask)
+    total = sum(f.evaluator.n for f in flights) * len(candidates)
+    shown = Progress("sweep", total, "steps") if progress else None
+    try:
+        results = evaluate(flights, candidates, dask, shown)
+    finally:
+        if shown is not None:
+            shown.close()
     t_eval = time.perf_counter() - t_eval
     rows = [
         SweepRow(points[i % len(points)], kinds[i // len(points)], f.aircraft, f.manoeuvre, ev, i)

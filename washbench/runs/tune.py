@@ -31,6 +31,7 @@ from washbench.cueing.params import WashoutParams
 from washbench.cueing.variants import Washout, apply_overrides, check_kind, value_of
 from washbench.errors import WashbenchError
 from washbench.io.atomic import write_text_atomic
+from washbench.io.progress import Progress
 from washbench.io.results import csv_number
 
 
@@ -108,6 +109,7 @@ def tune_command(
         return Washout(kind, kind, apply_overrides(base, point, "--tune"), registry.plugin_spec(kind))
 
     history: list[tuple[np.ndarray, float, float, float]] = []
+    shown = Progress("tune", budget, "evaluations") if progress else None
 
     def objective(xs: np.ndarray) -> np.ndarray:
         results = evaluate(train, [candidate(x) for x in xs], dask)
@@ -116,11 +118,17 @@ def tune_command(
         frac = np.mean([r.saturated_s / d for r, d in zip(results, durations, strict=True)], axis=0)
         obj = score + saturation_weight * frac
         history.extend((x.copy(), float(s), float(t), float(o)) for x, s, t, o in zip(xs, score, sat, obj, strict=True))
+        if shown is not None:
+            shown.update(len(history), f"best objective {min(h[3] for h in history):.4f}")
         return obj
 
     x0 = np.array([_value(base, k) for k in keys])
-    [base_obj] = objective(x0[None, :])  # evaluation 0: the starting set
-    best_x = minimise(objective, bounds, budget - 1, seed, x0)
+    try:
+        [base_obj] = objective(x0[None, :])  # evaluation 0: the starting set
+        best_x = minimise(objective, bounds, budget - 1, seed, x0)
+    finally:
+        if shown is not None:
+            shown.close()
     tuned = candidate(best_x).params
     label = f"{base.name} tuned for {kind}"
     tuned = tuned.model_copy(update={"name": label})
@@ -139,7 +147,31 @@ def tune_command(
         f"{time.perf_counter() - start:.1f} s; objective {base.name} {base_obj:.4f} -> tuned {best[3]:.4f} "
         f"({', '.join(f'{k}={v:.6g}' for k, v in zip(keys, best_x, strict=True))}); wrote {out_dir / 'tuned.yaml'}"
     )
+    for line in score_lines(base.name, table):
+        print(line)
     return 0
+
+
+def score_lines(base_name: str, table: list) -> list[str]:
+    """``tune: mean score on the training manoeuvres: CW1 0.595 -> tuned 0.512 (better)``, then the same for the
+    test manoeuvres when there are any, and a warning line when the tuned set scored worse on them (it fits the
+    training manoeuvres, not the motion in general). ``table``: (group, aircraft, manoeuvre, evaluation) rows
+    whose ``score`` holds the starting and the tuned set's scores (lower is better)."""
+    out = []
+    for group in ("training", "test"):
+        pairs = [(float(r.score[0]), float(r.score[1])) for g, _, _, r in table if g == group]
+        if not pairs:
+            continue
+        a, b = np.mean(pairs, axis=0)
+        verdict = "better" if b < a else "worse" if b > a else "unchanged"
+        out.append(f"tune: mean score on the {len(pairs)} {group} manoeuvre(s): {base_name} {a:.4f} -> tuned {b:.4f} "
+                   f"({verdict})")  # fmt: skip
+        if group == "test" and b > a:
+            out.append(
+                f"tune: warning: the tuned set scores worse than {base_name} on the held-out test manoeuvres "
+                f"({a:.4f} -> {b:.4f}): it fits the training manoeuvres, not the motion in general"
+            )
+    return out
 
 
 def _value(params: WashoutParams, key: str) -> float:
