@@ -21,7 +21,7 @@ from typing import Annotated, Any, Literal, get_args
 
 from pydantic import Field, PrivateAttr, ValidationInfo, field_validator, model_validator
 
-from washbench.errors import WashbenchError, located
+from washbench.errors import WashbenchError, located, printable
 from washbench.flight.columns import COLUMN_NAMES, RUNWAY_COLUMNS
 from washbench.flight.profile import PilotProfile, load_profile
 from washbench.io.atomic import write_text_atomic
@@ -876,7 +876,7 @@ def validate_command(paths: Sequence[Path], aircraft_dirs: Sequence[Path] = ()) 
             load_manoeuvre(path, aircraft_dirs)
         except WashbenchError as exc:
             for problem in exc.problems:
-                print(f"washbench: error: {problem}", file=sys.stderr)
+                print(f"washbench: error: {printable(problem)}", file=sys.stderr)
             bad += 1
         else:
             print(f"{path}: OK")
