@@ -231,7 +231,11 @@ def fly_script(
     ``hook(k, f_mps2, omega_radps)`` called once per recorded sample of it, in order (eyepoint specific
     force m/s^2 and body rates rad/s, body axes x forward, y right, z down).
     """
+    from washbench.io.budget import check_samples
+
     info = load_script_info(path, aircraft_dirs)
+    span_s = min(info.end_s, math.inf if max_time_s is None else max_time_s)
+    check_samples(span_s / info.dt_s, f"<run end={info.end_s:g} dt={info.dt_s:g}> (give --max-time-s)", info.path)
     with tempfile.TemporaryDirectory(prefix="washbench-jsbsim-") as junk:
         return _fly(info, _make_fdm(info, Path(junk)), max_time_s, segment_hook)
 

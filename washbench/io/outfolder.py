@@ -56,7 +56,7 @@ def is_own_hidden(name: str) -> bool:
     )
 
 
-def _remove(path: Path) -> None:
+def remove_tree(path: Path) -> None:
     """Remove a file, link or folder (a link is removed itself, never followed)."""
     with contextlib.suppress(FileNotFoundError):
         if path.is_dir() and not path.is_symlink():
@@ -65,23 +65,28 @@ def _remove(path: Path) -> None:
             path.unlink()
 
 
-def recover(out_dir: Path) -> None:
+def recover(out_dir: Path, *, only_washbench: bool = False) -> None:
     """Finish or remove what an interrupted command left in ``out_dir`` (call it holding the folder's lock).
 
     A journal ``.washbench-swap-PID`` means the command was killed while publishing: its publication is
     finished (the stage was complete). Every other leftover (stage, old folders, ``.*.tmp``, legacy
     ``.NAME.partial-PID``/``.NAME.old-PID``) is removed; so are ``.*.tmp`` files one level down.
+    ``only_washbench`` (a folder of the user's, ``washbench examples``): only ``.washbench-*`` leftovers.
     """
     for journal in sorted(out_dir.glob(JOURNAL_PREFIX + "*")):
         _roll_forward(out_dir, journal)
     for entry in list(out_dir.iterdir()):
         name = entry.name
+        if only_washbench:
+            if name.startswith((STAGE_PREFIX, OLD_PREFIX, ".washbench-probe-")):
+                remove_tree(entry)
+            continue
         if name.startswith((STAGE_PREFIX, OLD_PREFIX, ".washbench-probe-")) or _LEGACY.match(name) or _TMP.match(name):
-            _remove(entry)
+            remove_tree(entry)
         elif entry.is_dir() and not entry.is_symlink():
             for sub in list(entry.iterdir()):
                 if _TMP.match(sub.name) or _LEGACY.match(sub.name):
-                    _remove(sub)
+                    remove_tree(sub)
 
 
 def _roll_forward(out_dir: Path, journal: Path) -> None:
@@ -90,7 +95,7 @@ def _roll_forward(out_dir: Path, journal: Path) -> None:
         previous, new = list(doc["previous"]), list(doc["new"])
         stage, old = out_dir / str(doc["stage"]), out_dir / str(doc["old"])
     except (OSError, ValueError, KeyError, TypeError):
-        _remove(journal)
+        remove_tree(journal)
         return
     safe = [n for n in (*previous, *new) if isinstance(n, str) and "/" not in n and n not in ("", ".", "..")]
     old.mkdir(exist_ok=True)
@@ -104,9 +109,9 @@ def _roll_forward(out_dir: Path, journal: Path) -> None:
     for name in new:
         if name in safe and present(stage / name):
             os.replace(stage / name, out_dir / name)
-    _remove(journal)
-    _remove(old)
-    _remove(stage)
+    remove_tree(journal)
+    remove_tree(old)
+    remove_tree(stage)
 
 
 def read_manifest(out_dir: Path) -> tuple[str, list[str]] | None:
@@ -166,7 +171,7 @@ def signals_held() -> Iterator[None]:
 def make_stage(out_dir: Path) -> Path:
     """A new empty hidden folder inside ``out_dir`` to build a result set in."""
     stage = out_dir / f"{STAGE_PREFIX}{os.getpid()}"
-    _remove(stage)
+    remove_tree(stage)
     try:
         stage.mkdir()
     except OSError as exc:
@@ -210,8 +215,8 @@ def swap_in(stage: Path, out_dir: Path, previous: Sequence[Path]) -> None:
             raise WashbenchError(located(out_dir, f"cannot publish the results: {_why(exc)}")) from None
         finally:
             if not journal.exists():
-                _remove(old)
-                _remove(stage)
+                remove_tree(old)
+                remove_tree(stage)
 
 
 def check_out_path(out: str | Path) -> Path:
@@ -240,7 +245,7 @@ def result_set(out: str | Path, command: str) -> Iterator[Path]:
             write_manifest(stage, command)
             swap_in(stage, out_dir, previous)
         finally:
-            _remove(stage)
+            remove_tree(stage)
 
 
 def replace_entries(folder: Path, stage: Path, names: Sequence[str]) -> None:
