@@ -28,7 +28,6 @@ from __future__ import annotations
 import math
 import re
 import tempfile
-import xml.etree.ElementTree as ET
 from array import array
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -146,17 +145,10 @@ def load_script_info(path: str | Path, aircraft_dirs: Sequence[Path] = ()) -> Sc
 
     The aircraft is looked up along washbench's search path (``aircraft_dirs``, an ``aircraft/`` folder next
     to the script, washbench's bundled aircraft, JSBSim's own)."""
+    from washbench.flight.jsbsim_xml import read_xml
+
     path = Path(path)
-    try:
-        root = ET.parse(path).getroot()
-    except FileNotFoundError:
-        raise WashbenchError(located(path, "no such file")) from None
-    except IsADirectoryError:
-        raise WashbenchError(located(path, "is a folder, not a file")) from None
-    except ET.ParseError as exc:
-        raise WashbenchError(located(path, f"not well-formed XML ({exc.msg})", line=exc.position[0])) from None
-    except OSError as exc:
-        raise WashbenchError(located(path, f"cannot read: {exc.strerror or exc}")) from None
+    root = read_xml(path)
     if root.tag != "runscript":
         raise WashbenchError(located(path, f"not a JSBSim script: the root element is <{root.tag}>, not <runscript>"))
     use = root.find("use")
@@ -196,19 +188,22 @@ def _structure_contacts(fdm: object) -> list[object]:
 
 
 def _make_fdm(info: ScriptInfo, output_dir: Path) -> object:
-    """The FDM with the script loaded and initialised. JSBSim opens the script's and the aircraft's
-    ``<output>`` files at load time (relative to its root folder, i.e. inside the jsbsim package): they are
-    sent to ``output_dir`` (a temporary folder) and switched off."""
+    """The FDM with the script loaded and initialised. The script's and the aircraft's ``<output>`` directives
+    are taken out before JSBSim reads them (:mod:`washbench.flight.jsbsim_xml`: copies in ``output_dir``, a
+    temporary folder), so JSBSim writes no file and opens no socket; output is also switched off."""
     import jsbsim
 
-    root = info.aircraft_root
+    from washbench.flight.jsbsim_xml import aircraft_for_jsbsim, script_for_jsbsim
+
+    root = aircraft_for_jsbsim(info.aircraft_root, info.aircraft, output_dir / "aircraft")
+    script = script_for_jsbsim(info.path.resolve(), output_dir)
     with quiet_stdout():
         fdm = jsbsim.FGFDMExec(str(jsbsim_root()), None)
         fdm.set_debug_level(0)
         fdm.set_output_path(str(output_dir))
         fdm.set_aircraft_path(str(root))
         try:
-            ok = fdm.load_script(str(info.path.resolve()))
+            ok = fdm.load_script(str(script))
         except Exception as exc:  # JSBSim raises plain exceptions on broken scripts or models
             raise WashbenchError(located(info.path, f"JSBSim could not load the script ({exc})")) from None
         if not ok:
