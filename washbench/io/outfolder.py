@@ -244,8 +244,19 @@ def result_set(out: str | Path, command: str) -> Iterator[Path]:
             yield stage
             write_manifest(stage, command)
             swap_in(stage, out_dir, previous)
+        except WashbenchError as exc:  # name the files where they were going, not the hidden stage
+            shown = [_unstaged(p, stage, out_dir) for p in exc.problems]
+            raise WashbenchError(shown[0], shown[1:]) from None
         finally:
             remove_tree(stage)
+
+
+_TMP_PART = re.compile(r"/\.([^/]+?)\.[A-Za-z0-9_]{8}\.tmp\b")
+
+
+def _unstaged(message: str, stage: Path, out_dir: Path) -> str:
+    """``message`` with the stage folder and temporary file names replaced by the published ones."""
+    return _TMP_PART.sub(r"/\1", message.replace(str(stage), str(out_dir)))
 
 
 def replace_entries(folder: Path, stage: Path, names: Sequence[str]) -> None:
