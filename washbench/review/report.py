@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import math
 import os
-import shutil
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -78,7 +77,7 @@ def provenance_lines(prov: dict[str, Any] | None, created_utc: str | None) -> li
     file_row("pilot profile", prov.get("pilot_profile"))
     inp = prov.get("input")
     file_row("input trace", inp)
-    if inp and inp.get("provenance", {}).get("manoeuvre"):
+    if inp and (inp.get("provenance") or {}).get("manoeuvre"):
         file_row("input's manoeuvre file", inp["provenance"]["manoeuvre"])
     file_row("washout parameters", prov.get("params"))
     if prov.get("washouts"):
@@ -88,10 +87,10 @@ def provenance_lines(prov: dict[str, Any] | None, created_utc: str | None) -> li
         ]  # fmt: skip
         rows.append(("washouts", ", ".join(runs)))
     file_row("platform", prov.get("platform"))
-    if "turbulence" in prov or (inp and "turbulence" in inp.get("provenance", {})):
-        turb = prov.get("turbulence", inp.get("provenance", {}).get("turbulence") if inp else None)
+    if "turbulence" in prov or (inp and "turbulence" in (inp.get("provenance") or {})):
+        turb = prov.get("turbulence", (inp.get("provenance") or {}).get("turbulence") if inp else None)
         rows.append(("turbulence", f"{turb['severity']}, seed {turb['seed']}" if turb else "none"))
-    sw = prov.get("software", {})
+    sw = prov.get("software") or {}
     parts = [
         f"washbench {sw.get('washbench', '?')}"
         + (f" (git `{_short_commit(sw['washbench_git'])}`)" if sw.get("washbench_git") else "")
@@ -235,19 +234,14 @@ def time_above_threshold(data: ResultData) -> dict[str, float]:
     }
 
 
-def result_figures(data: ResultData, pdf: bool = False) -> dict[str, Path]:
-    """Draw the result's figures into ``folder/figures/`` (PNG, and PDF with ``pdf``); figure name -> PNG path.
-
-    A PDF left from an earlier ``washbench report`` is removed when none is drawn (it would show other data).
-    """
+def result_figures(data: ResultData, pdf: bool = False, into: Path | None = None) -> dict[str, Path]:
+    """Draw the result's figures into ``into/figures/`` (a new folder; ``into`` is the result folder by default;
+    PNG, and PDF with ``pdf``); figure name -> PNG path."""
     from washbench.review.figures import envelope_figure, perceived_figure
 
-    fig_dir = data.folder / FIGURES_DIR
+    fig_dir = (into or data.folder) / FIGURES_DIR
     fig_dir.mkdir(exist_ok=True)
     formats = ("png", "pdf") if pdf else ("png",)
-    if not pdf:
-        for stem in ("perceived", "envelope"):
-            (fig_dir / f"{stem}.pdf").unlink(missing_ok=True)
     thresholds, rest = perception_thresholds()
     out = {}
     out["perceived"] = perceived_figure(
@@ -336,10 +330,20 @@ def write_result_report(
     ``table``: the traces.parquet columns already in memory (not read again); ``pdf``: PDF figures besides the PNG;
     ``figures=False``: none drawn (``--no-figures``; figures of an earlier run in the folder are removed).
     """
+    from washbench.io.outfolder import make_stage, remove_tree, replace_entries
+
     data = load_result(Path(result_dir), table, series=figures)
-    if not figures:
-        shutil.rmtree(data.folder / FIGURES_DIR, ignore_errors=True)
-    drawn = result_figures(data, pdf) if figures else {}
+    stage = make_stage(data.folder)  # report.md and figures/ replace the previous ones together (links never followed)
+    try:
+        _write_result_report(data, stage, pdf, figures)
+        replace_entries(data.folder, stage, [REPORT_FILE, FIGURES_DIR])
+    finally:
+        remove_tree(stage)
+    return data.folder / REPORT_FILE
+
+
+def _write_result_report(data: ResultData, stage: Path, pdf: bool, figures: bool) -> None:
+    drawn = result_figures(data, pdf, into=stage) if figures else {}
     lines = [f"# {data.title}", "", *_status_line(data)]
     checks = f", checks {sum(bool(c.get('passed')) for c in data.checks)}/{len(data.checks)}" if data.checks else ""
     status = {True: "ok", False: "FAILED", None: "cued"}[data.ok]
@@ -349,23 +353,26 @@ def write_result_report(
         "",
     ]
     lines += provenance_lines(data.provenance, data.created_utc)
-    lines += result_sections(data, drawn, data.folder, 2)
-    path = data.folder / REPORT_FILE
-    write_text_atomic(path, "\n".join(lines).rstrip() + "\n")
-    return path
+    lines += result_sections(data, drawn, stage, 2)
+    write_text_atomic(stage / REPORT_FILE, "\n".join(lines).rstrip() + "\n")
 
 
 def report_command(results_dir: Path) -> int:
     """``washbench report DIR``: write report.md and the figures (PNG and PDF) again from a result or suite folder's
     files."""
+    from washbench.io.lock import output_lock
+    from washbench.io.outfolder import recover
+
     folder = Path(results_dir)
     if not folder.is_dir():
         raise WashbenchError(located(folder, "no such folder"))
-    if is_result_folder(folder) and not (folder / SUITE_FILE).exists():
-        path = write_result_report(folder, pdf=True)
-    else:
-        from washbench.review.suite_report import write_suite_report
+    with output_lock(folder):  # no other washbench command writes into it meanwhile
+        recover(folder)
+        if is_result_folder(folder) and not (folder / SUITE_FILE).exists():
+            path = write_result_report(folder, pdf=True)
+        else:
+            from washbench.review.suite_report import write_suite_report
 
-        path = write_suite_report(folder, regenerate_results=True)
+            path = write_suite_report(folder, regenerate_results=True)
     print(f"report: {path}")
     return 0
