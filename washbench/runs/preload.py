@@ -14,6 +14,9 @@ import pyarrow.parquet  # noqa: F401
 
 import washbench.perception.vestibular  # noqa: F401
 from washbench.cueing.bank import _warm_up, warm_up_block
+from washbench.runs.parent_death import die_with_parent
+
+die_with_parent()  # the process server ends with the washbench command that started it (even on SIGKILL)
 
 # Only the serial steps are run here: a parallel (prange) kernel would start numba's OpenMP threads, and a process
 # using GNU OpenMP must not fork. The block step is the lockstep's; the per-sample step, JSBSim scripts'.
