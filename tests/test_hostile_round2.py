@@ -93,7 +93,7 @@ def test_a_link_planted_as_the_lock_is_refused_never_truncated(command: str, mot
         "run": ("run", m, "--out", out),
         "suite": ("suite", m, "--out", out),
         "omct": ("omct", "--out", out),
-        "sweep": ("sweep", m, "--set", "tilt.gain_per_s=1,2", "--out", out),
+        "sweep": ("sweep", m, "--set", "tilt.gain_per_s=1,2", "--out", out, "--quiet"),
         "report": ("report", out),
     }[command]
     proc = washbench(*args, timeout=90)
@@ -102,16 +102,14 @@ def test_a_link_planted_as_the_lock_is_refused_never_truncated(command: str, mot
     assert tree(out) == [".washbench.lock"]
 
 
-def test_links_inside_out_are_never_followed_when_replacing(cued: Path, tmp_path: Path) -> None:
+def test_links_inside_out_are_never_followed_when_replacing(cued: Path, motion: Path, tmp_path: Path) -> None:
     """cue into its own previous set whose figures/ became a link: refused before any work, target untouched."""
     victims, before = canary(tmp_path)
     out = copy_of(cued, tmp_path / "out")
     (out / "figures").rename(tmp_path / "moved")
     (out / "figures").symlink_to(victims, target_is_directory=True)
     set_before = digest(out)
-    proc = washbench("cue", cued.parent.parent / "motion" / "motion.csv", "--out", out, timeout=60)
-    if "no such file" in proc.stderr:  # the motion fixture lives in its own temporary folder
-        pytest.skip("motion file not found beside the cued fixture")
+    proc = washbench("cue", motion, "--out", out, timeout=60)
     assert_clean_error(proc, str(out / "figures"), "symbolic link")
     assert digest(victims) == before and digest(out) == set_before
     proc = washbench("report", out, timeout=60)  # report: the same refusal, nothing written through the link
@@ -125,7 +123,8 @@ def test_report_never_leaves_the_suite_folder(cued: Path, tmp_path: Path) -> Non
     copy_of(cued, victims / "res")
     before = digest(victims)
     suite = tmp_path / "suite"
-    copy_of(cued, suite / "inside") if suite.mkdir() is None else None
+    suite.mkdir()
+    copy_of(cued, suite / "inside")
     for result in ("../canary/res", str(victims / "res"), "linked"):
         (suite / "linked").unlink(missing_ok=True)
         (suite / "linked").symlink_to(victims / "res", target_is_directory=True)
@@ -159,8 +158,11 @@ def test_a_folder_holding_a_users_file_is_refused_by_every_command(motion: Path,
     commands = {
         "cue": (("cue", motion), "report.md"),
         "fly": (("fly", m), "flight.json"),
-        "sweep": (("sweep", m, "--set", "tilt.gain_per_s=1,2"), "sweep.csv"),
-        "tune": (("tune", m, "--washout", "small-angle", "--tune", "tilt.gain_per_s=1:2", "--budget", "6"), "tuned.yaml"),
+        "sweep": (("sweep", m, "--set", "tilt.gain_per_s=1,2", "--quiet"), "sweep.csv"),
+        "tune": (
+            ("tune", m, "--washout", "small-angle", "--tune", "tilt.gain_per_s=1:2", "--budget", "6"),
+            "tuned.yaml",
+        ),
         "omct": (("omct",), "report.md"),
     }
 
@@ -196,8 +198,9 @@ def test_empty_out_and_non_utf8_paths_are_one_line(motion: Path, tmp_path: Path)
         proc = washbench(*command, "--out", "", timeout=30)
         assert proc.returncode == 2 and "Traceback" not in proc.stderr and "empty path" in proc.stderr
     bad = os.fsdecode(bytes(tmp_path) + b"/r\xe9sultats")
-    proc = subprocess.run([sys.executable, "-m", "washbench", "cue", str(motion), "--out", bad],
-                          capture_output=True, timeout=30)  # fmt: skip
+    proc = subprocess.run(
+        [sys.executable, "-m", "washbench", "cue", str(motion), "--out", bad], capture_output=True, timeout=30
+    )
     assert proc.returncode == 2 and b"Traceback" not in proc.stderr and b"not valid UTF-8" in proc.stderr
     assert b"\\xe9" in proc.stderr and len(proc.stderr.splitlines()) == 1
     assert tree(tmp_path) == []
@@ -231,8 +234,9 @@ def test_jsbsim_output_directives_write_nothing_and_open_no_socket(tmp_path: Pat
     work.mkdir()
     script = work / "hostile.xml"
     script.write_text(HOSTILE_SCRIPT.format(victim=victims / "victim.txt", port=port))
-    proc = washbench("run", script, "--out", work / "out", "--no-recording", "--no-figures", "--quiet",
-                     timeout=90, cwd=work)  # fmt: skip
+    proc = washbench(
+        "run", script, "--out", work / "out", "--no-recording", "--no-figures", "--quiet", timeout=90, cwd=work
+    )
     assert proc.returncode == 0, proc.stderr
     assert "Traceback" not in proc.stderr
     assert f"{script}: 4 JSBSim <output> directive(s) switched off" in proc.stderr
@@ -253,11 +257,13 @@ def test_a_users_aircraft_with_outputs_or_bad_xml(tmp_path: Path) -> None:
     victims, before = canary(tmp_path)
     src = jsbsim_root() / "aircraft" / "c172p"
     acdir = tmp_path / "aircraft"
-    copy_of(src, acdir / "c172p") if acdir.mkdir() is None else None
+    acdir.mkdir()
+    copy_of(src, acdir / "c172p")
     model = acdir / "c172p" / "c172p.xml"
     text = model.read_text()
-    model.write_text(text.replace("</fdm_config>",
-                                  f'<output name="{victims / "victim.txt"}" type="CSV" rate="1"/></fdm_config>'))  # fmt: skip
+    model.write_text(
+        text.replace("</fdm_config>", f'<output name="{victims / "victim.txt"}" type="CSV" rate="1"/></fdm_config>')
+    )
     m = short(tmp_path)
     proc = washbench("fly", m, "--out", tmp_path / "out", "--aircraft-dir", acdir, "--quiet", timeout=90)
     assert proc.returncode == 0, proc.stderr
@@ -281,7 +287,7 @@ def test_a_users_aircraft_with_outputs_or_bad_xml(tmp_path: Path) -> None:
 # ------------------------------------------------------------------------------------------ full disk, signals
 
 
-def _file_size_limit(limit: int):  # noqa: ANN202 - a preexec_fn
+def _file_size_limit(limit: int):  # a preexec_fn
     def apply() -> None:
         signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # writes beyond the limit fail with EFBIG, like a full disk
         resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
@@ -297,8 +303,11 @@ def test_a_recording_that_cannot_be_written_is_one_line_not_a_hang(cued: Path, m
     assert rrd > traces  # the limit lets the traces through and stops the recording
     proc = subprocess.run(
         [sys.executable, "-m", "washbench", "cue", str(motion), "--out", str(out), "--no-figures"],
-        capture_output=True, text=True, timeout=60, preexec_fn=_file_size_limit((rrd + traces) // 2),
-    )  # fmt: skip
+        capture_output=True,
+        text=True,
+        timeout=60,
+        preexec_fn=_file_size_limit((rrd + traces) // 2),
+    )
     assert_clean_error(proc, str(out / "recording.rrd"))
     assert "ERROR" not in proc.stderr and "WARN" not in proc.stderr  # no rerun SDK log lines
     assert digest(out) == before  # the previous set stands, whole
@@ -319,8 +328,12 @@ def test_a_signal_whenever_a_file_lands_leaves_the_previous_set_whole(
     n, seen_all = 1, False
     while not seen_all and n <= 4:
         out = copy_of(base, tmp_path / f"out{n}")
-        proc = subprocess.Popen([sys.executable, "-m", "washbench", "cue", str(motion), "--out", str(out)],
-                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)  # fmt: skip
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "washbench", "cue", str(motion), "--out", str(out)],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
         landed: set[str] = set()
         while proc.poll() is None and len(landed) < n:
             landed |= _stage_names(out)
@@ -345,8 +358,11 @@ def test_a_signal_whenever_a_file_lands_leaves_the_previous_set_whole(
 
 def test_what_a_killed_run_leaves_goes_with_the_next_run(cued: Path, motion: Path, tmp_path: Path) -> None:
     out = copy_of(cued, tmp_path / "out")
-    proc = subprocess.Popen([sys.executable, "-m", "washbench", "cue", str(motion), "--out", str(out)],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)  # fmt: skip
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "washbench", "cue", str(motion), "--out", str(out)],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
     deadline = time.monotonic() + 60
     while not _stage_names(out) and time.monotonic() < deadline:
         time.sleep(0.005)
@@ -372,8 +388,12 @@ def test_a_publication_cut_by_a_kill_is_finished_by_the_next_run(tmp_path: Path)
     (out / "c.csv").write_text("new c")  # new, already moved in
     (stage / "a.csv").write_text("new a")  # new, not yet moved
     (out / "gone.csv").write_text("old only")  # old, not in the new set
-    doc = {"stage": stage.name, "old": old.name, "previous": ["a.csv", "b.csv", "gone.csv"],
-           "new": ["a.csv", "b.csv", "c.csv"]}  # fmt: skip
+    doc = {
+        "stage": stage.name,
+        "old": old.name,
+        "previous": ["a.csv", "b.csv", "gone.csv"],
+        "new": ["a.csv", "b.csv", "c.csv"],
+    }
     (stage / "b.csv").write_text("new b")
     (out / f"{JOURNAL_PREFIX}999999").write_text(json.dumps(doc))
     recover(out)
@@ -386,9 +406,12 @@ def test_workers_end_when_the_suite_is_killed(tmp_path: Path) -> None:
     for i in range(2):
         short(folder, name=f"long_{i}", seconds=900)
     out = tmp_path / "out"
-    proc = subprocess.Popen([sys.executable, "-m", "washbench", "suite", str(folder), "--out", str(out), "--jobs",
-                             "2", "--quiet"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                            start_new_session=True)  # fmt: skip
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "washbench", "suite", str(folder), "--out", str(out), "--jobs", "2", "--quiet"],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        start_new_session=True,
+    )
     deadline = time.monotonic() + 60
     while len(live_processes(proc.pid)) < 4 and time.monotonic() < deadline:  # main, server, 2 workers
         time.sleep(0.1)
@@ -411,8 +434,9 @@ def test_workers_end_when_the_suite_is_killed(tmp_path: Path) -> None:
 
 def test_what_a_command_would_allocate_is_bounded_before_allocating(motion: Path, tmp_path: Path) -> None:
     script = tmp_path / "long.xml"
-    script.write_text('<runscript><use aircraft="c172x" initialize="reset01"/><run start="0" end="1e30" '
-                      'dt="0.0083333"/></runscript>')  # fmt: skip
+    script.write_text(
+        '<runscript><use aircraft="c172x" initialize="reset01"/><run start="0" end="1e30" dt="0.0083333"/></runscript>'
+    )
     bomb = tmp_path / "blank.csv.gz"
     with gzip.open(bomb, "wb", compresslevel=9) as fh:
         fh.write(b"t_s,f_x_mps2,f_y_mps2,f_z_mps2,omega_x_degps,omega_y_degps,omega_z_degps\n")
@@ -420,20 +444,88 @@ def test_what_a_command_would_allocate_is_bounded_before_allocating(motion: Path
     m = short(tmp_path)
     cases = [
         (("omct", "--rate-hz", "1e8", "--out", tmp_path / "o1"), "--rate-hz"),
-        (("signal", "sine", "--axis", "f_x", "--amplitude", "1", "--frequency-hz", "1", "--duration-s", "1e9",
-          "--out", tmp_path / "s.csv"), "--duration-s"),  # fmt: skip
-        (("signal", "sine", "--axis", "f_x", "--amplitude", "1", "--frequency-hz", "1", "--rate-hz", "1e12",
-          "--out", tmp_path / "s.csv"), "--rate-hz"),  # fmt: skip
+        (
+            (
+                "signal",
+                "sine",
+                "--axis",
+                "f_x",
+                "--amplitude",
+                "1",
+                "--frequency-hz",
+                "1",
+                "--duration-s",
+                "1e9",
+                "--out",
+                tmp_path / "s.csv",
+            ),
+            "--duration-s",
+        ),
+        (
+            (
+                "signal",
+                "sine",
+                "--axis",
+                "f_x",
+                "--amplitude",
+                "1",
+                "--frequency-hz",
+                "1",
+                "--rate-hz",
+                "1e12",
+                "--out",
+                tmp_path / "s.csv",
+            ),
+            "--rate-hz",
+        ),
         (("omct", "--params", "/dev/zero", "--out", tmp_path / "o2"), "/dev/zero"),
         (("run", script, "--out", tmp_path / "o3"), str(script)),
-        (("sweep", m, "--set", "tilt.gain_per_s=" + ",".join(str(i) for i in range(1, 80)),
-          "--set", "translation.x.gain=" + ",".join(str(i / 100) for i in range(1, 30)), "--out", tmp_path / "o4"),
-         "--force"),  # fmt: skip
+        (
+            (
+                "sweep",
+                m,
+                "--set",
+                "tilt.gain_per_s=" + ",".join(str(i) for i in range(1, 80)),
+                "--set",
+                "translation.x.gain=" + ",".join(str(i / 100) for i in range(1, 30)),
+                "--out",
+                tmp_path / "o4",
+            ),
+            "--force",
+        ),
         (("cue", bomb, "--out", tmp_path / "o5"), str(bomb)),
-        (("tune", m, "--washout", "small-angle", "--tune", "tilt.gain_per_s=1:2", "--seed", "-1", "--out",
-          tmp_path / "o6"), "--seed"),  # fmt: skip
-        (("tune", m, "--washout", "small-angle", "--tune", "tilt.gain_per_s=1:2", "--tune", "tilt.rate_limit_degps=1:3",
-          "--budget", "6", "--out", tmp_path / "o7"), "--budget 6"),  # fmt: skip
+        (
+            (
+                "tune",
+                m,
+                "--washout",
+                "small-angle",
+                "--tune",
+                "tilt.gain_per_s=1:2",
+                "--seed",
+                "-1",
+                "--out",
+                tmp_path / "o6",
+            ),
+            "--seed",
+        ),
+        (
+            (
+                "tune",
+                m,
+                "--washout",
+                "small-angle",
+                "--tune",
+                "tilt.gain_per_s=1:2",
+                "--tune",
+                "tilt.rate_limit_degps=1:3",
+                "--budget",
+                "6",
+                "--out",
+                tmp_path / "o7",
+            ),
+            "--budget 6",
+        ),
         (("sweep", m, "--set", "tilt.gain_per_s=1,1.0", "--out", tmp_path / "o8"), "listed twice"),
     ]
 
@@ -469,8 +561,9 @@ def test_dask_address_that_is_no_scheduler_is_one_line_quickly(tmp_path: Path) -
     port = server.getsockname()[1]
     for address in ("not an address:::", f"tcp://127.0.0.1:{port}"):
         t0 = time.monotonic()
-        proc = washbench("sweep", m, "--set", "tilt.gain_per_s=1,2", "--dask", address, "--out", tmp_path / "o",
-                         timeout=60)  # fmt: skip
+        proc = washbench(
+            "sweep", m, "--set", "tilt.gain_per_s=1,2", "--dask", address, "--quiet", "--out", tmp_path / "o", timeout=60
+        )
         assert_clean_error(proc, "--dask")
         assert time.monotonic() - t0 < 25
     server.close()
@@ -490,9 +583,15 @@ def test_report_on_tampered_result_files_rebuilds_or_refuses_cleanly(cued: Path,
     base = copy_of(cued, tmp_path / "base")
     doc = json.loads((base / "run.json").read_text())
     keys = sorted(doc)
-    values = st.one_of(st.none(), st.booleans(), st.integers(-5, 5), st.floats(allow_nan=False), st.text(max_size=5),
-                       st.lists(st.integers(), max_size=2), st.dictionaries(st.text(max_size=3), st.integers(),
-                                                                             max_size=2))  # fmt: skip
+    values = st.one_of(
+        st.none(),
+        st.booleans(),
+        st.integers(-5, 5),
+        st.floats(allow_nan=False),
+        st.text(max_size=5),
+        st.lists(st.integers(), max_size=2),
+        st.dictionaries(st.text(max_size=3), st.integers(), max_size=2),
+    )
     counter = iter(range(10_000))
 
     @settings(max_examples=25, deadline=None, suppress_health_check=list(HealthCheck))
