@@ -264,17 +264,18 @@ def result_figures(data: ResultData, pdf: bool = False, into: Path | None = None
 NO_FIGURES = "_No figures were drawn (`--no-figures`): `washbench report` on this folder draws them from its files._"
 
 
-def _image(png: Path, start: Path, alt: str) -> list[str]:
-    """The figure embedded, and its PDF linked when there is one (else how to get it)."""
+def _image(png: Path, start: Path, alt: str, vector: bool | None = None) -> list[str]:
+    """The figure embedded, and its PDF linked when there is one (``vector``: whether there is, when the figure is
+    still in a stage; else how to get it)."""
     rel = _rel(png, start)
     pdf = Path(rel).with_suffix(".pdf")
-    if png.with_suffix(".pdf").is_file():
+    if png.with_suffix(".pdf").is_file() if vector is None else vector:
         return [f"![{alt}]({rel})", "", f"Vector version for papers: [{pdf.name}]({pdf.as_posix()})", ""]
     return [f"![{alt}]({rel})", "", "Vector versions for papers (PDF): `washbench report` on this folder.", ""]
 
 
 def result_sections(
-    data: ResultData, figures: dict[str, Path], start: Path, level: int, brief: bool = False
+    data: ResultData, figures: dict[str, Path], start: Path, level: int, brief: bool = False, vector: bool | None = None
 ) -> list[str]:
     """The body of one result's report; links relative to ``start`` (the folder report.md is in).
 
@@ -291,13 +292,15 @@ def result_sections(
         "(Zacharias 1978) around the resting value, what lies between them is not felt; shaded: the phases.",
         "",
     ]
-    lines += _image(figures["perceived"], start, "perceived motion") if "perceived" in figures else [NO_FIGURES, ""]
+    lines += (
+        _image(figures["perceived"], start, "perceived motion", vector) if "perceived" in figures else [NO_FIGURES, ""]
+    )
     lines += [f"{h} Metrics", "", *metric_tables(data)]
     lines += [f"{h} Platform", ""]
     if brief:
         pass
     elif "envelope" in figures:
-        lines += _image(figures["envelope"], start, "platform envelope")
+        lines += _image(figures["envelope"], start, "platform envelope", vector)
     elif not figures:
         pass
     else:
@@ -353,7 +356,8 @@ def _write_result_report(data: ResultData, stage: Path, pdf: bool, figures: bool
         "",
     ]
     lines += provenance_lines(data.provenance, data.created_utc)
-    lines += result_sections(data, drawn, stage, 2)
+    final = {k: data.folder / p.relative_to(stage) for k, p in drawn.items()}  # where they will be
+    lines += result_sections(data, final, data.folder, 2, vector=pdf)
     write_text_atomic(stage / REPORT_FILE, "\n".join(lines).rstrip() + "\n")
 
 

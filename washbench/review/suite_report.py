@@ -196,13 +196,14 @@ def _write_suite_report(
     if any_above:
         lines += [SCORE_NOTE, ""]
     if "scores" in drawn:
-        lines += _image(drawn["scores"], stage, "score per manoeuvre and washout")
+        lines += _image(suite_dir / drawn["scores"].relative_to(stage), suite_dir, "score per manoeuvre and washout",
+                        regenerate_results)  # fmt: skip
     if "table4" in drawn:
         lines += [f"## Against {reference} (Table 4 of the paper)", ""]
         lines += [f"Each cell: how much better than {reference} the washout is, in percent of the "
                   f"{reference} value (positive, green: better). Absolute differences are in "
                   "`comparison.csv`.", ""]  # fmt: skip
-        lines += _image(drawn["table4"], stage, "Table 4")
+        lines += _image(suite_dir / drawn["table4"].relative_to(stage), suite_dir, "Table 4", regenerate_results)
     lines += ["## How to read the numbers", "", *_HOW_TO_READ]
     for d in loaded:
         rel = _rel(d.folder, suite_dir)
