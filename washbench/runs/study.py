@@ -115,11 +115,22 @@ def _map(fn, args: list[tuple], jobs: int | None, dask: str | None) -> list:
     jobs = max(1, min(jobs or os.cpu_count() or 1, len(args)))
     if jobs == 1:
         return [fn(*a) for a in args]
-    from washbench.runs.suite import pool_context
+    from washbench.runs.suite import _signals_deferred, _signals_held, _stop_pool, _worker_init, pool_context
 
-    ctx, initializer = pool_context()
-    with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=initializer) as pool:
-        return list(pool.map(fn, *zip(*args, strict=True)))
+    # As the suite's pool: the workers ignore Ctrl-C (no traceback from each), the main process stops them at once
+    # on SIGINT/SIGTERM, a signal while they start is acted on once they exist, and they die with their parent.
+    ctx, initializer = pool_context(main_stops_workers=True)
+    pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_init, initargs=(initializer,))
+    try:
+        with _signals_deferred():
+            futures = [pool.submit(fn, *a) for a in args]
+        results = [f.result() for f in futures]
+    except BaseException:
+        with _signals_held():
+            _stop_pool(pool)
+        raise
+    pool.shutdown(wait=True)
+    return results
 
 
 def _evaluate_task(evaluator: FlightEvaluator, cfg: np.ndarray, coef: np.ndarray) -> Evaluation:
