@@ -487,7 +487,7 @@ def test_what_a_command_would_allocate_is_bounded_before_allocating(motion: Path
                 "--set",
                 "tilt.gain_per_s=" + ",".join(str(i) for i in range(1, 80)),
                 "--set",
-                "translation.x.gain=" + ",".join(str(i / 100) for i in range(1, 30)),
+                "translational_highpass_wn_radps.x=" + ",".join(str(i / 10) for i in range(1, 30)),
                 "--out",
                 tmp_path / "o4",
             ),
@@ -547,7 +547,7 @@ def test_inputs_users_write(motion: Path, tmp_path: Path) -> None:
     bom.write_bytes(b"\xef\xbb\xbf" + motion.read_bytes())
     proc = washbench("cue", bom, "--out", tmp_path / "o", "--no-figures", "--no-recording", timeout=60)
     assert proc.returncode == 0, proc.stderr
-    m = short(tmp_path, extra="\x1b[31mevil\x1b[0m: 1\n")
+    m = short(tmp_path, extra='"\\e[31mevil\\e[0m": 1\n')  # a YAML key holding ESC (double-quoted escape)
     proc = washbench("validate", m, timeout=30)
     assert proc.returncode == 2 and "\x1b" not in proc.stderr and "\\x1b[31mevil" in proc.stderr, proc.stderr
 
@@ -562,7 +562,16 @@ def test_dask_address_that_is_no_scheduler_is_one_line_quickly(tmp_path: Path) -
     for address in ("not an address:::", f"tcp://127.0.0.1:{port}"):
         t0 = time.monotonic()
         proc = washbench(
-            "sweep", m, "--set", "tilt.gain_per_s=1,2", "--dask", address, "--quiet", "--out", tmp_path / "o", timeout=60
+            "sweep",
+            m,
+            "--set",
+            "tilt.gain_per_s=1,2",
+            "--dask",
+            address,
+            "--quiet",
+            "--out",
+            tmp_path / "o",
+            timeout=60,
         )
         assert_clean_error(proc, "--dask")
         assert time.monotonic() - t0 < 25

@@ -52,10 +52,24 @@ def _probe(address: str) -> None:
     if url.scheme not in ("tcp", "tls", "ws", "wss") or not host or port is None:
         raise WashbenchError(f"--dask {address}: not a scheduler address (expected tcp://HOST:PORT)")
     try:
-        with socket.create_connection((host, port), timeout=CONNECT_TIMEOUT_S):
-            pass
+        sock = socket.create_connection((host, port), timeout=CONNECT_TIMEOUT_S)
     except OSError as exc:
         raise WashbenchError(f"--dask {address}: nothing answered at {host}:{port} ({exc.strerror or exc})") from None
+    with sock:
+        if url.scheme != "tcp":
+            return
+        try:  # a Dask scheduler sends its handshake as soon as a connection is accepted
+            first = sock.recv(64)
+        except TimeoutError:
+            first = None
+        except OSError as exc:
+            first = f"{exc.strerror or exc}".encode()
+    if not first:
+        what = "closed the connection at once" if first == b"" else f"sent nothing within {CONNECT_TIMEOUT_S:g} s"
+        raise WashbenchError(f"--dask {address}: something accepted the connection but {what}: not a Dask scheduler")
+    if first[:4] in (b"HTTP", b"SSH-", b"220 ", b"<!DO", b"<htm"):
+        shown = first[:24].decode("ascii", "backslashreplace").strip()
+        raise WashbenchError(f"--dask {address}: the server answered {shown!r}: not a Dask scheduler")
 
 
 def dask_map(address: str, fn: Callable[..., Any], args: Sequence[tuple[Any, ...]]) -> Iterator[Any]:
