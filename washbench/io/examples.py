@@ -37,7 +37,7 @@ def copy_examples(dest: Path) -> int:
     ``dest``'s lock: a full disk or a signal leaves nothing half-copied, so a rerun works.
     """
     from washbench.io.lock import output_lock
-    from washbench.io.outfolder import make_stage, recover, remove_tree, swap_in
+    from washbench.io.outfolder import discard_stage, make_stage, recover, swap_in
 
     if dest.exists() and not dest.is_dir():
         raise WashbenchError(located(dest, "exists and is not a folder"))
@@ -56,7 +56,7 @@ def copy_examples(dest: Path) -> int:
         except OSError as exc:
             raise WashbenchError(located(dest, f"cannot write ({exc.strerror or exc})")) from None
         finally:
-            remove_tree(stage)
+            discard_stage(stage)
     pairs = example_files(dest)
     n_m = sum(1 for _, d in pairs if d.suffix == ".yaml" and "manoeuvres" in d.parts)
     print(f"{n_m} manoeuvres and {len(pairs) - n_m} pilot profiles copied to {dest}")

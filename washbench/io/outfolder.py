@@ -26,6 +26,7 @@ import os
 import re
 import shutil
 import signal
+import threading
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 
@@ -159,13 +160,32 @@ def owned_entries(out_dir: Path, command: str) -> list[Path]:
 
 @contextlib.contextmanager
 def signals_held() -> Iterator[None]:
-    """Hold SIGINT and SIGTERM back (blocked, not lost) for a short critical section."""
-    sigs = {signal.SIGINT, signal.SIGTERM}
-    old = signal.pthread_sigmask(signal.SIG_BLOCK, sigs)
+    """Hold SIGINT and SIGTERM back for a short critical section: noted, and acted on (KeyboardInterrupt or
+    :class:`washbench.errors.Terminated`) once it is over; never lost, never in the middle."""
+    if threading.current_thread() is not threading.main_thread():  # handlers run in the main thread only
+        yield
+        return
+    noted: list[int] = []
+
+    def note(signum: int, frame: object) -> None:
+        noted.append(signum)
+
+    saved = {sig: signal.signal(sig, note) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
         yield
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        for sig, handler in saved.items():
+            signal.signal(sig, handler)
+    if noted:
+        from washbench.errors import Terminated
+
+        raise KeyboardInterrupt if noted[0] == signal.SIGINT else Terminated()
+
+
+def discard_stage(stage: Path) -> None:
+    """Remove ``stage`` unless a journal says its publication is under way (then :func:`recover` finishes it)."""
+    if not (stage.parent / f"{JOURNAL_PREFIX}{os.getpid()}").exists():
+        remove_tree(stage)
 
 
 def make_stage(out_dir: Path) -> Path:
@@ -248,7 +268,7 @@ def result_set(out: str | Path, command: str) -> Iterator[Path]:
             shown = [_unstaged(p, stage, out_dir) for p in exc.problems]
             raise WashbenchError(shown[0], shown[1:]) from None
         finally:
-            remove_tree(stage)
+            discard_stage(stage)
 
 
 _TMP_PART = re.compile(r"/\.([^/]+?)\.[A-Za-z0-9_]{8}\.tmp\b")

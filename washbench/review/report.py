@@ -333,7 +333,7 @@ def write_result_report(
     ``table``: the traces.parquet columns already in memory (not read again); ``pdf``: PDF figures besides the PNG;
     ``figures=False``: none drawn (``--no-figures``; figures of an earlier run in the folder are removed).
     """
-    from washbench.io.outfolder import make_stage, remove_tree, replace_entries
+    from washbench.io.outfolder import discard_stage, make_stage, replace_entries
 
     data = load_result(Path(result_dir), table, series=figures)
     stage = make_stage(data.folder)  # report.md and figures/ replace the previous ones together (links never followed)
@@ -341,7 +341,7 @@ def write_result_report(
         _write_result_report(data, stage, pdf, figures)
         replace_entries(data.folder, stage, [REPORT_FILE, FIGURES_DIR])
     finally:
-        remove_tree(stage)
+        discard_stage(stage)
     return data.folder / REPORT_FILE
 
 

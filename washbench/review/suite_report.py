@@ -89,7 +89,7 @@ def write_suite_report(suite_dir: Path, *, regenerate_results: bool = False, fig
     and every figure as PNG and PDF; otherwise the PNG figures the runs wrote are linked and the suite's are PNG.
     """
 
-    from washbench.io.outfolder import make_stage, remove_tree, replace_entries
+    from washbench.io.outfolder import discard_stage, make_stage, replace_entries
 
     suite_dir = Path(suite_dir)
     entries, doc = _entries(suite_dir)
@@ -98,7 +98,7 @@ def write_suite_report(suite_dir: Path, *, regenerate_results: bool = False, fig
         _write_suite_report(suite_dir, stage, entries, doc, regenerate_results, figures)
         replace_entries(suite_dir, stage, [REPORT_FILE, FIGURES_DIR])
     finally:
-        remove_tree(stage)
+        discard_stage(stage)
     return suite_dir / REPORT_FILE
 
 

@@ -34,7 +34,6 @@ import io
 import math
 import multiprocessing
 import os
-import shutil
 import signal
 import sys
 import time
@@ -56,7 +55,7 @@ from washbench.analysis.ranking import (
 from washbench.errors import Terminated, WashbenchError, located
 from washbench.io.atomic import write_text_atomic
 from washbench.io.lock import output_lock
-from washbench.io.outfolder import is_own_hidden, recover, swap_in
+from washbench.io.outfolder import discard_stage, is_own_hidden, recover, swap_in
 from washbench.io.paths import MANOEUVRES_DIR, bundled_names, resolve_manoeuvre
 from washbench.io.publish import clean_partials, is_leftover, is_washbench_result, read_marker
 from washbench.io.results import csv_number
@@ -599,7 +598,7 @@ def suite_command(
             write_suite_results(outcomes, stage, provenance, outputs.figures)
             swap_in(stage, out_dir, previous)  # journalled, signals held: whole or not at all
         finally:
-            shutil.rmtree(stage, ignore_errors=True)
+            discard_stage(stage)  # unless a journal says it is being published (recover finishes it)
     n_ok = sum(o.run.ok for o in outcomes)
     print(
         f"suite: {n_ok}/{len(outcomes)} runs ok in {time.perf_counter() - start:.1f} s; report: {out_dir / 'report.md'}"
