@@ -79,7 +79,7 @@ def recover(out_dir: Path, *, only_washbench: bool = False) -> None:
     for entry in list(out_dir.iterdir()):
         name = entry.name
         if only_washbench:
-            if name.startswith((STAGE_PREFIX, OLD_PREFIX, ".washbench-probe-")):
+            if name.startswith((STAGE_PREFIX, OLD_PREFIX, ".washbench-probe-", ".suite.partial-", ".suite.old-")):
                 remove_tree(entry)
             continue
         if name.startswith((STAGE_PREFIX, OLD_PREFIX, ".washbench-probe-")) or _LEGACY.match(name) or _TMP.match(name):
@@ -145,9 +145,11 @@ def owned_entries(out_dir: Path, command: str) -> list[Path]:
                 "replaced; choose another --out"))  # fmt: skip
         listed = set(manifest[1])
     found: list[Path] = []
+    from washbench.io.lock import LOCK_NAME
+
     for entry in sorted(out_dir.iterdir()):
-        if is_own_hidden(entry.name):
-            continue
+        if is_own_hidden(entry.name) and (manifest is not None or entry.name == LOCK_NAME):
+            continue  # in a folder without a manifest, a hidden file is the user's unless it is the lock
         if entry.is_symlink():
             raise WashbenchError(located(entry, "is a symbolic link: washbench never follows or replaces a link in "
                                          "its output folder; remove it or choose another --out"))  # fmt: skip
@@ -221,7 +223,7 @@ def swap_in(stage: Path, out_dir: Path, previous: Sequence[Path]) -> None:
     doc = {"stage": stage.name, "old": old.name, "previous": [p.name for p in previous], "new": new}
     with signals_held():
         try:
-            tmp = journal.with_name(f".{journal.name}.tmp")
+            tmp = journal.with_name(f"{journal.name}.tmp")
             tmp.write_text(json.dumps(doc), encoding="utf-8")
             os.replace(tmp, journal)
             old.mkdir(exist_ok=True)
@@ -257,7 +259,8 @@ def result_set(out: str | Path, command: str) -> Iterator[Path]:
     from washbench.io.lock import output_lock
 
     with output_lock(check_out_path(out)) as out_dir:
-        recover(out_dir)
+        foreign = read_manifest(out_dir) is None  # not (yet) washbench's: only its own .washbench-* leftovers go
+        recover(out_dir, only_washbench=foreign)
         previous = owned_entries(out_dir, command)
         stage = make_stage(out_dir)
         try:

@@ -573,7 +573,9 @@ def suite_command(
     check_unique_names(files, aircraft_dirs)
     start = time.perf_counter()
     with output_lock(out_dir):
-        recover(out_dir)  # under the lock every leftover is stale; a publication cut by a kill is finished
+        # under the lock every leftover is stale; a publication cut by a kill is finished. In a folder that holds
+        # no suite (no suite.json), only washbench's own leftovers: a hidden file there is the user's.
+        recover(out_dir, only_washbench=read_marker(out_dir, SUITE_MARKER) is None)
         previous = previous_results(out_dir)
         for entry in previous:
             if entry.is_dir() and not entry.is_symlink():
