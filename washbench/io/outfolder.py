@@ -98,6 +98,10 @@ def _roll_forward(out_dir: Path, journal: Path) -> None:
     except (OSError, ValueError, KeyError, TypeError):
         remove_tree(journal)
         return
+    plain = all("/" not in p.name and p.parent == out_dir for p in (stage, old))
+    if not (plain and stage.name.startswith((STAGE_PREFIX, ".suite.partial-")) and old.name.startswith(OLD_PREFIX)):
+        remove_tree(journal)  # not a journal washbench wrote: nothing is moved by it
+        return
     safe = [n for n in (*previous, *new) if isinstance(n, str) and "/" not in n and n not in ("", ".", "..")]
     old.mkdir(exist_ok=True)
 
