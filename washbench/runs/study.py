@@ -89,7 +89,10 @@ def load_flights(
         dirs = tuple(str(d) for d in aircraft_dirs)
         args = [(p, str(root), dirs) for p, _, _ in ids]
         if progress:
-            print(f"study: flying {len(args)} manoeuvre(s) once -> {root}", file=sys.stderr, flush=True)
+            from washbench.io.outfolder import STAGE_PREFIX
+
+            shown = root.parent.parent / FLIGHTS_DIR if root.parent.name.startswith(STAGE_PREFIX) else root
+            print(f"study: flying {len(args)} manoeuvre(s) once -> {shown}", file=sys.stderr, flush=True)
         for aircraft, name, ok, reason in _map(_fly_one, args, jobs, dask):
             status[(aircraft, name)] = (ok, reason)
             if progress:
