@@ -37,6 +37,8 @@ def client(address: str) -> Any:
 
 #: How long to wait for the scheduler to answer (s).
 CONNECT_TIMEOUT_S = 5.0
+#: How long to wait for a scheduler's handshake, which it sends as soon as it accepts a connection (s).
+HANDSHAKE_TIMEOUT_S = 2.0
 
 
 def _probe(address: str) -> None:
@@ -59,13 +61,14 @@ def _probe(address: str) -> None:
         if url.scheme != "tcp":
             return
         try:  # a Dask scheduler sends its handshake as soon as a connection is accepted
+            sock.settimeout(HANDSHAKE_TIMEOUT_S)
             first = sock.recv(64)
         except TimeoutError:
             first = None
         except OSError as exc:
             first = f"{exc.strerror or exc}".encode()
     if not first:
-        what = "closed the connection at once" if first == b"" else f"sent nothing within {CONNECT_TIMEOUT_S:g} s"
+        what = "closed the connection at once" if first == b"" else f"sent nothing within {HANDSHAKE_TIMEOUT_S:g} s"
         raise WashbenchError(f"--dask {address}: something accepted the connection but {what}: not a Dask scheduler")
     if first[:4] in (b"HTTP", b"SSH-", b"220 ", b"<!DO", b"<htm"):
         shown = first[:24].decode("ascii", "backslashreplace").strip()
