@@ -70,6 +70,7 @@ def test_cue_writes_traces_and_metrics(kind: str, inputs: dict[str, Path], tmp_p
     assert res.returncode == 0, res.stderr
     assert "2401 rows" in res.stdout and f"wrote {out}" in res.stdout
     assert sorted(p.name for p in out.iterdir()) == [
+        ".washbench.json",  # the manifest: what washbench wrote here (washbench/io/outfolder.py)
         "figures",
         "metrics.csv",
         "ranking.csv",

@@ -327,7 +327,7 @@ def test_time_problems(trace: dict[str, np.ndarray], tmp_path: Path) -> None:
     assert run_cue(tmp_path / "reset.parquet", tmp_path / "o7", options=CueOptions(recording=False)) == 0
     a, b = (read_metrics_csv(tmp_path / "o7" / s / "metrics.csv") for s in ("segment_1", "segment_2"))
     assert a == b  # the same data cued twice, each from its own start
-    assert sorted(p.name for p in (tmp_path / "o7").iterdir()) == ["segment_1", "segment_2"]
+    assert sorted(p.name for p in (tmp_path / "o7").iterdir()) == [".washbench.json", "segment_1", "segment_2"]
 
 
 def test_rest_start_feels_a_mid_manoeuvre_start(trace: dict[str, np.ndarray], tmp_path: Path) -> None:
@@ -375,13 +375,13 @@ def test_cli_cue_with_options(trace: dict[str, np.ndarray], tmp_path: Path, caps
     p = tmp_path / "log.tsv"
     p.write_text("\n".join(lines) + "\n")
     out = tmp_path / "out"
-    (out).mkdir()
-    (out / "recording.rrd").write_text("an earlier run's recording")
     cols = "t=time_ms:ms,f_x=ax,f_y=ay,f_z=az,omega_x=p,omega_y=q,omega_z=r"
     argv = ["cue", str(p), "--out", str(out), "--columns", cols, "--start-s", "2", "--end-s", "20"]
+    assert main([*argv, "--end-s", "3", "--no-figures"]) == 0  # an earlier run's recording
+    assert (out / "recording.rrd").is_file()
     assert main([*argv, "--resample", "100", "--no-recording"]) == 0
-    assert sorted(x.name for x in out.iterdir()) == ["figures", "metrics.csv", "ranking.csv", "report.md", "run.json",
-                                                      "traces.parquet"]  # fmt: skip
+    assert sorted(x.name for x in out.iterdir()) == [".washbench.json", "figures", "metrics.csv", "ranking.csv",
+                                                      "report.md", "run.json", "traces.parquet"]  # fmt: skip
     doc = json.loads((out / "run.json").read_text())
     assert doc["dt_s"] == 0.01 and doc["t_start_s"] == pytest.approx(2.0, abs=0.01) and doc["t_end_s"] <= 20.0
     capsys.readouterr()

@@ -177,16 +177,17 @@ def test_variant_names_in_every_output(variant_run: Path) -> None:
     assert lines[0] == "aircraft" and set(lines[1:]) == names  # one line per source, names from the data
     # the suite's tables: better_by against the first washout listed when small-angle does not run
     summary = json.loads((variant_run / "run.json").read_text())
+    out = variant_run.parent.parent / "suite_tables"
+    inside = out / "c172p" / "short_turn"  # a suite's results lie inside its folder (report refuses others)
+    shutil.copytree(variant_run, inside)
     run = RunSummary(
         ok=True,
         aircraft="c172p",
         manoeuvre="short_turn",
-        run_dir=variant_run,
+        run_dir=inside,
         metrics=read_metrics_csv(variant_run / "metrics.csv"),
         motion={d: v["value"] for d, v in summary["perceived_motion"].items()},
     )
-    out = variant_run.parent.parent / "suite_tables"
-    out.mkdir()
     write_suite_results([Outcome(path="short_turn.yaml", wall_s=0.0, run=run)], out)
     header = (out / "comparison.csv").read_text().splitlines()[0].split(",")
     assert header[4:] == ["cw1", "fast_tilt", "fast_tilt_better_by"]

@@ -16,7 +16,7 @@ from typing import Any
 
 from washbench.cli_examples import add_examples, subcommands
 from washbench.cueing.params import WASHOUT_KINDS
-from washbench.errors import Terminated, WashbenchError
+from washbench.errors import Terminated, WashbenchError, printable
 from washbench.io import config as project_config
 
 _VARIANT_HELP = "add a washout NAME of KIND with dotted-key overrides of the parameter file, repeatable"
@@ -81,6 +81,25 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message}\n")
 
 
+def _out_path(text: str) -> Path:
+    """``--out``: not empty (an empty string would silently mean the current folder)."""
+    if not text:
+        raise argparse.ArgumentTypeError("an empty path; name a folder (. for the current one)")
+    return Path(text)
+
+
+def _check_paths(args: argparse.Namespace) -> None:
+    """Every path argument must be valid UTF-8 (results and messages name it): one line otherwise."""
+    for key, value in vars(args).items():
+        for item in value if isinstance(value, list) else [value]:
+            if isinstance(item, Path):
+                try:
+                    str(item).encode("utf-8")
+                except UnicodeEncodeError:
+                    shown = str(item).encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
+                    raise WashbenchError(f"{shown}: the path is not valid UTF-8 ({key}); rename it") from None
+
+
 def _jobs(text: str) -> int:
     """``--jobs``: a whole number of at least 1 (argparse reports anything else as a usage error)."""
     try:
@@ -109,7 +128,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="CSV/TSV/TXT (.gz too), Parquet, X-Plane Data.txt or JSBSim CSV output; washbench's own columns "
         "t_s, f_{x,y,z}_mps2, omega_{x,y,z}_degps unless mapped",
     )
-    p.add_argument("--out", type=Path, required=True, help="output folder (a run result folder's files)")
+    p.add_argument("--out", type=_out_path, required=True, help="output folder (a run result folder's files)")
     _cue_input_options(p)
     _washout_options(p)
     _rank_option(p)
@@ -118,7 +137,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("fly", help="fly a manoeuvre file with JSBSim and the scripted pilot")
     p.add_argument("manoeuvre", type=Path, help="manoeuvre YAML file, or a bundled one by name (c172/takeoff)")
-    p.add_argument("--out", type=Path, required=True, help="output folder (flight.parquet, flight.json)")
+    p.add_argument("--out", type=_out_path, required=True, help="output folder (flight.parquet, flight.json)")
     _aircraft_dir_option(p)
     p.add_argument("--quiet", action="store_true", help="no progress display")
 
@@ -133,7 +152,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "manoeuvre", type=Path, help="manoeuvre YAML file, a bundled one by name (c172/takeoff), or a JSBSim script"
     )
-    p.add_argument("--out", type=Path, required=True, help="results folder; writes OUT/<aircraft>/<manoeuvre>/")
+    p.add_argument("--out", type=_out_path, required=True, help="results folder; writes OUT/<aircraft>/<manoeuvre>/")
     _washout_options(p)
     _rank_option(p)
     _aircraft_dir_option(p)
@@ -154,7 +173,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--jsbsim-scripts", nargs="+", default=[], metavar="NAME", help="scripts shipped with JSBSim")
     p.add_argument("--max-time-s", type=float, metavar="S", help="JSBSim scripts: stop each after S s (default 1200)")
-    p.add_argument("--out", type=Path, required=True, help="results folder")
+    p.add_argument("--out", type=_out_path, required=True, help="results folder")
     _aircraft_dir_option(p)
     p.add_argument("--jobs", type=_jobs, help="parallel processes (default: the CPUs this process may use)")
     _washout_options(p)
@@ -166,7 +185,7 @@ def build_parser() -> argparse.ArgumentParser:
     _output_options(p)
 
     p = sub.add_parser("omct", help="Objective Motion Cueing Test: gain and phase of each washout, Bode plots")
-    p.add_argument("--out", type=Path, required=True, help="output folder (omct.csv, bode_<test>.png, report.md)")
+    p.add_argument("--out", type=_out_path, required=True, help="output folder (omct.csv, bode_<test>.png, report.md)")
     _washout_options(p)
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
@@ -185,7 +204,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--duration-s", type=float, default=20.0, help="length (default 20 s)")
     p.add_argument("--rate-hz", type=float, default=120.0, help="sample rate (default 120 Hz)")
     p.add_argument("--start-s", type=float, default=1.0, help="onset of step, pulse, doublet, chirp (default 1 s)")
-    p.add_argument("--out", type=Path, required=True, help="output file, .csv or .parquet")
+    p.add_argument("--out", type=_out_path, required=True, help="output file, .csv or .parquet")
 
     p = sub.add_parser("sweep", help="a grid of washout parameters on recorded flights: scores and metrics per point")
     p.add_argument("manoeuvres", type=Path, nargs="+", help="manoeuvre files or folders")
@@ -198,7 +217,10 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="KEY=V1,V2,...",
         help="a parameter-file key and its values, repeatable (the grid is every combination)",
     )
-    p.add_argument("--out", type=Path, required=True, help="output folder (sweep.csv, sweep_metrics.csv, sweep.png)")
+    p.add_argument(
+        "--out", type=_out_path, required=True, help="output folder (sweep.csv, sweep_metrics.csv, sweep.png)"
+    )
+    p.add_argument("--force", action="store_true", help="run a grid of more than 2000 points")
     _study_options(p)
 
     p = sub.add_parser("tune", help="tune washout parameters on training manoeuvres (differential evolution)")
@@ -221,7 +243,7 @@ def build_parser() -> argparse.ArgumentParser:
         default=1.0,
         help="penalty per unit fraction of time at a platform limit (default 1)",
     )
-    p.add_argument("--out", type=Path, required=True, help="output folder (tuned.yaml, tune.csv, report.md)")
+    p.add_argument("--out", type=_out_path, required=True, help="output folder (tuned.yaml, tune.csv, report.md)")
     _study_options(p)
     p = sub.add_parser("examples", help="copy the bundled manoeuvres and pilot profiles into a folder to edit")
     p.add_argument("folder", type=Path, help="destination (created; existing files are never overwritten)")
@@ -528,7 +550,9 @@ def _study(args: argparse.Namespace) -> int:
     if args.command == "sweep":
         from washbench.runs.sweep import sweep_command
 
-        return sweep_command(args.manoeuvres, args.out, washouts=args.washout, sets=args.sets, **common)
+        return sweep_command(
+            args.manoeuvres, args.out, washouts=args.washout, sets=args.sets, force=args.force, **common
+        )
     from washbench.runs.tune import tune_command
 
     return tune_command(
@@ -593,18 +617,23 @@ def main(argv: list[str] | None = None) -> int:
     signal.signal(signal.SIGTERM, _terminate)
     try:
         try:
+            _check_paths(args)
             _load_plugins(args)
             status = _dispatch(args)
             sys.stdout.flush()
             return status
         except WashbenchError as exc:
-            print(f"washbench: error: {exc}", file=sys.stderr)
+            print(f"washbench: error: {printable(str(exc))}", file=sys.stderr)
             return 2
         except BrokenPipeError:
             return _quiet_broken_pipe()
         except OSError as exc:  # the environment (disk full, permissions) where no file-specific message was made
             where = f"{exc.filename}: " if exc.filename else ""
-            print(f"washbench: error: {where}{exc.strerror or exc}", file=sys.stderr)
+            print(f"washbench: error: {printable(where + str(exc.strerror or exc))}", file=sys.stderr)
+            return 2
+        except MemoryError:
+            print("washbench: error: out of memory (an input or option asks for more than this machine has)",
+                  file=sys.stderr)  # fmt: skip
             return 2
     except KeyboardInterrupt:
         print("washbench: interrupted", file=sys.stderr)

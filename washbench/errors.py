@@ -36,3 +36,20 @@ def located(path: str | Path, problem: str, line: int | None = None, field: str 
     where = str(path) if line is None else f"{path}:{line}"
     what = problem if field is None else f"{field}: {problem}"
     return f"{where}: {what}".replace("\n", " ")
+
+
+def printable(text: str) -> str:
+    """``text`` safe for a terminal: control characters (escape sequences, carriage returns, C1 codes) and bytes
+    that were not UTF-8 shown as ``\\x1b``-style escapes, so a quoted input can never drive the terminal."""
+    out = []
+    for ch in text:
+        code = ord(ch)
+        if code < 0x20 or 0x7F <= code < 0xA0:
+            out.append(f"\\x{code:02x}")
+        elif 0xDC80 <= code <= 0xDCFF:  # a byte that was not UTF-8 (surrogateescape)
+            out.append(f"\\x{code - 0xDC00:02x}")
+        elif 0xD800 <= code <= 0xDFFF:
+            out.append(f"\\u{code:04x}")
+        else:
+            out.append(ch)
+    return "".join(out)

@@ -122,6 +122,9 @@ def check_spec(spec: SignalSpec) -> SignalSpec:
     duration = _positive("--duration-s", spec.duration_s)
     if duration * rate < 1.0:
         raise WashbenchError(f"--duration-s {duration} s is shorter than one sample at {rate} Hz")
+    from washbench.io.budget import check_samples
+
+    check_samples(duration * rate + 1.0, f"--duration-s {duration:g} at --rate-hz {rate:g}")
     if not (math.isfinite(spec.start_s) and spec.start_s >= 0.0):
         raise WashbenchError(f"--start-s must be a number >= 0, got {spec.start_s!r}")
     if spec.kind in NEEDS_FREQUENCY:

@@ -39,7 +39,8 @@ def parse_set(text: str) -> Axis:
         raise WashbenchError(f"{where}: expected KEY=V1,V2,...")
     check_key(key, where)
     parsed = tuple(parse_value(v) for v in values.split(","))
-    if len(set(map(repr, parsed))) != len(parsed):
+    same = [float(v) if isinstance(v, (int, float)) and not isinstance(v, bool) else repr(v) for v in parsed]
+    if len(set(same)) != len(same):  # 1 and 1.0 are the same value
         raise WashbenchError(f"{where}: a value is listed twice")
     return Axis(key, parsed)
 

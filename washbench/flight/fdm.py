@@ -9,7 +9,9 @@ from __future__ import annotations
 
 import math
 import os
+import tempfile
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 from washbench.errors import WashbenchError
@@ -46,12 +48,19 @@ def make_fdm(m: Manoeuvre, profile: PilotProfile) -> tuple[Any, Setup]:
     os.environ["JSBSIM_DEBUG"] = "0"
     import jsbsim
 
+    from washbench.flight.jsbsim_xml import aircraft_for_jsbsim
+
     root = m.aircraft_files.root
     fdm = jsbsim.FGFDMExec(str(jsbsim_root()), None)
-    fdm.set_aircraft_path(str(root))
-    with quiet_stdout():
-        if not fdm.load_model(m.aircraft):
-            raise WashbenchError(m.located(("aircraft",), f"JSBSim could not load the model {root / m.aircraft}"))
+    with tempfile.TemporaryDirectory(prefix="washbench-aircraft-") as tmp:  # the model without <output>
+        fdm.set_aircraft_path(str(aircraft_for_jsbsim(root, m.aircraft, Path(tmp))))
+        with quiet_stdout():
+            try:
+                loaded = fdm.load_model(m.aircraft)
+            except Exception as exc:  # JSBSim raises plain exceptions on broken models
+                raise WashbenchError(m.located(("aircraft",), f"JSBSim could not load the model ({exc})")) from None
+            if not loaded:
+                raise WashbenchError(m.located(("aircraft",), f"JSBSim could not load the model {root / m.aircraft}"))
     fdm.set_dt(m.dt_s)
 
     rw = m.runway

@@ -491,17 +491,17 @@ def fly_command(manoeuvre_path: Path, out_dir: Path, progress: bool = True, airc
 
     The output folder is checked (and locked) before flying, so a bad ``--out`` costs no flight.
     """
-    from washbench.io.lock import output_lock
+    from washbench.io.outfolder import result_set
 
     m = load_manoeuvre(manoeuvre_path, aircraft_dirs)
-    with output_lock(out_dir):
+    with result_set(out_dir, "fly") as stage:  # the whole set replaces the previous one at once
         wall = time.monotonic()
         result = fly(m, progress=progress)
         wall = time.monotonic() - wall
         prov = build_provenance(
             manoeuvre_path=manoeuvre_path, turbulence=m.environment.turbulence, aircraft_files=m.aircraft_files
         )
-        write_flight(out_dir, result, str(manoeuvre_path), prov)
+        write_flight(stage, result, str(manoeuvre_path), prov)
     passed = sum(1 for c in result.checks if c[3])
     line = (
         f"{m.name} ({m.aircraft}): {result.status}, {passed}/{len(result.checks)} checks passed, "

@@ -28,7 +28,6 @@ from __future__ import annotations
 import math
 import re
 import tempfile
-import xml.etree.ElementTree as ET
 from array import array
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -197,7 +196,10 @@ def scripts_dir() -> Path:
 
 
 def is_runscript(path: Path) -> bool:
-    """True for an XML file whose root element is a JSBSim ``<runscript>`` (cheap: reads the first element)."""
+    """True for an XML file whose root element is a JSBSim ``<runscript>`` (cheap: reads the first element; no
+    entity is expanded before it)."""
+    import xml.etree.ElementTree as ET
+
     try:
         for _, elem in ET.iterparse(path, events=("start",)):
             return elem.tag == "runscript"
@@ -239,17 +241,10 @@ def load_script_info(path: str | Path, aircraft_dirs: Sequence[Path] = ()) -> Sc
 
     The aircraft is looked up along washbench's search path (``aircraft_dirs``, an ``aircraft/`` folder next
     to the script, washbench's bundled aircraft, JSBSim's own)."""
+    from washbench.flight.jsbsim_xml import read_xml
+
     path = Path(path)
-    try:
-        root = ET.parse(path).getroot()
-    except FileNotFoundError:
-        raise WashbenchError(located(path, "no such file")) from None
-    except IsADirectoryError:
-        raise WashbenchError(located(path, "is a folder, not a file")) from None
-    except ET.ParseError as exc:
-        raise WashbenchError(located(path, f"not well-formed XML ({exc.msg})", line=exc.position[0])) from None
-    except OSError as exc:
-        raise WashbenchError(located(path, f"cannot read: {exc.strerror or exc}")) from None
+    root = read_xml(path)
     if root.tag != "runscript":
         raise WashbenchError(located(path, f"not a JSBSim script: the root element is <{root.tag}>, not <runscript>"))
     use = root.find("use")
@@ -289,19 +284,22 @@ def _structure_contacts(fdm: object) -> list[object]:
 
 
 def _make_fdm(info: ScriptInfo, output_dir: Path) -> object:
-    """The FDM with the script loaded and initialised. JSBSim opens the script's and the aircraft's
-    ``<output>`` files at load time (relative to its root folder, i.e. inside the jsbsim package): they are
-    sent to ``output_dir`` (a temporary folder) and switched off."""
+    """The FDM with the script loaded and initialised. The script's and the aircraft's ``<output>`` directives
+    are taken out before JSBSim reads them (:mod:`washbench.flight.jsbsim_xml`: copies in ``output_dir``, a
+    temporary folder), so JSBSim writes no file and opens no socket; output is also switched off."""
     import jsbsim
 
-    root = info.aircraft_root
+    from washbench.flight.jsbsim_xml import aircraft_for_jsbsim, script_for_jsbsim
+
+    root = aircraft_for_jsbsim(info.aircraft_root, info.aircraft, output_dir / "aircraft")
+    script = script_for_jsbsim(info.path.resolve(), output_dir)
     with quiet_stdout():
         fdm = jsbsim.FGFDMExec(str(jsbsim_root()), None)
         fdm.set_debug_level(0)
         fdm.set_output_path(str(output_dir))
         fdm.set_aircraft_path(str(root))
         try:
-            ok = fdm.load_script(str(info.path.resolve()))
+            ok = fdm.load_script(str(script))
         except Exception as exc:  # JSBSim raises plain exceptions on broken scripts or models
             raise WashbenchError(located(info.path, f"JSBSim could not load the script ({exc})")) from None
         if not ok:
@@ -324,7 +322,11 @@ def fly_script(
     ``hook(k, f_mps2, omega_radps)`` called once per recorded sample of it, in order (eyepoint specific
     force m/s^2 and body rates rad/s, body axes x forward, y right, z down).
     """
+    from washbench.io.budget import check_samples
+
     info = load_script_info(path, aircraft_dirs)
+    span_s = min(info.end_s, math.inf if max_time_s is None else max_time_s)
+    check_samples(span_s / info.dt_s, f"<run end={info.end_s:g} dt={info.dt_s:g}> (give --max-time-s)", info.path)
     with tempfile.TemporaryDirectory(prefix="washbench-jsbsim-") as junk:
         return _fly(info, _make_fdm(info, Path(junk)), max_time_s, segment_hook)
 

@@ -19,7 +19,7 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from washbench.errors import WashbenchError, located
+from washbench.errors import WashbenchError, located, printable
 from washbench.flight.manoeuvre import load_manoeuvre
 from washbench.flight.scripts import is_runscript, is_script, load_script_info
 from washbench.io.paths import resolve_manoeuvre
@@ -59,7 +59,7 @@ def validate_command(paths: Sequence[Path], aircraft_dirs: Sequence[Path] = ()) 
                 load_manoeuvre(path, aircraft_dirs)
         except WashbenchError as exc:
             for problem in exc.problems:
-                print(f"washbench: error: {problem}", file=sys.stderr)
+                print(f"washbench: error: {printable(problem)}", file=sys.stderr)
             bad += 1
         else:
             print(f"{path}: OK")

@@ -30,21 +30,34 @@ def example_files(dest: Path) -> list[tuple[Path, Path]]:
 
 
 def copy_examples(dest: Path) -> int:
-    """Copy the examples into ``dest`` (created); refuse before writing anything if a destination file exists."""
+    """Copy the examples into ``dest`` (created), all or nothing; refuse before writing anything if
+    ``dest/manoeuvres`` or ``dest/aircraft`` exists (a link there is never followed).
+
+    Built in a hidden stage folder inside ``dest`` and published whole (:mod:`washbench.io.outfolder`), under
+    ``dest``'s lock: a full disk or a signal leaves nothing half-copied, so a rerun works.
+    """
+    from washbench.io.lock import output_lock
+    from washbench.io.outfolder import discard_stage, make_stage, recover, swap_in
+
     if dest.exists() and not dest.is_dir():
         raise WashbenchError(located(dest, "exists and is not a folder"))
+    with output_lock(dest):
+        recover(dest, only_washbench=True)  # the user's folder: only washbench's own leftovers
+        for top in ("manoeuvres", "aircraft"):
+            if (dest / top).exists() or (dest / top).is_symlink():
+                raise WashbenchError(located(dest / top, "already exists; nothing copied (examples never overwrite)"))
+        stage = make_stage(dest)
+        try:
+            pairs = example_files(stage)
+            for src, dst in pairs:
+                dst.parent.mkdir(parents=True, exist_ok=True)
+                write_text_atomic(dst, src.read_text())
+            swap_in(stage, dest, [])
+        except OSError as exc:
+            raise WashbenchError(located(dest, f"cannot write ({exc.strerror or exc})")) from None
+        finally:
+            discard_stage(stage)
     pairs = example_files(dest)
-    existing = [d for _, d in pairs if d.exists()]
-    if existing:
-        raise WashbenchError(
-            located(existing[0], f"already exists ({len(existing)} of the files to copy do); nothing copied")
-        )
-    try:
-        for src, dst in pairs:
-            dst.parent.mkdir(parents=True, exist_ok=True)
-            write_text_atomic(dst, src.read_text())
-    except OSError as exc:
-        raise WashbenchError(located(dest, f"cannot write ({exc.strerror or exc})")) from None
     n_m = sum(1 for _, d in pairs if d.suffix == ".yaml" and "manoeuvres" in d.parts)
     print(f"{n_m} manoeuvres and {len(pairs) - n_m} pilot profiles copied to {dest}")
     print(f"  run one:   washbench run {dest / 'manoeuvres' / 'c172' / 'coordinated_turn.yaml'} --out results")

@@ -2,16 +2,20 @@
 
 Two commands writing into the same ``--out`` at once would mix their results; the second one gets a
 clear error at once instead. The lock is an ``fcntl.flock`` on ``.washbench.lock`` (holding the
-holder's PID), which the kernel releases when the process ends, however it ends. The file is removed
-when the command finishes; a lock taken on a file that was removed meanwhile is detected (inode check)
-and taken again on the new file, so two processes never both hold it.
+holder's PID), which the kernel releases when the process ends, however it ends. The file is created with
+``O_CREAT|O_EXCL|O_NOFOLLOW`` and an existing one is opened with ``O_NOFOLLOW`` and must be a small plain file
+with one name: a symbolic link (or hard link) planted as the lock is refused, never followed or truncated.
+The file is removed when the command finishes; a lock taken on a file that was removed meanwhile is detected
+(inode check) and taken again on the new file, so two processes never both hold it.
 """
 
 from __future__ import annotations
 
 import contextlib
+import errno
 import fcntl
 import os
+import stat
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -21,21 +25,50 @@ from washbench.io.publish import prepare_output_dir
 LOCK_NAME = ".washbench.lock"
 
 
+def _open_lock(out_dir: Path, path: Path) -> int:
+    """Open ``path`` as the lock file: created with ``O_CREAT|O_EXCL|O_NOFOLLOW`` (never through a link), or,
+    when one exists (a finished or killed command's), opened with ``O_NOFOLLOW`` and proven a plain file."""
+    flags = os.O_RDWR | os.O_CLOEXEC | os.O_NOFOLLOW
+    try:
+        return os.open(path, flags | os.O_CREAT | os.O_EXCL, 0o666)
+    except FileExistsError:
+        pass
+    except OSError as exc:
+        raise WashbenchError(located(out_dir, f"cannot create the lock {LOCK_NAME}: {exc.strerror}")) from None
+    try:
+        fd = os.open(path, flags | os.O_NONBLOCK)
+    except FileNotFoundError:
+        return -1  # removed meanwhile: try again
+    except OSError as exc:
+        if exc.errno == errno.ELOOP:
+            problem = f"{LOCK_NAME} is a symbolic link (not washbench's lock): not followed; remove it"
+        else:
+            problem = f"cannot open the lock {LOCK_NAME}: {exc.strerror}"
+        raise WashbenchError(located(out_dir, problem)) from None
+    st = os.fstat(fd)
+    if not stat.S_ISREG(st.st_mode) or st.st_nlink != 1 or st.st_size > 64:
+        os.close(fd)
+        problem = f"{LOCK_NAME} is not washbench's lock (not a small plain file with one name): remove it"
+        raise WashbenchError(located(out_dir, problem))
+    os.set_blocking(fd, True)
+    return fd
+
+
 def _acquire(out_dir: Path, path: Path) -> int:
     for _ in range(5):
-        try:
-            fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o666)
-        except OSError as exc:
-            raise WashbenchError(located(out_dir, f"cannot create the lock {LOCK_NAME}: {exc.strerror}")) from None
+        fd = _open_lock(out_dir, path)
+        if fd < 0:
+            continue
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
             holder = os.pread(fd, 32, 0).decode("ascii", "replace").strip() or "?"
             os.close(fd)
+            holder = holder if holder.isdigit() else "?"
             problem = f"another washbench command (PID {holder}) is writing into this folder; wait or use another --out"
             raise WashbenchError(located(out_dir, problem)) from None
         try:
-            same = os.stat(path).st_ino == os.fstat(fd).st_ino
+            same = os.lstat(path).st_ino == os.fstat(fd).st_ino
         except FileNotFoundError:
             same = False
         if same:

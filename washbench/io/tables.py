@@ -60,11 +60,11 @@ def _head_lines(path: Path, limit: int = 1 << 16) -> list[str]:
     except (OSError, pa.ArrowException) as exc:
         raise WashbenchError(located(path, f"cannot read: {getattr(exc, 'strerror', None) or exc}")) from None
     try:
-        text = raw.decode("utf-8")
+        text = raw.decode("utf-8-sig")  # a byte-order mark (Excel's "CSV UTF-8") is dropped
     except UnicodeDecodeError as exc:
         if exc.start < len(raw) - 4:  # not just a multi-byte character cut at the end of the block
             raise WashbenchError(located(path, "not a readable CSV file: it is not UTF-8 text")) from None
-        text = raw[: exc.start].decode("utf-8")
+        text = raw[: exc.start].decode("utf-8-sig")
     lines = text.splitlines()
     return lines[:-1] if len(raw) == limit and len(lines) > 1 else lines
 
@@ -89,6 +89,25 @@ def header(path: Path, delimiter: str | None) -> tuple[int, list[str], str]:
     raise WashbenchError(located(path, "the file is empty" if not lines else "no header line (only comments)"))
 
 
+def _check_text_size(path: Path) -> None:
+    """Stream the (decompressed) text once, refusing it beyond the allocation bound before it is parsed: a small
+    gzip file expanding to gigabytes, or millions of blank lines, costs a second and no memory."""
+    from washbench.io.budget import MAX_SAMPLES, MAX_TEXT_BYTES
+
+    size = lines = 0
+    try:
+        with pa.input_stream(str(path), compression="detect") as f:
+            while block := f.read(1 << 22):
+                size += len(block)
+                lines += block.count(b"\n")
+                if size > MAX_TEXT_BYTES or lines > MAX_SAMPLES + 10_000:
+                    what = f"more than {MAX_TEXT_BYTES // 2**30} GiB" if size > MAX_TEXT_BYTES else f"{lines:,}+ lines"
+                    raise WashbenchError(located(path, f"{what} of text (decompressed): more than washbench reads "
+                                                       f"for one time series ({MAX_SAMPLES:,} rows)"))  # fmt: skip
+    except (OSError, pa.ArrowException) as exc:
+        raise WashbenchError(located(path, f"cannot read: {getattr(exc, 'strerror', None) or exc}")) from None
+
+
 def read_text_table(path: Path, delimiter: str | None, string_columns: set[str], decimal: str = ".") -> SourceTable:
     """A CSV-like text file with pyarrow: header and delimiter sniffed, ``#`` lines skipped, names trimmed.
 
@@ -102,6 +121,7 @@ def read_text_table(path: Path, delimiter: str | None, string_columns: set[str],
     if size == 0:
         raise WashbenchError(located(path, "the file is empty"))
     header_line, names, delim = header(path, delimiter)
+    _check_text_size(path)
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
         raise WashbenchError(located(path, f"column {dup[0]!r} appears more than once", line=header_line))

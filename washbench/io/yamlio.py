@@ -342,8 +342,10 @@ def read_yaml(path: Path) -> tuple[Any, dict[Loc, int]]:
 
     Raises WashbenchError for an unreadable, empty or malformed file, or duplicate keys.
     """
+    from washbench.io.budget import read_bounded
+
     try:
-        text = Path(path).read_text(encoding="utf-8")
+        text = read_bounded(path).decode("utf-8")
     except FileNotFoundError:
         raise WashbenchError(located(path, "no such file")) from None
     except IsADirectoryError:

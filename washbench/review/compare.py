@@ -23,7 +23,7 @@ import rerun.blueprint as rrb
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import atomic_path
 from washbench.review.blueprint import AIRCRAFT_WIDTH, WASHOUT_WIDTH, series_color
-from washbench.review.rerun_log import AIRCRAFT, DOFS, ENVELOPE_QUANTITIES, TIMELINE, phase_lane_path
+from washbench.review.rerun_log import AIRCRAFT, DOFS, ENVELOPE_QUANTITIES, TIMELINE, RrdFile, phase_lane_path
 from washbench.review.rrd_read import (
     read_component,
     read_properties,
@@ -127,8 +127,8 @@ def write_comparison(a: Path, b: Path, out: Path) -> None:
         rrb.TimePanel(state="collapsed", timeline=TIMELINE),
     )
     with atomic_path(out) as tmp:
+        rrd = RrdFile(rec, tmp, blueprint)
         try:
-            rec.save(tmp, default_blueprint=blueprint)
             rec.send_recording_name(f"{la} vs {lb}")
             rec.send_property("compared", rr.AnyValues(a=str(a), b=str(b), label_a=la, label_b=lb))
             for prefix in ("perceived", "raw"):
@@ -152,9 +152,10 @@ def write_comparison(a: Path, b: Path, out: Path) -> None:
             for sub, path in (("a", a), ("b", b)):
                 doc = read_text_documents(path).get("/metrics", "")
                 rec.log(f"/metrics/{sub}", rr.TextDocument(doc, media_type=rr.MediaType.MARKDOWN), static=True)
-        finally:
-            rec.flush()
-            rec.disconnect()
+            rrd.close()
+        except BaseException:
+            rrd.abandon()
+            raise
 
 
 def _send_legend(

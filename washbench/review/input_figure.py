@@ -114,17 +114,25 @@ def _short(text: str, n: int) -> str:
     return text if len(text) <= n else text[: n - 1] + "…"
 
 
-def input_section(folder: Path, pdf: bool, image: Callable[[Path, Path, str], list[str]]) -> list[str]:
+def input_section(
+    folder: Path, pdf: bool, image: Callable[..., list[str]], into: Path | None = None
+) -> list[str]:
     """The report's first section when the result has an input figure (a ``cue`` result), else nothing.
 
     ``pdf`` (``washbench report``): the figure is drawn again, PNG and PDF, from the result's files
-    (:func:`redraw`); ``image``: the report's way of embedding a figure and linking its PDF.
+    (:func:`redraw`); ``image``: the report's way of embedding a figure and linking its PDF. ``into``: the stage
+    folder whose ``figures/`` will replace the result's (the figure is drawn, or copied, there).
     """
     png = folder / "figures" / f"{INPUT_STEM}.png"
     if not png.is_file():
         return []
-    if pdf:
-        png = redraw(folder, ("png", "pdf")) or png
+    target = (into or folder) / "figures"
+    target.mkdir(parents=True, exist_ok=True)
+    drawn = redraw(folder, ("png", "pdf"), target) if pdf else None
+    if drawn is None and into is not None:
+        import shutil
+
+        shutil.copyfile(png, target / png.name)
     return [
         "## Input as read",
         "",
@@ -132,13 +140,14 @@ def input_section(folder: Path, pdf: bool, image: Callable[[Path, Path, str], li
         "names the column, unit and sign they came from, the dashed line level flight. Check them before the "
         "results: a unit or sign mistake shows here.",
         "",
-        *image(png, folder, "input as read"),
+        *image(png, folder, "input as read", bool(drawn)),
     ]
 
 
-def redraw(folder: Path, formats: Sequence[str]) -> Path | None:
-    """Draw ``folder/figures/input.*`` again from the result's files: the input columns of traces.parquet and the
-    legends and notes run.json keeps (``input_labels``, ``conversions``); None when run.json has no legends."""
+def redraw(folder: Path, formats: Sequence[str], fig_dir: Path | None = None) -> Path | None:
+    """Draw ``folder/figures/input.*`` (or ``fig_dir/input.*``) again from the result's files: the input columns of
+    traces.parquet and the legends and notes run.json keeps (``input_labels``, ``conversions``); None when run.json
+    has no legends."""
     import json
 
     import pyarrow.parquet as pq
@@ -156,8 +165,9 @@ def redraw(folder: Path, formats: Sequence[str]) -> Path | None:
     table = pq.read_table(folder / "traces.parquet", columns=cols)
     arr = np.column_stack([table[c].to_numpy() for c in cols])
     title = f"{Path(str(doc.get('input', 'input'))).name} {doc.get('segment', '')}".strip()
-    return input_figure(folder / "figures" / INPUT_STEM, title, arr[:, 0], arr[:, 1:4], arr[:, 4:7], labels,
-                        doc.get("conversions", ()), formats)  # fmt: skip
+    stem = (fig_dir or folder / "figures") / INPUT_STEM
+    return input_figure(stem, title, arr[:, 0], arr[:, 1:4], arr[:, 4:7], labels, doc.get("conversions", ()),
+                        formats)  # fmt: skip
 
 
 def draw_for_result(folder: Path, title: str, motion: Any, labels: Sequence[str], notes: Sequence[str]) -> Path:

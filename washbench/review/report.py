@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import math
 import os
-import shutil
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -89,7 +88,7 @@ def provenance_lines(prov: dict[str, Any] | None, created_utc: str | None) -> li
     file_row("pilot profile", prov.get("pilot_profile"))
     inp = prov.get("input")
     file_row("input trace", inp)
-    if inp and inp.get("provenance", {}).get("manoeuvre"):
+    if inp and (inp.get("provenance") or {}).get("manoeuvre"):
         file_row("input's manoeuvre file", inp["provenance"]["manoeuvre"])
     file_row("washout parameters", prov.get("params"))
     if prov.get("washouts"):
@@ -107,10 +106,10 @@ def provenance_lines(prov: dict[str, Any] | None, created_utc: str | None) -> li
     ranking = prov.get("ranking")
     if isinstance(ranking, dict) and ranking.get("by"):
         rows.append(("ranking rule", f"`--rank-by {ranking['by']}`"))
-    if "turbulence" in prov or (inp and "turbulence" in inp.get("provenance", {})):
-        turb = prov.get("turbulence", inp.get("provenance", {}).get("turbulence") if inp else None)
+    if "turbulence" in prov or (inp and "turbulence" in (inp.get("provenance") or {})):
+        turb = prov.get("turbulence", (inp.get("provenance") or {}).get("turbulence") if inp else None)
         rows.append(("turbulence", f"{turb['severity']}, seed {turb['seed']}" if turb else "none"))
-    sw = prov.get("software", {})
+    sw = prov.get("software") or {}
     parts = [
         f"washbench {sw.get('washbench', '?')}"
         + (f" (git `{_short_commit(sw['washbench_git'])}`)" if sw.get("washbench_git") else "")
@@ -354,19 +353,21 @@ def time_above_threshold(data: ResultData) -> dict[str, float]:
     }
 
 
-def result_figures(data: ResultData, pdf: bool = False, palette: str | None = None) -> dict[str, Path]:
-    """Draw the result's figures into ``folder/figures/`` (PNG, and PDF with ``pdf``); figure name -> PNG path.
+def result_figures(
+    data: ResultData, pdf: bool = False, palette: str | None = None, into: Path | None = None
+) -> dict[str, Path]:
+    """Draw the result's figures into ``into/figures/`` (``into``: a stage folder whose ``figures/`` replaces the
+    result's; by default the result folder itself) as PNG, and PDF with ``pdf``; figure name -> PNG path.
 
     ``palette``: :data:`washbench.review.palette.PALETTES` (None: ``$WASHBENCH_PALETTE`` or the default).
-
-    A PDF left from an earlier ``washbench report`` is removed when none is drawn (it would show other data).
+    A PDF left from an earlier ``washbench report`` in the result folder is removed when none is drawn.
     """
     from washbench.review.figures import envelope_figure, perceived_figure
 
-    fig_dir = data.folder / FIGURES_DIR
+    fig_dir = (into or data.folder) / FIGURES_DIR
     fig_dir.mkdir(exist_ok=True)
     formats = ("png", "pdf") if pdf else ("png",)
-    if not pdf:
+    if not pdf and into is None:
         for stem in ("perceived", "envelope", "cues"):
             (fig_dir / f"{stem}.pdf").unlink(missing_ok=True)
     thresholds, rest = perception_thresholds(data)
@@ -398,17 +399,18 @@ def result_figures(data: ResultData, pdf: bool = False, palette: str | None = No
 NO_FIGURES = "_No figures were drawn (`--no-figures`): `washbench report` on this folder draws them from its files._"
 
 
-def _image(png: Path, start: Path, alt: str) -> list[str]:
-    """The figure embedded, and its PDF linked when there is one (else how to get it)."""
+def _image(png: Path, start: Path, alt: str, vector: bool | None = None) -> list[str]:
+    """The figure embedded, and its PDF linked when there is one (``vector``: whether there is, when the figure is
+    still in a stage; else how to get it)."""
     rel = _rel(png, start)
     pdf = Path(rel).with_suffix(".pdf")
-    if png.with_suffix(".pdf").is_file():
+    if png.with_suffix(".pdf").is_file() if vector is None else vector:
         return [f"![{alt}]({rel})", "", f"Vector version for papers: [{pdf.name}]({pdf.as_posix()})", ""]
     return [f"![{alt}]({rel})", "", "Vector versions for papers (PDF): `washbench report` on this folder.", ""]
 
 
 def result_sections(
-    data: ResultData, figures: dict[str, Path], start: Path, level: int, brief: bool = False
+    data: ResultData, figures: dict[str, Path], start: Path, level: int, brief: bool = False, vector: bool | None = None
 ) -> list[str]:
     """The body of one result's report; links relative to ``start`` (the folder report.md is in).
 
@@ -427,17 +429,19 @@ def result_sections(
         "at the start), what lies inside it is not felt; shaded: the phases.",
         "",
     ]
-    lines += _image(figures["perceived"], start, "perceived motion") if "perceived" in figures else [NO_FIGURES, ""]
+    lines += (
+        _image(figures["perceived"], start, "perceived motion", vector) if "perceived" in figures else [NO_FIGURES, ""]
+    )
     lines += [f"{h} Cues: correct, scaled, false, missing", "", *cue_lines(data)]
     if "cues" in figures:
-        lines += _image(figures["cues"], start, "false and missing cues")
+        lines += _image(figures["cues"], start, "false and missing cues", vector)
     lines += [f"{h} Motion sickness dose", "", *sickness_lines(data)]
     lines += [f"{h} Metrics", "", *metric_tables(data)]
     lines += [f"{h} Platform", ""]
     if brief:
         pass
     elif "envelope" in figures:
-        lines += _image(figures["envelope"], start, "platform envelope")
+        lines += _image(figures["envelope"], start, "platform envelope", vector)
     elif not figures:
         pass
     else:
@@ -470,10 +474,20 @@ def write_result_report(
     ``table``: the traces.parquet columns already in memory (not read again); ``pdf``: PDF figures besides the PNG;
     ``figures=False``: none drawn (``--no-figures``; figures of an earlier run in the folder are removed).
     """
+    from washbench.io.outfolder import discard_stage, make_stage, replace_entries
+
     data = load_result(Path(result_dir), table, series=figures)
-    if not figures:
-        shutil.rmtree(data.folder / FIGURES_DIR, ignore_errors=True)
-    drawn = result_figures(data, pdf) if figures else {}
+    stage = make_stage(data.folder)  # report.md and figures/ replace the previous ones together (links never followed)
+    try:
+        _write_result_report(data, stage, pdf, figures)
+        replace_entries(data.folder, stage, [REPORT_FILE, FIGURES_DIR])
+    finally:
+        discard_stage(stage)
+    return data.folder / REPORT_FILE
+
+
+def _write_result_report(data: ResultData, stage: Path, pdf: bool, figures: bool) -> None:
+    drawn = result_figures(data, pdf, into=stage) if figures else {}
     lines = [f"# {data.title}", "", *_status_line(data)]
     checks = f", checks {sum(bool(c.get('passed')) for c in data.checks)}/{len(data.checks)}" if data.checks else ""
     status = {True: "ok", False: "FAILED", None: "cued"}[data.ok]
@@ -484,9 +498,8 @@ def write_result_report(
     ]
     from washbench.review.input_figure import input_section
 
-    lines += input_section(data.folder, pdf, _image) if figures else []  # a cue result: the input as read, first
+    lines += input_section(data.folder, pdf, _image, stage) if figures else []  # a cue result: the input as read, first
     lines += provenance_lines(data.provenance, data.created_utc)
-    lines += result_sections(data, drawn, data.folder, 2)
-    path = data.folder / REPORT_FILE
-    write_text_atomic(path, "\n".join(lines).rstrip() + "\n")
-    return path
+    final = {k: data.folder / p.relative_to(stage) for k, p in drawn.items()}  # where they will be
+    lines += result_sections(data, final, data.folder, 2, vector=pdf)
+    write_text_atomic(stage / REPORT_FILE, "\n".join(lines).rstrip() + "\n")

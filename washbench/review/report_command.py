@@ -23,12 +23,17 @@ def report_command(results_dir: Path, palette: str | None = None) -> int:
 
     if palette is not None:
         os.environ[PALETTE_ENV] = palette_name(palette)
+    from washbench.io.lock import output_lock
+    from washbench.io.outfolder import recover
+
     folder = Path(results_dir)
     if not folder.is_dir():
         raise WashbenchError(located(folder, "no such folder"))
-    if is_result_folder(folder) and not (folder / SUITE_FILE).exists():
-        path = write_result_report(folder, pdf=True)
-    else:
-        path = write_suite_report(folder, regenerate_results=True)
+    with output_lock(folder):  # no other washbench command writes into it meanwhile
+        recover(folder)
+        if is_result_folder(folder) and not (folder / SUITE_FILE).exists():
+            path = write_result_report(folder, pdf=True)
+        else:
+            path = write_suite_report(folder, regenerate_results=True)
     print(f"report: {path}")
     return 0

@@ -38,6 +38,8 @@ sample; the sources of one panel share one row (one time and one row id for all 
 
 from __future__ import annotations
 
+import contextlib
+import os
 import uuid
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -644,6 +646,56 @@ def _layout(data: RecordingData, perceived: list[np.ndarray], raw: list[np.ndarr
     )
 
 
+#: Longest wait (s) for the rerun SDK to encode what was logged (in memory: no disk involved).
+ENCODE_DEADLINE_S = 300.0
+
+
+class RrdFile:
+    """A recording stream whose bytes washbench writes to the file itself (one way for every .rrd it writes).
+
+    The stream's only sink is an in-memory binary stream (:func:`rerun.binary_stream`), written into ``tmp``
+    by Python when the recording is complete (:meth:`close`; the stream is read once: a stream read in parts
+    fails the file's checksum): a full disk or any file error is an ``OSError`` at once (one line through
+    :func:`washbench.io.atomic.atomic_path`), never a hang of the SDK's file sink (which blocks for ever when
+    its writes fail). The encoded recording is held in memory until then (about the size of the .rrd file).
+    ``blueprint`` is sent as the recording's default blueprint (what ``save(default_blueprint=...)`` stores).
+    """
+
+    def __init__(self, rec: rr.RecordingStream, tmp: Path, blueprint: object | None = None) -> None:
+        self.rec = rec
+        self.stream = rr.binary_stream(recording=rec)
+        self.fh = open(tmp, "wb")  # noqa: SIM115 - closed in close()
+        if blueprint is not None:
+            rec.send_blueprint(blueprint, make_active=False, make_default=True)  # type: ignore[arg-type]
+
+    def _drain(self, flush: bool = True) -> None:
+        """Write what was logged to the file (``flush``: everything logged, encoded first)."""
+        try:
+            data = self.stream.read(flush=flush, flush_timeout_sec=ENCODE_DEADLINE_S)
+        except Exception as exc:  # the rerun SDK: encoding did not finish within the deadline
+            problem = f"the rerun SDK did not encode the recording within {ENCODE_DEADLINE_S:g} s ({exc})"
+            raise OSError(problem) from None
+        if data:
+            self.fh.write(data)
+
+    def close(self) -> None:
+        """Drain everything, end the stream and close the file (errors as OSError)."""
+        try:
+            self._drain()
+            self.rec.disconnect()
+            self._drain(flush=False)
+            self.fh.flush()
+            os.fsync(self.fh.fileno())
+        finally:
+            self.fh.close()
+
+    def abandon(self) -> None:
+        """Stop without writing more (after an error)."""
+        with contextlib.suppress(Exception):
+            self.rec.disconnect()
+        self.fh.close()
+
+
 def write_recording(path: Path, data: RecordingData, properties: Mapping[str, str] | None = None) -> None:
     """Write ``data`` to the .rrd file ``path`` atomically (temp file in the same folder, then rename).
 
@@ -673,8 +725,8 @@ def write_recording(path: Path, data: RecordingData, properties: Mapping[str, st
     layout = _layout(data, perceived, raw)
     blueprint = build_blueprint(layout)
     with atomic_path(path) as tmp:
+        rrd = RrdFile(rec, tmp, blueprint)
         try:
-            rec.save(tmp, default_blueprint=blueprint)
             rec.send_recording_name(data.title)
             if props:
                 rec.send_property(PROPERTIES, rr.AnyValues(**props))
@@ -694,6 +746,7 @@ def write_recording(path: Path, data: RecordingData, properties: Mapping[str, st
             )
             _send_text(rec, data)
             _send_legend(rec, data)
-        finally:
-            rec.flush()
-            rec.disconnect()
+            rrd.close()
+        except BaseException:
+            rrd.abandon()
+            raise

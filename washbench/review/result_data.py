@@ -81,14 +81,11 @@ def is_result_folder(folder: Path) -> bool:
     return (folder / METRICS_FILE).is_file() and (folder / TRACES_FILE).is_file()
 
 
-def _read_json(path: Path) -> dict[str, Any] | None:
-    if not path.is_file():
-        return None
-    try:
-        doc = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, ValueError) as exc:
-        raise WashbenchError(located(path, f"not a readable JSON file ({exc})")) from None
-    return doc if isinstance(doc, dict) else None
+def _read_json(path: Path, model: Any) -> dict[str, Any] | None:
+    """``path`` checked as strictly as a user's file (:mod:`washbench.io.readback`), or None when absent."""
+    from washbench.io.readback import read_doc
+
+    return read_doc(path, model)
 
 
 def _washout_order(metrics: list[MetricRow]) -> list[str]:
@@ -167,6 +164,7 @@ def load_result(folder: Path, table: Mapping[str, np.ndarray] | None = None, *, 
     when None. ``series=False``: only the time and the saturation flags are read (for tables: ranking, metrics,
     time at a limit); ``perceived`` and ``usage`` are then empty.
     """
+    import pyarrow as pa
     import pyarrow.parquet as pq
 
     folder = Path(folder)
@@ -180,7 +178,7 @@ def load_result(folder: Path, table: Mapping[str, np.ndarray] | None = None, *, 
     if table is None:
         try:
             names = set(pq.read_schema(traces_path).names)
-        except (OSError, ValueError) as exc:
+        except (OSError, ValueError, pa.ArrowException) as exc:
             raise WashbenchError(located(traces_path, f"not a readable Parquet file ({exc})")) from None
     else:
         names = set(table)
@@ -198,14 +196,24 @@ def load_result(folder: Path, table: Mapping[str, np.ndarray] | None = None, *, 
     if table is None:
         try:
             arrow = pq.read_table(traces_path, columns=want, use_threads=False)
-        except (OSError, ValueError) as exc:
+        except (OSError, ValueError, pa.ArrowException) as exc:
             raise WashbenchError(located(traces_path, f"not a readable Parquet file ({exc})")) from None
-        table = {c: arrow.column(c).to_numpy() for c in want}
+        for c in want:  # read back as strictly as a user's input
+            kind = arrow.schema.field(c).type
+            numeric = pa.types.is_floating(kind) or pa.types.is_integer(kind) or pa.types.is_boolean(kind)
+            if not numeric or arrow.column(c).null_count:
+                what = f"holds {kind}, not numbers" if not numeric else "has empty values"
+                raise WashbenchError(located(traces_path, f"column {c!r} {what} (edited or damaged?)"))
+        table = {c: arrow.column(c).to_numpy(zero_copy_only=False) for c in want}
     t = np.asarray(table[TIME_COLUMN], dtype=np.float64)
     if t.shape[0] < 2:
         raise WashbenchError(located(traces_path, "fewer than 2 samples"))
-    run = _read_json(folder / "run.json") or {}
-    flight = _read_json(folder / "flight.json") or {}
+    if not (np.all(np.isfinite(t)) and np.all(np.diff(t) > 0)):
+        raise WashbenchError(located(traces_path, f"{TIME_COLUMN}: not finite and increasing (edited or damaged?)"))
+    from washbench.io.readback import FlightDoc, RunDoc, check_provenance
+
+    run = _read_json(folder / "run.json", RunDoc) or {}
+    flight = _read_json(folder / "flight.json", FlightDoc) or {}
     dt = float(run.get("dt_s") or flight.get("dt_s") or (t[-1] - t[0]) / (t.shape[0] - 1))
     perceived = {
         src: np.column_stack([table[c] for c in (*perceived_f_columns(src), *perceived_omega_columns(src))])
@@ -215,7 +223,10 @@ def load_result(folder: Path, table: Mapping[str, np.ndarray] | None = None, *, 
         w: {c.split(".sat_", 1)[1]: np.asarray(table[c]) != 0 for c in want if c.startswith(f"{w}.sat_")}
         for w in washouts
     }
-    prov = run.get("provenance") or read_parquet_provenance(traces_path)
+    if run.get("provenance"):
+        prov = check_provenance(run["provenance"], folder / "run.json")
+    else:
+        prov = check_provenance(read_parquet_provenance(traces_path), traces_path)
     limits = _limits_from(prov)
     usage = envelope_usage(table, washouts, limits) if limits is not None and series else {}
     motion_doc = run.get("perceived_motion")

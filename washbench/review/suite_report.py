@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import json
 import math
-import shutil
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -75,14 +74,19 @@ def write_suite_json(
 
 def _entries(suite_dir: Path) -> tuple[list[dict[str, Any]], dict[str, Any]]:
     """The manoeuvre entries and the suite document (suite.json, or found result folders without it)."""
+    from washbench.io.readback import SuiteDoc, read_doc, suite_member
+
     path = suite_dir / SUITE_FILE
-    if path.is_file():
-        try:
-            doc = json.loads(path.read_text(encoding="utf-8"))
-            return list(doc["manoeuvres"]), doc
-        except (OSError, ValueError, KeyError, TypeError) as exc:
-            raise WashbenchError(located(path, f"not a readable suite.json ({exc})")) from None
-    folders = sorted({p.parent for p in suite_dir.rglob("metrics.csv") if is_result_folder(p.parent)})
+    doc = read_doc(path, SuiteDoc)  # checked as strictly as a user's file
+    if doc is not None:
+        entries = list(doc["manoeuvres"])
+        for e in entries:  # every result inside the suite folder, through no link
+            if e.get("result"):
+                suite_member(suite_dir, e["result"], path)
+        return entries, doc
+    folders = sorted({p.parent for p in suite_dir.rglob("metrics.csv") if is_result_folder(p.parent)
+                      and not any(q.is_symlink() for q in (p.parent, *p.parent.parents) if q != suite_dir
+                                  and q.is_relative_to(suite_dir))})  # fmt: skip
     if not folders:
         raise WashbenchError(located(suite_dir, "neither a result folder nor a suite folder (no results found)"))
     return [{"file": "", "result": _rel(f, suite_dir)} for f in folders], {}
@@ -94,10 +98,26 @@ def write_suite_report(suite_dir: Path, *, regenerate_results: bool = False, fig
     ``regenerate_results`` (``washbench report``): first write every result folder's own report and figures again,
     and every figure as PNG and PDF; otherwise the PNG figures the runs wrote are linked and the suite's are PNG.
     """
-    from washbench.review.figures import score_heatmap, table4_figure
+
+    from washbench.io.outfolder import discard_stage, make_stage, replace_entries
 
     suite_dir = Path(suite_dir)
     entries, doc = _entries(suite_dir)
+    stage = make_stage(suite_dir)  # report.md and figures/ replace the previous ones together (links never followed)
+    try:
+        _write_suite_report(suite_dir, stage, entries, doc, regenerate_results, figures)
+        replace_entries(suite_dir, stage, [REPORT_FILE, FIGURES_DIR])
+    finally:
+        discard_stage(stage)
+    return suite_dir / REPORT_FILE
+
+
+def _write_suite_report(
+    suite_dir: Path, stage: Path, entries: list[dict[str, Any]], doc: dict[str, Any], regenerate_results: bool,
+    figures: bool,
+) -> None:  # fmt: skip
+    from washbench.review.figures import score_heatmap, table4_figure
+
     results: list[tuple[dict[str, Any], ResultData | None]] = []
     for e in entries:
         folder = suite_dir / e["result"] if e.get("result") else None
@@ -114,15 +134,10 @@ def write_suite_report(suite_dir: Path, *, regenerate_results: bool = False, fig
     rule = rule_from_record(prov.get("ranking") if isinstance(prov, dict) else None)
     rankings = {id(d): rank(d.metrics, d.motion, rule) for d in loaded}
 
-    fig_dir = suite_dir / FIGURES_DIR
+    fig_dir = stage / FIGURES_DIR
     if figures:
-        fig_dir.mkdir(exist_ok=True)
-    else:
-        shutil.rmtree(fig_dir, ignore_errors=True)
+        fig_dir.mkdir()
     formats = ("png", "pdf") if regenerate_results else ("png",)
-    if not regenerate_results and figures:
-        for stem in ("scores", "table4"):
-            (fig_dir / f"{stem}.pdf").unlink(missing_ok=True)
     drawn: dict[str, Path] = {}
     labels = [d.title + (" (FAILED)" if d.ok is False else "") + _tie_label(rankings[id(d)]) for d in loaded]
     if loaded and figures:
@@ -201,13 +216,14 @@ def write_suite_report(suite_dir: Path, *, regenerate_results: bool = False, fig
     if any_above:
         lines += [SCORE_NOTE, ""]
     if "scores" in drawn:
-        lines += _image(drawn["scores"], suite_dir, "score per manoeuvre and washout")
+        lines += _image(suite_dir / drawn["scores"].relative_to(stage), suite_dir, "score per manoeuvre and washout",
+                        regenerate_results)  # fmt: skip
     if "table4" in drawn:
         lines += [f"## Against {reference} (Table 4 of the paper)", ""]
         lines += [f"Each cell: how much better than {reference} the washout is, in percent of the "
                   f"{reference} value (positive, green: better). Absolute differences are in "
                   "`comparison.csv`.", ""]  # fmt: skip
-        lines += _image(drawn["table4"], suite_dir, "Table 4")
+        lines += _image(suite_dir / drawn["table4"].relative_to(stage), suite_dir, "Table 4", regenerate_results)
     lines += ["## How to read the numbers", "", *_HOW_TO_READ]
     for d in loaded:
         rel = _rel(d.folder, suite_dir)
@@ -217,20 +233,20 @@ def write_suite_report(suite_dir: Path, *, regenerate_results: bool = False, fig
         if d.ok is False:
             lines += [f"> **FAILED**: {d.reason or 'a check failed'}", ""]
         lines += result_sections(d, _existing_figures(d) if figures else {}, suite_dir, 3, brief=True)
-    path = suite_dir / REPORT_FILE
-    write_text_atomic(path, "\n".join(lines).rstrip() + "\n")
-    return path
+    write_text_atomic(stage / REPORT_FILE, "\n".join(lines).rstrip() + "\n")
 
 
 def _existing_figures(d: ResultData) -> dict[str, Path]:
-    """The result's figures as its report links them (drawn again when missing)."""
-    from washbench.review.report import result_figures
+    """The result's figures as its report links them (drawn again, with its report, when missing)."""
+    from washbench.review.report import write_result_report
 
-    found = {name: d.folder / FIGURES_DIR / f"{name}.png" for name in ("perceived", "envelope", "cues")}
-    found = {k: p for k, p in found.items() if p.is_file()}
-    if "perceived" not in found:
-        return result_figures(load_result(d.folder))  # with every series (the suite's tables read only a few)
-    return found
+    def found() -> dict[str, Path]:
+        paths = {name: d.folder / FIGURES_DIR / f"{name}.png" for name in ("perceived", "envelope", "cues")}
+        return {k: p for k, p in paths.items() if p.is_file() and not p.parent.is_symlink()}
+
+    if "perceived" not in found():
+        write_result_report(d.folder)  # staged: a link in the result folder is refused, never written through
+    return found()
 
 
 def _tie_label(ranking: Sequence[RankRow]) -> str:

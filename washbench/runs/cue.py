@@ -28,7 +28,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from washbench.analysis.metrics import MetricRow, dof_metrics
-from washbench.errors import WashbenchError, located
+from washbench.errors import WashbenchError, located, printable
 from washbench.io.atomic import atomic_path
 from washbench.io.input_format import InputFormat
 from washbench.io.names import check_identifier
@@ -630,9 +630,10 @@ def run_cue(
     """
     from washbench.cueing.bank import check_filter_start
     from washbench.cueing.variants import select_washouts
-    from washbench.io.lock import output_lock
+    from washbench.io.outfolder import check_out_path, result_set
     from washbench.platform import load_platform_limits
 
+    check_out_path(out_dir)
     opts = options or CueOptions()
     for flag, value in (("--max-gap-s", opts.max_gap_s), ("--resample", opts.resample_hz)):
         if value is not None and not (math.isfinite(value) and value > 0.0):
@@ -644,11 +645,11 @@ def run_cue(
     limits = load_platform_limits(platform_path)
     samples = read_input(input_path, opts.fmt)
     segments = prepare_segments(samples, opts)
-    with output_lock(out_dir):
+    with result_set(out_dir, "cue") as stage:  # the whole set replaces the previous one at once
         for seg in segments:
             for f in seg.findings:
                 where = f"{input_path}{f' ({seg.name})' if seg.name else ''}"
-                print(f"washbench: warning: {where}: {f.text}", file=sys.stderr)
+                print(f"washbench: warning: {printable(f'{where}: {f.text}')}", file=sys.stderr)
         from washbench.io.provenance import file_record, read_parquet_provenance
         from washbench.runs.pipeline import run_provenance
 
@@ -659,7 +660,8 @@ def run_cue(
         input_prov = read_parquet_provenance(input_path) if is_parquet else None
         if input_prov:
             prov["input"]["provenance"] = input_prov
-        done = write_outputs(out_dir, input_path, segments, specs, limits, opts, start, prov, progress=opts.progress)
+        done = write_outputs(stage, input_path, segments, specs, limits, opts, start, prov, progress=opts.progress)
+    out_dir = Path(out_dir)
     for seg, (summary, result) in zip(segments, done, strict=True):
         m = seg.motion
         label = f"{input_path}{f' {seg.name}' if seg.name else ''}"
@@ -672,5 +674,5 @@ def run_cue(
             print(f"  {name}: saturated samples: {sat}")
         if not summary.ok:
             print(f"  FAILED: {summary.reason}")
-        print(f"wrote {summary.run_dir}")
+        print(f"wrote {out_dir / summary.run_dir.relative_to(stage)}")
     return 0 if all(s.ok for s, _ in done) else 1

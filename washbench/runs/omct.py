@@ -27,7 +27,7 @@ from washbench.analysis import omct
 from washbench.analysis.omct_boundaries import BoundaryFile
 from washbench.analysis.signals import amplitude_unit, generate
 from washbench.cueing.variants import Washout
-from washbench.errors import WashbenchError, located
+from washbench.errors import WashbenchError
 from washbench.io.atomic import write_text_atomic
 from washbench.io.progress import Progress
 from washbench.io.results import csv_number
@@ -144,6 +144,11 @@ def measure(
         raise WashbenchError(f"--rate-hz {rate_hz}: {top:.4g} rad/s is at or above the Nyquist frequency")
     dt = 1.0 / rate_hz
     sigma = slowest_decay(entries)
+    from washbench.io.budget import check_samples
+
+    longest_s = max(omct.timing(w, sigma).duration_s for w in frequencies_radps)
+    check_samples(longest_s * rate_hz * len(entries), f"--rate-hz {rate_hz:g}: {len(entries)} washout(s) x "
+                  f"the longest OMCT run ({longest_s:.4g} s)")  # fmt: skip
     model = VestibularModel(dt, vestibular)
     raw: dict[tuple[str, str], list[tuple[float, float, str, complex, float, tuple[str, ...], complex, complex]]] = {}
     shown = Progress("omct", len(tests) * len(frequencies_radps), "test points") if progress else None
@@ -296,24 +301,21 @@ def run_entries(
     progress: bool = False,
 ) -> list[OmctPoint]:
     """Measure ``entries`` and write the results (the part of :func:`run_omct` a variant list can call)."""
+    from washbench.io.outfolder import result_set
+
     out_dir = Path(out_dir)
-    if out_dir.exists() and not out_dir.is_dir():
-        raise WashbenchError(located(out_dir, "output path exists and is not a folder"))
     bounds = boundary.bounds() if boundary else None
-    points, settings = measure(
-        entries, limits, rate_hz=rate_hz, boundaries=bounds, amplitude_scale=amplitude_scale, progress=progress
-    )
-    try:
-        out_dir.mkdir(parents=True, exist_ok=True)
+    with result_set(out_dir, "omct") as stage:  # the whole set replaces the previous one at once
+        points, settings = measure(
+            entries, limits, rate_hz=rate_hz, boundaries=bounds, amplitude_scale=amplitude_scale, progress=progress
+        )
         files: dict[str, str] = {}
         if plots:
             from washbench.review.bode import write_bode_plots
 
-            files = write_bode_plots(out_dir, points, boundary.bounds() if boundary else {}, [e.name for e in entries])
-        write_text_atomic(out_dir / CSV_FILE, csv_text(points))
-        write_text_atomic(out_dir / REPORT_FILE, report_text(points, settings, entries, boundary, files))
-    except OSError as exc:
-        raise WashbenchError(located(out_dir, f"cannot write results: {exc.strerror or exc}")) from None
+            files = write_bode_plots(stage, points, boundary.bounds() if boundary else {}, [e.name for e in entries])
+        write_text_atomic(stage / CSV_FILE, csv_text(points))
+        write_text_atomic(stage / REPORT_FILE, report_text(points, settings, entries, boundary, files))
     n_bad = sum(1 for p in points if not p.linear)
     print(
         f"OMCT: {len(entries)} washout{'s' if len(entries) != 1 else ''} x {len({p.test for p in points})} tests x "

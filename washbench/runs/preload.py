@@ -19,11 +19,13 @@ from washbench.cueing.kernel import bank_block, bank_step
 from washbench.numerics.jitcache import announce_compile
 from washbench.perception.sections import sections_apply, sections_apply_from, sections_run
 from washbench.review.thinning import _changes, _keep
+from washbench.runs.parent_death import die_with_parent
 
 # One line for the whole suite when a kernel its workers run is not compiled yet (after an install or upgrade):
 # the workers fork from here and inherit that it was said.
 announce_compile(bank_block, bank_step, sections_apply, sections_apply_from, sections_run, signal_metrics, _keep,
                  _changes)  # fmt: skip
+die_with_parent()  # the process server ends with the washbench command that started it (even on SIGKILL)
 
 # Only the serial steps are run here: a parallel (prange) kernel would start numba's OpenMP threads, and a process
 # using GNU OpenMP must not fork. The block step is the lockstep's; the per-sample step, JSBSim scripts'.

@@ -90,7 +90,10 @@ def load_flights(
         dirs = tuple(str(d) for d in aircraft_dirs)
         args = [(p, str(root), dirs) for p, _, _ in ids]
         if progress:
-            print(f"study: flying {len(args)} manoeuvre(s) once -> {root}", file=sys.stderr, flush=True)
+            from washbench.io.outfolder import STAGE_PREFIX
+
+            shown = root.parent.parent / FLIGHTS_DIR if root.parent.name.startswith(STAGE_PREFIX) else root
+            print(f"study: flying {len(args)} manoeuvre(s) once -> {shown}", file=sys.stderr, flush=True)
         for aircraft, name, ok, reason in _map(_fly_one, args, jobs, dask):
             status[(aircraft, name)] = (ok, reason)
             if progress:
@@ -116,11 +119,22 @@ def _map(fn, args: list[tuple], jobs: int | None, dask: str | None) -> list:
     jobs = max(1, min(jobs or usable_cpus(), len(args)))
     if jobs == 1:
         return [fn(*a) for a in args]
-    from washbench.runs.suite import pool_context
+    from washbench.runs.suite import _signals_deferred, _signals_held, _stop_pool, _worker_init, pool_context
 
-    ctx, initializer = pool_context()
-    with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=initializer) as pool:
-        return list(pool.map(fn, *zip(*args, strict=True)))
+    # As the suite's pool: the workers ignore Ctrl-C (no traceback from each), the main process stops them at once
+    # on SIGINT/SIGTERM, a signal while they start is acted on once they exist, and they die with their parent.
+    ctx, initializer = pool_context(main_stops_workers=True)
+    pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_init, initargs=(initializer,))
+    try:
+        with _signals_deferred():
+            futures = [pool.submit(fn, *a) for a in args]
+        results = [f.result() for f in futures]
+    except BaseException:
+        with _signals_held():
+            _stop_pool(pool)
+        raise
+    pool.shutdown(wait=True)
+    return results
 
 
 def _evaluate_task(

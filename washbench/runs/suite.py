@@ -34,7 +34,6 @@ import io
 import math
 import multiprocessing
 import os
-import shutil
 import signal
 import sys
 import time
@@ -59,7 +58,8 @@ from washbench.analysis.ranking import (
 from washbench.errors import Terminated, WashbenchError, located
 from washbench.io.atomic import write_text_atomic
 from washbench.io.cpus import usable_cpus
-from washbench.io.lock import LOCK_NAME, output_lock
+from washbench.io.lock import output_lock
+from washbench.io.outfolder import discard_stage, is_own_hidden, recover, swap_in
 from washbench.io.paths import MANOEUVRES_DIR, bundled_names, resolve_manoeuvre
 from washbench.io.progress import Progress
 from washbench.io.publish import clean_partials, is_leftover, is_washbench_result, read_marker
@@ -216,6 +216,13 @@ def _preload() -> None:
     import washbench.runs.preload  # noqa: F401
 
 
+def _die_with_parent() -> None:
+    """Worker initializer: the worker ends when its parent (the process server) does."""
+    from washbench.runs.parent_death import die_with_parent
+
+    die_with_parent()
+
+
 _QUIET_TRACKER = "ignore:resource_tracker:UserWarning"
 
 FIGURE_MODULES = ("matplotlib.figure", "matplotlib.backends.backend_agg")
@@ -242,7 +249,7 @@ def pool_context(
         first = ["washbench.runs.worker_signals"] if main_stops_workers else []
         optional = [*(FIGURE_MODULES if figures else ()), *(["rerun"] if recording else [])]
         ctx.set_forkserver_preload([*first, "washbench.runs.preload", *optional])
-        return ctx, None
+        return ctx, _die_with_parent
     return multiprocessing.get_context("spawn"), _preload
 
 
@@ -455,19 +462,24 @@ def check_unique_names(files: Sequence[Path], aircraft_dirs: Sequence[Path] = ()
     Files that do not load are left for the run to report. Raises WashbenchError naming both files.
     """
     from washbench.flight.manoeuvre import load_manoeuvre
+    from washbench.flight.scripts import is_script, load_script_info
 
     seen: dict[tuple[str, str], Path] = {}
     for path in files:
         try:
-            m = load_manoeuvre(path, aircraft_dirs)
+            if is_script(path):  # a JSBSim script's result folder is named after its file
+                info = load_script_info(path, aircraft_dirs)
+                key, where = (info.aircraft, info.name), f"{path}: the script's file name:"
+            else:
+                m = load_manoeuvre(path, aircraft_dirs)
+                key, where = (m.aircraft, m.name), m.located(("name",), "")[:-1]
         except WashbenchError:
             continue
-        key = (m.aircraft, m.name)
         if key in seen:
             raise WashbenchError(
-                m.located(("name",), f"'{m.name}' ({m.aircraft}) is also the name of {seen[key]}: both would "
-                          f"write {m.aircraft}/{m.name}/; give each manoeuvre its own name")
-            )  # fmt: skip
+                f"{where} '{key[1]}' ({key[0]}) is also the name of {seen[key]}: both would write "
+                f"{key[0]}/{key[1]}/; give each its own name"
+            )
         seen[key] = path
 
 
@@ -487,37 +499,25 @@ def previous_results(out_dir: Path) -> list[Path]:
     found: list[Path] = []
     for entry in sorted(out_dir.iterdir()):
         name = entry.name
-        if name == LOCK_NAME or is_leftover(name):
+        if is_own_hidden(name) or is_leftover(name):
             continue
+        if entry.is_symlink():  # never followed, never replaced (nor anything deleted through it)
+            raise WashbenchError(located(entry, "is a symbolic link: washbench never follows or replaces a link in "
+                                         "its output folder; remove it or choose another --out"))  # fmt: skip
         if name in SUITE_FILES or name == SUITE_MARKER or name in listed:
             found.append(entry)
             continue
-        if entry.is_dir() and not entry.is_symlink():
+        if entry.is_dir():
             subs = [e for e in entry.iterdir() if not is_leftover(e.name)]
-            if all(_is_run_folder(e, name) for e in subs):
+            if subs and all(_is_run_folder(e, name) for e in subs):  # an empty folder is the user's
                 found.append(entry)
                 continue
-            stranger = next(e for e in subs if not _is_run_folder(e, name))
-            entry = stranger
+            entry = next((e for e in subs if not _is_run_folder(e, name)), entry)
         raise WashbenchError(
             located(entry, "washbench did not write this: a suite replaces only a previous washbench result as a "
                     "whole; choose an empty or new --out folder")
         )  # fmt: skip
     return found
-
-
-def _swap_in(stage: Path, out_dir: Path, previous: Sequence[Path]) -> None:
-    """Replace ``previous`` entries of ``out_dir`` by everything in ``stage`` (renames, signals held)."""
-    with _signals_held():
-        old = out_dir / f".suite.old-{os.getpid()}"
-        old.mkdir()
-        for entry in previous:
-            if entry.exists() or entry.is_symlink():
-                os.replace(entry, old / entry.name)
-        for entry in sorted(stage.iterdir()):
-            os.replace(entry, out_dir / entry.name)
-        stage.rmdir()
-        shutil.rmtree(old, ignore_errors=True)
 
 
 def write_run_review(
@@ -603,10 +603,12 @@ def suite_command(
             announce_script(f, max_time_s, aircraft_dirs, washouts, variants, params_path, outputs)
     start = time.perf_counter()
     with output_lock(out_dir):
-        clean_partials(out_dir, only_dead=False)  # under the lock every leftover is stale
+        # under the lock every leftover is stale; a publication cut by a kill is finished. In a folder that holds
+        # no suite (no suite.json), only washbench's own leftovers: a hidden file there is the user's.
+        recover(out_dir, only_washbench=read_marker(out_dir, SUITE_MARKER) is None)
         previous = previous_results(out_dir)
         for entry in previous:
-            if entry.is_dir():
+            if entry.is_dir() and not entry.is_symlink():
                 clean_partials(entry, only_dead=False)
         stage = out_dir / f".suite.partial-{os.getpid()}"
         stage.mkdir()
@@ -628,9 +630,9 @@ def suite_command(
                 vestibular=vestibular,
             )
             write_suite_results(outcomes, stage, provenance, outputs.figures)
-            _swap_in(stage, out_dir, previous)
+            swap_in(stage, out_dir, previous)  # journalled, signals held: whole or not at all
         finally:
-            shutil.rmtree(stage, ignore_errors=True)
+            discard_stage(stage)  # unless a journal says it is being published (recover finishes it)
     n_ok = sum(o.run.ok for o in outcomes)
     print(
         f"suite: {n_ok}/{len(outcomes)} runs ok in {time.perf_counter() - start:.1f} s; report: {out_dir / 'report.md'}"

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import csv
 import io
+import math
 import sys
 import time
 from collections.abc import Sequence
@@ -33,6 +34,25 @@ def _csv(rows: list[list[str]]) -> str:
     return buf.getvalue()
 
 
+#: Largest grid (points times washouts) a sweep runs without ``--force``.
+MAX_POINTS = 2000
+#: Largest grid even with ``--force`` (its parameter sets alone would fill the memory).
+MAX_POINTS_FORCED = 1_000_000
+
+
+def check_grid_size(n_points: int, n_flights: int, force: bool, say: bool = True) -> None:
+    """Say how big the grid is (and refuse one beyond :data:`MAX_POINTS` without ``force``) before any work."""
+    if n_points > MAX_POINTS_FORCED:
+        raise WashbenchError(f"sweep: the grid has {n_points} points, more than the {MAX_POINTS_FORCED} washbench runs")
+    if n_points > MAX_POINTS and not force:
+        raise WashbenchError(
+            f"sweep: the grid has {n_points} points (x {n_flights} flight(s)), more than {MAX_POINTS}: give --force "
+            "to run it anyway, or fewer --set values"
+        )
+    if say:
+        print(f"sweep: {n_points} grid point(s) x {n_flights} flight(s)", file=sys.stderr, flush=True)
+
+
 def sweep_command(
     manoeuvres: Sequence[Path],
     out_dir: Path,
@@ -46,8 +66,11 @@ def sweep_command(
     dask: str | None = None,
     progress: bool = True,
     aircraft_dirs: Sequence[Path] = (),
+    force: bool = False,
 ) -> int:
-    """CLI entry of ``washbench sweep``; 0 when every flight ran and passed its checks, 1 otherwise."""
+    """CLI entry of ``washbench sweep``; 0 when every flight ran and passed its checks, 1 otherwise.
+
+    A grid of more than :data:`MAX_POINTS` points (over all washouts) needs ``force`` (``--force``)."""
     from washbench.cueing.variants import load_param_file
     from washbench.platform import load_platform_limits
     from washbench.runs.study import evaluate, load_flights
@@ -57,42 +80,47 @@ def sweep_command(
     if not sets:
         raise WashbenchError("sweep: give at least one --set KEY=V1,V2,...")
     axes = [parse_set(s) for s in sets]
+    kinds = list(dict.fromkeys(washouts or WASHOUT_NAMES))
+    files = find_manoeuvres(manoeuvres)
+    n_points = math.prod(len(a.values) for a in axes) * len(kinds)
+    check_grid_size(n_points, len(files), force, progress)  # before building the grid
     points = grid(axes)
     keys = [a.key for a in axes]
-    kinds = list(dict.fromkeys(washouts or WASHOUT_NAMES))
     base, _ = load_param_file(params_path)
     candidates = [w for k in kinds for w in point_washouts(k, base, points)]
     limits = load_platform_limits(platform_path)
-    files = find_manoeuvres(manoeuvres)
-    flights = load_flights(files, out_dir, limits, from_dir=from_dir, jobs=jobs, dask=dask, progress=progress,
-        aircraft_dirs=aircraft_dirs,
-    )
-    t_eval = time.perf_counter()
-    total = sum(f.evaluator.n for f in flights) * len(candidates)
-    shown = Progress("sweep", total, "steps") if progress else None
-    try:
-        results = evaluate(flights, candidates, dask, shown)
-    finally:
-        if shown is not None:
-            shown.close()
-    t_eval = time.perf_counter() - t_eval
-    rows = [
-        SweepRow(points[i % len(points)], kinds[i // len(points)], f.aircraft, f.manoeuvre, ev, i)
-        for f, ev in zip(flights, results, strict=True)
-        for i in range(len(candidates))
-    ]
-    rows.sort(key=lambda r: (r.index, r.aircraft, r.manoeuvre))  # grid point by grid point
-    out_dir.mkdir(parents=True, exist_ok=True)
-    write_text_atomic(out_dir / "sweep.csv", _csv(sweep_csv(keys, rows)))
-    write_text_atomic(out_dir / "sweep_metrics.csv", _csv(sweep_metrics_csv(keys, rows)))
-    from washbench.review.study_figures import sweep_figure
+    from washbench.io.outfolder import result_set
 
-    sweep_figure(out_dir / "sweep.png", keys, rows)
+    with result_set(out_dir, "sweep") as stage:  # the whole set replaces the previous one at once
+        flights = load_flights(files, stage, limits, from_dir=from_dir, jobs=jobs, dask=dask, progress=progress,
+            aircraft_dirs=aircraft_dirs,
+        )
+        t_eval = time.perf_counter()
+        total = sum(f.evaluator.n for f in flights) * len(candidates)
+        shown = Progress("sweep", total, "steps") if progress else None
+        try:
+            results = evaluate(flights, candidates, dask, shown)
+        finally:
+            if shown is not None:
+                shown.close()
+        t_eval = time.perf_counter() - t_eval
+        rows = [
+            SweepRow(points[i % len(points)], kinds[i // len(points)], f.aircraft, f.manoeuvre, ev, i)
+            for f, ev in zip(flights, results, strict=True)
+            for i in range(len(candidates))
+        ]
+        rows.sort(key=lambda r: (r.index, r.aircraft, r.manoeuvre))  # grid point by grid point
+        write_text_atomic(stage / "sweep.csv", _csv(sweep_csv(keys, rows)))
+        write_text_atomic(stage / "sweep_metrics.csv", _csv(sweep_metrics_csv(keys, rows)))
+        from washbench.review.study_figures import sweep_figure
+
+        sweep_figure(stage / "sweep.png", keys, rows)
+    out_dir = Path(out_dir)
     n_eval = len(candidates) * len(flights)
     steps = sum(f.evaluator.n for f in flights) * len(candidates)
     print(
         f"sweep: {len(points)} grid point(s) x {len(kinds)} washout(s) x {len(flights)} flight(s) = {n_eval} "
-        f"evaluations ({steps / t_eval / 1e6:.2f} M steps/s) in {time.perf_counter() - start:.1f} s; "
+        f"evaluations ({steps / max(t_eval, 1e-9) / 1e6:.2f} M steps/s) in {time.perf_counter() - start:.1f} s; "
         f"wrote {out_dir / 'sweep.csv'}, sweep_metrics.csv, sweep.png"
     )
     failed = [f for f in flights if not f.ok]

@@ -20,6 +20,7 @@ import time
 from collections.abc import Sequence
 from datetime import UTC, datetime
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import yaml
@@ -69,7 +70,6 @@ def tune_command(
     """CLI entry of ``washbench tune``; 0 on success (the flights' own check results are reported, not fatal)."""
     from washbench.cueing.variants import load_param_file
     from washbench.platform import load_platform_limits
-    from washbench.runs.study import evaluate, load_flights
     from washbench.runs.suite import find_manoeuvres
 
     start = time.perf_counter()
@@ -80,10 +80,18 @@ def tune_command(
         raise WashbenchError(f"--saturation-weight: expected a number >= 0, got {saturation_weight}")
     if budget < 6:
         raise WashbenchError(f"--budget: expected at least 6 evaluations (1 for the starting set), got {budget}")
+    if not 0 <= seed < 2**32:
+        raise WashbenchError(f"--seed: expected a whole number from 0 to {2**32 - 1}, got {seed}")
     bounds = [parse_tune(t) for t in tunes]
     keys = [b.key for b in bounds]
     if len(set(keys)) != len(keys):
         raise WashbenchError(f"--tune: a key is tuned twice: {', '.join(keys)}")
+    if budget < 1 + 5 * len(keys):
+        raise WashbenchError(
+            f"--budget {budget} is too small for {len(keys)} tuned key(s): differential evolution needs a first "
+            f"population of at least 5 evaluations per key besides the starting set (--budget {1 + 5 * len(keys)} "
+            "or more)"
+        )
     base, _ = load_param_file(params_path)
     for b in bounds:  # both ends must be valid values of the key
         for v in (b.low, b.high):
@@ -91,6 +99,33 @@ def tune_command(
     limits = load_platform_limits(platform_path)
     train_files = find_manoeuvres(manoeuvres)
     test_files = [p for p in (find_manoeuvres(test) if test else []) if p not in train_files]
+    from washbench.io.outfolder import result_set
+
+    with result_set(out_dir, "tune") as stage:  # the whole set replaces the previous one at once
+        best_x, best, base_obj, train, table = _tune(
+            stage, base, kind, bounds, keys, train_files, test_files, limits, budget, seed, saturation_weight,
+            manoeuvres, from_dir, jobs, dask, progress, aircraft_dirs,
+        )  # fmt: skip
+    print(
+        f"tune: {kind}, {best[4]} evaluations on {len(train)} training flight(s) in "
+        f"{time.perf_counter() - start:.1f} s; objective {base.name} {base_obj:.4f} -> tuned {best[3]:.4f} "
+        f"({', '.join(f'{k}={v:.6g}' for k, v in zip(keys, best_x, strict=True))}); "
+        f"wrote {Path(out_dir) / 'tuned.yaml'}"
+    )
+    for line in score_lines(base.name, table):
+        print(line)
+    return 0
+
+
+def _tune(
+    out_dir: Path, base: Any, kind: str, bounds: list[Any], keys: list[str], train_files: list[Path],
+    test_files: list[Path], limits: Any, budget: int, seed: int, saturation_weight: float,
+    manoeuvres: Sequence[Path], from_dir: Path | None, jobs: int | None, dask: str | None, progress: bool,
+    aircraft_dirs: Sequence[Path],
+) -> tuple[Any, ...]:  # fmt: skip
+    """Fly, tune and write into ``out_dir`` (the stage); (best_x, best history row + count, base objective, ...)."""
+    from washbench.runs.study import evaluate, load_flights
+
     flights = load_flights(
         [*train_files, *test_files],
         out_dir,
@@ -141,15 +176,8 @@ def tune_command(
         for f, r in zip(fl, evaluate(fl, both, dask) if fl else [], strict=True):
             table.append((group, f.aircraft, f.manoeuvre, r))
     _report(out_dir, base, tuned, kind, bounds, best_x, table, history, base_obj, budget, seed, saturation_weight)
-    best = min(history, key=lambda h: h[3])
-    print(
-        f"tune: {kind}, {len(history)} evaluations on {len(train)} training flight(s) in "
-        f"{time.perf_counter() - start:.1f} s; objective {base.name} {base_obj:.4f} -> tuned {best[3]:.4f} "
-        f"({', '.join(f'{k}={v:.6g}' for k, v in zip(keys, best_x, strict=True))}); wrote {out_dir / 'tuned.yaml'}"
-    )
-    for line in score_lines(base.name, table):
-        print(line)
-    return 0
+    best = (*min(history, key=lambda h: h[3]), len(history))
+    return best_x, best, base_obj, train, table
 
 
 def score_lines(base_name: str, table: list) -> list[str]:

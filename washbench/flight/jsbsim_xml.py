@@ -1,0 +1,126 @@
+"""What JSBSim is given to read: XML checked first, and its ``<output>`` directives taken out.
+
+A JSBSim script (``<runscript>``) or aircraft (``<fdm_config>``) may hold ``<output>`` directives: JSBSim then
+writes CSV files wherever they say (a path climbing out of any folder, an absolute path onto an existing file)
+or opens TCP/UDP sockets, at load time. washbench records the flight itself, so these directives are switched
+off: JSBSim reads a copy without them (a script in a temporary folder; an aircraft in a temporary aircraft
+folder that links every other file of the model's folder), and washbench says so on standard error. Nothing
+is ever written by JSBSim and no socket is opened.
+
+Before JSBSim sees a file, :func:`read_xml` parses it with Python's expat, at most :data:`MAX_XML_BYTES`,
+accepting only plain internal text entities (JSBSim's scripts name constants so) and refusing entities that
+refer to entities (a "billion laughs" DTD), external and parameter entities: a malformed, empty or hostile
+file is one line naming the file and line, never a parser traceback or an exhausted memory.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import xml.etree.ElementTree as ET
+import xml.parsers.expat as expat
+from pathlib import Path
+
+from washbench.errors import WashbenchError, located, printable
+
+#: Largest XML file read (JSBSim's biggest aircraft file is about 1 MB).
+MAX_XML_BYTES = 32 * 1024 * 1024
+
+
+class _RefusedError(Exception):
+    pass
+
+
+def _plain_entity(
+    name: str, parameter: bool, value: str | None, base: str | None, system: str | None, public: str | None,
+    notation: str | None,
+) -> None:  # fmt: skip
+    """Accept only a plain internal text entity (JSBSim's scripts name constants so); refuse the rest."""
+    if parameter or value is None or system or public or notation:
+        raise _RefusedError(f"entity {name!r}: only plain text entities are accepted (no external or parameter ones)")
+    if "&" in value or len(value) > 1024:
+        raise _RefusedError(f"entity {name!r} refers to other entities or is longer than 1024 characters (refused: "
+                            "an entity expansion bomb)")  # fmt: skip
+
+
+def read_xml(path: str | Path) -> ET.Element:
+    """The root element of XML file ``path``; WashbenchError (file, line, what) if it is not plain, well-formed XML."""
+    from washbench.io.budget import read_bounded
+
+    path = Path(path)
+    try:
+        data = read_bounded(path, MAX_XML_BYTES)
+    except FileNotFoundError:
+        raise WashbenchError(located(path, "no such file")) from None
+    except IsADirectoryError:
+        raise WashbenchError(located(path, "is a folder, not a file")) from None
+    except OSError as exc:
+        raise WashbenchError(located(path, f"cannot read: {exc.strerror or exc}")) from None
+    if not data.strip():
+        raise WashbenchError(located(path, "the file is empty"))
+    builder = ET.TreeBuilder()
+    parser = expat.ParserCreate()
+    parser.StartElementHandler = builder.start
+    parser.EndElementHandler = builder.end
+    parser.CharacterDataHandler = builder.data
+    parser.EntityDeclHandler = _plain_entity
+    try:
+        parser.Parse(data, True)
+        return builder.close()
+    except _RefusedError as exc:
+        raise WashbenchError(located(path, str(exc), line=parser.CurrentLineNumber)) from None
+    except expat.ExpatError as exc:
+        what = expat.errors.messages.get(exc.code, str(exc))
+        raise WashbenchError(located(path, f"not well-formed XML ({what})", line=exc.lineno)) from None
+
+
+def _strip(root: ET.Element) -> int:
+    found = root.findall("output")
+    for elem in found:
+        root.remove(elem)
+    return len(found)
+
+
+def _note(path: Path, n: int) -> None:
+    print(
+        printable(f"washbench: note: {path}: {n} JSBSim <output> directive(s) switched off (washbench records the "
+                  "flight itself; no file is written and no socket opened by JSBSim)"),
+        file=sys.stderr,
+    )  # fmt: skip
+
+
+def script_for_jsbsim(path: Path, tmp: Path) -> Path:
+    """``path`` if its ``<runscript>`` has no ``<output>``; else a copy without them in folder ``tmp``."""
+    root = read_xml(path)
+    n = _strip(root)
+    if not n:
+        return path
+    copy = tmp / path.name
+    ET.ElementTree(root).write(copy, encoding="utf-8", xml_declaration=True)
+    _note(path, n)
+    return copy
+
+
+def aircraft_for_jsbsim(aircraft_root: Path, name: str, tmp: Path) -> Path:
+    """The aircraft folder to give JSBSim for model ``name``: ``aircraft_root`` if ``<name>/<name>.xml`` holds
+    no ``<output>``; else ``tmp`` holding ``<name>/`` with the file without them and links to the rest.
+
+    The model file is checked with :func:`read_xml` either way.
+    """
+    model = aircraft_root / name / f"{name}.xml"
+    root = read_xml(model)
+    if root.tag != "fdm_config":
+        raise WashbenchError(
+            located(model, f"not a JSBSim aircraft: the root element is <{root.tag}>, not <fdm_config>")
+        )
+    n = _strip(root)
+    if not n:
+        return aircraft_root
+    folder = tmp / name
+    folder.mkdir(parents=True, exist_ok=True)
+    for entry in (aircraft_root / name).iterdir():
+        if entry.name != model.name:
+            os.symlink(entry.resolve(), folder / entry.name)
+    ET.ElementTree(root).write(folder / model.name, encoding="utf-8", xml_declaration=True)
+    _note(model, n)
+    return tmp

@@ -1,0 +1,308 @@
+"""One way to own, build and publish an output folder: every command that writes a result set into ``--out``.
+
+:func:`result_set` is what ``cue``, ``fly``, ``sweep``, ``tune``, ``omct`` and ``examples`` write through (and
+``report`` through :func:`replace_entries`; ``run`` and ``suite`` share the lock, :func:`recover` and
+:func:`swap_in`):
+
+1. the lock (:func:`washbench.io.lock.output_lock`: created with ``O_CREAT|O_EXCL|O_NOFOLLOW``, a link refused);
+2. :func:`recover`: what a killed command left is removed (hidden stage and old folders, ``.*.tmp`` files,
+   ``.NAME.partial-PID`` folders), or, if it was killed in the middle of publishing, the publication finished
+   from its journal, so the folder holds one whole result set, never a mix;
+3. :func:`owned_entries`: everything in the folder must be listed in the manifest ``.washbench.json`` a
+   previous run of the same command wrote; anything else (a user's file of the same name as a result, a
+   symbolic link) is refused with one line before any work, and left untouched;
+4. the command writes into a fresh hidden stage folder ``OUT/.washbench-stage-PID`` (inside ``--out``, so no
+   link in ``--out`` is ever followed: every file is created inside a folder washbench just made);
+5. :func:`swap_in`: with SIGINT and SIGTERM held back, a journal is written, the previous entries are renamed
+   into a hidden old folder, the new ones renamed into place, the journal removed, the old folder deleted
+   (``shutil.rmtree`` never follows links). A signal during the swap takes effect once the set is whole.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import re
+import shutil
+import signal
+import threading
+from collections.abc import Iterator, Sequence
+from pathlib import Path
+
+from washbench.errors import WashbenchError, located
+
+#: The manifest: which command wrote the folder and every top-level name it wrote.
+MANIFEST = ".washbench.json"
+STAGE_PREFIX = ".washbench-stage-"
+OLD_PREFIX = ".washbench-old-"
+JOURNAL_PREFIX = ".washbench-swap-"
+_TMP = re.compile(r"^\..+\.tmp$")
+_LEGACY = re.compile(r"^\..+\.(?:partial|old)-\d+$")
+
+
+def _why(exc: OSError) -> str:
+    return exc.strerror or type(exc).__name__
+
+
+def is_own_hidden(name: str) -> bool:
+    """Names washbench keeps in an output folder besides the results (lock, manifest, leftovers)."""
+    from washbench.io.lock import LOCK_NAME
+
+    return (
+        name in (LOCK_NAME, MANIFEST)
+        or name.startswith((STAGE_PREFIX, OLD_PREFIX, JOURNAL_PREFIX, ".washbench-probe-"))
+        or _TMP.match(name) is not None
+        or _LEGACY.match(name) is not None
+    )
+
+
+def remove_tree(path: Path) -> None:
+    """Remove a file, link or folder (a link is removed itself, never followed)."""
+    with contextlib.suppress(FileNotFoundError):
+        if path.is_dir() and not path.is_symlink():
+            shutil.rmtree(path, ignore_errors=True)
+        else:
+            path.unlink()
+
+
+def recover(out_dir: Path, *, only_washbench: bool = False) -> None:
+    """Finish or remove what an interrupted command left in ``out_dir`` (call it holding the folder's lock).
+
+    A journal ``.washbench-swap-PID`` means the command was killed while publishing: its publication is
+    finished (the stage was complete). Every other leftover (stage, old folders, ``.*.tmp``, legacy
+    ``.NAME.partial-PID``/``.NAME.old-PID``) is removed; so are ``.*.tmp`` files one level down.
+    ``only_washbench`` (a folder of the user's, ``washbench examples``): only ``.washbench-*`` leftovers.
+    """
+    for journal in sorted(out_dir.glob(JOURNAL_PREFIX + "*")):
+        _roll_forward(out_dir, journal)
+    for entry in list(out_dir.iterdir()):
+        name = entry.name
+        if only_washbench:
+            if name.startswith((STAGE_PREFIX, OLD_PREFIX, ".washbench-probe-", ".suite.partial-", ".suite.old-")):
+                remove_tree(entry)
+            continue
+        if name.startswith((STAGE_PREFIX, OLD_PREFIX, ".washbench-probe-")) or _LEGACY.match(name) or _TMP.match(name):
+            remove_tree(entry)
+        elif entry.is_dir() and not entry.is_symlink():
+            for sub in list(entry.iterdir()):
+                if _TMP.match(sub.name) or _LEGACY.match(sub.name):
+                    remove_tree(sub)
+
+
+def _roll_forward(out_dir: Path, journal: Path) -> None:
+    try:
+        doc = json.loads(journal.read_text(encoding="utf-8"))
+        previous, new = list(doc["previous"]), list(doc["new"])
+        stage, old = out_dir / str(doc["stage"]), out_dir / str(doc["old"])
+    except (OSError, ValueError, KeyError, TypeError):
+        remove_tree(journal)
+        return
+    plain = all("/" not in p.name and p.parent == out_dir for p in (stage, old))
+    if not (plain and stage.name.startswith((STAGE_PREFIX, ".suite.partial-")) and old.name.startswith(OLD_PREFIX)):
+        remove_tree(journal)  # not a journal washbench wrote: nothing is moved by it
+        return
+    safe = [n for n in (*previous, *new) if isinstance(n, str) and "/" not in n and n not in ("", ".", "..")]
+    old.mkdir(exist_ok=True)
+
+    def present(path: Path) -> bool:
+        return path.exists() or path.is_symlink()
+
+    for name in previous:  # an old entry still in place goes, unless the new one already replaced it
+        if name in safe and present(out_dir / name) and (name not in new or present(stage / name)):
+            os.replace(out_dir / name, old / name)
+    for name in new:
+        if name in safe and present(stage / name):
+            os.replace(stage / name, out_dir / name)
+    remove_tree(journal)
+    remove_tree(old)
+    remove_tree(stage)
+
+
+def read_manifest(out_dir: Path) -> tuple[str, list[str]] | None:
+    """(command, top-level names) from ``out_dir/.washbench.json``, or None if missing or not washbench's."""
+    path = out_dir / MANIFEST
+    if path.is_symlink() or not path.is_file():
+        return None
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    if not isinstance(doc, dict) or not isinstance(doc.get("command"), str) or not isinstance(doc.get("entries"), list):
+        return None
+    names = [n for n in doc["entries"] if isinstance(n, str) and "/" not in n and n not in ("", ".", "..")]
+    return doc["command"], names
+
+
+def owned_entries(out_dir: Path, command: str) -> list[Path]:
+    """The entries of ``out_dir`` a new result set of ``command`` replaces (those its manifest lists).
+
+    Raises WashbenchError (one line, naming the entry) for anything else: a file or folder washbench did
+    not write, another command's result set, or a symbolic link (never followed, never replaced).
+    """
+    manifest = read_manifest(out_dir)
+    listed: set[str] = set()
+    if manifest is not None:
+        if manifest[0] != command:
+            raise WashbenchError(located(
+                out_dir, f"holds the results of `washbench {manifest[0]}`, not of `washbench {command}`: not "
+                "replaced; choose another --out"))  # fmt: skip
+        listed = set(manifest[1])
+    found: list[Path] = []
+    from washbench.io.lock import LOCK_NAME
+
+    for entry in sorted(out_dir.iterdir()):
+        if is_own_hidden(entry.name) and (manifest is not None or entry.name == LOCK_NAME):
+            continue  # in a folder without a manifest, a hidden file is the user's unless it is the lock
+        if entry.is_symlink():
+            raise WashbenchError(located(entry, "is a symbolic link: washbench never follows or replaces a link in "
+                                         "its output folder; remove it or choose another --out"))  # fmt: skip
+        if entry.name not in listed:
+            raise WashbenchError(located(entry, "washbench did not write this (not listed in .washbench.json): "
+                                         "not replaced; move it away or choose an empty or new --out"))  # fmt: skip
+        found.append(entry)
+    return found
+
+
+@contextlib.contextmanager
+def signals_held() -> Iterator[None]:
+    """Hold SIGINT and SIGTERM back for a short critical section: noted, and acted on (KeyboardInterrupt or
+    :class:`washbench.errors.Terminated`) once it is over; never lost, never in the middle."""
+    if threading.current_thread() is not threading.main_thread():  # handlers run in the main thread only
+        yield
+        return
+    noted: list[int] = []
+
+    def note(signum: int, frame: object) -> None:
+        noted.append(signum)
+
+    saved = {sig: signal.signal(sig, note) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for sig, handler in saved.items():
+            signal.signal(sig, handler)
+    if noted:
+        from washbench.errors import Terminated
+
+        raise KeyboardInterrupt if noted[0] == signal.SIGINT else Terminated()
+
+
+def discard_stage(stage: Path) -> None:
+    """Remove ``stage`` unless a journal says its publication is under way (then :func:`recover` finishes it)."""
+    if not (stage.parent / f"{JOURNAL_PREFIX}{os.getpid()}").exists():
+        remove_tree(stage)
+
+
+def make_stage(out_dir: Path) -> Path:
+    """A new empty hidden folder inside ``out_dir`` to build a result set in."""
+    stage = out_dir / f"{STAGE_PREFIX}{os.getpid()}"
+    remove_tree(stage)
+    try:
+        stage.mkdir()
+    except OSError as exc:
+        raise WashbenchError(located(out_dir, f"cannot create a folder to build the results in: {_why(exc)}")) from None
+    return stage
+
+
+def write_manifest(stage: Path, command: str, extra: Sequence[str] = ()) -> None:
+    """``stage/.washbench.json``: the command and every top-level name of the set (``extra`` too)."""
+    names = sorted({e.name for e in stage.iterdir() if not is_own_hidden(e.name)} | set(extra))
+    text = json.dumps({"washbench": 1, "command": command, "entries": names}, indent=2) + "\n"
+    try:
+        (stage / MANIFEST).write_text(text, encoding="utf-8")
+    except OSError as exc:
+        raise WashbenchError(located(stage.parent / MANIFEST, f"cannot write: {_why(exc)}")) from None
+
+
+def swap_in(stage: Path, out_dir: Path, previous: Sequence[Path]) -> None:
+    """Replace the ``previous`` entries of ``out_dir`` by everything in ``stage``, as one step.
+
+    Journalled (a kill in the middle is finished by the next :func:`recover`) and with SIGINT/SIGTERM held.
+    """
+    pid = os.getpid()
+    old = out_dir / f"{OLD_PREFIX}{pid}"
+    journal = out_dir / f"{JOURNAL_PREFIX}{pid}"
+    new = sorted(e.name for e in stage.iterdir())
+    doc = {"stage": stage.name, "old": old.name, "previous": [p.name for p in previous], "new": new}
+    with signals_held():
+        try:
+            tmp = journal.with_name(f"{journal.name}.tmp")
+            tmp.write_text(json.dumps(doc), encoding="utf-8")
+            os.replace(tmp, journal)
+            old.mkdir(exist_ok=True)
+            for entry in previous:
+                if entry.exists() or entry.is_symlink():
+                    os.replace(entry, old / entry.name)
+            for name in new:
+                os.replace(stage / name, out_dir / name)
+            journal.unlink()
+        except OSError as exc:
+            raise WashbenchError(located(out_dir, f"cannot publish the results: {_why(exc)}")) from None
+        finally:
+            if not journal.exists():
+                remove_tree(old)
+                remove_tree(stage)
+
+
+def check_out_path(out: str | Path) -> Path:
+    """``--out`` as a Path; an empty string is refused (it would mean the current folder)."""
+    if str(out) == "":
+        raise WashbenchError("--out: an empty path; name a folder (use . for the current folder)")
+    return Path(out)
+
+
+@contextlib.contextmanager
+def result_set(out: str | Path, command: str) -> Iterator[Path]:
+    """Own ``out`` for one result set of ``command``; yield the stage folder to write the set into.
+
+    Lock, recover, refuse foreign entries (before the caller does any work), build in the stage, then publish
+    the whole set at once with its manifest (:func:`swap_in`). On an exception (a signal included) nothing is
+    published and the previous set stays as it was; a folder created here is removed again if left empty.
+    """
+    from washbench.io.lock import output_lock
+
+    with output_lock(check_out_path(out)) as out_dir:
+        foreign = read_manifest(out_dir) is None  # not (yet) washbench's: only its own .washbench-* leftovers go
+        recover(out_dir, only_washbench=foreign)
+        previous = owned_entries(out_dir, command)
+        stage = make_stage(out_dir)
+        try:
+            yield stage
+            write_manifest(stage, command)
+            swap_in(stage, out_dir, previous)
+        except WashbenchError as exc:  # name the files where they were going, not the hidden stage
+            shown = [_unstaged(p, stage, out_dir) for p in exc.problems]
+            raise WashbenchError(shown[0], shown[1:]) from None
+        finally:
+            discard_stage(stage)
+
+
+_TMP_PART = re.compile(r"/\.([^/]+?)\.[A-Za-z0-9_]{8}\.tmp\b")
+
+
+def _unstaged(message: str, stage: Path, out_dir: Path) -> str:
+    """``message`` with the stage folder and temporary file names replaced by the published ones."""
+    return _TMP_PART.sub(r"/\1", message.replace(str(stage), str(out_dir)))
+
+
+def replace_entries(folder: Path, stage: Path, names: Sequence[str]) -> None:
+    """Publish ``stage``'s entries into ``folder`` replacing the entries ``names`` (``washbench report``).
+
+    Each of ``names`` present in ``folder`` must not be a symbolic link (refused, one line). A manifest in
+    ``folder`` is rewritten to list the new entries too.
+    """
+    previous = []
+    for name in names:
+        entry = folder / name
+        if entry.is_symlink():
+            raise WashbenchError(located(entry, "is a symbolic link: washbench never follows or replaces a link in "
+                                         "a result folder; remove it"))  # fmt: skip
+        if entry.exists():
+            previous.append(entry)
+    manifest = read_manifest(folder)
+    if manifest is not None:
+        listed = set(manifest[1]) | {e.name for e in stage.iterdir()}
+        write_manifest(stage, manifest[0], sorted(listed))
+        previous.append(folder / MANIFEST)
+    swap_in(stage, folder, previous)
