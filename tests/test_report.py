@@ -204,7 +204,7 @@ def test_cue_results_get_the_same_report(run_dir: Path, tmp_path: Path) -> None:
     assert sha256(run_dir / "flight.parquet") in text and flown["manoeuvre"]["sha256"] in text
     assert "| sa_slow_tilt |" in text and "sa_slow_tilt vs small-angle (% better)" in text
     assert "| washouts | small-angle, sa_slow_tilt (small-angle) with its own values |" in text
-    assert check_images(out / "report.md") == 3  # a cue's report shows the input as read first, then the run's two
+    assert check_images(out / "report.md") == 4  # input as read, perceived, cues, envelope
     assert text.split("\n## ")[1].startswith("Input as read")
 
 

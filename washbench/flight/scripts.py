@@ -179,6 +179,11 @@ def _mb(x: float) -> str:
     return f"{x:.2g}" if x < 10 else f"{x:,.0f}"
 
 
+def plan_limit_s(max_time_s: float | None) -> float:
+    """The simulated time a script is flown for at most: ``--max-time-s``, else :data:`DEFAULT_MAX_TIME_S`."""
+    return DEFAULT_MAX_TIME_S if max_time_s is None else max_time_s
+
+
 def script_plan(info: ScriptInfo, max_time_s: float | None, washouts: int = 3, recording: bool = True) -> ScriptPlan:
     """The plan of flying ``info`` with ``--max-time-s`` ``max_time_s`` (None: up to :data:`DEFAULT_MAX_TIME_S`)."""
     capped = max_time_s is None and info.end_s > DEFAULT_MAX_TIME_S

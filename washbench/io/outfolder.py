@@ -134,11 +134,13 @@ def read_manifest(out_dir: Path) -> tuple[str, list[str]] | None:
     return doc["command"], names
 
 
-def owned_entries(out_dir: Path, command: str) -> list[Path]:
+def owned_entries(out_dir: Path, command: str, adopt: Sequence[str] = ()) -> list[Path]:
     """The entries of ``out_dir`` a new result set of ``command`` replaces (those its manifest lists).
 
     Raises WashbenchError (one line, naming the entry) for anything else: a file or folder washbench did
-    not write, another command's result set, or a symbolic link (never followed, never replaced).
+    not write, another command's result set, or a symbolic link (never followed, never replaced). ``adopt``:
+    names the command itself is writing there for the new set (``washbench live``'s saved input), neither
+    refused nor replaced.
     """
     manifest = read_manifest(out_dir)
     listed: set[str] = set()
@@ -154,6 +156,8 @@ def owned_entries(out_dir: Path, command: str) -> list[Path]:
     for entry in sorted(out_dir.iterdir()):
         if is_own_hidden(entry.name) and (manifest is not None or entry.name == LOCK_NAME):
             continue  # in a folder without a manifest, a hidden file is the user's unless it is the lock
+        if entry.name in adopt and entry.is_file() and not entry.is_symlink():
+            continue
         if entry.is_symlink():
             raise WashbenchError(located(entry, "is a symbolic link: washbench never follows or replaces a link in "
                                          "its output folder; remove it or choose another --out"))  # fmt: skip
@@ -253,22 +257,27 @@ def check_out_path(out: str | Path) -> Path:
 
 
 @contextlib.contextmanager
-def result_set(out: str | Path, command: str) -> Iterator[Path]:
+def result_set(out: str | Path, command: str, adopt: Sequence[str] = ()) -> Iterator[Path]:
     """Own ``out`` for one result set of ``command``; yield the stage folder to write the set into.
 
     Lock, recover, refuse foreign entries (before the caller does any work), build in the stage, then publish
     the whole set at once with its manifest (:func:`swap_in`). On an exception (a signal included) nothing is
     published and the previous set stays as it was; a folder created here is removed again if left empty.
+    ``adopt``: files the command already wrote into ``out`` for this set (``washbench live``'s saved input):
+    moved into the set when it is published, left where they are otherwise.
     """
     from washbench.io.lock import output_lock
 
     with output_lock(check_out_path(out)) as out_dir:
         foreign = read_manifest(out_dir) is None  # not (yet) washbench's: only its own .washbench-* leftovers go
         recover(out_dir, only_washbench=foreign)
-        previous = owned_entries(out_dir, command)
+        previous = owned_entries(out_dir, command, adopt)
         stage = make_stage(out_dir)
         try:
             yield stage
+            for name in adopt:
+                if (out_dir / name).is_file():
+                    os.replace(out_dir / name, stage / name)
             write_manifest(stage, command)
             swap_in(stage, out_dir, previous)
         except WashbenchError as exc:  # name the files where they were going, not the hidden stage

@@ -621,8 +621,11 @@ def run_cue(
     platform_path: Path | None = None,
     variants: Sequence[str] = (),
     options: CueOptions | None = None,
+    adopt: Sequence[str] = (),
 ) -> int:
     """The ``washbench cue`` command: read, convert, cut and check, cue, write; 0, or 1 if the data holds a crash.
+
+    ``adopt``: files already in ``out_dir`` that become part of the published set (``washbench live``'s input).
 
     ``washouts``, ``variants`` and ``params_path`` select the washouts
     (:func:`washbench.cueing.variants.select_washouts`).
@@ -645,7 +648,7 @@ def run_cue(
     limits = load_platform_limits(platform_path)
     samples = read_input(input_path, opts.fmt)
     segments = prepare_segments(samples, opts)
-    with result_set(out_dir, "cue") as stage:  # the whole set replaces the previous one at once
+    with result_set(out_dir, "cue", adopt) as stage:  # the whole set replaces the previous one at once
         for seg in segments:
             for f in seg.findings:
                 where = f"{input_path}{f' ({seg.name})' if seg.name else ''}"

@@ -357,6 +357,9 @@ def run_live(
     # a Ctrl-C or SIGTERM from the moment the port is bound only stops the loop: the result is written first
     with stop_on_signals() as got, contextlib.closing(sink), contextlib.closing(bind_udp(opts.listen)) as sock, \
             output_lock(opts.out) as out:  # fmt: skip
+        from washbench.io.outfolder import owned_entries
+
+        owned_entries(out, "cue", (INPUT_FILE,))  # a folder holding someone else's files is refused before listening
         writer = InputWriter(out / INPUT_FILE)
         viewer = open_viewer(names, limits, opts.filter_start) if opts.viewer else None
         to = f"udp://{opts.sink[0]}:{opts.sink[1]} ({opts.sink_format})" if opts.sink else "nowhere (no --sink)"
@@ -401,7 +404,7 @@ def run_live(
     cue_opts = CueOptions(resample_hz=resample, filter_start=opts.filter_start, recording=opts.recording,
                           figures=opts.figures)  # fmt: skip
     fig["resample_hz"] = resample
-    result = run_cue(saved, out, washouts, params_path, platform_path, variants, cue_opts)
+    result = run_cue(saved, out, washouts, params_path, platform_path, variants, cue_opts, adopt=(INPUT_FILE,))
     _add_live_figures(out, saved, fig)
     if status:
         print(f"washbench: {session.stop}: the result folder holds every sample received", file=sys.stderr)

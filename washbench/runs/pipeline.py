@@ -552,10 +552,15 @@ def announce_script(
     simulated time, the steps, the expected size and wall time, and the cap (:func:`washbench.flight.scripts.
     script_plan`)."""
     from washbench.cueing.variants import select_washouts
-    from washbench.flight.scripts import load_script_info, script_plan
+    from washbench.flight.scripts import load_script_info, plan_limit_s, script_plan
+    from washbench.io.budget import check_samples
 
     n = len(select_washouts(washouts, variants, params_path))
-    plan = script_plan(load_script_info(path, aircraft_dirs), max_time_s, n, outputs.recording)
+    info = load_script_info(path, aircraft_dirs)
+    plan = script_plan(info, max_time_s, n, outputs.recording)
+    span_s = min(info.end_s, plan_limit_s(max_time_s))
+    # beyond what washbench allocates for one time series: refused (one line) before anything is announced
+    check_samples(span_s / info.dt_s, f"<run end={info.end_s:g} dt={info.dt_s:g}> (give --max-time-s)", info.path)
     if plan.long:
         print(f"washbench: {plan.text()}", file=sys.stderr, flush=True)
 
