@@ -17,8 +17,9 @@ limited, and a rotational part), x_0 the washout's current state and r_k the air
 over the horizon (``reference_decay_per_s`` > 0: decaying as e^{-gamma t}): no knowledge of the future. The
 horizon's intervals are ``prediction_step_s`` (coarser than the sample: see docs/optimal-mpc.md). The first move
 u_0 is applied for one sample (exact discretisation at dt) and the set points are the resulting position and
-attitude. Every solve's status is checked: a failed or inaccurate solve, or a first move that would leave the
-platform unable to stop within its travel, is replaced by braking (counted in :attr:`MpcWashout.fallbacks`).
+attitude. Every solve's status is checked: a failed solve, or a first move that would leave the platform unable to stop
+within its travel, is replaced by the last accepted plan continued (feasible: the platform's constraints do not
+depend on the aircraft input) or, without one, by braking (counted: :meth:`MpcWashout.report`).
 """
 
 from __future__ import annotations
@@ -66,10 +67,10 @@ class MpcWeights(StrictModel):
 class OsqpSettings(StrictModel):
     """OSQP's settings for the per-step QP (see OSQP's documentation)."""
 
-    max_iter: Annotated[int, Field(ge=1, le=1_000_000)] = 200
+    max_iter: Annotated[int, Field(ge=1, le=1_000_000)] = 400
     eps_abs: Annotated[float, Field(gt=0.0, le=1.0)] = 1e-4
     eps_rel: Annotated[float, Field(gt=0.0, le=1.0)] = 1e-4
-    polish: bool = False
+    polishing: bool = False
     adaptive_rho: bool = True
     time_limit_s: Annotated[float, Field(ge=0.0, le=10.0)] = 0.0
     """0: none"""
@@ -198,6 +199,8 @@ def stacked_inputs(f_mps2: np.ndarray, omega_radps: np.ndarray, gravity_mps2: fl
     return np.concatenate([channel_inputs(c, f_mps2, omega_radps, gravity_mps2) for c in CHANNELS], axis=-1)
 
 
+_ACCEPTED = ("solved", "solved inaccurate")
+
 # sign patterns of the 1-norm ball's facets |p| + |q| + |r| <= w, as |s . omega| <= w (roll, pitch, yaw)
 _FACETS = np.array([[1.0, 1.0, 1.0], [1.0, 1.0, -1.0], [1.0, -1.0, 1.0], [1.0, -1.0, -1.0]])
 
@@ -242,15 +245,17 @@ class MpcWashout:
         s = p.solver
         self.solver = osqp.OSQP()
         extra = {"time_limit": s.time_limit_s} if s.time_limit_s > 0.0 else {}
-        self.solver.setup(
-            self.P_qp, np.zeros(self.nz), self.A_qp, self.l0, self.u0, verbose=False, warm_starting=True,
-            max_iter=s.max_iter, eps_abs=s.eps_abs, eps_rel=s.eps_rel, polish=s.polish, adaptive_rho=s.adaptive_rho,
-            check_termination=5, **extra,
-        )  # fmt: skip
+        settings = {"max_iter": s.max_iter, "eps_abs": s.eps_abs, "eps_rel": s.eps_rel, "polishing": s.polishing}
+        settings.update(adaptive_rho=s.adaptive_rho, check_termination=5, verbose=False, warm_starting=True, **extra)
+        self.solver.setup(self.P_qp, np.zeros(self.nz), self.A_qp, self.l0, self.u0, **settings)
         self.x = np.zeros(self.n)
         self.u = np.zeros(self.m)
         self.solves = 0
         self.fallbacks = 0
+        self.inaccurate = 0
+        self.brakes = 0
+        self._plan: np.ndarray | None = None
+        self._plan_age = 0
         self.iterations: list[int] = []
         self._sat_tilt = False
         self._sat_rot = False
@@ -349,6 +354,7 @@ class MpcWashout:
             r0 = stacked_inputs(np.asarray(f_mps2, float), np.asarray(omega_radps, float), self.g)
         self.x = self._steady_error(r0)
         self.u = np.zeros(self.m)
+        self._plan, self._plan_age = None, 0
         return self._set_point()
 
     def _steady_error(self, r0: np.ndarray) -> np.ndarray:
@@ -394,6 +400,19 @@ class MpcWashout:
         dw = np.linalg.norm(w - self._total_rates(self.u))
         return bool(np.linalg.norm(w) <= self.w_max and dw <= self.alpha_max * self.dt)
 
+    def _fallback_move(self) -> np.ndarray:
+        """The move of a failed step: the last accepted plan, continued (feasible for the platform: its limits do not
+        depend on the aircraft input), at rest after its end; braking (counted in :attr:`brakes`) if there is none or
+        it is not safe; holding still if even braking is not (it always is, short of rounding)."""
+        if self._plan is not None:
+            j = int(self._plan_age * self.dt / self.tp + 1e-9)
+            move = self._plan[j].copy() if j < self.N else np.zeros(self.m)
+            if (self.params.terminal_rest or j < self.N) and self._safe(move):
+                return move
+        self.brakes += 1
+        move = self._brake()
+        return move if self._safe(move) else np.zeros(self.m)
+
     def _brake(self) -> np.ndarray:
         """Braking move: each axis decelerates towards rest at its acceleration limit; the rates likewise."""
         sm = self.model
@@ -411,15 +430,20 @@ class MpcWashout:
     def plan(self, r: np.ndarray) -> tuple[bool, np.ndarray]:
         """Solve the QP from the current state for the stacked aircraft input ``r`` (6,).
 
-        Returns (solved, controls (N, m)); ``solved`` is False unless OSQP reports ``solved`` with a finite result.
+        Returns (solved, controls (N, m)); ``solved`` is False unless OSQP reports ``solved`` or ``solved inaccurate``
+        (the iteration limit reached with residuals within ten times the tolerances: counted in
+        :attr:`inaccurate`; its first move is still checked by :meth:`_safe`) with a finite result.
         """
         lo, hi = self._update_bounds(r)
         self.solver.update(l=lo, u=hi)
-        res = self.solver.solve()
+        res = self.solver.solve(raise_error=False)
         self.solves += 1
         self.iterations.append(int(res.info.iter))
         z = res.x
-        ok = res.info.status == "solved" and z is not None and bool(np.all(np.isfinite(z)))
+        status = res.info.status
+        ok = status in _ACCEPTED and z is not None and bool(np.all(np.isfinite(z)))
+        if ok and status != "solved":
+            self.inaccurate += 1
         if not ok:
             return False, np.zeros((self.N, self.m))
         return True, np.stack([z[self._iu(k) : self._iu(k) + self.m] for k in range(self.N)])
@@ -431,14 +455,13 @@ class MpcWashout:
             raise ValueError("mpc: non-finite input")
         ok, plan = self.plan(r)
         self._r_term = self.gam_rf @ r
-        u0 = plan[0] if ok else None
-        if ok and self._safe(u0):
-            move = u0.copy()
+        if ok and self._safe(plan[0]):
+            move = plan[0].copy()
+            self._plan, self._plan_age = plan, 0
         else:
             self.fallbacks += 1
-            move = self._brake()
-            if not self._safe(move):  # braking cannot leave the limits; if rounding says so, hold still
-                move = np.zeros(self.m)
+            move = self._fallback_move()
+        self._plan_age += 1
         self._sat_tilt = bool(np.any(np.abs(move[self.model.j_tilt]) >= 0.999 * self._tilt_max))
         self._sat_rot = bool(np.sum(np.abs(self._total_rates(move))) >= 0.999 * self.params.limit_margin * self.w_max)
         self.u = move
@@ -450,11 +473,14 @@ class MpcWashout:
         return self._sat_tilt, self._sat_rot
 
     def report(self) -> dict[str, float]:
-        """Solver statistics so far: solves, fallbacks (braking steps), iterations (median, max)."""
+        """Solver statistics so far: solves, fallbacks (failed or unsafe solves), of which brakes (no usable previous
+        plan: braking), inaccurate (accepted at the iteration limit), iterations (median, max)."""
         it = np.array(self.iterations) if self.iterations else np.zeros(1)
         return {
             "solves": float(self.solves),
             "fallbacks": float(self.fallbacks),
+            "inaccurate": float(self.inaccurate),
+            "brakes": float(self.brakes),
             "iterations_median": float(np.median(it)),
             "iterations_max": float(np.max(it)),
         }
