@@ -20,21 +20,34 @@ from washbench.errors import Terminated, WashbenchError
 _VARIANT_HELP = "add a washout NAME of KIND with dotted-key overrides of the parameter file, repeatable"
 
 
+def _plugin_option(p: argparse.ArgumentParser) -> None:
+    """--washout-plugin FILE.py:NAME, shared by every command that runs washouts."""
+    p.add_argument(
+        "--washout-plugin",
+        action="append",
+        default=[],
+        metavar="FILE.py:NAME",
+        help="load a washout algorithm from a Python file (docs/washouts.md); its name is then a washout, repeatable",
+    )
+
+
 def _washout_options(p: argparse.ArgumentParser, variants: bool = True) -> None:
     """--washout (built-in washouts) and --variant (named variants), shared by cue, run, suite (and omct)."""
     p.add_argument(
         "--washout",
         action="append",
         metavar="NAME",
-        help=f"built-in washout to run, repeatable: {', '.join(WASHOUT_KINDS)} (default: all three, or none with "
-        "a variant)",
+        help=f"washout to run, repeatable: {', '.join(WASHOUT_KINDS)}, or a plugin's name (default: the first "
+        "three, or none with a variant)",
     )
     if variants:
         p.add_argument("--variant", action="append", default=[], metavar="NAME=KIND[,KEY=VALUE...]", help=_VARIANT_HELP)
+    _plugin_option(p)
 
 
 def _study_options(p: argparse.ArgumentParser) -> None:
     """What sweep and tune share."""
+    _plugin_option(p)
     p.add_argument("--params", type=Path, help="base washout parameter YAML (default: bundled CW1)")
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
     p.add_argument(
@@ -442,6 +455,16 @@ def _quiet_broken_pipe() -> int:
     return 141  # 128 + SIGPIPE, what a shell reports for a tool stopped by a closed pipe
 
 
+def _load_plugins(args: argparse.Namespace) -> None:
+    """Load every ``--washout-plugin`` before anything reads a parameter file or a washout name."""
+    specs = getattr(args, "washout_plugin", None) or []
+    if specs:
+        from washbench.cueing import registry
+
+        for spec in specs:
+            registry.load_plugin(spec)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``washbench`` console script; returns the exit status.
 
@@ -452,6 +475,7 @@ def main(argv: list[str] | None = None) -> int:
     signal.signal(signal.SIGTERM, _terminate)
     try:
         try:
+            _load_plugins(args)
             status = _dispatch(args)
             sys.stdout.flush()
             return status

@@ -28,7 +28,7 @@ from washbench.analysis.metric_sums import NACC, acc_update, finish
 from washbench.analysis.metrics import DOFS, MetricRow, npc_from_pc
 from washbench.analysis.ranking import dof_weights, perceived_motion, score_of
 from washbench.cueing.jitcache import announce_compile, drop_stale_cache
-from washbench.cueing.kernel import NFIELDS, NSTATE, O_HEAD_F, O_HEAD_OMEGA, O_SAT, SAT_KINDS, step_one
+from washbench.cueing.kernel import C_KIND, NFIELDS, NSTATE, O_HEAD_F, O_HEAD_OMEGA, O_SAT, SAT_KINDS, step_one
 from washbench.perception.sections import sections_init, sections_step
 
 PLATFORM_SAT = tuple(SAT_KINDS.index(k) for k in ("pos", "vel", "acc", "rate", "angacc"))
@@ -38,6 +38,33 @@ washout's)."""
 _DEG = 180.0 / math.pi
 
 
+@njit(cache=True)
+def _account(k, row, ob, ophi, oss, cb, cphi, css, xo, xc, u_prev, ac_perceived, acc):
+    """Sample k of one candidate: its output ``row`` through the vestibular models into the DOF accumulators
+    ``acc`` (6, NACC); returns 1 if a platform limit was active at this sample."""
+    if k == 0:
+        for j in range(3):
+            sections_init(oss, xo[j], row[O_HEAD_F + j])
+            sections_init(css, xc[j], row[O_HEAD_OMEGA + j])
+            u_prev[j] = row[O_HEAD_F + j]
+            u_prev[3 + j] = row[O_HEAD_OMEGA + j]
+    for j in range(3):
+        u = row[O_HEAD_F + j]
+        y = sections_step(ob, ophi, xo[j], u_prev[j], u)
+        u_prev[j] = u
+        acc_update(acc[j], ac_perceived[k, j], y)
+    for j in range(3):
+        u = row[O_HEAD_OMEGA + j]
+        y = sections_step(cb, cphi, xc[j], u_prev[3 + j], u)
+        u_prev[3 + j] = u
+        acc_update(acc[3 + j], ac_perceived[k, 3 + j], y * _DEG)
+    hit = 0
+    for j in PLATFORM_SAT:
+        if row[O_SAT + j] != 0.0:
+            hit = 1
+    return hit
+
+
 @njit(cache=True, parallel=True)
 def evaluate_batch(f, om, cfg, coef, oto, can, ac_perceived, dt, acc_out, counts_out):
     """Run candidates i = 0..M-1 (``cfg`` (M, NCFG), ``coef`` (M, NFILT, 9)) over f, om (N, 3), checked finite.
@@ -45,46 +72,49 @@ def evaluate_batch(f, om, cfg, coef, oto, can, ac_perceived, dt, acc_out, counts
     ``oto`` and ``can``: (b (S, 2), phi (S,), steady (S,)) of the otolith and canal models. ``ac_perceived`` (N, 6):
     the aircraft pilot's perceived specific force (m/s^2) and angular velocity (deg/s). Writes per candidate the
     six DOF accumulators ``acc_out`` (M, 6, NACC) and ``counts_out`` (M, 8) int64: steps at each limit kind, then
-    steps at any platform limit.
+    steps at any platform limit. Compiled washouts only (a Python algorithm's candidates go through
+    :func:`evaluate_fields`).
     """
     n = f.shape[0]
     ob, ophi, oss = oto
     cb, cphi, css = can
     for i in prange(cfg.shape[0]):
+        if cfg[i, C_KIND] < 0.0:  # a Python algorithm: evaluate_fields
+            continue
         state = np.zeros(NSTATE)
         counts = np.zeros(len(SAT_KINDS), dtype=np.int64)
         row = np.zeros(NFIELDS)
         xo = np.zeros((3, ophi.shape[0]))
         xc = np.zeros((3, cphi.shape[0]))
         u_prev = np.zeros(6)
-        acc = acc_out[i]
         any_sat = 0
         for k in range(n):
             step_one(f[k], om[k], cfg[i], coef[i], state, counts, row)
-            if k == 0:
-                for j in range(3):
-                    sections_init(oss, xo[j], row[O_HEAD_F + j])
-                    sections_init(css, xc[j], row[O_HEAD_OMEGA + j])
-                    u_prev[j] = row[O_HEAD_F + j]
-                    u_prev[3 + j] = row[O_HEAD_OMEGA + j]
-            for j in range(3):
-                u = row[O_HEAD_F + j]
-                y = sections_step(ob, ophi, xo[j], u_prev[j], u)
-                u_prev[j] = u
-                acc_update(acc[j], ac_perceived[k, j], y)
-            for j in range(3):
-                u = row[O_HEAD_OMEGA + j]
-                y = sections_step(cb, cphi, xc[j], u_prev[3 + j], u)
-                u_prev[3 + j] = u
-                acc_update(acc[3 + j], ac_perceived[k, 3 + j], y * _DEG)
-            hit = 0
-            for j in PLATFORM_SAT:
-                if row[O_SAT + j] != 0.0:
-                    hit = 1
-            any_sat += hit
+            any_sat += _account(k, row, ob, ophi, oss, cb, cphi, css, xo, xc, u_prev, ac_perceived, acc_out[i])
         for j in range(len(SAT_KINDS)):
             counts_out[i, j] = counts[j]
         counts_out[i, len(SAT_KINDS)] = any_sat
+
+
+@njit(cache=True)
+def evaluate_fields(out, oto, can, ac_perceived, acc, counts_out):
+    """One candidate already run (its field-major outputs ``out`` (NFIELDS, N), e.g. a Python algorithm through
+    :func:`washbench.cueing.bank.cue_trace`): the same perception and accumulation as :func:`evaluate_batch`, into
+    ``acc`` (6, NACC) and ``counts_out`` (8,) int64."""
+    ob, ophi, oss = oto
+    cb, cphi, css = can
+    xo = np.zeros((3, ophi.shape[0]))
+    xc = np.zeros((3, cphi.shape[0]))
+    u_prev = np.zeros(6)
+    row = np.zeros(NFIELDS)
+    any_sat = 0
+    for k in range(out.shape[1]):
+        for j in range(NFIELDS):
+            row[j] = out[j, k]
+        for j in range(len(SAT_KINDS)):
+            counts_out[j] += int(row[O_SAT + j] != 0.0)
+        any_sat += _account(k, row, ob, ophi, oss, cb, cphi, css, xo, xc, u_prev, ac_perceived, acc)
+    counts_out[len(SAT_KINDS)] = any_sat
 
 
 @dataclass(frozen=True)
@@ -148,16 +178,30 @@ class FlightEvaluator:
     def evaluate(self, washouts: Sequence[object]) -> Evaluation:
         """Evaluate every candidate (:class:`washbench.cueing.variants.Washout`) on this flight."""
         cfg, coef = self.arrays(washouts)
-        return self.evaluate_arrays(cfg, coef)
+        return self.evaluate_arrays(cfg, coef, washouts)
 
-    def evaluate_arrays(self, cfg: np.ndarray, coef: np.ndarray) -> Evaluation:
-        """Evaluate candidates given as compiled arrays (M, NCFG), (M, NFILT, 9)."""
+    def evaluate_arrays(self, cfg: np.ndarray, coef: np.ndarray, washouts: Sequence[object] = ()) -> Evaluation:
+        """Evaluate candidates given as compiled arrays (M, NCFG), (M, NFILT, 9). A Python algorithm's rows (kind
+        KIND_SETPOINT) need their ``washouts`` (the Washout objects, same order): they are run through
+        :func:`washbench.cueing.bank.cue_trace` and then the same compiled perception and metrics."""
         m = cfg.shape[0]
         acc = np.zeros((m, len(DOFS), NACC))
         counts = np.zeros((m, len(SAT_KINDS) + 1), dtype=np.int64)
+        python = [i for i in range(m) if cfg[i, C_KIND] < 0.0]
         if m:
             announce_compile(evaluate_batch)
             evaluate_batch(self.f, self.om, cfg, coef, self.oto, self.can, self.ac_perceived, self.dt_s, acc, counts)
+        if python:
+            from washbench.cueing.bank import cue_trace
+
+            if len(washouts) != m:
+                raise ValueError("a Python algorithm's candidate needs its Washout")
+            for i in python:
+                w = washouts[i]
+                out = np.empty((NFIELDS, self.n))
+                trace = cue_trace(self.f, self.om, self.dt_s, [w], None, self.limits, fields_out=out)
+                del trace
+                evaluate_fields(out, self.oto, self.can, self.ac_perceived, acc[i], counts[i])
         npc = np.empty((m, len(DOFS)))
         integral = np.empty((m, len(DOFS)))
         max_error = np.empty((m, len(DOFS)))
@@ -191,4 +235,4 @@ drop_stale_cache(
     ],
 )
 
-__all__ = ["PLATFORM_SAT", "Evaluation", "FlightEvaluator", "evaluate_batch"]
+__all__ = ["PLATFORM_SAT", "Evaluation", "FlightEvaluator", "evaluate_batch", "evaluate_fields"]

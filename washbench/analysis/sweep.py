@@ -15,6 +15,7 @@ from typing import Any
 
 from washbench.analysis.evaluate import Evaluation
 from washbench.analysis.metrics import DOFS
+from washbench.cueing import registry
 from washbench.cueing.params import WashoutParams
 from washbench.cueing.variants import Washout, apply_overrides, check_key, check_kind, parse_value
 from washbench.errors import WashbenchError
@@ -57,7 +58,7 @@ def point_washouts(kind: str, base: WashoutParams, points: Sequence[Mapping[str,
     out = []
     for point in points:
         where = "--set " + ",".join(f"{k}={format_value(v)}" for k, v in point.items())
-        out.append(Washout(kind, kind, apply_overrides(base, point, where)))
+        out.append(Washout(kind, kind, apply_overrides(base, point, where), registry.plugin_spec(kind)))
     return out
 
 

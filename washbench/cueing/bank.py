@@ -23,6 +23,7 @@ import numpy as np
 from washbench.cueing import filters
 from washbench.cueing.jitcache import announce_compile
 from washbench.cueing.kernel import (
+    C_ADAPT,
     C_ALPHA,
     C_AMAX,
     C_CATCH,
@@ -30,10 +31,17 @@ from washbench.cueing.kernel import (
     C_DT,
     C_FREEFALL,
     C_G,
+    C_GK,
+    C_GP,
     C_HEAD_EULER,
     C_JAC,
+    C_KHI,
     C_KIND,
+    C_KLO,
     C_LP_BEFORE,
+    C_P0,
+    C_PHI,
+    C_PLO,
     C_PMAX,
     C_R,
     C_REST,
@@ -44,7 +52,13 @@ from washbench.cueing.kernel import (
     C_TILT_K,
     C_TILT_RATE,
     C_VMAX,
+    C_WF,
+    C_WKG,
     C_WMAX,
+    C_WPG,
+    C_WV,
+    C_WW,
+    C_WX,
     F_EULER_D,
     F_OMEGA_D,
     F_ROT_HP,
@@ -52,6 +66,7 @@ from washbench.cueing.kernel import (
     F_TRANS_HP,
     FIELDS,
     KIND_LARGE,
+    KIND_SETPOINT,
     KIND_SMALL,
     KIND_UNRESTRICTED,
     NCFG,
@@ -69,18 +84,36 @@ from washbench.cueing.kernel import (
     O_SP_Q,
     O_VEL,
     O_WHEEL,
+    S_COST,
+    S_GK,
+    S_GP,
+    S_GRAD,
+    S_PSP,
+    S_QSP,
     SAT_KINDS,
     bank_block,
     bank_step,
     bank_trace,
+    setpoint_block,
+    setpoint_step,
+    setpoint_trace,
 )
-from washbench.cueing.params import WashoutParams
+from washbench.cueing.params import ADAPTIVE_KINDS, WashoutParams
+from washbench.cueing.setpoints import SetPointSource
 from washbench.cueing.variants import Washout, as_washouts
 from washbench.errors import WashbenchError
 from washbench.io.results import DT_RANGE_S
 from washbench.platform.limits import PlatformLimits, wheel_jacobian
 
-_KINDS = {"small-angle": KIND_SMALL, "large-angle": KIND_LARGE, "unrestricted": KIND_UNRESTRICTED}
+_KINDS = {
+    "small-angle": KIND_SMALL,
+    "large-angle": KIND_LARGE,
+    "unrestricted": KIND_UNRESTRICTED,
+    "adaptive": KIND_SMALL,
+    "adaptive-large-angle": KIND_LARGE,
+    "adaptive-unrestricted": KIND_UNRESTRICTED,
+}
+"""Compiled kinds -> the kernel's structure; any other kind is a Python algorithm (KIND_SETPOINT)."""
 
 
 def _check_dt(dt_s: float) -> float:
@@ -113,7 +146,7 @@ def washout_arrays(washout: Washout, limits: PlatformLimits, dt: float) -> tuple
 
     ``dt`` (s) is already checked (:func:`_check_dt`).
     """
-    params, kind = washout.params, _KINDS[washout.kind]
+    params, kind = washout.params, _KINDS.get(washout.kind, KIND_SETPOINT)
     lim = limits.translation
     cfg = np.zeros(NCFG)
     cfg[C_KIND] = kind
@@ -142,6 +175,8 @@ def washout_arrays(washout: Washout, limits: PlatformLimits, dt: float) -> tuple
     cfg[C_LP_BEFORE] = 1.0 if before else 0.0
     method = params.head.rate_method
     cfg[C_HEAD_EULER] = 1.0 if method == "euler_estimator" or (method == "auto" and kind == KIND_SMALL) else 0.0
+    if washout.kind in ADAPTIVE_KINDS:
+        _adaptive_cfg(cfg, washout)
 
     coef = np.zeros((NFILT, filters.NCOEF))
     for j, wn in enumerate(params.translational_highpass_wn_radps.xyz):
@@ -159,6 +194,37 @@ def washout_arrays(washout: Washout, limits: PlatformLimits, dt: float) -> tuple
         coef[F_TILT_LP + j] = filters.discretise(filters.tilt_lowpass(tilt_wn[j]), dt)
         coef[F_ROT_HP + j] = filters.discretise(filters.rotational_highpass(rot_wn[j]), dt)
     return cfg, coef
+
+
+def _adaptive_cfg(cfg: np.ndarray, washout: Washout) -> None:
+    """The adaptive washout's rates, weights and bounds into its configuration row (checked consistent)."""
+    params = washout.params
+    a = params.adaptive
+    p, k = a.translational_gain, a.tilt_gain_per_s
+    where = f"washout {washout.name}: adaptive"
+    if not p.min <= p.initial <= p.max:
+        raise WashbenchError(
+            f"{where}.translational_gain: need min <= initial <= max, got {p.min}, {p.initial}, {p.max}"
+        )
+    if not k.min <= params.tilt.gain_per_s <= k.max or k.min <= 0.0:
+        raise WashbenchError(
+            f"{where}.tilt_gain_per_s: need 0 < min <= tilt.gain_per_s ({params.tilt.gain_per_s}) <= max, "
+            f"got {k.min}..{k.max}"
+        )
+    cfg[C_ADAPT] = 1.0
+    cfg[C_GP] = a.rate_translational
+    cfg[C_GK] = a.rate_tilt
+    cfg[C_WF] = a.weight_specific_force
+    cfg[C_WW] = a.weight_angular_velocity
+    cfg[C_WX] = a.weight_position
+    cfg[C_WV] = a.weight_velocity
+    cfg[C_WPG] = a.weight_gain_translational
+    cfg[C_WKG] = a.weight_gain_tilt
+    cfg[C_P0] = p.initial
+    cfg[C_PLO] = p.min
+    cfg[C_PHI] = p.max
+    cfg[C_KLO] = k.min
+    cfg[C_KHI] = k.max
 
 
 def build_arrays(
@@ -316,6 +382,14 @@ class CueingBank:
         self._state = np.zeros((n, NSTATE))
         self._counts = np.zeros((n, len(SAT_KINDS)), dtype=np.int64)
         self._out = np.zeros((n, NFIELDS))
+        self._py = python_sources(self.specs, limits, self.dt_s, filter_start)
+        self._started = False
+
+    def _start(self, f: np.ndarray, om: np.ndarray) -> None:
+        """Start the Python washouts on the first sample (their start set point into the state)."""
+        for i, src in self._py:
+            _set_start(self._state[i], *src.start(f, om))
+        self._started = True
 
     def step(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> np.ndarray:
         """Advance all washouts by one sample; return the reused (n_washouts, N_FIELDS) output array."""
@@ -327,6 +401,15 @@ class CueingBank:
             f = np.ascontiguousarray(f_mps2, dtype=np.float64).reshape(-1)
             w = np.ascontiguousarray(omega_radps, dtype=np.float64).reshape(-1)
             bank_step(f, w, self._cfg, self._coef, self._state, self._counts, self._out)
+        if self._py:
+            f = np.asarray(f_mps2, dtype=np.float64).reshape(-1)
+            w = np.asarray(omega_radps, dtype=np.float64).reshape(-1)
+            if not self._started:
+                self._start(f, w)
+            for i, src in self._py:
+                pos, q, ft, fr = src.step(f, w)
+                c, st = self._cfg[i], self._state[i]
+                setpoint_step(pos, q, ft, fr, c, self._coef[i], st, self._counts[i], self._out[i])
         return self._out
 
     def steps(self, f_mps2: np.ndarray, omega_radps: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
@@ -349,8 +432,31 @@ class CueingBank:
         elif out.shape != shape or out.dtype != np.float64 or not out.flags.c_contiguous:
             raise ValueError(f"out must be a C-contiguous float64 array of shape {shape}")
         bank_block(f, w, self._cfg, self._coef, self._state, self._counts, out)
+        if self._py and f.shape[0]:
+            if not self._started:
+                self._start(f[0], w[0])
+            for i, src in self._py:
+                pos, q, flags = src.run(f, w)
+                setpoint_block(pos, q, flags, self._cfg[i], self._coef[i], self._state[i], self._counts[i], out[i])
         if f.shape[0]:
             self._out[:] = out[:, -1]
+        return out
+
+    def adaptation(self) -> dict[str, dict[str, np.ndarray | float]]:
+        """The adaptive washouts' state after the last sample: name -> ``p`` (3,) translational gains per inertial
+        axis, ``k`` (3,) tilt gains per body axis (1/s), ``grad_p``, ``grad_k`` (3,) the cost's gradient the last
+        step descended, ``cost`` J of the last step (docs/washouts.md)."""
+        out: dict[str, dict[str, np.ndarray | float]] = {}
+        for i, w in enumerate(self.specs):
+            if w.kind in ADAPTIVE_KINDS:
+                st = self._state[i]
+                out[w.name] = {
+                    "p": st[S_GP : S_GP + 3].copy(),
+                    "k": st[S_GK : S_GK + 3].copy(),
+                    "grad_p": st[S_GRAD : S_GRAD + 3].copy(),
+                    "grad_k": st[S_GRAD + 3 : S_GRAD + 6].copy(),
+                    "cost": float(st[S_COST]),
+                }
         return out
 
     def saturation_counts(self) -> dict[str, dict[str, int]]:
@@ -368,6 +474,7 @@ def cue_trace(
     params: WashoutParams | None,
     limits: PlatformLimits,
     filter_start: str = "steady",
+    fields_out: np.ndarray | None = None,
 ) -> dict[str, WashoutTrace]:
     """Whole-trace form: run the washouts over arrays f (N, 3) m/s^2 and omega (N, 3) rad/s sampled every dt_s.
 
@@ -376,7 +483,8 @@ def cue_trace(
     (naming the first bad sample) and for a step outside ``washbench.io.results.DT_RANGE_S``. Magnitudes are not
     limited here (the platform stays within its limits whatever the input); the readers refuse physically
     absurd recordings at the file edge.
-    ``filter_start``: see :data:`FILTER_STARTS`.
+    ``filter_start``: see :data:`FILTER_STARTS`. ``fields_out``: for one washout, a (N_FIELDS, N) float64 array to
+    write its outputs into (the traces are views of it).
     """
     specs = as_washouts(washouts, params)
     names = [w.name for w in specs]
@@ -392,6 +500,28 @@ def cue_trace(
     state = np.zeros((len(names), NSTATE))
     counts = np.zeros((len(names), len(SAT_KINDS)), dtype=np.int64)
     out = np.empty((len(names), NFIELDS, f.shape[0]))
+    if fields_out is not None:  # one washout's field-major outputs written where the caller wants them
+        if len(names) != 1 or fields_out.shape != out.shape[1:]:
+            raise ValueError("fields_out needs one washout and shape (NFIELDS, N)")
+        out = fields_out[None]
     announce_compile(bank_trace)
     bank_trace(f, w, cfg, coef, state, counts, out)
+    if len(f):
+        for i, src in python_sources(specs, limits, dt, filter_start):
+            _set_start(state[i], *src.start(f[0], w[0]))
+            pos, q, flags = src.run(f, w, whole=True)
+            setpoint_trace(pos, q, flags, cfg[i], coef[i], state[i], counts[i], out[i])
     return {name: WashoutTrace.from_fields(out[i]) for i, name in enumerate(names)}
+
+
+def python_sources(
+    specs: Sequence[Washout], limits: PlatformLimits, dt: float, filter_start: str
+) -> list[tuple[int, SetPointSource]]:
+    """(index, source) of every washout of ``specs`` that is a Python algorithm (not compiled)."""
+    return [(i, SetPointSource(w, limits, dt, filter_start)) for i, w in enumerate(specs) if w.kind not in _KINDS]
+
+
+def _set_start(state: np.ndarray, pos: np.ndarray, q: np.ndarray) -> None:
+    """A set-point washout's start set point into its state row."""
+    state[S_PSP : S_PSP + 3] = pos
+    state[S_QSP : S_QSP + 4] = q

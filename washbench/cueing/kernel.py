@@ -45,6 +45,7 @@ from washbench.cueing.rotations import (
 from washbench.platform.kinematics import track_axis, track_rotation, wheel_speeds
 
 KIND_SMALL, KIND_LARGE, KIND_UNRESTRICTED = 0, 1, 2
+KIND_SETPOINT = -1  # an algorithm outside the kernel gives the set points (:func:`setpoint_step`)
 
 SAT_KINDS: tuple[str, ...] = ("pos", "vel", "acc", "rate", "angacc", "tilt_rate", "rot_rate")
 
@@ -75,7 +76,10 @@ C_TILT_AXIS = 34  # 1: the tilt-rate limit clips each axis; 0: it limits the nor
 C_LP_BEFORE = 35  # 1: tilt low-pass on f before the cross product; 0: on the tilt rate after it
 C_HEAD_EULER = 36  # 1: head rate by the Eq. 8 estimator on Euler angles; 0: quaternion difference (Eqs. 18-19)
 C_REST = 37  # 1: start from rest (level, f = [0, 0, -g], no rotation) instead of the first sample's steady state
-NCFG = 38
+# the coordinated adaptive washout (:func:`_adapt`, docs/washouts.md): 1 to adapt, adaptation rates, cost weights,
+# the translational gain's start and bounds, the tilt gain's bounds (its start is C_TILT_K)
+C_ADAPT, C_GP, C_GK, C_WF, C_WW, C_WX, C_WV, C_WPG, C_WKG, C_P0, C_PLO, C_PHI, C_KLO, C_KHI = range(38, 52)
+NCFG = 52
 
 # filter indices (each 3 consecutive axes)
 F_TRANS_HP, F_TILT_LP, F_ROT_HP, F_EULER_D, F_OMEGA_D = 0, 3, 6, 9, 12
@@ -89,7 +93,16 @@ S_QSP = 13  # attitude set point (4)
 S_P, S_V, S_Q, S_W = 17, 20, 23, 27  # platform position, velocity, quaternion, body rate
 S_EUL = 30  # small-angle head: previous (unwrapped) platform Euler angles
 S_FX = 33  # filter states, 2 per filter
-NSTATE = S_FX + 2 * NFILT
+S_AD = S_FX + 2 * NFILT  # adaptive washout: gains and sensitivities
+S_GP = S_AD  # translational gains p (3), per inertial axis
+S_GK = S_AD + 3  # tilt gains k (3), 1/s, per simulator body axis
+S_SA = S_AD + 6  # d(a_sp)/dp per axis: the translational high-pass of the unscaled input (3 filters' outputs)
+S_SV, S_SX = S_AD + 9, S_AD + 12  # d(v_sp)/dp, d(x_sp)/dp (3 each)
+S_TH = S_AD + 15  # d(theta_sp)/dk: attitude sensitivity, body axes, 3x3 row-major [i, j] = component i of column j
+S_SFX = S_AD + 24  # the sensitivity high-pass filters' states (3 filters x 2)
+S_GRAD = S_AD + 30  # the last step's gradient dJ/dp (3), dJ/dk (3)
+S_COST = S_AD + 36  # the last step's cost J
+NSTATE = S_AD + 37
 
 
 @njit(cache=True)
@@ -102,6 +115,19 @@ def _tilt_rate(g_s, f, gain, eps):
     c = cross(g_s, f)
     k = gain / (nf * ng)
     return (c[0] * k, c[1] * k, c[2] * k)
+
+
+@njit(cache=True)
+def _tilt_rate3(g_s, f, k, eps):
+    """Tilt-coordination angular velocity with one gain per body axis: k_j (g_S/|g_S| x f/|f|)_j, rad/s; zero in free
+    fall. With k_x = k_y = k_z = gain it is :func:`_tilt_rate` to the bit."""
+    nf = norm3(f)
+    ng = norm3(g_s)
+    if nf < eps or ng == 0.0:
+        return (0.0, 0.0, 0.0)
+    c = cross(g_s, f)
+    d = nf * ng
+    return (c[0] * (k[0] / d), c[1] * (k[1] / d), c[2] * (k[2] / d))
 
 
 @njit(cache=True, inline="always")
@@ -120,6 +146,12 @@ def _limit_tilt(v, vmax, per_axis):
 def _fx(state, i):
     """View of filter i's two states."""
     return state[S_FX + 2 * i : S_FX + 2 * i + 2]
+
+
+@njit(cache=True)
+def _sfx(state, j):
+    """View of the translational sensitivity filter j's two states."""
+    return state[S_SFX + 2 * j : S_SFX + 2 * j + 2]
 
 
 @njit(cache=True, inline="always")
@@ -179,18 +211,124 @@ def _init_washout(kind, c, coef, state, fs, ws):
     _init3(coef, state, F_TRANS_HP, (a_i[0], a_i[1], a_i[2] + g))
     _init3(coef, state, F_TILT_LP, tilt_in)
     _init3(coef, state, F_ROT_HP, rot_in)
+    if c[C_ADAPT] != 0.0:
+        for j in range(3):
+            state[S_GP + j] = c[C_P0]
+            state[S_GK + j] = c[C_TILT_K]
+            state[S_SA + j] = 0.0
+            state[S_SV + j] = 0.0
+            state[S_SX + j] = 0.0
+            filt_init(coef[F_TRANS_HP + j], _sfx(state, j), (a_i[0], a_i[1], a_i[2] + g)[j])
+        for j in range(9):
+            state[S_TH + j] = 0.0
 
 
 @njit(cache=True)
-def step_one(f, om, c, coef, state, counts, row):
-    """Advance one washout (+ platform + head motion) by one sample and write its output ``row``."""
+def _adapt(c, coef, state, fs, ws, u, g_s, f_lp, wt_raw, wt, sat_tilt, a_hp, q_sp_prev, q_sp):
+    """One step of the coordinated adaptive washout's steepest descent (docs/washouts.md, Eqs. A1-A9).
+
+    Cost J = 1/2 [W_f |f_A - f_S|^2 + W_w |w_A - w_S|^2 + W_x |x|^2 + W_v |v|^2 + W_p |p - p0|^2 + W_k |k - k0|^2]
+    with f_A, w_A the scaled aircraft motion (``fs``, ``ws``), f_S = R(q_sp)^T (a_sp - g_I) and w_S the set point's
+    specific force and body rate, x, v the translational set point. The gains move by p -= G_p dJ/dp dt,
+    k -= G_k dJ/dk dt, then are clipped to their bounds. Sensitivities (the past held at the current gains):
+    d(a_sp)/dp_j = HP_j(u_j) exactly; d(theta)/dk_j integrates d(w_t)/dk_j = w_t,j / k_j e_j (plus, with the low-pass
+    before the cross product, the attitude's effect through g_S) through the tilt-rate limit's Jacobian, with the
+    rotation of the body frame (-w_S x theta dt).
+    """
+    dt = c[C_DT]
+    g = c[C_G]
+    # translational sensitivities: exact for the discrete channel
+    for j in range(3):
+        sa = filt_step(coef[F_TRANS_HP + j], _sfx(state, j), u[j])
+        state[S_SA + j] = sa
+        state[S_SV + j] += sa * dt
+        state[S_SX + j] += state[S_SV + j] * dt
+    # the set point's specific force (body) and body rate
+    f_i = (a_hp[0], a_hp[1], a_hp[2] - g)
+    f_s = qrot_inv(q_sp, f_i)
+    w_s = qrate_body(q_sp, q_sp_prev, dt)
+    e_f = (fs[0] - f_s[0], fs[1] - f_s[1], fs[2] - f_s[2])
+    e_w = (ws[0] - w_s[0], ws[1] - w_s[1], ws[2] - w_s[2])
+    e_fi = qrot(q_sp, e_f)  # the specific-force error in inertial axes
+    # tilt-rate sensitivities dw_t/dk_j (before the limit): direct term, and the attitude's through g_S
+    nf = norm3(f_lp)
+    ng = norm3(g_s)
+    before = c[C_LP_BEFORE] != 0.0 and nf >= c[C_FREEFALL] and ng > 0.0
+    dw = np.zeros((3, 3))  # [i, j]: component i of dw_t/dk_j
+    for j in range(3):
+        kj = state[S_GK + j]
+        dw[j, j] = wt_raw[j] / kj if kj > 0.0 else 0.0
+        if before:
+            th = (state[S_TH + j], state[S_TH + 3 + j], state[S_TH + 6 + j])
+            dc = cross(cross(g_s, th), f_lp)
+            for i in range(3):
+                dw[i, j] += state[S_GK + i] * dc[i] / (nf * ng)
+    if sat_tilt:  # through the limit: the norm limit's Jacobian (vmax/|v|)(I - v v^T/|v|^2); the axis limit's zeros
+        vmax = c[C_TILT_RATE]
+        n = norm3(wt_raw)
+        for j in range(3):
+            col = (dw[0, j], dw[1, j], dw[2, j])
+            if c[C_TILT_AXIS] != 0.0:
+                for i in range(3):
+                    if wt[i] != wt_raw[i]:
+                        dw[i, j] = 0.0
+            elif n > 0.0:
+                d = (col[0] * wt_raw[0] + col[1] * wt_raw[1] + col[2] * wt_raw[2]) / (n * n)
+                for i in range(3):
+                    dw[i, j] = (vmax / n) * (col[i] - wt_raw[i] * d)
+    # gradients
+    gp_l = [0.0, 0.0, 0.0]
+    gk_l = [0.0, 0.0, 0.0]
+    for j in range(3):
+        gp_l[j] = (
+            -c[C_WF] * e_fi[j] * state[S_SA + j]
+            + c[C_WX] * state[S_PSP + j] * state[S_SX + j]
+            + c[C_WV] * state[S_VSP + j] * state[S_SV + j]
+            + c[C_WPG] * (state[S_GP + j] - c[C_P0])
+        )
+        th = (state[S_TH + j], state[S_TH + 3 + j], state[S_TH + 6 + j])
+        df = cross(f_s, th)  # d(f_S)/dk_j: f_S(theta + d) = f_S + f_S x d
+        gk_l[j] = (
+            -c[C_WF] * (e_f[0] * df[0] + e_f[1] * df[1] + e_f[2] * df[2])
+            - c[C_WW] * (e_w[0] * dw[0, j] + e_w[1] * dw[1, j] + e_w[2] * dw[2, j])
+            + c[C_WKG] * (state[S_GK + j] - c[C_TILT_K])
+        )
+    gp = (gp_l[0], gp_l[1], gp_l[2])
+    gk = (gk_l[0], gk_l[1], gk_l[2])
+    for j in range(3):
+        state[S_GRAD + j] = gp[j]
+        state[S_GRAD + 3 + j] = gk[j]
+    cost = 0.0
+    for j in range(3):
+        cost += c[C_WF] * e_f[j] * e_f[j] + c[C_WW] * e_w[j] * e_w[j]
+        cost += c[C_WX] * state[S_PSP + j] ** 2 + c[C_WV] * state[S_VSP + j] ** 2
+        cost += c[C_WPG] * (state[S_GP + j] - c[C_P0]) ** 2 + c[C_WKG] * (state[S_GK + j] - c[C_TILT_K]) ** 2
+    state[S_COST] = 0.5 * cost
+    # attitude sensitivity: body-frame perturbation carried by the set point's rotation, plus this step's rate
+    for j in range(3):
+        th = (state[S_TH + j], state[S_TH + 3 + j], state[S_TH + 6 + j])
+        rot = cross(w_s, th)
+        for i in range(3):
+            state[S_TH + 3 * i + j] = th[i] - rot[i] * dt + dw[i, j] * dt
+    # steepest descent, clipped to the bounds
+    for j in range(3):
+        state[S_GP + j] = min(c[C_PHI], max(c[C_PLO], state[S_GP + j] - c[C_GP] * gp[j] * dt))
+        state[S_GK + j] = min(c[C_KHI], max(c[C_KLO], state[S_GK + j] - c[C_GK] * gk[j] * dt))
+
+
+@njit(cache=True)
+def washout_classical(f, om, c, coef, state, first, rest):
+    """The classical-family washout (small-angle, large-angle, unrestricted) by one sample: scaling, the rotational
+    saturation, tilt coordination, the rotational and translational channels. Updates the set points in
+    ``state`` (S_PSP position, S_QSP attitude) and returns (sat_tilt, sat_rot): whether the tilt-rate and
+    rotational-rate limits acted; and the set points before this sample (q_sp_prev, p_sp_prev), which on the first
+    sample are the washout's start state."""
     kind = int(c[C_KIND])
+    adapt = c[C_ADAPT] != 0.0
     dt = c[C_DT]
     g = c[C_G]
     fs = (c[C_SF] * f[0], c[C_SF] * f[1], c[C_SF] * f[2])
     ws, sat_rot = limit_norm((c[C_SW] * om[0], c[C_SW] * om[1], c[C_SW] * om[2]), c[C_ROT_SAT])
-    first = state[S_INIT] == 0.0
-    rest = c[C_REST] != 0.0
     if first:
         if rest:  # the simulator was at rest before the recording began: the first sample is a change
             _init_washout(kind, c, coef, state, (0.0, 0.0, -c[C_SF] * g), (0.0, 0.0, 0.0))
@@ -200,18 +338,29 @@ def step_one(f, om, c, coef, state, counts, row):
     q_sp_prev = (state[S_QSP], state[S_QSP + 1], state[S_QSP + 2], state[S_QSP + 3])
     p_sp_prev = (state[S_PSP], state[S_PSP + 1], state[S_PSP + 2])
 
-    # ---- washout: attitude set point and inertial acceleration of the translational channel
+    # ---- attitude set point and inertial acceleration of the translational channel
     if kind == KIND_SMALL:
         phi = state[S_BT] + state[S_BR]
         theta = state[S_BT + 1] + state[S_BR + 1]
         psi = state[S_BT + 2] + state[S_BR + 2]
         a_i = rot_euler(phi, theta, psi, fs)
         g_s = rot_euler_inv(phi, theta, psi, g_i)
-        if c[C_LP_BEFORE] != 0.0:
+        f_lp = fs
+        if adapt:
+            k = (state[S_GK], state[S_GK + 1], state[S_GK + 2])
+            if c[C_LP_BEFORE] != 0.0:
+                f_lp = _filt3(coef, state, F_TILT_LP, fs)
+                wt = _tilt_rate3(g_s, f_lp, k, c[C_FREEFALL])
+            else:
+                wt = _filt3(coef, state, F_TILT_LP, _tilt_rate3(g_s, fs, k, c[C_FREEFALL]))
+        elif c[C_LP_BEFORE] != 0.0:
             wt = _tilt_rate(g_s, _filt3(coef, state, F_TILT_LP, fs), c[C_TILT_K], c[C_FREEFALL])
         else:
             wt = _filt3(coef, state, F_TILT_LP, _tilt_rate(g_s, fs, c[C_TILT_K], c[C_FREEFALL]))
+        wt_raw = wt
         bdot_t, sat_tilt = _limit_tilt(euler_rates(phi, theta, wt, c[C_COSMIN]), c[C_TILT_RATE], c[C_TILT_AXIS])
+        if sat_tilt:  # the limited tilt rate in body axes (for the adaptation's sensitivities)
+            wt = body_rates(phi, theta, bdot_t)
         bdot_r = _filt3(coef, state, F_ROT_HP, euler_rates(phi, theta, ws, c[C_COSMIN]))
         for j in range(3):
             state[S_BT + j] += bdot_t[j] * dt
@@ -222,22 +371,48 @@ def step_one(f, om, c, coef, state, counts, row):
     else:
         a_i = qrot(q_sp_prev, fs)
         g_s = qrot_inv(q_sp_prev, g_i)
-        if c[C_LP_BEFORE] != 0.0:
+        f_lp = fs
+        if adapt:
+            k = (state[S_GK], state[S_GK + 1], state[S_GK + 2])
+            if c[C_LP_BEFORE] != 0.0:
+                f_lp = _filt3(coef, state, F_TILT_LP, fs)
+                wt = _tilt_rate3(g_s, f_lp, k, c[C_FREEFALL])
+            else:
+                wt = _filt3(coef, state, F_TILT_LP, _tilt_rate3(g_s, fs, k, c[C_FREEFALL]))
+        elif c[C_LP_BEFORE] != 0.0:
             wt = _tilt_rate(g_s, _filt3(coef, state, F_TILT_LP, fs), c[C_TILT_K], c[C_FREEFALL])
         else:
             wt = _filt3(coef, state, F_TILT_LP, _tilt_rate(g_s, fs, c[C_TILT_K], c[C_FREEFALL]))
+        wt_raw = wt
         wt, sat_tilt = _limit_tilt(wt, c[C_TILT_RATE], c[C_TILT_AXIS])
         wr = _filt3(coef, state, F_ROT_HP, ws)
         q_sp = qintegrate(q_sp_prev, (wt[0] + wr[0], wt[1] + wr[1], wt[2] + wr[2]), dt)
     for j in range(4):
         state[S_QSP + j] = q_sp[j]
     # translational channel: + g_I, high-pass, double integration (semi-implicit Euler)
-    a_hp = _filt3(coef, state, F_TRANS_HP, (a_i[0], a_i[1], a_i[2] + g))
+    u = (a_i[0], a_i[1], a_i[2] + g)
+    if adapt:
+        a_hp = _filt3(coef, state, F_TRANS_HP, (state[S_GP] * u[0], state[S_GP + 1] * u[1], state[S_GP + 2] * u[2]))
+    else:
+        a_hp = _filt3(coef, state, F_TRANS_HP, u)
     for j in range(3):
         state[S_VSP + j] += a_hp[j] * dt
         state[S_PSP + j] += state[S_VSP + j] * dt
+    if adapt:
+        _adapt(c, coef, state, fs, ws, u, g_s, f_lp, wt_raw, wt, sat_tilt, a_hp, q_sp_prev, q_sp)
+    return q_sp_prev, p_sp_prev, sat_tilt, sat_rot
 
-    # ---- platform
+
+@njit(cache=True)
+def platform_head(p_sp_prev, p_sp, q_sp_prev, q_sp, first, rest, c, coef, state, counts, row, sat_tilt, sat_rot):
+    """The Atlas platform tracking the set points (from ``p_sp_prev``, ``q_sp_prev`` to ``p_sp``, ``q_sp``) within
+    its limits, and the simulator pilot-head motion from what the platform actually does; writes the output
+    ``row`` (every field, the set points and the saturation flags, the washout's two given) and counts the flags.
+
+    On the ``first`` sample the platform starts centred at attitude ``q_sp_prev``, at rest (``rest``) or turning
+    at the set point's rate."""
+    dt = c[C_DT]
+    g_i = (0.0, 0.0, c[C_G])
     if first:
         for j in range(3):
             state[S_P + j] = 0.0
@@ -256,7 +431,7 @@ def step_one(f, om, c, coef, state, counts, row):
             state[S_P + j],
             v_prev,
             p_sp_prev[j],
-            state[S_PSP + j],
+            p_sp[j],
             c[C_PMAX + j],
             c[C_VMAX + j],
             c[C_AMAX + j],
@@ -319,7 +494,7 @@ def step_one(f, om, c, coef, state, counts, row):
         row[O_HEAD_F + j] = a_s[j] - g_sh[j] + t1[j] + t2[j]
         row[O_HEAD_OMEGA + j] = wh[j]
         row[O_WHEEL + j] = wheels[j]
-        row[O_SP_POS + j] = state[S_PSP + j]
+        row[O_SP_POS + j] = p_sp[j]
     for j in range(4):
         row[O_Q + j] = q[j]
         row[O_SP_Q + j] = q_sp[j]
@@ -327,7 +502,56 @@ def step_one(f, om, c, coef, state, counts, row):
     for j in range(7):
         row[O_SAT + j] = float(flags[j])
         counts[j] += flags[j]
+
+
+@njit(cache=True)
+def step_one(f, om, c, coef, state, counts, row):
+    """Advance one washout (+ platform + head motion) by one sample and write its output ``row``:
+    washout -> set points -> platform -> head."""
+    first = state[S_INIT] == 0.0
+    rest = c[C_REST] != 0.0
+    q_sp_prev, p_sp_prev, sat_tilt, sat_rot = washout_classical(f, om, c, coef, state, first, rest)
+    q_sp = (state[S_QSP], state[S_QSP + 1], state[S_QSP + 2], state[S_QSP + 3])
+    p_sp = (state[S_PSP], state[S_PSP + 1], state[S_PSP + 2])
+    platform_head(p_sp_prev, p_sp, q_sp_prev, q_sp, first, rest, c, coef, state, counts, row, sat_tilt, sat_rot)
     state[S_INIT] = 1.0
+
+
+@njit(cache=True)
+def setpoint_step(p_sp, q_sp, sat_tilt, sat_rot, c, coef, state, counts, row):
+    """One sample of a washout computed outside the kernel (a Python algorithm, :mod:`washbench.cueing.algorithm`):
+    the platform tracks its new set point ``p_sp`` (3,) m and ``q_sp`` (4,) (unit quaternion) from the previous one,
+    kept in ``state`` (S_PSP, S_QSP; before the first sample: the algorithm's start set point). ``sat_tilt``,
+    ``sat_rot``: the algorithm's own limit flags (0 or 1)."""
+    first = state[S_INIT] == 0.0
+    rest = c[C_REST] != 0.0
+    q_prev = (state[S_QSP], state[S_QSP + 1], state[S_QSP + 2], state[S_QSP + 3])
+    p_prev = (state[S_PSP], state[S_PSP + 1], state[S_PSP + 2])
+    pn = (p_sp[0], p_sp[1], p_sp[2])
+    qn = (q_sp[0], q_sp[1], q_sp[2], q_sp[3])
+    platform_head(p_prev, pn, q_prev, qn, first, rest, c, coef, state, counts, row, sat_tilt, sat_rot)
+    for j in range(3):
+        state[S_PSP + j] = pn[j]
+    for j in range(4):
+        state[S_QSP + j] = qn[j]
+    state[S_INIT] = 1.0
+
+
+@njit(cache=True)
+def setpoint_trace(sp_pos, sp_q, flags, c, coef, state, counts, out):
+    """:func:`setpoint_step` over a whole trace: sp_pos (N, 3), sp_q (N, 4), flags (N, 2) int64; out (NFIELDS, N)."""
+    row = np.zeros(NFIELDS)
+    for k in range(sp_pos.shape[0]):
+        setpoint_step(sp_pos[k], sp_q[k], flags[k, 0], flags[k, 1], c, coef, state, counts, row)
+        for j in range(NFIELDS):
+            out[j, k] = row[j]
+
+
+@njit(cache=True)
+def setpoint_block(sp_pos, sp_q, flags, c, coef, state, counts, out):
+    """:func:`setpoint_step` over a block: sp_pos (M, 3), sp_q (M, 4), flags (M, 2) int64; out (M, NFIELDS)."""
+    for k in range(sp_pos.shape[0]):
+        setpoint_step(sp_pos[k], sp_q[k], flags[k, 0], flags[k, 1], c, coef, state, counts, out[k])
 
 
 @njit(cache=True)
@@ -344,6 +568,8 @@ def bank_step(f, om, cfg, coef, state, counts, out):
     """Streaming form: advance every washout of the bank by one sample (f, om: (3,) float64)."""
     _check_input(f, om)
     for i in range(cfg.shape[0]):
+        if cfg[i, C_KIND] < 0.0:  # a set-point washout: stepped by the caller (setpoint_step)
+            continue
         step_one(f, om, cfg[i], coef[i], state[i], counts[i], out[i])
 
 
@@ -356,6 +582,8 @@ def bank_trace(f, om, cfg, coef, state, counts, out):
     washout's samples in order on one thread: the same operations in the same order as streaming).
     """
     for i in prange(cfg.shape[0]):
+        if cfg[i, C_KIND] < 0.0:
+            continue
         row = np.zeros(NFIELDS)
         for k in range(f.shape[0]):
             step_one(f[k], om[k], cfg[i], coef[i], state[i], counts[i], row)
@@ -371,6 +599,8 @@ def bank_block(f, om, cfg, coef, state, counts, out):
     """
     for k in range(f.shape[0]):
         for i in range(cfg.shape[0]):
+            if cfg[i, C_KIND] < 0.0:
+                continue
             step_one(f[k], om[k], cfg[i], coef[i], state[i], counts[i], out[i, k])
 
 
@@ -393,5 +623,10 @@ __all__ = [
     "bank_block",
     "bank_step",
     "bank_trace",
+    "platform_head",
+    "setpoint_block",
+    "setpoint_step",
+    "setpoint_trace",
     "step_one",
+    "washout_classical",
 ]

@@ -18,24 +18,34 @@ from washbench.errors import WashbenchError
 from washbench.io.paths import DATA_DIR
 from washbench.io.yamlio import StrictModel, validate_data
 
-WASHOUT_KINDS: tuple[str, ...] = ("small-angle", "large-angle", "unrestricted")
-"""The three washout algorithms (kinds). A run's washouts are a list of (name, kind, parameters): the
-built-in washouts are named after their kind, variants (:mod:`washbench.cueing.variants`) have their own names."""
+CLASSICAL_KINDS: tuple[str, ...] = ("small-angle", "large-angle", "unrestricted")
+"""The paper's three classical-family washouts."""
 
-WASHOUT_NAMES = WASHOUT_KINDS
-"""The built-in washouts run by default (one per kind, named after it)."""
+ADAPTIVE_KINDS: tuple[str, ...] = ("adaptive", "adaptive-large-angle", "adaptive-unrestricted")
+"""The coordinated adaptive washout on the small-angle, large-angle and unrestricted structures (docs/washouts.md)."""
+
+WASHOUT_KINDS: tuple[str, ...] = CLASSICAL_KINDS + ADAPTIVE_KINDS
+"""The compiled built-in washout algorithms (kinds). A run's washouts are a list of (name, kind, parameters): the
+built-in washouts are named after their kind, variants (:mod:`washbench.cueing.variants`) have their own names.
+Algorithms outside the kernel (Python: built-in ones and plugins) are in :mod:`washbench.cueing.registry`."""
+
+WASHOUT_NAMES = CLASSICAL_KINDS
+"""The built-in washouts run by default (one per kind, named after it): the paper's three."""
 
 DEFAULT_PARAMS_PATH = DATA_DIR / "cw1.yaml"
 
 
 def check_washouts(washouts: Sequence[str]) -> tuple[str, ...]:
-    """Built-in washout names as a tuple; WashbenchError if none, one is unknown or one is listed twice."""
+    """Built-in or registered washout names as a tuple; WashbenchError if none, one is unknown or one is listed
+    twice."""
+    from washbench.cueing.registry import known_kinds
+
     names = tuple(washouts)
     if not names:
         raise WashbenchError("no washout selected")
     for name in names:
-        if name not in WASHOUT_KINDS:
-            raise WashbenchError(f"unknown washout {name!r} (valid: {', '.join(WASHOUT_KINDS)})")
+        if name not in known_kinds():
+            raise WashbenchError(f"unknown washout {name!r} (valid: {', '.join(known_kinds())})")
     if len(set(names)) != len(names):
         raise WashbenchError(f"washout listed twice: {', '.join(names)}")
     return names
@@ -125,6 +135,47 @@ class SmallAngle(StrictModel):
     min_cos_pitch: Annotated[float, Field(gt=0.0, lt=1.0)]
 
 
+class GainBounds(StrictModel):
+    """An adapted gain's bounds (and, for the translational gain, its start)."""
+
+    min: NonNegative
+    max: Positive
+
+
+class TranslationalGain(GainBounds):
+    """The translational channel's adaptive gain p (dimensionless), per inertial axis."""
+
+    initial: Annotated[float, Field(ge=0.0, le=10.0, allow_inf_nan=False)] = 1.0
+
+
+class Adaptive(StrictModel):
+    """The coordinated adaptive washout (kinds ``adaptive``, ``adaptive-large-angle``, ``adaptive-unrestricted``):
+    steepest descent on J = 1/2 [W_f |f_A - f_S|^2 + W_w |w_A - w_S|^2 + W_x |x|^2 + W_v |v|^2 + W_p |p - p0|^2
+    + W_k |k - k0|^2] (docs/washouts.md). Rates of 0 give the classical washout of the same structure exactly.
+    All values chosen (Reid and Nahon's published set was not available to us); their effect is in the docs."""
+
+    rate_translational: NonNegative = 1.0
+    """G_p: adaptation rate of the translational gains p, 1/((m/s^2)^2 s) per unit cost."""
+    rate_tilt: NonNegative = 1.0
+    """G_k: adaptation rate of the tilt gains k (1/s), per unit cost and second."""
+    weight_specific_force: NonNegative = 1.0
+    """W_f on the specific-force error, per (m/s^2)^2."""
+    weight_angular_velocity: NonNegative = 10.0
+    """W_w on the angular-velocity error, per (rad/s)^2."""
+    weight_position: NonNegative = 1.0
+    """W_x on the translational set point's distance from centre, per m^2."""
+    weight_velocity: NonNegative = 1.0
+    """W_v on its speed, per (m/s)^2."""
+    weight_gain_translational: NonNegative = 0.1
+    """W_p pulling p back to its start."""
+    weight_gain_tilt: NonNegative = 0.1
+    """W_k pulling k back to the tilt gain (tilt.gain_per_s)."""
+    translational_gain: TranslationalGain = TranslationalGain(min=0.0, max=1.5)
+    """p: start and bounds."""
+    tilt_gain_per_s: GainBounds = GainBounds(min=0.05, max=5.0)
+    """k bounds, 1/s (it starts at tilt.gain_per_s)."""
+
+
 class WashoutParams(StrictModel):
     """A complete washout parameter set (e.g. CW1), shared by the three washouts."""
 
@@ -137,6 +188,11 @@ class WashoutParams(StrictModel):
     head: Head
     small_angle: SmallAngle
     free_fall_threshold_mps2: Annotated[float, Field(gt=0.0, le=100.0, allow_inf_nan=False)]
+    adaptive: Adaptive = Adaptive()
+    """The adaptive washouts' rates, weights and gain bounds (defaults when the section is absent)."""
+    sections: dict[str, dict[str, Any]] = Field(default_factory=dict)
+    """The Python algorithms' own sections (:mod:`washbench.cueing.registry`), by kind: in the file each is a
+    top-level key named after the algorithm; validated by the algorithm's ``Params`` when a washout is made."""
 
 
 def load_washout_params(path: Path | None = None) -> WashoutParams:

@@ -31,7 +31,8 @@ from typing import Any
 import pydantic
 from pydantic import BaseModel
 
-from washbench.cueing.params import DEFAULT_PARAMS_PATH, WASHOUT_KINDS, WashoutParams, check_washouts
+from washbench.cueing import registry
+from washbench.cueing.params import DEFAULT_PARAMS_PATH, WASHOUT_NAMES, WashoutParams, check_washouts
 from washbench.errors import WashbenchError, located
 from washbench.io.names import identifier_problem
 from washbench.io.yamlio import Loc, line_of, read_yaml, validate_data
@@ -46,6 +47,8 @@ class Washout:
     name: str
     kind: str
     params: WashoutParams
+    source: str | None = None
+    """For a plugin loaded from a file: its ``FILE.py:NAME`` (so a worker process can load it too)."""
 
 
 @dataclass(frozen=True)
@@ -76,15 +79,15 @@ def check_name(name: str, where: str = "--variant") -> str:
     problem = identifier_problem(name)
     if problem is not None:
         raise WashbenchError(f"{where}: variant name: {problem}")
-    if name in WASHOUT_KINDS or name in RESERVED_NAMES:
+    if name in registry.known_kinds() or name in RESERVED_NAMES:
         raise WashbenchError(f"{where}: variant name {name!r} is reserved (a built-in washout or output name)")
     return name
 
 
 def check_kind(kind: str, where: str = "--variant") -> str:
     """A washout kind, checked."""
-    if kind not in WASHOUT_KINDS:
-        raise WashbenchError(f"{where}: unknown washout kind {kind!r} (valid: {', '.join(WASHOUT_KINDS)})")
+    if kind not in registry.known_kinds():
+        raise WashbenchError(f"{where}: unknown washout kind {kind!r} (valid: {', '.join(registry.known_kinds())})")
     return kind
 
 
@@ -117,6 +120,13 @@ def check_key(key: str, where: str, model: type[BaseModel] = WashoutParams) -> t
     import difflib
 
     parts = tuple(key.split("."))
+    if model is WashoutParams and parts[0] in registry.python_kinds():  # a Python algorithm's own section
+        sub_model = registry.get(parts[0]).params_model
+        if sub_model is None:
+            raise WashbenchError(f"{where}: {key}: washout {parts[0]!r} takes no parameters")
+        if len(parts) == 1:
+            raise WashbenchError(f"{where}: {key}: is a group; set its values one by one")
+        return (parts[0], *check_key(".".join(parts[1:]), f"{where}: {parts[0]}", sub_model))
     current: type[BaseModel] = model
     for i, part in enumerate(parts):
         fields = current.model_fields
@@ -159,8 +169,11 @@ def apply_overrides(
     for key, value in items:
         parts = check_key(key, where)
         node = data
+        if parts[0] in registry.python_kinds():  # into the algorithm's section (validated when the washout is made)
+            node = data["sections"].setdefault(parts[0], {})
+            parts = parts[1:]
         for part in parts[:-1]:
-            node = node[part]
+            node = node.setdefault(part, {}) if isinstance(node, dict) else node[part]
         node[parts[-1]] = value
     try:
         return WashoutParams.model_validate_json(json.dumps(data, allow_nan=True))
@@ -175,10 +188,23 @@ def apply_overrides(
         raise WashbenchError(located(where, problem, line=line, field=field_prefix + key)) from None
 
 
+def value_of(params: WashoutParams, key: str) -> Any:
+    """The value of a dotted key in a parameter set (a Python algorithm's key: from its validated section)."""
+    parts = key.split(".")
+    node: Any = params
+    if parts[0] in registry.python_kinds():
+        node = registry.get(parts[0]).make_params(params.sections.get(parts[0]), "parameters")
+        parts = parts[1:]
+    for part in parts:
+        node = node[part] if isinstance(node, dict) else getattr(node, part)
+    return node
+
+
 def resolve(variant: VariantText, base: WashoutParams, where: str | None = None) -> Washout:
     """The variant as a :class:`Washout`: ``base`` with its overrides applied."""
     src = where or f"--variant {variant.name}"
-    return Washout(variant.name, variant.kind, apply_overrides(base, variant.overrides, src))
+    params = apply_overrides(base, variant.overrides, src)
+    return Washout(variant.name, variant.kind, params, registry.plugin_spec(variant.kind))
 
 
 def _flatten(value: Any, prefix: str, loc: Loc, out: dict[str, tuple[Any, Loc]]) -> None:
@@ -218,7 +244,7 @@ def _file_variants(path: Path, data: Any, lines: dict[Loc, int], base: WashoutPa
         for key in flat:
             check_key(key, located(path, field, line=key_lines[key]))
         params = apply_overrides(base, {k: v for k, (v, _) in flat.items()}, str(path), key_lines, f"{field}.")
-        out.append(Washout(str(name), kind, params))
+        out.append(Washout(str(name), kind, params, registry.plugin_spec(kind)))
     return tuple(out)
 
 
@@ -231,13 +257,21 @@ def load_param_file(path: Path | None = None) -> tuple[WashoutParams, tuple[Wash
     if not isinstance(data, dict):
         return validate_data(path, data, lines, WashoutParams), ()
     variants = data.pop("variants", None)
+    kinds = registry.python_kinds()
+    sections = {k: data.pop(k) for k in list(data) if k in kinds}
+    for kind, section in sections.items():  # each validated now, so its errors name the file and line
+        if not isinstance(section, dict):
+            raise WashbenchError(located(path, "expected a mapping", line=line_of(lines, (kind,)), field=kind))
+        registry.get(kind).make_params(section, str(path), lines)
+    if sections:
+        data = {**data, "sections": {**data.get("sections", {}), **sections}}
     base = load_base_params(path, data, lines)
     return base, (() if variants is None else _file_variants(path, variants, lines, base))
 
 
 def builtin(names: Sequence[str], params: WashoutParams) -> tuple[Washout, ...]:
-    """Built-in washouts (named after their kind) with one parameter set."""
-    return tuple(Washout(n, n, params) for n in check_washouts(names))
+    """Built-in washouts and registered algorithms (named after their kind) with one parameter set."""
+    return tuple(Washout(n, n, params, registry.plugin_spec(n)) for n in check_washouts(names))
 
 
 def as_washouts(washouts: Sequence[str | Washout], params: WashoutParams | None) -> tuple[Washout, ...]:
@@ -272,7 +306,7 @@ def select_washouts(
     base, from_file = load_param_file(params_path)
     parsed = [parse_variant(v) for v in variants]
     extra = from_file + tuple(resolve(v, base) for v in parsed)
-    named = list(dict.fromkeys(washouts)) if washouts else ([] if extra else list(WASHOUT_KINDS))
+    named = list(dict.fromkeys(washouts)) if washouts else ([] if extra else list(WASHOUT_NAMES))
     return as_washouts([*builtin(named, base), *extra] if named else list(extra), None)
 
 
@@ -288,4 +322,5 @@ __all__ = [
     "parse_variant",
     "resolve",
     "select_washouts",
+    "value_of",
 ]

@@ -122,9 +122,11 @@ def _map(fn, args: list[tuple], jobs: int | None, dask: str | None) -> list:
         return list(pool.map(fn, *zip(*args, strict=True)))
 
 
-def _evaluate_task(evaluator: FlightEvaluator, cfg: np.ndarray, coef: np.ndarray) -> Evaluation:
+def _evaluate_task(
+    evaluator: FlightEvaluator, cfg: np.ndarray, coef: np.ndarray, washouts: Sequence[Washout] = ()
+) -> Evaluation:
     """Cluster task: one batch of candidates (compiled arrays) on one flight."""
-    return evaluator.evaluate_arrays(cfg, coef)
+    return evaluator.evaluate_arrays(cfg, coef, washouts)
 
 
 def _concat(parts: Sequence[Evaluation]) -> Evaluation:
@@ -157,7 +159,14 @@ def evaluate(
         [ev] = c.scatter([f.evaluator], broadcast=True, hash=False)
         futures.append(
             [
-                c.submit(_evaluate_task, ev, cfg[i : i + chunk], coef[i : i + chunk], pure=False)
+                c.submit(
+                    _evaluate_task,
+                    ev,
+                    cfg[i : i + chunk],
+                    coef[i : i + chunk],
+                    list(candidates[i : i + chunk]),
+                    pure=False,
+                )
                 for i in range(0, len(candidates), chunk)
             ]
         )

@@ -21,7 +21,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from washbench.analysis.sweep import SweepRow, grid, parse_set, point_washouts, sweep_csv, sweep_metrics_csv
-from washbench.cueing.params import WASHOUT_KINDS
+from washbench.cueing.params import WASHOUT_NAMES
 from washbench.errors import WashbenchError
 from washbench.io.atomic import write_text_atomic
 
@@ -58,7 +58,7 @@ def sweep_command(
     axes = [parse_set(s) for s in sets]
     points = grid(axes)
     keys = [a.key for a in axes]
-    kinds = list(dict.fromkeys(washouts or WASHOUT_KINDS))
+    kinds = list(dict.fromkeys(washouts or WASHOUT_NAMES))
     base, _ = load_param_file(params_path)
     candidates = [w for k in kinds for w in point_washouts(k, base, points)]
     limits = load_platform_limits(platform_path)

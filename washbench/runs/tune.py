@@ -26,8 +26,9 @@ import yaml
 
 from washbench.analysis.sweep import format_value
 from washbench.analysis.tune import Bound, minimise, parse_tune
+from washbench.cueing import registry
 from washbench.cueing.params import WashoutParams
-from washbench.cueing.variants import Washout, apply_overrides, check_kind
+from washbench.cueing.variants import Washout, apply_overrides, check_kind, value_of
 from washbench.errors import WashbenchError
 from washbench.io.atomic import write_text_atomic
 from washbench.io.results import csv_number
@@ -104,7 +105,7 @@ def tune_command(
 
     def candidate(x: np.ndarray) -> Washout:
         point = dict(zip(keys, (float(v) for v in x), strict=True))
-        return Washout(kind, kind, apply_overrides(base, point, "--tune"))
+        return Washout(kind, kind, apply_overrides(base, point, "--tune"), registry.plugin_spec(kind))
 
     history: list[tuple[np.ndarray, float, float, float]] = []
 
@@ -125,7 +126,8 @@ def tune_command(
     tuned = tuned.model_copy(update={"name": label})
     _write(out_dir, base, tuned, kind, bounds, history, budget, seed, saturation_weight, manoeuvres, base_obj)
 
-    both = [Washout(base.name, kind, base), Washout("tuned", kind, tuned)]
+    spec = registry.plugin_spec(kind)
+    both = [Washout(base.name, kind, base, spec), Washout("tuned", kind, tuned, spec)]
     table = []
     for group, fl in (("training", train), ("test", tests)):
         for f, r in zip(fl, evaluate(fl, both, dask) if fl else [], strict=True):
@@ -141,9 +143,7 @@ def tune_command(
 
 
 def _value(params: WashoutParams, key: str) -> float:
-    node: object = params
-    for part in key.split("."):
-        node = getattr(node, part)
+    node = value_of(params, key)
     if node is None or isinstance(node, bool | str):
         raise WashbenchError(f"--tune {key}: the base value is {format_value(node)}, not a number to start from")
     return float(node)  # type: ignore[arg-type]

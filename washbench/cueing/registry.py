@@ -1,0 +1,203 @@
+"""Which washout algorithms exist: the compiled built-ins, the built-in Python ones, and users' plugins.
+
+A washout *kind* names an algorithm. The compiled kinds (:data:`washbench.cueing.params.WASHOUT_KINDS`) run inside
+the numba kernel. Every other kind is a Python algorithm (:mod:`washbench.cueing.algorithm`): a factory
+``factory(params, context) -> WashoutAlgorithm`` whose parameters are the section of the parameter file named after
+the kind, validated by the factory's ``Params`` pydantic model (``params`` is ``None`` when it has none).
+
+Where Python algorithms come from, in this order:
+
+- built in (:data:`BUILTIN_PYTHON`, imported when first used);
+- plugins loaded from a file, ``--washout-plugin FILE.py:NAME`` (:func:`load_plugin`);
+- installed packages, through the entry-point group ``washbench.washouts`` (the entry point's name is the kind).
+
+A plugin's kind is its ``washout_name`` attribute if it has one, else ``NAME``. Kinds are plain identifiers
+(letters, digits, ``_`` and ``-``): they become column prefixes, entity paths and parts of file names.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.metadata
+import importlib.util
+import sys
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from pydantic import BaseModel
+
+from washbench.cueing.params import WASHOUT_KINDS
+from washbench.errors import WashbenchError
+from washbench.io.names import identifier_problem
+
+ENTRY_POINT_GROUP = "washbench.washouts"
+
+BUILTIN_PYTHON: dict[str, str] = {}
+"""Built-in Python algorithms: kind -> ``module:attribute`` of the factory (imported on first use)."""
+
+
+@dataclass(frozen=True)
+class Algorithm:
+    """A Python washout algorithm: its kind, factory, parameter model (or None) and where it came from."""
+
+    kind: str
+    factory: Callable[..., Any]
+    params_model: type[BaseModel] | None
+    source: str
+
+    def make_params(self, section: dict[str, Any] | None, where: str, lines: Any = None) -> BaseModel | None:
+        """The validated parameter section (``section``: the raw mapping from the parameter file, or None).
+
+        WashbenchError ``WHERE[:LINE]: KIND.FIELD: problem``; ``lines`` (a YAML line map, optional) gives the line.
+        """
+        from washbench.errors import located
+        from washbench.io.yamlio import line_of
+
+        if self.params_model is None:
+            if section:
+                raise WashbenchError(located(where, "this washout takes no parameters", field=self.kind))
+            return None
+        import pydantic
+
+        try:
+            return self.params_model.model_validate(section or {})
+        except pydantic.ValidationError as exc:
+            err = exc.errors(include_url=False)[0]
+            loc = tuple(err["loc"])
+            line = line_of(lines, (self.kind, *loc)) if lines else None
+            field = ".".join((self.kind, *(str(p) for p in loc)))
+            raise WashbenchError(located(where, err["msg"], line=line, field=field)) from None
+
+
+_LOADED: dict[str, Algorithm] = {}
+_PLUGIN_SPECS: dict[str, str] = {}  # kind -> FILE.py:NAME, for processes that must load it again
+
+
+def _params_model(obj: Any, where: str) -> type[BaseModel] | None:
+    model = getattr(obj, "Params", None)
+    if model is None:
+        return None
+    if not (isinstance(model, type) and issubclass(model, BaseModel)):
+        raise WashbenchError(f"{where}: its Params must be a pydantic BaseModel class")
+    return model
+
+
+def _algorithm(obj: Any, kind: str, source: str) -> Algorithm:
+    where = f"washout plugin {source}"
+    if not callable(obj):
+        raise WashbenchError(f"{where}: {type(obj).__name__} is not a class or callable")
+    problem = identifier_problem(kind)
+    if problem is not None:
+        raise WashbenchError(f"{where}: washout name {kind!r}: {problem}")
+    if kind in WASHOUT_KINDS or kind in BUILTIN_PYTHON or kind in ("aircraft", "limit", "t_s", "bound"):
+        raise WashbenchError(f"{where}: washout name {kind!r} is taken by a built-in washout or output")
+    return Algorithm(kind, obj, _params_model(obj, where), source)
+
+
+def load_plugin(spec: str) -> Algorithm:
+    """Load ``FILE.py:NAME`` and register it; WashbenchError (one line) if it cannot be loaded."""
+    text = str(spec)
+    file, sep, name = text.rpartition(":")
+    where = f"--washout-plugin {text}"
+    if not sep or not file or not name:
+        raise WashbenchError(f"{where}: expected FILE.py:NAME")
+    path = Path(file).expanduser()
+    if not path.is_file():
+        raise WashbenchError(f"{where}: {path}: no such file")
+    module_name = f"washbench_plugin_{abs(hash(str(path.resolve())))}"
+    try:
+        mod_spec = importlib.util.spec_from_file_location(module_name, path)
+        if mod_spec is None or mod_spec.loader is None:
+            raise WashbenchError(f"{where}: {path}: not a Python file")
+        module = importlib.util.module_from_spec(mod_spec)
+        sys.modules[module_name] = module
+        mod_spec.loader.exec_module(module)
+    except WashbenchError:
+        raise
+    except Exception as exc:  # a user's file: whatever it raises becomes one line
+        line = ""
+        tb = exc.__traceback__
+        while tb is not None:
+            if tb.tb_frame.f_code.co_filename == str(path):
+                line = f":{tb.tb_lineno}"
+            tb = tb.tb_next
+        if isinstance(exc, SyntaxError) and exc.lineno:
+            line = f":{exc.lineno}"
+        raise WashbenchError(f"{where}: {path}{line}: {type(exc).__name__}: {exc}") from None
+    if not hasattr(module, name):
+        raise WashbenchError(f"{where}: {path} has no {name!r}")
+    obj = getattr(module, name)
+    kind = str(getattr(obj, "washout_name", name))
+    algo = _algorithm(obj, kind, text)
+    previous = _PLUGIN_SPECS.get(kind)
+    if previous is not None and previous != text:
+        raise WashbenchError(f"{where}: washout name {kind!r} is already loaded from {previous}")
+    _LOADED[kind] = algo
+    _PLUGIN_SPECS[kind] = text
+    return algo
+
+
+def _entry_points() -> dict[str, importlib.metadata.EntryPoint]:
+    return {ep.name: ep for ep in importlib.metadata.entry_points(group=ENTRY_POINT_GROUP)}
+
+
+def python_kinds() -> tuple[str, ...]:
+    """Every Python algorithm's kind known in this process: built in, loaded plugins, entry points."""
+    return tuple(dict.fromkeys([*BUILTIN_PYTHON, *_LOADED, *_entry_points()]))
+
+
+def known_kinds() -> tuple[str, ...]:
+    """Every washout kind: compiled built-ins, then the Python ones."""
+    return WASHOUT_KINDS + python_kinds()
+
+
+def is_python(kind: str) -> bool:
+    """Whether ``kind`` is a Python algorithm (not one of the compiled built-ins)."""
+    return kind not in WASHOUT_KINDS
+
+
+def plugin_spec(kind: str) -> str | None:
+    """``FILE.py:NAME`` of a plugin loaded from a file, for worker processes (None otherwise)."""
+    return _PLUGIN_SPECS.get(kind)
+
+
+def get(kind: str, spec: str | None = None) -> Algorithm:
+    """The Python algorithm ``kind`` (loading ``spec`` = ``FILE.py:NAME`` first if it is not loaded here)."""
+    if kind in _LOADED:
+        return _LOADED[kind]
+    if spec is not None:
+        algo = load_plugin(spec)
+        if algo.kind == kind:
+            return algo
+    if kind in BUILTIN_PYTHON:
+        module, _, attr = BUILTIN_PYTHON[kind].partition(":")
+        obj = getattr(importlib.import_module(module), attr)
+        algo = Algorithm(kind, obj, _params_model(obj, kind), "built-in")
+        _LOADED[kind] = algo
+        return algo
+    eps = _entry_points()
+    if kind in eps:
+        source = f"entry point {eps[kind].value}"
+        try:
+            obj = eps[kind].load()
+        except Exception as exc:
+            raise WashbenchError(f"washout plugin {source}: {type(exc).__name__}: {exc}") from None
+        algo = _algorithm(obj, kind, source)
+        _LOADED[kind] = algo
+        return algo
+    raise WashbenchError(f"unknown washout {kind!r} (valid: {', '.join(known_kinds())})")
+
+
+__all__ = [
+    "BUILTIN_PYTHON",
+    "ENTRY_POINT_GROUP",
+    "Algorithm",
+    "get",
+    "is_python",
+    "known_kinds",
+    "load_plugin",
+    "plugin_spec",
+    "python_kinds",
+]

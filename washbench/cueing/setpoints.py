@@ -1,0 +1,154 @@
+"""Running a Python washout algorithm (:mod:`washbench.cueing.algorithm`) on the bench, with its output checked.
+
+:class:`SetPointSource` makes the algorithm from a :class:`washbench.cueing.variants.Washout`, starts it, steps it
+and checks every set point it returns: a tuple (pos_m, q) of 3 and 4 finite numbers, q not zero (it is normalised
+here). Anything else, or an exception raised inside the algorithm, becomes one line naming the washout, the plugin,
+the step and the time (:class:`washbench.errors.WashbenchError`), so no command shows a traceback or writes a
+result made of a plugin's garbage.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from washbench.cueing import registry
+from washbench.cueing.algorithm import WashoutContext
+from washbench.errors import WashbenchError
+
+
+class SetPointSource:
+    """One Python washout on one recording: :meth:`start`, then :meth:`step` per sample (or :meth:`trace`)."""
+
+    def __init__(self, washout: Any, limits: Any, dt_s: float, filter_start: str) -> None:
+        self.name = washout.name
+        self.kind = washout.kind
+        algo = registry.get(washout.kind, washout.source)
+        self.source = algo.source
+        params = washout.params
+        section = algo.make_params(params.sections.get(washout.kind), f"washout {self.name}")
+        self.context = WashoutContext(
+            dt_s=dt_s,
+            gravity_mps2=params.gravity_mps2,
+            limits=limits,
+            filter_start=filter_start,
+            head_offset_m=tuple(params.head.offset_m),
+        )
+        self.dt_s = dt_s
+        self.k = -1  # the step being computed (-1: start)
+        try:
+            self.algo = algo.factory(section, self.context)
+        except Exception as exc:
+            raise WashbenchError(self._where("making it") + f": {type(exc).__name__}: {exc}") from None
+        for method in ("start", "step"):
+            if not callable(getattr(self.algo, method, None)):
+                raise WashbenchError(self._where("making it") + f": the algorithm has no {method}() method")
+        self.has_flags = callable(getattr(self.algo, "flags", None))
+        self.has_trace = callable(getattr(self.algo, "trace", None))
+
+    def _where(self, what: str | None = None) -> str:
+        label = self.name if self.source == "built-in" else f"{self.name} ({self.source})"
+        if what is None:
+            what = "start" if self.k < 0 else f"step {self.k} (t = {self.k * self.dt_s:.6g} s)"
+        return f"washout {label}: {what}"
+
+    def _call(self, fn: Any, *args: Any) -> Any:
+        try:
+            return fn(*args)
+        except WashbenchError:
+            raise
+        except Exception as exc:
+            raise WashbenchError(f"{self._where()}: raised {type(exc).__name__}: {exc}") from None
+
+    def _check(self, out: Any) -> tuple[np.ndarray, np.ndarray]:
+        if not isinstance(out, tuple | list) or len(out) != 2:
+            raise WashbenchError(f"{self._where()}: returned {type(out).__name__}, expected a tuple (pos_m, q)")
+        try:
+            pos = np.asarray(out[0], dtype=np.float64).reshape(-1)
+            q = np.asarray(out[1], dtype=np.float64).reshape(-1)
+        except (TypeError, ValueError) as exc:
+            raise WashbenchError(f"{self._where()}: set point is not numbers: {exc}") from None
+        if pos.shape != (3,) or q.shape != (4,):
+            raise WashbenchError(f"{self._where()}: set point shapes {pos.shape} and {q.shape}, expected (3,) and (4,)")
+        p0, p1, p2 = pos.tolist()
+        q0, q1, q2, q3 = q.tolist()
+        nq = math.sqrt(q0 * q0 + q1 * q1 + q2 * q2 + q3 * q3)
+        if not (math.isfinite(p0 + p1 + p2) and math.isfinite(nq)):
+            raise WashbenchError(f"{self._where()}: set point is not finite: pos_m={pos.tolist()}, q={q.tolist()}")
+        if nq < 1e-6:
+            raise WashbenchError(f"{self._where()}: attitude set point q is zero")
+        q /= nq
+        return pos, q
+
+    def _flags(self) -> tuple[int, int]:
+        if not self.has_flags:
+            return 0, 0
+        out = self._call(self.algo.flags)
+        try:
+            a, b = out
+        except (TypeError, ValueError):
+            raise WashbenchError(f"{self._where()}: flags() returned {out!r}, expected (tilt, rotational)") from None
+        return int(bool(a)), int(bool(b))
+
+    def start(self, f0: np.ndarray, om0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The start set point, from the first sample (or rest, with ``filter_start="rest"``)."""
+        self.k = -1
+        if self.context.filter_start == "rest":
+            f0 = np.array([0.0, 0.0, -self.context.gravity_mps2])
+            om0 = np.zeros(3)
+        return self._check(self._call(self.algo.start, _ro(f0), _ro(om0)))
+
+    def step(self, f: np.ndarray, om: np.ndarray) -> tuple[np.ndarray, np.ndarray, int, int]:
+        """The next set point and the algorithm's two limit flags."""
+        self.k += 1
+        pos, q = self._check(self._call(self.algo.step, _ro(f), _ro(om)))
+        return pos, q, *self._flags()
+
+    def run(
+        self, f: np.ndarray, om: np.ndarray, whole: bool = False
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Set points for samples f, om (M, 3) in order: pos (M, 3), q (M, 4), flags (M, 2) int64. ``whole``: these
+        are all the samples there will be (the algorithm's ``trace`` form may then be used)."""
+        m = f.shape[0]
+        pos = np.empty((m, 3))
+        q = np.empty((m, 4))
+        flags = np.zeros((m, 2), dtype=np.int64)
+        if whole and self.has_trace and self.k == -1 and m > 0:
+            return self._trace(f, om)
+        for i in range(m):
+            pos[i], q[i], flags[i, 0], flags[i, 1] = self.step(f[i], om[i])
+        return pos, q, flags
+
+    def _trace(self, f: np.ndarray, om: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        self.k = 0
+        out = self._call(self.algo.trace, _ro(f), _ro(om))
+        m = f.shape[0]
+        try:
+            pos = np.asarray(out[0], dtype=np.float64)
+            q = np.asarray(out[1], dtype=np.float64)
+        except (TypeError, ValueError, IndexError) as exc:
+            raise WashbenchError(f"{self._where('trace')}: returned {type(out).__name__}: {exc}") from None
+        if pos.shape != (m, 3) or q.shape != (m, 4):
+            raise WashbenchError(
+                f"{self._where('trace')}: set point shapes {pos.shape} and {q.shape}, expected ({m}, 3) and ({m}, 4)"
+            )
+        bad = ~(np.isfinite(pos).all(axis=1) & np.isfinite(q).all(axis=1))
+        norms = np.sqrt((q * q).sum(axis=1))
+        bad |= ~(norms >= 1e-6)
+        if bad.any():
+            self.k = int(np.argmax(bad))
+            raise WashbenchError(f"{self._where()}: set point is not finite or q is zero")
+        self.k = m - 1
+        return pos, q / norms[:, None], np.zeros((m, 2), dtype=np.int64)
+
+
+def _ro(a: np.ndarray) -> np.ndarray:
+    """A read-only float64 copy-free view for the algorithm."""
+    v = np.asarray(a, dtype=np.float64).view()
+    v.flags.writeable = False
+    return v
+
+
+__all__ = ["SetPointSource"]
