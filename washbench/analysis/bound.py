@@ -333,10 +333,37 @@ def oracle_bound(
     return BoundResult(traj, float(np.sum(per)), still, {k: float(v) for k, v in channels.items()}, statuses)
 
 
+def costs_from_columns(
+    cols: dict[str, np.ndarray],
+    dt_s: float,
+    limits: PlatformLimits,
+    gravity_mps2: float,
+    params: BoundParams | None = None,
+    vestibular: VestibularParams | None = None,
+) -> tuple[BoundResult, dict[str, float]]:
+    """The bound and every washout's cost from the columns of a run's ``traces.parquet`` (``aircraft.f_x_mps2`` ...,
+    ``NAME.acc_x_mps2``, ``NAME.omega_platform_x_degps``, ``NAME.q_w`` ...)."""
+    f_air = np.column_stack([cols[f"aircraft.f_{a}_mps2"] for a in "xyz"])
+    w_air = np.radians(np.column_stack([cols[f"aircraft.omega_{a}_degps"] for a in "xyz"]))
+    res = oracle_bound(f_air, w_air, dt_s, limits, gravity_mps2, params, vestibular)
+    costs = {}
+    for key in cols:
+        if not key.endswith(".acc_x_mps2"):
+            continue
+        name = key[: -len(".acc_x_mps2")]
+        acc = np.column_stack([cols[f"{name}.acc_{a}_mps2"] for a in "xyz"])
+        om = np.radians(np.column_stack([cols[f"{name}.omega_platform_{a}_degps"] for a in "xyz"]))
+        q = np.column_stack([cols[f"{name}.q_{c}"] for c in "wxyz"])
+        traj = trajectory_from_trace(acc, om, q, dt_s)
+        costs[name] = washout_cost(traj, f_air, w_air, dt_s, gravity_mps2, params, vestibular)
+    return res, costs
+
+
 __all__ = [
     "BoundParams",
     "BoundResult",
     "Trajectory",
+    "costs_from_columns",
     "linear_head_motion",
     "oracle_bound",
     "perceived_cost",
