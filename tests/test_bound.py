@@ -132,3 +132,24 @@ def test_bound_params_validate():
     assert BoundParams.model_validate({"rate_weight": 2.0}).rate_weight == 2.0
     with pytest.raises(Exception, match="bogus"):
         BoundParams.model_validate({"bogus": 1})
+
+
+def test_bound_replayed_as_a_washout_through_the_platform(limits):
+    """Kind ``bound`` through the bench's whole-trace path (cue_trace: Atlas model, head motion): the platform
+    tracks its set points without touching a translational limit; its cost from its own trace is near the bound's
+    (started at rest; measured 10 % above: the sphere's norm limits on rate and angular acceleration, which the bound
+    relaxes to per-axis ones, bind when roll and pitch change together) and below the washout's."""
+    a = generate(SignalSpec("doublet", "f_x", 4.0, frequency_hz=0.25, duration_s=6.0, start_s=0.5))
+    b = generate(SignalSpec("doublet", "roll", 15.0, frequency_hz=0.3, duration_s=6.0, start_s=1.0))
+    f = a.f_mps2 + b.f_mps2 - np.array([0.0, 0.0, -G])
+    w = b.omega_radps
+    dt = a.dt_s
+    traces = cue_trace(f, w, dt, ["bound", "large-angle"], load_washout_params(), limits)
+    tb = traces["bound"]
+    for kind in ("pos", "vel", "acc"):
+        assert int(np.sum(tb.saturated[kind])) == 0, kind
+    replay = washout_cost(trajectory_from_trace(tb.acc_mps2, tb.omega_radps, tb.q, dt), f, w, dt, G)
+    at_rest = oracle_bound(f, w, dt, limits, G, start_at_rest=True)
+    assert at_rest.cost * (1 - 1e-6) <= replay <= 1.2 * at_rest.cost
+    tl = traces["large-angle"]
+    assert replay < washout_cost(trajectory_from_trace(tl.acc_mps2, tl.omega_radps, tl.q, dt), f, w, dt, G)

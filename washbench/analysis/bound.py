@@ -17,7 +17,8 @@ The bound (:func:`oracle_bound`) minimises J over every platform trajectory on t
 |p| <= p_max, |v| <= v_max, |v_k - v_{k-1}| <= a_max dt per axis (the Atlas stage, exactly), and each body-rate
 component within the rate limit and each component's change within alpha_max dt (a relaxation of the sphere's norm
 limits: every trajectory the platform can make satisfies them), with the future known, starting from any position,
-velocity, attitude and rate within the limits (a relaxation of every start). The channels (surge + pitch, sway +
+attitude and rate within the limits and at rest in translation (as the Atlas stage always starts: a relaxation of
+every start). The channels (surge + pitch, sway +
 roll, heave, yaw) separate, so it is four sparse QPs (Clarabel's interior-point method: accurate in a few dozen
 factorisations of the banded KKT system, where a first-order method needs many thousand iterations here). Since
 every washout's trajectory is feasible for the same problem, the bound's cost is at most every washout's; the bound
@@ -159,6 +160,7 @@ def _solve_channel(
     lim: dict[str, float],
     params: BoundParams,
     vest: VestibularParams,
+    start_at_rest: bool = False,
 ) -> tuple[dict[str, np.ndarray], str]:
     """One channel's QP. Per sample k the variables are [a, w, ang, p, v, z_o (2), z_c (3)] restricted to those the
     channel has; four more start variables ang_-1, p_-1, v_-1, w_-1. Returns the optimal sequences and the status."""
@@ -243,6 +245,10 @@ def _solve_channel(
             lo[-1], hi[-1] = -lim["dw"], lim["dw"]
     for name in starts:
         box(scol[name], math.pi if name == "ang" else lim[name])
+        if start_at_rest or name == "v":  # the Atlas stage always starts at rest in translation
+            lo[-1] = hi[-1] = 0.0
+    if start_at_rest and has_f:  # the replay also ends at rest: the stage can stop within its travel at the end
+        box(v(n - 1, "v"), 0.0)
     A = sparse.csc_matrix((vals, (rows, cols)), shape=(r, nz))
     # cost: dt (w_f (C_o z_o)^2 + w_w (C_c z_c)^2) per sample
     pr, pc, pv = [], [], []
@@ -287,15 +293,23 @@ def oracle_bound(
     gravity_mps2: float,
     params: BoundParams | None = None,
     vestibular: VestibularParams | None = None,
+    start_at_rest: bool = False,
 ) -> BoundResult:
-    """The bound on a flight's aircraft head motion f_air (N, 3) m/s^2, w_air (N, 3) rad/s (see the module)."""
+    """The bound on a flight's aircraft head motion f_air (N, 3) m/s^2, w_air (N, 3) rad/s (see the module).
+
+    The platform starts at rest in translation, anywhere within its travel, at any attitude and rate; with
+    ``start_at_rest`` centred, level and still, and at rest in translation at the end (what :class:`BoundWashout`
+    replays: the Atlas stage must always be able to stop within its travel, which the free bound need not at the
+    end of the recording)."""
     p = params if params is not None else BoundParams()
     vest = vestibular if vestibular is not None else VestibularParams()
     f_air = np.asarray(f_air, dtype=np.float64)
     w_air = np.asarray(w_air, dtype=np.float64)
     n = f_air.shape[0]
     t = limits.translation
-    relax = 1.0 + 1e-9  # the platform's own rounding
+    # the platform's own rounding; the replay stays 0.1 % inside, where the stage's discrete braking bound is not
+    # touched by rounding
+    relax = 0.999 if start_at_rest else 1.0 + 1e-9
     w_max = math.radians(limits.rotation.rate_limit_degps) * relax
     dw = math.radians(limits.rotation.acceleration_limit_degps2) * dt_s * relax
     g = float(gravity_mps2)
@@ -317,7 +331,7 @@ def oracle_bound(
                        a=t.acceleration_limit_mps2.xyz[ax] * relax)  # fmt: skip
         r_f = None if ax is None else (f_air[:, 2] + g if ax == 2 else f_air[:, ax])
         r_w = None if wax is None else w_air[:, wax]
-        sol, statuses[name] = _solve_channel(name, r_f, r_w, sign, dt_s, g, lim, p, vest)
+        sol, statuses[name] = _solve_channel(name, r_f, r_w, sign, dt_s, g, lim, p, vest, start_at_rest)
         if ax is not None:
             acc[:, ax], pos[:, ax], vel[:, ax] = sol["a"], sol["p"], sol["v"]
         if wax is not None:
@@ -359,9 +373,42 @@ def costs_from_columns(
     return res, costs
 
 
+class BoundWashout:
+    """The bound as a washout (kind ``bound``; whole-trace paths only: ``cue_trace``/``cue_motion``, omct, sweep,
+    tune; ``run`` and ``cue`` feed samples in order and get a one-line error): its ``trace`` solves
+    the bound for the whole recording, started centred, level and still, and returns its positions and attitudes
+    (ZYX Euler from the integrated roll, pitch and yaw) as set points, so the platform, head motion, perception,
+    metrics, ranking, report and figures treat it like any washout. It knows the future; ``step`` (a live or
+    lockstep run) cannot and raises."""
+
+    Params = BoundParams
+    name = "bound"
+
+    def __init__(self, params: BoundParams | None, context) -> None:
+        self.params = params if params is not None else BoundParams()
+        self.context = context
+
+    def start(self, f_mps2: np.ndarray, omega_radps: np.ndarray):
+        return np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0])
+
+    def step(self, f_mps2: np.ndarray, omega_radps: np.ndarray):
+        raise RuntimeError("the oracle bound needs the whole recording (whole-trace paths: cue_trace, cue_motion, "
+                           "omct, sweep, tune); run and cue feed it sample by sample")  # fmt: skip
+
+    def trace(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        from washbench.cueing.rotations import quat_from_euler
+
+        c = self.context
+        res = oracle_bound(f_mps2, omega_radps, c.dt_s, c.limits, c.gravity_mps2, self.params, start_at_rest=True)
+        ang = res.trajectory.angles
+        q = np.array([quat_from_euler(float(a), float(b), float(y)) for a, b, y in ang])
+        return res.trajectory.pos.copy(), q
+
+
 __all__ = [
     "BoundParams",
     "BoundResult",
+    "BoundWashout",
     "Trajectory",
     "costs_from_columns",
     "linear_head_motion",
