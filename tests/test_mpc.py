@@ -64,6 +64,8 @@ def test_unconstrained_mpc_approaches_the_lq_solution_as_the_horizon_grows(limit
         "tilt_rate_limit_degps": None,
         "terminal_rest": False,
         "limit_margin": 1.0,
+        # the LQ comparison uses the standard stage cost x' Q x + u' R u (no direct force term)
+        **{ch: {"direct_force": 0.0} for ch in ("pitch", "roll", "heave")},
         "solver": {"eps_abs": 1e-9, "eps_rel": 1e-9, "max_iter": 100000, "polishing": True},
     }
     # a state reached on a real signal: a surge doublet and a roll-rate doublet through the long-horizon MPC
@@ -188,3 +190,16 @@ def test_params_reject_a_prediction_step_shorter_than_the_sample(limits):
         MpcWashout(MpcParams.model_validate({"prediction_step_s": 0.001}), _context(limits))
     with pytest.raises(Exception, match="bogus"):
         MpcParams.model_validate({"solver": {"bogus": 1}})
+
+
+@pytest.mark.parametrize("axis, amp", [(0, 2.0), (1, 2.0), (2, -4.9)])
+def test_translational_cue_starts_in_the_direction_of_the_force(limits, axis, amp):
+    """A surge, sway or heave (pull-up) onset moves the platform with the force first (north, east, up). With the
+    input held over the horizon and no direct force term, a pull-up moved it down (docs/optimal-mpc.md)."""
+    n = int(2.0 / DT)
+    f = np.tile([0.0, 0.0, -G], (n, 1))
+    f[12:, axis] += amp
+    pos, _ = _run(MpcWashout(None, _context(limits)), f, np.zeros((n, 3)))
+    p = pos[:, axis] * np.sign(amp)
+    assert p.min() > -1e-4, p.min()
+    assert p[int(1.0 / DT)] > 0.02

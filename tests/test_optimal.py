@@ -38,13 +38,14 @@ def test_riccati_solution_and_optimality(designs, channel):
     A, B, Q = d.augmented()
     R = d.R
     K = np.hstack([d.K_x, d.K_r])
-    res = A.T @ d.P + d.P @ A - d.P @ B @ np.linalg.solve(R, B.T @ d.P) + Q
+    S = d.S
+    res = A.T @ d.P + d.P @ A - (d.P @ B + S) @ np.linalg.solve(R, B.T @ d.P + S.T) + Q
     assert np.max(np.abs(res)) < 1e-8 * max(1.0, np.max(np.abs(d.P)))
 
     def cost_matrix(gain):
         acl = A - B @ gain
         assert np.all(np.linalg.eigvals(acl).real < 0)
-        return linalg.solve_continuous_lyapunov(acl.T, -(Q + gain.T @ R @ gain))
+        return linalg.solve_continuous_lyapunov(acl.T, -(Q - S @ gain - gain.T @ S.T + gain.T @ R @ gain))
 
     p_opt = cost_matrix(K)
     np.testing.assert_allclose(p_opt, d.P, rtol=1e-6, atol=1e-9 * np.max(np.abs(d.P)))
@@ -157,3 +158,17 @@ def test_params_section_validates():
     assert p.pitch.force == 2.0 and p.roll.force == OptimalParams().roll.force
     with pytest.raises(Exception, match="bogus"):
         OptimalParams.model_validate({"pitch": {"bogus": 1.0}})
+
+
+@pytest.mark.parametrize("axis, amp", [(0, 2.0), (1, 2.0), (2, -4.9)])
+def test_translational_cue_starts_in_the_direction_of_the_force(context, axis, amp):
+    """A surge, sway or heave (pull-up) onset moves the platform with the force first (north, east, up), never
+    against it: the direct force-error weight keeps the LQ design from starting with a sharp opposite move (it did,
+    by up to 6 mm north and 0.14 m down for a pull-up, without it)."""
+    n = int(3.0 / DT)
+    f = np.tile([0.0, 0.0, -G], (n, 1))
+    f[12:, axis] += amp
+    pos, _ = _run(OptimalWashout(None, context), f, np.zeros((n, 3)))
+    p = pos[:, axis] * np.sign(amp)
+    assert p.min() > -1e-4, p.min()
+    assert p[int(1.0 / DT)] > 0.02

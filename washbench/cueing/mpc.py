@@ -48,6 +48,8 @@ class MpcWeights(StrictModel):
 
     force: Weight = 1.0
     """perceived specific-force error (otolith), per (m/s^2)^2"""
+    direct_force: Weight = 1.0
+    """specific-force error at the head itself (before the otolith model), per (m/s^2)^2 (see docs/optimal-mpc.md)"""
     rate: Weight = 10.0
     """perceived angular-velocity error (canals), per (rad/s)^2"""
     tilt_angle: Weight = 0.1
@@ -90,8 +92,10 @@ class MpcParams(StrictModel):
     """N, the number of prediction intervals"""
     prediction_step_s: Annotated[float, Field(gt=0.0, le=5.0, allow_inf_nan=False)] = 0.1
     """the prediction interval (s); at least the sample step"""
-    reference_decay_per_s: Annotated[float, Field(ge=0.0, le=100.0, allow_inf_nan=False)] = 0.0
-    """gamma: the aircraft input predicted as r e^{-gamma t} over the horizon (0: held, the default)"""
+    reference_decay_per_s: Annotated[float, Field(ge=0.0, le=100.0, allow_inf_nan=False)] = 0.5
+    """gamma: the aircraft input predicted as r e^{-gamma t} over the horizon (0: held; the default 0.5 1/s: with the
+    input held the plan must undo within the horizon any cue it gives, and heave cues came out with the wrong sign,
+    see docs/optimal-mpc.md)"""
     limit_margin: Annotated[float, Field(gt=0.0, le=1.0)] = 0.95
     """the QP's limits are this fraction of the platform's"""
     tilt_rate_limit_degps: Annotated[float, Field(gt=0.0, le=1000.0)] | None = 3.0
@@ -127,8 +131,10 @@ def split_angle(model: ChannelModel) -> ChannelModel:
     B[n, m] = 1.0
     E = np.vstack([model.E, np.zeros((1, model.E.shape[1]))])
     grow = np.zeros((model.C_err.shape[0], 1))
-    return replace(model, A=A, B=B, E=E, C_err=np.hstack([model.C_err, grow]),
-                   C_head=np.hstack([model.C_head, grow]), controls=(*model.controls, "rotation"))  # fmt: skip
+    c_head = np.hstack([model.C_head, model.C_head[:, model.i_angle : model.i_angle + 1]])  # g (theta_t + theta_r)
+    d_head = np.hstack([model.D_head, model.D_head[:, 1:2]])  # rate row: tilt + rotational rate
+    return replace(model, A=A, B=B, E=E, C_err=np.hstack([model.C_err, grow]), C_head=c_head, D_head=d_head,
+                   controls=(*model.controls, "rotation"))  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -147,6 +153,9 @@ class StackedModel:
     j_acc: np.ndarray  # (3,) controls a_x, a_y, a_z
     j_tilt: np.ndarray  # (2,) roll, pitch tilt rates
     j_rot: np.ndarray  # (3,) roll, pitch rotational rates, yaw rate
+    C_dir: np.ndarray  # (3, n) head specific force (x, y, z rows, deviation from level) from the state ...
+    D_dir: np.ndarray  # (3, m) ... and the controls
+    W_dir: np.ndarray  # (3,) direct_force weights of the pitch, roll and heave channels
 
 
 def stacked_model(params: MpcParams, gravity_mps2: float) -> StackedModel:
@@ -178,6 +187,13 @@ def stacked_model(params: MpcParams, gravity_mps2: float) -> StackedModel:
     E = linalg.block_diag(*[models[c].E for c in CHANNELS])
     mp, mr, mh, my = (models[c] for c in CHANNELS)
     ox, ou = offs_x, offs_u
+    n_all, m_all = ix, iu
+    c_dir = np.zeros((3, n_all))
+    d_dir = np.zeros((3, m_all))
+    for row, ch in enumerate(("pitch", "roll", "heave")):
+        mm = models[ch]
+        c_dir[row, ox[ch] : ox[ch] + mm.A.shape[0]] = mm.C_head[0]
+        d_dir[row, ou[ch] : ou[ch] + mm.B.shape[1]] = mm.D_head[0]
     return StackedModel(
         A=A,
         B=B,
@@ -191,6 +207,9 @@ def stacked_model(params: MpcParams, gravity_mps2: float) -> StackedModel:
         j_acc=np.array([ou["pitch"], ou["roll"], ou["heave"]]),
         j_tilt=np.array([ou["roll"] + 1, ou["pitch"] + 1]),
         j_rot=np.array([ou["roll"] + 2, ou["pitch"] + 2, ou["yaw"]]),
+        C_dir=c_dir,
+        D_dir=d_dir,
+        W_dir=np.array([params.pitch.direct_force, params.roll.direct_force, params.heave.direct_force]),
     )
 
 
@@ -271,10 +290,16 @@ class MpcWashout:
         sm, n, m, N, tp = self.model, self.n, self.m, self.N, self.tp
         p = self.params
         self.nz = nz = N * (n + m)
-        blocks = []
-        for _ in range(N):
-            blocks += [sm.R * tp, sm.Q * tp]
-        self.P_qp = sparse.csc_matrix(sparse.triu(sparse.block_diag(blocks)))
+        # stage k: [u_k, x_{k+1}] with u' R u + x' Q x + w_d |C_dir x + D_dir u - r_f|^2 (r_f: the aircraft force
+        # deviation held), all times dt_p; OSQP minimises 1/2 z' P z + q' z (the whole cost halved: same minimiser)
+        mdir = np.hstack([sm.D_dir, sm.C_dir])  # (3, m + n)
+        wdir = np.diag(sm.W_dir)
+        block = linalg.block_diag(sm.R, sm.Q) + mdir.T @ wdir @ mdir
+        self.P_qp = sparse.csc_matrix(sparse.triu(sparse.block_diag([block * tp] * N)))
+        sel = np.zeros((3, 6))
+        sel[0, 0] = sel[1, 2] = sel[2, 4] = 1.0  # r = [f_x, omega_y | f_y, omega_x | f_z + g | omega_z]
+        qblk = -(mdir.T @ wdir @ sel) * tp  # (m + n, 6)
+        self._q_map = np.vstack([qblk * self.rho**k for k in range(N)])  # q = _q_map @ r
         rows: list[sparse.spmatrix] = []
         # dynamics: x_{k+1} - Phi x_k - Gamma u_k = (Phi x_0 if k == 0) + Gamma_r r_k
         dyn = sparse.lil_matrix((N * n, nz))
@@ -435,7 +460,7 @@ class MpcWashout:
         :attr:`inaccurate`; its first move is still checked by :meth:`_safe`) with a finite result.
         """
         lo, hi = self._update_bounds(r)
-        self.solver.update(l=lo, u=hi)
+        self.solver.update(q=self._q_map @ r, l=lo, u=hi)
         res = self.solver.solve(raise_error=False)
         self.solves += 1
         self.iterations.append(int(res.info.iter))

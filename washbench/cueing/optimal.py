@@ -52,6 +52,9 @@ class ChannelWeights(StrictModel):
 
     force: Weight = 1.0
     """on the perceived specific-force error (otolith model output), per (m/s^2)^2"""
+    direct_force: Weight = 0.0
+    """on the specific-force error itself at the head (simulator minus aircraft, before the otolith model), per
+    (m/s^2)^2: without it the design may start a translational cue with a sharp opposite move (see the docs)"""
     rate: Weight = 1.0
     """on the perceived angular-velocity error (canal model output), per (rad/s)^2"""
     angle: Weight = 0.0
@@ -80,6 +83,7 @@ def _default_weights() -> dict[str, ChannelWeights]:
     # chosen (not published for this platform): see docs/optimal-mpc.md for the effect of each
     tilt = ChannelWeights(
         force=1.0,
+        direct_force=1.0,
         rate=10.0,
         angle=1.0,
         position=0.4,
@@ -91,7 +95,9 @@ def _default_weights() -> dict[str, ChannelWeights]:
     return {
         "pitch": tilt,
         "roll": tilt,
-        "heave": ChannelWeights(force=1.0, position=4.0, velocity=1.0, position_integral=0.5, acceleration=0.05),
+        "heave": ChannelWeights(
+            force=1.0, direct_force=1.0, position=4.0, velocity=1.0, position_integral=0.5, acceleration=0.05
+        ),
         "yaw": ChannelWeights(rate=10.0, angle=0.5, angular_rate=0.5),
     }
 
@@ -145,10 +151,13 @@ class ChannelDesign:
     K_r: np.ndarray
     A_w: np.ndarray
     B_w: np.ndarray
+    S: np.ndarray  # cross weight between [x; r] and u (the direct force error term)
+    Q_aug: np.ndarray  # the augmented state weight including the direct force error term
 
     def augmented(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(A_aug, B_aug, Q_aug) of the Riccati problem."""
-        return augmented_system(self.model, self.gamma, self.Q)
+        """(A_aug, B_aug, Q_aug) of the Riccati problem (its cost: z' Q_aug z + u' R u + 2 z' S u)."""
+        a, b, _ = augmented_system(self.model, self.gamma, self.Q)
+        return a, b, self.Q_aug
 
     def outputs(self) -> tuple[np.ndarray, np.ndarray, list[str]]:
         """(C, D, names): set-point outputs y = C x + D r: position (m) and angle (rad) where the channel has them."""
@@ -185,20 +194,29 @@ def design_channel(model: ChannelModel, weights: ChannelWeights, gamma: float) -
     """
     Q, R = cost_matrices(model, weights)
     A, B, Qa = augmented_system(model, gamma, Q)
+    n, m = model.B.shape
+    k = model.E.shape[1]
+    # direct force error d = C_head x + D_head u - r on the force rows: d = Cz z + D u with Cz = [C_head, -I]
+    nf = model.force_inputs
+    Cz = np.hstack([model.C_head[:nf], -np.eye(k)[:nf]])
+    D = model.D_head[:nf]
+    wd = weights.direct_force
+    Qa = Qa + wd * Cz.T @ Cz
+    R = R + wd * D.T @ D
+    S = wd * Cz.T @ D
     try:
-        P = linalg.solve_continuous_are(A, B, Qa, R)
+        P = linalg.solve_continuous_are(A, B, Qa, R, s=S)
     except (ValueError, np.linalg.LinAlgError) as exc:
         raise ValueError(
             f"optimal washout: the {model.name} design is not stable ({exc}: weights leave a state free)"
         ) from None
-    K = np.linalg.solve(R, B.T @ P)
-    n = model.A.shape[0]
+    K = np.linalg.solve(R, B.T @ P + S.T)
     K_x, K_r = K[:, :n], K[:, n:]
     A_w = model.A - model.B @ K_x
     B_w = model.E - model.B @ K_r
     if not np.all(np.linalg.eigvals(A_w).real < 0.0):
         raise ValueError(f"optimal washout: the {model.name} design is not stable (weights leave a state free)")
-    return ChannelDesign(model, gamma, Q, R, P, K_x, K_r, A_w, B_w)
+    return ChannelDesign(model, gamma, Q, R, P, K_x, K_r, A_w, B_w, S, Qa)
 
 
 def design(params: OptimalParams, gravity_mps2: float) -> dict[str, ChannelDesign]:
