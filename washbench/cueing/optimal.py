@@ -194,7 +194,7 @@ def design_channel(model: ChannelModel, weights: ChannelWeights, gamma: float) -
     """
     Q, R = cost_matrices(model, weights)
     A, B, Qa = augmented_system(model, gamma, Q)
-    n, m = model.B.shape
+    n = model.B.shape[0]
     k = model.E.shape[1]
     # direct force error d = C_head x + D_head u - r on the force rows: d = Cz z + D u with Cz = [C_head, -I]
     nf = model.force_inputs
