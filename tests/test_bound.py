@@ -114,7 +114,7 @@ def test_bound_below_every_washout_on_a_stress_signal(limits):
 
 
 def test_bound_below_every_washout_on_a_real_flight(limits):
-    """The C172 elevator doublet (its first 10 s: settle, doublet, the start of the controls-fixed response), flown by JSBSim."""
+    """The C172 elevator doublet flown by JSBSim (its first 10 s: settle, doublet, start of the response)."""
     flight = fly(load_manoeuvre(DATA_DIR / "manoeuvres" / "c172" / "elevator_doublet.yaml"))
     c = flight.columns
     n = round(10.0 / flight.dt_s)

@@ -190,6 +190,8 @@ def test_params_reject_a_prediction_step_shorter_than_the_sample(limits):
         MpcWashout(MpcParams.model_validate({"prediction_step_s": 0.001}), _context(limits))
     with pytest.raises(Exception, match="bogus"):
         MpcParams.model_validate({"solver": {"bogus": 1}})
+    p = MpcParams.model_validate({"heave": {"force": 2.0}})
+    assert p.heave.force == 2.0 and p.heave.position == MpcParams().heave.position  # the channel's default kept
 
 
 @pytest.mark.parametrize("axis, amp", [(0, 2.0), (1, 2.0), (2, -4.9)])

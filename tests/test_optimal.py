@@ -156,6 +156,9 @@ def test_sustained_specific_force_ends_as_tilt_with_the_platform_centred(context
 def test_params_section_validates():
     p = OptimalParams.model_validate({"input_break_radps": 0.5, "pitch": {"force": 2.0, "position": 1.0}})
     assert p.pitch.force == 2.0 and p.roll.force == OptimalParams().roll.force
+    # a partial channel section keeps the channel's other defaults (not the field defaults of the weight model)
+    assert p.pitch.angle == OptimalParams().pitch.angle and p.pitch.direct_force == OptimalParams().pitch.direct_force
+    design(OptimalParams.model_validate({"pitch": {"direct_force": 0.0}}), G)  # stable: the other weights kept
     with pytest.raises(Exception, match="bogus"):
         OptimalParams.model_validate({"pitch": {"bogus": 1.0}})
 

@@ -26,14 +26,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import Field
+from pydantic import Field, model_validator
 from scipy import linalg, sparse
 
 from washbench.cueing.algorithm import SetPoint, WashoutContext
 from washbench.cueing.motion_model import CHANNELS, ChannelModel, channel_inputs, channel_model, discretise_zoh
+from washbench.cueing.optimal import merge_channel_defaults
 from washbench.cueing.rotations import quat_from_euler
 from washbench.io.yamlio import StrictModel
 from washbench.perception.vestibular import CanalParams, OtolithParams
@@ -110,6 +111,13 @@ class MpcParams(StrictModel):
     solver: OsqpSettings = OsqpSettings()
     fallback: Literal["brake"] = "brake"
     """what a failed solve does (brake: decelerate translation and rotation at the limits)"""
+
+    @model_validator(mode="before")
+    @classmethod
+    def _channel_defaults(cls, data: Any) -> Any:
+        """A channel section given in part keeps that channel's defaults for the keys it does not give."""
+        defaults = {ch: f.default.model_dump() for ch, f in cls.model_fields.items() if ch in CHANNELS}
+        return merge_channel_defaults(data, defaults)
 
 
 def split_angle(model: ChannelModel) -> ChannelModel:

@@ -21,10 +21,10 @@ update (two matrix-vector products). Equations, weights and interpretations: ``d
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Annotated
+from typing import Annotated, Any
 
 import numpy as np
-from pydantic import Field
+from pydantic import Field, model_validator
 from scipy import linalg
 
 from washbench.cueing.algorithm import SetPoint, WashoutContext
@@ -112,6 +112,23 @@ class OptimalParams(StrictModel):
     roll: ChannelWeights = Field(default_factory=lambda: _default_weights()["roll"])
     heave: ChannelWeights = Field(default_factory=lambda: _default_weights()["heave"])
     yaw: ChannelWeights = Field(default_factory=lambda: _default_weights()["yaw"])
+
+    @model_validator(mode="before")
+    @classmethod
+    def _channel_defaults(cls, data: Any) -> Any:
+        """A channel section given in part keeps that channel's defaults for the keys it does not give."""
+        return merge_channel_defaults(data, {ch: w.model_dump() for ch, w in _default_weights().items()})
+
+
+def merge_channel_defaults(data: Any, defaults: dict[str, dict[str, Any]]) -> Any:
+    """``data`` with each channel mapping laid over that channel's default mapping (other values unchanged)."""
+    if not isinstance(data, dict):
+        return data
+    out = dict(data)
+    for ch, base in defaults.items():
+        if isinstance(out.get(ch), dict):
+            out[ch] = {**base, **out[ch]}
+    return out
 
 
 def cost_matrices(model: ChannelModel, w: ChannelWeights) -> tuple[np.ndarray, np.ndarray]:
