@@ -1,6 +1,6 @@
 """SHA-256 digests of every bundled manoeuvre's flight: the check that a faster flight loop flies the same bits.
 
-Each manoeuvre under ``washbench/data/manoeuvres`` is flown twice through :func:`washbench.flight.fly.fly`,
+Each manoeuvre under ``manoeuvres/`` is flown twice through :func:`washbench.flight.fly.fly`,
 the loop ``washbench fly`` and ``washbench run`` use: once alone (``fly``) and once with the three washouts
 in lockstep as ``washbench run`` feeds them (:func:`washbench.runs.pipeline.lockstep_blocks`). Printed per
 manoeuvre: the digest of the recorded columns (every flight.parquet column in order, name, dtype, shape and

@@ -108,7 +108,7 @@ def main() -> None:
             t = k / 120.0
             lines.append(f"{t!r},{math.sin(t)!r},0.0,-9.80665,{math.cos(t)!r},0.0,0.0")
         (tmp / "short.csv").write_text("\n".join(lines) + "\n")
-        takeoff = str(HERE.parent / "washbench" / "data" / "manoeuvres" / "c172" / "takeoff.yaml")
+        takeoff = str(HERE.parent / "manoeuvres" / "c172" / "takeoff.yaml")
         validate_file = takeoff
         cases = [
             ("validate", ["validate", validate_file], 0),

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import argparse
 import multiprocessing
-import os
 import tempfile
 import time
 from concurrent.futures import ProcessPoolExecutor
@@ -22,11 +21,13 @@ from pathlib import Path
 
 from baseline import manoeuvre_wall_s
 
+from washbench.io.cpus import usable_cpus
+
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("inputs", nargs="*", type=Path)
-    parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
+    parser.add_argument("--jobs", type=int, default=usable_cpus())
     parser.add_argument("--no-recording", action="store_true", help="run the suite without recording.rrd files")
     parser.add_argument("--no-figures", action="store_true", help="run the suite without the reports' figures")
     args = parser.parse_args()

@@ -11,7 +11,7 @@ def run(*args: str) -> subprocess.CompletedProcess[str]:
 def test_help_lists_every_subcommand() -> None:
     out = run("--help")
     assert out.returncode == 0
-    for name in ("cue", "fly", "validate", "schema", "run", "suite", "report", "replay"):
+    for name in ("cue", "fly", "validate", "schema", "run", "suite", "report", "replay", "live", "send"):
         assert name in out.stdout
 
 

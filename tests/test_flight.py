@@ -268,8 +268,8 @@ def test_progress_when_asked(tmp_path: Path, capsys: pytest.CaptureFixture[str])
 
 
 def test_the_documented_example_flies_with_its_checks_passing(tmp_path: Path) -> None:
-    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
-    section = readme.split("## Manoeuvre files", 1)[1]
+    page = (Path(__file__).resolve().parents[1] / "docs" / "how-to" / "own-manoeuvre.md").read_text()
+    section = page.split("## A worked example", 1)[1]
     example = section.split("```yaml\n", 1)[1].split("```", 1)[0]
     result = fly(load_manoeuvre(write(tmp_path, "example.yaml", example)))
     assert result.status == "ok", result.reason

@@ -47,7 +47,7 @@ EXPECTED = {
     "unknown_aircraft.yaml": ":2: aircraft: unknown aircraft 'c999x': no c999x/c999x.xml in the searched folders (",
     "unknown_key.yaml": ":11: phases[1].hold.bank_dge: unknown key (did you mean 'bank_deg'?)",
     "unknown_signal.yaml": (
-        ":15: checks[0].signal: unknown signal 'bank' (a signal is a flight.parquet column, see README.md)"
+        ":15: checks[0].signal: unknown signal 'bank' (a signal is a flight.parquet column, e.g. phi_deg)"
     ),
     "unreadable_yaml.yaml": ":8: invalid YAML: expected ',' or '}', but got ':'",
     "wrong_type.yaml": ":11: phases[1].hold.bank_deg: expected a number, got 'thirty'",

@@ -2,7 +2,7 @@
 
 Each test builds a small project in a temporary folder with real copies of the bundled Columbia 400 model
 (renamed, so only the copy can match) and checks which folder the search picks, against the order written in
-the README: --aircraft-dir, WASHBENCH_AIRCRAFT_PATH, aircraft/ next to the manoeuvre (up to the project
+docs/how-to/own-aircraft.md: --aircraft-dir, WASHBENCH_AIRCRAFT_PATH, aircraft/ next to the manoeuvre (up to the project
 root), bundled, JSBSim.
 """
 

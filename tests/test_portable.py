@@ -11,8 +11,8 @@ import sys
 from pathlib import Path
 
 import pytest
+from hostile import short
 
-from washbench.io.paths import MANOEUVRES_DIR
 from washbench.review.replay import _has_display
 from washbench.runs import suite
 
@@ -21,18 +21,21 @@ def test_suite_runs_with_spawn_where_forkserver_does_not_exist(tmp_path: Path, m
     monkeypatch.setattr(multiprocessing, "get_all_start_methods", lambda: ["spawn"])
     ctx, initializer = suite.pool_context()
     assert ctx.get_start_method() == "spawn" and initializer is not None
-    files = [MANOEUVRES_DIR / "c172" / "stall_recovery.yaml", MANOEUVRES_DIR / "c172" / "coordinated_turn.yaml"]
-    outcomes = suite.run_suite(files, tmp_path, jobs=2, progress=False)
+    # two short flights (what is tested is the start method: every worker imports and loads the kernels itself)
+    files = [short(tmp_path, name="spawn_a", seconds=2), short(tmp_path, name="spawn_b", seconds=2)]
+    outcomes = suite.run_suite(files, tmp_path / "out", jobs=2, progress=False)
     assert [o.run.ok for o in outcomes] == [True, True]
-    with open(tmp_path / "c172p" / "stall_recovery" / "metrics.csv", newline="") as f:
+    with open(tmp_path / "out" / "c172p" / "spawn_a" / "metrics.csv", newline="") as f:
         assert len(list(csv.DictReader(f))) == 18  # 3 washouts x 6 DOFs
+    assert (tmp_path / "out" / "c172p" / "spawn_b" / "figures" / "perceived.png").is_file()
+    assert (tmp_path / "out" / "c172p" / "spawn_b" / "recording.rrd").is_file()
 
 
 def test_numba_cache_goes_to_the_user_cache_folder_when_the_package_is_read_only(tmp_path: Path) -> None:
     """In a fresh interpreter with the package folders reported read-only, NUMBA_CACHE_DIR points at the user cache
     (XDG_CACHE_HOME here) and numba writes the kernel's cache there."""
     code = (
-        "import os, washbench.cueing.jitcache as j\n"
+        "import os, washbench.numerics.jitcache as j\n"
         "j._writable = lambda folder: False\n"
         "j.configure_cache()\n"
         "print(os.environ['NUMBA_CACHE_DIR'])\n"
@@ -60,3 +63,23 @@ def test_numba_cache_goes_to_the_user_cache_folder_when_the_package_is_read_only
 )
 def test_native_viewer_on_desktops(platform: str, environ: dict[str, str], native: bool) -> None:
     assert _has_display(platform, environ) is native
+
+
+def test_a_first_compile_is_announced_in_one_line_and_a_cached_one_not(tmp_path: Path) -> None:
+    """Two kernels compiled in one process (a fresh numba cache): one line; the same again from the cache: none."""
+    code = (
+        "import numpy as np\n"
+        "from washbench.review.thinning import keep_changes, keep_samples\n"
+        "v = np.cumsum(np.ones((50, 2)), axis=0)\n"
+        "keep_samples(np.arange(50.0), v, 0.1, 10.0)\n"
+        "keep_changes(v, 0.1, 10)\n"
+        "keep_samples(np.arange(50.0), v, 0.1, 10.0)\n"
+    )
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "numba")}
+    first, again = (subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=300)
+                    for _ in range(2))  # fmt: skip
+    assert first.returncode == 0 and again.returncode == 0, first.stderr + again.stderr
+    lines = first.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("washbench: compiling"), first.stderr
+    assert str(tmp_path / "numba") in lines[0]
+    assert again.stderr.strip() == ""

@@ -48,6 +48,7 @@ def test_ties_are_broken_by_the_order_the_washouts_were_listed() -> None:
     assert [r.washout for r in ranking] == ["unrestricted", "small-angle"]
     ranking = rank(rows_for("small-angle", same) + rows_for("unrestricted", same), {"surge": 1.0})
     assert [r.washout for r in ranking] == ["small-angle", "unrestricted"]
+    assert [(r.rank, r.tied) for r in ranking] == [(1, True), (1, True)]  # equal scores share the rank
 
 
 def test_comparison_sign_positive_means_better() -> None:
@@ -60,3 +61,57 @@ def test_comparison_sign_positive_means_better() -> None:
     npc = next(r for r in table if r.dof == "surge" and r.metric == "npc")
     assert math.isnan(npc.better_than_reference["large-angle"])
     assert len(table) == 6 * 3
+
+
+def test_close_scores_share_a_rank_and_the_margin_does_not_chain() -> None:
+    from washbench.analysis.ranking import tie_groups
+
+    # the C172 takeoff case: 0.605 and 0.595 differ by 1.7 % < 3 %: tied
+    assert tie_groups([0.605, 0.595, 0.9]) == [1, 1, 3]
+    # 1.00, 1.025, 1.05: 1.05 is 5 % from the group's best, so it starts a group of its own (no chaining)
+    assert tie_groups([1.05, 1.0, 1.025]) == [3, 1, 1]
+    # near zero the absolute margin 0.005 decides
+    assert tie_groups([0.0, 0.004, 0.006]) == [1, 1, 3]
+    assert tie_groups([0.2, math.nan, 0.1]) == [2, 3, 1]
+    assert tie_groups([0.5, 0.5, 0.5]) == [1, 1, 1]
+
+
+def test_rank_marks_ties_and_counts_undecided_first_places() -> None:
+    from washbench.analysis.ranking import undecided
+
+    motion = {"surge": 1.0}
+    a = rows_for("small-angle", {"surge": 0.605})
+    b = rows_for("large-angle", {"surge": 0.595})
+    c = rows_for("unrestricted", {"surge": 0.9})
+    ranking = rank(a + b + c, motion)
+    assert [(r.washout, r.rank, r.tied) for r in ranking] == [  # within the tie by value
+        ("large-angle", 1, True), ("small-angle", 1, True), ("unrestricted", 3, False)
+    ]
+    assert undecided(ranking)
+    assert wins([ranking]) == {"small-angle": 1, "large-angle": 1, "unrestricted": 0}
+    clear = rank(rows_for("small-angle", {"surge": 0.5}) + c, motion)
+    assert [(r.rank, r.tied) for r in clear] == [(1, False), (2, False)] and not undecided(clear)
+
+
+def test_rank_by_false_cue_time_and_by_user_dof_weights() -> None:
+    import dataclasses
+
+    from washbench.analysis.ranking import RankRule, rule_from_record
+
+    def with_false(rows, frac):
+        return [dataclasses.replace(r, cue_false_frac=frac.get(r.dof, 0.0)) for r in rows]
+
+    a = with_false(rows_for("small-angle", {"surge": 1.0, "roll": 1.0}), {"surge": 0.1, "yaw": 0.05})
+    b = with_false(rows_for("large-angle", {"surge": 0.5, "roll": 8.0}), {"roll": 0.3})
+    motion = {"surge": 2.0, "roll": 10.0}
+    by_false = rank(a + b, motion, RankRule("false-cue"))
+    assert [(r.washout, r.score) for r in by_false] == [("small-angle", pytest.approx(0.15)),
+                                                        ("large-angle", pytest.approx(0.3))]
+    # user weights surge 3, roll 1 (yaw unfelt, its weight dropped): score = 0.75 E_surge/2 + 0.25 E_roll/10
+    rule = RankRule("weighted", (("surge", 3.0), ("roll", 1.0), ("yaw", 5.0)))
+    by_user = {r.washout: r.score for r in rank(a + b, motion, rule)}
+    assert by_user == pytest.approx({"small-angle": 0.75 * 0.5 + 0.25 * 0.1, "large-angle": 0.75 * 0.25 + 0.25 * 0.8})
+    assert rule_from_record(rule.record()) == rule
+    assert rule_from_record(None) == RankRule()
+    with pytest.raises(ValueError, match="unknown ranking rule"):
+        RankRule("best")

@@ -58,7 +58,8 @@ def columns6(trace: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.n
 
 
 def cue_dir(inp: Path, out: Path, capsys: pytest.CaptureFixture[str] | None = None, **kw: object) -> dict:
-    opts = CueOptions(start_s=kw.pop("start_s", START_S), recording=False, **kw)  # type: ignore[arg-type]
+    # no figures: these tests read the numbers (the figures of a cue are tested in test_report.py)
+    opts = CueOptions(start_s=kw.pop("start_s", START_S), recording=False, figures=False, **kw)  # type: ignore[arg-type]
     code = run_cue(inp, out, options=opts)
     doc = json.loads((out / "run.json").read_text())
     doc["exit"] = code
@@ -234,7 +235,7 @@ def warnings_of(cols: dict[str, np.ndarray], tmp_path: Path, capsys: pytest.Capt
     p = tmp_path / "w.parquet"
     pq.write_table(pa.table(cols), p)
     capsys.readouterr()
-    run_cue(p, tmp_path / "wout", options=CueOptions(recording=False, **kw))  # type: ignore[arg-type]
+    run_cue(p, tmp_path / "wout", options=CueOptions(recording=False, figures=False, **kw))  # type: ignore[arg-type]
     return capsys.readouterr().err
 
 
@@ -338,8 +339,9 @@ def test_rest_start_feels_a_mid_manoeuvre_start(trace: dict[str, np.ndarray], tm
     pq.write_table(pa.table(c), tmp_path / "mid.parquet")
     from washbench.io.results import read_traces
 
-    run_cue(tmp_path / "mid.parquet", tmp_path / "steady", options=CueOptions(recording=False))
-    run_cue(tmp_path / "mid.parquet", tmp_path / "rest", options=CueOptions(recording=False, filter_start="rest"))
+    run_cue(tmp_path / "mid.parquet", tmp_path / "steady", options=CueOptions(recording=False, figures=False))
+    run_cue(tmp_path / "mid.parquet", tmp_path / "rest",
+            options=CueOptions(recording=False, figures=False, filter_start="rest"))  # fmt: skip
     steady = read_traces(tmp_path / "steady" / "traces.parquet")["aircraft.perceived_f_x_mps2"]
     rest = read_traces(tmp_path / "rest" / "traces.parquet")["aircraft.perceived_f_x_mps2"]
     assert np.allclose(steady, 2.0)

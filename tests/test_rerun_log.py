@@ -296,7 +296,35 @@ def test_limit_lanes_reproduce_the_saturation_flags(written):
         )
         np.testing.assert_array_equal(at, expected)
     assert [p.rsplit("/", 1)[1] for p in sorted(k for k in lanes if k.startswith("/lanes/"))] == [
-        "0_phase", "1_small-angle", "2_large-angle", "3_unrestricted"]  # fmt: skip
+        "0_phase", "1_small-angle", "2_large-angle", "3_unrestricted",
+        "cues_1_small-angle", "cues_2_large-angle", "cues_3_unrestricted"]  # fmt: skip
+
+
+def test_false_cue_lanes_and_events(written):
+    """Each washout's cue lane names, at every sample, the DOFs classified false (analysis.cues, the rule of
+    metrics.csv); every listed false-cue event is a WARN line at its start."""
+    from washbench.analysis.cues import FALSE, classify, dof_thresholds, false_events
+
+    path, data = written
+    lanes = read_component(path, "StateChange:state")
+    thresholds, rest = dof_thresholds()
+    ac = np.column_stack([data.aircraft.perceived_f_mps2, np.rad2deg(data.aircraft.perceived_omega_radps)])
+    n_events = 0
+    for i, w in enumerate(WASHOUTS):
+        m = data.washouts[w]
+        sim = np.column_stack([m.perceived_f_mps2, np.rad2deg(m.perceived_omega_radps)])
+        names = [d[0] for d in DOFS]
+        cls = [classify(ac[:, j], sim[:, j], thresholds[j], rest[j]) for j in range(6)]
+        expected = np.array(["false: " + "+".join(d for j, d in enumerate(names) if cls[j][k] == FALSE)
+                             if any(c[k] == FALSE for c in cls) else "" for k in range(len(data.t_s))])  # fmt: skip
+        t_ch, states = lanes[f"/lanes/cues_{i + 1}_{w}"]
+        np.testing.assert_array_equal(_state_at(t_ch, states, data.t_s), expected)
+        dt = float(data.t_s[1] - data.t_s[0])
+        n_events += sum(len(false_events(cls[j], sim[:, j] - rest[j], dt, names[j])) for j in range(6))
+    assert n_events > 0  # the synthetic data has false cues
+    t_ev, text = read_component(path, "TextLog:text")["/events/false_cues"]
+    assert len(text) == n_events and all(": false " in s and " cue until " in s for s in text)
+    assert np.all(np.diff(t_ev) >= 0)
 
 
 def test_saturation_onset_events(written):

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from washbench.cueing import rotations as r
+from washbench.numerics import rotations as r
 
 RNG = np.random.default_rng(7)
 ROTS = Rotation.random(20, random_state=3)

@@ -88,7 +88,7 @@ def test_signal_command_writes_a_cue_input(tmp_path: Path, capsys: pytest.Captur
         np.testing.assert_array_equal(m.f_mps2, sig.f_mps2)
         np.testing.assert_allclose(m.omega_radps, sig.omega_radps, rtol=1e-15, atol=1e-18)
     out = tmp_path / "cue"
-    assert main(["cue", str(csv_file), "--out", str(out)]) == 0
+    assert main(["cue", str(csv_file), "--out", str(out), "--no-figures", "--no-recording"]) == 0
     assert (out / "traces.parquet").is_file() and (out / "metrics.csv").is_file()
 
 

@@ -111,7 +111,8 @@ def test_sweep_points_equal_separate_cue_runs(
     metrics = read_csv(sweep_dir / "sweep_metrics.csv")
     for flight in sorted((sweep_dir / "flights").glob("*/*/flight.parquet")):
         out = tmp_path / flight.parent.name
-        assert main(["cue", str(flight), "--out", str(out), "--params", str(params), "--washout", kind]) == 0
+        assert main(["cue", str(flight), "--out", str(out), "--params", str(params), "--washout", kind,
+                     "--no-figures", "--no-recording"]) == 0  # fmt: skip
         rows, scores = cue_score(out)
         mine = [
             m
@@ -158,7 +159,7 @@ def test_two_variants_equal_two_runs_with_two_parameter_files(variant_run: Path,
         params = params_file(tmp_path, name, gain)
         out = tmp_path / name
         cue = ["cue", str(variant_run / "flight.parquet"), "--out", str(out), "--params", str(params)]
-        assert main([*cue, "--washout", "large-angle"]) == 0
+        assert main([*cue, "--washout", "large-angle", "--no-figures", "--no-recording"]) == 0
         separate = read_metrics_csv(out / "metrics.csv")
         mine = [r for r in run_rows if r.washout == name]
         assert [(r.dof, r.integral_error, r.max_error) for r in separate] == [
@@ -240,6 +241,8 @@ def test_tune_beats_cw1_and_tuned_yaml_reproduces_its_score(tuned: Path, sweep_d
             str(tuned / "tuned.yaml"),
             "--washout",
             "large-angle",
+            "--no-figures",
+            "--no-recording",
         ]
         assert main(args) == 0
         scores.append(cue_score(out)[1]["large-angle"])

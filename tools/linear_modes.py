@@ -1,6 +1,6 @@
 """Print the linearised modes of an aircraft at a manoeuvre's start: JSBSim's FGLinearization.
 
-    .venv/bin/python tools/linear_modes.py washbench/data/manoeuvres/c172/rudder_doublet.yaml
+    .venv/bin/python tools/linear_modes.py manoeuvres/c172/rudder_doublet.yaml
 
 The start state is the one ``washbench fly`` begins from (trimmed, or the flying start); the
 lateral-directional block (beta, phi, p, r) and the longitudinal one (Vt, alpha, theta, q) of the

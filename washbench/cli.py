@@ -14,8 +14,10 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from washbench.cli_examples import add_examples, subcommands
 from washbench.cueing.params import WASHOUT_KINDS
 from washbench.errors import Terminated, WashbenchError
+from washbench.io import config as project_config
 
 _VARIANT_HELP = "add a washout NAME of KIND with dotted-key overrides of the parameter file, repeatable"
 
@@ -45,6 +47,15 @@ def _washout_options(p: argparse.ArgumentParser, variants: bool = True) -> None:
     _plugin_option(p)
 
 
+def _rank_option(p: argparse.ArgumentParser) -> None:
+    """--rank-by and --vestibular (cue, run, suite), recorded in the provenance (docs/fidelity.md)."""
+    p.add_argument("--rank-by", choices=("score", "false-cue", "weighted"),
+                   help="ranking rule (default: the parameter file's ranking: section, else score); weighted uses "
+                   "its ranking.dof_weights")  # fmt: skip
+    p.add_argument("--vestibular", choices=("young-meiry", "telban-cardullo"),
+                   help="vestibular models (default young-meiry: Meiry-Young otolith, Young-Oman canals)")
+
+
 def _study_options(p: argparse.ArgumentParser) -> None:
     """What sweep and tune share."""
     _plugin_option(p)
@@ -57,7 +68,7 @@ def _study_options(p: argparse.ArgumentParser) -> None:
         metavar="RESULTS_DIR",
         help="read RESULTS_DIR/<aircraft>/<manoeuvre>/flight.parquet instead of flying",
     )
-    p.add_argument("--jobs", type=_jobs, help="parallel processes for the flights (default: number of cores)")
+    p.add_argument("--jobs", type=_jobs, help="processes for the flights (default: the CPUs this process may use)")
     p.add_argument("--dask", metavar="ADDRESS", help="send the work to this Dask scheduler (washbench[cluster])")
     p.add_argument("--quiet", action="store_true", help="no progress display")
     _aircraft_dir_option(p)
@@ -101,6 +112,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", type=Path, required=True, help="output folder (a run result folder's files)")
     _cue_input_options(p)
     _washout_options(p)
+    _rank_option(p)
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
 
@@ -123,6 +135,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--out", type=Path, required=True, help="results folder; writes OUT/<aircraft>/<manoeuvre>/")
     _washout_options(p)
+    _rank_option(p)
     _aircraft_dir_option(p)
     p.add_argument("--max-time-s", type=float, metavar="S", help="JSBSim script: stop after S s simulated")
     p.add_argument("--filter-start", choices=("steady", "rest"), default="steady", help="filters' start state")
@@ -143,8 +156,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--max-time-s", type=float, metavar="S", help="JSBSim scripts: stop each after S s simulated")
     p.add_argument("--out", type=Path, required=True, help="results folder")
     _aircraft_dir_option(p)
-    p.add_argument("--jobs", type=_jobs, help="parallel processes (default: number of cores)")
+    p.add_argument("--jobs", type=_jobs, help="parallel processes (default: the CPUs this process may use)")
     _washout_options(p)
+    _rank_option(p)
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
     p.add_argument("--dask", metavar="ADDRESS", help="run on this Dask scheduler instead of local processes")
@@ -156,7 +170,7 @@ def build_parser() -> argparse.ArgumentParser:
     _washout_options(p)
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
-    p.add_argument("--boundaries", type=Path, help="gain/phase boundaries YAML, drawn and checked (README)")
+    p.add_argument("--boundaries", type=Path, help="gain/phase boundaries YAML, drawn and checked (docs: OMCT)")
     p.add_argument("--rate-hz", type=float, default=120.0, help="washout sample rate (default 120)")
     p.add_argument("--amplitude-scale", type=float, default=1.0, help="multiply every input amplitude (default 1)")
 
@@ -164,7 +178,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("kind", help="signal shape: sine, step, pulse, doublet, chirp, multisine")
     p.add_argument("--axis", required=True, help="body axis: f_x, f_y, f_z (specific force), roll, pitch, yaw")
     p.add_argument("--amplitude", type=float, required=True, help="m/s^2 (f_x, f_y, f_z) or deg/s (rotations)")
-    p.add_argument("--frequency-hz", type=float, help="frequency (every kind but step; see README)")
+    p.add_argument("--frequency-hz", type=float, help="frequency (every kind but step; see docs/how-to/omct.md)")
     p.add_argument("--duration-s", type=float, default=20.0, help="length (default 20 s)")
     p.add_argument("--rate-hz", type=float, default=120.0, help="sample rate (default 120 Hz)")
     p.add_argument("--start-s", type=float, default=1.0, help="onset of step, pulse, doublet, chirp (default 1 s)")
@@ -211,13 +225,84 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("report", help="write report.md and its figures (PNG and PDF) again from existing results")
     p.add_argument("results", type=Path, help="a result folder (washbench run / cue) or a suite folder")
+    p.add_argument("--palette", choices=("default", "colorblind"), default=None,
+                   help="figure colours: default, or colorblind (Okabe-Ito); also $WASHBENCH_PALETTE")  # fmt: skip
 
     p = sub.add_parser("replay", help="open a recording (or compare two) in the rerun viewer")
     p.add_argument(
         "recording", type=Path, nargs="+", help=".rrd file(s) from washbench run or suite: one, or two to compare"
     )
     p.add_argument("--web", action="store_true", help="always use the web viewer")
+    _live_parsers(sub)
+    add_examples(parser)  # the docs named at the top level, examples at the end of each command's help
     return parser
+
+
+def _live_parsers(sub: Any) -> None:
+    """``washbench live`` and ``washbench send`` (docs/live.md)."""
+    from washbench.live import FORMATS
+
+    p = sub.add_parser("live", help="run the washouts live on a flight simulator's UDP output; drive a platform")
+    p.add_argument("--listen", metavar="HOST:PORT", help="where to receive the simulator's datagrams")
+    p.add_argument("--format", choices=FORMATS, help="what the simulator sends (docs/live.md)")
+    p.add_argument("--out", type=Path, help="output folder: the result folder of washbench cue on the saved input")
+    p.add_argument("--sink", metavar="udp://HOST:PORT", help="send the platform commands there (default: nowhere)")
+    p.add_argument("--sink-format", choices=("binary", "json"), default="binary", help="command packets (docs/live.md)")
+    p.add_argument("--duration", type=float, metavar="S", help="stop after S seconds")
+    p.add_argument("--idle-timeout", type=float, metavar="S", help="stop when the source is quiet for S seconds")
+    p.add_argument("--rate-hz", type=float, metavar="HZ", help="the source's rate (default: measured)")
+    p.add_argument("--resample", type=float, metavar="HZ", help="cue the saved input at HZ (default: only if needed)")
+    p.add_argument("--xplane", metavar="HOST:PORT", default="127.0.0.1:49000", help="X-Plane's address for RREF")
+    p.add_argument("--rref-hz", type=int, default=60, metavar="HZ", help="RREF subscription rate (default 60)")
+    p.add_argument("--no-viewer", action="store_true", help="no live rerun viewer")
+    p.add_argument("--realtime", action="store_true", help="SCHED_FIFO priority while receiving (root/CAP_SYS_NICE)")
+    p.add_argument("--filter-start", choices=("steady", "rest"), default="steady", help="filters' start state")
+    p.add_argument("--print-flightgear-protocol", action="store_true", help="print FlightGear's protocol file, exit")
+    _washout_options(p)
+    p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
+    p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
+    _output_options(p)
+
+    p = sub.add_parser("send", help="send a recorded file or a JSBSim flight over UDP as a flight simulator would")
+    p.add_argument("file", type=Path, nargs="?", help="any washbench cue input")
+    p.add_argument("--fly", type=Path, metavar="MANOEUVRE", help="fly this manoeuvre with JSBSim and send it")
+    p.add_argument("--to", metavar="HOST:PORT", help="where washbench live listens")
+    p.add_argument("--format", choices=FORMATS, default="washbench", help="what to send as (default washbench)")
+    p.add_argument("--speed", type=float, default=1.0, help="times real time (default 1)")
+    p.add_argument("--listen", metavar="HOST:PORT", help="xplane-rref: where to take subscriptions (X-Plane's 49000)")
+    _aircraft_dir_option(p)
+
+
+def _live(args: argparse.Namespace) -> int:
+    from washbench.live.endpoints import parse_address
+    from washbench.runs.live import LiveOptions, run_live
+
+    if args.print_flightgear_protocol:
+        from washbench.live.packets import flightgear_protocol
+
+        print(flightgear_protocol(), end="")
+        return 0
+    for flag, value in (("--listen", args.listen), ("--format", args.format), ("--out", args.out)):
+        if value is None:
+            raise WashbenchError(f"{flag} is required")
+    opts = LiveOptions(
+        listen=parse_address(args.listen, "--listen"), fmt=args.format, out=args.out,
+        sink=parse_address(args.sink, "--sink") if args.sink else None, sink_format=args.sink_format,
+        duration_s=args.duration, idle_timeout_s=args.idle_timeout, rate_hz=args.rate_hz, resample_hz=args.resample,
+        xplane=parse_address(args.xplane, "--xplane"), rref_hz=args.rref_hz, viewer=not args.no_viewer,
+        recording=not args.no_recording, figures=not args.no_figures, filter_start=args.filter_start,
+        realtime=args.realtime,
+    )  # fmt: skip
+    return run_live(opts, args.washout, args.params, args.platform, args.variant)
+
+
+def _send(args: argparse.Namespace) -> int:
+    from washbench.live.endpoints import parse_address
+    from washbench.runs.send import run_send
+
+    to = parse_address(args.to, "--to") if args.to else None
+    listen = parse_address(args.listen, "--listen") if args.listen else None
+    return run_send(args.format, to, args.file, args.fly, args.speed, listen, tuple(args.aircraft_dir))
 
 
 def _cue_input_options(p: argparse.ArgumentParser) -> None:
@@ -270,6 +355,8 @@ def _cue(args: argparse.Namespace) -> int:
         strict=args.strict,
         recording=not args.no_recording,
         figures=not args.no_figures,
+        rank_by=args.rank_by,
+        vestibular=args.vestibular,
     )
     return run_cue(
         args.input,
@@ -349,6 +436,8 @@ def _dispatch(args: argparse.Namespace) -> int:
             washouts=args.washout,
             variants=args.variant,
             aircraft_dirs=args.aircraft_dir,
+            rank_by=args.rank_by,
+            vestibular=args.vestibular,
         )
     if args.command == "suite":
         from washbench.runs.suite import suite_command
@@ -367,6 +456,8 @@ def _dispatch(args: argparse.Namespace) -> int:
             washouts=args.washout,
             variants=args.variant,
             dask=args.dask,
+            rank_by=args.rank_by,
+            vestibular=args.vestibular,
         )
     if args.command == "omct":
         from washbench.runs.omct import run_omct
@@ -402,9 +493,11 @@ def _dispatch(args: argparse.Namespace) -> int:
 
         return copy_examples(args.folder)
     if args.command == "report":
-        from washbench.review.report import report_command
+        from washbench.review.report_command import report_command
 
-        return report_command(args.results)
+        return report_command(args.results, args.palette)
+    if args.command in ("live", "send"):
+        return _live(args) if args.command == "live" else _send(args)
     if args.command == "replay":
         from washbench.review.replay import replay_command
 
@@ -471,7 +564,22 @@ def main(argv: list[str] | None = None) -> int:
     SIGINT and SIGTERM stop the command at once: cleanup code runs (half-built results are removed, worker
     processes and viewers stopped), one line is printed and the status is 130 or 143.
     """
-    args = build_parser().parse_args(argv)
+    try:  # the project configuration file (washbench.toml or [tool.washbench]) gives defaults; a flag wins
+        config = project_config.discover()
+    except WashbenchError as exc:
+        if not {"-h", "--help", "--version"} & set(sys.argv[1:] if argv is None else argv):
+            print(f"washbench: error: {exc}", file=sys.stderr)
+            return 2
+        config = None
+    parser = build_parser()
+    if config is not None:
+        _config_defaults(parser, config)
+    args = parser.parse_args(argv)
+    if config is not None and getattr(args, "aircraft_dir", None) == []:
+        args.aircraft_dir = list(config.aircraft_dirs)  # a --aircraft-dir given at all replaces the file's list
+    env_before = os.environ.pop(project_config.CONFIG_USED_ENV, None)
+    if config is not None:  # recorded in the provenance, also by worker processes
+        os.environ[project_config.CONFIG_USED_ENV] = str(config.path)
     signal.signal(signal.SIGTERM, _terminate)
     try:
         try:
@@ -496,6 +604,20 @@ def main(argv: list[str] | None = None) -> int:
         return 143
     finally:
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        os.environ.pop(project_config.CONFIG_USED_ENV, None)
+        if env_before is not None:
+            os.environ[project_config.CONFIG_USED_ENV] = env_before
+
+
+def _config_defaults(parser: argparse.ArgumentParser, config: project_config.ProjectConfig) -> None:
+    """The configuration file's values as each command's defaults (a required --out is then optional)."""
+    for name, sub in subcommands(parser).items():
+        defaults = project_config.defaults_for(config, name, [a.dest for a in sub._actions])
+        defaults.pop("aircraft_dir", None)  # appended to by --aircraft-dir, so applied after parsing instead
+        for action in sub._actions:
+            if action.dest in defaults:
+                action.default = defaults[action.dest]
+                action.required = False
 
 
 if __name__ == "__main__":

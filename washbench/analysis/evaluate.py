@@ -27,8 +27,8 @@ from numba import njit, prange
 from washbench.analysis.metric_sums import NACC, acc_update, finish
 from washbench.analysis.metrics import DOFS, MetricRow, npc_from_pc
 from washbench.analysis.ranking import dof_weights, perceived_motion, score_of
-from washbench.cueing.jitcache import announce_compile, drop_stale_cache
 from washbench.cueing.kernel import C_KIND, NFIELDS, NSTATE, O_HEAD_F, O_HEAD_OMEGA, O_SAT, SAT_KINDS, step_one
+from washbench.numerics.jitcache import announce_compile, drop_stale_cache
 from washbench.perception.sections import sections_init, sections_step
 
 PLATFORM_SAT = tuple(SAT_KINDS.index(k) for k in ("pos", "vel", "acc", "rate", "angacc"))
@@ -228,7 +228,7 @@ drop_stale_cache(
     [
         _HERE / "metric_sums.py",
         _PKG / "cueing" / "kernel.py",
-        _PKG / "cueing" / "rotations.py",
+        _PKG / "numerics" / "rotations.py",
         _PKG / "cueing" / "filters.py",
         _PKG / "platform" / "kinematics.py",
         _PKG / "perception" / "sections.py",

@@ -16,7 +16,7 @@ import math
 import numpy as np
 from numba import njit
 
-import washbench.cueing.jitcache  # noqa: F401  (numba's cache folder is set before anything here is compiled)
+import washbench.numerics.jitcache  # noqa: F401  (numba's cache folder is set before anything here is compiled)
 
 A_N, A_SUM, A_FIRST, A_LAST, A_MAX, A_MX, A_MY, A_M2X, A_M2Y, A_CXY, A_PX, A_PY = range(12)
 NACC = 12

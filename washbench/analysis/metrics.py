@@ -5,10 +5,12 @@ simulator pilot's perceived signal ``y`` sampled on the same uniform grid:
 
 * ``npc``: normalized Pearson correlation, Eqs. 20-21 with K = 1:
   ``NPC = K / (1 + PC) + 1 - K / 2``. 1.0 for perfect correlation, 1.5 for none, larger is worse.
+
   - PC = -1 (perfectly anti-correlated, to within 1e-12): NPC is reported as ``inf`` (the limit of
     Eq. 21; written as ``inf`` in CSV, read back as ``float('inf')``).
   - a flat signal (standard deviation at most 1e-9 of its own peak magnitude, or exactly zero)
     leaves PC undefined: NPC is ``nan`` (an empty field in CSV), never a made-up number.
+
 * ``integral_error``: Eq. 22, ``integral |x - y| dt`` by the trapezoid rule on the uniform grid,
   from the first to the last sample.
 * ``max_error``: ``max |x - y|``.
@@ -29,6 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from washbench.analysis.metric_sums import FLAT_RTOL, signal_metrics
+from washbench.numerics.jitcache import announce_compile
 
 NPC_K = 1.0
 """The K of Eq. 21 used in the paper."""
@@ -58,6 +61,7 @@ def is_flat(x: np.ndarray, rtol: float = FLAT_RTOL) -> bool:
 def pearson(x: np.ndarray, y: np.ndarray) -> float:
     """Pearson correlation PC (Eq. 20) in [-1, 1]; ``nan`` if either signal is flat (see :func:`is_flat`)."""
     x, y = _as_pair(x, y)
+    announce_compile(signal_metrics)
     return float(signal_metrics(x, y, 1.0)[0])
 
 
@@ -78,24 +82,39 @@ def npc(x: np.ndarray, y: np.ndarray, k: float = NPC_K) -> float:
 def integral_abs_error(x: np.ndarray, y: np.ndarray, dt_s: float) -> float:
     """Eq. 22: ``integral |x - y| dt`` over the trace, trapezoid rule on a uniform grid of step ``dt_s`` [s]."""
     x, y = _as_pair(x, y)
+    announce_compile(signal_metrics)
     return float(signal_metrics(x, y, float(dt_s))[1])
 
 
 def max_abs_error(x: np.ndarray, y: np.ndarray) -> float:
     """``max |x - y|`` over the trace."""
     x, y = _as_pair(x, y)
+    announce_compile(signal_metrics)
     return float(signal_metrics(x, y, 1.0)[2])
 
 
 @dataclass(frozen=True)
 class MetricRow:
-    """One row of ``metrics.csv``: a washout's metrics for one DOF (units: see module docstring)."""
+    """One row of ``metrics.csv``: a washout's metrics for one DOF (units: see module docstring).
+
+    The cue classification (:mod:`washbench.analysis.cues`): time fractions ``cue_*_frac`` (NaN where not
+    classified, e.g. a study's evaluation) and the false-cue events as ``start-end@peak;...`` text. On the heave row,
+    the motion sickness dose values (MSDV, m/s^1.5, ISO 2631-1 Wf) of the simulator pilot and of the aircraft pilot
+    (NaN on the other rows).
+    """
 
     washout: str
     dof: str
     npc: float
     integral_error: float
     max_error: float
+    cue_correct_frac: float = math.nan
+    cue_scaled_frac: float = math.nan
+    cue_false_frac: float = math.nan
+    cue_missing_frac: float = math.nan
+    msdv_mps15: float = math.nan
+    msdv_aircraft_mps15: float = math.nan
+    false_cue_events: str = ""
 
 
 def dof_metrics(
@@ -118,6 +137,7 @@ def dof_metrics(
         a = np.ascontiguousarray(np.asarray(a, dtype=np.float64).T) * scale  # (3, N): contiguous per axis
         s = np.ascontiguousarray(np.asarray(s, dtype=np.float64).T) * scale
         for axis in range(3):
+            announce_compile(signal_metrics)
             pc, integral, max_error = signal_metrics(*_as_pair(a[axis], s[axis]), float(dt_s))
             rows.append(
                 MetricRow(

@@ -24,9 +24,24 @@ Ranking (the scoring rule). For one manoeuvre, washout W gets the score
   ``MOTION_FLOOR``) weighs nothing, so a tiny denominator cannot blow a score up. If a whole group is
   below the floor, the other group takes all the weight.
 
-Lower score is better; ranks are 1 (best) to the number of washouts, ties broken by the order the washouts
-were listed in (the configuration's), for determinism. The score is
-objective (computed from the traces only) and is reported next to every rank.
+Lower score is better. The score is objective (computed from the traces only) and is reported next to every rank.
+
+Other rules (:class:`RankRule`, ``--rank-by`` and the parameter file's ``ranking:`` section), all lower is better:
+
+- ``score``: the rule above (the default).
+- ``false-cue``: the false-cue time, ``sum over DOFs of cue_false_frac`` (:mod:`washbench.analysis.cues`): the
+  time during which the simulator pilot feels a false cue, in DOF-manoeuvre lengths (0: never; 6: always, in
+  every DOF).
+- ``weighted``: ``sum_d u_d E(W, d) / M_d`` with the user's DOF weights ``u_d`` (the parameter file's
+  ``ranking: dof_weights:``), over the DOFs the aircraft pilot felt (``M_d`` at least ``MOTION_FLOOR``), the
+  weights renormalised to sum 1 over those DOFs.
+
+**Ties** (honest ranks). Values are sorted (lower first); a tie group starts at the best value ``v0`` not yet
+ranked and takes every further value ``v`` with ``v - v0 <= max(TIE_RELATIVE * |v0|, TIE_ABSOLUTE)`` (measured
+from the group's best, so a group never chains beyond the margin). Every washout of a group gets the same rank,
+one more than the number of washouts ranked before the group ("1, 1, 3"), and is marked ``tied``. Rows are
+ordered by rank, then value, then the order the washouts were listed in. The margins are CHOSEN
+(docs/fidelity.md): 3 % of the score (0.605 against 0.595 is a tie) or 0.005, whichever is larger.
 """
 
 from __future__ import annotations
@@ -43,6 +58,15 @@ TRANSLATIONAL_DOFS = DOFS[:3]  # surge, sway, heave
 ROTATIONAL_DOFS = DOFS[3:]  # roll, pitch, yaw
 METRICS = ("npc", "integral_error", "max_error")
 REFERENCE_WASHOUT = "small-angle"
+
+RANK_BY: tuple[str, ...] = ("score", "false-cue", "weighted")
+"""The ranking rules (module docstring)."""
+
+TIE_RELATIVE = 0.03
+"""Relative margin within which two values tie (chosen, docs/fidelity.md)."""
+
+TIE_ABSOLUTE = 0.005
+"""Absolute margin within which two values tie (chosen; for values near 0, e.g. false-cue time)."""
 
 #: Motion below which a DOF is not weighed: integral of |perceived change| in m/s^2*s for the
 #: translational DOFs and deg for the rotational ones. 0.05 m/s^2 (about the otolith threshold of
@@ -62,12 +86,71 @@ class ComparisonRow:
 
 @dataclass(frozen=True)
 class RankRow:
-    """A washout's score (lower is better) and rank within one manoeuvre."""
+    """A washout's value of the rule (``score``, lower is better) and rank within one manoeuvre.
+
+    ``tied``: another washout shares this rank (their values differ by less than the tie margin).
+    """
 
     washout: str
     score: float
     rank: int
     weights: dict[str, float]
+    tied: bool = False
+
+
+@dataclass(frozen=True)
+class RankRule:
+    """How washouts are ranked: ``by`` one of RANK_BY; ``dof_weights`` (DOF -> weight >= 0) for ``weighted``."""
+
+    by: str = "score"
+    dof_weights: tuple[tuple[str, float], ...] = ()
+    tie_relative: float = TIE_RELATIVE
+    tie_absolute: float = TIE_ABSOLUTE
+
+    def __post_init__(self) -> None:
+        if self.by not in RANK_BY:
+            raise ValueError(f"unknown ranking rule {self.by!r} (valid: {', '.join(RANK_BY)})")
+        if self.by == "weighted" and not any(w > 0.0 for _, w in self.dof_weights):
+            raise ValueError("ranking rule 'weighted' needs dof_weights with at least one positive weight")
+
+    def record(self) -> dict[str, object]:
+        """The rule as recorded in the provenance (``ranking``)."""
+        return {
+            "by": self.by,
+            "dof_weights": dict(self.dof_weights) if self.by == "weighted" else None,
+            "tie_relative": self.tie_relative,
+            "tie_absolute": self.tie_absolute,
+        }
+
+    def label(self) -> str:
+        """One line for reports: the rule and its tie margin."""
+        what = {
+            "score": "score (weighted relative integral error)",
+            "false-cue": "false-cue time (sum of the DOFs' false-cue time fractions)",
+            "weighted": "user-weighted relative integral error ("
+            + ", ".join(f"{d} {w:g}" for d, w in self.dof_weights)
+            + ")",
+        }[self.by]
+        return (
+            f"{what}; ties: values within {100 * self.tie_relative:g} % or {self.tie_absolute:g} of the "
+            "best of their group share a rank"
+        )
+
+
+DEFAULT_RULE = RankRule()
+
+
+def rule_from_record(record: object) -> RankRule:
+    """The rule of a provenance's ``ranking`` entry (the default for a result written before rules existed)."""
+    if not isinstance(record, Mapping):
+        return DEFAULT_RULE
+    weights = record.get("dof_weights") or {}
+    return RankRule(
+        by=str(record.get("by", "score")),
+        dof_weights=tuple((str(d), float(w)) for d, w in weights.items()) if isinstance(weights, Mapping) else (),
+        tie_relative=float(record.get("tie_relative", TIE_RELATIVE)),
+        tie_absolute=float(record.get("tie_absolute", TIE_ABSOLUTE)),
+    )
 
 
 def washout_order(rows: Iterable[MetricRow]) -> list[str]:
@@ -130,20 +213,79 @@ def score_of(integral_error: np.ndarray, weights: Mapping[str, float], motion: M
     return total
 
 
-def rank(rows: Sequence[MetricRow], motion: Mapping[str, float]) -> list[RankRow]:
-    """Score and rank the washouts of one manoeuvre (module doc gives the rule)."""
-    weights = dof_weights(motion)
+def user_weights(motion: Mapping[str, float], weights: Mapping[str, float]) -> dict[str, float]:
+    """The ``weighted`` rule's weights: the user's, on the DOFs felt (MOTION_FLOOR), renormalised to sum 1."""
+    felt = {d: float(weights.get(d, 0.0)) if float(motion.get(d, 0.0)) >= MOTION_FLOOR[d] else 0.0 for d in DOFS}
+    total = sum(felt.values())
+    return {d: (w / total if total > 0.0 else 0.0) for d, w in felt.items()}
+
+
+def tie_groups(values: Sequence[float], rel: float = TIE_RELATIVE, absolute: float = TIE_ABSOLUTE) -> list[int]:
+    """Competition ranks ("1, 1, 3") of ``values`` (lower is better) with ties within the margin (module doc).
+
+    A NaN value ranks last and ties with nothing. Returns the rank of each value in the given order.
+    """
+    idx = sorted(range(len(values)), key=lambda i: (math.isnan(values[i]), values[i] if not math.isnan(values[i])
+                                                     else 0.0, i))  # fmt: skip
+    ranks = [0] * len(values)
+    pos = 0
+    while pos < len(idx):
+        v0 = values[idx[pos]]
+        end = pos + 1
+        if not math.isnan(v0):
+            margin = max(rel * abs(v0), absolute)
+            while end < len(idx) and not math.isnan(values[idx[end]]) and values[idx[end]] - v0 <= margin:
+                end += 1
+        for i in idx[pos:end]:
+            ranks[i] = pos + 1
+        pos = end
+    return ranks
+
+
+def rule_values(
+    rows: Sequence[MetricRow], motion: Mapping[str, float], rule: RankRule = DEFAULT_RULE
+) -> tuple[dict[str, float], dict[str, float]]:
+    """Each washout's value of ``rule`` (lower is better) and the DOF weights it used."""
     washouts = washout_order(rows)
     by_key = {(r.washout, r.dof): r for r in rows}
-    scores = {w: float(score_of(np.array([by_key[(w, d)].integral_error for d in DOFS]), weights, motion))
-              for w in washouts}
-    order = {w: i for i, w in enumerate(washouts)}
-    ordered = sorted(washouts, key=lambda w: (scores[w], order[w]))
-    return [RankRow(washout=w, score=scores[w], rank=i + 1, weights=weights) for i, w in enumerate(ordered)]
+    if rule.by == "false-cue":
+        values = {w: float(sum(by_key[(w, d)].cue_false_frac for d in DOFS)) for w in washouts}
+        return values, dict.fromkeys(DOFS, 1.0 / len(DOFS))
+    weights = dof_weights(motion) if rule.by == "score" else user_weights(motion, dict(rule.dof_weights))
+    values = {w: float(score_of(np.array([by_key[(w, d)].integral_error for d in DOFS]), weights, motion))
+              for w in washouts}  # fmt: skip
+    return values, weights
+
+
+def rank(rows: Sequence[MetricRow], motion: Mapping[str, float], rule: RankRule = DEFAULT_RULE) -> list[RankRow]:
+    """Rank the washouts of one manoeuvre by ``rule`` with honest ties (module doc gives the rules).
+
+    Rows come best first; within a tie by value (the shared rank says the order is not a verdict), equal values
+    in the order the washouts were listed.
+    """
+    washouts = washout_order(rows)
+    values, weights = rule_values(rows, motion, rule)
+    ranks = tie_groups([values[w] for w in washouts], rule.tie_relative, rule.tie_absolute)
+    share = {r: ranks.count(r) for r in ranks}
+    def value(i: int) -> float:
+        v = values[washouts[i]]
+        return math.inf if math.isnan(v) else v
+
+    ordered = sorted(range(len(washouts)), key=lambda i: (ranks[i], value(i), i))
+    return [
+        RankRow(washout=washouts[i], score=values[washouts[i]], rank=ranks[i], weights=weights,
+                tied=share[ranks[i]] > 1)
+        for i in ordered
+    ]  # fmt: skip
+
+
+def undecided(ranking: Sequence[RankRow]) -> bool:
+    """True when the first place is shared: the ranking is decided by less than the tie margin."""
+    return sum(1 for r in ranking if r.rank == 1) > 1
 
 
 def wins(rankings: Iterable[Sequence[RankRow]]) -> dict[str, int]:
-    """How many manoeuvres each washout ranked first in."""
+    """How many manoeuvres each washout ranked first in (a shared first place counts for each)."""
     count: dict[str, int] = {}
     for ranking in rankings:
         for r in ranking:

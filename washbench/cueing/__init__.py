@@ -12,24 +12,20 @@ g_I = [0, 0, +g]; specific force f = a - g (m/s^2, [0, 0, -g] at rest); body ang
 quaternions scalar first, body->inertial; break frequencies rad/s.
 
 Modules: ``params`` (cw1.yaml model), ``variants`` (named washouts with their own parameters), ``filters``
-(transfer functions, discretisation), ``rotations`` (quaternion and Euler kinematics), ``kernel`` (the
-compiled step), ``bank`` (CueingBank, cue_trace).
-The bank names are loaded lazily so that :mod:`washbench.platform` can use ``rotations`` without an
-import cycle.
+(transfer functions, discretisation), ``kernel`` (the compiled step), ``bank`` (CueingBank, cue_trace).
+Quaternion and Euler kinematics and numba's cache are one floor down, in :mod:`washbench.numerics`
+(``washbench.cueing.rotations`` and ``washbench.cueing.jitcache`` still name the same modules).
+The bank names are loaded lazily, so importing the package for its parameters stays light.
 """
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from washbench.cueing.jitcache import configure_cache
-from washbench.cueing.params import (
-    WASHOUT_KINDS,
-    WASHOUT_NAMES,
-    WashoutParams,
-    check_washouts,
-    load_washout_params,
-)
+from washbench.cueing.params import WASHOUT_KINDS, WASHOUT_NAMES, WashoutParams
+from washbench.cueing.registry import check_washouts
+from washbench.cueing.variants import load_washout_params
+from washbench.numerics.jitcache import configure_cache
 
 configure_cache()  # before any jitted module is imported (numba reads its cache folder at decoration)
 

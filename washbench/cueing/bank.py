@@ -21,7 +21,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from washbench.cueing import filters
-from washbench.cueing.jitcache import announce_compile
 from washbench.cueing.kernel import (
     C_ADAPT,
     C_ALPHA,
@@ -103,6 +102,7 @@ from washbench.cueing.setpoints import SetPointSource
 from washbench.cueing.variants import Washout, as_washouts
 from washbench.errors import WashbenchError
 from washbench.io.results import DT_RANGE_S
+from washbench.numerics.jitcache import announce_compile
 from washbench.platform.limits import PlatformLimits, wheel_jacobian
 
 _KINDS = {
@@ -431,6 +431,7 @@ class CueingBank:
             out = np.empty(shape)
         elif out.shape != shape or out.dtype != np.float64 or not out.flags.c_contiguous:
             raise ValueError(f"out must be a C-contiguous float64 array of shape {shape}")
+        announce_compile(bank_block)
         bank_block(f, w, self._cfg, self._coef, self._state, self._counts, out)
         if self._py and f.shape[0]:
             if not self._started:

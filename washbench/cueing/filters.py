@@ -24,7 +24,7 @@ import functools
 import numpy as np
 from numba import njit
 
-from washbench.cueing.numbastart import prepare
+from washbench.numerics.numbastart import prepare
 
 prepare()
 

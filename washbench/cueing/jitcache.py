@@ -1,106 +1,12 @@
-"""numba's on-disk cache for the compiled washout kernel: where it lives, when it is stale, and saying so.
+"""Moved to :mod:`washbench.numerics.jitcache` (the floor below cueing, platform and perception).
 
-- Where: numba's own default (``__pycache__`` next to the sources) when the installed package folder is
-  writable; otherwise (a read-only site-packages) a writable user cache folder,
-  ``platformdirs.user_cache_dir("washbench")/numba``, set through ``NUMBA_CACHE_DIR`` before numba reads its
-  configuration. A ``NUMBA_CACHE_DIR`` the user set is left alone.
-- Stale: numba keys a cached function on its own source file only: when a jitted function inlines jitted
-  helpers from another file and that file changes, the stale machine code would still be loaded. Each module
-  that compiles in helpers from elsewhere calls :func:`drop_stale_cache` at import, before anything is compiled.
-- Saying so: the first run after an install or upgrade compiles the kernel (10-15 s). :func:`announce_compile`
-  prints one line about it, once per process, when the cache holds nothing for a function about to run.
+This name stays for code written against it: importing it gives the very same module object.
 """
 
 from __future__ import annotations
 
-import hashlib
-import os
 import sys
-from pathlib import Path
 
-_PACKAGE_DIR = Path(__file__).resolve().parent.parent
-_announced = False
+from washbench.numerics import jitcache as _moved
 
-
-def _writable(folder: Path) -> bool:
-    cache = folder / "__pycache__"
-    return os.access(cache if cache.is_dir() else folder, os.W_OK)
-
-
-def configure_cache() -> None:
-    """Send numba's cache to the user cache folder when the package's own folders are not writable.
-
-    Must run before numba is imported (``washbench.cueing`` calls it first thing); if numba is already
-    imported, its configuration is updated in place (it is read when a jitted function is decorated).
-    """
-    if os.environ.get("NUMBA_CACHE_DIR"):
-        return
-    if all(_writable(_PACKAGE_DIR / sub) for sub in ("cueing", "platform", "perception", "analysis")):
-        return
-    import platformdirs
-
-    folder = str(Path(platformdirs.user_cache_dir("washbench")) / "numba")
-    os.environ["NUMBA_CACHE_DIR"] = folder
-    numba = sys.modules.get("numba")
-    if numba is not None:
-        numba.config.CACHE_DIR = folder
-
-
-def _cache_dir(module_file: Path) -> Path:
-    """The folder numba caches ``module_file``'s functions in (numba's own choice of locator)."""
-    try:
-        from numba.core.caching import FunctionCache
-
-        for cls in FunctionCache._impl_class._locator_classes:
-            locator = cls.from_function(None, str(module_file))
-            if locator is not None:
-                return Path(locator.get_cache_path())
-    except (ImportError, AttributeError, TypeError):  # pragma: no cover - another numba's internals
-        pass
-    return module_file.parent / "__pycache__"
-
-
-def drop_stale_cache(module_file: str, deps: list[Path]) -> None:
-    """Delete ``module_file``'s numba cache files if it or any of ``deps`` changed since they were written.
-
-    A hash of the sources is kept next to the cache files in ``<module>.deps.sha256``. Errors (a cache folder
-    that cannot be written) are ignored: numba does not cache there either.
-    """
-    here = Path(module_file).resolve()
-    digest = hashlib.sha256(b"".join(p.read_bytes() for p in [here, *deps])).hexdigest()
-    cache_dir = _cache_dir(here)
-    stamp = cache_dir / f"{here.stem}.deps.sha256"
-    try:
-        if stamp.is_file() and stamp.read_text() == digest:
-            return
-        cache_dir.mkdir(parents=True, exist_ok=True)
-        for p in cache_dir.glob(f"{here.stem}.*.nb[ic]"):
-            p.unlink(missing_ok=True)
-        stamp.write_text(digest)
-    except OSError:
-        pass
-
-
-def announce_compile(*dispatchers: object) -> None:
-    """Print one line to stderr, once per process, if any of these jitted functions is about to be compiled.
-
-    A function with no compiled signature in memory and no index file in its on-disk cache will compile
-    now; one whose cache exists is loaded in well under a second and is not announced.
-    """
-    global _announced
-    if _announced:
-        return
-    for d in dispatchers:
-        if getattr(d, "signatures", None):
-            continue
-        cache = getattr(d, "_cache", None)
-        index = getattr(getattr(cache, "_cache_file", None), "_index_path", None)
-        if index is None or not os.path.exists(index):
-            _announced = True
-            print(
-                "washbench: compiling the washout kernel (once after install or upgrade, 10-20 s; cached in "
-                f"{Path(index).parent if index else 'memory only'})",
-                file=sys.stderr,
-                flush=True,
-            )
-            return
+sys.modules[__name__] = _moved

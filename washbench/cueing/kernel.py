@@ -25,8 +25,8 @@ import numpy as np
 from numba import njit, prange
 
 from washbench.cueing.filters import filt_init, filt_step
-from washbench.cueing.jitcache import drop_stale_cache
-from washbench.cueing.rotations import (
+from washbench.numerics.jitcache import drop_stale_cache
+from washbench.numerics.rotations import (
     body_rates,
     cross,
     euler_from_quat,
@@ -607,7 +607,12 @@ def bank_block(f, om, cfg, coef, state, counts, out):
 _HERE = Path(__file__).resolve().parent
 drop_stale_cache(
     __file__,
-    [_HERE / "rotations.py", _HERE / "filters.py", _HERE / "jitcache.py", _HERE.parent / "platform" / "kinematics.py"],
+    [
+        _HERE.parent / "numerics" / "rotations.py",
+        _HERE / "filters.py",
+        _HERE.parent / "numerics" / "jitcache.py",
+        _HERE.parent / "platform" / "kinematics.py",
+    ],
 )
 
 __all__ = [

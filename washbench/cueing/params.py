@@ -8,13 +8,11 @@ non-positive values are rejected with one line naming file, line and field.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
 from pydantic import BeforeValidator, Field
 
-from washbench.errors import WashbenchError
 from washbench.io.paths import DATA_DIR
 from washbench.io.yamlio import StrictModel, validate_data
 
@@ -33,22 +31,6 @@ WASHOUT_NAMES = CLASSICAL_KINDS
 """The built-in washouts run by default (one per kind, named after it): the paper's three."""
 
 DEFAULT_PARAMS_PATH = DATA_DIR / "cw1.yaml"
-
-
-def check_washouts(washouts: Sequence[str]) -> tuple[str, ...]:
-    """Built-in or registered washout names as a tuple; WashbenchError if none, one is unknown or one is listed
-    twice."""
-    from washbench.cueing.registry import known_kinds
-
-    names = tuple(washouts)
-    if not names:
-        raise WashbenchError("no washout selected")
-    for name in names:
-        if name not in known_kinds():
-            raise WashbenchError(f"unknown washout {name!r} (valid: {', '.join(known_kinds())})")
-    if len(set(names)) != len(names):
-        raise WashbenchError(f"washout listed twice: {', '.join(names)}")
-    return names
 
 
 # Accepted ranges (a finite but absurd number, e.g. a scale of 1e300, would make the platform model meaningless
@@ -193,17 +175,6 @@ class WashoutParams(StrictModel):
     sections: dict[str, dict[str, Any]] = Field(default_factory=dict)
     """The Python algorithms' own sections (:mod:`washbench.cueing.registry`), by kind: in the file each is a
     top-level key named after the algorithm; validated by the algorithm's ``Params`` when a washout is made."""
-
-
-def load_washout_params(path: Path | None = None) -> WashoutParams:
-    """Load a washout parameter YAML file (``None``: the bundled CW1 set, ``washbench/data/cw1.yaml``).
-
-    A ``variants:`` section is checked and left out (:func:`washbench.cueing.variants.load_param_file` reads it).
-    Raises :class:`washbench.errors.WashbenchError` with ``file:line: field: problem`` on bad input.
-    """
-    from washbench.cueing.variants import load_param_file
-
-    return load_param_file(path)[0]
 
 
 def load_base_params(path: Path, data: Any, lines: dict[Any, int]) -> WashoutParams:

@@ -21,7 +21,7 @@ import importlib
 import importlib.metadata
 import importlib.util
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -111,6 +111,10 @@ def load_plugin(spec: str) -> Algorithm:
     path = Path(file).expanduser()
     if not path.is_file():
         raise WashbenchError(f"{where}: {path}: no such file")
+    text = f"{path.resolve()}:{name}"  # absolute: worker processes load the same file
+    for kind, loaded in _PLUGIN_SPECS.items():
+        if loaded == text:
+            return _LOADED[kind]
     module_name = f"washbench_plugin_{abs(hash(str(path.resolve())))}"
     try:
         mod_spec = importlib.util.spec_from_file_location(module_name, path)
@@ -168,6 +172,25 @@ def plugin_spec(kind: str) -> str | None:
     return _PLUGIN_SPECS.get(kind)
 
 
+def plugin_specs() -> tuple[str, ...]:
+    """Every plugin loaded from a file in this process, as ``FILE.py:NAME`` (for worker processes)."""
+    return tuple(_PLUGIN_SPECS.values())
+
+
+def check_washouts(washouts: Sequence[str]) -> tuple[str, ...]:
+    """Built-in or registered washout names as a tuple; WashbenchError if none, one is unknown or one is listed
+    twice."""
+    names = tuple(washouts)
+    if not names:
+        raise WashbenchError("no washout selected")
+    for name in names:
+        if name not in known_kinds():
+            raise WashbenchError(f"unknown washout {name!r} (valid: {', '.join(known_kinds())})")
+    if len(set(names)) != len(names):
+        raise WashbenchError(f"washout listed twice: {', '.join(names)}")
+    return names
+
+
 def get(kind: str, spec: str | None = None) -> Algorithm:
     """The Python algorithm ``kind`` (loading ``spec`` = ``FILE.py:NAME`` first if it is not loaded here)."""
     if kind in _LOADED:
@@ -199,10 +222,12 @@ __all__ = [
     "BUILTIN_PYTHON",
     "ENTRY_POINT_GROUP",
     "Algorithm",
+    "check_washouts",
     "get",
     "is_python",
     "known_kinds",
     "load_plugin",
     "plugin_spec",
+    "plugin_specs",
     "python_kinds",
 ]

@@ -32,7 +32,12 @@ import pydantic
 from pydantic import BaseModel
 
 from washbench.cueing import registry
-from washbench.cueing.params import DEFAULT_PARAMS_PATH, WASHOUT_NAMES, WashoutParams, check_washouts
+from washbench.cueing.params import (
+    DEFAULT_PARAMS_PATH,
+    WASHOUT_NAMES,
+    WashoutParams,
+    load_base_params,
+)
 from washbench.errors import WashbenchError, located
 from washbench.io.names import identifier_problem
 from washbench.io.yamlio import Loc, line_of, read_yaml, validate_data
@@ -248,15 +253,23 @@ def _file_variants(path: Path, data: Any, lines: dict[Loc, int], base: WashoutPa
     return tuple(out)
 
 
+def load_washout_params(path: Path | None = None) -> WashoutParams:
+    """Load a washout parameter YAML file (``None``: the bundled CW1 set, ``washbench/data/cw1.yaml``).
+
+    A ``variants:`` section is checked and left out (:func:`load_param_file` reads it).
+    Raises :class:`washbench.errors.WashbenchError` with ``file:line: field: problem`` on bad input.
+    """
+    return load_param_file(path)[0]
+
+
 def load_param_file(path: Path | None = None) -> tuple[WashoutParams, tuple[Washout, ...]]:
     """A parameter file's base set and its ``variants:`` section (``None``: the bundled CW1, no variants)."""
-    from washbench.cueing.params import load_base_params
-
     path = DEFAULT_PARAMS_PATH if path is None else Path(path)
     data, lines = read_yaml(path)
     if not isinstance(data, dict):
         return validate_data(path, data, lines, WashoutParams), ()
     variants = data.pop("variants", None)
+    data.pop("ranking", None)  # the ranking rule's section (washbench.runs.rank_rule)
     kinds = registry.python_kinds()
     sections = {k: data.pop(k) for k in list(data) if k in kinds}
     for kind, section in sections.items():  # each validated now, so its errors name the file and line
@@ -271,7 +284,7 @@ def load_param_file(path: Path | None = None) -> tuple[WashoutParams, tuple[Wash
 
 def builtin(names: Sequence[str], params: WashoutParams) -> tuple[Washout, ...]:
     """Built-in washouts and registered algorithms (named after their kind) with one parameter set."""
-    return tuple(Washout(n, n, params, registry.plugin_spec(n)) for n in check_washouts(names))
+    return tuple(Washout(n, n, params, registry.plugin_spec(n)) for n in registry.check_washouts(names))
 
 
 def as_washouts(washouts: Sequence[str | Washout], params: WashoutParams | None) -> tuple[Washout, ...]:

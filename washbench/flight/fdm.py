@@ -7,15 +7,13 @@ TOWARDS), so the from-direction is turned round here and nowhere else.
 
 from __future__ import annotations
 
-import contextlib
 import math
 import os
-import sys
-from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Any
 
 from washbench.errors import WashbenchError
+from washbench.flight.console import quiet_stdout
 from washbench.flight.geo import DEFAULT_LATITUDE_DEG, DEFAULT_LONGITUDE_DEG, LocalFrame
 from washbench.flight.manoeuvre import Hold, Manoeuvre
 from washbench.flight.pilot import Pilot
@@ -37,26 +35,6 @@ class Setup:
     threshold_ne_m: tuple[float, float] | None  # runway threshold, north/east of the origin
     runway_heading_rad: float | None
     runway_elevation_ft: float
-
-
-@contextlib.contextmanager
-def quiet_stdout() -> Iterator[None]:
-    """Silence JSBSim's C++ console messages (trim reports) by redirecting file descriptor 1."""
-    sys.stdout.flush()
-    try:
-        saved = os.dup(1)
-    except OSError:  # no real stdout (embedded): nothing to silence
-        yield
-        return
-    devnull = os.open(os.devnull, os.O_WRONLY)
-    try:
-        os.dup2(devnull, 1)
-        yield
-    finally:
-        sys.stdout.flush()
-        os.dup2(saved, 1)
-        os.close(saved)
-        os.close(devnull)
 
 
 def make_fdm(m: Manoeuvre, profile: PilotProfile) -> tuple[Any, Setup]:

@@ -3,7 +3,7 @@
 A manoeuvre names the aircraft, the start (in the air or at rest on a runway), the
 environment, a sequence of phases (what the pilot holds, and when the phase ends) and the
 checks that prove it was flown. Keys carry their units (``altitude_ft``, ``bank_deg``).
-The format is documented in README.md, section "Manoeuvre files".
+The format is documented in docs/reference/manoeuvre-format.md.
 
 Conventions: headings and wind directions are true, in degrees; the wind is given by the
 direction it blows FROM (aviation convention: ``from_deg: 270`` is a westerly wind,
@@ -633,7 +633,7 @@ def _check_semantics(m: Manoeuvre, where: _Where, aircraft_dirs: Sequence[Path] 
         base = ("checks", j)
         if check.signal not in COLUMN_NAMES and check.signal != "sink_fps":
             close = difflib.get_close_matches(check.signal, [*COLUMN_NAMES, "sink_fps"], n=1, cutoff=0.7)
-            hint = f"did you mean '{close[0]}'?" if close else "a signal is a flight.parquet column, see README.md"
+            hint = f"did you mean '{close[0]}'?" if close else "a signal is a flight.parquet column, e.g. phi_deg"
             where.add((*base, "signal"), f"unknown signal '{check.signal}' ({hint})")
         if check.signal == "sink_fps" and check.stat not in EVENT_STATS:
             where.add((*base, "stat"), "sink_fps is measured at an event: use at_touchdown or at_liftoff")
@@ -793,7 +793,7 @@ def _check_properties(m: Manoeuvre, where: _Where) -> None:
 
     import jsbsim
 
-    from washbench.flight.fdm import quiet_stdout  # here: fdm imports this module
+    from washbench.flight.console import quiet_stdout
 
     os.environ["JSBSIM_DEBUG"] = "0"
     fdm = jsbsim.FGFDMExec(str(jsbsim_root()), None)

@@ -38,7 +38,7 @@ import numpy as np
 
 from washbench.errors import WashbenchError, located
 from washbench.flight.columns import FLIGHT_COLUMNS
-from washbench.flight.fdm import quiet_stdout
+from washbench.flight.console import quiet_stdout
 from washbench.flight.fly import FPS_TO_KT, FT_S2_TO_M_S2, R2D, StepHook
 from washbench.flight.manoeuvre import aircraft_path
 from washbench.flight.monitor import Monitor

@@ -1,7 +1,11 @@
 """Where washbench finds its files: the bundled package data and the user's own aircraft and pilot profiles.
 
-Bundled files live under ``washbench/data/`` in the source tree and in the wheel alike and are found through
-:mod:`importlib.resources`, so an editable checkout and an installed wheel behave the same.
+Bundled files: the parameter set and platform limits live in ``washbench/data/``; the aircraft and the
+manoeuvres live at the repository root (``aircraft/``, ``manoeuvres/``, beside ``washbench/``, where a user
+looks for them), and the wheel carries copies of them as ``washbench/data/aircraft`` and
+``washbench/data/manoeuvres`` (``setup.py`` copies them at build time). :func:`bundled_folder` picks the
+installed copy when there is one and the checkout's folder otherwise, so an editable checkout and an
+installed wheel behave the same from any folder.
 
 A user's aircraft (``<folder>/<name>/<name>.xml`` with its ``Engines/`` and ``Systems/``) is searched, in this
 order:
@@ -10,14 +14,14 @@ order:
 2. the folders in the ``WASHBENCH_AIRCRAFT_PATH`` environment variable (``os.pathsep``-separated);
 3. an ``aircraft/`` folder next to the manoeuvre file or in one of its parents, up to the project root (the
    first parent that holds ``.git``, ``pyproject.toml`` or ``.washbench``; the filesystem root if none does);
-4. the bundled aircraft (``washbench/data/aircraft``);
+4. the bundled aircraft (``aircraft/`` of the checkout, ``washbench/data/aircraft`` in the wheel);
 5. JSBSim's own models (``<jsbsim package>/aircraft``).
 
 A pilot profile is, in this order: the file named by the manoeuvre's ``pilot_profile`` key (relative to the
 manoeuvre file); ``<folder>/<name>/pilot.yaml`` in the same folders as above, in the same order (so a profile
 can sit next to the user's copy of an aircraft, or alone in ``aircraft/<name>/pilot.yaml`` for a JSBSim model);
-the bundled profiles are the ``pilot.yaml`` files of the bundled aircraft folders (``washbench/data/aircraft/
-<name>/pilot.yaml``). Errors for an unknown aircraft or a missing profile list every place searched.
+the bundled profiles are the ``pilot.yaml`` files of the bundled aircraft folders (``aircraft/<name>/pilot.yaml``).
+Errors for an unknown aircraft or a missing profile list every place searched.
 """
 
 from __future__ import annotations
@@ -31,12 +35,24 @@ from pathlib import Path
 
 from washbench.errors import WashbenchError
 
-#: ``washbench/data``: parameter sets, platform limits, aircraft with their pilot profiles, manoeuvres.
+#: ``washbench/data``: the bundled parameter set (``cw1.yaml``) and platform limits (``atlas.yaml``).
 DATA_DIR = Path(str(files("washbench") / "data"))
+#: Top-level folders of the repository that the wheel ships as ``washbench/data/<name>`` (see ``setup.py``).
+BUNDLED_FOLDERS = ("aircraft", "manoeuvres")
+
+
+def bundled_folder(name: str) -> Path:
+    """A bundled top-level folder: the wheel's ``washbench/data/<name>``, else the checkout's ``<repo>/<name>``."""
+    installed = DATA_DIR / name
+    if installed.is_dir():
+        return installed
+    return DATA_DIR.parent.parent / name
+
+
 #: Bundled aircraft models (``<name>/<name>.xml``) and pilot profiles (``<name>/pilot.yaml``).
-AIRCRAFT_DIR = DATA_DIR / "aircraft"
+AIRCRAFT_DIR = bundled_folder("aircraft")
 #: Bundled manoeuvres (``<aircraft>/<name>.yaml``): what ``washbench suite`` runs by default.
-MANOEUVRES_DIR = DATA_DIR / "manoeuvres"
+MANOEUVRES_DIR = bundled_folder("manoeuvres")
 #: Environment variable with extra aircraft folders, separated by ``os.pathsep``.
 AIRCRAFT_PATH_ENV = "WASHBENCH_AIRCRAFT_PATH"
 #: Files or folders that mark a project root (where the search for ``aircraft/`` next to a manoeuvre stops).

@@ -12,7 +12,9 @@ One JSON-able dict (:func:`build_provenance`) records
   and SHA-256 of the file actually used (the bundled ``cw1.yaml`` / ``atlas.yaml`` when none was given) and the
   values read from it (so a result can be re-examined without the file);
 - ``washouts``: the washouts that ran, name and kind, and a variant's own parameter values;
-- ``turbulence``: severity and seed of the manoeuvre's turbulence (``None`` without turbulence).
+- ``turbulence``: severity and seed of the manoeuvre's turbulence (``None`` without turbulence);
+- ``config``: the project configuration file the command found (``washbench.toml`` or a ``pyproject.toml`` with
+  ``[tool.washbench]``, see :mod:`washbench.io.config`), its path and SHA-256; left out when there was none.
 
 It goes into ``run.json`` (``"provenance"``, with the date ``"created_utc"`` beside it), the key-value metadata of
 ``traces.parquet`` and ``flight.parquet`` (key ``washbench.provenance``, JSON) and the report header. The date is
@@ -26,11 +28,14 @@ import functools
 import hashlib
 import importlib.metadata
 import json
+import os
 import platform as _platform
 import subprocess
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
+
+from washbench.io.config import CONFIG_USED_ENV
 
 PARQUET_KEY = b"washbench.provenance"
 """Key of the provenance JSON in a Parquet file's key-value metadata."""
@@ -116,6 +121,8 @@ def build_provenance(
     turbulence: Any = None,
     aircraft_files: Any = None,
     washouts: Sequence[Any] = (),
+    ranking: Mapping[str, Any] | None = None,
+    vestibular: Mapping[str, Any] | None = None,
 ) -> dict[str, Any]:
     """The provenance of one result (module docstring); no date in it.
 
@@ -125,7 +132,9 @@ def build_provenance(
     where the manoeuvre's aircraft was found) adds the JSBSim model file ``<name>/<name>.xml`` and the pilot profile,
     each with its path and SHA-256 (the model's own file only: engines and systems it includes are not hashed).
     ``washouts`` (``washbench.cueing.variants.Washout``: name, kind, params) lists what ran; a variant's complete
-    parameter values are recorded where they differ from the file's base set.
+    parameter values are recorded where they differ from the file's base set. ``ranking``: the ranking rule
+    (:meth:`washbench.analysis.ranking.RankRule.record`); ``vestibular``: the vestibular model
+    (:func:`washbench.perception.vestibular.model_record`: its name and values).
     """
     prov: dict[str, Any] = {"software": software_versions()}
     if manoeuvre_path is not None:
@@ -146,6 +155,13 @@ def build_provenance(
         prov["platform"] = file_record(platform_path, platform.name, platform.model_dump(mode="json"))
     if manoeuvre_path is not None:
         prov["turbulence"] = turbulence_record(turbulence)
+    config_used = os.environ.get(CONFIG_USED_ENV)
+    if config_used and Path(config_used).is_file():
+        prov["config"] = file_record(config_used)
+    if ranking is not None:
+        prov["ranking"] = dict(ranking)
+    if vestibular is not None:
+        prov["vestibular"] = dict(vestibular)
     return prov
 
 

@@ -22,7 +22,11 @@ unchanged to ``traces.parquet`` (e.g. the flight pipeline's state columns).
     W.sat_<kind>                                             saturation flags, 0/1 (int8)
     <extra input columns, unchanged>
 
-``DIR/metrics.csv``: ``washout,dof,npc,integral_error,max_error``, one row per washout and DOF
+``DIR/metrics.csv``: ``washout,dof,npc,integral_error,max_error`` then the cue classification
+(:mod:`washbench.analysis.cues`) ``cue_correct_frac,cue_scaled_frac,cue_false_frac,cue_missing_frac`` (time
+fractions), on the heave row the motion sickness dose values ``msdv_mps15,msdv_aircraft_mps15`` (ISO 2631-1 Wf,
+m/s^1.5: the simulator pilot's and the aircraft pilot's, :mod:`washbench.perception.sickness`) and
+``false_cue_events`` (``start_s-end_s@peak`` joined by ``;``), one row per washout and DOF
 (surge, sway, heave, roll, pitch, yaw). Floats are written with ``repr`` (exact round trip); an
 undefined NPC (flat signal) is an empty field; PC = -1 gives ``inf``.
 """
@@ -54,7 +58,14 @@ INPUT_COLUMNS = (TIME_COLUMN, *F_COLUMNS, *OMEGA_COLUMNS)
 AIRCRAFT = "aircraft"
 """Source name of the aircraft pilot in traces.parquet."""
 
-METRICS_COLUMNS = ("washout", "dof", "npc", "integral_error", "max_error")
+METRICS_COLUMNS = (
+    "washout", "dof", "npc", "integral_error", "max_error",
+    "cue_correct_frac", "cue_scaled_frac", "cue_false_frac", "cue_missing_frac",
+    "msdv_mps15", "msdv_aircraft_mps15", "false_cue_events",
+)  # fmt: skip
+"""metrics.csv columns; files written before the cue classification have the first five only (still read)."""
+METRICS_TEXT_COLUMNS = ("washout", "dof", "false_cue_events")
+N_BASE_METRICS_COLUMNS = 5
 
 #: Time steps an input motion may have, s: beyond, the filters cannot be discretised (a subnormal step, or one of
 #: 8e307 s, overflows them). Wide on purpose: a time column in ms or ns read as seconds still passes, and the
@@ -302,7 +313,9 @@ def metrics_csv_text(rows: Iterable[MetricRow]) -> str:
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(METRICS_COLUMNS)
     for r in rows:
-        w.writerow([r.washout, r.dof, csv_number(r.npc), csv_number(r.integral_error), csv_number(r.max_error)])
+        w.writerow(
+            [getattr(r, c) if c in METRICS_TEXT_COLUMNS else csv_number(getattr(r, c)) for c in METRICS_COLUMNS]
+        )
     return buf.getvalue()
 
 
@@ -320,15 +333,17 @@ def read_metrics_csv(path: str | Path) -> list[MetricRow]:
         raise WashbenchError(located(path, f"cannot read: {getattr(exc, 'strerror', None) or exc}")) from None
     reader = csv.reader(io.StringIO(text))
     header = next(reader, None)
-    if header is None or tuple(header) != METRICS_COLUMNS:
+    if header is None or tuple(header) not in (METRICS_COLUMNS, METRICS_COLUMNS[:N_BASE_METRICS_COLUMNS]):
         raise WashbenchError(located(path, f"expected header {','.join(METRICS_COLUMNS)}", line=1))
+    ncol = len(header)
     rows = []
     for line, rec in enumerate(reader, start=2):
-        if len(rec) != len(METRICS_COLUMNS):
-            raise WashbenchError(located(path, f"expected {len(METRICS_COLUMNS)} fields, got {len(rec)}", line=line))
+        if len(rec) != ncol:
+            raise WashbenchError(located(path, f"expected {ncol} fields, got {len(rec)}", line=line))
         try:
-            nums = [math.nan if v == "" else float(v) for v in rec[2:]]
+            values = {c: v if c in METRICS_TEXT_COLUMNS else (math.nan if v == "" else float(v))
+                      for c, v in zip(header, rec, strict=True)}  # fmt: skip
         except ValueError as exc:
             raise WashbenchError(located(path, f"not a number: {exc}", line=line)) from None
-        rows.append(MetricRow(rec[0], rec[1], *nums))
+        rows.append(MetricRow(**values))
     return rows

@@ -13,8 +13,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-import washbench.cueing.jitcache  # noqa: F401  (numba's cache folder is set before anything here is compiled)
-from washbench.cueing.numbastart import prepare
+import washbench.numerics.jitcache  # noqa: F401  (numba's cache folder is set before anything here is compiled)
+from washbench.numerics.numbastart import prepare
 
 prepare()
 

@@ -29,6 +29,17 @@ begins mid-manoeuvre is then felt as a change, not as motion the pilot has long 
 
 Optional perception thresholds (:mod:`washbench.perception.thresholds`) are applied to the
 model outputs as a dead band; they are off by default.
+
+**Telban and Cardullo** (NASA CR-2005-213747, 2005), the other choice (``--vestibular telban-cardullo``,
+:data:`MODELS`): the same two forms with other values and a lead on the canal model::
+
+      f_hat / f = (tau_A s + 1) / ((tau_L s + 1)(tau_S s + 1))            tau_A 10, tau_L 5, tau_S 0.016 s
+      w_hat / w = T_L T_a s^2 (T_N s + 1) / ((T_L s + 1)(T_S s + 1)(T_a s + 1))
+                                                        T_L 5.73, T_S 0.005, T_a 80, T_N 0.06 s
+
+The canal model is then proper, not strictly proper: its direct term ``T_N / T_S`` (12) is one more section
+with ``phi = 0``. The values are those of Telban and Cardullo as quoted in the motion-cueing literature that
+cites them; the report itself was not available to this project (docs/fidelity.md).
 """
 
 from __future__ import annotations
@@ -57,14 +68,15 @@ class OtolithParams(StrictModel):
 
 
 class CanalParams(StrictModel):
-    """Semicircular canal model, Eq. 12: ``T_L T_a s^2 / ((T_L s + 1)(T_S s + 1)(T_a s + 1))``.
+    """Semicircular canal model, Eq. 12: ``T_L T_a s^2 (T_N s + 1) / ((T_L s + 1)(T_S s + 1)(T_a s + 1))``.
 
-    Defaults are the paper's "typical values" (Reid and Nahon, Part 1).
+    Defaults are the paper's "typical values" (Reid and Nahon, Part 1), without lead (``T_N_s`` 0: Young-Oman).
     """
 
     T_L_s: float = Field(default=10.2, gt=0.0, description="long time constant [s]")
     T_S_s: float = Field(default=0.1, gt=0.0, description="short time constant [s]")
     T_a_s: float = Field(default=30.0, gt=0.0, description="adaptation time constant [s]")
+    T_N_s: float = Field(default=0.0, ge=0.0, description="lead time constant [s] (Telban-Cardullo)")
 
 
 class VestibularParams(StrictModel):
@@ -73,6 +85,33 @@ class VestibularParams(StrictModel):
     otolith: OtolithParams = OtolithParams()
     canals: CanalParams = CanalParams()
     thresholds: Thresholds | None = None
+
+
+MODELS: dict[str, VestibularParams] = {
+    "young-meiry": VestibularParams(),
+    "telban-cardullo": VestibularParams(
+        otolith=OtolithParams(K=1.0, tau_L_s=5.0, tau_S_s=0.016, tau_a_s=10.0),
+        canals=CanalParams(T_L_s=5.73, T_S_s=0.005, T_a_s=80.0, T_N_s=0.06),
+    ),
+}
+"""The vestibular models ``--vestibular`` chooses (module docstring): ``young-meiry`` (the paper's Meiry-Young
+otolith and Young-Oman canals, the default) and ``telban-cardullo``."""
+
+DEFAULT_MODEL = "young-meiry"
+
+
+def model_record(name: str | None) -> dict[str, object]:
+    """The provenance record of a model of :data:`MODELS`: ``{"model": name, "values": its parameters}``."""
+    key = DEFAULT_MODEL if name is None else name
+    return {"model": key, "values": model_params(key).model_dump(mode="json")}
+
+
+def model_params(name: str | None) -> VestibularParams:
+    """The parameters of a model of :data:`MODELS` (None: the default); ValueError naming the valid ones."""
+    key = DEFAULT_MODEL if name is None else name
+    if key not in MODELS:
+        raise ValueError(f"unknown vestibular model {name!r} (valid: {', '.join(MODELS)})")
+    return MODELS[key]
 
 
 def otolith_tf(p: OtolithParams) -> tuple[np.ndarray, np.ndarray]:
@@ -85,27 +124,36 @@ def otolith_tf(p: OtolithParams) -> tuple[np.ndarray, np.ndarray]:
 def canal_tf(p: CanalParams) -> tuple[np.ndarray, np.ndarray]:
     """Continuous semicircular canal transfer function as (numerator, denominator) coefficients in s."""
     num = np.array([p.T_L_s * p.T_a_s, 0.0, 0.0])
+    if p.T_N_s > 0.0:
+        num = np.polymul(num, [p.T_N_s, 1.0])
     den = np.polymul(np.polymul([p.T_L_s, 1.0], [p.T_S_s, 1.0]), [p.T_a_s, 1.0])
     return num, den
 
 
 @dataclass(frozen=True)
 class PartialFractions:
-    """``H(s) = sum_i residues[i] / (s - poles[i])`` with real, distinct, negative poles [1/s]."""
+    """``H(s) = direct + sum_i residues[i] / (s - poles[i])`` with real, distinct, negative poles [1/s]."""
 
     residues: tuple[float, ...]
     poles: tuple[float, ...]
+    direct: float = 0.0
 
 
 def partial_fractions(num: np.ndarray, time_constants_s: tuple[float, ...]) -> PartialFractions:
-    """Partial fractions of ``num(s) / prod_i (tau_i s + 1)`` (degree of ``num`` below the number of taus).
+    """Partial fractions of ``num(s) / prod_i (tau_i s + 1)`` (degree of ``num`` at most the number of taus; a
+    proper one has the direct term ``num[0] / prod tau_i``).
 
     Raises ValueError if two time constants are (nearly) equal: the models then have a repeated
     pole, which this parallel form does not represent.
     """
     taus = tuple(float(t) for t in time_constants_s)
-    if len(num) > len(taus):
-        raise ValueError("transfer function must be strictly proper")
+    num = np.asarray(num, dtype=np.float64)
+    if len(num) > len(taus) + 1:
+        raise ValueError("transfer function must be proper")
+    direct = 0.0
+    if len(num) == len(taus) + 1:  # proper: take out the direct term, leave a strictly proper remainder
+        direct = float(num[0]) / math.prod(taus)
+        num = np.polysub(num, direct * np.poly1d(np.poly([-1.0 / t for t in taus])).coeffs * math.prod(taus))[1:]
     for i, a in enumerate(taus):
         for b in taus[i + 1 :]:
             if abs(a - b) <= 1e-6 * max(a, b):
@@ -116,7 +164,7 @@ def partial_fractions(num: np.ndarray, time_constants_s: tuple[float, ...]) -> P
     for i, p_i in enumerate(poles):
         others = math.prod(p_i - p_j for j, p_j in enumerate(poles) if j != i)
         residues.append(float(np.polyval(num, p_i)) / (lead * others))
-    return PartialFractions(residues=tuple(residues), poles=poles)
+    return PartialFractions(residues=tuple(residues), poles=poles, direct=direct)
 
 
 def _foh_weights(x: float) -> tuple[float, float]:
@@ -169,6 +217,10 @@ class DiscreteModel:
             b.append((r * dt_s * g1, r * dt_s * g0))
             phi.append(math.exp(-a * dt_s))
         steady = tuple(-r / p for r, p in zip(pf.residues, pf.poles, strict=True))
+        if pf.direct != 0.0:  # the direct term: a section x[k] = direct u[k] (phi 0), steady value = direct
+            b.append((pf.direct, 0.0))
+            phi.append(0.0)
+            steady = (*steady, pf.direct)
         return cls(dt_s=dt_s, b=tuple(b), phi=tuple(phi), dc_gain=sum(steady), steady=steady)
 
     def start(self, u0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -182,8 +234,10 @@ class DiscreteModel:
 
         The same compiled step as :meth:`apply`: feeding a trace in chunks gives the same bits as feeding it whole.
         """
+        from washbench.numerics.jitcache import announce_compile
         from washbench.perception.sections import sections_run
 
+        announce_compile(sections_run)
         b, phi, _ = self.arrays()
         x, u_prev = state
         return sections_run(b, phi, x, u_prev, np.ascontiguousarray(u, dtype=np.float64))
@@ -194,8 +248,10 @@ class DiscreteModel:
         Returns float64 of the same shape. One compiled pass per column (:mod:`washbench.perception.sections`),
         the same step the studies' evaluation kernel takes per sample.
         """
+        from washbench.numerics.jitcache import announce_compile
         from washbench.perception.sections import sections_apply, sections_apply_from
 
+        announce_compile(sections_apply if start is None else sections_apply_from)
         u = np.asarray(u, dtype=np.float64)
         if u.ndim not in (1, 2) or u.shape[0] == 0:
             raise ValueError(f"expected a non-empty (N,) or (N, m) array, got shape {u.shape}")

@@ -27,10 +27,10 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
-from washbench.cueing.jitcache import drop_stale_cache
-from washbench.cueing.rotations import limit_norm, norm3, qconj, qintegrate, qmul, qrotvec
+from washbench.numerics.jitcache import drop_stale_cache
+from washbench.numerics.rotations import limit_norm, norm3, qconj, qintegrate, qmul, qrotvec
 
-drop_stale_cache(__file__, [Path(__file__).resolve().parent.parent / "cueing" / "rotations.py"])
+drop_stale_cache(__file__, [Path(__file__).resolve().parent.parent / "numerics" / "rotations.py"])
 
 
 #: Beyond this many braking steps (r / (a_max dt^2)) the discrete braking sum is inverted in its continuous form.

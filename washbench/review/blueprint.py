@@ -155,13 +155,13 @@ def build_blueprint(layout: Layout) -> rrb.Blueprint:
         row_shares=[2.0, 1.3 + 0.25 * len(layout.washouts), 2.4],
     )
     perceived = rrb.Vertical(
-        _lanes(layout, "/lanes", "Phases; limits reached"),
+        _lanes(layout, "/lanes", "Phases; limits reached; false cues"),
         *_stack(layout, "perceived", layout.perceived_ranges, "perceived "),
         row_shares=[0.9 + 0.6 * (1 + len(layout.washouts))] + [2.0] * len(layout.dofs),
         name="Perceived",
     )
     raw = rrb.Vertical(
-        _lanes(layout, "/lanes", "Phases; limits reached"),
+        _lanes(layout, "/lanes", "Phases; limits reached; false cues"),
         *_stack(layout, "raw", layout.raw_ranges, ""),
         row_shares=[0.9 + 0.6 * (1 + len(layout.washouts))] + [2.0] * len(layout.dofs),
         name="Raw motion",
@@ -205,7 +205,7 @@ def build_blueprint(layout: Layout) -> rrb.Blueprint:
     enc = rrb.encodings
     events = rrb.TextLogView(
         origin="/events",
-        name="Phases and limit events",
+        name="Phases, limit and false-cue events",
         columns=rrb.archetypes.TextLogColumns(
             timeline_columns=[enc.TimelineColumn("time")],
             text_log_columns=[

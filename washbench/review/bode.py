@@ -1,11 +1,13 @@
 """Bode plots of the OMCT (``washbench omct``): one PNG per test, every washout overlaid.
 
-Left column: the simulator's motion at the pilot's head (gain on a log axis, absolute, as the OMCT literature
-plots it; phase in degrees), with the boundaries if given (dashed, the band between them shaded). Right
-column: what the pilot perceives through the vestibular models, each simulator pilot against the aircraft
-pilot (black, dashed) for the same input. Non-linear points are drawn as crosses, points outside the
-boundaries get a red ring. matplotlib is imported
-lazily with the Agg backend (no display needed).
+Left column: the simulator's motion at the pilot's head, measured on the platform's own state (gain on a log axis,
+absolute, as the OMCT literature plots it; phase in degrees), with the boundaries if given (dashed, the band between
+them shaded). Where the head-motion estimate of ``washbench cue`` (the paper's Eq. 8 estimator for the small-angle
+washout, the quaternion difference of Eqs. 18-19 otherwise) differs from it, that estimate is drawn as a thin
+dotted line of the washout's colour, labelled "cue head estimate": a separate curve, not the test's result. Right
+column: what the pilot perceives through the vestibular models, each simulator pilot against the aircraft pilot
+(black, dashed) for the same input. Non-linear points are drawn as crosses, points outside the boundaries get a red
+ring. matplotlib is imported lazily with the Agg backend (no display needed).
 """
 
 from __future__ import annotations
@@ -80,6 +82,13 @@ def write_bode_plots(
             colour = _COLOURS[i % len(_COLOURS)]
             _series(ag, aph, w, np.array([p.gain for p in mine]), np.array([p.phase_deg for p in mine]), lin, i,
                     color=colour, label=name)  # fmt: skip
+            g_est = np.array([p.estimator_gain for p in mine])
+            ph_est = np.array([p.estimator_phase_deg for p in mine])
+            g_meas = np.array([p.gain for p in mine])
+            if np.nanmax(np.abs(g_est * np.exp(1j * np.radians(ph_est)) / (g_meas * np.exp(
+                    1j * np.radians(np.array([p.phase_deg for p in mine])))) - 1.0)) > 1e-3:  # fmt: skip
+                ag.plot(w, g_est, ":", lw=1.0, color=colour, label=f"{name}: cue head estimate (not the test)")
+                aph.plot(w, ph_est, ":", lw=1.0, color=colour)
             _series(apg, app, w, np.array([p.perceived_gain for p in mine]),
                     np.array([p.perceived_phase_deg for p in mine]), lin, i, color=colour, label=name)  # fmt: skip
             for p in mine:  # outside the boundaries: a red ring
@@ -106,7 +115,7 @@ def write_bode_plots(
             ax.set_xlabel("frequency (rad/s)")
         ag.set_ylabel("gain (-)")
         aph.set_ylabel("phase (deg)")
-        ag.set_title(f"{test.input_axis} -> {test.output_axis}: motion at the pilot's head")
+        ag.set_title(f"{test.input_axis} -> {test.output_axis}: platform motion at the pilot's head")
         apg.set_title("perceived (vestibular models)")
         ag.legend(fontsize=8, loc="best")
         apg.legend(fontsize=8, loc="best")

@@ -32,7 +32,8 @@ from typing import Any
 
 import numpy as np
 
-from washbench.review.palette import AIRCRAFT_COLOR, mpl, washout_colors
+from washbench.review.numbers import SCORE_FLAG
+from washbench.review.palette import aircraft_color, mpl, palette_name, washout_colors, washout_dashes
 
 FIGURE_FORMATS = ("png", "pdf")
 """The formats a figure can be written in: STEM.png (embedded in report.md) and STEM.pdf (vector, for papers).
@@ -64,8 +65,14 @@ SATURATION_LABELS = {
 METRIC_LABELS = {"npc": "NPC", "integral_error": "integral of |error|", "max_error": "maximum |error|"}
 
 _THRESHOLD_COLOR = (0.45, 0.45, 0.45)
+_THRESHOLD_FILL = (0.0, 0.0, 0.0, 0.07)
 _PHASE_SHADE = (0.0, 0.0, 0.0, 0.05)
-_DECIMATE_BUCKETS = 1500
+_CHAR_IN = 7.5 * 0.56 / 72.0  # mean width of a phase-label character (DejaVu Sans at 7.5 pt) [in]
+_LAYOUT_CACHE: dict[tuple[Any, ...], tuple[Any, Any]] = {}
+_LAYOUT_CACHE_SIZE = 6
+
+PERCEIVED_SIZE_IN = (8.6, 11.0)
+PERCEIVED_MARGINS_IN = (0.85, 0.12, 0.62, 0.45)
 
 
 def _new_figure(
@@ -91,10 +98,77 @@ def _new_figure(
     return fig
 
 
+def _stacked_layout(
+    key: tuple[Any, ...], size_in: tuple[float, float], margins_in: tuple[float, float, float, float],
+    ratios: Sequence[float],
+) -> tuple[Any, Any]:  # fmt: skip
+    """A figure of panels stacked on one shared time axis, laid out once per process and reused.
+
+    Building the axes and their ticks costs more than drawing the data; a worker that draws many results reuses the
+    layout it already built for the same ``key`` (size, margins and panel ratios), emptied of the previous data:
+    lines, patches, texts, collections, legends, titles, tick choices and data limits. Same data, same pixels.
+    """
+    cached = _LAYOUT_CACHE.pop(key, None)
+    if cached is None:
+        fig = _new_figure(size_in[0], size_in[1], margins_in)
+        axes = fig.subplots(len(ratios), 1, sharex=True, gridspec_kw={"height_ratios": list(ratios)})
+        # Axis labels at fixed places (y: ending 0.32 in inside the figure's left edge, x: 0.24 in under the axis)
+        # instead of matplotlib measuring every tick label of every shared panel before each drawing to place them.
+        for ax in axes:
+            box = ax.get_position()
+            width_in, height_in = box.width * size_in[0], box.height * size_in[1]
+            ax.yaxis.set_label_coords(-(margins_in[0] - 0.32) / width_in, 0.5)
+            ax.xaxis.set_label_coords(0.5, -0.24 / height_in)
+        if len(_LAYOUT_CACHE) >= _LAYOUT_CACHE_SIZE:
+            _LAYOUT_CACHE.pop(next(iter(_LAYOUT_CACHE)))
+    else:
+        fig, axes = cached
+        for legend in list(fig.legends):
+            legend.remove()
+        for ax in axes:
+            for artist in [*ax.lines, *ax.patches, *ax.texts, *ax.collections]:
+                artist.remove()
+            ax.set_title("")
+            ax.set_ylabel("")
+            ax.set_xlabel("")
+            ax.relim()
+            ax.ignore_existing_data_limits = True
+            ax.set_autoscale_on(True)
+            ax.yaxis.set_major_locator(_auto_locator())
+            ax.yaxis.set_major_formatter(_auto_formatter())
+    _LAYOUT_CACHE[key] = (fig, axes)
+    return fig, axes
+
+
+def _auto_locator() -> Any:
+    from matplotlib.ticker import AutoLocator
+
+    return AutoLocator()
+
+
+def _auto_formatter() -> Any:
+    from matplotlib.ticker import ScalarFormatter
+
+    return ScalarFormatter()
+
+
+def _plot_width_px(size_in: tuple[float, float], margins_in: tuple[float, float, float, float]) -> int:
+    """Width of the panels in PNG pixels (the resolution a trace is drawn at)."""
+    return max(math.ceil((size_in[0] - margins_in[0] - margins_in[1]) * PNG_DPI), 16)
+
+
+_LEGEND_ROW = 6
+"""Entries in one legend row; more (the aircraft and six or more washouts) go on two rows in a smaller font."""
+
+
 def _top_legend(fig: Any, handles: list[Any]) -> None:
-    """The legend in one row above the panels (under the figure's top edge)."""
-    fig.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, 1.0 - 0.04 / fig.get_figheight()),
-               ncol=len(handles), fontsize=8.5, frameon=False)  # fmt: skip
+    """The legend above the panels (under the figure's top edge): one row, or two when there are more than
+    :data:`_LEGEND_ROW` entries (so that every name stays inside the picture)."""
+    two = len(handles) > _LEGEND_ROW
+    fig.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, 1.0 - 0.02 / fig.get_figheight()),
+               ncol=math.ceil(len(handles) / 2) if two else len(handles), fontsize=7.0 if two else 8.5,
+               frameon=False, handlelength=3.2, borderaxespad=0.0,
+               labelspacing=0.15, columnspacing=1.2)  # fmt: skip
 
 
 def save_figure(fig: Any, stem: Path, formats: Sequence[str] = ("png",)) -> list[Path]:
@@ -115,15 +189,17 @@ def save_figure(fig: Any, stem: Path, formats: Sequence[str] = ("png",)) -> list
     return paths
 
 
-def minmax_decimate(t: np.ndarray, y: np.ndarray, buckets: int = _DECIMATE_BUCKETS) -> tuple[np.ndarray, np.ndarray]:
+def minmax_decimate(t: np.ndarray, y: np.ndarray, buckets: int = 1500) -> tuple[np.ndarray, np.ndarray]:
     """At most ``2 * buckets`` points that draw like ``(t, y)``: each bucket's minimum and maximum, in time order.
 
+    The figures pass one bucket per pixel column of the panel, so every peak stays where the full trace puts it.
     Shorter traces are returned unchanged. NaNs are kept out of the min/max (a bucket of NaNs stays NaN).
     """
     n = t.shape[0]
     if n <= 2 * buckets:
         return t, y
     size = math.ceil(n / buckets)
+    buckets = math.ceil(n / size)
     pad = size * buckets - n
     yp = np.concatenate([y, np.full(pad, y[-1])]).reshape(buckets, size)
     tp = np.concatenate([t, np.full(pad, t[-1])]).reshape(buckets, size)
@@ -137,28 +213,54 @@ def minmax_decimate(t: np.ndarray, y: np.ndarray, buckets: int = _DECIMATE_BUCKE
     return idx_t, idx_y
 
 
-def _phase_lane(ax: Any, phases: Sequence[tuple[str, float, float]], t_end: float) -> None:
-    """Phases as labelled boxes on a lane axis (names shortened or dropped where the box is too narrow)."""
+def phase_label(name: str, width_in: float) -> str:
+    """``name`` as it fits a phase box ``width_in`` inches wide: on one line, else wrapped at spaces onto two,
+    else shortened with an ellipsis (or dropped where not even four characters fit)."""
+    chars = int(width_in / _CHAR_IN)
+    if len(name) <= chars:
+        return name
+    words = name.split()
+    if len(words) > 1:
+        for cut in range(len(words) - 1, 0, -1):
+            first, second = " ".join(words[:cut]), " ".join(words[cut:])
+            if len(first) <= chars and len(second) <= chars:
+                return f"{first}\n{second}"
+    return name[: max(chars - 1, 0)] + "…" if chars >= 4 else ""
+
+
+def _phase_lane(ax: Any, phases: Sequence[tuple[str, float, float]], t0_s: float, t1_s: float,
+                width_in: float) -> None:  # fmt: skip
+    """Phases as labelled boxes on a lane axis (names wrapped, shortened or dropped where the box is too narrow)."""
     ax.set_ylim(0, 1)
     ax.set_yticks([])
     for side in ("top", "right", "left"):
         ax.spines[side].set_visible(False)
-    span = max(t_end, 1e-9)
-    for i, (name, t0, t1) in enumerate(phases):
+    span = max(t1_s - t0_s, 1e-9)
+    for i, (name, a, b) in enumerate(phases):
         shade = (0.82, 0.86, 0.92) if i % 2 == 0 else (0.90, 0.92, 0.96)
-        ax.axvspan(t0, t1, color=shade, lw=0)
-        chars = int((t1 - t0) / span * 110)  # about 110 characters fit across the lane
-        label = name if len(name) <= chars else (name[: max(chars - 1, 0)] + "…" if chars >= 4 else "")
+        ax.axvspan(a, b, color=shade, lw=0)
+        label = phase_label(name, (min(b, t1_s) - max(a, t0_s)) / span * width_in)
         if label:
-            ax.text(0.5 * (t0 + t1), 0.5, label, ha="center", va="center", fontsize=7.5, clip_on=True)
+            ax.text(0.5 * (a + b), 0.5, label, ha="center", va="center", fontsize=7.5, clip_on=True,
+                    linespacing=1.0)  # fmt: skip
     ax.set_ylabel("phase", rotation=0, ha="right", va="center", fontsize=8)
+    ax.yaxis.set_label_coords(-0.01, 0.5)
 
 
 def _shade_phases(ax: Any, phases: Sequence[tuple[str, float, float]]) -> None:
-    for i, (_, t0, t1) in enumerate(phases):
-        if i % 2 == 1:
-            ax.axvspan(t0, t1, color=_PHASE_SHADE, lw=0, zorder=0)
-        ax.axvline(t0, color=(0.6, 0.6, 0.6), lw=0.5, zorder=0.5)
+    """Every other phase shaded and a thin line at each phase start (one collection each: fewer artists to draw)."""
+    from matplotlib.collections import LineCollection, PolyCollection
+
+    if not phases:
+        return
+    trans = ax.get_xaxis_transform()  # x in data, y in axes fraction
+    boxes = [[(t0, 0.0), (t1, 0.0), (t1, 1.0), (t0, 1.0)] for i, (_, t0, t1) in enumerate(phases) if i % 2 == 1]
+    if boxes:
+        ax.add_collection(PolyCollection(boxes, facecolors=[_PHASE_SHADE], linewidths=0, zorder=0, transform=trans),
+                          autolim=False)  # fmt: skip
+    starts = [[(t0, 0.0), (t0, 1.0)] for _, t0, _ in phases]
+    ax.add_collection(LineCollection(starts, colors=[(0.6, 0.6, 0.6)], linewidths=0.5, zorder=0.5, transform=trans),
+                      autolim=False)  # fmt: skip
 
 
 def perceived_figure(
@@ -171,45 +273,53 @@ def perceived_figure(
     thresholds: Sequence[float] | None = None,
     rest: Sequence[float] = (0.0, 0.0, -9.80665, 0.0, 0.0, 0.0),
     formats: Sequence[str] = ("png",),
+    palette: str | None = None,
 ) -> list[Path]:
     """The six stacked perceived-motion panels (module docstring); returns the paths (PNG first).
 
     ``perceived``: ``"aircraft"`` and each washout -> (N, 6) array, columns surge, sway, heave [m/s^2], roll, pitch,
-    yaw [deg/s]; the washouts are drawn in the mapping's order. ``thresholds`` (6,) in the same units, drawn as
-    ``rest +- threshold``; ``phases``: (name, t_start_s, t_end_s).
+    yaw [deg/s]; the washouts are drawn in the mapping's order. ``thresholds`` (6,) in the same units, drawn as a
+    band ``rest +- threshold`` (``rest``: the pilot's resting value per DOF, same units); ``phases``:
+    (name, t_start_s, t_end_s); ``palette``: :data:`washbench.review.palette.PALETTES` (None: the environment's).
     """
     from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
 
+    pal = palette_name(palette)
     washouts = [s for s in perceived if s != "aircraft"]
-    colors = washout_colors(washouts)
-    fig = _new_figure(8.6, 11.0, (0.85, 0.12, 0.62, 0.45))
-    ratios = [0.35] + [1.0] * 6 if phases else [1.0] * 6
-    axes = fig.subplots(len(ratios), 1, sharex=True, gridspec_kw={"height_ratios": ratios})
+    colors, dashes = washout_colors(washouts, pal), washout_dashes(washouts)
+    ac_color = mpl(aircraft_color(pal))
+    ratios = (0.35, *[1.0] * 6) if phases else (1.0,) * 6
+    fig, axes = _stacked_layout(("perceived", ratios), PERCEIVED_SIZE_IN, PERCEIVED_MARGINS_IN, ratios)
+    width_px = _plot_width_px(PERCEIVED_SIZE_IN, PERCEIVED_MARGINS_IN)
+    t0, t1 = float(t_s[0]), float(t_s[-1])
     if phases:
-        _phase_lane(axes[0], phases, float(t_s[-1]))
+        width_in = PERCEIVED_SIZE_IN[0] - PERCEIVED_MARGINS_IN[0] - PERCEIVED_MARGINS_IN[1]
+        _phase_lane(axes[0], phases, t0, t1, width_in)
         panels = axes[1:]
     else:
         panels = axes
     for i, (ax, (dof, unit)) in enumerate(zip(panels, PERCEIVED_PANELS, strict=True)):
         _shade_phases(ax, phases)
         if thresholds is not None:
-            for sign in (-1.0, 1.0):
-                ax.axhline(rest[i] + sign * thresholds[i], color=_THRESHOLD_COLOR, lw=0.8, ls=(0, (4, 3)), zorder=1)
+            lo, hi = rest[i] - thresholds[i], rest[i] + thresholds[i]
+            ax.axhspan(lo, hi, facecolor=_THRESHOLD_FILL, edgecolor="none", zorder=1)
+            ax.plot([t0, t1, np.nan, t0, t1], [lo, lo, np.nan, hi, hi], color=_THRESHOLD_COLOR, lw=0.6, zorder=1)
         for w in washouts:
-            tt, yy = minmax_decimate(t_s, perceived[w][:, i])
-            ax.plot(tt, yy, color=mpl(colors[w]), lw=1.0, zorder=2)
-        tt, yy = minmax_decimate(t_s, perceived["aircraft"][:, i])
-        ax.plot(tt, yy, color=mpl(AIRCRAFT_COLOR), lw=1.7, zorder=3)
+            tt, yy = minmax_decimate(t_s, perceived[w][:, i], width_px)
+            ax.plot(tt, yy, color=mpl(colors[w]), lw=1.0, ls=dashes[w], zorder=2)
+        tt, yy = minmax_decimate(t_s, perceived["aircraft"][:, i], width_px)
+        ax.plot(tt, yy, color=ac_color, lw=1.7, zorder=3)
         ax.set_ylabel(f"{dof}\n({unit})", fontsize=9)
         ax.tick_params(labelsize=8)
         ax.grid(True, color=(0.9, 0.9, 0.9), lw=0.5)
         ax.margins(x=0)
     panels[-1].set_xlabel("time (s)", fontsize=9)
-    panels[-1].set_xlim(float(t_s[0]), float(t_s[-1]))
-    handles = [Line2D([], [], color=mpl(AIRCRAFT_COLOR), lw=1.7, label="aircraft pilot")]
-    handles += [Line2D([], [], color=mpl(colors[w]), lw=1.2, label=w) for w in washouts]
+    panels[-1].set_xlim(t0, t1)
+    handles = [Line2D([], [], color=ac_color, lw=1.7, label="aircraft pilot")]
+    handles += [Line2D([], [], color=mpl(colors[w]), lw=1.2, ls=dashes[w], label=w) for w in washouts]
     if thresholds is not None:
-        handles.append(Line2D([], [], color=_THRESHOLD_COLOR, lw=0.8, ls=(0, (4, 3)), label="perception threshold"))
+        handles.append(Patch(facecolor=_THRESHOLD_FILL, edgecolor=_THRESHOLD_COLOR, lw=0.6, label="not felt"))
     _top_legend(fig, handles)
     axes[0].set_title(f"{title}: perceived motion", fontsize=11)
     return save_figure(fig, stem, formats)
@@ -231,6 +341,7 @@ def envelope_figure(
     *,
     phases: Sequence[tuple[str, float, float]] = (),
     formats: Sequence[str] = ("png",),
+    palette: str | None = None,
 ) -> list[Path]:
     """Platform envelope usage and saturation lanes (module docstring); returns the paths (PNG first).
 
@@ -239,24 +350,27 @@ def envelope_figure(
     """
     from matplotlib.lines import Line2D
 
+    pal = palette_name(palette)
     washouts = list(dict.fromkeys(w for per in usage.values() for w in per))
-    colors = washout_colors(washouts)
+    colors, dashes = washout_colors(washouts, pal), washout_dashes(washouts)
     lanes = [(w, k, flags) for w in washouts for k, flags in saturated.get(w, {}).items() if np.any(flags)]
     n_lanes = max(len(lanes), 1)
     # the lane labels (7.5 pt, about 0.06 in a character) and the "limit active" label set the left margin
     label_in = max([len(SATURATION_LABELS.get(k, k)) for _, k, _ in lanes] + [8]) * 0.062
-    fig = _new_figure(8.6, 1.55 * len(usage) + 0.9 + 0.2 * n_lanes, (max(0.85, label_in + 0.45), 0.12, 0.62, 0.45))
-    ratios = [1.0] * len(usage) + [0.12 * n_lanes + 0.25]
-    axes = fig.subplots(len(ratios), 1, sharex=True, gridspec_kw={"height_ratios": ratios})
+    size_in = (8.6, 1.55 * len(usage) + 0.9 + 0.2 * n_lanes)
+    margins_in = (max(0.85, label_in + 0.45), 0.12, 0.62, 0.45)
+    ratios = (*[1.0] * len(usage), 0.12 * n_lanes + 0.25)
+    fig, axes = _stacked_layout(("envelope", size_in, margins_in, ratios), size_in, margins_in, ratios)
+    width_px = _plot_width_px(size_in, margins_in)
     dt = float(t_s[1] - t_s[0]) if t_s.shape[0] > 1 else 0.0
     for ax, (label, per) in zip(axes, usage.items(), strict=False):
         _shade_phases(ax, phases)
-        ax.axhline(1.0, color=(0.3, 0.3, 0.3), lw=0.9, ls="--", zorder=1)
+        ax.axhline(1.0, color=(0.3, 0.3, 0.3), lw=0.9, ls=(0, (2.0, 2.0)), zorder=1)
         top = 1.0
         for w, u in per.items():
-            tt, yy = minmax_decimate(t_s, u)
-            ax.plot(tt, yy, color=mpl(colors[w]), lw=1.0, zorder=2)
-            if u.size:
+            tt, yy = minmax_decimate(t_s, u, width_px)
+            ax.plot(tt, yy, color=mpl(colors[w]), lw=1.0, ls=dashes[w], zorder=2)
+            if u.size and np.isfinite(u).any():
                 top = max(top, float(np.nanmax(u)))
         ax.set_ylim(0.0, 1.08 * top)
         ax.set_ylabel(f"{label}\n(of limit)", fontsize=9)
@@ -282,8 +396,8 @@ def envelope_figure(
     lane_ax.tick_params(axis="x", labelsize=8)
     lane_ax.set_xlabel("time (s)", fontsize=9)
     lane_ax.set_xlim(float(t_s[0]), float(t_s[-1]))
-    handles = [Line2D([], [], color=mpl(colors[w]), lw=1.2, label=w) for w in washouts]
-    handles.append(Line2D([], [], color=(0.3, 0.3, 0.3), lw=0.9, ls="--", label="limit"))
+    handles = [Line2D([], [], color=mpl(colors[w]), lw=1.2, ls=dashes[w], label=w) for w in washouts]
+    handles.append(Line2D([], [], color=(0.3, 0.3, 0.3), lw=0.9, ls=(0, (2.0, 2.0)), label="limit"))
     _top_legend(fig, handles)
     axes[0].set_title(f"{title}: platform envelope", fontsize=11)
     return save_figure(fig, stem, formats)
@@ -324,7 +438,7 @@ def score_heatmap(
         best = np.nanmin(row) if np.isfinite(row).any() else math.nan
         for c in range(len(washouts)):
             v = row[c]
-            text = "-" if not math.isfinite(v) else _sig(v) + (" !" if v > 1.0 else "")
+            text = "-" if not math.isfinite(v) else _sig(v) + (f" {SCORE_FLAG}" if v > 1.0 else "")
             is_best = math.isfinite(v) and v == best
             ax.text(c, r, text, ha="center", va="center", fontsize=8, fontweight="bold" if is_best else "normal")
             if is_best:
@@ -335,7 +449,8 @@ def score_heatmap(
     bar = fig.colorbar(image, ax=ax, shrink=0.8, pad=0.02)
     bar.set_label("score (lower is better)", fontsize=7.5)
     bar.ax.tick_params(labelsize=7)
-    ax.set_title(f"{title}: best per manoeuvre framed;\n! above 1 = worse than a simulator standing still", fontsize=9)
+    ax.set_title(f"{title}: best per manoeuvre framed;\n{SCORE_FLAG} above 1 = worse than a simulator standing still",
+                 fontsize=9)  # fmt: skip
     return save_figure(fig, stem, formats)
 
 
@@ -352,19 +467,26 @@ def table4_figure(
 
     ``better_pct``: washout -> (R, len(metrics) * len(dofs)) array of 100 * (reference - washout) / reference, columns
     grouped by metric, then DOF; positive means better than the reference. NaN where undefined. Returns the paths.
+
+    The colours follow a symmetric logarithmic scale (linear within +-10 %, then one step per decade) up to the
+    largest magnitude in the table, so -1273 % is redder than -150 %, which is redder than -20 %; every cell prints
+    its value.
     """
-    from matplotlib.colors import Normalize
+    from matplotlib.colors import SymLogNorm
 
     others = list(better_pct)
     ncol = len(metrics) * len(dofs)
     fig = _new_figure(2.2 + 0.42 * ncol, 0.9 + len(others) * (0.85 + 0.3 * len(rows)))
     axes = np.atleast_1d(fig.subplots(len(others), 1, squeeze=False)[:, 0])
     cmap = _diverging_cmap()
-    norm = Normalize(vmin=-100.0, vmax=100.0)
+    values_of = {w: np.asarray(better_pct[w], dtype=np.float64).reshape(len(rows), ncol) for w in others}
+    finite = np.concatenate([np.abs(v[np.isfinite(v)]) for v in values_of.values()] + [np.zeros(1)])
+    vmax = max(100.0, float(finite.max()))
+    norm = SymLogNorm(linthresh=10.0, linscale=1.0, vmin=-vmax, vmax=vmax, base=10)
     image = None
     for ax, w in zip(axes, others, strict=True):
-        values = np.asarray(better_pct[w], dtype=np.float64).reshape(len(rows), ncol)
-        image = ax.imshow(np.ma.masked_invalid(np.clip(values, -100, 100)), cmap=cmap, norm=norm, aspect="auto")
+        values = values_of[w]
+        image = ax.imshow(np.ma.masked_invalid(values), cmap=cmap, norm=norm, aspect="auto")
         for r in range(len(rows)):
             for c in range(ncol):
                 v = values[r, c]
@@ -381,7 +503,10 @@ def table4_figure(
         ax.set_title(f"{w} better than {reference} (% of {reference}'s value)", fontsize=9)
     if image is not None:
         bar = fig.colorbar(image, ax=list(axes), shrink=0.6, pad=0.01)
-        bar.set_label("% better (green) / worse (red)", fontsize=7.5)
+        decades = [10.0**k for k in range(1, math.floor(math.log10(vmax)) + 1)]
+        ticks = [-d for d in reversed(decades)] + [0.0] + decades
+        bar.set_ticks(ticks, labels=[f"{t:+.0f}" if t else "0" for t in ticks])
+        bar.set_label("% better (green) / worse (red), log scale beyond +-10", fontsize=7.5)
         bar.ax.tick_params(labelsize=7)
     return save_figure(fig, stem, formats)
 

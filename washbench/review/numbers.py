@@ -10,6 +10,9 @@ import math
 
 SIG_DIGITS = 3
 
+SCORE_FLAG = "⚠"
+"""The mark of a ranking score above 1 (worse than a simulator standing still), in the report and its figures."""
+
 
 def sig(x: float, digits: int = SIG_DIGITS, signed: bool = False) -> str:
     """``x`` rounded to ``digits`` significant digits, written without an exponent (``signed``: always a sign)."""

@@ -31,8 +31,12 @@ def report_text(
         "",
         f"Washouts: {', '.join(f'{e.name} ({e.kind})' for e in washouts)}. Sample rate {settings.rate_hz:g} Hz.",
         "",
-        "Output: the simulator's motion at the pilot's head (specific force and angular velocity from the "
-        "platform kinematics), not the vestibular estimators. Gains are dimensionless; for `f_x_to_pitch` and "
+        "Output: the simulator's actual motion at the pilot's head, from the platform's own state (its "
+        "position, attitude and body rates, centred at each sample: `washbench/analysis/omct.py`, "
+        "`platform_head_motion`), not the head-rate estimate of `washbench cue` (the paper's Eq. 8 derivative "
+        "estimator for the small-angle washout) and not the vestibular models. That estimate is in `omct.csv` "
+        "(`estimator_gain`, `estimator_phase_deg`) and drawn as a separate dotted curve, for comparison only. "
+        "Gains are dimensionless; for `f_x_to_pitch` and "
         "`f_y_to_roll` the output is the attitude as the specific force it tilts into the pilot (g theta, "
         "-g phi), so a perfect static tilt coordination has gain 1.",
         "",

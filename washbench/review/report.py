@@ -24,17 +24,26 @@ from typing import Any
 import numpy as np
 
 from washbench.analysis.metrics import DOFS
-from washbench.analysis.ranking import METRICS, RankRow, compare, rank, reference_washout
-from washbench.errors import WashbenchError, located
+from washbench.analysis.ranking import (
+    DEFAULT_RULE,
+    METRICS,
+    RankRow,
+    RankRule,
+    compare,
+    rank,
+    reference_washout,
+    rule_from_record,
+    undecided,
+)
 from washbench.io.atomic import write_text_atomic
-from washbench.review.numbers import pct, sig
-from washbench.review.result_data import ResultData, is_result_folder, load_result
+from washbench.review.numbers import SCORE_FLAG, pct, sig
+from washbench.review.result_data import ResultData, load_result
 
 REPORT_FILE = "report.md"
 FIGURES_DIR = "figures"
 SUITE_FILE = "suite.json"
 
-FLAG = "⚠"
+FLAG = SCORE_FLAG
 SCORE_NOTE = (
     f"{FLAG} a score above 1: the washout's perceived error is larger than that of a simulator that stands still, "
     "i.e. it gives more false cues than it gives true ones on this manoeuvre."
@@ -45,7 +54,9 @@ _UNITS = {
     "max_error": ("m/s²", "deg/s"),
 }
 _METRIC_TITLES = {
-    "npc": "Normalized Pearson correlation (NPC: 1 is perfect, 1.5 uncorrelated, lower is better; - where flat)",
+    "npc": "Normalized Pearson correlation (NPC, lower is better: 1 perfect, 1.5 uncorrelated, above 1.5 "
+    "anti-correlated, i.e. the cue moves against the aircraft's: 2.5 at a correlation of -0.5, infinite at -1; "
+    "- where flat)",
     "integral_error": "Integral of |perceived error| (lower is better)",
     "max_error": "Maximum |perceived error| (lower is better)",
 }
@@ -88,6 +99,14 @@ def provenance_lines(prov: dict[str, Any] | None, created_utc: str | None) -> li
         ]  # fmt: skip
         rows.append(("washouts", ", ".join(runs)))
     file_row("platform", prov.get("platform"))
+    vest = prov.get("vestibular")
+    if isinstance(vest, dict) and vest.get("model"):
+        names = {"young-meiry": "Meiry-Young otolith, Young-Oman canals (the paper's)",
+                 "telban-cardullo": "Telban-Cardullo otolith and canals (NASA CR-2005-213747)"}  # fmt: skip
+        rows.append(("vestibular models", names.get(vest["model"], str(vest["model"]))))
+    ranking = prov.get("ranking")
+    if isinstance(ranking, dict) and ranking.get("by"):
+        rows.append(("ranking rule", f"`--rank-by {ranking['by']}`"))
     if "turbulence" in prov or (inp and "turbulence" in inp.get("provenance", {})):
         turb = prov.get("turbulence", inp.get("provenance", {}).get("turbulence") if inp else None)
         rows.append(("turbulence", f"{turb['severity']}, seed {turb['seed']}" if turb else "none"))
@@ -118,21 +137,65 @@ def _score_cell(score: float, best: bool) -> str:
     return f"{text} {FLAG}" if score > 1.0 else text
 
 
-def ranking_lines(data: ResultData, ranking: list[RankRow]) -> list[str]:
-    """Ranking table (rank, washout, score) and the DOF weights used."""
+def result_rule(data: ResultData) -> RankRule:
+    """The ranking rule a result was written with (its provenance's ``ranking``; the default before rules)."""
+    prov = data.provenance
+    return rule_from_record(prov.get("ranking") if isinstance(prov, dict) else None)
+
+
+def rank_cell(r: RankRow) -> str:
+    """A rank as shown: ``1`` or, when shared (a tie within the margin), ``1 (tie)``."""
+    return f"{r.rank} (tie)" if r.tied else str(r.rank)
+
+
+END_STOP_SHARE = 0.05
+"""Share of the manoeuvre at a stage position limit (an end stop) from which the report says, next to the score,
+that the score reflects the end stop: the stage then stops hard, and the steps it makes in the simulator pilot's
+specific force (up to the 1 g acceleration limit) are perceived errors the washout's filters did not make."""
+
+
+def end_stop_note(data: ResultData, washout: str) -> str:
+    """``end stop: stage at its position limit for 32.8 s (54 %)`` when that share reaches :data:`END_STOP_SHARE`,
+    else empty."""
+    flags = data.saturated.get(washout, {}).get("pos")
+    steps = int(np.count_nonzero(flags)) if flags is not None else 0
+    if not steps or steps < END_STOP_SHARE * data.n:
+        return ""
+    return (f"end stop: stage at its position limit for {sig(steps * data.dt_s)} s "
+            f"({pct(100.0 * steps / data.n, False)}), the score reflects its hard stops")  # fmt: skip
+
+
+def ranking_lines(data: ResultData, ranking: list[RankRow], rule: RankRule = DEFAULT_RULE) -> list[str]:
+    """Ranking table (rank, washout, the rule's value, and a note where end stops dominate), the rule with its tie
+    margin and the DOF weights used."""
     if not ranking:
         return []
-    lines = ["| rank | washout | score (-) |", "|---|---|---|"]
-    lines += [f"| {r.rank} | {r.washout} | {_score_cell(r.score, r.rank == 1)} |" for r in ranking]
+    unit = "false-cue time (DOF lengths)" if rule.by == "false-cue" else "score (-)"
+    flag = rule.by != "false-cue"
+    notes = {r.washout: end_stop_note(data, r.washout) for r in ranking}
+
+    def value(r: RankRow) -> str:
+        return _score_cell(r.score, r.rank == 1) if flag else sig(r.score)
+
+    if any(notes.values()):
+        lines = [f"| rank | washout | {unit} | note |", "|---|---|---|---|"]
+        lines += [f"| {rank_cell(r)} | {r.washout} | {value(r)} | {notes[r.washout]} |" for r in ranking]
+    else:
+        lines = [f"| rank | washout | {unit} |", "|---|---|---|"]
+        lines += [f"| {rank_cell(r)} | {r.washout} | {value(r)} |" for r in ranking]
     weights = ranking[0].weights
-    lines += [
-        "",
-        "Score: sum over DOFs of weight x integral error / the aircraft pilot's own perceived motion in that DOF (0 "
-        "perfect, 1 no better than standing still). Weights: "
-        + ", ".join(f"{d} {sig(weights[d], 2)}" for d in DOFS)
-        + ".",
-    ]
-    if any(r.score > 1.0 for r in ranking):
+    lines += ["", f"Ranked by {rule.label()}."]
+    if undecided(ranking):
+        lines += ["", "**The first place is a tie**: the best values differ by less than the tie margin."]
+    if rule.by != "false-cue":
+        lines += [
+            "",
+            "Score: sum over DOFs of weight x integral error / the aircraft pilot's own perceived motion in that DOF "
+            "(0 perfect, 1 no better than standing still). Weights: "
+            + ", ".join(f"{d} {sig(weights[d], 2)}" for d in DOFS)
+            + ".",
+        ]
+    if flag and any(r.score > 1.0 for r in ranking):
         lines += ["", SCORE_NOTE]
     return [*lines, ""]
 
@@ -185,6 +248,55 @@ def metric_tables(data: ResultData) -> list[str]:
     return lines
 
 
+def cue_lines(data: ResultData) -> list[str]:
+    """Time fractions of correct, scaled, false and missing cues per washout and DOF, and the false-cue events."""
+    from washbench.analysis.cues import SCALE_BAND, parse_events
+
+    rows = [m for m in data.metrics if not math.isnan(m.cue_false_frac)]
+    if not rows:
+        return ["_This result was written before the cue classification: `washbench cue` it again for it._", ""]
+    lines = [
+        "Percent of the manoeuvre's time (docs/fidelity.md): a cue is correct when both pilots feel the DOF (above "
+        f"the Zacharias threshold) in the same direction with a magnitude ratio within {SCALE_BAND[0]:g}-"
+        f"{SCALE_BAND[1]:g}, scaled outside that ratio, false when the simulator pilot feels motion the aircraft "
+        "pilot does not or in the opposite direction, missing when the aircraft pilot feels motion the simulator "
+        "pilot does not.",
+        "",
+        "| washout | DOF | correct (%) | scaled (%) | false (%) | missing (%) | false-cue events |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for m in rows:
+        events = parse_events(m.false_cue_events, m.dof)
+        longest = max(events, key=lambda e: e.end_s - e.start_s, default=None)
+        ev = f"{len(events)}" + (f" (longest {sig(longest.start_s)}-{sig(longest.end_s)} s, peak "
+                                 f"{sig(longest.peak)} {_unit('max_error', m.dof)})" if longest else "")  # fmt: skip
+        cells = (m.cue_correct_frac, m.cue_scaled_frac, m.cue_false_frac, m.cue_missing_frac)
+        lines.append(f"| {m.washout} | {m.dof} | " + " | ".join(sig(100.0 * c) for c in cells) + f" | {ev} |")
+    washouts = dict.fromkeys(r.washout for r in rows)
+    false_time = {w: sum(m.cue_false_frac for m in rows if m.washout == w) for w in washouts}
+    lines += ["", "False-cue time (sum over DOFs, manoeuvre lengths): "
+              + ", ".join(f"{w} {sig(v)}" for w, v in false_time.items()) + ".", ""]  # fmt: skip
+    return lines
+
+
+def sickness_lines(data: ResultData) -> list[str]:
+    """MSDV (ISO 2631-1 Wf) of the vertical motion at each pilot's head (the heave rows of metrics.csv)."""
+    heave = [m for m in data.metrics if m.dof == "heave" and not math.isnan(m.msdv_mps15)]
+    if not heave:
+        return ["_This result was written before the motion sickness dose: `washbench cue` it again for it._", ""]
+    lines = [
+        "Motion sickness dose value MSDV = sqrt(integral a_w^2 dt) of the vertical acceleration at the head, "
+        "weighted by ISO 2631-1 Wf (peak near 0.16 Hz), over the manoeuvre (docs/fidelity.md). Lower is better; "
+        "a simulator pilot above the aircraft pilot gets more vertical low-frequency motion than the flight had.",
+        "",
+        "| pilot | MSDV (m/s^1.5) |",
+        "|---|---|",
+        f"| aircraft | {sig(heave[0].msdv_aircraft_mps15)} |",
+    ]
+    lines += [f"| {m.washout} | {sig(m.msdv_mps15)} |" for m in heave]
+    return [*lines, ""]
+
+
 def saturation_lines(data: ResultData) -> list[str]:
     """Time at each limit per washout, in seconds and percent of the manoeuvre."""
     from washbench.review.figures import SATURATION_LABELS
@@ -217,26 +329,35 @@ def check_lines(data: ResultData) -> list[str]:
     return [*lines, ""]
 
 
-def perception_thresholds() -> tuple[tuple[float, ...], tuple[float, ...]]:
-    """Zacharias thresholds and the resting values they are taken around, per DOF (m/s^2, deg/s)."""
-    from washbench.perception.thresholds import STANDARD_GRAVITY_MPS2, ZACHARIAS
+def perception_thresholds(data: ResultData) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """Zacharias thresholds and the resting values they are taken around, per DOF (m/s^2, deg/s).
+
+    The resting value is what the aircraft pilot perceives at the first sample (trimmed flight, or standing on the
+    runway): a steady cue the pilot has been exposed to is not a change felt, so the band "not felt" lies around it
+    (for a level start about (0, 0, -g, 0, 0, 0); a descent or a climb starts with its own surge).
+    """
+    from washbench.perception.thresholds import ZACHARIAS
 
     th = ZACHARIAS
     thresholds = (th.f_x_mps2, th.f_y_mps2, th.f_z_mps2, th.omega_x_degps, th.omega_y_degps, th.omega_z_degps)
-    return thresholds, (0.0, 0.0, -STANDARD_GRAVITY_MPS2, 0.0, 0.0, 0.0)
+    rest = tuple(float(v) for v in data.perceived["aircraft"][0])
+    return thresholds, rest
 
 
 def time_above_threshold(data: ResultData) -> dict[str, float]:
-    """Per DOF, how long the aircraft pilot's perceived motion lies beyond the perception threshold [s]."""
-    thresholds, rest = perception_thresholds()
+    """Per DOF, how long the aircraft pilot's perceived motion lies beyond the perception threshold around its
+    resting value (:func:`perception_thresholds`) [s]."""
+    thresholds, rest = perception_thresholds(data)
     p = data.perceived["aircraft"]
     return {
         d: float(np.count_nonzero(np.abs(p[:, i] - rest[i]) > thresholds[i])) * data.dt_s for i, d in enumerate(DOFS)
     }
 
 
-def result_figures(data: ResultData, pdf: bool = False) -> dict[str, Path]:
+def result_figures(data: ResultData, pdf: bool = False, palette: str | None = None) -> dict[str, Path]:
     """Draw the result's figures into ``folder/figures/`` (PNG, and PDF with ``pdf``); figure name -> PNG path.
+
+    ``palette``: :data:`washbench.review.palette.PALETTES` (None: ``$WASHBENCH_PALETTE`` or the default).
 
     A PDF left from an earlier ``washbench report`` is removed when none is drawn (it would show other data).
     """
@@ -246,9 +367,9 @@ def result_figures(data: ResultData, pdf: bool = False) -> dict[str, Path]:
     fig_dir.mkdir(exist_ok=True)
     formats = ("png", "pdf") if pdf else ("png",)
     if not pdf:
-        for stem in ("perceived", "envelope"):
+        for stem in ("perceived", "envelope", "cues"):
             (fig_dir / f"{stem}.pdf").unlink(missing_ok=True)
-    thresholds, rest = perception_thresholds()
+    thresholds, rest = perception_thresholds(data)
     out = {}
     out["perceived"] = perceived_figure(
         fig_dir / "perceived",
@@ -259,10 +380,17 @@ def result_figures(data: ResultData, pdf: bool = False) -> dict[str, Path]:
         thresholds=thresholds,
         rest=rest,
         formats=formats,
+        palette=palette,
     )[0]
+    if data.washouts and all(w in data.perceived for w in data.washouts):
+        from washbench.review.cue_figures import cue_classes, cue_lane_figure
+
+        classes = cue_classes(data.perceived, data.washouts)
+        out["cues"] = cue_lane_figure(fig_dir / "cues", data.title, data.t_s, classes, formats=formats)[0]
     if data.usage:
         out["envelope"] = envelope_figure(
-            fig_dir / "envelope", data.title, data.t_s, data.usage, data.saturated, phases=data.phases, formats=formats
+            fig_dir / "envelope", data.title, data.t_s, data.usage, data.saturated, phases=data.phases, formats=formats,
+            palette=palette,
         )[0]
     return out
 
@@ -289,15 +417,21 @@ def result_sections(
     """
     h = "#" * level
     lines: list[str] = []
-    ranking = rank(data.metrics, data.motion) if data.metrics else []
-    lines += [f"{h} Ranking", "", *ranking_lines(data, ranking)]
+    rule = result_rule(data)
+    ranking = rank(data.metrics, data.motion, rule) if data.metrics else []
+    lines += [f"{h} Ranking", "", *ranking_lines(data, ranking, rule)]
     lines += [f"{h} Perceived motion", ""]
     lines += [
-        "Aircraft pilot (magenta, wide) against each washout's simulator pilot; dashed: perception thresholds "
-        "(Zacharias 1978) around the resting value, what lies between them is not felt; shaded: the phases.",
+        "Aircraft pilot (wide solid line) against each washout's simulator pilot (each its own colour and dash); "
+        "grey band: the perception thresholds (Zacharias 1978) around the pilot's resting value (what was perceived "
+        "at the start), what lies inside it is not felt; shaded: the phases.",
         "",
     ]
     lines += _image(figures["perceived"], start, "perceived motion") if "perceived" in figures else [NO_FIGURES, ""]
+    lines += [f"{h} Cues: correct, scaled, false, missing", "", *cue_lines(data)]
+    if "cues" in figures:
+        lines += _image(figures["cues"], start, "false and missing cues")
+    lines += [f"{h} Motion sickness dose", "", *sickness_lines(data)]
     lines += [f"{h} Metrics", "", *metric_tables(data)]
     lines += [f"{h} Platform", ""]
     if brief:
@@ -353,19 +487,3 @@ def write_result_report(
     path = data.folder / REPORT_FILE
     write_text_atomic(path, "\n".join(lines).rstrip() + "\n")
     return path
-
-
-def report_command(results_dir: Path) -> int:
-    """``washbench report DIR``: write report.md and the figures (PNG and PDF) again from a result or suite folder's
-    files."""
-    folder = Path(results_dir)
-    if not folder.is_dir():
-        raise WashbenchError(located(folder, "no such folder"))
-    if is_result_folder(folder) and not (folder / SUITE_FILE).exists():
-        path = write_result_report(folder, pdf=True)
-    else:
-        from washbench.review.suite_report import write_suite_report
-
-        path = write_suite_report(folder, regenerate_results=True)
-    print(f"report: {path}")
-    return 0

@@ -108,6 +108,7 @@ DOFS: tuple[tuple[str, str, int, str], ...] = (
     ("yaw", "omega", 2, "deg/s"),
 )
 """Degrees of freedom: (name, signal "f" or "omega", body axis index, unit shown in the recording)."""
+DOF_NAMES: tuple[str, ...] = tuple(d[0] for d in DOFS)
 
 ENVELOPE_QUANTITIES: tuple[tuple[str, str, str], ...] = (
     ("position", "pos_m", "m"),
@@ -544,6 +545,51 @@ def _send_lanes(rec: rr.RecordingStream, data: RecordingData) -> None:
         )
 
 
+def cue_lane_path(data: RecordingData, washout: str) -> str:
+    """State lane of the DOFs in which ``washout``'s simulator pilot feels a false cue (joined by "+")."""
+    return f"/lanes/cues_{_lane_name(data, washout)}"
+
+
+def _send_cues(rec: rr.RecordingStream, data: RecordingData) -> None:
+    """Per washout a lane "false: surge+roll" while false cues last (:mod:`washbench.analysis.cues`), and one
+    ``/events/false_cues`` line per false-cue event (start, end, DOF, peak)."""
+    from washbench.analysis.cues import FALSE, classify, dof_thresholds, false_events
+
+    t_s = np.asarray(data.t_s, dtype=np.float64)
+    dt = float(t_s[1] - t_s[0]) if t_s.size > 1 else 1.0
+    thresholds, rest = dof_thresholds()
+
+    def dof_cols(m: MotionSeries) -> np.ndarray:
+        return np.column_stack([m.perceived_f_mps2, np.rad2deg(m.perceived_omega_radps)])
+
+    ac = dof_cols(data.aircraft)
+    lines: list[tuple[float, str]] = []
+    for w, series in data.washouts.items():
+        sim = dof_cols(series)
+        code = np.zeros(t_s.size, dtype=np.int64)
+        for j, dof in enumerate(DOF_NAMES):
+            cls = classify(ac[:, j], sim[:, j], thresholds[j], rest[j])
+            code |= (cls == FALSE).astype(np.int64) << j
+            for e in false_events(cls, sim[:, j] - rest[j], dt, dof, float(t_s[0])):
+                unit = "m/s^2" if j < 3 else "deg/s"
+                lines.append((e.start_s, f"{e.start_s:.2f} s  {w}: false {dof} cue until {e.end_s:.2f} s, "
+                                         f"peak {e.peak:.3g} {unit}"))  # fmt: skip
+        change = np.flatnonzero(np.diff(code, prepend=0))
+        if change.size == 0:
+            change = np.array([0])
+        states = [("false: " + "+".join(d for j, d in enumerate(DOF_NAMES) if code[i] >> j & 1)) if code[i] else ""
+                  for i in change]  # fmt: skip
+        _send_states(rec, cue_lane_path(data, w), t_s, states, change)
+    if lines:
+        lines.sort(key=lambda item: item[0])
+        rec.send_columns(
+            "/events/false_cues",
+            indexes=[_time_column(np.array([t for t, _ in lines]))],
+            columns=rr.TextLog.columns(text=[s for _, s in lines], level=["WARN"] * len(lines)),
+            strict=True,
+        )
+
+
 def _send_text(rec: rr.RecordingStream, data: RecordingData) -> None:
     rec.log(
         "/metrics", rr.TextDocument(data.metrics_markdown, media_type=rr.MediaType.MARKDOWN), static=True, strict=True
@@ -635,6 +681,7 @@ def write_recording(path: Path, data: RecordingData, properties: Mapping[str, st
             _send_motion(rec, data, perceived, raw, layout)
             _send_platforms(rec, data, _usage(data))
             _send_lanes(rec, data)
+            _send_cues(rec, data)
             scene3d.send_scene(
                 rec,
                 _time_column,

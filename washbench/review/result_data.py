@@ -121,15 +121,20 @@ def _limits_from(prov: dict[str, Any] | None) -> Any:
 def envelope_usage(table: dict[str, np.ndarray], washouts: list[str], limits: Any) -> dict[str, dict[str, np.ndarray]]:
     """Envelope usage per panel and washout: max over axes |value| / limit (stage), |omega| / rate limit (sphere).
 
-    The wheel limit is the fastest any wheel turns with the sphere at its rate limit (as in the recording).
+    The sphere's angular acceleration is |omega_k - omega_(k-1)| / dt (the body-rate change per step the platform
+    limits, :func:`washbench.platform.kinematics.track_rotation`) over its limit, 0 at the first sample. The wheel
+    limit is the fastest any wheel turns with the sphere at its rate limit (as in the recording).
     """
     from washbench.platform.limits import wheel_jacobian
 
     t = limits.translation
     rate_limit_degps = limits.rotation.rate_limit_degps
+    acc_limit_degps2 = limits.rotation.acceleration_limit_degps2
+    time = np.asarray(table[TIME_COLUMN], dtype=np.float64) if TIME_COLUMN in table else None
     wheel_max = float(np.max(np.linalg.norm(wheel_jacobian(limits), axis=1)) * math.radians(rate_limit_degps))
     out: dict[str, dict[str, np.ndarray]] = {
-        "position": {}, "velocity": {}, "acceleration": {}, "sphere rate": {}, "wheel speed": {}
+        "position": {}, "velocity": {}, "acceleration": {}, "sphere rate": {}, "sphere ang. acc.": {},
+        "wheel speed": {},
     }  # fmt: skip
     for w in washouts:
         stage = (
@@ -143,7 +148,12 @@ def envelope_usage(table: dict[str, np.ndarray], washouts: list[str], limits: An
                 out[label][w] = np.max(np.column_stack(ratios), axis=1)
         cols = omega_platform_columns(w)
         if all(c in table for c in cols):
-            out["sphere rate"][w] = np.linalg.norm(np.column_stack([table[c] for c in cols]), axis=1) / rate_limit_degps
+            omega = np.column_stack([table[c] for c in cols])
+            out["sphere rate"][w] = np.linalg.norm(omega, axis=1) / rate_limit_degps
+            if time is not None and time.shape[0] > 1:
+                alpha = np.zeros(time.shape[0])
+                alpha[1:] = np.linalg.norm(np.diff(omega, axis=0), axis=1) / np.diff(time)
+                out["sphere ang. acc."][w] = alpha / acc_limit_degps2
         cols = wheel_columns(w)
         if all(c in table for c in cols):
             out["wheel speed"][w] = np.max(np.abs(np.column_stack([table[c] for c in cols])), axis=1) / wheel_max

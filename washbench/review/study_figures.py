@@ -30,6 +30,33 @@ def _save(fig, path: Path) -> None:
         fig.savefig(tmp, format="png", dpi=110)
 
 
+UNIT_SUFFIXES: tuple[tuple[str, str], ...] = (
+    ("_radps", "rad/s"),
+    ("_degps2", "deg/s²"),
+    ("_degps", "deg/s"),
+    ("_deg", "deg"),
+    ("_mps2", "m/s²"),
+    ("_mps", "m/s"),
+    ("_per_s", "1/s"),
+    ("_m", "m"),
+    ("_s", "s"),
+)
+"""Unit suffixes of parameter names (SI inside, the unit in the name: ``lowpass_wn_radps``) and how they read."""
+
+
+def key_label(key: str) -> str:
+    """A swept key with its unit, from the unit in its dotted name: ``tilt.lowpass_wn_radps.x`` ->
+    ``tilt.lowpass_wn_radps.x (rad/s)``; a scale factor is ``(-)``; a key whose name carries no unit stays as it is."""
+    parts = key.split(".")
+    for part in reversed(parts):
+        for suffix, unit in UNIT_SUFFIXES:
+            if part.endswith(suffix):
+                return f"{key} ({unit})"
+    if parts[0] == "scale":
+        return f"{key} (-)"
+    return key
+
+
 def sweep_figure(path: Path, keys: Sequence[str], rows: Sequence[SweepRow]) -> None:
     """Mean score over the manoeuvres against each swept key, one line per washout.
 
@@ -63,7 +90,7 @@ def sweep_figure(path: Path, keys: Sequence[str], rows: Sequence[SweepRow]) -> N
             ax.set_xticks(xs, values)
             ax.minorticks_off()
         ax.axhline(1.0, color="0.6", lw=0.8, ls="--")
-        ax.set_xlabel(key)
+        ax.set_xlabel(key_label(key))
         ax.set_ylabel("mean score (lower is better)" + (", best over other keys" if len(keys) > 1 else ""))
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
@@ -75,13 +102,17 @@ def sweep_figure(path: Path, keys: Sequence[str], rows: Sequence[SweepRow]) -> N
 
 
 def convergence_figure(path: Path, objective: np.ndarray, baseline: float, label: str) -> None:
-    """Every evaluation's objective (dots) and the best so far (line) against the evaluation index."""
+    """Every evaluation's objective (dots) and the best so far (a step at each improvement) against the evaluation
+    number (integer ticks)."""
+    from matplotlib.ticker import MaxNLocator
+
     plt = _pyplot()
     obj = np.asarray(objective, dtype=float)
     fig, ax = plt.subplots(figsize=(6.4, 3.8))
-    idx = np.arange(len(obj))
+    idx = np.arange(1, len(obj) + 1)  # evaluations counted from 1
     ax.plot(idx, obj, ".", ms=3, color="0.6", label="each evaluation")
-    ax.plot(idx, np.minimum.accumulate(obj), color="C0", lw=1.8, label="best so far")
+    ax.step(idx, np.fmin.accumulate(obj), where="post", color="C0", lw=1.8, label="best so far")
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.axhline(baseline, color="C3", ls="--", lw=1.0, label=label)
     finite = obj[np.isfinite(obj)]
     if finite.size:

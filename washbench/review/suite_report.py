@@ -10,13 +10,23 @@ from __future__ import annotations
 import json
 import math
 import shutil
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from washbench.analysis.metrics import DOFS
-from washbench.analysis.ranking import METRICS, compare, rank, reference_washout, wins
+from washbench.analysis.ranking import (
+    METRICS,
+    RankRow,
+    compare,
+    rank,
+    reference_washout,
+    rule_from_record,
+    undecided,
+    wins,
+)
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
 from washbench.review.numbers import sig
@@ -100,7 +110,9 @@ def write_suite_report(suite_dir: Path, *, regenerate_results: bool = False, fig
     loaded = [d for _, d in results if d is not None]
     washouts = list(dict.fromkeys(w for d in loaded for w in d.washouts))
     reference = reference_washout(washouts)
-    rankings = {id(d): rank(d.metrics, d.motion) for d in loaded}
+    prov = doc.get("provenance")
+    rule = rule_from_record(prov.get("ranking") if isinstance(prov, dict) else None)
+    rankings = {id(d): rank(d.metrics, d.motion, rule) for d in loaded}
 
     fig_dir = suite_dir / FIGURES_DIR
     if figures:
@@ -112,7 +124,7 @@ def write_suite_report(suite_dir: Path, *, regenerate_results: bool = False, fig
         for stem in ("scores", "table4"):
             (fig_dir / f"{stem}.pdf").unlink(missing_ok=True)
     drawn: dict[str, Path] = {}
-    labels = [d.title + (" (FAILED)" if d.ok is False else "") for d in loaded]
+    labels = [d.title + (" (FAILED)" if d.ok is False else "") + _tie_label(rankings[id(d)]) for d in loaded]
     if loaded and figures:
         scores = np.full((len(loaded), len(washouts)), math.nan)
         for r, d in enumerate(loaded):
@@ -161,12 +173,13 @@ def write_suite_report(suite_dir: Path, *, regenerate_results: bool = False, fig
             continue
         ranking = rankings[id(d)]
         by_name = {r.washout: r.score for r in ranking}
-        best = ranking[0].washout if ranking else ""
+        best = " = ".join(r.washout for r in ranking if r.rank == 1) + (" (tie)" if undecided(ranking) else "")
+        firsts = {r.washout for r in ranking if r.rank == 1}
         cells = []
         for w in washouts:
             s = by_name.get(w, math.nan)
             any_above |= s > 1.0
-            text = f"**{sig(s)}**" if w == best else sig(s)
+            text = f"**{sig(s)}**" if w in firsts else sig(s)
             cells.append(f"{text} {FLAG}" if s > 1.0 else text)
         checks = f"{sum(bool(c.get('passed')) for c in d.checks)}/{len(d.checks)}" if d.checks else "-"
         rel = _rel(d.folder, suite_dir)
@@ -177,7 +190,14 @@ def write_suite_report(suite_dir: Path, *, regenerate_results: bool = False, fig
     lines.append("")
     if rankings:
         count = wins(rankings.values())
-        lines += ["Manoeuvres won: " + ", ".join(f"{w} {n}" for w, n in count.items()) + ".", ""]
+        lines += ["Manoeuvres won (a shared first place counts for each): "
+                  + ", ".join(f"{w} {n}" for w, n in count.items()) + ".", ""]  # fmt: skip
+        n_tied = sum(1 for r in rankings.values() if undecided(r))
+        n_any = sum(1 for r in rankings.values() if any(x.tied for x in r))
+        lines += [f"Ranked by {rule.label()}. **{n_tied} of {len(rankings)} rankings are decided by less than that "
+                  f"margin** (first place shared); {n_any} have a tie at some rank. Shared ranks are marked "
+                  "\"(tie)\" in the reports, `tied` in `ranking.csv` and \"tie:\" in the score figure's row "
+                  "labels.", ""]  # fmt: skip
     if any_above:
         lines += [SCORE_NOTE, ""]
     if "scores" in drawn:
@@ -206,8 +226,13 @@ def _existing_figures(d: ResultData) -> dict[str, Path]:
     """The result's figures as its report links them (drawn again when missing)."""
     from washbench.review.report import result_figures
 
-    found = {name: d.folder / FIGURES_DIR / f"{name}.png" for name in ("perceived", "envelope")}
+    found = {name: d.folder / FIGURES_DIR / f"{name}.png" for name in ("perceived", "envelope", "cues")}
     found = {k: p for k, p in found.items() if p.is_file()}
     if "perceived" not in found:
         return result_figures(load_result(d.folder))  # with every series (the suite's tables read only a few)
     return found
+
+
+def _tie_label(ranking: Sequence[RankRow]) -> str:
+    """Row-label suffix of the score figure naming a shared first place (a second line ``tie: a = b``), else empty."""
+    return "\ntie: " + " = ".join(r.washout for r in ranking if r.rank == 1) if undecided(ranking) else ""

@@ -20,6 +20,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from washbench.numerics.jitcache import announce_compile
+
 __all__ = ["keep_changes", "keep_samples"]
 
 
@@ -29,7 +31,7 @@ def _float_array(a: np.ndarray) -> np.ndarray:
     return out if out.flags.writeable else out.copy()
 
 
-@njit("b1[:](f8[:], f8[:, :], f8[:], f8)", cache=True)
+@njit(cache=True)  # compiled on first use (announced), for the float64 arrays the wrapper passes
 def _keep(t: np.ndarray, values: np.ndarray, tolerance: np.ndarray, max_gap: float) -> np.ndarray:  # pragma: no cover
     n, k = values.shape
     keep = np.zeros(n, dtype=np.bool_)
@@ -93,10 +95,11 @@ def keep_samples(t: np.ndarray, values: np.ndarray, tolerance: np.ndarray | floa
     tol = np.array(np.broadcast_to(np.asarray(tolerance, dtype=np.float64), (v.shape[1],)))
     if not np.all(tol >= 0) or not max_gap > 0 or x.shape != (v.shape[0],):
         raise ValueError(f"tolerance must be >= 0, max_gap > 0 and t (N,), got {tol.tolist()}, {max_gap}, {x.shape}")
+    announce_compile(_keep)
     return np.flatnonzero(_keep(x, v, tol, float(max_gap)))
 
 
-@njit("b1[:](f8[:, :], f8[:], i8)", cache=True)
+@njit(cache=True)  # compiled on first use (announced)
 def _changes(values: np.ndarray, tolerance: np.ndarray, max_gap: int) -> np.ndarray:  # pragma: no cover - compiled
     n, k = values.shape
     keep = np.zeros(n, dtype=np.bool_)
@@ -127,4 +130,5 @@ def keep_changes(values: np.ndarray, tolerance: np.ndarray | float, max_gap: int
     tol = np.array(np.broadcast_to(np.asarray(tolerance, dtype=np.float64), (v.shape[1],)))
     if not np.all(tol >= 0) or max_gap < 1:
         raise ValueError(f"tolerance must be >= 0 and max_gap >= 1, got {tol.tolist()}, {max_gap}")
+    announce_compile(_changes)
     return np.flatnonzero(_changes(v, tol, int(max_gap)))

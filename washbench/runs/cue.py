@@ -56,7 +56,7 @@ from washbench.io.results import (
     write_metrics_csv,
     write_traces,
 )
-from washbench.perception.vestibular import Perceived, VestibularModel, VestibularParams
+from washbench.perception.vestibular import Perceived, VestibularModel, VestibularParams, model_params
 
 TRACES_FILE = "traces.parquet"
 METRICS_FILE = "metrics.csv"
@@ -198,19 +198,35 @@ def analyse(
                 raise ValueError(f"washout {name!r}: saturated[{kind!r}] has shape {np.shape(flags)}, expected ({n},)")
         perceived[name] = model.perceive(arr["head_f_mps2"], arr["head_omega_radps"], filter_start)
         checked[name] = arr
-    rows = _metric_rows(perceived, motion.dt_s)
+    vertical = {AIRCRAFT: motion.f_mps2[:, 2], **{w: a["head_f_mps2"][:, 2] for w, a in checked.items()}}
+    rows = _metric_rows(perceived, motion.dt_s, vertical)
     result = CueResult(motion=motion, traces=dict(traces), perceived=perceived, metrics=rows, arrays=checked)
     result.columns(0, 0)  # an input column that clashes with a result column fails now, before anything is written
     return result
 
 
-def _metric_rows(perceived: Mapping[str, Perceived], dt_s: float) -> list[MetricRow]:
-    """Six metric rows per washout: each simulator pilot's perceived motion against the aircraft pilot's."""
+def _metric_rows(
+    perceived: Mapping[str, Perceived], dt_s: float, vertical: Mapping[str, np.ndarray]
+) -> list[MetricRow]:
+    """Six metric rows per washout: each simulator pilot's perceived motion against the aircraft pilot's, the cue
+    classification, and on the heave row the MSDV of each pilot's head (``vertical``: pilot -> body-z specific
+    force (N,), m/s^2)."""
+    import dataclasses
+
+    from washbench.analysis.cues import classified_rows
+    from washbench.perception.sickness import head_msdv
+
     ac = perceived[AIRCRAFT]
+    msdv_ac = head_msdv(vertical[AIRCRAFT], dt_s)
     rows: list[MetricRow] = []
     for name, p in perceived.items():
         if name != AIRCRAFT:
-            rows += dof_metrics(name, ac.f_mps2, ac.omega_radps, p.f_mps2, p.omega_radps, dt_s)
+            base = dof_metrics(name, ac.f_mps2, ac.omega_radps, p.f_mps2, p.omega_radps, dt_s)
+            msdv = head_msdv(vertical[name], dt_s)
+            rows += [
+                dataclasses.replace(r, msdv_mps15=msdv, msdv_aircraft_mps15=msdv_ac) if r.dof == "heave" else r
+                for r in classified_rows(base, ac.f_mps2, ac.omega_radps, p.f_mps2, p.omega_radps, dt_s)
+            ]
     return rows
 
 
@@ -323,6 +339,7 @@ def stream_cue(
     figures: bool = True,
     chunk_rows: int = CHUNK_ROWS,
     progress: Progress | None = None,
+    vestibular: VestibularParams | None = None,
 ) -> CueResult:
     """:func:`cue_motion` and the traces.parquet of :func:`write_results` in one pass, ``chunk_rows`` samples at a
     time (washouts, vestibular models, one Parquet row group per chunk): the same columns and metrics, bit for bit.
@@ -345,9 +362,10 @@ def stream_cue(
         raise WashbenchError("nothing to cue: the input has no rows")
     bank = CueingBank(washouts, None, limits, motion.dt_s, filter_start)
     names = bank.washouts
-    model = VestibularModel(motion.dt_s)
+    model = VestibularModel(motion.dt_s, vestibular)
     streams = {p: PerceptionStream(model, filter_start) for p in (AIRCRAFT, *names)}
     felt = {p: Perceived(np.empty((n, 3)), np.empty((n, 3))) for p in streams}
+    vertical = {p: np.empty(n) for p in streams}  # body-z specific force at each pilot's head (MSDV)
     keep = (_REVIEW_FIELDS if figures or recording else ()) + (_RECORDING_FIELDS if recording else ())
     kept = {w: {f: np.empty((n, _TRACE_FIELDS[f])) for f in keep} for w in names}
     flags: dict[str, dict[str, np.ndarray]] = {w: {} for w in names}
@@ -367,6 +385,7 @@ def stream_cue(
                 fields[w] = {f: getattr(tr, f) for f in _TRACE_FIELDS} if finite else _checked_trace(w, tr, b - a, a)
                 saturated[w] = tr.saturated
                 perceived[w] = streams[w].perceive(fields[w]["head_f_mps2"], fields[w]["head_omega_radps"])
+                vertical[w][rows] = fields[w]["head_f_mps2"][:, 2]
                 for f in keep:
                     kept[w][f][rows] = fields[w][f]
                 for k, v in tr.saturated.items():
@@ -379,7 +398,8 @@ def stream_cue(
                 progress.update(b)
 
     write_trace_chunks(traces_path, tables(), metadata)
-    metrics = _metric_rows(felt, motion.dt_s)
+    vertical[AIRCRAFT][:] = motion.f_mps2[:, 2]
+    metrics = _metric_rows(felt, motion.dt_s, vertical)
     counts = bank.saturation_counts()
     traces = {w: SimpleNamespace(**kept[w], saturated=flags[w], saturation_counts=counts[w]) for w in names}
     return CueResult(motion=motion, traces=traces, perceived=felt, metrics=metrics)
@@ -424,6 +444,8 @@ class CueOptions:
     strict: bool = False
     recording: bool = True
     figures: bool = True
+    rank_by: str | None = None  # the ranking rule (--rank-by; None: the parameter file's)
+    vestibular: str | None = None  # the vestibular model (--vestibular; None: young-meiry)
 
 
 @dataclass(frozen=True, eq=False)
@@ -547,6 +569,7 @@ def write_outputs(
                 result = stream_cue(
                     seg.motion, washouts, limits, tmp[TRACES_FILE], meta,
                     filter_start=opts.filter_start, recording=opts.recording, figures=opts.figures, progress=shown,
+                    vestibular=model_params(opts.vestibular),
                 )  # fmt: skip
                 offset += seg.motion.n
                 summary = segment_summary(input_path, seg, result, folder)
@@ -617,7 +640,8 @@ def run_cue(
         from washbench.io.provenance import file_record, read_parquet_provenance
         from washbench.runs.pipeline import run_provenance
 
-        prov = run_provenance(params_path, platform_path, specs, limits)
+        prov = run_provenance(params_path, platform_path, specs, limits, rank_by=opts.rank_by,
+                              vestibular=opts.vestibular)  # fmt: skip
         prov["input"] = file_record(input_path)
         is_parquet = input_path.suffix.lower() in (".parquet", ".pq")
         input_prov = read_parquet_provenance(input_path) if is_parquet else None

@@ -41,6 +41,7 @@ CSV_COLUMNS: tuple[str, ...] = (
     "washout", "test", "input", "output", "frequency_radps", "amplitude", "amplitude_unit", "gain", "phase_deg",
     "linear", "distortion", "saturated", "gain_inside", "phase_inside",
     "perceived_gain", "perceived_phase_deg", "aircraft_perceived_gain", "aircraft_perceived_phase_deg",
+    "estimator_gain", "estimator_phase_deg",
 )  # fmt: skip
 
 
@@ -48,6 +49,10 @@ CSV_COLUMNS: tuple[str, ...] = (
 class OmctPoint:
     """One test of one washout at one frequency. Phases in degrees, continuous along frequency.
 
+    ``gain``/``phase_deg``: the platform's own motion at the pilot's head
+    (:func:`washbench.analysis.omct.platform_head_motion`). ``estimator_*``: the same test on the head motion
+    ``washbench cue`` estimates (the paper's Eq. 8 derivative estimator for the small-angle washout, the quaternion
+    difference of Eqs. 18-19 for the others), shown for comparison only, never the test's result.
     ``saturated``: limit kinds that bound during the run; ``gain_inside``/``phase_inside``: None where no
     boundary covers the point; ``*_phase_deg``: NaN where the gain is 0 (the aircraft pilot of a tilt test).
     """
@@ -70,6 +75,8 @@ class OmctPoint:
     perceived_phase_deg: float
     aircraft_perceived_gain: float
     aircraft_perceived_phase_deg: float
+    estimator_gain: float = math.nan
+    estimator_phase_deg: float = math.nan
 
 
 @dataclass(frozen=True)
@@ -134,7 +141,7 @@ def measure(
     dt = 1.0 / rate_hz
     sigma = slowest_decay(entries)
     model = VestibularModel(dt, vestibular)
-    raw: dict[tuple[str, str], list[tuple[float, float, str, complex, float, tuple[str, ...], complex]]] = {}
+    raw: dict[tuple[str, str], list[tuple[float, float, str, complex, float, tuple[str, ...], complex, complex]]] = {}
     for test in tests:
         for w in frequencies_radps:
             tm = omct.timing(w, sigma)
@@ -145,10 +152,12 @@ def measure(
             traces = cue_trace(sig.f_mps2, sig.omega_radps, dt, entries, None, limits)
             for m in entries:
                 tr = traces[m.name]
-                r = omct.response(test, ref, tr.head_f_mps2, tr.head_omega_radps, dt, w, tm.periods, _g(m))
+                head = omct.platform_head_motion(tr.pos_m, tr.q, tr.omega_radps, m.params.head.offset_m, dt, _g(m))
+                r = omct.platform_response(test, ref, head, dt, w, tm.periods, _g(m))
+                est = omct.response(test, ref, tr.head_f_mps2, tr.head_omega_radps, dt, w, tm.periods, _g(m))
                 sat = omct.saturated_kinds(tr.saturation_counts)
                 raw.setdefault((m.name, test.name), []).append(
-                    (w, spec.amplitude, amplitude_unit(test.input_axis), r.h, r.distortion, sat, aircraft.h)
+                    (w, spec.amplitude, amplitude_unit(test.input_axis), r.h, r.distortion, sat, aircraft.h, est.h)
                 )
     points: list[OmctPoint] = []
     for e in entries:
@@ -164,7 +173,7 @@ def _g(entry: Washout) -> float:
 def _points(
     washout: str,
     test: omct.OmctTest,
-    rows: list[tuple[float, float, str, complex, float, tuple[str, ...], complex]],
+    rows: list[tuple[float, float, str, complex, float, tuple[str, ...], complex, complex]],
     model: VestibularModel,
     dt: float,
     bounds: omct.Bounds | None,
@@ -176,8 +185,9 @@ def _points(
     phase = omct.unwrap_phase_deg([_phase(r[3]) for r in rows])
     p_phase = omct.unwrap_phase_deg([_phase(vi * r[3]) for vi, r in zip(v, rows, strict=True)])
     a_phase = omct.unwrap_phase_deg([_phase(vi * r[6]) for vi, r in zip(v, rows, strict=True)])
+    e_phase = omct.unwrap_phase_deg([_phase(r[7]) for r in rows])
     out = []
-    for i, (w, amp, unit, h, dist, sat, h_ac) in enumerate(rows):
+    for i, (w, amp, unit, h, dist, sat, h_ac, h_est) in enumerate(rows):
         gain_in, phase_in = omct.check_bounds(bounds, w, abs(h), phase[i])
         out.append(
             OmctPoint(
@@ -199,6 +209,8 @@ def _points(
                 perceived_phase_deg=p_phase[i],
                 aircraft_perceived_gain=abs(v[i] * h_ac),
                 aircraft_perceived_phase_deg=a_phase[i],
+                estimator_gain=abs(h_est),
+                estimator_phase_deg=e_phase[i],
             )
         )
     return out
@@ -224,6 +236,7 @@ def csv_text(points: Sequence[OmctPoint]) -> str:
                 csv_number(p.distortion), ";".join(p.saturated), _flag(p.gain_inside), _flag(p.phase_inside),
                 csv_number(p.perceived_gain), csv_number(p.perceived_phase_deg),
                 csv_number(p.aircraft_perceived_gain), csv_number(p.aircraft_perceived_phase_deg),
+                csv_number(p.estimator_gain), csv_number(p.estimator_phase_deg),
             ]
         )  # fmt: skip
     return buf.getvalue()

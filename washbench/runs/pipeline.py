@@ -134,6 +134,8 @@ def run_manoeuvre(
     filter_start: str = "steady",
     aircraft_dirs: Sequence[Path] = (),
     outputs: Outputs = DEFAULT_OUTPUTS,
+    rank_by: str | None = None,
+    vestibular: str | None = None,
 ) -> RunSummary:
     """Fly one manoeuvre with the washouts in lockstep and write its results folder.
 
@@ -160,7 +162,8 @@ def run_manoeuvre(
     turbulence = manoeuvre.environment.turbulence
     ac_files = manoeuvre.aircraft_files
     flight_prov = build_provenance(manoeuvre_path=manoeuvre_path, turbulence=turbulence, aircraft_files=ac_files)
-    prov = run_provenance(params_path, platform_path, specs, limits, manoeuvre_path, turbulence, ac_files)
+    prov = run_provenance(params_path, platform_path, specs, limits, manoeuvre_path, turbulence, ac_files, rank_by,
+                          vestibular)  # fmt: skip
     final = run_dir(Path(out_root), manoeuvre.aircraft, manoeuvre.name)
     marker = _marker(manoeuvre.aircraft, manoeuvre.name)
     check_replaceable(final, RUN_MARKER, marker)  # before flying: a folder in the way fails now, not after
@@ -217,11 +220,16 @@ def run_provenance(
     manoeuvre_path: Path | None = None,
     turbulence: Any = None,
     aircraft_files: Any = None,
+    rank_by: str | None = None,
+    vestibular: str | None = None,
 ) -> dict[str, Any]:
-    """The provenance of a run (:mod:`washbench.io.provenance`): the files actually used, the washouts, versions."""
+    """The provenance of a run (:mod:`washbench.io.provenance`): the files actually used, the washouts, versions,
+    the ranking rule (:func:`washbench.runs.rank_rule.load_rank_rule`)."""
     from washbench.cueing import load_washout_params
     from washbench.cueing.params import DEFAULT_PARAMS_PATH
+    from washbench.perception.vestibular import model_record
     from washbench.platform.limits import DEFAULT_LIMITS_PATH
+    from washbench.runs.rank_rule import load_rank_rule
 
     return build_provenance(
         manoeuvre_path=manoeuvre_path,
@@ -232,6 +240,8 @@ def run_provenance(
         washouts=specs,
         platform_path=platform_path or DEFAULT_LIMITS_PATH,
         platform=limits,
+        ranking=load_rank_rule(params_path, rank_by).record(),
+        vestibular=model_record(vestibular),
     )
 
 
@@ -321,7 +331,8 @@ def write_cued_folder(
     """Everything after the flight, into ``folder`` (which already holds ``flight.parquet``): perception and
     metrics on the flight read back (as ``washbench cue`` reads it), traces.parquet, metrics.csv, recording.rrd,
     run.json, ranking.csv, report.md and figures/. Returns ``summary`` completed with the steps, metrics and
-    saturations. ``provenance`` (no date) goes into traces.parquet's metadata; ``extra`` into run.json."""
+    saturations. ``provenance`` (no date) goes into traces.parquet's metadata; ``extra`` into run.json. The
+    vestibular model is the one the provenance records (``vestibular``; the default without)."""
     from washbench.cueing import WashoutTrace
     from washbench.io.results import read_motion
     from washbench.runs.cue import analyse, write_results
@@ -331,7 +342,10 @@ def write_cued_folder(
     block = stacked_rows(rows)  # (washouts, N, fields); the lockstep's blocks are freed
     traces = {w: WashoutTrace.from_rows(block[i]) for i, w in enumerate(washouts)}  # contiguous columns
     del block
-    result = analyse(motion, traces, filter_start=filter_start)
+    from washbench.perception.vestibular import model_params
+
+    vest = (provenance or {}).get("vestibular") or {}
+    result = analyse(motion, traces, model_params(vest.get("model")), filter_start=filter_start)
     write_results(folder, result, provenance)
     if outputs.recording:
         title = f"{summary.aircraft} / {summary.manoeuvre}"
@@ -364,6 +378,8 @@ def run_script(
     washouts: Sequence[str] | None = None,
     variants: Sequence[str] = (),
     outputs: Outputs = DEFAULT_OUTPUTS,
+    rank_by: str | None = None,
+    vestibular: str | None = None,
 ) -> list[RunSummary]:
     """Fly a JSBSim script (:mod:`washbench.flight.scripts`) with the washouts in lockstep, one result per run.
 
@@ -380,7 +396,8 @@ def run_script(
     check_max_time(max_time_s)
     specs = select_washouts(washouts, variants, params_path)
     limits = load_platform_limits(platform_path)
-    prov = run_provenance(params_path, platform_path, specs, limits, script_path)
+    prov = run_provenance(params_path, platform_path, specs, limits, script_path, rank_by=rank_by,
+                          vestibular=vestibular)  # fmt: skip
     created = utc_now()
     final = run_dir(Path(out_root), info.aircraft, info.name)
     marker = {"aircraft": info.aircraft}  # one run.json, or one per run of a script that resets
@@ -533,6 +550,8 @@ def run_command(
     variants: Sequence[str] = (),
     aircraft_dirs: Sequence[Path] = (),
     outputs: Outputs = DEFAULT_OUTPUTS,
+    rank_by: str | None = None,
+    vestibular: str | None = None,
 ) -> int:
     """CLI entry of ``washbench run`` (a YAML manoeuvre or a JSBSim script): 0 if every run was ok, else 1.
 
@@ -559,6 +578,8 @@ def run_command(
                 washouts=washouts,
                 variants=variants,
                 outputs=outputs,
+                rank_by=rank_by,
+                vestibular=vestibular,
             )
         else:
             if max_time_s is not None:
@@ -577,6 +598,8 @@ def run_command(
                     washouts=washouts,
                     variants=variants,
                     outputs=outputs,
+                    rank_by=rank_by,
+                    vestibular=vestibular,
                 )
             ]
     wall = time.perf_counter() - start

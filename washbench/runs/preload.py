@@ -13,7 +13,17 @@ import jsbsim  # noqa: F401
 import pyarrow.parquet  # noqa: F401
 
 import washbench.perception.vestibular  # noqa: F401
+from washbench.analysis.metric_sums import signal_metrics
 from washbench.cueing.bank import _warm_up, warm_up_block
+from washbench.cueing.kernel import bank_block, bank_step
+from washbench.numerics.jitcache import announce_compile
+from washbench.perception.sections import sections_apply, sections_apply_from, sections_run
+from washbench.review.thinning import _changes, _keep
+
+# One line for the whole suite when a kernel its workers run is not compiled yet (after an install or upgrade):
+# the workers fork from here and inherit that it was said.
+announce_compile(bank_block, bank_step, sections_apply, sections_apply_from, sections_run, signal_metrics, _keep,
+                 _changes)  # fmt: skip
 
 # Only the serial steps are run here: a parallel (prange) kernel would start numba's OpenMP threads, and a process
 # using GNU OpenMP must not fork. The block step is the lockstep's; the per-sample step, JSBSim scripts'.

@@ -11,7 +11,6 @@ batch of candidates in one compiled call over the whole trace, parallel over can
 from __future__ import annotations
 
 import math
-import os
 import sys
 from collections.abc import Sequence
 from concurrent.futures import ProcessPoolExecutor
@@ -23,6 +22,7 @@ import numpy as np
 from washbench.analysis.evaluate import Evaluation, FlightEvaluator
 from washbench.cueing.variants import Washout
 from washbench.errors import WashbenchError, located
+from washbench.io.cpus import usable_cpus
 
 FLIGHTS_DIR = "flights"
 
@@ -112,7 +112,7 @@ def _map(fn, args: list[tuple], jobs: int | None, dask: str | None) -> list:
         from washbench.runs.cluster import dask_map
 
         return list(dask_map(dask, fn, args))
-    jobs = max(1, min(jobs or os.cpu_count() or 1, len(args)))
+    jobs = max(1, min(jobs or usable_cpus(), len(args)))
     if jobs == 1:
         return [fn(*a) for a in args]
     from washbench.runs.suite import pool_context

@@ -46,15 +46,19 @@ from pathlib import Path
 from typing import Any
 
 from washbench.analysis.ranking import (
+    DEFAULT_RULE,
     DOFS,
     METRICS,
     RankRow,
+    RankRule,
     compare,
     rank,
     reference_washout,
+    rule_from_record,
 )
 from washbench.errors import Terminated, WashbenchError, located
 from washbench.io.atomic import write_text_atomic
+from washbench.io.cpus import usable_cpus
 from washbench.io.lock import LOCK_NAME, output_lock
 from washbench.io.paths import MANOEUVRES_DIR, bundled_names, resolve_manoeuvre
 from washbench.io.publish import clean_partials, is_leftover, is_washbench_result, read_marker
@@ -181,9 +185,14 @@ def _run_one(
     aircraft_dirs: tuple[str, ...] = (),
     max_time_s: float | None = None,
     outputs: Outputs = DEFAULT_OUTPUTS,
+    rank_by: str | None = None,
+    vestibular: str | None = None,
+    plugins: tuple[str, ...] = (),
 ) -> list[Outcome]:
     """Worker: run one manoeuvre or JSBSim script (one outcome per run segment); never raises (failures
-    come back as an Outcome)."""
+    come back as an Outcome). ``plugins``: the washout plugins' ``FILE.py:NAME`` to load first (a worker process
+    has only what its parent loaded before it started)."""
+    from washbench.cueing import registry
     from washbench.flight.scripts import is_script
     from washbench.runs.pipeline import run_manoeuvre, run_script
 
@@ -191,9 +200,12 @@ def _run_one(
     params = Path(params_path) if params_path else None
     platform = Path(platform_path) if platform_path else None
     try:
+        for spec in plugins:
+            registry.load_plugin(spec)
         dirs = [Path(d) for d in aircraft_dirs]
         common = {"params_path": params, "platform_path": platform, "aircraft_dirs": dirs}
-        common |= {"washouts": washouts, "variants": variants, "outputs": outputs}
+        common |= {"washouts": washouts, "variants": variants, "outputs": outputs, "rank_by": rank_by}
+        common |= {"vestibular": vestibular}
         if is_script(Path(path)):
             runs = run_script(Path(path), Path(out_dir), max_time_s=max_time_s, **common)
         else:
@@ -257,6 +269,8 @@ def run_suite(
     aircraft_dirs: Sequence[Path] = (),
     max_time_s: float | None = None,
     outputs: Outputs = DEFAULT_OUTPUTS,
+    rank_by: str | None = None,
+    vestibular: str | None = None,
 ) -> list[Outcome]:
     """Run every file in parallel processes (or on the Dask cluster at ``dask``); outcomes in the order of ``files``
     (a JSBSim script that resets gives one outcome per run segment, in order). ``outputs``: whether the
@@ -265,20 +279,23 @@ def run_suite(
     On any exception (KeyboardInterrupt and :class:`washbench.errors.Terminated` included) the local workers are
     stopped before it propagates, so no worker writes anything afterwards.
     """
-    jobs = max(1, min(jobs or os.cpu_count() or 1, len(files)))
+    jobs = max(1, min(jobs or usable_cpus(), len(files)))
     out_dir.mkdir(parents=True, exist_ok=True)
     dirs = tuple(str(d) for d in aircraft_dirs)
     params = str(params_path) if params_path else None
     platform = str(platform_path) if platform_path else None
     chosen = tuple(washouts) if washouts else None
-    args = [(str(f), str(out_dir), params, platform, chosen, tuple(variants), dirs, max_time_s, outputs)
-            for f in files]
+    from washbench.cueing import registry
+
+    plugins = registry.plugin_specs()
+    args = [(str(f), str(out_dir), params, platform, chosen, tuple(variants), dirs, max_time_s, outputs, rank_by,
+             vestibular, plugins) for f in files]  # fmt: skip
     outcomes: dict[str, list[Outcome]] = {}
     start = time.perf_counter()
     if progress:
         print(
             f"suite: {len(files)} manoeuvres on {jobs} process{'es' if jobs > 1 else ''} -> {_destination(out_dir)}\n"
-            "suite: loading JSBSim, rerun and the washout kernel (compiled once after install: a few seconds)",
+            "suite: loading JSBSim, rerun and the compiled kernels",
             file=sys.stderr,
         )
     if dask:
@@ -347,20 +364,13 @@ def _runs_with_metrics(outcomes: Sequence[Outcome]) -> list[Outcome]:
 
 def metrics_table(outcomes: Sequence[Outcome]) -> str:
     """``metrics.csv`` of the suite (every run that produced metrics, failed checks included)."""
-    rows = [["aircraft", "manoeuvre", "washout", "dof", "npc", "integral_error", "max_error"]]
+    from washbench.io.results import METRICS_COLUMNS, METRICS_TEXT_COLUMNS
+
+    rows = [["aircraft", "manoeuvre", *METRICS_COLUMNS]]
     for o in _runs_with_metrics(outcomes):
         for m in o.run.metrics:
-            rows.append(
-                [
-                    o.run.aircraft,
-                    o.run.manoeuvre,
-                    m.washout,
-                    m.dof,
-                    csv_number(m.npc),
-                    csv_number(m.integral_error),
-                    csv_number(m.max_error),
-                ]
-            )
+            cells = [getattr(m, c) if c in METRICS_TEXT_COLUMNS else csv_number(getattr(m, c)) for c in METRICS_COLUMNS]
+            rows.append([o.run.aircraft, o.run.manoeuvre, *cells])
     return _csv(rows)
 
 
@@ -382,12 +392,14 @@ def comparison_table(outcomes: Sequence[Outcome]) -> str:
     return _csv(rows)
 
 
-def ranking_table(rankings: dict[tuple[str, str], list[RankRow]]) -> str:
-    """``ranking.csv``: rank, washout and score (lower is better) per manoeuvre."""
-    rows = [["aircraft", "manoeuvre", "rank", "washout", "score"]]
+def ranking_table(rankings: dict[tuple[str, str], list[RankRow]], rule: RankRule = DEFAULT_RULE) -> str:
+    """``ranking.csv``: rank, washout and the rule's value (``score``, lower is better) per manoeuvre; ``tied``
+    (true when the rank is shared: values within the tie margin) and ``rule`` (``--rank-by``)."""
+    rows = [["aircraft", "manoeuvre", "rank", "washout", "score", "tied", "rule"]]
     for (aircraft, manoeuvre), ranking in rankings.items():
         for r in ranking:
-            rows.append([aircraft, manoeuvre, str(r.rank), r.washout, csv_number(r.score)])
+            tied = "true" if r.tied else "false"
+            rows.append([aircraft, manoeuvre, str(r.rank), r.washout, csv_number(r.score), tied, rule.by])
     return _csv(rows)
 
 
@@ -407,12 +419,14 @@ def write_suite_results(
     from washbench.io.provenance import utc_now
     from washbench.review.suite_report import write_suite_json, write_suite_report
 
+    rule = rule_from_record((provenance or {}).get("ranking"))
     rankings = {
-        (o.run.aircraft, o.run.manoeuvre): rank(o.run.metrics, o.run.motion) for o in _runs_with_metrics(outcomes)
+        (o.run.aircraft, o.run.manoeuvre): rank(o.run.metrics, o.run.motion, rule)
+        for o in _runs_with_metrics(outcomes)
     }
     write_text_atomic(out_dir / "metrics.csv", metrics_table(outcomes))
     write_text_atomic(out_dir / "comparison.csv", comparison_table(outcomes))
-    write_text_atomic(out_dir / "ranking.csv", ranking_table(rankings))
+    write_text_atomic(out_dir / "ranking.csv", ranking_table(rankings, rule))
     entries = [
         {
             "file": _short(o.path),
@@ -521,8 +535,12 @@ def write_run_review(
     """
     from washbench.review.report import write_result_report
 
-    rankings = {(summary.aircraft, summary.manoeuvre): rank(summary.metrics, summary.motion)} if summary.metrics else {}
-    write_text_atomic(run_dir / "ranking.csv", ranking_table(rankings))
+    prov = (read_marker(run_dir, RUN_MARKER) or {}).get("provenance")
+    rule = rule_from_record(prov.get("ranking") if isinstance(prov, dict) else None)
+    rankings = (
+        {(summary.aircraft, summary.manoeuvre): rank(summary.metrics, summary.motion, rule)} if summary.metrics else {}
+    )
+    write_text_atomic(run_dir / "ranking.csv", ranking_table(rankings, rule))
     write_result_report(run_dir, table, figures=figures)
 
 
@@ -541,6 +559,8 @@ def suite_command(
     jsbsim_scripts: Sequence[str] = (),
     max_time_s: float | None = None,
     outputs: Outputs = DEFAULT_OUTPUTS,
+    rank_by: str | None = None,
+    vestibular: str | None = None,
 ) -> int:
     """CLI entry: run the suite, write its results, print where they are; 0 if all succeeded, else 1.
 
@@ -560,8 +580,10 @@ def suite_command(
     from washbench.cueing.params import DEFAULT_PARAMS_PATH
     from washbench.cueing.variants import select_washouts
     from washbench.io.provenance import build_provenance
+    from washbench.perception.vestibular import model_record
     from washbench.platform import load_platform_limits
     from washbench.platform.limits import DEFAULT_LIMITS_PATH
+    from washbench.runs.rank_rule import load_rank_rule
 
     provenance = build_provenance(
         params_path=params_path or DEFAULT_PARAMS_PATH,
@@ -569,6 +591,8 @@ def suite_command(
         washouts=select_washouts(washouts, variants, params_path),
         platform_path=platform_path or DEFAULT_LIMITS_PATH,
         platform=load_platform_limits(platform_path),
+        ranking=load_rank_rule(params_path, rank_by).record(),
+        vestibular=model_record(vestibular),
     )
     check_unique_names(files, aircraft_dirs)
     start = time.perf_counter()
@@ -594,6 +618,8 @@ def suite_command(
                 aircraft_dirs=aircraft_dirs,
                 max_time_s=max_time_s,
                 outputs=outputs,
+                rank_by=rank_by,
+                vestibular=vestibular,
             )
             write_suite_results(outcomes, stage, provenance, outputs.figures)
             _swap_in(stage, out_dir, previous)

@@ -1,0 +1,106 @@
+"""Per-result figures: line styles and palettes, the reused layout, phase labels (synthetic traces, no flight)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from washbench.errors import WashbenchError
+from washbench.review.figures import envelope_figure, perceived_figure, phase_label
+from washbench.review.palette import (
+    CB_WASHOUT_COLORS,
+    PALETTES,
+    WASHOUT_COLORS,
+    palette_name,
+    washout_colors,
+    washout_dashes,
+)
+
+NAMES = ["small-angle", "large-angle", "unrestricted", "my-a", "my-b"]
+
+
+def traces(n: int, seed: int) -> dict[str, np.ndarray]:
+    rng = np.random.default_rng(seed)
+    base = np.cumsum(rng.normal(size=(n, 6)), axis=0) * 0.01
+    return {"aircraft": base, **{w: base + 0.1 * i for i, w in enumerate(NAMES[:3])}}
+
+
+def draw(folder: Path, seed: int, n: int = 5000) -> bytes:
+    t = np.arange(n) / 120.0
+    perceived = traces(n, seed)
+    phases = [("level", 0.0, 10.0), ("roll in", 10.0, 20.0), ("clean climb", 20.0, t[-1])]
+    (png,) = perceived_figure(folder / "perceived", "test", t, perceived, phases=phases, thresholds=[0.1] * 6,
+                              rest=list(perceived["aircraft"][0]))  # fmt: skip
+    usage = {"position": {w: np.abs(perceived[w][:, 0]) for w in NAMES[:3]}}
+    saturated = {"small-angle": {"pos": np.arange(n) % 500 < 3}}
+    (env,) = envelope_figure(folder / "envelope", "test", t, usage, saturated, phases=phases)
+    return png.read_bytes() + env.read_bytes()
+
+
+def test_a_reused_layout_draws_the_same_pixels_as_a_fresh_one(tmp_path: Path) -> None:
+    """The second figure of a process reuses the first one's axes; the third (the first's data again) must match
+    the first byte for byte, so nothing of the second leaks into it."""
+    first = draw(tmp_path, seed=1)
+    other = draw(tmp_path, seed=2, n=3000)
+    again = draw(tmp_path, seed=1)
+    assert first == again
+    assert other != first
+
+
+def test_every_washout_has_its_own_colour_and_line_style_in_each_palette() -> None:
+    for pal in PALETTES:
+        colors = washout_colors(NAMES, pal)
+        assert len(set(colors.values())) == len(NAMES)
+    dashes = washout_dashes(NAMES)
+    assert len({str(d) for d in dashes.values()}) == len(NAMES)
+    assert washout_colors(NAMES)["large-angle"] == WASHOUT_COLORS["large-angle"]
+    assert washout_colors(NAMES, "colorblind")["large-angle"] == CB_WASHOUT_COLORS["large-angle"]
+
+
+def test_palette_from_the_environment_and_unknown_names(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("WASHBENCH_PALETTE", "colorblind")
+    assert palette_name() == "colorblind" and palette_name("default") == "default"
+    monkeypatch.setenv("WASHBENCH_PALETTE", "pastel")
+    with pytest.raises(WashbenchError, match="WASHBENCH_PALETTE"):
+        palette_name()
+
+
+@pytest.mark.parametrize(
+    ("name", "width_in", "expected"),
+    [
+        ("clean climb", 2.0, "clean climb"),
+        ("clean climb", 0.35, "clean\nclimb"),
+        ("approach", 0.3, "appr…"),
+        ("approach", 0.1, ""),
+    ],
+)
+def test_phase_labels_wrap_before_they_are_cut(name: str, width_in: float, expected: str) -> None:
+    assert phase_label(name, width_in) == expected
+
+
+def test_swept_keys_carry_the_unit_of_their_name() -> None:
+    from washbench.review.study_figures import key_label
+
+    assert key_label("translational_highpass_wn_radps.x") == "translational_highpass_wn_radps.x (rad/s)"
+    assert key_label("tilt.gain_per_s") == "tilt.gain_per_s (1/s)"
+    assert key_label("rotational.saturation_degps") == "rotational.saturation_degps (deg/s)"
+    assert key_label("scale.specific_force") == "scale.specific_force (-)"
+    assert key_label("tilt.rate_limit_mode") == "tilt.rate_limit_mode"
+
+
+def test_the_report_names_an_end_stop_next_to_the_score_it_dominates() -> None:
+    from washbench.review.report import END_STOP_SHARE, end_stop_note
+    from washbench.review.result_data import ResultData
+
+    n = 1000
+    pos = np.zeros(n, bool)
+    pos[:540] = True
+    below = np.arange(n) < END_STOP_SHARE * n - 1
+    data = ResultData(folder=Path("."), title="t", washouts=["a", "b", "c"], metrics=[], t_s=np.arange(n) / 100.0,
+                      dt_s=0.01, perceived={}, usage={}, motion={},
+                      saturated={"a": {"pos": pos}, "b": {"pos": below}, "c": {}})  # fmt: skip
+    note = end_stop_note(data, "a")
+    assert note == "end stop: stage at its position limit for 5.40 s (54 %), the score reflects its hard stops"
+    assert end_stop_note(data, "b") == "" and end_stop_note(data, "c") == ""

@@ -1,0 +1,409 @@
+"""``washbench live``: the washouts in real time on a flight simulator's UDP output, platform commands out, and at
+the end exactly the result folder ``washbench cue`` writes for the same samples.
+
+One loop, one thread: a datagram arrives (:mod:`washbench.live.packets` decodes it), the link sorts out loss,
+reordering, duplicates and restarts (:mod:`washbench.live.link`), each sample to cue is appended to
+``OUT/live_input.csv`` (a ``washbench cue`` input in washbench's own columns, written as it arrives, so memory does
+not grow and a killed session leaves a readable file), run through :class:`washbench.cueing.CueingBank` (washouts,
+Atlas model, head motion) and its command sent (:mod:`washbench.live.commands`); the viewer gets it last.
+
+On stop (Ctrl-C, SIGTERM, ``--duration``, ``--idle-timeout``) the saved input is cued by :func:`run_cue`, the code
+of ``washbench cue`` itself: traces.parquet, metrics.csv and the rest are those of ``washbench cue
+OUT/live_input.csv`` bit for bit (with ``--resample`` when the source's clock is not on a uniform grid, chosen
+and printed as ``washbench cue`` advises it). The session's figures (counts, latency, jitter) go into run.json
+under ``live``.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import gc
+import json
+import math
+import os
+import signal
+import socket
+import sys
+import threading
+import time
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from washbench.errors import WashbenchError
+from washbench.live import commands
+from washbench.live.endpoints import Sink, bind_udp
+from washbench.live.link import LatencyStats, Link, Out
+from washbench.live.packets import RREF_DATAREFS, RREF_ID0, Decoder, PacketError, decoder, rref_request
+from washbench.live.saved_input import INPUT_FILE, InputWriter
+
+POLL_S = 0.05
+"""The loop wakes up at least this often to check the stop conditions."""
+
+
+@dataclass(frozen=True)
+class LiveOptions:
+    """Everything ``washbench live`` is told besides the washouts, parameter and platform files."""
+
+    listen: tuple[str, int]
+    fmt: str
+    out: Path
+    sink: tuple[str, int] | None = None
+    sink_format: str = "binary"
+    duration_s: float | None = None
+    idle_timeout_s: float | None = None
+    rate_hz: float | None = None
+    resample_hz: float | None = None
+    xplane: tuple[str, int] = ("127.0.0.1", 49000)
+    rref_hz: int = 60
+    viewer: bool = True
+    recording: bool = True
+    figures: bool = True
+    filter_start: str = "steady"
+    realtime: bool = False
+
+
+@contextlib.contextmanager
+def stop_on_signals() -> Iterator[list[int]]:
+    """While inside, SIGINT and SIGTERM only record themselves (the loop stops at its next turn and the result is
+    written); yields the list they are recorded in. Outside the main thread (tests), nothing is installed."""
+    got: list[int] = []
+    if threading.current_thread() is not threading.main_thread():
+        yield got
+        return
+
+    def note(signum: int, frame: object) -> None:
+        got.append(signum)
+
+    old = {s: signal.signal(s, note) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield got
+    finally:
+        for s, h in old.items():
+            signal.signal(s, h)
+
+
+class Session:
+    """One live session: the socket, the link, the saved input, the bank, the sink and the figures."""
+
+    def __init__(self, opts: LiveOptions, dec: Decoder, specs: Sequence[Any], limits: Any, sock: socket.socket,
+                 writer: InputWriter, sink: Sink, viewer: Any) -> None:  # fmt: skip
+        self.opts, self.dec, self.specs, self.limits = opts, dec, specs, limits
+        self.sock, self.writer, self.sink, self.viewer = sock, writer, sink, viewer
+        dt = 1.0 / opts.rate_hz if opts.rate_hz else None
+        self.link = Link(dt, dec.lag_shift)
+        self.latency = LatencyStats()
+        self.bank: Any = None
+        self.rows: np.ndarray | None = None
+        self.foreign = 0
+        self.malformed = 0
+        self.socket_errors = 0
+        self.first_arrival: float | None = None
+        self.last_arrival: float | None = None
+        self.stop = ""
+        self.cpu0 = self.cpu1 = 0.0
+        self.last_done: float | None = None
+        self._f = np.empty(3)
+        self._w = np.empty(3)
+
+    # ------------------------------------------------------------------ the hot path
+
+    def cue(self, o: Out) -> None:
+        """Save, cue and command one sample."""
+        s = o.sample
+        if o.new_segment or self.bank is None:
+            from washbench.cueing import CueingBank
+
+            self.bank = CueingBank(self.specs, None, self.limits, self.link.dt_s, self.opts.filter_start)
+        f, w = self._f, self._w
+        f[0], f[1], f[2] = s[1], s[2], s[3]
+        w[0], w[1], w[2] = s[4], s[5], s[6]
+        rows = self.rows = self.bank.step(f, np.radians(w))
+        flags = (commands.FLAG_HELD if o.held else 0) | (commands.FLAG_NEW_SEGMENT if o.new_segment else 0)
+        self.sink.send(s[0], flags, rows)
+        self.writer.row(s, o.held, o.new_segment)  # after the command: not on the latency path
+        if self.viewer is not None:
+            self.viewer.add(s, rows, self.link.dt_s, o.new_segment)
+
+    def receive(self, data: bytes, arrival_ns: int) -> None:
+        try:
+            sample = self.dec.decode(data)
+        except PacketError as exc:
+            if exc.kind == "foreign":
+                self.foreign += 1
+            else:
+                self.malformed += 1
+            return
+        if sample is None:
+            return
+        outs = self.link.push(sample)
+        for o in outs:
+            self.cue(o)
+        if outs:
+            done = time.perf_counter_ns()
+            last = outs[-1]
+            if not last.held:
+                self.latency.add(done - arrival_ns, self.link.dt_s)
+            self.latency.arrival(arrival_ns * 1e-9, last.new_segment)
+
+    def run(self, got_signal: list[int]) -> None:
+        """Receive until a stop condition; ``stop`` says which."""
+        opts, sock = self.opts, self.sock
+        sock.settimeout(POLL_S)
+        recv = sock.recvfrom
+        clock = time.perf_counter_ns
+        start = time.monotonic()
+        deadline = start + opts.duration_s if opts.duration_s is not None else math.inf
+        idle = opts.idle_timeout_s
+        subscribe = self.dec.name == "xplane-rref"
+        next_subscribe = 0.0
+        while True:
+            now = time.monotonic()
+            if got_signal:
+                self.stop = "interrupted (Ctrl-C)" if got_signal[0] == signal.SIGINT else "terminated (SIGTERM)"
+                self.drain()
+                return
+            if now >= deadline:
+                self.stop = f"--duration {opts.duration_s:g} s"
+                return
+            if subscribe and self.link.counts.received == 0 and now >= next_subscribe:
+                self.rref(self.opts.rref_hz)  # again every 2 s until X-Plane answers (it may start later)
+                next_subscribe = now + 2.0
+            self.writer.tick()
+            try:
+                data, _ = recv(65536)
+            except TimeoutError:  # nothing waiting: the source may have gone quiet
+                if idle is not None and self.last_arrival is not None and time.monotonic() - self.last_arrival > idle:
+                    self.stop = f"the source was quiet for --idle-timeout {idle:g} s"
+                    return
+                continue
+            except InterruptedError:
+                continue
+            except OSError:  # an ICMP error of our own RREF requests, reported on this socket
+                self.socket_errors += 1
+                continue
+            arrival = clock()
+            self.last_arrival = time.monotonic()
+            if self.first_arrival is None:
+                self.first_arrival = self.last_arrival
+                self.cpu0 = time.process_time()
+            self.receive(data, arrival)
+            self.cpu1, self.last_done = time.process_time(), time.monotonic()
+            if self.viewer is not None and self.viewer.closed_now():
+                self.viewer = None
+
+    def drain(self) -> None:
+        """Take the datagrams already waiting in the socket (received by the system before the stop)."""
+        self.sock.setblocking(False)
+        while True:
+            try:
+                data, _ = self.sock.recvfrom(65536)
+            except (BlockingIOError, InterruptedError):
+                return
+            except OSError:
+                self.socket_errors += 1
+                continue
+            self.receive(data, time.perf_counter_ns())
+
+    def finish(self) -> None:
+        """The samples still held back, cued; the RREF subscription cancelled."""
+        for o in self.link.flush():
+            self.cue(o)
+        if self.dec.name == "xplane-rref":
+            self.rref(0)
+
+    def rref(self, freq_hz: int) -> None:
+        """Subscribe to (or with 0 cancel) the datarefs of :data:`RREF_DATAREFS` at ``opts.xplane``."""
+        for i, (path, _unit) in enumerate(RREF_DATAREFS):
+            with contextlib.suppress(OSError):
+                self.sock.sendto(rref_request(freq_hz, RREF_ID0 + i, path), self.opts.xplane)
+
+    def figures(self) -> dict[str, Any]:
+        c = self.link.counts
+        return {
+            "format": self.dec.name,
+            "listen": f"{self.opts.listen[0]}:{self.opts.listen[1]}",
+            "stop": self.stop,
+            "dt_s": self.link.dt_s,
+            "counts": {
+                "received": c.received,
+                "cued": self.writer.rows,
+                "lost_held": c.lost,
+                "duplicate": c.duplicate,
+                "reordered": c.reordered,
+                "restarts": c.restarts,
+                "segments": self.writer.segments,
+                "short_segments_dropped": self.writer.short_segments,
+                "time_jumps": c.time_jumps,
+                "lag_unshifted": c.unshifted,
+                "foreign": self.foreign,
+                "malformed": self.malformed,
+                "socket_errors": self.socket_errors,
+                "commands": self.sink.seq,
+                "sink_sent": self.sink.sent,
+                "sink_errors": self.sink.errors,
+            },
+            "latency": self.latency.summary(),
+            "active_wall_s": round(self.last_done - self.first_arrival, 3)
+            if self.last_done is not None and self.first_arrival is not None
+            else 0.0,  # from the first datagram to the last one handled
+            "active_cpu_s": round(self.cpu1 - self.cpu0, 3),  # CPU time of this process over that span
+            "sink": None if self.opts.sink is None else f"udp://{self.opts.sink[0]}:{self.opts.sink[1]}",
+            "sink_format": self.opts.sink_format,
+            "washouts": [w.name for w in self.specs],
+            "viewer": "closed" if self.viewer is None and self.opts.viewer else ("on" if self.viewer else "off"),
+        }
+
+
+REALTIME_PRIORITY = 50
+"""``--realtime``: SCHED_FIFO at this priority (of 1..99; the kernel's own threads run at 50 too)."""
+
+
+def realtime_priority() -> tuple[int, os.sched_param] | None:
+    """Put this process at the real-time priority :data:`REALTIME_PRIORITY` (Linux SCHED_FIFO; needs root or
+    CAP_SYS_NICE); returns the policy and parameter to restore, or None with one line if it cannot."""
+    try:
+        before = (os.sched_getscheduler(0), os.sched_getparam(0))
+        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(REALTIME_PRIORITY))
+    except (AttributeError, OSError) as exc:
+        why = getattr(exc, "strerror", None) or "not supported here"
+        print(f"live: --realtime: cannot take a real-time priority ({why}); running at the ordinary one",
+              file=sys.stderr)  # fmt: skip
+        return None
+    print(f"  real-time priority: SCHED_FIFO {REALTIME_PRIORITY} while receiving")
+    return before
+
+
+def _print_figures(fig: dict[str, Any]) -> None:
+    c, lat = fig["counts"], fig["latency"]
+
+    def ms(v: float | None) -> str:
+        return "-" if v is None else f"{v:.3f}"
+
+    print(f"live: stopped: {fig['stop']}")
+    print(f"  received {c['received']}, cued {c['cued']} in {c['segments']} segment(s); lost (held) {c['lost_held']}, "
+          f"duplicate {c['duplicate']}, reordered {c['reordered']}, restarts {c['restarts']}, foreign "
+          f"{c['foreign']}, malformed {c['malformed']}")  # fmt: skip
+    print(f"  commands {c['commands']} (sink sent {c['sink_sent']}, errors {c['sink_errors']}); latency median "
+          f"{ms(lat['latency_median_ms'])} ms, p99 {ms(lat['latency_p99_ms'])} ms, max "
+          f"{ms(lat['latency_max_ms'])} ms, late {lat['late']}; jitter mean {ms(lat['jitter_mean_ms'])} ms, "
+          f"max {ms(lat['jitter_max_ms'])} ms")  # fmt: skip
+
+
+def _auto_resample(path: Path) -> float | None:
+    """A rate to resample the saved input at when a segment's times are not on a uniform grid (else None)."""
+    import pyarrow.csv as pacsv
+
+    from washbench.io.resample import suggest_rate, uniform_step
+
+    t = pacsv.read_csv(path, convert_options=pacsv.ConvertOptions(include_columns=["t_s"])).column(0).to_numpy()
+    back = np.flatnonzero(np.diff(t) < 0.0) + 1
+    for part in np.split(t, back):
+        if part.size >= 2 and uniform_step(part)[0] is None:
+            return suggest_rate(part)
+    return None
+
+
+def _add_live_figures(out: Path, input_path: Path, fig: dict[str, Any]) -> None:
+    """Put the session's figures into run.json (``live``) of every result folder cued from ``input_path``."""
+    from washbench.io.atomic import write_text_atomic
+
+    for folder in (out, *sorted(out.glob("segment_*"))):
+        path = folder / "run.json"
+        try:
+            doc = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            continue
+        if doc.get("input") != str(input_path):
+            continue
+        doc["live"] = fig
+        write_text_atomic(path, json.dumps(doc, indent=2) + "\n")
+
+
+def run_live(
+    opts: LiveOptions,
+    washouts: Sequence[str] | None = None,
+    params_path: Path | None = None,
+    platform_path: Path | None = None,
+    variants: Sequence[str] = (),
+) -> int:
+    """The ``washbench live`` command; returns the exit status (that of ``washbench cue`` on the saved input, or
+    130 / 143 after a Ctrl-C / SIGTERM once the result folder is written)."""
+    from washbench.cueing import CueingBank
+    from washbench.cueing.bank import check_filter_start
+    from washbench.cueing.variants import select_washouts
+    from washbench.io.lock import output_lock
+    from washbench.live.viewer import open_viewer
+    from washbench.platform import load_platform_limits
+    from washbench.runs.cue import CueOptions, run_cue
+
+    for flag, value in (("--duration", opts.duration_s), ("--idle-timeout", opts.idle_timeout_s),
+                        ("--rate-hz", opts.rate_hz), ("--resample", opts.resample_hz)):  # fmt: skip
+        if value is not None and not (math.isfinite(value) and value > 0.0):
+            raise WashbenchError(f"{flag}: expected a positive number, got {value:g}")
+    if not 0 < opts.rref_hz <= 10000:
+        raise WashbenchError(f"--rref-hz: expected 1..10000 Hz, got {opts.rref_hz}")
+    specs = select_washouts(washouts, variants, params_path)
+    names = [w.name for w in specs]
+    check_filter_start(opts.filter_start)
+    limits = load_platform_limits(platform_path)
+    dec = decoder(opts.fmt)
+    CueingBank(specs, None, limits, 0.01, opts.filter_start).step(np.zeros(3), np.zeros(3))  # compiled before listening
+    sink = Sink(opts.sink, opts.sink_format, names)
+    t_wall = time.perf_counter()
+    # a Ctrl-C or SIGTERM from the moment the port is bound only stops the loop: the result is written first
+    with stop_on_signals() as got, contextlib.closing(sink), contextlib.closing(bind_udp(opts.listen)) as sock, \
+            output_lock(opts.out) as out:  # fmt: skip
+        writer = InputWriter(out / INPUT_FILE)
+        viewer = open_viewer(names, limits, opts.filter_start) if opts.viewer else None
+        to = f"udp://{opts.sink[0]}:{opts.sink[1]} ({opts.sink_format})" if opts.sink else "nowhere (no --sink)"
+        print(f"live: listening on udp://{opts.listen[0]}:{opts.listen[1]} for {opts.fmt} packets; washouts "
+              f"{', '.join(names)}; commands to {to}")  # fmt: skip
+        rcvbuf = sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF)
+        print(f"  receive buffer {rcvbuf // 1024} KiB (raise net.core.rmem_max for more)")
+        for note in dec.notes:
+            print(f"  {note}")
+        sys.stdout.flush()
+        session = Session(opts, dec, specs, limits, sock, writer, sink, viewer)
+        gc.collect()
+        gc.freeze()  # what exists now is never scanned again: shorter collector pauses in the loop
+        before = realtime_priority() if opts.realtime else None
+        try:
+            session.run(got)
+        finally:
+            if before is not None:
+                os.sched_setscheduler(0, *before)  # the final cue runs at the ordinary priority again
+            gc.unfreeze()
+            session.finish()
+            saved = writer.close()
+            if session.viewer is not None:
+                session.viewer.close()
+    fig = session.figures()
+    fig["wall_s"] = round(time.perf_counter() - t_wall, 3)
+    _print_figures(fig)
+    status = {signal.SIGINT: 130, signal.SIGTERM: 143}.get(got[0], 0) if got else 0
+    if writer.rows < 2:
+        saved.unlink(missing_ok=True)
+        with contextlib.suppress(OSError):
+            out.rmdir()
+        if status:
+            print(f"washbench: {session.stop}: fewer than 2 samples received, nothing to cue", file=sys.stderr)
+            return status
+        raise WashbenchError(f"--listen {opts.listen[0]}:{opts.listen[1]}: {writer.rows} sample(s) received "
+                             f"({session.stop}): nothing to cue")  # fmt: skip
+    resample = opts.resample_hz or _auto_resample(saved)
+    if resample and not opts.resample_hz:
+        print(f"  the source's clock is not on a uniform grid: cued with --resample {resample:g} "
+              f"(washbench cue {saved} --resample {resample:g} gives the same)")  # fmt: skip
+    cue_opts = CueOptions(resample_hz=resample, filter_start=opts.filter_start, recording=opts.recording,
+                          figures=opts.figures)  # fmt: skip
+    fig["resample_hz"] = resample
+    result = run_cue(saved, out, washouts, params_path, platform_path, variants, cue_opts)
+    _add_live_figures(out, saved, fig)
+    if status:
+        print(f"washbench: {session.stop}: the result folder holds every sample received", file=sys.stderr)
+        return status
+    return result
