@@ -26,7 +26,7 @@ from washbench.cueing.mpc import MpcParams, MpcWashout
 from washbench.cueing.optimal import OptimalWashout
 from washbench.flight.fly import fly
 from washbench.flight.manoeuvre import load_manoeuvre
-from washbench.io.paths import DATA_DIR
+from washbench.io.paths import MANOEUVRES_DIR
 from washbench.platform.limits import load_platform_limits
 
 
@@ -57,7 +57,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seconds", type=float, default=30.0)
     ap.add_argument("--horizons", type=int, nargs="*", default=[10, 20, 40])
-    ap.add_argument("--manoeuvre", type=Path, default=DATA_DIR / "manoeuvres" / "c172" / "steep_turn.yaml")
+    ap.add_argument("--manoeuvre", type=Path, default=MANOEUVRES_DIR / "c172" / "steep_turn.yaml")
     args = ap.parse_args()
     f, w, dt = head_motion(args.manoeuvre, args.seconds)
     ctx = WashoutContext(dt, 9.80665, load_platform_limits(), "steady", (0.0, 0.0, 0.0))

@@ -14,10 +14,11 @@ from washbench.cueing.algorithm import WashoutContext
 from washbench.cueing.bank import cue_trace
 from washbench.cueing.mpc import MpcWashout
 from washbench.cueing.optimal import OptimalWashout
-from washbench.cueing.params import WASHOUT_NAMES, load_washout_params
+from washbench.cueing.params import WASHOUT_NAMES
+from washbench.cueing.variants import load_washout_params
 from washbench.flight.fly import fly
 from washbench.flight.manoeuvre import load_manoeuvre
-from washbench.io.paths import DATA_DIR
+from washbench.io.paths import MANOEUVRES_DIR
 from washbench.platform.kinematics import track_axis, track_rotation
 from washbench.platform.limits import PlatformLimits, load_platform_limits
 
@@ -115,7 +116,7 @@ def test_bound_below_every_washout_on_a_stress_signal(limits):
 
 def test_bound_below_every_washout_on_a_real_flight(limits):
     """The C172 elevator doublet flown by JSBSim (its first 10 s: settle, doublet, start of the response)."""
-    flight = fly(load_manoeuvre(DATA_DIR / "manoeuvres" / "c172" / "elevator_doublet.yaml"))
+    flight = fly(load_manoeuvre(MANOEUVRES_DIR / "c172" / "elevator_doublet.yaml"))
     c = flight.columns
     n = round(10.0 / flight.dt_s)
     f = np.column_stack([c[f"f_{a}_mps2"][:n] for a in "xyz"])
