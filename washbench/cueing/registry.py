@@ -34,7 +34,12 @@ from washbench.io.names import identifier_problem
 
 ENTRY_POINT_GROUP = "washbench.washouts"
 
-BUILTIN_PYTHON: dict[str, str] = {}
+BUILTIN_PYTHON: dict[str, str] = {
+    "optimal": "washbench.cueing.optimal:OptimalWashout",
+    "mpc": "washbench.cueing.mpc:MpcWashout",
+    # the oracle bound replayed as a washout (whole recordings only); by name, so cueing imports no analysis module
+    "bound": "washbench.analysis.bound:BoundWashout",
+}
 """Built-in Python algorithms: kind -> ``module:attribute`` of the factory (imported on first use)."""
 
 

@@ -1,0 +1,522 @@
+"""The model-predictive washout (``mpc``): a quadratic program per step, the platform's limits as hard constraints.
+
+At every sample the washout solves, by OSQP (a sparse ADMM QP solver, warm-started from the previous step),
+
+    minimise    sum_{k=1..N} x_k' Q x_k dt_p  +  sum_{k=0..N-1} u_k' R u_k dt_p
+    subject to  x_{k+1} = Phi x_k + Gamma u_k + Gamma_r r_k           (the linear model, held controls)
+                |position|, |velocity| <= margin * limit, per axis     (nodes 1..N)
+                |acceleration| <= margin * limit, per axis             (moves 0..N-1)
+                |tilt rate| <= tilt-rate limit (pitch and roll)        (moves 0..N-1)
+                |p| + |q| + |r| <= margin * rate limit                 (the 1-norm ball: inside the 2-norm one)
+                |Delta omega|_1 <= margin * alpha_max * interval       (the first: over dt, from the current rate)
+                velocity_N = 0                                         (optional: the plan ends at rest)
+
+with the state x of :mod:`washbench.cueing.motion_model` (perceived-error states of the otolith and canal models,
+cockpit angles, platform position and velocity; the pitch and roll angles split into a tilt part, whose rate is
+limited, and a rotational part), x_0 the washout's current state and r_k the aircraft input of this sample held
+over the horizon (``reference_decay_per_s`` > 0: decaying as e^{-gamma t}): no knowledge of the future. The
+horizon's intervals are ``prediction_step_s`` (coarser than the sample: see docs/optimal-mpc.md). The first move
+u_0 is applied for one sample (exact discretisation at dt) and the set points are the resulting position and
+attitude. Every solve's status is checked: a failed solve, or a first move that would leave the platform unable to stop
+within its travel, is replaced by the last accepted plan continued (feasible: the platform's constraints do not
+depend on the aircraft input) or, without one, by braking (counted: :meth:`MpcWashout.report`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from typing import Annotated, Any, Literal
+
+import numpy as np
+from pydantic import Field, model_validator
+from scipy import linalg, sparse
+
+from washbench.cueing.algorithm import SetPoint, WashoutContext
+from washbench.cueing.motion_model import CHANNELS, ChannelModel, channel_inputs, channel_model, discretise_zoh
+from washbench.cueing.optimal import merge_channel_defaults
+from washbench.cueing.rotations import quat_from_euler
+from washbench.io.yamlio import StrictModel
+from washbench.perception.vestibular import CanalParams, OtolithParams
+from washbench.platform.kinematics import brake_speed
+
+Weight = Annotated[float, Field(ge=0.0, le=1e9, allow_inf_nan=False)]
+PositiveWeight = Annotated[float, Field(gt=0.0, le=1e9, allow_inf_nan=False)]
+
+
+class MpcWeights(StrictModel):
+    """Weights of one channel's stage cost (SI units squared; fields a channel lacks are ignored)."""
+
+    force: Weight = 1.0
+    """perceived specific-force error (otolith), per (m/s^2)^2"""
+    direct_force: Weight = 1.0
+    """specific-force error at the head itself (before the otolith model), per (m/s^2)^2 (see docs/optimal-mpc.md)"""
+    rate: Weight = 10.0
+    """perceived angular-velocity error (canals), per (rad/s)^2"""
+    tilt_angle: Weight = 0.1
+    """tilt part of the pitch/roll angle (or the yaw angle), per rad^2"""
+    rotation_angle: Weight = 5.0
+    """rotational part of the pitch/roll angle, per rad^2 (washes the rotational cue out)"""
+    position: Weight = 0.4
+    """platform position, per m^2"""
+    velocity: Weight = 0.4
+    """platform velocity, per (m/s)^2"""
+    acceleration: PositiveWeight = 0.05
+    """platform acceleration (control), per (m/s^2)^2"""
+    angular_rate: PositiveWeight = 0.5
+    """cockpit angular rates (controls), per (rad/s)^2"""
+
+
+class OsqpSettings(StrictModel):
+    """OSQP's settings for the per-step QP (see OSQP's documentation)."""
+
+    max_iter: Annotated[int, Field(ge=1, le=1_000_000)] = 400
+    eps_abs: Annotated[float, Field(gt=0.0, le=1.0)] = 1e-4
+    eps_rel: Annotated[float, Field(gt=0.0, le=1.0)] = 1e-4
+    polishing: bool = False
+    adaptive_rho: bool = True
+    time_limit_s: Annotated[float, Field(ge=0.0, le=10.0)] = 0.0
+    """0: none"""
+
+
+class VestibularChoice(StrictModel):
+    """The vestibular models in the cost (default: the paper's Eqs. 11-12, as the bench's perception)."""
+
+    otolith: OtolithParams = OtolithParams()
+    canals: CanalParams = CanalParams()
+
+
+class MpcParams(StrictModel):
+    """The ``mpc:`` section of the parameter file."""
+
+    horizon_steps: Annotated[int, Field(ge=1, le=500)] = 20
+    """N, the number of prediction intervals"""
+    prediction_step_s: Annotated[float, Field(gt=0.0, le=5.0, allow_inf_nan=False)] = 0.1
+    """the prediction interval (s); at least the sample step"""
+    reference_decay_per_s: Annotated[float, Field(ge=0.0, le=100.0, allow_inf_nan=False)] = 0.5
+    """gamma: the aircraft input predicted as r e^{-gamma t} over the horizon (0: held; the default 0.5 1/s: with the
+    input held the plan must undo within the horizon any cue it gives, and heave cues came out with the wrong sign,
+    see docs/optimal-mpc.md)"""
+    limit_margin: Annotated[float, Field(gt=0.0, le=1.0)] = 0.95
+    """the QP's limits are this fraction of the platform's"""
+    tilt_rate_limit_degps: Annotated[float, Field(gt=0.0, le=1000.0)] | None = 3.0
+    """hard limit on the tilt part's rate (deg/s, per axis); null: none"""
+    terminal_rest: bool = True
+    """the plan ends with the platform at rest (velocity 0 at node N)"""
+    vestibular: VestibularChoice = VestibularChoice()
+    pitch: MpcWeights = MpcWeights()
+    roll: MpcWeights = MpcWeights()
+    heave: MpcWeights = MpcWeights(position=4.0, velocity=1.0)
+    yaw: MpcWeights = MpcWeights(tilt_angle=0.5)
+    solver: OsqpSettings = OsqpSettings()
+    fallback: Literal["brake"] = "brake"
+    """what a failed solve does (brake: decelerate translation and rotation at the limits)"""
+
+    @model_validator(mode="before")
+    @classmethod
+    def _channel_defaults(cls, data: Any) -> Any:
+        """A channel section given in part keeps that channel's defaults for the keys it does not give."""
+        defaults = {ch: f.default.model_dump() for ch, f in cls.model_fields.items() if ch in CHANNELS}
+        return merge_channel_defaults(data, defaults)
+
+
+def split_angle(model: ChannelModel) -> ChannelModel:
+    """Pitch/roll model with the angle split into tilt (``i_angle``) and rotational parts (a new last state).
+
+    Controls become [a, tilt rate, rotational rate]; both angles act on the otolith alike and both rates on the
+    canals. Channels without a tilt (heave, yaw) are returned unchanged.
+    """
+    if model.name not in ("pitch", "roll"):
+        return model
+    n, m = model.B.shape
+    A = np.zeros((n + 1, n + 1))
+    A[:n, :n] = model.A
+    A[:n, n] = model.A[:n, model.i_angle]  # the rotational angle tilts the otolith input like the tilt angle
+    B = np.zeros((n + 1, m + 1))
+    B[:n, :m] = model.B
+    B[:n, m] = model.B[:n, 1]  # canal input: the total rate
+    B[model.i_angle, m] = 0.0
+    B[n, m] = 1.0
+    E = np.vstack([model.E, np.zeros((1, model.E.shape[1]))])
+    grow = np.zeros((model.C_err.shape[0], 1))
+    c_head = np.hstack([model.C_head, model.C_head[:, model.i_angle : model.i_angle + 1]])  # g (theta_t + theta_r)
+    d_head = np.hstack([model.D_head, model.D_head[:, 1:2]])  # rate row: tilt + rotational rate
+    return replace(model, A=A, B=B, E=E, C_err=np.hstack([model.C_err, grow]), C_head=c_head, D_head=d_head,
+                   controls=(*model.controls, "rotation"))  # fmt: skip
+
+
+@dataclass(frozen=True)
+class StackedModel:
+    """The four channels side by side (block-diagonal), with index maps into the stacked state and control."""
+
+    A: np.ndarray
+    B: np.ndarray
+    E: np.ndarray
+    Q: np.ndarray
+    R: np.ndarray
+    i_pos: np.ndarray  # (3,) x, y, z
+    i_vel: np.ndarray  # (3,)
+    i_tilt: np.ndarray  # (3,) roll, pitch, yaw angle states (the tilt part; yaw: its angle)
+    i_rot: np.ndarray  # (2,) roll, pitch rotational angle states
+    j_acc: np.ndarray  # (3,) controls a_x, a_y, a_z
+    j_tilt: np.ndarray  # (2,) roll, pitch tilt rates
+    j_rot: np.ndarray  # (3,) roll, pitch rotational rates, yaw rate
+    C_dir: np.ndarray  # (3, n) head specific force (x, y, z rows, deviation from level) from the state ...
+    D_dir: np.ndarray  # (3, m) ... and the controls
+    W_dir: np.ndarray  # (3,) direct_force weights of the pitch, roll and heave channels
+
+
+def stacked_model(params: MpcParams, gravity_mps2: float) -> StackedModel:
+    """Build the stacked continuous model and its stage-cost matrices (per second)."""
+    v = params.vestibular
+    models = {ch: split_angle(channel_model(ch, v.otolith, v.canals, gravity_mps2)) for ch in CHANNELS}
+    offs_x, offs_u, qs, rs = {}, {}, [], []
+    ix = iu = 0
+    for ch in CHANNELS:
+        m = models[ch]
+        w: MpcWeights = getattr(params, ch)
+        offs_x[ch], offs_u[ch] = ix, iu
+        n, k = m.A.shape[0], m.C_err.shape[0]
+        we = np.array([w.force if i < m.force_inputs else w.rate for i in range(k)])
+        q = m.C_err.T @ np.diag(we) @ m.C_err
+        if m.i_angle >= 0:
+            q[m.i_angle, m.i_angle] += w.tilt_angle
+        if ch in ("pitch", "roll"):
+            q[n - 1, n - 1] += w.rotation_angle
+        if m.i_pos >= 0:
+            q[m.i_pos, m.i_pos] += w.position
+            q[m.i_vel, m.i_vel] += w.velocity
+        qs.append(0.5 * (q + q.T))
+        rs.append(np.diag([w.acceleration if c.startswith("a_") else w.angular_rate for c in m.controls]))
+        ix += n
+        iu += m.B.shape[1]
+    A = linalg.block_diag(*[models[c].A for c in CHANNELS])
+    B = linalg.block_diag(*[models[c].B for c in CHANNELS])
+    E = linalg.block_diag(*[models[c].E for c in CHANNELS])
+    mp, mr, mh, my = (models[c] for c in CHANNELS)
+    ox, ou = offs_x, offs_u
+    n_all, m_all = ix, iu
+    c_dir = np.zeros((3, n_all))
+    d_dir = np.zeros((3, m_all))
+    for row, ch in enumerate(("pitch", "roll", "heave")):
+        mm = models[ch]
+        c_dir[row, ox[ch] : ox[ch] + mm.A.shape[0]] = mm.C_head[0]
+        d_dir[row, ou[ch] : ou[ch] + mm.B.shape[1]] = mm.D_head[0]
+    return StackedModel(
+        A=A,
+        B=B,
+        E=E,
+        Q=linalg.block_diag(*qs),
+        R=linalg.block_diag(*rs),
+        i_pos=np.array([ox["pitch"] + mp.i_pos, ox["roll"] + mr.i_pos, ox["heave"] + mh.i_pos]),
+        i_vel=np.array([ox["pitch"] + mp.i_vel, ox["roll"] + mr.i_vel, ox["heave"] + mh.i_vel]),
+        i_tilt=np.array([ox["roll"] + mr.i_angle, ox["pitch"] + mp.i_angle, ox["yaw"] + my.i_angle]),
+        i_rot=np.array([ox["roll"] + mr.A.shape[0] - 1, ox["pitch"] + mp.A.shape[0] - 1]),
+        j_acc=np.array([ou["pitch"], ou["roll"], ou["heave"]]),
+        j_tilt=np.array([ou["roll"] + 1, ou["pitch"] + 1]),
+        j_rot=np.array([ou["roll"] + 2, ou["pitch"] + 2, ou["yaw"]]),
+        C_dir=c_dir,
+        D_dir=d_dir,
+        W_dir=np.array([params.pitch.direct_force, params.roll.direct_force, params.heave.direct_force]),
+    )
+
+
+def stacked_inputs(f_mps2: np.ndarray, omega_radps: np.ndarray, gravity_mps2: float) -> np.ndarray:
+    """The stacked aircraft input r (6,): [f_x, omega_y | f_y, omega_x | f_z + g | omega_z]."""
+    return np.concatenate([channel_inputs(c, f_mps2, omega_radps, gravity_mps2) for c in CHANNELS], axis=-1)
+
+
+_ACCEPTED = ("solved", "solved inaccurate")
+
+# sign patterns of the 1-norm ball's facets |p| + |q| + |r| <= w, as |s . omega| <= w (roll, pitch, yaw)
+_FACETS = np.array([[1.0, 1.0, 1.0], [1.0, 1.0, -1.0], [1.0, -1.0, 1.0], [1.0, -1.0, -1.0]])
+
+
+class MpcWashout:
+    """The MPC washout per step (:class:`washbench.cueing.algorithm.WashoutAlgorithm`).
+
+    State: the stacked model state ``x`` (perceived-error states, angles, position, velocity), the last applied
+    controls ``u`` and OSQP's workspace (warm start). Counters: :attr:`solves`, :attr:`fallbacks` (failed or
+    rejected solves replaced by braking), :attr:`iterations` (OSQP iterations per step).
+    """
+
+    Params = MpcParams
+    name = "mpc"
+
+    def __init__(self, params: MpcParams | None, context: WashoutContext) -> None:
+        import osqp  # imported when an MPC washout is made (loading it costs ~0.1 s)
+
+        self.params = p = params if params is not None else MpcParams()
+        self.context = context
+        self.dt = float(context.dt_s)
+        self.g = float(context.gravity_mps2)
+        if p.prediction_step_s < self.dt * (1.0 - 1e-9):
+            raise ValueError(f"mpc: prediction_step_s {p.prediction_step_s} s is shorter than the sample {self.dt} s")
+        self.model = sm = stacked_model(p, self.g)
+        lim = context.limits
+        self.p_max = np.array(lim.translation.position_limit_m.xyz)
+        self.v_max = np.array(lim.translation.velocity_limit_mps.xyz)
+        self.a_max = np.array(lim.translation.acceleration_limit_mps2.xyz)
+        self.w_max = math.radians(lim.rotation.rate_limit_degps)
+        self.alpha_max = math.radians(lim.rotation.acceleration_limit_degps2)
+        self.n, self.m = sm.B.shape
+        self.N = p.horizon_steps
+        self.tp = p.prediction_step_s
+        ab = np.hstack([sm.B, sm.E])
+        self.phi_p, gam = discretise_zoh(sm.A, ab, self.tp)
+        self.gam_p, self.gam_rp = gam[:, : self.m], gam[:, self.m :]
+        self.phi_f, gam = discretise_zoh(sm.A, ab, self.dt)
+        self.gam_f, self.gam_rf = gam[:, : self.m], gam[:, self.m :]
+        self.rho = math.exp(-p.reference_decay_per_s * self.tp)
+        self._build_qp()
+        s = p.solver
+        self.solver = osqp.OSQP()
+        extra = {"time_limit": s.time_limit_s} if s.time_limit_s > 0.0 else {}
+        settings = {"max_iter": s.max_iter, "eps_abs": s.eps_abs, "eps_rel": s.eps_rel, "polishing": s.polishing}
+        settings.update(adaptive_rho=s.adaptive_rho, check_termination=5, verbose=False, warm_starting=True, **extra)
+        self.solver.setup(self.P_qp, np.zeros(self.nz), self.A_qp, self.l0, self.u0, **settings)
+        self.x = np.zeros(self.n)
+        self.u = np.zeros(self.m)
+        self.solves = 0
+        self.fallbacks = 0
+        self.inaccurate = 0
+        self.brakes = 0
+        self._plan: np.ndarray | None = None
+        self._plan_age = 0
+        self.iterations: list[int] = []
+        self._sat_tilt = False
+        self._sat_rot = False
+
+    # ---- the QP: z = [u_0, x_1, u_1, x_2, ..., u_{N-1}, x_N]
+    def _iu(self, k: int) -> int:
+        return k * (self.m + self.n)
+
+    def _ix(self, k: int) -> int:  # x_k, k >= 1
+        return (k - 1) * (self.m + self.n) + self.m
+
+    def _build_qp(self) -> None:
+        sm, n, m, N, tp = self.model, self.n, self.m, self.N, self.tp
+        p = self.params
+        self.nz = nz = N * (n + m)
+        # stage k: [u_k, x_{k+1}] with u' R u + x' Q x + w_d |C_dir x + D_dir u - r_f|^2 (r_f: the aircraft force
+        # deviation held), all times dt_p; OSQP minimises 1/2 z' P z + q' z (the whole cost halved: same minimiser)
+        mdir = np.hstack([sm.D_dir, sm.C_dir])  # (3, m + n)
+        wdir = np.diag(sm.W_dir)
+        block = linalg.block_diag(sm.R, sm.Q) + mdir.T @ wdir @ mdir
+        self.P_qp = sparse.csc_matrix(sparse.triu(sparse.block_diag([block * tp] * N)))
+        sel = np.zeros((3, 6))
+        sel[0, 0] = sel[1, 2] = sel[2, 4] = 1.0  # r = [f_x, omega_y | f_y, omega_x | f_z + g | omega_z]
+        qblk = -(mdir.T @ wdir @ sel) * tp  # (m + n, 6)
+        self._q_map = np.vstack([qblk * self.rho**k for k in range(N)])  # q = _q_map @ r
+        rows: list[sparse.spmatrix] = []
+        # dynamics: x_{k+1} - Phi x_k - Gamma u_k = (Phi x_0 if k == 0) + Gamma_r r_k
+        dyn = sparse.lil_matrix((N * n, nz))
+        for k in range(N):
+            r0 = k * n
+            dyn[r0 : r0 + n, self._ix(k + 1) : self._ix(k + 1) + n] = np.eye(n)
+            dyn[r0 : r0 + n, self._iu(k) : self._iu(k) + m] = -self.gam_p
+            if k > 0:
+                dyn[r0 : r0 + n, self._ix(k) : self._ix(k) + n] = -self.phi_p
+        rows.append(dyn.tocsc())
+        lo_b = np.full(nz, -np.inf)
+        hi_b = np.full(nz, np.inf)
+        mg = p.limit_margin
+        tilt = math.radians(p.tilt_rate_limit_degps) if p.tilt_rate_limit_degps is not None else np.inf
+        for k in range(N):
+            iu, ix = self._iu(k), self._ix(k + 1)
+            hi_b[iu + sm.j_acc] = mg * self.a_max
+            hi_b[iu + sm.j_tilt] = tilt
+            hi_b[iu + sm.j_rot] = mg * self.w_max
+            hi_b[ix + sm.i_pos] = mg * self.p_max
+            hi_b[ix + sm.i_vel] = mg * self.v_max
+        lo_b = -hi_b
+        if p.terminal_rest:
+            ixn = self._ix(N)
+            lo_b[ixn + sm.i_vel] = 0.0
+            hi_b[ixn + sm.i_vel] = 0.0
+        finite = np.isfinite(hi_b)
+        self._bound_idx = np.flatnonzero(finite)
+        rows.append(sparse.eye(nz, format="csc")[self._bound_idx])
+        # total angular rates omega = tilt + rotational (roll, pitch), yaw: 1-norm ball and its change
+        rate = sparse.lil_matrix((N * 4, nz))
+        dacc = sparse.lil_matrix((N * 4, nz))
+        for k in range(N):
+            iu = self._iu(k)
+            for f, s in enumerate(_FACETS):
+                row = 4 * k + f
+                for ax in range(3):
+                    cols = [iu + sm.j_rot[ax]] + ([iu + sm.j_tilt[ax]] if ax < 2 else [])
+                    for c in cols:
+                        rate[row, c] = s[ax]
+                        dacc[row, c] = s[ax]
+                        if k > 0:
+                            dacc[row, c - (n + m)] = -s[ax]
+        rows += [rate.tocsc(), dacc.tocsc()]
+        self.A_qp = sparse.vstack(rows, format="csc")
+        n_dyn = N * n
+        n_b = self._bound_idx.size
+        self._rows_dyn = slice(0, n_dyn)
+        self._rows_dacc0 = slice(n_dyn + n_b + 4 * N, n_dyn + n_b + 4 * N + 4)
+        w = mg * self.w_max
+        dw = mg * self.alpha_max * tp
+        self.l0 = np.concatenate([np.zeros(n_dyn), lo_b[self._bound_idx], np.full(4 * N, -w), np.full(4 * N, -dw)])
+        self.u0 = np.concatenate([np.zeros(n_dyn), hi_b[self._bound_idx], np.full(4 * N, w), np.full(4 * N, dw)])
+        self._dw0 = mg * self.alpha_max * self.dt
+        self._tilt_max = tilt
+        self._gam_r_stack = np.vstack([self.gam_rp * self.rho**k for k in range(N)])
+
+    def _total_rates(self, u: np.ndarray) -> np.ndarray:
+        sm = self.model
+        w = u[sm.j_rot].copy()
+        w[:2] += u[sm.j_tilt]
+        return w
+
+    # ---- the washout
+    def _set_point(self) -> SetPoint:
+        sm, x = self.model, self.x
+        ang = x[sm.i_tilt].copy()
+        ang[:2] += x[sm.i_rot]
+        return x[sm.i_pos].copy(), np.array(quat_from_euler(float(ang[0]), float(ang[1]), float(ang[2])))
+
+    def start(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> SetPoint:
+        """Start level and centred at rest, with the perceived-error states of a pilot who has sat level and still
+        (the error models start at the steady error of the first sample, or of rest)."""
+        if self.context.filter_start == "rest":
+            r0 = stacked_inputs(np.array([0.0, 0.0, -self.g]), np.zeros(3), self.g)
+        else:
+            r0 = stacked_inputs(np.asarray(f_mps2, float), np.asarray(omega_radps, float), self.g)
+        self.x = self._steady_error(r0)
+        self.u = np.zeros(self.m)
+        self._plan, self._plan_age = None, 0
+        return self._set_point()
+
+    def _steady_error(self, r0: np.ndarray) -> np.ndarray:
+        """State with the platform level, centred and still and the error models in their steady state."""
+        sm = self.model
+        x = np.zeros(self.n)
+        plat = np.zeros(self.n, dtype=bool)
+        plat[np.concatenate([sm.i_pos, sm.i_vel, sm.i_tilt, sm.i_rot])] = True
+        vest = ~plat
+        a = sm.A[np.ix_(vest, vest)]
+        x[vest] = -np.linalg.solve(a, (sm.E @ r0)[vest])
+        return x
+
+    def _update_bounds(self, r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        n = self.n
+        lo, hi = self.l0.copy(), self.u0.copy()
+        aff = self._gam_r_stack @ r
+        aff[:n] += self.phi_p @ self.x
+        lo[self._rows_dyn] = aff
+        hi[self._rows_dyn] = aff
+        s = _FACETS @ self._total_rates(self.u)
+        lo[self._rows_dacc0] = s - self._dw0
+        hi[self._rows_dacc0] = s + self._dw0
+        return lo, hi
+
+    def _safe(self, u0: np.ndarray) -> bool:
+        """Whether the first move keeps the platform within its limits at the sample step and able to stop."""
+        sm = self.model
+        if not np.all(np.isfinite(u0)):
+            return False
+        x1 = self.phi_f @ self.x + self.gam_f @ u0 + self._r_term
+        p1 = x1[sm.i_pos]
+        v1 = x1[sm.i_vel]
+        if np.any(np.abs(p1) > self.p_max) or np.any(np.abs(v1) > self.v_max):
+            return False
+        if np.any(np.abs(u0[sm.j_acc]) > self.a_max * (1 + 1e-9)):
+            return False
+        for j in range(3):
+            room = self.p_max[j] - p1[j] if v1[j] > 0 else self.p_max[j] + p1[j]
+            if abs(v1[j]) > brake_speed(room, self.a_max[j], self.dt) + 1e-9:
+                return False
+        w = self._total_rates(u0)
+        dw = np.linalg.norm(w - self._total_rates(self.u))
+        return bool(np.linalg.norm(w) <= self.w_max and dw <= self.alpha_max * self.dt)
+
+    def _fallback_move(self) -> np.ndarray:
+        """The move of a failed step: the last accepted plan, continued (feasible for the platform: its limits do not
+        depend on the aircraft input), at rest after its end; braking (counted in :attr:`brakes`) if there is none or
+        it is not safe; holding still if even braking is not (it always is, short of rounding)."""
+        if self._plan is not None:
+            j = int(self._plan_age * self.dt / self.tp + 1e-9)
+            move = self._plan[j].copy() if j < self.N else np.zeros(self.m)
+            if (self.params.terminal_rest or j < self.N) and self._safe(move):
+                return move
+        self.brakes += 1
+        move = self._brake()
+        return move if self._safe(move) else np.zeros(self.m)
+
+    def _brake(self) -> np.ndarray:
+        """Braking move: each axis decelerates towards rest at its acceleration limit; the rates likewise."""
+        sm = self.model
+        u = np.zeros(self.m)
+        v = self.x[sm.i_vel]
+        u[sm.j_acc] = -np.clip(v / self.dt, -self.a_max, self.a_max)
+        rates = self.u.copy()
+        for idx in (sm.j_tilt, sm.j_rot):
+            w = rates[idx]
+            nw = np.linalg.norm(w)
+            step = self.alpha_max * self.dt / math.sqrt(5.0)  # the five rate controls share the limit
+            u[idx] = 0.0 if nw <= step else w * (1.0 - step / nw)
+        return u
+
+    def plan(self, r: np.ndarray) -> tuple[bool, np.ndarray]:
+        """Solve the QP from the current state for the stacked aircraft input ``r`` (6,).
+
+        Returns (solved, controls (N, m)); ``solved`` is False unless OSQP reports ``solved`` or ``solved inaccurate``
+        (the iteration limit reached with residuals within ten times the tolerances: counted in
+        :attr:`inaccurate`; its first move is still checked by :meth:`_safe`) with a finite result.
+        """
+        lo, hi = self._update_bounds(r)
+        self.solver.update(q=self._q_map @ r, l=lo, u=hi)
+        res = self.solver.solve(raise_error=False)
+        self.solves += 1
+        self.iterations.append(int(res.info.iter))
+        z = res.x
+        status = res.info.status
+        ok = status in _ACCEPTED and z is not None and bool(np.all(np.isfinite(z)))
+        if ok and status != "solved":
+            self.inaccurate += 1
+        if not ok:
+            return False, np.zeros((self.N, self.m))
+        return True, np.stack([z[self._iu(k) : self._iu(k) + self.m] for k in range(self.N)])
+
+    def step(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> SetPoint:
+        """Solve the QP for this sample, apply its first move for one sample, return the set point."""
+        r = stacked_inputs(f_mps2, omega_radps, self.g)
+        if not np.all(np.isfinite(r)):
+            raise ValueError("mpc: non-finite input")
+        ok, plan = self.plan(r)
+        self._r_term = self.gam_rf @ r
+        if ok and self._safe(plan[0]):
+            move = plan[0].copy()
+            self._plan, self._plan_age = plan, 0
+        else:
+            self.fallbacks += 1
+            move = self._fallback_move()
+        self._plan_age += 1
+        self._sat_tilt = bool(np.any(np.abs(move[self.model.j_tilt]) >= 0.999 * self._tilt_max))
+        self._sat_rot = bool(np.sum(np.abs(self._total_rates(move))) >= 0.999 * self.params.limit_margin * self.w_max)
+        self.u = move
+        self.x = self.phi_f @ self.x + self.gam_f @ move + self._r_term
+        return self._set_point()
+
+    def flags(self) -> tuple[bool, bool]:
+        """(tilt-rate limit reached, rotational-rate limit reached) on the last step."""
+        return self._sat_tilt, self._sat_rot
+
+    def report(self) -> dict[str, float]:
+        """Solver statistics so far: solves, fallbacks (failed or unsafe solves), of which brakes (no usable previous
+        plan: braking), inaccurate (accepted at the iteration limit), iterations (median, max)."""
+        it = np.array(self.iterations) if self.iterations else np.zeros(1)
+        return {
+            "solves": float(self.solves),
+            "fallbacks": float(self.fallbacks),
+            "inaccurate": float(self.inaccurate),
+            "brakes": float(self.brakes),
+            "iterations_median": float(np.median(it)),
+            "iterations_max": float(np.max(it)),
+        }
+
+
+__all__ = ["MpcParams", "MpcWashout", "MpcWeights", "OsqpSettings", "StackedModel", "stacked_model"]
