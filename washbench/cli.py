@@ -39,8 +39,8 @@ def _washout_options(p: argparse.ArgumentParser, variants: bool = True) -> None:
         "--washout",
         action="append",
         metavar="NAME",
-        help=f"washout to run, repeatable: {', '.join(WASHOUT_KINDS)}, or a plugin's name (default: the first "
-        "three, or none with a variant)",
+        help=f"washout to run, repeatable: {', '.join(WASHOUT_KINDS)}, optimal, mpc, bound (whole recordings), or "
+        "a plugin's name (default: the first three, or none with a variant)",
     )
     if variants:
         p.add_argument("--variant", action="append", default=[], metavar="NAME=KIND[,KEY=VALUE...]", help=_VARIANT_HELP)
@@ -225,7 +225,10 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("tune", help="tune washout parameters on training manoeuvres (differential evolution)")
     p.add_argument("manoeuvres", type=Path, nargs="+", help="training manoeuvre files or folders")
-    p.add_argument("--washout", required=True, metavar="KIND", help=f"washout kind: {', '.join(WASHOUT_KINDS)}")
+    p.add_argument(
+        "--washout", required=True, metavar="KIND",
+        help=f"washout kind: {', '.join(WASHOUT_KINDS)}, optimal, mpc or a plugin's name",
+    )  # fmt: skip
     p.add_argument(
         "--tune",
         dest="tunes",
