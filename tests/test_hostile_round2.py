@@ -591,7 +591,7 @@ def test_dask_address_that_is_no_scheduler_is_one_line_quickly(tmp_path: Path) -
 def test_report_on_tampered_result_files_rebuilds_or_refuses_cleanly(cued: Path, tmp_path: Path) -> None:
     """Hypothesis: washbench's own result files mutated (types, missing keys, text columns): `washbench report`
     either rebuilds the report (exit 0) or refuses with one line naming the file (exit 2); never a traceback."""
-    from hypothesis import HealthCheck, given, settings
+    from hypothesis import HealthCheck, example, given, settings
     from hypothesis import strategies as st
 
     from washbench.cli import main
@@ -610,7 +610,11 @@ def test_report_on_tampered_result_files_rebuilds_or_refuses_cleanly(cued: Path,
     )
     counter = iter(range(10_000))
 
-    @settings(max_examples=12, deadline=None, suppress_health_check=list(HealthCheck))
+    # derandomized: the same examples in every run (a CI run cannot fail by chance); the explicit ones are what a
+    # random run once found (the input figure's legends and notes, read back from run.json)
+    @settings(max_examples=12, deadline=None, suppress_health_check=list(HealthCheck), derandomize=True)
+    @example(target="run.json", key="conversions", value=None, drop=False)
+    @example(target="run.json", key="input_labels", value=[1, 2, 3, 4, 5, 6], drop=False)
     @given(
         target=st.sampled_from(["run.json", "traces.parquet", "metrics.csv", "flight.json", "provenance"]),
         key=st.sampled_from(keys),

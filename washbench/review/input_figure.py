@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from washbench.errors import WashbenchError, located
 from washbench.io.input_format import ColumnSource
 from washbench.io.units import G0_MPS2, axes_matrix, is_identity_axes
 
@@ -158,16 +159,23 @@ def redraw(folder: Path, formats: Sequence[str], fig_dir: Path | None = None) ->
         doc = json.loads((folder / "run.json").read_text())
     except (OSError, ValueError):
         return None
+    if not isinstance(doc, dict):
+        return None
     labels = doc.get("input_labels")
     if not isinstance(labels, list) or len(labels) != 6:
         return None
+    notes = doc.get("conversions", [])
+    where = folder / "run.json"
+    for key, value in (("input_labels", labels), ("conversions", notes)):
+        if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
+            raise WashbenchError(located(where, f"{key}: not as washbench writes it (a list of texts); edited or "
+                                                "damaged? write it again"))  # fmt: skip
     cols = [TIME_COLUMN, *f_columns(AIRCRAFT), *omega_columns(AIRCRAFT)]
     table = pq.read_table(folder / "traces.parquet", columns=cols)
     arr = np.column_stack([table[c].to_numpy() for c in cols])
     title = f"{Path(str(doc.get('input', 'input'))).name} {doc.get('segment', '')}".strip()
     stem = (fig_dir or folder / "figures") / INPUT_STEM
-    return input_figure(stem, title, arr[:, 0], arr[:, 1:4], arr[:, 4:7], labels, doc.get("conversions", ()),
-                        formats)  # fmt: skip
+    return input_figure(stem, title, arr[:, 0], arr[:, 1:4], arr[:, 4:7], labels, notes, formats)
 
 
 def draw_for_result(folder: Path, title: str, motion: Any, labels: Sequence[str], notes: Sequence[str]) -> Path:
