@@ -170,9 +170,23 @@ def redraw(folder: Path, formats: Sequence[str], fig_dir: Path | None = None) ->
         if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
             raise WashbenchError(located(where, f"{key}: not as washbench writes it (a list of texts); edited or "
                                                 "damaged? write it again"))  # fmt: skip
+    import pyarrow as pa
+
     cols = [TIME_COLUMN, *f_columns(AIRCRAFT), *omega_columns(AIRCRAFT)]
-    table = pq.read_table(folder / "traces.parquet", columns=cols)
-    arr = np.column_stack([table[c].to_numpy() for c in cols])
+    traces = folder / "traces.parquet"
+    try:
+        table = pq.read_table(traces, columns=cols)
+    except (OSError, KeyError, ValueError, pa.ArrowException) as exc:
+        raise WashbenchError(located(traces, f"cannot read the input columns: {exc}")) from None
+    for c in cols:  # what the figure draws must be numbers (a file edited by hand may say otherwise)
+        kind = table.schema.field(c).type
+        if not (pa.types.is_floating(kind) or pa.types.is_integer(kind)):
+            raise WashbenchError(located(traces, f"{c}: not as washbench writes it (numbers, got {kind}); edited or "
+                                                 "damaged? write it again"))  # fmt: skip
+    arr = np.column_stack([table[c].to_numpy(zero_copy_only=False).astype(np.float64) for c in cols])
+    if not np.isfinite(arr).all():
+        raise WashbenchError(located(traces, "the input columns hold values that are not finite; edited or damaged? "
+                                             "write it again"))  # fmt: skip
     title = f"{Path(str(doc.get('input', 'input'))).name} {doc.get('segment', '')}".strip()
     stem = (fig_dir or folder / "figures") / INPUT_STEM
     return input_figure(stem, title, arr[:, 0], arr[:, 1:4], arr[:, 4:7], labels, notes, formats)
