@@ -17,6 +17,7 @@ A plugin's kind is its ``washout_name`` attribute if it has one, else ``NAME``. 
 
 from __future__ import annotations
 
+import functools
 import importlib
 import importlib.metadata
 import importlib.util
@@ -148,7 +149,9 @@ def load_plugin(spec: str) -> Algorithm:
     return algo
 
 
+@functools.cache
 def _entry_points() -> dict[str, importlib.metadata.EntryPoint]:
+    """The ``washbench.washouts`` entry points installed, read once per process (every name check asks)."""
     return {ep.name: ep for ep in importlib.metadata.entry_points(group=ENTRY_POINT_GROUP)}
 
 

@@ -119,14 +119,15 @@ def _map(fn, args: list[tuple], jobs: int | None, dask: str | None) -> list:
     jobs = max(1, min(jobs or usable_cpus(), len(args)))
     if jobs == 1:
         return [fn(*a) for a in args]
-    from washbench.runs.suite import _signals_deferred, _signals_held, _stop_pool, _worker_init, pool_context
+    from washbench.io.outfolder import signals_held
+    from washbench.runs.suite import _signals_held, _stop_pool, _worker_init, pool_context
 
     # As the suite's pool: the workers ignore Ctrl-C (no traceback from each), the main process stops them at once
     # on SIGINT/SIGTERM, a signal while they start is acted on once they exist, and they die with their parent.
     ctx, initializer = pool_context(main_stops_workers=True)
     pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_init, initargs=(initializer,))
     try:
-        with _signals_deferred():
+        with signals_held():  # a signal while the workers start is acted on once they exist
             futures = [pool.submit(fn, *a) for a in args]
         results = [f.result() for f in futures]
     except BaseException:

@@ -55,11 +55,11 @@ from washbench.analysis.ranking import (
     reference_washout,
     rule_from_record,
 )
-from washbench.errors import Terminated, WashbenchError, located
+from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
 from washbench.io.cpus import usable_cpus
 from washbench.io.lock import output_lock
-from washbench.io.outfolder import discard_stage, is_own_hidden, recover, swap_in
+from washbench.io.outfolder import discard_stage, is_own_hidden, recover, signals_held, swap_in
 from washbench.io.paths import MANOEUVRES_DIR, bundled_names, resolve_manoeuvre
 from washbench.io.progress import Progress
 from washbench.io.publish import clean_partials, is_leftover, is_washbench_result, read_marker
@@ -127,29 +127,6 @@ def _signals_held() -> Iterator[None]:
     finally:
         for sig, handler in saved.items():
             signal.signal(sig, handler)
-
-
-@contextlib.contextmanager
-def _signals_deferred() -> Iterator[None]:
-    """Hold SIGINT and SIGTERM back while worker processes are being started, then act on them.
-
-    A worker is started by sending it its start-up data through the process server; interrupted half-way,
-    the worker would start after this process exits and print a traceback. So a signal arriving meanwhile is
-    noted and raised (KeyboardInterrupt or Terminated) once the workers exist and can be stopped.
-    """
-    noted: list[int] = []
-
-    def note(signum: int, frame: object) -> None:
-        noted.append(signum)
-
-    saved = {sig: signal.signal(sig, note) for sig in (signal.SIGINT, signal.SIGTERM)}
-    try:
-        yield
-    finally:
-        for sig, handler in saved.items():
-            signal.signal(sig, handler)
-    if noted:
-        raise KeyboardInterrupt if noted[0] == signal.SIGINT else Terminated()
 
 
 def _stop_pool(pool: ProcessPoolExecutor) -> None:
@@ -312,7 +289,7 @@ def run_suite(
                 max_workers=jobs, mp_context=ctx, initializer=_worker_init, initargs=(initializer,)
             )
             try:
-                with _signals_deferred():  # submitting starts the workers (up to ``jobs``)
+                with signals_held():  # submitting starts the workers (up to ``jobs``)
                     futures = [pool.submit(_run_one, *a) for a in args]
                 for fut in as_completed(futures):
                     runs = fut.result()
