@@ -35,6 +35,9 @@ from washbench.io.names import identifier_problem
 
 ENTRY_POINT_GROUP = "washbench.washouts"
 
+RESERVED_NAMES = frozenset({"aircraft", "limit", "t_s"})
+"""Names no washout (variant or plugin) may take: they are column prefixes of the outputs."""
+
 BUILTIN_PYTHON: dict[str, str] = {
     "optimal": "washbench.cueing.optimal:OptimalWashout",
     "mpc": "washbench.cueing.mpc:MpcWashout",
@@ -97,7 +100,7 @@ def _algorithm(obj: Any, kind: str, source: str) -> Algorithm:
     problem = identifier_problem(kind)
     if problem is not None:
         raise WashbenchError(f"{where}: washout name {kind!r}: {problem}")
-    if kind in WASHOUT_KINDS or kind in BUILTIN_PYTHON or kind in ("aircraft", "limit", "t_s", "bound"):
+    if kind in WASHOUT_KINDS or kind in BUILTIN_PYTHON or kind in RESERVED_NAMES:
         raise WashbenchError(f"{where}: washout name {kind!r} is taken by a built-in washout or output")
     return Algorithm(kind, obj, _params_model(obj, where), source)
 
@@ -224,6 +227,7 @@ def get(kind: str, spec: str | None = None) -> Algorithm:
 __all__ = [
     "BUILTIN_PYTHON",
     "ENTRY_POINT_GROUP",
+    "RESERVED_NAMES",
     "Algorithm",
     "check_washouts",
     "get",

@@ -42,7 +42,7 @@ from washbench.errors import WashbenchError, located
 from washbench.io.names import identifier_problem
 from washbench.io.yamlio import Loc, line_of, read_yaml, validate_data
 
-RESERVED_NAMES = frozenset({"aircraft", "limit", "t_s"})
+RESERVED_NAMES = registry.RESERVED_NAMES
 
 
 @dataclass(frozen=True)
