@@ -100,7 +100,9 @@ class MetricRow:
     The cue classification (:mod:`washbench.analysis.cues`): time fractions ``cue_*_frac`` (NaN where not
     classified, e.g. a study's evaluation) and the false-cue events as ``start-end@peak;...`` text. On the heave row,
     the motion sickness dose values (MSDV, m/s^1.5, ISO 2631-1 Wf) of the simulator pilot and of the aircraft pilot
-    (NaN on the other rows).
+    and their predicted motion-sickness incidence at the end of the manoeuvre (MSI, %, the 6-DOF subjective
+    vertical conflict model of :mod:`washbench.perception.svc`: one value per pilot, of all six DOFs) (NaN on the
+    other rows).
     """
 
     washout: str
@@ -115,6 +117,8 @@ class MetricRow:
     msdv_mps15: float = math.nan
     msdv_aircraft_mps15: float = math.nan
     false_cue_events: str = ""
+    msi_pct: float = math.nan
+    msi_aircraft_pct: float = math.nan
 
 
 def dof_metrics(
