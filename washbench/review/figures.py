@@ -32,6 +32,7 @@ from typing import Any
 
 import numpy as np
 
+from washbench.io.outfolder import uninterrupted
 from washbench.review.numbers import SCORE_FLAG
 from washbench.review.palette import aircraft_color, mpl, palette_name, washout_colors, washout_dashes
 
@@ -263,6 +264,7 @@ def _shade_phases(ax: Any, phases: Sequence[tuple[str, float, float]]) -> None:
                       autolim=False)  # fmt: skip
 
 
+@uninterrupted
 def perceived_figure(
     stem: Path,
     title: str,
@@ -332,6 +334,7 @@ def _runs(flags: np.ndarray) -> list[tuple[int, int]]:
     return list(zip(edges[::2].tolist(), edges[1::2].tolist(), strict=True))
 
 
+@uninterrupted
 def envelope_figure(
     stem: Path,
     title: str,
@@ -409,6 +412,7 @@ def _sig(x: float, digits: int = 3) -> str:
     return sig(x, digits)
 
 
+@uninterrupted
 def score_heatmap(
     stem: Path,
     rows: Sequence[str],
@@ -454,6 +458,7 @@ def score_heatmap(
     return save_figure(fig, stem, formats)
 
 
+@uninterrupted
 def table4_figure(
     stem: Path,
     rows: Sequence[str],
