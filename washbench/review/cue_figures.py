@@ -15,6 +15,7 @@ import numpy as np
 
 from washbench.analysis.cues import FALSE, MISSING, classify, dof_thresholds
 from washbench.analysis.metrics import DOFS
+from washbench.io.outfolder import uninterrupted
 
 FALSE_COLOUR = (0.84, 0.15, 0.16)
 MISSING_COLOUR = (0.72, 0.72, 0.72)
@@ -38,6 +39,7 @@ def cue_classes(perceived: Mapping[str, np.ndarray], washouts: Sequence[str]) ->
     }
 
 
+@uninterrupted
 def cue_lane_figure(
     stem: Path,
     title: str,
