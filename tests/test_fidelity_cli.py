@@ -161,3 +161,14 @@ def test_msi_on_the_heave_rows_equals_the_model_on_the_input(runs: dict[str, Pat
     assert all(r.msi_pct >= 0.0 and math.isfinite(r.msi_pct) for r in heave)
     report = (runs["default"] / "report.md").read_text()
     assert "| pilot | MSDV (m/s^1.5) | MSI (%) |" in report and "subjective vertical conflict" in report
+
+
+def test_the_sickness_models_are_in_the_provenance_and_report(runs: dict[str, Path]) -> None:
+    from washbench.perception.svc import IN1
+
+    rec = _prov(runs["tc"])["vestibular"]["sickness"]
+    assert rec["msdv"] == "ISO 2631-1 Wf" and rec["msi"]["model"] == "6dof-svc-in1"
+    assert rec["msi"]["values"]["tau_i_s"] == IN1.tau_i_s == 720.0 and rec["msi"]["values"]["k_vc"] == 5.0
+    assert "| sickness models | MSDV: ISO 2631-1 Wf; MSI: 6-DOF subjective vertical conflict, In1" in (
+        runs["tc"] / "report.md"
+    ).read_text()

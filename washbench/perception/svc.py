@@ -84,6 +84,19 @@ IN1 = SvcParams()
 WADA2018 = SvcParams(k_a=0.1, k_w=0.8, k_wc=5.0, k_vc=5.0, k_ac=1.0, tau_s=5.0)
 """Wada, Fujisawa and Doi (2018), as quoted (commented out) in the same parameter file."""
 
+MODEL_NAME = "6dof-svc-in1"
+"""The model's name in the provenance (:func:`sickness_record`)."""
+
+
+def sickness_record(params: SvcParams = IN1) -> dict[str, object]:
+    """Provenance of the sickness numbers: the MSDV weighting and the MSI model with its parameter values."""
+    name = MODEL_NAME if params == IN1 else "6dof-svc"
+    return {
+        "msdv": "ISO 2631-1 Wf",
+        "msi": {"model": name, "values": dict(zip(params.__dataclass_fields__, astuple(params), strict=True))},
+    }
+
+
 N_STATE = 23
 _V_S, _HV_S, _X_VC, _G, _MSI = 6, 9, 15, 18, 22
 

@@ -103,6 +103,11 @@ def provenance_lines(prov: dict[str, Any] | None, created_utc: str | None) -> li
         names = {"young-meiry": "Meiry-Young otolith, Young-Oman canals (the paper's)",
                  "telban-cardullo": "Telban-Cardullo otolith and canals (NASA CR-2005-213747)"}  # fmt: skip
         rows.append(("vestibular models", names.get(vest["model"], str(vest["model"]))))
+        msi = (vest.get("sickness") or {}).get("msi") or {}
+        if msi.get("model"):
+            rows.append(("sickness models", "MSDV: ISO 2631-1 Wf; MSI: "
+                         + ("6-DOF subjective vertical conflict, In1 (Inoue, Liu and Wada 2023)"
+                            if msi["model"] == "6dof-svc-in1" else str(msi["model"]))))  # fmt: skip
     ranking = prov.get("ranking")
     if isinstance(ranking, dict) and ranking.get("by"):
         rows.append(("ranking rule", f"`--rank-by {ranking['by']}`"))
