@@ -102,7 +102,8 @@ def _reference_rhs(p: svc.SvcParams, u_of_t: Callable[[float], tuple[np.ndarray,
     return rhs
 
 
-@pytest.mark.parametrize("params", [svc.IN1, svc.WADA2018], ids=["in1", "wada2018"])
+@pytest.mark.parametrize("params", [svc.IN1, svc.WADA2018, svc.SvcParams(n=3.0, b_mps2=0.3)],
+                         ids=["in1", "wada2018", "hill-n3"])  # fmt: skip
 def test_six_dof_motion_against_an_independent_solve_ivp(params: svc.SvcParams) -> None:
     """A smooth roll to 25 deg held (tilt coordination), a surge pulse and a yaw sine, 40 s: the compiled RK4 on
     120 Hz samples against solve_ivp (DOP853, tight tolerances) of the equations written again in the test, on

@@ -142,26 +142,25 @@ def _cross(a: np.ndarray, ia: int, b: np.ndarray, ib: int, out: np.ndarray, io: 
 
 
 @njit(cache=True)
-def _deriv(x: np.ndarray, u: np.ndarray, prm: np.ndarray, out: np.ndarray, tmp: np.ndarray) -> float:
-    """dx/dt into ``out`` for input ``u = [omega (3), f (3)]``; returns the conflict |v_s - hv_s|."""
+def _deriv(x: np.ndarray, u: np.ndarray, prm: np.ndarray, out: np.ndarray, tmp: np.ndarray) -> None:
+    """dx/dt into ``out`` for input ``u = [omega (3), f (3)]`` (``prm``: :func:`_coefficients`)."""
     ka, kw, kwc, kvc, kac = prm[0], prm[1], prm[2], prm[3], prm[4]
-    taud, taua, tau, b, taui, pp, n = prm[5], prm[6], prm[7], prm[8], prm[9], prm[10], prm[11]
-    c1 = 1.0 / taud + 1.0 / taua
-    c0 = 1.0 / (taud * taua)
+    c1, c0, inv_tau, inv_kac1, inv_kwc1, inv_taud = prm[5], prm[6], prm[7], prm[8], prm[9], prm[10]
+    inv_b2, taui, inv_taui2, pp, n, square = prm[11], prm[12], prm[13], prm[14], prm[15], prm[16]
     d2 = 0.0
     for i in range(3):
         w = u[i]
         f = u[3 + i]
         oms = c1 * x[3 + i] + c0 * x[i] + w  # tmp[0:3]: omega_s
-        hf = (ka * (f - x[18 + i]) + kvc * x[15 + i] + kac * (f - x[6 + i] + x[9 + i])) / (1.0 + kac)
-        homs = (x[12 + i] + kw * w + kwc * oms) / (1.0 + kwc)  # tmp[3:6]: internal omega_s
+        hf = (ka * (f - x[18 + i]) + kvc * x[15 + i] + kac * (f - x[6 + i] + x[9 + i])) * inv_kac1
+        homs = (x[12 + i] + kw * w + kwc * oms) * inv_kwc1  # tmp[3:6]: internal omega_s
         tmp[i] = oms
         tmp[3 + i] = homs
         out[i] = x[3 + i]
         out[3 + i] = -c1 * x[3 + i] - c0 * x[i] - w
-        out[6 + i] = (f - x[6 + i]) / tau
-        out[9 + i] = (hf - x[9 + i]) / tau
-        out[12 + i] = -(x[12 + i] + kw * w + kwc * (oms - homs)) / taud
+        out[6 + i] = (f - x[6 + i]) * inv_tau
+        out[9 + i] = (hf - x[9 + i]) * inv_tau
+        out[12 + i] = -(x[12 + i] + kw * w + kwc * (oms - homs)) * inv_taud
         dv = x[6 + i] - x[9 + i]
         out[15 + i] = dv
         out[18 + i] = 0.0
@@ -169,11 +168,19 @@ def _deriv(x: np.ndarray, u: np.ndarray, prm: np.ndarray, out: np.ndarray, tmp: 
     _cross(tmp, 0, x, 6, out, 6, -1.0)
     _cross(tmp, 3, x, 9, out, 9, -1.0)
     _cross(u, 0, x, 18, out, 18, -1.0)
-    c = math.sqrt(d2)
-    r = (c / b) ** n
-    out[21] = (-2.0 * taui * x[21] - x[22] + pp * r / (1.0 + r)) / (taui * taui)
+    r = d2 * inv_b2 if square else (d2 * inv_b2) ** (0.5 * n)  # (c / b)^n, c = |v_s - hv_s|
+    out[21] = (-2.0 * taui * x[21] - x[22] + pp * r / (1.0 + r)) * inv_taui2
     out[22] = x[21]
-    return c
+
+
+def _coefficients(p: SvcParams) -> np.ndarray:
+    """The parameters as the compiled loop uses them (reciprocals precomputed)."""
+    return np.array([
+        p.k_a, p.k_w, p.k_wc, p.k_vc, p.k_ac,
+        1.0 / p.tau_d_s + 1.0 / p.tau_a_s, 1.0 / (p.tau_d_s * p.tau_a_s), 1.0 / p.tau_s, 1.0 / (1.0 + p.k_ac),
+        1.0 / (1.0 + p.k_wc), 1.0 / p.tau_d_s, 1.0 / (p.b_mps2 * p.b_mps2), p.tau_i_s, 1.0 / (p.tau_i_s * p.tau_i_s),
+        p.p_pct, p.n, 1.0 if p.n == 2.0 else 0.0,
+    ])  # fmt: skip
 
 
 @njit(cache=True)
@@ -240,7 +247,7 @@ class SvcStream:
             raise ValueError(f"unknown start {start!r} (valid: steady, rest)")
         self.dt_s = float(dt_s)
         self.params = params
-        self._prm = np.array(astuple(params), dtype=np.float64)
+        self._prm = _coefficients(params)
         self._x: np.ndarray | None = None
         self._u_prev = np.zeros(6)
         if start == "rest":
