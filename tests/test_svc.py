@@ -181,5 +181,7 @@ def test_bad_inputs_are_clear_errors() -> None:
         svc.SvcParams(tau_i_s=0.0)
     with pytest.raises(ValueError, match="k_vc"):
         svc.SvcParams(k_vc=math.nan)
+    with pytest.raises(ValueError, match="k_vc"):
+        svc.SvcParams(k_vc=0.0)  # no conflict integral: no steady state
     with pytest.raises(ValueError, match="non-zero"):
         svc.svc_msi(np.zeros((5, 3)), np.zeros((5, 3)), 0.01)

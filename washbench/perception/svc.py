@@ -74,7 +74,7 @@ class SvcParams:
         for name, v in zip(self.__dataclass_fields__, astuple(self), strict=True):
             if not (math.isfinite(v) and v >= 0.0):
                 raise ValueError(f"SVC parameter {name} must be a finite number >= 0, got {v!r}")
-        for name in ("tau_d_s", "tau_a_s", "tau_s", "b_mps2", "tau_i_s", "n"):
+        for name in ("k_vc", "tau_d_s", "tau_a_s", "tau_s", "b_mps2", "tau_i_s", "n"):
             if getattr(self, name) <= 0.0:
                 raise ValueError(f"SVC parameter {name} must be positive, got {getattr(self, name)!r}")
 
