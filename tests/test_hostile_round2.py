@@ -291,6 +291,38 @@ def test_a_users_aircraft_with_outputs_or_bad_xml(tmp_path: Path) -> None:
         assert not (tmp_path / f"o_{what}").exists()
 
 
+
+def test_jsbsim_state_files_never_land_outside_out(tmp_path: Path) -> None:
+    """JSBSim writes ``initfile.T.xml`` into its output path (its own installation unless set) whenever
+    ``simulation/write-state-file`` is written: a manoeuvre asking for it is refused in one line; an aircraft whose
+    flight controls write it flies, and no such file appears in JSBSim's folder, the current folder or --out."""
+    from washbench.io.paths import jsbsim_root
+
+    def state_files() -> list[Path]:
+        return [*jsbsim_root().glob("initfile*"), *tmp_path.rglob("initfile*")]
+
+    before = state_files()
+    m = short(tmp_path, name="wsf", seconds=0.2)
+    wsf = "    inputs:\n      properties:\n        - {property: simulation/write-state-file, fixed: 1}\n"
+    m.write_text(m.read_text().replace("    until:", wsf + "    until:"))
+    proc = washbench("fly", m, "--out", tmp_path / "o1", "--quiet", timeout=60, cwd=tmp_path)
+    assert_clean_error(proc, str(m), "simulation/write-state-file", "properties[0].property")
+    assert not (tmp_path / "o1").exists()
+
+    acdir = tmp_path / "aircraft"
+    acdir.mkdir()
+    copy_of(jsbsim_root() / "aircraft" / "c172p", acdir / "c172p")
+    model = acdir / "c172p" / "c172p.xml"
+    model.write_text(model.read_text().replace("</fdm_config>", (
+        '<system name="w"><channel name="w"><fcs_function name="w/state"><function><value>1</value></function>'
+        "<output>simulation/write-state-file</output></fcs_function></channel></system></fdm_config>")))  # fmt: skip
+    proc = washbench("fly", short(tmp_path, seconds=0.2), "--out", tmp_path / "o2", "--aircraft-dir", acdir,
+                     "--quiet", timeout=60, cwd=tmp_path)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert (tmp_path / "o2" / "flight.parquet").is_file()
+    assert state_files() == before
+
+
 # ------------------------------------------------------------------------------------------ full disk, signals
 
 

@@ -55,8 +55,11 @@ def aircraft_root(name: str) -> Path:
 def make_fdm(name: str, loading: Loading | None = None) -> jsbsim.FGFDMExec:
     """A loaded, silent FDM for aircraft ``name`` at dt = 1/120 s, optionally reloaded to a gross weight."""
     os.environ.setdefault("JSBSIM_DEBUG", "0")
+    from washbench.flight.jsbsim_xml import scratch_output_dir
+
     fdm = jsbsim.FGFDMExec(None)
     fdm.set_debug_level(0)
+    fdm.set_output_path(scratch_output_dir())  # not the current folder (JSBSim's own files are thrown away)
     fdm.set_aircraft_path(str(aircraft_root(name)))
     if not fdm.load_model(name):
         raise WashbenchError(f"{name}: JSBSim could not load the model")

@@ -48,10 +48,11 @@ def make_fdm(m: Manoeuvre, profile: PilotProfile) -> tuple[Any, Setup]:
     os.environ["JSBSIM_DEBUG"] = "0"
     import jsbsim
 
-    from washbench.flight.jsbsim_xml import aircraft_for_jsbsim
+    from washbench.flight.jsbsim_xml import aircraft_for_jsbsim, scratch_output_dir
 
     root = m.aircraft_files.root
     fdm = jsbsim.FGFDMExec(str(jsbsim_root()), None)
+    fdm.set_output_path(scratch_output_dir())  # not JSBSim's root: its own files (write-state-file) are thrown away
     with tempfile.TemporaryDirectory(prefix="washbench-aircraft-") as tmp:  # the model without <output>
         fdm.set_aircraft_path(str(aircraft_for_jsbsim(root, m.aircraft, Path(tmp))))
         with quiet_stdout():

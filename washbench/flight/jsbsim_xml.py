@@ -7,6 +7,12 @@ off: JSBSim reads a copy without them (a script in a temporary folder; an aircra
 folder that links every other file of the model's folder), and washbench says so on standard error. Nothing
 is ever written by JSBSim and no socket is opened.
 
+JSBSim writes one more file of its own: setting the property ``simulation/write-state-file`` (a script's
+``<set>``, an aircraft's flight-control component, a manoeuvre's property input) writes ``initfile.T.xml`` into
+its output path, which is JSBSim's root folder (the installed package) unless set. Every FDM washbench creates
+gets :func:`scratch_output_dir` (a private temporary folder of the process, removed when it ends) as its
+output path, so such a file never lands in the JSBSim installation, the current folder or ``--out``.
+
 Before JSBSim sees a file, :func:`read_xml` parses it with Python's expat, at most :data:`MAX_XML_BYTES`,
 accepting only plain internal text entities (JSBSim's scripts name constants so) and refusing entities that
 refer to entities (a "billion laughs" DTD), external and parameter entities: a malformed, empty or hostile
@@ -17,6 +23,7 @@ from __future__ import annotations
 
 import os
 import sys
+import tempfile
 import xml.etree.ElementTree as ET
 import xml.parsers.expat as expat
 from pathlib import Path
@@ -72,6 +79,28 @@ def read_xml(path: str | Path) -> ET.Element:
     except expat.ExpatError as exc:
         what = expat.errors.messages.get(exc.code, str(exc))
         raise WashbenchError(located(path, f"not well-formed XML ({what})", line=exc.lineno)) from None
+
+
+_SCRATCH: tuple[int, str] | None = None
+
+
+def scratch_output_dir() -> str:
+    """A private temporary folder of this process for JSBSim's output path (``FGFDMExec.set_output_path``).
+
+    Created on first use (per process: a forked worker gets its own), removed when the process ends (a pool
+    worker's exit included); whatever JSBSim writes there (``simulation/write-state-file``) is thrown away.
+    """
+    global _SCRATCH
+    if _SCRATCH is None or _SCRATCH[0] != os.getpid():
+        import multiprocessing.util
+        import shutil
+
+        path = tempfile.mkdtemp(prefix="washbench-jsbsim-out-")
+        _SCRATCH = (os.getpid(), path)
+        # run at exit by the main process (atexit) and by multiprocessing workers alike
+        multiprocessing.util.Finalize(None, shutil.rmtree, args=(path,), kwargs={"ignore_errors": True},
+                                      exitpriority=0)  # fmt: skip
+    return _SCRATCH[1] + os.sep
 
 
 def _strip(root: ET.Element) -> int:

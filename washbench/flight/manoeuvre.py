@@ -689,6 +689,9 @@ PILOT_PROPERTIES = (
     "fcs/right-brake-cmd-norm",
 )
 
+#: JSBSim properties whose writing makes JSBSim write a file (``initfile.T.xml``): refused as inputs.
+FILE_WRITING_PROPERTIES = ("simulation/write-state-file",)
+
 
 def _add(where: _Where, loc: Loc, problem: str) -> bool:
     """Add a problem to ``where``; False (for ``return _add(...)``: the check failed)."""
@@ -790,6 +793,10 @@ def _check_inputs(phase: Phase, loc: Loc, profile: PilotProfile, where: _Where) 
         if pi.property in PILOT_PROPERTIES:
             where.add((*at, "property"), f"'{pi.property}' is written by the pilot: use the axis keys")
             continue
+        if pi.property.strip("/") in FILE_WRITING_PROPERTIES:
+            where.add((*at, "property"), f"'{pi.property}' makes JSBSim write a file on every write (washbench "
+                      "records the flight itself)")  # fmt: skip
+            continue
         if pi.property in seen:
             where.add((*at, "property"), f"'{pi.property}' is given twice in this phase")
             continue
@@ -840,16 +847,23 @@ def _check_properties(m: Manoeuvre, where: _Where) -> None:
     if not wanted:
         return
     import os
+    import tempfile
 
     import jsbsim
 
     from washbench.flight.console import quiet_stdout
+    from washbench.flight.jsbsim_xml import aircraft_for_jsbsim, scratch_output_dir
 
     os.environ["JSBSIM_DEBUG"] = "0"
     fdm = jsbsim.FGFDMExec(str(jsbsim_root()), None)
-    fdm.set_aircraft_path(str(m.aircraft_files.root))
-    with quiet_stdout():
-        loaded = fdm.load_model(m.aircraft)
+    fdm.set_output_path(scratch_output_dir())
+    with tempfile.TemporaryDirectory(prefix="washbench-aircraft-") as tmp:  # the model without <output>
+        fdm.set_aircraft_path(str(aircraft_for_jsbsim(m.aircraft_files.root, m.aircraft, Path(tmp))))
+        with quiet_stdout():
+            try:
+                loaded = fdm.load_model(m.aircraft)
+            except Exception as exc:  # JSBSim raises plain exceptions on broken models
+                raise where.error(("aircraft",), f"JSBSim could not load the model ({exc})") from None
     if not loaded:
         raise where.error(("aircraft",), "JSBSim could not load the model")
     pm = fdm.get_property_manager()
