@@ -467,6 +467,46 @@ def test_workers_end_when_the_suite_is_killed(tmp_path: Path) -> None:
     assert (digest(stage[0]) if stage else {}) == sizes  # nobody writes into the stage any more
 
 
+
+def _server_started(pgid: int) -> bool:
+    """A process server (forkserver) of process group ``pgid`` exists (it may still be importing)."""
+    for line in live_processes(pgid):
+        try:
+            if b"forkserver" in Path(f"/proc/{line.split()[0]}/cmdline").read_bytes():
+                return True
+        except OSError:
+            continue
+    return False
+
+
+def test_a_suite_killed_while_its_server_starts_leaves_no_process(tmp_path: Path) -> None:
+    """Killed while its process server is still importing JSBSim and numba (seconds under load): the server, once
+    started, finds its parent gone and ends at once (the parent-death request alone would come too late)."""
+    folder = tmp_path / "m"
+    folder.mkdir()
+    for i in range(2):
+        short(folder, name=f"long_{i}", seconds=900)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "washbench", "suite", str(folder), "--out", str(tmp_path / "out"), "--jobs", "2",
+         "--quiet"],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        start_new_session=True,
+    )  # fmt: skip
+    deadline = time.monotonic() + 60
+    while not _server_started(proc.pid) and time.monotonic() < deadline:
+        time.sleep(0.005)
+    assert _server_started(proc.pid)
+    proc.kill()
+    proc.wait()
+    deadline = time.monotonic() + 20
+    while (left := live_processes(proc.pid)) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    for line in left:  # not to leave them to the rest of the session if the assertion fails
+        os.kill(int(line.split()[0]), signal.SIGKILL)
+    assert left == []
+
+
 # ------------------------------------------------------------------------------------------ bounds, inputs
 
 

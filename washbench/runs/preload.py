@@ -9,23 +9,30 @@ recording streams are created in the workers), so forking stays safe.
 
 from __future__ import annotations
 
-import jsbsim  # noqa: F401
-import pyarrow.parquet  # noqa: F401
+import os
 
-import washbench.perception.vestibular  # noqa: F401
-from washbench.analysis.metric_sums import signal_metrics
-from washbench.cueing.bank import _warm_up, warm_up_block
-from washbench.cueing.kernel import bank_block, bank_step
-from washbench.numerics.jitcache import announce_compile
-from washbench.perception.sections import sections_apply, sections_apply_from, sections_run
-from washbench.review.thinning import _changes, _keep
-from washbench.runs.parent_death import die_with_parent
+from washbench.runs import parent_death
+
+# First, before the slow imports: the process server ends with the washbench command that started it (even on
+# SIGKILL), and at once if that command already died while the server was starting.
+parent_death.die_with_parent(parent_death.main_pid())
+parent_death.SERVER_PID = os.getpid()  # the parent every worker forked from here must have
+
+import jsbsim  # noqa: E402, F401
+import pyarrow.parquet  # noqa: E402, F401
+
+import washbench.perception.vestibular  # noqa: E402, F401
+from washbench.analysis.metric_sums import signal_metrics  # noqa: E402
+from washbench.cueing.bank import _warm_up, warm_up_block  # noqa: E402
+from washbench.cueing.kernel import bank_block, bank_step  # noqa: E402
+from washbench.numerics.jitcache import announce_compile  # noqa: E402
+from washbench.perception.sections import sections_apply, sections_apply_from, sections_run  # noqa: E402
+from washbench.review.thinning import _changes, _keep  # noqa: E402
 
 # One line for the whole suite when a kernel its workers run is not compiled yet (after an install or upgrade):
 # the workers fork from here and inherit that it was said.
 announce_compile(bank_block, bank_step, sections_apply, sections_apply_from, sections_run, signal_metrics, _keep,
                  _changes)  # fmt: skip
-die_with_parent()  # the process server ends with the washbench command that started it (even on SIGKILL)
 
 # Only the serial steps are run here: a parallel (prange) kernel would start numba's OpenMP threads, and a process
 # using GNU OpenMP must not fork. The block step is the lockstep's; the per-sample step, JSBSim scripts'.

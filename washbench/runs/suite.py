@@ -195,9 +195,9 @@ def _preload() -> None:
 
 def _die_with_parent() -> None:
     """Worker initializer: the worker ends when its parent (the process server) does."""
-    from washbench.runs.parent_death import die_with_parent
+    from washbench.runs import parent_death
 
-    die_with_parent()
+    parent_death.die_with_parent(parent_death.SERVER_PID)  # the server's PID: ends at once if it died meanwhile
 
 
 _QUIET_TRACKER = "ignore:resource_tracker:UserWarning"
@@ -226,6 +226,9 @@ def pool_context(
         first = ["washbench.runs.worker_signals"] if main_stops_workers else []
         optional = [*(FIGURE_MODULES if figures else ()), *(["rerun"] if recording else [])]
         ctx.set_forkserver_preload([*first, "washbench.runs.preload", *optional])
+        from washbench.runs.parent_death import note_main_pid
+
+        note_main_pid()  # the server (started with the pool) must die with this process
         return ctx, _die_with_parent
     return multiprocessing.get_context("spawn"), _preload
 
