@@ -352,6 +352,21 @@ def test_a_recording_that_cannot_be_written_is_one_line_not_a_hang(cued: Path, m
     assert digest(out) == before  # the previous set stands, whole
 
 
+
+def test_a_disk_too_full_for_the_lock_names_the_folder(motion: Path, tmp_path: Path) -> None:
+    """A disk so full that the folder and an empty probe file can be made but not one byte written (the lock's
+    PID): one line naming the folder and the lock, not a bare 'No space left on device'; no folder left behind."""
+    out = tmp_path / "out"
+    proc = subprocess.run(
+        [sys.executable, "-m", "washbench", "cue", str(motion), "--out", str(out), "--no-figures"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        preexec_fn=_file_size_limit(0),
+    )
+    assert_clean_error(proc, f"{out}: cannot write the lock .washbench.lock")
+    assert not out.exists()
+
 def _stage_names(out: Path) -> set[str]:
     return {f"{s.name}/{p.name}" for s in out.glob(STAGE_PREFIX + "*") for p in s.iterdir()}
 

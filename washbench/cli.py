@@ -8,6 +8,7 @@ printed here as one line (no traceback) with exit status 2.
 from __future__ import annotations
 
 import argparse
+import errno
 import os
 import signal
 import sys
@@ -631,7 +632,9 @@ def main(argv: list[str] | None = None) -> int:
         except BrokenPipeError:
             return _quiet_broken_pipe()
         except OSError as exc:  # the environment (disk full, permissions) where no file-specific message was made
-            where = f"{exc.filename}: " if exc.filename else ""
+            full = exc.errno in (errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS)
+            named = exc.filename or (getattr(args, "out", None) if full else None)  # a full disk: name --out
+            where = f"{named}: " if named else ""
             print(f"washbench: error: {printable(where + str(exc.strerror or exc))}", file=sys.stderr)
             return 2
         except MemoryError:

@@ -89,8 +89,11 @@ def output_lock(out_dir: str | Path) -> Iterator[Path]:
     path = out_dir / LOCK_NAME
     fd = _acquire(out_dir, path)
     try:
-        os.ftruncate(fd, 0)
-        os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+        try:
+            os.ftruncate(fd, 0)
+            os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+        except OSError as exc:  # a full disk: the folder could be made, not one byte written
+            raise WashbenchError(located(out_dir, f"cannot write the lock {LOCK_NAME}: {exc.strerror}")) from None
         yield out_dir
     finally:
         with contextlib.suppress(OSError):
