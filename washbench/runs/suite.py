@@ -28,18 +28,15 @@ The exit status is 0 only if every manoeuvre ran and passed its checks.
 
 from __future__ import annotations
 
-import contextlib
 import csv
 import io
 import math
-import multiprocessing
 import os
-import signal
 import sys
 import time
 import traceback
-from collections.abc import Callable, Iterator, Mapping, Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from collections.abc import Mapping, Sequence
+from concurrent.futures import as_completed
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -59,13 +56,14 @@ from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
 from washbench.io.cpus import usable_cpus
 from washbench.io.lock import output_lock
-from washbench.io.outfolder import discard_stage, is_own_hidden, recover, signals_held, swap_in
+from washbench.io.outfolder import discard_stage, is_own_hidden, recover, swap_in
 from washbench.io.paths import MANOEUVRES_DIR, bundled_names, resolve_manoeuvre
 from washbench.io.progress import Progress
 from washbench.io.publish import clean_partials, is_leftover, is_washbench_result, read_marker
 from washbench.io.results import csv_number
 from washbench.runs.outputs import DEFAULT_OUTPUTS, Outputs
 from washbench.runs.pipeline import RUN_MARKER, RunSummary
+from washbench.runs.pool import submit_all, worker_pool
 
 #: The suite's own files in ``OUT`` (``suite.json`` lists everything a suite wrote at the top level).
 SUITE_FILES = ("metrics.csv", "comparison.csv", "ranking.csv", "report.md")
@@ -105,42 +103,6 @@ def find_manoeuvres(inputs: Sequence[Path], scripts: Sequence[Path] = ()) -> lis
     if not unique:
         raise WashbenchError(located(inputs[0], "no manoeuvre files (*.yaml) or JSBSim scripts (*.xml) found"))
     return unique
-
-
-def _worker_init(then: Callable[[], None] | None = None) -> None:
-    """In each worker: Ctrl-C is for the main process (it stops the workers); SIGTERM stops a worker at once.
-
-    ``then``: the start method's own initializer (:func:`pool_context`).
-    """
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
-    if then is not None:
-        then()
-
-
-@contextlib.contextmanager
-def _signals_held() -> Iterator[None]:
-    """Ignore SIGINT and SIGTERM for a short critical section (stopping workers, swapping results in)."""
-    saved = {sig: signal.signal(sig, signal.SIG_IGN) for sig in (signal.SIGINT, signal.SIGTERM)}
-    try:
-        yield
-    finally:
-        for sig, handler in saved.items():
-            signal.signal(sig, handler)
-
-
-def _stop_pool(pool: ProcessPoolExecutor) -> None:
-    """Stop every worker now (SIGTERM, then SIGKILL after 5 s) and drop the queued runs."""
-    processes = list((getattr(pool, "_processes", None) or {}).values())  # the executor keeps no public list
-    for p in processes:
-        with contextlib.suppress(Exception):
-            p.terminate()
-    pool.shutdown(wait=False, cancel_futures=True)
-    for p in processes:
-        p.join(5.0)
-        if p.is_alive():
-            p.kill()
-            p.join(5.0)
 
 
 def _run_one(
@@ -186,48 +148,6 @@ def _run_one(
         runs = [RunSummary(ok=False, reason=f"internal error: {type(exc).__name__}: {exc} ({where})")]
     wall = time.perf_counter() - start
     return [Outcome(path=path, wall_s=wall / len(runs), run=r) for r in runs]
-
-
-def _preload() -> None:
-    """Worker initializer where there is no forkserver: load the heavy modules once per worker."""
-    import washbench.runs.preload  # noqa: F401
-
-
-def _die_with_parent() -> None:
-    """Worker initializer: the worker ends when its parent (the process server) does."""
-    from washbench.runs.parent_death import die_with_parent
-
-    die_with_parent()
-
-
-_QUIET_TRACKER = "ignore:resource_tracker:UserWarning"
-
-FIGURE_MODULES = ("matplotlib.figure", "matplotlib.backends.backend_agg")
-"""Preloaded by the process server besides :mod:`washbench.runs.preload` when the runs draw figures."""
-
-
-def pool_context(
-    recording: bool = True, main_stops_workers: bool = False, figures: bool = True
-) -> tuple[multiprocessing.context.BaseContext, Callable[[], None] | None]:
-    """The process pool's start method and worker initializer.
-
-    ``forkserver`` (Linux, macOS) where it exists: workers fork from a server that has already imported the heavy
-    modules (JSBSim, the numba kernels, pyarrow; matplotlib with ``figures``, rerun with ``recording``), so each
-    starts in milliseconds. Elsewhere (Windows)
-    ``spawn``, with every worker importing them once at its start. With ``main_stops_workers`` (the suite, which
-    stops its workers itself on Ctrl-C) the server and its workers ignore SIGINT.
-    """
-    # An interrupted suite stops its workers at once; the resource tracker then removes the pool's semaphores itself
-    # but warns about each on stderr ("leaked semaphore objects"). Its warning filters come from ours when it starts.
-    if _QUIET_TRACKER not in sys.warnoptions:
-        sys.warnoptions.append(_QUIET_TRACKER)
-    if "forkserver" in multiprocessing.get_all_start_methods():
-        ctx = multiprocessing.get_context("forkserver")
-        first = ["washbench.runs.worker_signals"] if main_stops_workers else []
-        optional = [*(FIGURE_MODULES if figures else ()), *(["rerun"] if recording else [])]
-        ctx.set_forkserver_preload([*first, "washbench.runs.preload", *optional])
-        return ctx, _die_with_parent
-    return multiprocessing.get_context("spawn"), _preload
 
 
 def run_suite(
@@ -284,21 +204,10 @@ def run_suite(
             for a in args:
                 outcomes[a[0]] = _report(_run_one(*a), len(outcomes) + 1, len(files), start, shown)
         else:
-            ctx, initializer = pool_context(outputs.recording, main_stops_workers=True, figures=outputs.figures)
-            pool = ProcessPoolExecutor(
-                max_workers=jobs, mp_context=ctx, initializer=_worker_init, initargs=(initializer,)
-            )
-            try:
-                with signals_held():  # submitting starts the workers (up to ``jobs``)
-                    futures = [pool.submit(_run_one, *a) for a in args]
-                for fut in as_completed(futures):
+            with worker_pool(jobs, recording=outputs.recording, figures=outputs.figures) as pool:
+                for fut in as_completed(submit_all(pool, _run_one, args)):
                     runs = fut.result()
                     outcomes[runs[0].path] = _report(runs, len(outcomes) + 1, len(files), start, shown)
-            except BaseException:
-                with _signals_held():
-                    _stop_pool(pool)
-                raise
-            pool.shutdown(wait=True)
     finally:
         if shown is not None:
             shown.close()
