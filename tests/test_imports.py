@@ -41,9 +41,7 @@ FLOORS: dict[str, int] = {
 }
 
 #: Known cycles, as the exact edges (importer, imported) that lie on them. ``io``: the recorded-input readers and
-#: ``io/results.py`` (motion type, column names, Parquet, metrics CSV in one module) read each other; ``runs``:
-#: ``run``, ``cue`` and ``suite`` share the chain and the result folder through each other (issue 22, item 1;
-#: ``runs/`` is being restructured by issue 25's work, so it is left as it is here).
+#: ``io/results.py`` (motion type, column names, Parquet, metrics CSV in one module) read each other.
 KNOWN_CYCLE_EDGES: frozenset[tuple[str, str]] = frozenset(
     {
         ("washbench.io.input_format", "washbench.io.results"),
@@ -58,11 +56,6 @@ KNOWN_CYCLE_EDGES: frozenset[tuple[str, str]] = frozenset(
         ("washbench.io.results", "washbench.io.resample"),
         ("washbench.io.tables", "washbench.io.input_format"),
         ("washbench.io.xplane", "washbench.io.input_format"),
-        ("washbench.runs.cue", "washbench.runs.pipeline"),
-        ("washbench.runs.cue", "washbench.runs.suite"),
-        ("washbench.runs.pipeline", "washbench.runs.cue"),
-        ("washbench.runs.pipeline", "washbench.runs.suite"),
-        ("washbench.runs.suite", "washbench.runs.pipeline"),
     }
 )
 

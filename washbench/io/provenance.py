@@ -165,6 +165,22 @@ def build_provenance(
     return prov
 
 
+_ORDER = ("software", "manoeuvre", "aircraft", "pilot_profile", "input", "params", "washouts", "platform",
+          "turbulence", "config", "ranking", "vestibular")  # fmt: skip
+"""The keys of :func:`build_provenance`, in the order it writes them."""
+
+
+def merge_provenance(*parts: Mapping[str, Any]) -> dict[str, Any]:
+    """Several :func:`build_provenance` records as one, in :func:`build_provenance`'s key order (a later part wins a
+    key both hold): what one call with all their arguments gives, e.g. a run's records (parameters, washouts,
+    platform: built once per run) and a manoeuvre's."""
+    merged: dict[str, Any] = {}
+    for part in parts:
+        merged |= part
+    known = [k for k in _ORDER if k in merged]
+    return {k: merged[k] for k in [*known, *(k for k in merged if k not in _ORDER)]}
+
+
 def _washout_record(washout: Any, base: Any) -> dict[str, Any]:
     rec: dict[str, Any] = {"name": washout.name, "kind": washout.kind}
     if base is None or washout.params != base:

@@ -23,6 +23,7 @@ from washbench.cueing.variants import Washout
 from washbench.errors import WashbenchError, located
 from washbench.io.cpus import usable_cpus
 from washbench.io.progress import Progress
+from washbench.io.result_files import FLIGHT_FILE
 from washbench.runs.pool import submit_all, worker_pool
 
 FLIGHTS_DIR = "flights"
@@ -100,7 +101,7 @@ def load_flights(
                 print(f"  {aircraft}/{name}: {'ok' if ok else 'FAILED (' + reason + ')'}", file=sys.stderr, flush=True)
     flights = []
     for _, aircraft, name in ids:
-        src = root / aircraft / name / "flight.parquet"
+        src = root / aircraft / name / FLIGHT_FILE
         if not src.is_file():
             raise WashbenchError(located(src, f"no flight for {aircraft}/{name} (run or suite it first)"))
         motion = read_motion(src)
