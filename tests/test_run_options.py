@@ -11,6 +11,7 @@ import pytest
 from hostile import short
 
 import washbench.io.budget as budget
+import washbench.io.provenance as provenance
 from washbench.cueing.params import DEFAULT_PARAMS_PATH
 from washbench.flight.manoeuvre import load_manoeuvre
 from washbench.io.provenance import build_provenance
@@ -41,15 +42,19 @@ def params(tmp_path: Path) -> Path:
 
 @pytest.fixture
 def reads(monkeypatch: pytest.MonkeyPatch) -> Counter[Path]:
-    """How often each file is read and parsed as YAML (every YAML file washbench reads goes through read_bounded)."""
+    """How often each file is read: to parse it (every YAML file washbench reads goes through read_bounded) or to
+    hash it for the provenance (sha256_file)."""
     counts: Counter[Path] = Counter()
-    original = budget.read_bounded
 
-    def counting(path, *args, **kwargs):  # type: ignore[no-untyped-def]
-        counts[Path(path).resolve()] += 1
-        return original(path, *args, **kwargs)
+    def counted(original):  # type: ignore[no-untyped-def]
+        def counting(path, *args, **kwargs):  # type: ignore[no-untyped-def]
+            counts[Path(path).resolve()] += 1
+            return original(path, *args, **kwargs)
 
-    monkeypatch.setattr(budget, "read_bounded", counting)
+        return counting
+
+    monkeypatch.setattr(budget, "read_bounded", counted(budget.read_bounded))
+    monkeypatch.setattr(provenance, "sha256_file", counted(provenance.sha256_file))
     return counts
 
 
@@ -59,7 +64,8 @@ def test_cue_reads_the_parameter_file_once(params: Path, reads: Counter[Path], t
     reads.clear()
     opts = CueOptions(recording=False, figures=False, progress=False)
     assert run_cue(signal, tmp_path / "cue", washouts=["small-angle"], params_path=params, options=opts) == 0
-    assert reads[params.resolve()] == 1
+    assert reads[params.resolve()] == 1  # parsed and hashed from the same bytes
+    assert reads[DEFAULT_LIMITS_PATH.resolve()] == 1
     ranking = (tmp_path / "cue" / "ranking.csv").read_text().splitlines()
     assert [r.split(",")[3] for r in ranking[1:]] != [] and all(r.endswith(",weighted") for r in ranking[1:])
     assert {r.split(",")[3] for r in ranking[1:]} == {"small-angle", "sa_gain2"}  # the file's variant ran too
@@ -73,7 +79,8 @@ def test_run_and_suite_read_the_parameter_file_once(params: Path, reads: Counter
     assert summary.ok and [m.washout for m in summary.metrics[::6]] == ["unrestricted", "sa_gain2"]
     outcomes = run_suite([a, b], tmp_path / "suite", opts, jobs=1, progress=False)  # in this process: countable
     assert [o.run.ok for o in outcomes] == [True, True]
-    assert reads[params.resolve()] == 1  # neither the run nor the suite's runs read it again
+    assert reads[params.resolve()] == 1 and reads[DEFAULT_LIMITS_PATH.resolve()] == 1
+    assert reads[a.resolve()] >= 1  # (what is counted: the manoeuvre file is read; the options are read once)
 
 
 def test_provenance_is_one_build_provenance_of_everything(params: Path, tmp_path: Path) -> None:

@@ -97,13 +97,16 @@ def software_versions() -> dict[str, str]:
     return out
 
 
-def file_record(path: str | Path, name: str | None = None, values: Mapping[str, Any] | None = None) -> dict[str, Any]:
-    """``{"name", "path", "sha256", "values"}`` of one input file (name and values only when given)."""
+def file_record(
+    path: str | Path, name: str | None = None, values: Mapping[str, Any] | None = None, sha256: str | None = None
+) -> dict[str, Any]:
+    """``{"name", "path", "sha256", "values"}`` of one input file (name and values only when given); ``sha256``:
+    the digest of the bytes already read (:func:`washbench.io.yamlio.read_yaml_digest`), else the file is hashed."""
     rec: dict[str, Any] = {}
     if name is not None:
         rec["name"] = name
     rec["path"] = str(path)
-    rec["sha256"] = sha256_file(path)
+    rec["sha256"] = sha256 or sha256_file(path)
     if values is not None:
         rec["values"] = dict(values)
     return rec
@@ -123,6 +126,7 @@ def build_provenance(
     washouts: Sequence[Any] = (),
     ranking: Mapping[str, Any] | None = None,
     vestibular: Mapping[str, Any] | None = None,
+    digests: Mapping[str, str] | None = None,
 ) -> dict[str, Any]:
     """The provenance of one result (module docstring); no date in it.
 
@@ -134,8 +138,10 @@ def build_provenance(
     ``washouts`` (``washbench.cueing.variants.Washout``: name, kind, params) lists what ran; a variant's complete
     parameter values are recorded where they differ from the file's base set. ``ranking``: the ranking rule
     (:meth:`washbench.analysis.ranking.RankRule.record`); ``vestibular``: the vestibular model
-    (:func:`washbench.perception.vestibular.model_record`: its name and values).
+    (:func:`washbench.perception.vestibular.model_record`: its name and values). ``digests``: path (as given) ->
+    SHA-256 of a file already read (:func:`washbench.io.yamlio.read_yaml_digest`), so it is not read again.
     """
+    digests = digests or {}
     prov: dict[str, Any] = {"software": software_versions()}
     if manoeuvre_path is not None:
         prov["manoeuvre"] = file_record(manoeuvre_path)
@@ -148,11 +154,13 @@ def build_provenance(
         if input_provenance:
             prov["input"]["provenance"] = dict(input_provenance)
     if params is not None and params_path is not None:
-        prov["params"] = file_record(params_path, params.name, params.model_dump(mode="json"))
+        prov["params"] = file_record(params_path, params.name, params.model_dump(mode="json"),
+                                     digests.get(str(params_path)))  # fmt: skip
     if washouts:
         prov["washouts"] = [_washout_record(w, params) for w in washouts]
     if platform is not None and platform_path is not None:
-        prov["platform"] = file_record(platform_path, platform.name, platform.model_dump(mode="json"))
+        prov["platform"] = file_record(platform_path, platform.name, platform.model_dump(mode="json"),
+                                       digests.get(str(platform_path)))  # fmt: skip
     if manoeuvre_path is not None:
         prov["turbulence"] = turbulence_record(turbulence)
     config_used = os.environ.get(CONFIG_USED_ENV)

@@ -2,7 +2,8 @@
 workers) and ``live`` are given instead of a dozen loose keywords.
 
 :func:`load_options` checks what the command line said and reads each file once: the parameter file (parsed once
-for its base set, its ``variants:`` and its ``ranking:`` section), the platform file, the vestibular model. What
+for its base set, its ``variants:`` and its ``ranking:`` section, and hashed from the same bytes for the
+provenance), the platform file (likewise), the vestibular model. What
 it loads (the washouts, the platform limits, the ranking rule) and the run-wide part of the provenance go with
 the options, so a suite's worker process is handed the options as they are (picklable) and reads none of these
 files again.
@@ -22,9 +23,9 @@ from washbench.cueing.params import DEFAULT_PARAMS_PATH, WashoutParams
 from washbench.cueing.variants import Washout, param_file_from_data, select_from
 from washbench.errors import WashbenchError
 from washbench.io.provenance import build_provenance, merge_provenance
-from washbench.io.yamlio import read_yaml
+from washbench.io.yamlio import read_yaml_digest, validate_data
 from washbench.perception.vestibular import VestibularParams, model_params, model_record
-from washbench.platform.limits import DEFAULT_LIMITS_PATH, PlatformLimits, load_platform_limits
+from washbench.platform.limits import DEFAULT_LIMITS_PATH, PlatformLimits
 from washbench.runs.outputs import DEFAULT_OUTPUTS, Outputs
 from washbench.runs.rank_rule import rank_rule_from_data
 
@@ -104,21 +105,24 @@ def load_options(
 
     check_filter_start(filter_start)
     check_max_time(max_time_s)
-    source = DEFAULT_PARAMS_PATH if params_path is None else Path(params_path)
-    data, lines = read_yaml(source)  # the parameter file, read and parsed once
-    params, from_file = param_file_from_data(source, data, lines)
+    source = params_path or DEFAULT_PARAMS_PATH  # (as given: the provenance records the path as the user wrote it)
+    data, lines, params_sha = read_yaml_digest(Path(source))  # the parameter file, read and parsed once
+    params, from_file = param_file_from_data(Path(source), data, lines)
     chosen = select_from(washouts, variants, params, from_file)
-    limits = load_platform_limits(platform_path)
+    platform_source = platform_path or DEFAULT_LIMITS_PATH
+    platform_data, platform_lines, platform_sha = read_yaml_digest(Path(platform_source))
+    limits = validate_data(Path(platform_source), platform_data, platform_lines, PlatformLimits)
     rule = rank_rule_from_data(params_path, data, lines, rank_by)
     vestibular_params = model_params(vestibular)
     provenance = build_provenance(
         params_path=source,
         params=params,
         washouts=chosen,
-        platform_path=platform_path or DEFAULT_LIMITS_PATH,
+        platform_path=platform_source,
         platform=limits,
         ranking=rule.record(),
         vestibular=model_record(vestibular),
+        digests={str(source): params_sha, str(platform_source): platform_sha},  # not read again to hash them
     )
     return RunOptions(
         params_path=params_path,
