@@ -10,7 +10,7 @@ import pyarrow.parquet as pq
 import pytest
 
 from washbench.cueing.variants import select_washouts
-from washbench.io.results import Motion
+from washbench.io.motion import Motion
 from washbench.platform import load_platform_limits
 from washbench.runs.cue import Progress, cue_motion, stream_cue
 

@@ -466,7 +466,7 @@ def write_flight(
     """
     import pyarrow as pa
 
-    from washbench.io.results import write_parquet
+    from washbench.io.parquet_files import write_parquet
 
     out = Path(out_dir)
     try:

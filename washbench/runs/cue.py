@@ -27,20 +27,12 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from washbench.analysis.metrics import MetricRow, dof_metrics
+from washbench.analysis.metrics import dof_metrics
 from washbench.errors import WashbenchError, located, printable
 from washbench.io.atomic import atomic_path
-from washbench.io.input_format import InputFormat
-from washbench.io.names import check_identifier
-from washbench.io.plausibility import Finding, check_arrays
-from washbench.io.progress import Progress
-from washbench.io.publish import result_path
-from washbench.io.readers import Samples, read_samples
-from washbench.io.resample import check_gaps, check_step, resample, split_resets, to_motion, window
-from washbench.io.results import (
+from washbench.io.columns import (
     AIRCRAFT,
     TIME_COLUMN,
-    Motion,
     acc_columns,
     f_columns,
     omega_columns,
@@ -54,9 +46,17 @@ from washbench.io.results import (
     sp_q_columns,
     vel_columns,
     wheel_columns,
-    write_metrics_csv,
-    write_traces,
 )
+from washbench.io.input_format import InputFormat
+from washbench.io.metrics_csv import MetricRow, write_metrics_csv
+from washbench.io.motion import Motion
+from washbench.io.names import check_identifier
+from washbench.io.parquet_files import write_traces
+from washbench.io.plausibility import Finding, check_arrays
+from washbench.io.progress import Progress
+from washbench.io.publish import result_path
+from washbench.io.readers import Samples, read_samples
+from washbench.io.resample import check_gaps, check_step, resample, split_resets, to_motion, window
 from washbench.perception.vestibular import Perceived, VestibularModel, VestibularParams, model_params
 
 TRACES_FILE = "traces.parquet"
@@ -326,7 +326,7 @@ def stream_cue(
     on it (the table is in the file).
     """
     from washbench.cueing import CueingBank, WashoutTrace
-    from washbench.io.results import write_trace_chunks
+    from washbench.io.parquet_files import write_trace_chunks
     from washbench.perception.vestibular import PerceptionStream
 
     if chunk_rows < 1:
