@@ -9,12 +9,15 @@ an hour of flight, checks on known signals. Run by :class:`washbench.flight.mano
 from __future__ import annotations
 
 import difflib
+import os
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 from washbench.errors import WashbenchError, located
 from washbench.flight.columns import COLUMN_NAMES, RUNWAY_COLUMNS
+from washbench.flight.console import quiet_stdout
+from washbench.flight.inputs import shape_extent
 from washbench.flight.manoeuvre_schema import (
     EVENT_STATS,
     HEADING_SIGNALS,
@@ -356,8 +359,6 @@ def _check_travel(ci: ControlInput, travel: Any, phase: Phase, at: Loc, where: W
     pilot's, known only in flight) its swing, highest minus lowest deflection asked, must fit the whole travel.
     Where it fits only from some bases, a flight reports the time clipped at a stop (:mod:`washbench.flight.openloop`).
     """
-    from washbench.flight.inputs import shape_extent
-
     lo, hi = shape_extent(ci.shape, ci.start_s, ci.duration_s, ci.period_s, ci.start_hz, ci.end_hz, ci.sweep,
                           phase.until.duration_s)  # fmt: skip
     a = float(ci.amplitude_deg or 0.0)
@@ -388,11 +389,7 @@ def _check_properties(m: ManoeuvreFields, files: AircraftFiles, where: Where) ->
     ]
     if not wanted:
         return
-    import os
-
-    import jsbsim
-
-    from washbench.flight.console import quiet_stdout
+    import jsbsim  # imported only when an input names a property
 
     os.environ["JSBSIM_DEBUG"] = "0"
     fdm = jsbsim.FGFDMExec(str(jsbsim_root()), None)
