@@ -3,9 +3,10 @@
 Columns ``washout,dof,npc,integral_error,max_error`` (:mod:`washbench.analysis.metrics`) then the cue classification
 (:mod:`washbench.analysis.cues`) ``cue_correct_frac,cue_scaled_frac,cue_false_frac,cue_missing_frac`` (time
 fractions), on the heave row the motion sickness dose values ``msdv_mps15,msdv_aircraft_mps15`` (ISO 2631-1 Wf,
-m/s^1.5: the simulator pilot's and the aircraft pilot's, :mod:`washbench.perception.sickness`) and
-``false_cue_events`` (``start_s-end_s@peak`` joined by ``;``), one row per washout and DOF
-(surge, sway, heave, roll, pitch, yaw). Floats are written with ``repr`` (exact round trip); an
+m/s^1.5: the simulator pilot's and the aircraft pilot's, :mod:`washbench.perception.sickness`),
+``false_cue_events`` (``start_s-end_s@peak`` joined by ``;``) and on the heave row the predicted motion-sickness
+incidence ``msi_pct,msi_aircraft_pct`` (%, subjective vertical conflict, :mod:`washbench.perception.svc`), one row
+per washout and DOF (surge, sway, heave, roll, pitch, yaw). Floats are written with ``repr`` (exact round trip); an
 undefined NPC (flat signal) is an empty field; PC = -1 gives ``inf``.
 """
 
@@ -25,11 +26,13 @@ from washbench.io.csv_numbers import csv_number
 METRICS_COLUMNS = (
     "washout", "dof", "npc", "integral_error", "max_error",
     "cue_correct_frac", "cue_scaled_frac", "cue_false_frac", "cue_missing_frac",
-    "msdv_mps15", "msdv_aircraft_mps15", "false_cue_events",
+    "msdv_mps15", "msdv_aircraft_mps15", "false_cue_events", "msi_pct", "msi_aircraft_pct",
 )  # fmt: skip
-"""metrics.csv columns; files written before the cue classification have the first five only (still read)."""
+"""metrics.csv columns; files written before the cue classification have the first five only, before the MSI the
+first twelve (both still read)."""
 METRICS_TEXT_COLUMNS = ("washout", "dof", "false_cue_events")
 N_BASE_METRICS_COLUMNS = 5
+N_PRE_MSI_METRICS_COLUMNS = 12
 
 
 @dataclass(frozen=True)
@@ -39,7 +42,9 @@ class MetricRow:
     The cue classification (:mod:`washbench.analysis.cues`): time fractions ``cue_*_frac`` (NaN where not
     classified, e.g. a study's evaluation) and the false-cue events as ``start-end@peak;...`` text. On the heave row,
     the motion sickness dose values (MSDV, m/s^1.5, ISO 2631-1 Wf) of the simulator pilot and of the aircraft pilot
-    (NaN on the other rows).
+    and their predicted motion-sickness incidence at the end of the manoeuvre (MSI, %, the 6-DOF subjective
+    vertical conflict model of :mod:`washbench.perception.svc`: one value per pilot, of all six DOFs) (NaN on the
+    other rows).
     """
 
     washout: str
@@ -54,6 +59,8 @@ class MetricRow:
     msdv_mps15: float = math.nan
     msdv_aircraft_mps15: float = math.nan
     false_cue_events: str = ""
+    msi_pct: float = math.nan
+    msi_aircraft_pct: float = math.nan
 
 
 
@@ -83,7 +90,8 @@ def read_metrics_csv(path: str | Path) -> list[MetricRow]:
         raise WashbenchError(located(path, f"cannot read: {getattr(exc, 'strerror', None) or exc}")) from None
     reader = csv.reader(io.StringIO(text))
     header = next(reader, None)
-    if header is None or tuple(header) not in (METRICS_COLUMNS, METRICS_COLUMNS[:N_BASE_METRICS_COLUMNS]):
+    known = (METRICS_COLUMNS, METRICS_COLUMNS[:N_PRE_MSI_METRICS_COLUMNS], METRICS_COLUMNS[:N_BASE_METRICS_COLUMNS])
+    if header is None or tuple(header) not in known:
         raise WashbenchError(located(path, f"expected header {','.join(METRICS_COLUMNS)}", line=1))
     ncol = len(header)
     rows = []

@@ -20,6 +20,7 @@ import numpy as np
 
 from washbench.errors import WashbenchError, located
 from washbench.io.input_format import ColumnSource
+from washbench.io.outfolder import uninterrupted
 from washbench.io.units import G0_MPS2, axes_matrix, is_identity_axes
 
 INPUT_STEM = "input"
@@ -61,6 +62,7 @@ def input_labels(
     return out
 
 
+@uninterrupted
 def input_figure(
     stem: Path,
     title: str,
