@@ -18,7 +18,7 @@ from flight_helpers import write
 
 from washbench.analysis.ranking import perceived_motion, rank
 from washbench.cli import main
-from washbench.io.results import read_metrics_csv
+from washbench.io.metrics_csv import read_metrics_csv
 
 TURN = """\
     name: bank_left

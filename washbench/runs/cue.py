@@ -24,7 +24,10 @@ import numpy as np
 from washbench.analysis.ranking import perceived_motion
 from washbench.errors import WashbenchError, located, printable
 from washbench.io.atomic import atomic_path
+from washbench.io.columns import AIRCRAFT
 from washbench.io.input_format import InputFormat
+from washbench.io.metrics_csv import write_metrics_csv
+from washbench.io.motion import Motion
 from washbench.io.names import check_identifier
 from washbench.io.outfolder import check_out_path, result_set
 from washbench.io.plausibility import Finding, check_arrays
@@ -34,7 +37,6 @@ from washbench.io.publish import result_path
 from washbench.io.readers import Samples, read_samples
 from washbench.io.resample import check_gaps, check_step, resample, split_resets, to_motion, window
 from washbench.io.result_files import METRICS_FILE, RECORDING_FILE, RUN_FILE, TRACES_FILE
-from washbench.io.results import AIRCRAFT, Motion, write_metrics_csv
 from washbench.runs.chain import CueResult, aircraft_attitude, stream_cue
 from washbench.runs.options import RunOptions, load_options
 from washbench.runs.outputs import Outputs

@@ -146,7 +146,7 @@ def write_cued_folder(
     traces.parquet, metrics.csv, recording.rrd, run.json, ranking.csv, report.md and figures/. Returns ``summary``
     completed with the steps, metrics and saturations. ``provenance`` (no date) goes into traces.parquet's
     metadata; ``extra`` into run.json."""
-    from washbench.io.results import read_motion
+    from washbench.io.motion_file import read_motion
 
     motion = read_motion(folder / FLIGHT_FILE)
     result = from_lockstep(motion, rows, options.washout_order, options.vestibular_params, options.filter_start)

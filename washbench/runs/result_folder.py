@@ -25,18 +25,18 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from washbench.analysis.metrics import MetricRow
 from washbench.analysis.ranking import DEFAULT_RULE, DOFS, RankRow, RankRule, rank, rule_from_record
 from washbench.io.atomic import write_text_atomic
+from washbench.io.csv_numbers import csv_number
+from washbench.io.metrics_csv import MetricRow
 from washbench.io.publish import read_marker, result_path
 from washbench.io.result_files import RANKING_FILE, RUN_FILE
-from washbench.io.results import csv_number
 from washbench.platform.limits import wheel_jacobian
 from washbench.review.metrics_table import metrics_table_markdown
 from washbench.review.report import write_result_report
 
 if TYPE_CHECKING:
-    from washbench.io.results import Motion
+    from washbench.io.motion import Motion
     from washbench.platform import PlatformLimits
     from washbench.review.rerun_log import PlatformEnvelope
     from washbench.runs.chain import CueResult

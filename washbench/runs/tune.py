@@ -32,9 +32,9 @@ from washbench.cueing.params import WashoutParams
 from washbench.cueing.variants import Washout, apply_overrides, check_kind, value_of
 from washbench.errors import WashbenchError
 from washbench.io.atomic import write_text_atomic
+from washbench.io.csv_numbers import csv_number
 from washbench.io.progress import Progress
 from washbench.io.result_files import REPORT_FILE
-from washbench.io.results import csv_number
 from washbench.runs.inputs import find_manoeuvres
 from washbench.runs.study import evaluate, load_flights
 
