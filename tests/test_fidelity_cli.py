@@ -13,8 +13,8 @@ from scipy import signal
 
 from washbench.analysis.metrics import DOFS
 from washbench.cli import main
+from washbench.io.metrics_csv import read_metrics_csv
 from washbench.io.paths import DATA_DIR
-from washbench.io.results import read_metrics_csv
 from washbench.perception.sickness import wf_tf
 from washbench.perception.vestibular import MODELS, canal_tf
 

@@ -8,18 +8,11 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
-from washbench.analysis.metrics import MetricRow
 from washbench.errors import WashbenchError
-from washbench.io.results import (
-    INPUT_COLUMNS,
-    metrics_csv_text,
-    read_metrics_csv,
-    read_motion,
-    read_traces,
-    washout_columns,
-    write_metrics_csv,
-    write_traces,
-)
+from washbench.io.columns import INPUT_COLUMNS, washout_columns
+from washbench.io.metrics_csv import MetricRow, metrics_csv_text, read_metrics_csv, write_metrics_csv
+from washbench.io.motion_file import read_motion
+from washbench.io.parquet_files import read_traces, write_traces
 
 DT = 1 / 120
 
@@ -203,7 +196,8 @@ def test_metrics_csv_exact_round_trip_nan_empty_inf(tmp_path: Path) -> None:
 
 def test_dt_of_a_fixed_step_grid_is_recovered_exactly(tmp_path: Path) -> None:
     """t = k*dt written by a fixed-step simulator gives back dt itself, not the mean step."""
-    from washbench.io.results import INPUT_COLUMNS, read_motion
+    from washbench.io.columns import INPUT_COLUMNS
+    from washbench.io.motion_file import read_motion
 
     for hz in (30, 47, 120, 333, 1000):
         dt = 1.0 / hz

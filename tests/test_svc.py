@@ -184,4 +184,9 @@ def test_bad_inputs_are_clear_errors() -> None:
     with pytest.raises(ValueError, match="k_vc"):
         svc.SvcParams(k_vc=0.0)  # no conflict integral: no steady state
     with pytest.raises(ValueError, match="non-zero"):
-        svc.svc_msi(np.zeros((5, 3)), np.zeros((5, 3)), 0.01)
+        svc.steady_state(np.zeros(3))  # free fall fixes no vertical
+    # so a trace that starts in free fall (an all-zero file) starts from rest, upright: weightless from there on,
+    # the sensed vertical leaves the internal one and the incidence grows from 0
+    out = svc.svc_msi(np.zeros((600, 3)), np.zeros((600, 3)), 0.01)
+    assert out.msi_pct[0] == 0.0 and np.all(np.isfinite(out.msi_pct)) and np.all(np.diff(out.msi_pct) >= 0.0)
+    assert out.msi_pct[-1] > 0.0

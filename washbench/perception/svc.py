@@ -36,7 +36,8 @@ with the In1 values; and after a long sinusoidal exposure of amplitude ``A`` the
 Discretisation: classic Runge-Kutta (RK4) per sample step with the input linear between samples, ``g``
 renormalised to ``g0`` after each step (as the reference does after its Euler step). The model starts in the
 steady state of its first input sample held still (zero conflict, MSI = 0), the state the reference reaches by
-iterating a held input; a stream fed in chunks gives the same bits as the whole trace.
+iterating a held input (from rest, upright, where that sample is zero: free fall fixes no vertical); a stream
+fed in chunks gives the same bits as the whole trace.
 """
 
 from __future__ import annotations
@@ -237,7 +238,7 @@ class SvcStream:
     """One pilot's SVC model fed chunk by chunk (the same bits as :func:`svc_msi` on the whole trace).
 
     It starts in :func:`steady_state` of the first sample of the first chunk, or of rest (``start="rest"``:
-    ``f = [0, 0, -g0]``).
+    ``f = [0, 0, -g0]``; also where the first sample has no specific force at all, which fixes no vertical).
     """
 
     def __init__(self, dt_s: float, params: SvcParams = IN1, start: str = "steady") -> None:
@@ -267,8 +268,9 @@ class SvcStream:
         if n == 0:
             return SvcOutput(msi, conflict)
         first = 0
-        if self._x is None:
-            self._x = steady_state(f[0], self.params)
+        if self._x is None:  # a first sample with no specific force (free fall, an all-zero file): from rest
+            held = f[0] if np.all(np.isfinite(f[0])) and np.any(f[0] != 0.0) else np.array([0.0, 0.0, -G0_MPS2])
+            self._x = steady_state(held, self.params)
             self._u_prev[:] = u[0]
             msi[0], conflict[0] = 0.0, 0.0
             first = 1
