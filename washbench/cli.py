@@ -564,6 +564,29 @@ def _terminate(signum: int, frame: object) -> None:
     raise Terminated()
 
 
+def _signal_in_finalizer(unraisable: object) -> None:
+    """``sys.unraisablehook``: a Ctrl-C or SIGTERM whose exception was raised inside a finalizer (``__del__``, e.g.
+    the rerun SDK's RecordingStream as a recording is closed) is swallowed by Python with an "Exception ignored"
+    traceback, and the command would go on as if never signalled (and publish). The signal is sent again a few
+    milliseconds later, from a timer thread, so that it acts in the command itself (one line, 130 or 143, the
+    previous results left as they were)."""
+    exc = getattr(unraisable, "exc_value", None)
+    if not isinstance(exc, (KeyboardInterrupt, Terminated)):
+        sys.__unraisablehook__(unraisable)  # type: ignore[arg-type]
+        return
+    import threading
+
+    signum = signal.SIGINT if isinstance(exc, KeyboardInterrupt) else signal.SIGTERM
+    while True:
+        try:
+            timer = threading.Timer(0.01, os.kill, (os.getpid(), signum))
+            timer.daemon = True
+            timer.start()
+            return
+        except (KeyboardInterrupt, Terminated):  # signalled again in here: still one to send
+            continue
+
+
 def _quiet_broken_pipe() -> int:
     """Standard output was closed early (``washbench validate ... | head -1``): exit quietly, like a Unix tool."""
     try:
@@ -607,6 +630,7 @@ def main(argv: list[str] | None = None) -> int:
     if config is not None:  # recorded in the provenance, also by worker processes
         os.environ[project_config.CONFIG_USED_ENV] = str(config.path)
     signal.signal(signal.SIGTERM, _terminate)
+    hook, sys.unraisablehook = sys.unraisablehook, _signal_in_finalizer
     try:
         try:
             _check_paths(args)
@@ -637,6 +661,7 @@ def main(argv: list[str] | None = None) -> int:
         return 143
     finally:
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        sys.unraisablehook = hook
         os.environ.pop(project_config.CONFIG_USED_ENV, None)
         if env_before is not None:
             os.environ[project_config.CONFIG_USED_ENV] = env_before
