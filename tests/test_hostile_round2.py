@@ -187,6 +187,22 @@ def test_a_folder_holding_a_users_file_is_refused_by_every_command(motion: Path,
             assert tree(mine.parent) == [mine.name]
 
 
+
+def test_a_users_folder_inside_out_keeps_its_hidden_files(cued: Path, motion: Path, tmp_path: Path) -> None:
+    """A folder of the user's put into a cue result folder holds files named like washbench's leftovers
+    (``.notes.tmp``, ``.draft.partial-12``): the cue is refused naming the folder, and they are all still there
+    (the leftover cleaning went one level down into every folder before the refusal)."""
+    out = copy_of(cued, tmp_path / "out")
+    mine = out / "mine"
+    mine.mkdir()
+    (mine / ".notes.tmp").write_text("the user's notes\n")
+    (mine / ".draft.partial-12").mkdir()
+    (mine / ".draft.partial-12" / "draft.md").write_text("a draft\n")
+    before = digest(out)
+    proc = washbench("cue", motion, "--out", out, "--no-figures", timeout=60)
+    assert_clean_error(proc, str(mine))
+    assert digest(out) == before
+
 def test_a_second_cue_replaces_the_whole_previous_set(motion: Path, tmp_path: Path) -> None:
     """Two segments, then one: the old second segment does not stay beside the new result."""
     two = tmp_path / "two.csv"

@@ -78,9 +78,12 @@ def recover(out_dir: Path, *, only_washbench: bool = False) -> None:
     finished (the stage was complete). Every other leftover (stage, old folders, ``.*.tmp``, legacy
     ``.NAME.partial-PID``/``.NAME.old-PID``) is removed; so are ``.*.tmp`` files one level down.
     ``only_washbench`` (a folder of the user's, ``washbench examples``): only ``.washbench-*`` leftovers.
+    One level down only in the folders washbench wrote (listed in the manifest, or in a suite's ``suite.json``):
+    a folder of the user's inside ``--out`` is refused afterwards, never cleaned of the user's ``.*.tmp`` files.
     """
     for journal in sorted(out_dir.glob(JOURNAL_PREFIX + "*")):
         _roll_forward(out_dir, journal)
+    listed = _listed_folders(out_dir)
     for entry in list(out_dir.iterdir()):
         name = entry.name
         if only_washbench:
@@ -89,10 +92,26 @@ def recover(out_dir: Path, *, only_washbench: bool = False) -> None:
             continue
         if name.startswith((STAGE_PREFIX, OLD_PREFIX, ".washbench-probe-")) or _LEGACY.match(name) or _TMP.match(name):
             remove_tree(entry)
-        elif entry.is_dir() and not entry.is_symlink():
+        elif name in listed and entry.is_dir() and not entry.is_symlink():
             for sub in list(entry.iterdir()):
                 if _TMP.match(sub.name) or _LEGACY.match(sub.name):
                     remove_tree(sub)
+
+
+def _listed_folders(out_dir: Path) -> set[str]:
+    """Top-level names washbench wrote into ``out_dir``: its manifest's, or a suite's (``suite.json`` entries)."""
+    manifest = read_manifest(out_dir)
+    if manifest is not None:
+        return set(manifest[1])
+    suite = out_dir / "suite.json"
+    if suite.is_symlink() or not suite.is_file():
+        return set()
+    try:
+        doc = json.loads(suite.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return set()
+    entries = doc.get("entries") if isinstance(doc, dict) and doc.get("washbench") == "suite" else None
+    return {n for n in entries if isinstance(n, str) and "/" not in n} if isinstance(entries, list) else set()
 
 
 def _roll_forward(out_dir: Path, journal: Path) -> None:
