@@ -36,6 +36,7 @@ from washbench.analysis.ranking import perceived_motion
 from washbench.errors import WashbenchError, located
 from washbench.io.budget import check_samples
 from washbench.io.lock import output_lock
+from washbench.io.motion_file import read_motion
 from washbench.io.provenance import flat_strings, utc_now
 from washbench.io.publish import check_replaceable, clean_partials, partial_dir, publish_dir, remove_if_empty
 from washbench.io.result_files import FLIGHT_FILE, RECORDING_FILE, REPORT_FILE, RUN_FILE
@@ -146,8 +147,6 @@ def write_cued_folder(
     traces.parquet, metrics.csv, recording.rrd, run.json, ranking.csv, report.md and figures/. Returns ``summary``
     completed with the steps, metrics and saturations. ``provenance`` (no date) goes into traces.parquet's
     metadata; ``extra`` into run.json."""
-    from washbench.io.motion_file import read_motion
-
     motion = read_motion(folder / FLIGHT_FILE)
     result = from_lockstep(motion, rows, options.washout_order, options.vestibular_params, options.filter_start)
     write_results(folder, result, provenance)
