@@ -104,6 +104,8 @@ class CueResult:
     metrics: list[MetricRow]
     arrays: Mapping[str, Mapping[str, np.ndarray]] = field(default_factory=dict, repr=False)
     """washout -> the trace's fields as checked float64 arrays (:func:`analyse`); else read from ``traces``."""
+    algorithms: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
+    """washout -> what a Python washout reports of itself (:meth:`washbench.cueing.CueingBank.algorithm_reports`)."""
 
     @property
     def n(self) -> int:
@@ -334,7 +336,7 @@ def stream_cue(
     n = motion.n
     if n < 1:
         raise WashbenchError("nothing to cue: the input has no rows")
-    bank = CueingBank(washouts, None, limits, motion.dt_s, filter_start)
+    bank = CueingBank(washouts, None, limits, motion.dt_s, filter_start, future=(motion.f_mps2, motion.omega_radps))
     names = bank.washouts
     model = VestibularModel(motion.dt_s, vestibular)
     streams = {p: PerceptionStream(model, filter_start) for p in (AIRCRAFT, *names)}
@@ -376,7 +378,7 @@ def stream_cue(
     metrics = _metric_rows(felt, motion.dt_s, vertical)
     counts = bank.saturation_counts()
     traces = {w: SimpleNamespace(**kept[w], saturated=flags[w], saturation_counts=counts[w]) for w in names}
-    return CueResult(motion=motion, traces=traces, perceived=felt, metrics=metrics)
+    return CueResult(motion=motion, traces=traces, perceived=felt, metrics=metrics, algorithms=bank.algorithm_reports())
 
 
 def write_results(out_dir: Path, result: CueResult, provenance: Mapping[str, Any] | None = None) -> tuple[Path, Path]:
@@ -589,7 +591,13 @@ def write_outputs(
                     "conversions": list(seg.notes),
                     "input_labels": list(seg.labels),
                     "warnings": [f.text for f in seg.findings],
+                    "algorithms": dict(result.algorithms),
                 }
+                from washbench.runs.bound_stage import bound_outputs
+
+                bound = bound_outputs(folder, tmp[TRACES_FILE], seg.motion.dt_s, washouts, limits,
+                                      model_params(opts.vestibular))  # fmt: skip
+                extra |= {"bound": bound} if bound else {}
                 if provenance:
                     extra |= {"created_utc": created, "provenance": provenance}
                 write_run_json(tmp["run.json"], summary, time.perf_counter() - start, extra)

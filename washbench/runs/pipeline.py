@@ -170,9 +170,11 @@ def run_manoeuvre(
     clean_partials(final.parent)
 
     from washbench.flight.fly import fly, write_flight
+    from washbench.runs.bound_stage import split_whole
 
-    washouts = tuple(w.name for w in specs)
-    rows, lockstep = lockstep_blocks(specs, limits, manoeuvre.dt_s, filter_start)
+    stepped = split_whole(specs)[0]  # a whole-only washout (the bound) is cued after the flight, on it read back
+    washouts = tuple(w.name for w in stepped)
+    rows, lockstep = lockstep_blocks(stepped, limits, manoeuvre.dt_s, filter_start)
     partial = partial_dir(final)  # before flying: a file in the way of OUT/<aircraft>/ fails now
     published = False
     try:
@@ -197,10 +199,10 @@ def run_manoeuvre(
             checks_total=len(flight.checks),
         )
         ac_q = aircraft_attitude(cols["phi_deg"], cols["theta_deg"], cols["psi_deg"])
-        extra = {"created_utc": created, "provenance": prov}
+        extra = {"created_utc": created, "provenance": prov, "algorithms": lockstep.reports()}
         summary = write_cued_folder(
             partial, summary, rows, washouts, limits, ac_q, flight.phases, start, filter_start, extra, prov,
-            outputs=outputs,
+            outputs=outputs, specs=specs,
         )  # fmt: skip
         publish_dir(partial, final, RUN_MARKER, marker)
         published = True
@@ -269,6 +271,7 @@ def lockstep_washouts(
         np.degrees(omega_radps, out=omega_deg)
         rows.append(step(f_mps2, np.radians(omega_deg)).copy())
 
+    lockstep.reports = bank.algorithm_reports  # type: ignore[attr-defined]
     return rows, lockstep
 
 
@@ -297,6 +300,7 @@ def lockstep_blocks(
         rows.append(bank.steps(f_mps2, np.radians(np.degrees(omega_radps))))
         done[0] += f_mps2.shape[0]
 
+    lockstep.reports = bank.algorithm_reports  # type: ignore[attr-defined]
     return rows, lockstep
 
 
@@ -327,12 +331,15 @@ def write_cued_folder(
     extra: dict[str, object] | None = None,
     provenance: dict[str, Any] | None = None,
     outputs: Outputs = DEFAULT_OUTPUTS,
+    specs: Sequence[Any] = (),
 ) -> RunSummary:
     """Everything after the flight, into ``folder`` (which already holds ``flight.parquet``): perception and
     metrics on the flight read back (as ``washbench cue`` reads it), traces.parquet, metrics.csv, recording.rrd,
     run.json, ranking.csv, report.md and figures/. Returns ``summary`` completed with the steps, metrics and
     saturations. ``provenance`` (no date) goes into traces.parquet's metadata; ``extra`` into run.json. The
-    vestibular model is the one the provenance records (``vestibular``; the default without)."""
+    vestibular model is the one the provenance records (``vestibular``; the default without). ``specs``: every
+    washout as listed; those that need the whole recording (the oracle bound) are cued here on the flight read
+    back, and with the bound ``bound.csv`` is written (:mod:`washbench.runs.bound_stage`)."""
     from washbench.cueing import WashoutTrace
     from washbench.io.results import read_motion
     from washbench.runs.cue import analyse, write_results
@@ -343,10 +350,15 @@ def write_cued_folder(
     traces = {w: WashoutTrace.from_rows(block[i]) for i, w in enumerate(washouts)}  # contiguous columns
     del block
     from washbench.perception.vestibular import model_params
+    from washbench.runs.bound_stage import bound_outputs, split_whole, with_whole
 
+    traces = with_whole(traces, motion, split_whole(specs)[1], [s.name for s in specs] or washouts, limits,
+                        filter_start)  # fmt: skip
     vest = (provenance or {}).get("vestibular") or {}
     result = analyse(motion, traces, model_params(vest.get("model")), filter_start=filter_start)
-    write_results(folder, result, provenance)
+    traces_path, _ = write_results(folder, result, provenance)
+    bound = bound_outputs(folder, traces_path, motion.dt_s, specs, limits, model_params(vest.get("model")))
+    extra = {**(extra or {}), "bound": bound} if bound else extra
     if outputs.recording:
         title = f"{summary.aircraft} / {summary.manoeuvre}"
         props = flat_strings(provenance, str((extra or {}).get("created_utc") or "")) if provenance else None
@@ -358,7 +370,7 @@ def write_cued_folder(
         dt_s=motion.dt_s,
         metrics=list(result.metrics),
         motion=perceived_motion(ac.f_mps2, ac.omega_radps, motion.dt_s),
-        saturations={w: dict(traces[w].saturation_counts) for w in washouts},
+        saturations={w: dict(tr.saturation_counts) for w, tr in traces.items()},
     )
     write_run_json(folder / "run.json", summary, time.perf_counter() - start, extra)
     write_run_review(folder, dataclasses.replace(summary, run_dir=folder), table=result.columns(),
@@ -405,12 +417,17 @@ def run_script(
     marker = {"aircraft": info.aircraft}  # one run.json, or one per run of a script that resets
     check_replaceable(final, RUN_MARKER, marker, nested=True)
     clean_partials(final.parent)
-    names = tuple(w.name for w in specs)
+    from washbench.runs.bound_stage import split_whole
+
+    stepped = split_whole(specs)[0]  # a whole-only washout (the bound) is cued after the flight, on it read back
+    names = tuple(w.name for w in stepped)
     banks: list[list[np.ndarray]] = []
+    hooks: list[Any] = []
 
     def segment_hook(i: int, dt_s: float) -> Any:
-        rows, hook = lockstep_washouts(specs, limits, dt_s, filter_start)
+        rows, hook = lockstep_washouts(stepped, limits, dt_s, filter_start)
         banks.append(rows)
+        hooks.append(hook)
         return hook
 
     start = time.perf_counter()
@@ -419,7 +436,7 @@ def run_script(
     several = len(flight.segments) > 1
     summaries = []
     try:
-        for seg, rows in zip(flight.segments, banks, strict=True):
+        for seg, rows, hook in zip(flight.segments, banks, hooks, strict=True):
             folder = partial / seg.name if several else partial
             folder.mkdir(exist_ok=True)
             write_script_flight(folder, flight, seg)
@@ -436,10 +453,10 @@ def run_script(
             cols = seg.columns
             ac_q = aircraft_attitude(cols["phi_deg"], cols["theta_deg"], cols["psi_deg"])
             extra = {"script": str(info.path), "segment": seg.name, "stopped_by_time_limit": flight.stopped_by_limit}
-            extra |= {"created_utc": created, "provenance": prov}
+            extra |= {"created_utc": created, "provenance": prov, "algorithms": hook.reports()}
             summaries.append(
                 write_cued_folder(folder, summary, rows, names, limits, ac_q, [], start, filter_start, extra, prov,
-                                  outputs=outputs)
+                                  outputs=outputs, specs=specs)
             )
         publish_dir(partial, final, RUN_MARKER, marker, nested=True)
     finally:
