@@ -275,11 +275,6 @@ class MpcWashout:
         settings = {"max_iter": s.max_iter, "eps_abs": s.eps_abs, "eps_rel": s.eps_rel, "polishing": s.polishing}
         settings.update(adaptive_rho=s.adaptive_rho, check_termination=5, verbose=False, warm_starting=True, **extra)
         self.solver.setup(self.P_qp, np.zeros(self.nz), self.A_qp, self.l0, self.u0, **settings)
-        # the extension object behind the wrapper (osqp >= 1.0): updating and solving through it skips the wrapper's
-        # per-call copies, clipping and result namespace (about 0.2 ms a step; the same solver calls, the same bits).
-        # The bounds it gets are finite by construction (_build_qp), so the wrapper's clipping to OSQP_INFTY is moot.
-        raw = getattr(self.solver, "_solver", None)
-        self._raw = raw if all(callable(getattr(raw, a, None)) for a in ("update_data_vec", "solve")) else None
         self._lo = self.l0.copy()
         self._hi = self.u0.copy()
         self.x = np.zeros(self.n)
@@ -477,14 +472,9 @@ class MpcWashout:
         :attr:`inaccurate`; its first move is still checked by :meth:`_safe`) with a finite result.
         """
         lo, hi = self._update_bounds(r)
-        if self._raw is not None:
-            self._raw.update_data_vec(q=self._q_map @ r, l=lo, u=hi)
-            self._raw.solve()
-            info, z = self._raw.info, self._raw.solution.x
-        else:
-            self.solver.update(q=self._q_map @ r, l=lo, u=hi)
-            res = self.solver.solve(raise_error=False)
-            info, z = res.info, res.x
+        self.solver.update(q=self._q_map @ r, l=lo, u=hi)
+        res = self.solver.solve(raise_error=False)
+        info, z = res.info, res.x
         self.solves += 1
         self.iterations.append(int(info.iter))
         status = info.status
