@@ -17,7 +17,7 @@ import pytest
 
 from washbench.errors import WashbenchError
 from washbench.flight.scripts import bundled_script, load_script_info
-from washbench.io.results import read_metrics_csv
+from washbench.io.metrics_csv import read_metrics_csv
 from washbench.runs.cue import CueOptions, run_cue
 from washbench.runs.pipeline import run_script
 

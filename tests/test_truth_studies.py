@@ -18,7 +18,7 @@ from flight_helpers import write
 
 from washbench.analysis.ranking import rank
 from washbench.cli import main
-from washbench.io.results import read_metrics_csv
+from washbench.io.metrics_csv import read_metrics_csv
 from washbench.runs.pipeline import perceived_motion
 
 TURN = """\

@@ -452,7 +452,7 @@ def _dispatch(args: argparse.Namespace) -> int:
 
         return validate_command(args.manoeuvres, aircraft_dirs=args.aircraft_dir)
     if args.command == "schema":
-        from washbench.flight.manoeuvre import schema_command
+        from washbench.flight.json_schema import schema_command
 
         return schema_command(args.out)
     if args.command == "run":

@@ -26,11 +26,11 @@ the studies' evaluation kernel runs per sample.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
 from washbench.analysis.metric_sums import FLAT_RTOL, signal_metrics
+from washbench.io.metrics_csv import MetricRow
 from washbench.numerics.jitcache import announce_compile
 
 NPC_K = 1.0
@@ -91,30 +91,6 @@ def max_abs_error(x: np.ndarray, y: np.ndarray) -> float:
     x, y = _as_pair(x, y)
     announce_compile(signal_metrics)
     return float(signal_metrics(x, y, 1.0)[2])
-
-
-@dataclass(frozen=True)
-class MetricRow:
-    """One row of ``metrics.csv``: a washout's metrics for one DOF (units: see module docstring).
-
-    The cue classification (:mod:`washbench.analysis.cues`): time fractions ``cue_*_frac`` (NaN where not
-    classified, e.g. a study's evaluation) and the false-cue events as ``start-end@peak;...`` text. On the heave row,
-    the motion sickness dose values (MSDV, m/s^1.5, ISO 2631-1 Wf) of the simulator pilot and of the aircraft pilot
-    (NaN on the other rows).
-    """
-
-    washout: str
-    dof: str
-    npc: float
-    integral_error: float
-    max_error: float
-    cue_correct_frac: float = math.nan
-    cue_scaled_frac: float = math.nan
-    cue_false_frac: float = math.nan
-    cue_missing_frac: float = math.nan
-    msdv_mps15: float = math.nan
-    msdv_aircraft_mps15: float = math.nan
-    false_cue_events: str = ""
 
 
 def dof_metrics(

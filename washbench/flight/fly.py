@@ -24,7 +24,8 @@ from washbench.errors import WashbenchError
 from washbench.flight.checks import evaluate
 from washbench.flight.columns import COLUMN_NAMES
 from washbench.flight.fdm import make_fdm
-from washbench.flight.manoeuvre import Manoeuvre, Until, load_manoeuvre
+from washbench.flight.manoeuvre import Manoeuvre, load_manoeuvre
+from washbench.flight.manoeuvre_schema import Until
 from washbench.flight.monitor import BIG, Monitor
 from washbench.flight.openloop import OpenLoop
 from washbench.flight.pilot import Pilot
@@ -466,7 +467,7 @@ def write_flight(
     """
     import pyarrow as pa
 
-    from washbench.io.results import write_parquet
+    from washbench.io.parquet_files import write_parquet
 
     out = Path(out_dir)
     try:

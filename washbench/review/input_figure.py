@@ -20,6 +20,7 @@ import numpy as np
 
 from washbench.errors import WashbenchError, located
 from washbench.io.input_format import ColumnSource
+from washbench.io.outfolder import uninterrupted
 from washbench.io.units import G0_MPS2, axes_matrix, is_identity_axes
 
 INPUT_STEM = "input"
@@ -61,6 +62,7 @@ def input_labels(
     return out
 
 
+@uninterrupted
 def input_figure(
     stem: Path,
     title: str,
@@ -153,7 +155,7 @@ def redraw(folder: Path, formats: Sequence[str], fig_dir: Path | None = None) ->
 
     import pyarrow.parquet as pq
 
-    from washbench.io.results import AIRCRAFT, TIME_COLUMN, f_columns, omega_columns
+    from washbench.io.columns import AIRCRAFT, TIME_COLUMN, f_columns, omega_columns
 
     try:
         doc = json.loads((folder / "run.json").read_text())
@@ -193,7 +195,7 @@ def redraw(folder: Path, formats: Sequence[str], fig_dir: Path | None = None) ->
 
 
 def draw_for_result(folder: Path, title: str, motion: Any, labels: Sequence[str], notes: Sequence[str]) -> Path:
-    """``folder/figures/input.png`` of a cued segment (``motion``: :class:`washbench.io.results.Motion`); a PDF of an
+    """``folder/figures/input.png`` of a cued segment (``motion``: :class:`washbench.io.motion.Motion`); a PDF of an
     earlier ``washbench report`` is removed (it would show other data)."""
     fig_dir = folder / "figures"
     fig_dir.mkdir(parents=True, exist_ok=True)

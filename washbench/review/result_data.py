@@ -18,10 +18,9 @@ from typing import Any
 
 import numpy as np
 
-from washbench.analysis.metrics import DOFS, MetricRow, integral_abs_error
+from washbench.analysis.metrics import DOFS, integral_abs_error
 from washbench.errors import WashbenchError, located
-from washbench.io.provenance import read_parquet_provenance
-from washbench.io.results import (
+from washbench.io.columns import (
     AIRCRAFT,
     TIME_COLUMN,
     acc_columns,
@@ -29,10 +28,11 @@ from washbench.io.results import (
     perceived_f_columns,
     perceived_omega_columns,
     pos_columns,
-    read_metrics_csv,
     vel_columns,
     wheel_columns,
 )
+from washbench.io.metrics_csv import MetricRow, read_metrics_csv
+from washbench.io.provenance import read_parquet_provenance
 
 METRICS_FILE = "metrics.csv"
 TRACES_FILE = "traces.parquet"

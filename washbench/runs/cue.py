@@ -27,20 +27,12 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from washbench.analysis.metrics import MetricRow, dof_metrics
+from washbench.analysis.metrics import dof_metrics
 from washbench.errors import WashbenchError, located, printable
 from washbench.io.atomic import atomic_path
-from washbench.io.input_format import InputFormat
-from washbench.io.names import check_identifier
-from washbench.io.plausibility import Finding, check_arrays
-from washbench.io.progress import Progress
-from washbench.io.publish import result_path
-from washbench.io.readers import Samples, read_samples
-from washbench.io.resample import check_gaps, check_step, resample, split_resets, to_motion, window
-from washbench.io.results import (
+from washbench.io.columns import (
     AIRCRAFT,
     TIME_COLUMN,
-    Motion,
     acc_columns,
     f_columns,
     omega_columns,
@@ -54,9 +46,18 @@ from washbench.io.results import (
     sp_q_columns,
     vel_columns,
     wheel_columns,
-    write_metrics_csv,
-    write_traces,
 )
+from washbench.io.input_format import InputFormat
+from washbench.io.metrics_csv import MetricRow, write_metrics_csv
+from washbench.io.motion import Motion
+from washbench.io.names import check_identifier
+from washbench.io.parquet_files import write_traces
+from washbench.io.plausibility import Finding, check_arrays
+from washbench.io.progress import Progress
+from washbench.io.publish import result_path
+from washbench.io.readers import Samples, read_samples
+from washbench.io.resample import check_gaps, check_step, resample, split_resets, to_motion, window
+from washbench.perception.svc import SvcStream, head_msi
 from washbench.perception.vestibular import Perceived, VestibularModel, VestibularParams, model_params
 
 TRACES_FILE = "traces.parquet"
@@ -202,18 +203,24 @@ def analyse(
         perceived[name] = model.perceive(arr["head_f_mps2"], arr["head_omega_radps"], filter_start)
         checked[name] = arr
     vertical = {AIRCRAFT: motion.f_mps2[:, 2], **{w: a["head_f_mps2"][:, 2] for w, a in checked.items()}}
-    rows = _metric_rows(perceived, motion.dt_s, vertical)
+    heads = {AIRCRAFT: (motion.f_mps2, motion.omega_radps)}
+    heads |= {w: (a["head_f_mps2"], a["head_omega_radps"]) for w, a in checked.items()}
+    msi = {p: head_msi(f, w, motion.dt_s, start=filter_start) for p, (f, w) in heads.items()}
+    rows = _metric_rows(perceived, motion.dt_s, vertical, msi)
     result = CueResult(motion=motion, traces=dict(traces), perceived=perceived, metrics=rows, arrays=checked)
     result.columns(0, 0)  # an input column that clashes with a result column fails now, before anything is written
     return result
 
 
 def _metric_rows(
-    perceived: Mapping[str, Perceived], dt_s: float, vertical: Mapping[str, np.ndarray]
+    perceived: Mapping[str, Perceived],
+    dt_s: float,
+    vertical: Mapping[str, np.ndarray],
+    msi: Mapping[str, float],
 ) -> list[MetricRow]:
     """Six metric rows per washout: each simulator pilot's perceived motion against the aircraft pilot's, the cue
     classification, and on the heave row the MSDV of each pilot's head (``vertical``: pilot -> body-z specific
-    force (N,), m/s^2)."""
+    force (N,), m/s^2) and the predicted incidence (``msi``: pilot -> MSI at the end, %)."""
     import dataclasses
 
     from washbench.analysis.cues import classified_rows
@@ -227,7 +234,9 @@ def _metric_rows(
             base = dof_metrics(name, ac.f_mps2, ac.omega_radps, p.f_mps2, p.omega_radps, dt_s)
             msdv = head_msdv(vertical[name], dt_s)
             rows += [
-                dataclasses.replace(r, msdv_mps15=msdv, msdv_aircraft_mps15=msdv_ac) if r.dof == "heave" else r
+                dataclasses.replace(
+                    r, msdv_mps15=msdv, msdv_aircraft_mps15=msdv_ac, msi_pct=msi[name], msi_aircraft_pct=msi[AIRCRAFT]
+                ) if r.dof == "heave" else r
                 for r in classified_rows(base, ac.f_mps2, ac.omega_radps, p.f_mps2, p.omega_radps, dt_s)
             ]
     return rows
@@ -328,7 +337,7 @@ def stream_cue(
     on it (the table is in the file).
     """
     from washbench.cueing import CueingBank, WashoutTrace
-    from washbench.io.results import write_trace_chunks
+    from washbench.io.parquet_files import write_trace_chunks
     from washbench.perception.vestibular import PerceptionStream
 
     if chunk_rows < 1:
@@ -342,6 +351,7 @@ def stream_cue(
     streams = {p: PerceptionStream(model, filter_start) for p in (AIRCRAFT, *names)}
     felt = {p: Perceived(np.empty((n, 3)), np.empty((n, 3))) for p in streams}
     vertical = {p: np.empty(n) for p in streams}  # body-z specific force at each pilot's head (MSDV)
+    sick = {p: SvcStream(motion.dt_s, start=filter_start) for p in streams}  # predicted incidence (MSI)
     keep = (_REVIEW_FIELDS if figures or recording else ()) + (_RECORDING_FIELDS if recording else ())
     kept = {w: {f: np.empty((n, _TRACE_FIELDS[f])) for f in keep} for w in names}
     flags: dict[str, dict[str, np.ndarray]] = {w: {} for w in names}
@@ -354,6 +364,7 @@ def stream_cue(
             rows = slice(a, b)
             block = bank.steps(motion.f_mps2[rows], motion.omega_radps[rows], buf if b - a == buf.shape[1] else None)
             perceived = {AIRCRAFT: streams[AIRCRAFT].perceive(motion.f_mps2[rows], motion.omega_radps[rows])}
+            sick[AIRCRAFT].update(motion.f_mps2[rows], motion.omega_radps[rows])
             fields, saturated = {}, {}
             finite = bool(np.isfinite(block).all())  # one check of the chunk; the failing field named if not
             for i, w in enumerate(names):
@@ -362,6 +373,7 @@ def stream_cue(
                 saturated[w] = tr.saturated
                 perceived[w] = streams[w].perceive(fields[w]["head_f_mps2"], fields[w]["head_omega_radps"])
                 vertical[w][rows] = fields[w]["head_f_mps2"][:, 2]
+                sick[w].update(fields[w]["head_f_mps2"], fields[w]["head_omega_radps"])
                 for f in keep:
                     kept[w][f][rows] = fields[w][f]
                 for k, v in tr.saturated.items():
@@ -375,7 +387,7 @@ def stream_cue(
 
     write_trace_chunks(traces_path, tables(), metadata)
     vertical[AIRCRAFT][:] = motion.f_mps2[:, 2]
-    metrics = _metric_rows(felt, motion.dt_s, vertical)
+    metrics = _metric_rows(felt, motion.dt_s, vertical, {p: st.msi_pct for p, st in sick.items()})
     counts = bank.saturation_counts()
     traces = {w: SimpleNamespace(**kept[w], saturated=flags[w], saturation_counts=counts[w]) for w in names}
     return CueResult(motion=motion, traces=traces, perceived=felt, metrics=metrics, algorithms=bank.algorithm_reports())

@@ -29,8 +29,8 @@ from washbench.analysis.signals import amplitude_unit, generate
 from washbench.cueing.variants import Washout
 from washbench.errors import WashbenchError
 from washbench.io.atomic import write_text_atomic
+from washbench.io.csv_numbers import csv_number
 from washbench.io.progress import Progress
-from washbench.io.results import csv_number
 from washbench.io.yamlio import load_yaml_model
 from washbench.perception.vestibular import VestibularModel, VestibularParams
 from washbench.platform.limits import PlatformLimits

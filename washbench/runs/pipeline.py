@@ -36,10 +36,10 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from washbench.analysis.metrics import MetricRow
 from washbench.analysis.ranking import DOFS, perceived_motion
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
+from washbench.io.metrics_csv import MetricRow
 from washbench.io.provenance import build_provenance, flat_strings, utc_now
 from washbench.io.publish import (
     check_replaceable,
@@ -52,7 +52,7 @@ from washbench.io.publish import (
 from washbench.runs.outputs import DEFAULT_OUTPUTS, Outputs
 
 if TYPE_CHECKING:
-    from washbench.io.results import Motion
+    from washbench.io.motion import Motion
     from washbench.platform import PlatformLimits
     from washbench.review.rerun_log import PlatformEnvelope
     from washbench.runs.cue import CueResult
@@ -341,7 +341,7 @@ def write_cued_folder(
     washout as listed; those that need the whole recording (the oracle bound) are cued here on the flight read
     back, and with the bound ``bound.csv`` is written (:mod:`washbench.runs.bound_stage`)."""
     from washbench.cueing import WashoutTrace
-    from washbench.io.results import read_motion
+    from washbench.io.motion_file import read_motion
     from washbench.runs.cue import analyse, write_results
     from washbench.runs.suite import write_run_review
 

@@ -77,7 +77,7 @@ def load_flights(
     aircraft_dirs: Sequence[Path] = (),
 ) -> list[StudyFlight]:
     """The study's flights: flown once into ``out_dir/flights/`` or read from ``from_dir``; in manoeuvre order."""
-    from washbench.io.results import read_motion
+    from washbench.io.motion_file import read_motion
 
     ids = _identify(manoeuvres, aircraft_dirs)
     status: dict[tuple[str, str], tuple[bool, str]] = {}

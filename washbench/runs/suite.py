@@ -58,12 +58,12 @@ from washbench.analysis.ranking import (
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
 from washbench.io.cpus import usable_cpus
+from washbench.io.csv_numbers import csv_number
 from washbench.io.lock import output_lock
 from washbench.io.outfolder import discard_stage, is_own_hidden, recover, signals_held, swap_in
 from washbench.io.paths import MANOEUVRES_DIR, bundled_names, resolve_manoeuvre
 from washbench.io.progress import Progress
 from washbench.io.publish import clean_partials, is_leftover, is_washbench_result, read_marker
-from washbench.io.results import csv_number
 from washbench.runs.outputs import DEFAULT_OUTPUTS, Outputs
 from washbench.runs.pipeline import RUN_MARKER, RunSummary
 
@@ -348,7 +348,7 @@ def _runs_with_metrics(outcomes: Sequence[Outcome]) -> list[Outcome]:
 
 def metrics_table(outcomes: Sequence[Outcome]) -> str:
     """``metrics.csv`` of the suite (every run that produced metrics, failed checks included)."""
-    from washbench.io.results import METRICS_COLUMNS, METRICS_TEXT_COLUMNS
+    from washbench.io.metrics_csv import METRICS_COLUMNS, METRICS_TEXT_COLUMNS
 
     rows = [["aircraft", "manoeuvre", *METRICS_COLUMNS]]
     for o in _runs_with_metrics(outcomes):

@@ -32,8 +32,8 @@ from washbench.cueing.params import WashoutParams
 from washbench.cueing.variants import Washout, apply_overrides, check_kind, value_of
 from washbench.errors import WashbenchError
 from washbench.io.atomic import write_text_atomic
+from washbench.io.csv_numbers import csv_number
 from washbench.io.progress import Progress
-from washbench.io.results import csv_number
 
 
 def params_yaml(params: WashoutParams, header: str) -> str:
