@@ -21,7 +21,7 @@ import pyarrow.parquet as pq
 
 from washbench.analysis.bound import costs_from_columns
 from washbench.io.atomic import write_text_atomic
-from washbench.io.results import csv_number
+from washbench.io.csv_numbers import csv_number
 from washbench.platform.limits import load_platform_limits
 
 G = 9.80665

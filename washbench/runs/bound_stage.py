@@ -72,14 +72,8 @@ def bound_outputs(
 
     from washbench.analysis.bound import BoundParams, costs_from_columns
     from washbench.io.atomic import write_text_atomic
-    from washbench.io.results import (
-        acc_columns,
-        csv_number,
-        f_columns,
-        omega_columns,
-        omega_platform_columns,
-        q_columns,
-    )
+    from washbench.io.columns import acc_columns, f_columns, omega_columns, omega_platform_columns, q_columns
+    from washbench.io.csv_numbers import csv_number
 
     spec = bound_spec(specs)
     if spec is None:
