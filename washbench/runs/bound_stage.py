@@ -68,16 +68,16 @@ def bound_outputs(
     The bound is solved again here with a free start (any position, attitude and rate within the limits), which
     every washout's trajectory satisfies: J_bound <= J of every washout. Its cost weights are the parameter file's
     ``bound:`` section; ``vestibular`` the run's vestibular model (None: the default)."""
+    spec = bound_spec(specs)
+    if spec is None:
+        return None
     import pyarrow.parquet as pq
 
-    from washbench.analysis.bound import BoundParams, costs_from_columns
+    from washbench.analysis.bound import BoundParams, costs_from_columns  # scipy: only when the bound runs
     from washbench.io.atomic import write_text_atomic
     from washbench.io.columns import acc_columns, f_columns, omega_columns, omega_platform_columns, q_columns
     from washbench.io.csv_numbers import csv_number
 
-    spec = bound_spec(specs)
-    if spec is None:
-        return None
     params = BoundParams.model_validate(spec.params.sections.get(BOUND_WASHOUT) or {})
     names = [s.name for s in specs]
     wanted = [*f_columns("aircraft"), *omega_columns("aircraft")]
