@@ -209,9 +209,11 @@ def test_sweep_and_tune_take_optimal_and_mpc_weights_as_keys(suite_dir: Path, tm
     short = tmp_path / "m"
     short.mkdir()
     (short / "bound_doublet.yaml").write_text(SHORT)
-    proc = washbench("sweep", short, "--from", suite_dir, "--washout", "optimal", "--set",
-                     "optimal.pitch.position=0.1,3", "--out", tmp_path / "s", "--quiet", "--jobs", "1")  # fmt: skip
-    assert proc.returncode == 0, proc.stdout + proc.stderr
+    from washbench.cli import main  # in this process: the three commands share one start-up
+
+    assert main(["sweep", str(short), "--from", str(suite_dir), "--washout", "optimal", "--set",
+                 "optimal.pitch.position=0.1,3", "--out", str(tmp_path / "s"), "--quiet", "--jobs",
+                 "1"]) == 0  # fmt: skip
     rows = read_csv(tmp_path / "s" / "sweep.csv")
     key = next(k for k in rows[0] if "position" in k)
     score_key = next(k for k in rows[0] if k.startswith("score"))
@@ -220,14 +222,13 @@ def test_sweep_and_tune_take_optimal_and_mpc_weights_as_keys(suite_dir: Path, tm
     params = tmp_path / "p.yaml"
     params.write_text(CW1 + "optimal:\n  pitch: {position: 3}\n")
     flight = suite_dir / "c172p" / "bound_doublet" / "flight.parquet"
-    proc = washbench("cue", flight, "--out", tmp_path / "c", "--washout", "optimal", "--params", params,
-                     "--no-recording", "--no-figures", "--quiet")  # fmt: skip
-    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert main(["cue", str(flight), "--out", str(tmp_path / "c"), "--washout", "optimal", "--params", str(params),
+                 "--no-recording", "--no-figures", "--quiet"]) == 0  # fmt: skip
     score = float(read_csv(tmp_path / "c" / "ranking.csv")[0]["score"])
     assert score == pytest.approx(points[3.0], rel=1e-9)
-    proc = washbench("tune", short, "--from", suite_dir, "--washout", "mpc", "--tune", "mpc.heave.direct_force=0.5:2",
-                     "--budget", "6", "--out", tmp_path / "t", "--quiet", "--jobs", "1")  # fmt: skip
-    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert main(["tune", str(short), "--from", str(suite_dir), "--washout", "mpc", "--tune",
+                 "mpc.heave.direct_force=0.5:2", "--budget", "6", "--out", str(tmp_path / "t"), "--quiet", "--jobs",
+                 "1"]) == 0  # fmt: skip
     import yaml
 
     tuned = yaml.safe_load((tmp_path / "t" / "tuned.yaml").read_text())
