@@ -36,7 +36,7 @@ from washbench.io.motion_file import read_motion
 from washbench.perception import VestibularModel
 from washbench.perception.vestibular import CanalParams, OtolithParams, canal_tf, otolith_tf
 from washbench.platform import load_platform_limits
-from washbench.runs.cue import analyse, stream_cue, write_results
+from washbench.runs.chain import analyse, stream_cue, write_results
 
 
 def write_input(path: Path, n: int) -> None:

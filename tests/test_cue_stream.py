@@ -11,8 +11,9 @@ import pytest
 
 from washbench.cueing.variants import select_washouts
 from washbench.io.motion import Motion
+from washbench.io.progress import Progress
 from washbench.platform import load_platform_limits
-from washbench.runs.cue import Progress, cue_motion, stream_cue
+from washbench.runs.chain import cue_motion, stream_cue
 
 DT_S = 1.0 / 120.0
 

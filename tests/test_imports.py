@@ -40,18 +40,8 @@ FLOORS: dict[str, int] = {
     "__main__": 11,
 }
 
-#: Known cycles, as the exact edges (importer, imported) that lie on them. ``runs``: ``run``, ``cue`` and ``suite``
-#: share the chain and the result folder through each other (issue 22, item 1; ``runs/`` is being restructured by
-#: issue 25's work, so it is left as it is here).
-KNOWN_CYCLE_EDGES: frozenset[tuple[str, str]] = frozenset(
-    {
-        ("washbench.runs.cue", "washbench.runs.pipeline"),
-        ("washbench.runs.cue", "washbench.runs.suite"),
-        ("washbench.runs.pipeline", "washbench.runs.cue"),
-        ("washbench.runs.pipeline", "washbench.runs.suite"),
-        ("washbench.runs.suite", "washbench.runs.pipeline"),
-    }
-)
+#: Known cycles, as the exact edges (importer, imported) that lie on them: none left.
+KNOWN_CYCLE_EDGES: frozenset[tuple[str, str]] = frozenset()
 
 #: Known imports that run up the floors: none left.
 KNOWN_UPWARD_EDGES: frozenset[tuple[str, str]] = frozenset()

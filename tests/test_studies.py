@@ -21,7 +21,7 @@ from washbench.cli import main
 from washbench.io.metrics_csv import MetricRow, read_metrics_csv
 from washbench.io.paths import DATA_DIR
 from washbench.review.rrd_read import read_static
-from washbench.runs.pipeline import RunSummary
+from washbench.runs.result_folder import RunSummary
 from washbench.runs.suite import Outcome, write_suite_results
 
 HERE = Path(__file__).parent / "data" / "study"

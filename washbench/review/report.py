@@ -35,12 +35,9 @@ from washbench.analysis.ranking import (
     undecided,
 )
 from washbench.io.atomic import write_text_atomic
+from washbench.io.result_files import FIGURES_DIR, RECORDING_FILE, REPORT_FILE
 from washbench.review.numbers import SCORE_FLAG, pct, sig
 from washbench.review.result_data import ResultData, load_result
-
-REPORT_FILE = "report.md"
-FIGURES_DIR = "figures"
-SUITE_FILE = "suite.json"
 
 FLAG = SCORE_FLAG
 SCORE_NOTE = (
@@ -486,7 +483,7 @@ def result_sections(
         lines += [f"{h} Phases", "", "| phase | start (s) | end (s) |", "|---|---|---|"]
         lines += [f"| {n} | {t0:.2f} | {t1:.2f} |" for n, t0, t1 in data.phases]
         lines.append("")
-    recording = data.folder / "recording.rrd"
+    recording = data.folder / RECORDING_FILE
     if recording.exists():
         rel = _rel(recording, start)
         lines += [f"Recording: [{rel}]({rel}) (`washbench replay {rel}`).", ""]

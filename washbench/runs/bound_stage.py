@@ -54,6 +54,23 @@ def with_whole(
     return {name: both[name] for name in order}
 
 
+def lockstep_result(motion: Any, rows: list[Any], options: Any) -> Any:
+    """:func:`washbench.runs.chain.from_lockstep` with the whole-only washouts of ``options`` (a
+    :class:`washbench.runs.options.RunOptions`; they were not in the lockstep) cued here on ``motion``, the flight
+    read back, and put in their listed order."""
+    from washbench.cueing import WashoutTrace
+    from washbench.runs.chain import analyse, from_lockstep, stacked_rows
+
+    stepped, whole = split_whole(options.washouts)
+    if not whole:
+        return from_lockstep(motion, rows, options.washout_order, options.vestibular_params, options.filter_start)
+    block = stacked_rows(rows)  # (washouts, N, fields)
+    traces = {w.name: WashoutTrace.from_rows(block[i]) for i, w in enumerate(stepped)}
+    del block
+    traces = with_whole(traces, motion, whole, options.washout_order, options.limits, options.filter_start)
+    return analyse(motion, traces, options.vestibular_params, options.filter_start)
+
+
 def bound_spec(specs: Sequence[Any]) -> Any | None:
     """The washout named ``bound`` (kind ``bound``) among ``specs``, or None."""
     return next((s for s in specs if s.name == BOUND_WASHOUT and s.kind == BOUND_WASHOUT), None)
@@ -109,4 +126,4 @@ def bound_outputs(
     }
 
 
-__all__ = ["BOUND_COLUMNS", "BOUND_FILE", "bound_outputs", "bound_spec", "split_whole", "with_whole"]
+__all__ = ["BOUND_COLUMNS", "BOUND_FILE", "bound_outputs", "bound_spec", "lockstep_result", "split_whole", "with_whole"]

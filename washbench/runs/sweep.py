@@ -26,6 +26,8 @@ from washbench.cueing.params import WASHOUT_NAMES
 from washbench.errors import WashbenchError
 from washbench.io.atomic import write_text_atomic
 from washbench.io.progress import Progress
+from washbench.runs.inputs import find_manoeuvres
+from washbench.runs.study import evaluate, load_flights
 
 
 def _csv(rows: list[list[str]]) -> str:
@@ -73,8 +75,6 @@ def sweep_command(
     A grid of more than :data:`MAX_POINTS` points (over all washouts) needs ``force`` (``--force``)."""
     from washbench.cueing.variants import load_param_file
     from washbench.platform import load_platform_limits
-    from washbench.runs.study import evaluate, load_flights
-    from washbench.runs.suite import find_manoeuvres
 
     start = time.perf_counter()
     if not sets:
