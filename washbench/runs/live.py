@@ -34,6 +34,10 @@ from typing import Any
 import numpy as np
 
 from washbench.errors import WashbenchError
+from washbench.io.atomic import write_text_atomic
+from washbench.io.lock import output_lock
+from washbench.io.outfolder import owned_entries
+from washbench.io.resample import suggest_rate, uniform_step
 from washbench.io.result_files import RUN_FILE
 from washbench.live import commands
 from washbench.live.endpoints import Sink, bind_udp
@@ -299,8 +303,6 @@ def _auto_resample(path: Path) -> float | None:
     """A rate to resample the saved input at when a segment's times are not on a uniform grid (else None)."""
     import pyarrow.csv as pacsv
 
-    from washbench.io.resample import suggest_rate, uniform_step
-
     t = pacsv.read_csv(path, convert_options=pacsv.ConvertOptions(include_columns=["t_s"])).column(0).to_numpy()
     back = np.flatnonzero(np.diff(t) < 0.0) + 1
     for part in np.split(t, back):
@@ -311,8 +313,6 @@ def _auto_resample(path: Path) -> float | None:
 
 def _add_live_figures(out: Path, input_path: Path, fig: dict[str, Any]) -> None:
     """Put the session's figures into run.json (``live``) of every result folder cued from ``input_path``."""
-    from washbench.io.atomic import write_text_atomic
-
     for folder in (out, *sorted(out.glob("segment_*"))):
         path = folder / RUN_FILE
         try:
@@ -335,7 +335,6 @@ def run_live(
     """The ``washbench live`` command; returns the exit status (that of ``washbench cue`` on the saved input, or
     130 / 143 after a Ctrl-C / SIGTERM once the result folder is written)."""
     from washbench.cueing import CueingBank
-    from washbench.io.lock import output_lock
     from washbench.live.viewer import open_viewer
 
     for flag, value in (("--duration", opts.duration_s), ("--idle-timeout", opts.idle_timeout_s),
@@ -355,8 +354,6 @@ def run_live(
     # a Ctrl-C or SIGTERM from the moment the port is bound only stops the loop: the result is written first
     with stop_on_signals() as got, contextlib.closing(sink), contextlib.closing(bind_udp(opts.listen)) as sock, \
             output_lock(opts.out) as out:  # fmt: skip
-        from washbench.io.outfolder import owned_entries
-
         owned_entries(out, "cue", (INPUT_FILE,))  # a folder holding someone else's files is refused before listening
         writer = InputWriter(out / INPUT_FILE)
         viewer = open_viewer(names, limits, opts.filter_start) if opts.viewer else None

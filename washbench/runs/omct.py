@@ -25,15 +25,19 @@ from pathlib import Path
 
 from washbench.analysis import omct
 from washbench.analysis.omct_boundaries import BoundaryFile
-from washbench.analysis.signals import amplitude_unit, generate
-from washbench.cueing.variants import Washout
+from washbench.analysis.signals import SignalSpec, amplitude_unit, canonical_axis, generate
+from washbench.cueing.variants import Washout, select_washouts
 from washbench.errors import WashbenchError
 from washbench.io.atomic import write_text_atomic
+from washbench.io.budget import check_samples
 from washbench.io.csv_numbers import csv_number
+from washbench.io.motion_file import write_motion
+from washbench.io.outfolder import result_set
 from washbench.io.progress import Progress
 from washbench.io.result_files import REPORT_FILE
 from washbench.io.yamlio import load_yaml_model
 from washbench.perception.vestibular import VestibularModel, VestibularParams
+from washbench.platform import load_platform_limits
 from washbench.platform.limits import PlatformLimits
 from washbench.review.omct_report import report_text
 
@@ -144,8 +148,6 @@ def measure(
         raise WashbenchError(f"--rate-hz {rate_hz}: {top:.4g} rad/s is at or above the Nyquist frequency")
     dt = 1.0 / rate_hz
     sigma = slowest_decay(entries)
-    from washbench.io.budget import check_samples
-
     longest_s = max(omct.timing(w, sigma).duration_s for w in frequencies_radps)
     check_samples(longest_s * rate_hz * len(entries), f"--rate-hz {rate_hz:g}: {len(entries)} washout(s) x "
                   f"the longest OMCT run ({longest_s:.4g} s)")  # fmt: skip
@@ -278,9 +280,6 @@ def run_omct(
     ``omct.csv``, ``bode_<test>.png`` (with ``plots``) and ``report.md`` into ``out_dir``; bad input raises
     WashbenchError before anything is written.
     """
-    from washbench.cueing.variants import select_washouts
-    from washbench.platform import load_platform_limits
-
     entries = select_washouts(washouts, variants, params_path)
     limits = load_platform_limits(platform_path)
     boundary = load_boundaries(boundaries_path) if boundaries_path is not None else None
@@ -301,8 +300,6 @@ def run_entries(
     progress: bool = False,
 ) -> list[OmctPoint]:
     """Measure ``entries`` and write the results (the part of :func:`run_omct` a variant list can call)."""
-    from washbench.io.outfolder import result_set
-
     out_dir = Path(out_dir)
     bounds = boundary.bounds() if boundary else None
     with result_set(out_dir, "omct") as stage:  # the whole set replaces the previous one at once
@@ -340,9 +337,6 @@ def signal_command(
     out: Path,
 ) -> int:
     """The ``washbench signal`` command: generate a test signal and write it as a ``washbench cue`` input."""
-    from washbench.analysis.signals import SignalSpec, amplitude_unit, canonical_axis
-    from washbench.io.motion_file import write_motion
-
     given, axis = axis, canonical_axis(axis)  # surge/sway/heave (the metrics' names) or f_x/f_y/f_z
     spec = SignalSpec(kind, axis, amplitude, frequency_hz, duration_s, rate_hz, start_s)
     sig = generate(spec)

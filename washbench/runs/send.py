@@ -23,6 +23,8 @@ from pathlib import Path
 import numpy as np
 
 from washbench.errors import WashbenchError
+from washbench.io.paths import resolve_manoeuvre
+from washbench.io.readers import read_samples
 from washbench.live.packets import (
     ENCODERS,
     FORMATS,
@@ -69,8 +71,6 @@ class Pacer:
 def file_samples(path: Path) -> Iterator[Sample]:
     """The samples of a ``washbench cue`` input, in washbench units and axes, as the file orders them (the file is
     read and checked now; the rows are made tuples a block at a time)."""
-    from washbench.io.readers import read_samples
-
     s = read_samples(path)
     table = np.column_stack([s.t_s, s.f_mps2, s.omega_degps])
 
@@ -215,8 +215,6 @@ def _fly_and_send(path: Path, sender: Sender, pacer: Pacer, aircraft_dirs: tuple
     """Fly the manoeuvre with JSBSim, each step paced to (``--speed`` times) real time and sent as it is final."""
     from washbench.flight.fly import fly
     from washbench.flight.manoeuvre import load_manoeuvre
-    from washbench.io.paths import resolve_manoeuvre
-
     m = load_manoeuvre(resolve_manoeuvre(path), aircraft_dirs)
     dt = m.dt_s
     r2d = 180.0 / np.pi

@@ -22,6 +22,8 @@ from washbench.analysis.evaluate import Evaluation, FlightEvaluator
 from washbench.cueing.variants import Washout
 from washbench.errors import WashbenchError, located
 from washbench.io.cpus import usable_cpus
+from washbench.io.motion_file import read_motion
+from washbench.io.outfolder import STAGE_PREFIX
 from washbench.io.progress import Progress
 from washbench.io.result_files import FLIGHT_FILE
 from washbench.runs.pool import submit_all, worker_pool
@@ -78,8 +80,6 @@ def load_flights(
     aircraft_dirs: Sequence[Path] = (),
 ) -> list[StudyFlight]:
     """The study's flights: flown once into ``out_dir/flights/`` or read from ``from_dir``; in manoeuvre order."""
-    from washbench.io.motion_file import read_motion
-
     ids = _identify(manoeuvres, aircraft_dirs)
     status: dict[tuple[str, str], tuple[bool, str]] = {}
     if from_dir is not None:
@@ -91,8 +91,6 @@ def load_flights(
         dirs = tuple(str(d) for d in aircraft_dirs)
         args = [(p, str(root), dirs) for p, _, _ in ids]
         if progress:
-            from washbench.io.outfolder import STAGE_PREFIX
-
             shown = root.parent.parent / FLIGHTS_DIR if root.parent.name.startswith(STAGE_PREFIX) else root
             print(f"study: flying {len(args)} manoeuvre(s) once -> {shown}", file=sys.stderr, flush=True)
         for aircraft, name, ok, reason in _map(_fly_one, args, jobs, dask):

@@ -52,10 +52,13 @@ from washbench.io.atomic import write_text_atomic
 from washbench.io.cpus import usable_cpus
 from washbench.io.csv_numbers import csv_number
 from washbench.io.lock import output_lock
+from washbench.io.metrics_csv import METRICS_COLUMNS, METRICS_TEXT_COLUMNS
 from washbench.io.outfolder import discard_stage, is_own_hidden, recover, swap_in
 from washbench.io.progress import Progress
+from washbench.io.provenance import utc_now
 from washbench.io.publish import clean_partials, is_leftover, is_washbench_result, read_marker
 from washbench.io.result_files import COMPARISON_FILE, METRICS_FILE, RANKING_FILE, REPORT_FILE, SUITE_FILE, SUITE_FILES
+from washbench.review.suite_report import write_suite_json, write_suite_report
 from washbench.runs.inputs import check_unique_names, find_manoeuvres
 from washbench.runs.options import RunOptions, load_options
 from washbench.runs.pipeline import announce_script, run_manoeuvre, run_script
@@ -185,8 +188,6 @@ def _runs_with_metrics(outcomes: Sequence[Outcome]) -> list[Outcome]:
 
 def metrics_table(outcomes: Sequence[Outcome]) -> str:
     """``metrics.csv`` of the suite (every run that produced metrics, failed checks included)."""
-    from washbench.io.metrics_csv import METRICS_COLUMNS, METRICS_TEXT_COLUMNS
-
     rows = [["aircraft", "manoeuvre", *METRICS_COLUMNS]]
     for o in _runs_with_metrics(outcomes):
         for m in o.run.metrics:
@@ -226,9 +227,6 @@ def write_suite_results(
 
     The report is built from the files (:mod:`washbench.review.suite_report`), as ``washbench report`` builds it.
     """
-    from washbench.io.provenance import utc_now
-    from washbench.review.suite_report import write_suite_json, write_suite_report
-
     rule = rule_from_record((provenance or {}).get("ranking"))
     rankings = {
         (o.run.aircraft, o.run.manoeuvre): rank(o.run.metrics, o.run.motion, rule)

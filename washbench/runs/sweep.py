@@ -23,9 +23,12 @@ from pathlib import Path
 
 from washbench.analysis.sweep import SweepRow, grid, parse_set, point_washouts, sweep_csv, sweep_metrics_csv
 from washbench.cueing.params import WASHOUT_NAMES
+from washbench.cueing.variants import load_param_file
 from washbench.errors import WashbenchError
 from washbench.io.atomic import write_text_atomic
+from washbench.io.outfolder import result_set
 from washbench.io.progress import Progress
+from washbench.platform import load_platform_limits
 from washbench.runs.inputs import find_manoeuvres
 from washbench.runs.study import evaluate, load_flights
 
@@ -73,9 +76,6 @@ def sweep_command(
     """CLI entry of ``washbench sweep``; 0 when every flight ran and passed its checks, 1 otherwise.
 
     A grid of more than :data:`MAX_POINTS` points (over all washouts) needs ``force`` (``--force``)."""
-    from washbench.cueing.variants import load_param_file
-    from washbench.platform import load_platform_limits
-
     start = time.perf_counter()
     if not sets:
         raise WashbenchError("sweep: give at least one --set KEY=V1,V2,...")
@@ -89,8 +89,6 @@ def sweep_command(
     base, _ = load_param_file(params_path)
     candidates = [w for k in kinds for w in point_washouts(k, base, points)]
     limits = load_platform_limits(platform_path)
-    from washbench.io.outfolder import result_set
-
     with result_set(out_dir, "sweep") as stage:  # the whole set replaces the previous one at once
         flights = load_flights(files, stage, limits, from_dir=from_dir, jobs=jobs, dask=dask, progress=progress,
             aircraft_dirs=aircraft_dirs,

@@ -29,12 +29,14 @@ from washbench.analysis.sweep import format_value
 from washbench.analysis.tune import Bound, minimise, parse_tune
 from washbench.cueing import registry
 from washbench.cueing.params import WashoutParams
-from washbench.cueing.variants import Washout, apply_overrides, check_kind, value_of
+from washbench.cueing.variants import Washout, apply_overrides, check_kind, load_param_file, value_of
 from washbench.errors import WashbenchError
 from washbench.io.atomic import write_text_atomic
 from washbench.io.csv_numbers import csv_number
+from washbench.io.outfolder import result_set
 from washbench.io.progress import Progress
 from washbench.io.result_files import REPORT_FILE
+from washbench.platform import load_platform_limits
 from washbench.runs.inputs import find_manoeuvres
 from washbench.runs.study import evaluate, load_flights
 
@@ -47,7 +49,9 @@ def params_yaml(params: WashoutParams, header: str) -> str:
             return {k: off(x) for k, x in v.items()}
         return "off" if v is None else v
 
-    body = yaml.safe_dump(off(params.model_dump(mode="json")), sort_keys=False, default_flow_style=None)
+    data = off(params.model_dump(mode="json"))
+    data.update(data.pop("sections", None) or {})  # the Python algorithms' sections as top-level keys (optimal:, mpc:)
+    body = yaml.safe_dump(data, sort_keys=False, default_flow_style=None)
     comment = "".join(f"# {line}\n" if line else "#\n" for line in header.splitlines())
     return comment + body
 
@@ -71,9 +75,6 @@ def tune_command(
     aircraft_dirs: Sequence[Path] = (),
 ) -> int:
     """CLI entry of ``washbench tune``; 0 on success (the flights' own check results are reported, not fatal)."""
-    from washbench.cueing.variants import load_param_file
-    from washbench.platform import load_platform_limits
-
     start = time.perf_counter()
     kind = check_kind(washout, "--washout")
     if not tunes:
@@ -101,8 +102,6 @@ def tune_command(
     limits = load_platform_limits(platform_path)
     train_files = find_manoeuvres(manoeuvres)
     test_files = [p for p in (find_manoeuvres(test) if test else []) if p not in train_files]
-    from washbench.io.outfolder import result_set
-
     with result_set(out_dir, "tune") as stage:  # the whole set replaces the previous one at once
         best_x, best, base_obj, train, table = _tune(
             stage, base, kind, bounds, keys, train_files, test_files, limits, budget, seed, saturation_weight,
