@@ -443,6 +443,26 @@ def test_run_signalled_as_its_recording_lands_keeps_the_previous_result(tmp_path
         assert "Traceback" not in err and len(err.strip().splitlines()) == 1, err
         assert digest(result) == before
 
+
+def test_run_and_suite_on_a_full_disk_name_the_published_file(tmp_path: Path) -> None:
+    """``run`` and ``suite`` build in hidden partial folders: a recording that cannot be written is named where
+    it was going (``OUT/c172p/short/recording.rrd``), never ``.short.partial-PID`` or ``.suite.partial-PID``, in
+    the error line and in the suite's published failure reason."""
+    m = short(tmp_path, seconds=1)
+    common = ["--washout", "small-angle", "--quiet", "--no-figures"]
+    limit = _file_size_limit(300_000)  # the traces (~80 kB) pass, the recording (~700 kB) does not
+    out = tmp_path / "run"
+    proc = subprocess.run([sys.executable, "-m", "washbench", "run", str(m), "--out", str(out), *common],
+                          capture_output=True, text=True, timeout=120, preexec_fn=limit)  # fmt: skip
+    assert_clean_error(proc, f"{out / 'c172p' / 'short' / 'recording.rrd'}: cannot write")
+    assert "partial" not in proc.stderr
+    out = tmp_path / "suite"
+    proc = subprocess.run([sys.executable, "-m", "washbench", "suite", str(m), "--out", str(out), "--jobs", "1",
+                           *common], capture_output=True, text=True, timeout=120, preexec_fn=limit)  # fmt: skip
+    assert proc.returncode == 1, proc.stderr
+    reasons = [e["reason"] for e in json.loads((out / "suite.json").read_text())["manoeuvres"]]
+    assert reasons == [f"{out / 'c172p' / 'short' / 'recording.rrd'}: cannot write: File too large"], reasons
+
 def _stage_names(out: Path) -> set[str]:
     return {f"{s.name}/{p.name}" for s in out.glob(STAGE_PREFIX + "*") for p in s.iterdir()}
 

@@ -321,13 +321,19 @@ def result_set(out: str | Path, command: str, adopt: Sequence[str] = ()) -> Iter
             write_manifest(stage, command)
             swap_in(stage, out_dir, previous)
         except WashbenchError as exc:  # name the files where they were going, not the hidden stage
-            shown = [_unstaged(p, stage, out_dir) for p in exc.problems]
-            raise WashbenchError(shown[0], shown[1:]) from None
+            raise unstaged_error(exc, stage, out_dir) from None
         finally:
             discard_stage(stage)
 
 
 _TMP_PART = re.compile(r"/\.([^/]+?)\.[A-Za-z0-9_]{8}\.tmp\b")
+
+
+def unstaged_error(exc: WashbenchError, stage: Path, final: Path) -> WashbenchError:
+    """``exc`` with every path in the hidden folder ``stage`` named where it was going (in ``final``) and
+    temporary file names replaced by the published ones: what a command building its results in a stage raises."""
+    shown = [_unstaged(p, stage, final) for p in exc.problems]
+    return WashbenchError(shown[0], shown[1:])
 
 
 def _unstaged(message: str, stage: Path, out_dir: Path) -> str:

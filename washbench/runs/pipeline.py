@@ -120,6 +120,10 @@ def run_manoeuvre(
         summary = write_cued_folder(partial, summary, rows, opts, ac_q, flight.phases, start, extra, prov)
         publish_dir(partial, final, RUN_MARKER, marker)
         published = True
+    except WashbenchError as exc:  # name the files where they were going, not the hidden partial folder
+        from washbench.io.outfolder import unstaged_error
+
+        raise unstaged_error(exc, partial, final) from None
     finally:
         with contextlib.suppress(FileNotFoundError):
             shutil.rmtree(partial)

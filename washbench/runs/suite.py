@@ -28,6 +28,7 @@ The exit status is 0 only if every manoeuvre ran and passed its checks.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import sys
@@ -333,6 +334,9 @@ def suite_command(
         stage.mkdir()
         try:
             outcomes = run_suite(files, stage, options, jobs=jobs, progress=progress, dask=dask)
+            for o in outcomes:  # a failure names the files where they were going, not the hidden stage
+                if not o.run.ok and str(stage) in o.run.reason:
+                    o.run = dataclasses.replace(o.run, reason=o.run.reason.replace(str(stage), str(out_dir)))
             write_suite_results(outcomes, stage, dict(options.provenance), options.outputs.figures)
             swap_in(stage, out_dir, previous)  # journalled, signals held: whole or not at all
         finally:
