@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import re
 import resource
 import signal
 import subprocess
@@ -189,3 +190,22 @@ def test_a_suite_signalled_as_its_workers_start_stops_in_one_line(tmp_path: Path
         time.sleep(0.1)
     assert left == []
     assert not out.exists() or tree(out) == []
+
+
+def test_a_forced_big_sweep_says_its_size_and_estimated_time_first(flights: Path, tmp_path: Path) -> None:
+    """A grid beyond the bound needs --force, and then says, even with --quiet, its size and an estimated time
+    (its first points timed) before the evaluations; the estimate is within a factor of 10 of the time taken."""
+    m = flights.parent.parent / "brief.yaml"
+    xs = ",".join(str(0.5 + 0.01 * i) for i in range(45))
+    args = ("sweep", m, "--washout", "small-angle", "--set", f"translational_highpass_wn_radps.x={xs}",
+            "--set", f"translational_highpass_wn_radps.y={xs}", "--from", flights, "--quiet")  # fmt: skip
+    proc = washbench(*args, "--out", tmp_path / "refused", timeout=60)
+    assert_clean_error(proc, "2025 points", "--force")
+    proc = washbench(*args, "--force", "--out", tmp_path / "out", timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    said = re.search(r"^sweep: 2025 candidate\(s\) x 1 flight\(s\) \(\d+ samples in all\): about (\d+) (s|min)",
+                     proc.stderr, re.M)  # fmt: skip
+    assert said, proc.stderr
+    estimate_s = float(said[1]) * (60 if said[2] == "min" else 1)
+    taken_s = float(re.search(r"evaluations \(.*\) in ([\d.]+) s", proc.stdout)[1])
+    assert estimate_s <= 10 * taken_s + 1 and taken_s <= 10 * estimate_s + 1, (estimate_s, taken_s)

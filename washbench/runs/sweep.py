@@ -23,14 +23,14 @@ from pathlib import Path
 
 from washbench.analysis.sweep import SweepRow, grid, parse_set, point_washouts, sweep_csv, sweep_metrics_csv
 from washbench.cueing.params import WASHOUT_NAMES
-from washbench.cueing.variants import load_param_file
+from washbench.cueing.variants import Washout, load_param_file
 from washbench.errors import WashbenchError
 from washbench.io.atomic import write_text_atomic
 from washbench.io.outfolder import result_set
 from washbench.io.progress import Progress
 from washbench.platform import load_platform_limits
 from washbench.runs.inputs import find_manoeuvres
-from washbench.runs.study import evaluate, load_flights
+from washbench.runs.study import StudyFlight, evaluate, load_flights
 
 
 def _csv(rows: list[list[str]]) -> str:
@@ -56,6 +56,39 @@ def check_grid_size(n_points: int, n_flights: int, force: bool, say: bool = True
         )
     if say:
         print(f"sweep: {n_points} grid point(s) x {n_flights} flight(s)", file=sys.stderr, flush=True)
+
+
+#: Point-samples (grid points x samples of the shortest flight) timed to estimate a sweep's time.
+PROBE_POINT_SAMPLES = 300_000
+
+
+def say_estimate(flights: Sequence[StudyFlight], candidates: Sequence[Washout], dask: str | None) -> float | None:
+    """Print (stderr) how many evaluations the sweep runs and, for a grid evaluated here that is more than
+    about :data:`PROBE_POINT_SAMPLES` point-samples, its estimated time: the first points on the shortest flight
+    (that many point-samples, a fraction of a second; results discarded) timed and scaled to the whole grid.
+    Returns the estimate in s."""
+    samples = sum(f.evaluator.n for f in flights)
+    line = f"sweep: {len(candidates)} candidate(s) x {len(flights)} flight(s) ({samples} samples in all)"
+    estimate = None
+    if flights and not dask:
+        shortest = min(flights, key=lambda f: f.evaluator.n)
+        k = math.ceil(PROBE_POINT_SAMPLES / max(shortest.evaluator.n, 1))
+        if k < len(candidates):
+            t0 = time.perf_counter()
+            shortest.evaluator.evaluate(candidates[:k])
+            probe_s = time.perf_counter() - t0
+            estimate = probe_s * (samples * len(candidates)) / (shortest.evaluator.n * k)
+            line += f": about {_duration(estimate)} (timed on the first {k} points)"
+    print(line, file=sys.stderr, flush=True)
+    return estimate
+
+
+def _duration(seconds: float) -> str:
+    if seconds < 120:
+        return f"{seconds:.0f} s"
+    if seconds < 7200:
+        return f"{seconds / 60:.0f} min"
+    return f"{seconds / 3600:.1f} h"
 
 
 def sweep_command(
@@ -93,6 +126,8 @@ def sweep_command(
         flights = load_flights(files, stage, limits, from_dir=from_dir, jobs=jobs, dask=dask, progress=progress,
             aircraft_dirs=aircraft_dirs,
         )
+        if progress or n_points > MAX_POINTS:  # a big grid (--force) is told its time even with --quiet
+            say_estimate(flights, candidates, dask)
         t_eval = time.perf_counter()
         total = sum(f.evaluator.n for f in flights) * len(candidates)
         shown = Progress("sweep", total, "steps") if progress else None
