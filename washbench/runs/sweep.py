@@ -63,17 +63,17 @@ PROBE_POINT_SAMPLES = 300_000
 
 
 def say_estimate(flights: Sequence[StudyFlight], candidates: Sequence[Washout], dask: str | None) -> float | None:
-    """Print (stderr) how many evaluations the sweep runs and, for a grid evaluated here that is more than
-    about :data:`PROBE_POINT_SAMPLES` point-samples, its estimated time: the first points on the shortest flight
-    (that many point-samples, a fraction of a second; results discarded) timed and scaled to the whole grid.
-    Returns the estimate in s."""
+    """Print (stderr) how many evaluations the sweep runs and, for a grid of 20 points or more evaluated here, its
+    estimated time: the first points on the shortest flight (about :data:`PROBE_POINT_SAMPLES` point-samples, at
+    most 1/20 of the grid; results discarded) timed and scaled to the whole grid. Returns the estimate in s."""
     samples = sum(f.evaluator.n for f in flights)
     line = f"sweep: {len(candidates)} candidate(s) x {len(flights)} flight(s) ({samples} samples in all)"
     estimate = None
     if flights and not dask:
         shortest = min(flights, key=lambda f: f.evaluator.n)
-        k = math.ceil(PROBE_POINT_SAMPLES / max(shortest.evaluator.n, 1))
-        if k < len(candidates):
+        # at most 1/20 of the grid: the probe's work (thrown away) adds at most 5 % for a slow washout (mpc)
+        k = min(math.ceil(PROBE_POINT_SAMPLES / max(shortest.evaluator.n, 1)), len(candidates) // 20)
+        if k >= 1:
             t0 = time.perf_counter()
             shortest.evaluator.evaluate(candidates[:k])
             probe_s = time.perf_counter() - t0
