@@ -631,7 +631,7 @@ def run_cue(
     (:func:`washbench.cueing.variants.select_washouts`).
     Raises WashbenchError (one line) for bad names, parameter files or input; writes nothing then.
     """
-    from washbench.cueing.bank import check_filter_start
+    from washbench.cueing.params import check_filter_start
     from washbench.cueing.variants import select_washouts
     from washbench.io.outfolder import check_out_path, result_set
     from washbench.platform import load_platform_limits

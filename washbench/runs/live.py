@@ -333,7 +333,7 @@ def run_live(
     """The ``washbench live`` command; returns the exit status (that of ``washbench cue`` on the saved input, or
     130 / 143 after a Ctrl-C / SIGTERM once the result folder is written)."""
     from washbench.cueing import CueingBank
-    from washbench.cueing.bank import check_filter_start
+    from washbench.cueing.params import check_filter_start
     from washbench.cueing.variants import select_washouts
     from washbench.io.lock import output_lock
     from washbench.live.viewer import open_viewer

@@ -386,7 +386,7 @@ def run_script(
     Writes ``OUT/<aircraft>/<script>/`` (one run) or ``OUT/<aircraft>/<script>/<run_i>/`` (a script that
     resets), published as one folder. A crash still writes what was flown, with ``ok`` False and the reason.
     """
-    from washbench.cueing.bank import check_filter_start
+    from washbench.cueing.params import check_filter_start
     from washbench.cueing.variants import select_washouts
     from washbench.flight.scripts import DEFAULT_MAX_TIME_S, fly_script, load_script_info, write_script_flight
     from washbench.platform import load_platform_limits
@@ -585,7 +585,7 @@ def run_command(
 
     Holds the lock of ``out_root`` (:func:`washbench.io.lock.output_lock`) while it runs.
     """
-    from washbench.cueing.bank import check_filter_start
+    from washbench.cueing.params import check_filter_start
     from washbench.flight.scripts import is_script
     from washbench.io.lock import output_lock
     from washbench.review.numbers import pct, sig
