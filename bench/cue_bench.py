@@ -32,11 +32,11 @@ from baseline import DT_S, best_of, c172p_in_air, run_cpu_s
 
 from washbench.cueing import WASHOUT_NAMES, cue_trace, load_washout_params
 from washbench.cueing.variants import select_washouts
-from washbench.io.results import read_motion
+from washbench.io.motion_file import read_motion
 from washbench.perception import VestibularModel
 from washbench.perception.vestibular import CanalParams, OtolithParams, canal_tf, otolith_tf
 from washbench.platform import load_platform_limits
-from washbench.runs.cue import analyse, stream_cue, write_results
+from washbench.runs.chain import analyse, stream_cue, write_results
 
 
 def write_input(path: Path, n: int) -> None:

@@ -2,7 +2,7 @@
 
 Each manoeuvre under ``manoeuvres/`` is flown twice through :func:`washbench.flight.fly.fly`,
 the loop ``washbench fly`` and ``washbench run`` use: once alone (``fly``) and once with the three washouts
-in lockstep as ``washbench run`` feeds them (:func:`washbench.runs.pipeline.lockstep_blocks`). Printed per
+in lockstep as ``washbench run`` feeds them (:func:`washbench.runs.chain.lockstep_blocks`). Printed per
 manoeuvre: the digest of the recorded columns (every flight.parquet column in order, name, dtype, shape and
 bytes), of the summary (status, reason, phases, checks, events, as ``repr`` of the floats: exact), and of the
 washout rows of the lockstep flight. The lockstep flight must record the same columns as the plain one.
@@ -41,7 +41,7 @@ def summary_digest(result: FlightResult) -> str:
 
 def rows_digest(rows: list[np.ndarray]) -> str:
     """SHA-256 of the lockstep's washout rows as one (N, washouts, fields) array (sample-major, as it always was)."""
-    from washbench.runs.pipeline import stacked_rows
+    from washbench.runs.chain import stacked_rows
 
     block = np.ascontiguousarray(stacked_rows(rows).transpose(1, 0, 2)) if rows else np.empty(0)
     return hashlib.sha256(f"{block.dtype.str}:{block.shape}".encode() + block.tobytes()).hexdigest()
@@ -49,7 +49,7 @@ def rows_digest(rows: list[np.ndarray]) -> str:
 
 def main() -> None:
     from washbench.cueing.variants import select_washouts
-    from washbench.runs.pipeline import LOCKSTEP_BLOCK, lockstep_blocks
+    from washbench.runs.chain import LOCKSTEP_BLOCK, lockstep_blocks
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--only", default="", help="fly only the manoeuvres whose path contains this text")

@@ -10,7 +10,7 @@ processes hold the core), minimum of ``--repeat`` runs each.
     .venv/bin/python bench/marginal_bench.py [--seconds 120] [--repeat 5]
 
 Three figures: flight alone (``washbench fly``'s loop), flight + the three washouts in lockstep (the
-``washbench run`` loop: :func:`washbench.runs.pipeline.lockstep_blocks`), and the washouts alone called once per
+``washbench run`` loop: :func:`washbench.runs.chain.lockstep_blocks`), and the washouts alone called once per
 sample (``CueingBank.step``, the streaming form a simulator would call).
 """
 
@@ -29,7 +29,7 @@ from washbench.cueing.variants import select_washouts
 from washbench.flight.fly import fly
 from washbench.flight.manoeuvre import load_manoeuvre
 from washbench.platform import load_platform_limits
-from washbench.runs.pipeline import LOCKSTEP_BLOCK, lockstep_blocks, sample_count
+from washbench.runs.chain import LOCKSTEP_BLOCK, lockstep_blocks, sample_count
 
 TEMPLATE = """\
 name: marginal

@@ -24,10 +24,10 @@ from baseline import manoeuvre_start, run_cpu_s
 STAGES = (
     ("model load + start", "washbench.flight.fly", "make_fdm"),
     ("flight.parquet", "washbench.flight.fly", "write_flight"),
-    ("perception + metrics", "washbench.runs.cue", "analyse"),
-    ("traces.parquet + metrics.csv", "washbench.runs.cue", "write_results"),
+    ("perception + metrics", "washbench.runs.chain", "analyse"),
+    ("traces.parquet + metrics.csv", "washbench.runs.pipeline", "write_results"),
     ("recording", "washbench.runs.pipeline", "write_run_recording"),
-    ("report + figures", "washbench.runs.suite", "write_run_review"),
+    ("report + figures", "washbench.runs.pipeline", "write_run_review"),
 )
 
 

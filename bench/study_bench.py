@@ -28,9 +28,9 @@ from cueing_bench import DT_S, synthetic_motion, time_jsbsim
 from washbench.analysis.evaluate import FlightEvaluator
 from washbench.cueing import WASHOUT_NAMES, cue_trace, load_washout_params
 from washbench.cueing.variants import Washout, apply_overrides
-from washbench.io.results import Motion
+from washbench.io.motion import Motion
 from washbench.platform import load_platform_limits
-from washbench.runs.cue import analyse
+from washbench.runs.chain import analyse
 
 
 def candidates(m: int) -> list[Washout]:

@@ -32,15 +32,17 @@ def main() -> None:
     parser.add_argument("--no-figures", action="store_true", help="run the suite without the reports' figures")
     args = parser.parse_args()
 
+    from washbench.runs.inputs import find_manoeuvres
+    from washbench.runs.options import load_options
     from washbench.runs.outputs import Outputs
-    from washbench.runs.suite import find_manoeuvres, run_suite, write_suite_results
+    from washbench.runs.suite import run_suite, write_suite_results
 
     outputs = Outputs(recording=not args.no_recording, figures=not args.no_figures)
 
     files = find_manoeuvres(args.inputs)
     with tempfile.TemporaryDirectory() as tmp:
         start = time.perf_counter()
-        outcomes = run_suite(files, Path(tmp), jobs=args.jobs, progress=False, outputs=outputs)
+        outcomes = run_suite(files, Path(tmp), load_options(outputs=outputs), jobs=args.jobs, progress=False)
         write_suite_results(outcomes, Path(tmp), figures=outputs.figures)
         suite_s = time.perf_counter() - start
     failed = [o for o in outcomes if not o.run.ok]

@@ -20,7 +20,8 @@ from scipy.spatial.transform import Rotation
 from washbench.errors import WashbenchError
 from washbench.flight.checks import measure
 from washbench.flight.fly import FlightResult, fly
-from washbench.flight.manoeuvre import Check, load_manoeuvre
+from washbench.flight.manoeuvre import load_manoeuvre
+from washbench.flight.manoeuvre_schema import Check
 from washbench.io.paths import MANOEUVRES_DIR
 
 COLUMBIA = MANOEUVRES_DIR / "columbia400"

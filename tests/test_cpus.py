@@ -48,6 +48,25 @@ def test_v1_quota_and_no_quota(tmp_path: Path) -> None:
     assert cgroup_cpu_limit(root, tmp_path / "self") == pytest.approx(3.0)
 
 
+def test_v1_path_not_under_the_mount_uses_the_mounted_root(tmp_path: Path) -> None:
+    """A container without a cgroup namespace: /proc/self/cgroup names the host's path, the mount is the container's."""
+    root = tmp_path / "cg"
+    write(tmp_path / "self", "1:cpu:/docker/abc\n")
+    write(root / "cpu" / "cpu.cfs_quota_us", "150000\n")
+    write(root / "cpu" / "cpu.cfs_period_us", "100000\n")
+    assert cgroup_cpu_limit(root, tmp_path / "self") == pytest.approx(1.5)
+
+
+def test_a_quota_caps_the_count_rounded_up(monkeypatch: pytest.MonkeyPatch) -> None:
+    """1.5 CPUs of quota on a machine with more allows 2 processes, 0.2 CPUs still one; no quota: the affinity mask."""
+    import washbench.io.cpus as cpus
+
+    monkeypatch.setattr(cpus, "affinity_cpus", lambda: 8)
+    for quota, expected in ((None, 8), (1.5, 2), (0.2, 1), (2.0, 2), (64.0, 8)):
+        monkeypatch.setattr(cpus, "cgroup_cpu_limit", lambda q=quota: q)
+        assert cpus.usable_cpus() == expected, quota
+
+
 def test_no_cgroup_files(tmp_path: Path) -> None:
     assert cgroup_cpu_limit(tmp_path / "none", tmp_path / "missing") is None
 

@@ -12,14 +12,11 @@ import pytest
 
 from washbench.analysis.metrics import DOFS
 from washbench.cueing import WASHOUT_NAMES
+from washbench.io.columns import INPUT_COLUMNS, washout_columns
+from washbench.io.metrics_csv import read_metrics_csv
+from washbench.io.motion_file import read_motion
+from washbench.io.parquet_files import read_traces
 from washbench.io.paths import DATA_DIR
-from washbench.io.results import (
-    INPUT_COLUMNS,
-    read_metrics_csv,
-    read_motion,
-    read_traces,
-    washout_columns,
-)
 from washbench.perception import VestibularModel
 
 G = 9.80665

@@ -10,9 +10,10 @@ import pyarrow.parquet as pq
 import pytest
 
 from washbench.cueing.variants import select_washouts
-from washbench.io.results import Motion
+from washbench.io.motion import Motion
+from washbench.io.progress import Progress
 from washbench.platform import load_platform_limits
-from washbench.runs.cue import Progress, cue_motion, stream_cue
+from washbench.runs.chain import cue_motion, stream_cue
 
 DT_S = 1.0 / 120.0
 
@@ -43,7 +44,7 @@ def test_chunks_give_the_whole_trace_bit_for_bit(tmp_path: Path, filter_start: s
         assert np.array_equal(table.column(name).to_numpy(), np.asarray(values)), name
     assert [(r.washout, r.dof) for r in streamed.metrics] == [(r.washout, r.dof) for r in whole.metrics]
     for a, b in zip(streamed.metrics, whole.metrics, strict=True):
-        for attr in ("npc", "integral_error", "max_error"):
+        for attr in ("npc", "integral_error", "max_error", "msdv_mps15", "msi_pct", "msi_aircraft_pct"):
             x, y = getattr(a, attr), getattr(b, attr)
             assert x == y or (math.isnan(x) and math.isnan(y)), (a, attr)
     counts = {w: dict(tr.saturation_counts) for w, tr in whole.traces.items()}

@@ -6,8 +6,7 @@ import numpy as np
 import pytest
 
 from washbench.analysis import cues
-from washbench.analysis.metrics import MetricRow
-from washbench.io.results import read_metrics_csv, write_metrics_csv
+from washbench.io.metrics_csv import MetricRow, read_metrics_csv, write_metrics_csv
 
 DT = 0.01
 

@@ -13,8 +13,8 @@ from scipy import signal
 
 from washbench.analysis.metrics import DOFS
 from washbench.cli import main
+from washbench.io.metrics_csv import read_metrics_csv
 from washbench.io.paths import DATA_DIR
-from washbench.io.results import read_metrics_csv
 from washbench.perception.sickness import wf_tf
 from washbench.perception.vestibular import MODELS, canal_tf
 
@@ -143,3 +143,32 @@ def test_vestibular_choice_changes_the_perception_and_is_recorded(runs: dict[str
     p_ym = pq.read_table(runs["default"] / "traces.parquet").column("aircraft.perceived_omega_x_degps").to_numpy()
     assert np.max(np.abs(p_ym - p)) > 1.0  # a different model, a different perception
     assert _prov(runs["default"])["vestibular"]["model"] == "young-meiry"
+
+
+def test_msi_on_the_heave_rows_equals_the_model_on_the_input(runs: dict[str, Path]) -> None:
+    """The aircraft pilot's MSI: the SVC model on the input file's head motion (the surge step, roll doublet and
+    heave sine); every simulator pilot has one, the report shows them next to the MSDV."""
+    from washbench.perception.svc import head_msi, svc_msi
+
+    rows = read_metrics_csv(runs["default"] / "metrics.csv")
+    heave = [r for r in rows if r.dof == "heave"]
+    assert all(math.isnan(r.msi_pct) for r in rows if r.dof != "heave")
+    data = np.loadtxt(runs["trace"], delimiter=",", skiprows=1)
+    f, w = data[:, 1:4], np.radians(data[:, 4:7])
+    expected = head_msi(f, w, DT)
+    assert expected > 1e-4 and heave[0].msi_aircraft_pct == pytest.approx(expected, rel=1e-12)
+    assert svc_msi(f, w, DT).conflict_mps2.max() > 0.3  # the 2 m/s^2 surge step is a real conflict
+    assert all(r.msi_pct >= 0.0 and math.isfinite(r.msi_pct) for r in heave)
+    report = (runs["default"] / "report.md").read_text()
+    assert "| pilot | MSDV (m/s^1.5) | MSI (%) |" in report and "subjective vertical conflict" in report
+
+
+def test_the_sickness_models_are_in_the_provenance_and_report(runs: dict[str, Path]) -> None:
+    from washbench.perception.svc import IN1
+
+    rec = _prov(runs["tc"])["vestibular"]["sickness"]
+    assert rec["msdv"] == "ISO 2631-1 Wf" and rec["msi"]["model"] == "6dof-svc-in1"
+    assert rec["msi"]["values"]["tau_i_s"] == IN1.tau_i_s == 720.0 and rec["msi"]["values"]["k_vc"] == 5.0
+    assert "| sickness models | MSDV: ISO 2631-1 Wf; MSI: 6-DOF subjective vertical conflict, In1" in (
+        runs["tc"] / "report.md"
+    ).read_text()

@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+import itertools
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from washbench.errors import WashbenchError
-from washbench.review.figures import envelope_figure, perceived_figure, phase_label
+from washbench.review.figures import PlacedLabel, envelope_figure, perceived_figure, phase_label, place_phase_labels
 from washbench.review.palette import (
     CB_WASHOUT_COLORS,
     PALETTES,
@@ -78,6 +79,32 @@ def test_palette_from_the_environment_and_unknown_names(monkeypatch: pytest.Monk
 )
 def test_phase_labels_wrap_before_they_are_cut(name: str, width_in: float, expected: str) -> None:
     assert phase_label(name, width_in) == expected
+
+
+def test_phase_names_too_long_for_their_box_are_staggered_whole() -> None:
+    """The C172 take-off's phases on a 7.5-inch lane (what its figure has): 'rotate' (2.5 s) and 'initial climb'
+    (4.3 s) do not fit their boxes; both are written whole, in different halves, and no two names on one half of
+    the lane overlap (widths from the same mean character width the layout uses)."""
+    ends = [("run up", 0.0, 4.0), ("roll", 4.0, 17.2), ("rotate", 17.2, 19.7), ("initial climb", 19.7, 24.0),
+            ("climb", 24.0, 68.9), ("level off", 68.9, 88.9)]  # fmt: skip
+    scale = 7.5 / 88.9
+    boxes = [(n, a * scale, b * scale) for n, a, b in ends]
+    placed = place_phase_labels(boxes, 7.5)
+    assert [p.text.replace("\n", " ") for p in placed] == [n for n, _, _ in ends]  # every name, whole, in order
+    rows = {p.text: p.row for p in placed}
+    assert rows["rotate"] in (1, 2) and rows["initial climb"] in (1, 2) and rows["rotate"] != rows["initial climb"]
+    char_in = 7.5 * 0.56 / 72.0
+
+    def span(p: PlacedLabel) -> tuple[float, float]:
+        half = 0.5 * max(map(len, p.text.split("\n"))) * char_in
+        return p.x_in - half, p.x_in + half
+
+    for half in (1, 2):
+        mine = sorted(span(p) for p in placed if p.row in (0, half))
+        assert all(a[1] <= b[0] for a, b in itertools.pairwise(mine)), mine
+        assert all(lo >= 0.0 and hi <= 7.5 for lo, hi in mine)
+    one_box = place_phase_labels([("a very long phase name indeed", 0.0, 0.3)], 0.3)
+    assert one_box == [] or one_box[0].row == 0  # no room anywhere: shortened to its box (here dropped)
 
 
 def test_swept_keys_carry_the_unit_of_their_name() -> None:

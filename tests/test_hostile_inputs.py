@@ -23,9 +23,9 @@ from washbench.cueing.params import DEFAULT_PARAMS_PATH
 from washbench.errors import WashbenchError
 from washbench.flight.manoeuvre import Manoeuvre, load_manoeuvre
 from washbench.io.atomic import atomic_path
+from washbench.io.motion_file import read_motion
 from washbench.io.names import IDENTIFIER_MAX_LENGTH
 from washbench.io.paths import MANOEUVRES_DIR
-from washbench.io.results import read_motion
 from washbench.io.yamlio import MAX_DEPTH, MAX_NODES
 from washbench.platform import load_platform_limits
 from washbench.platform.limits import DEFAULT_LIMITS_PATH

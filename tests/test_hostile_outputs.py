@@ -8,7 +8,7 @@ from pathlib import Path
 from hostile import assert_clean_error, short, tree, washbench
 
 from washbench.io.lock import output_lock
-from washbench.runs.pipeline import RUN_FILES
+from washbench.io.result_files import RUN_FILES
 
 
 def test_run_replaces_only_its_own_previous_result(tmp_path: Path) -> None:

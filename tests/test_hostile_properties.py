@@ -21,8 +21,8 @@ from washbench.cueing import WASHOUT_NAMES, cue_trace, load_washout_params
 from washbench.errors import WashbenchError
 from washbench.flight.fly import FlightResult, fly
 from washbench.flight.manoeuvre import load_manoeuvre
+from washbench.io.motion_file import read_motion
 from washbench.io.paths import MANOEUVRES_DIR
-from washbench.io.results import read_motion
 from washbench.platform import load_platform_limits
 
 BUNDLED = sorted(MANOEUVRES_DIR.glob("*/*.yaml"))

@@ -40,38 +40,11 @@ FLOORS: dict[str, int] = {
     "__main__": 11,
 }
 
-#: Known cycles, as the exact edges (importer, imported) that lie on them. ``io``: the recorded-input readers and
-#: ``io/results.py`` (motion type, column names, Parquet, metrics CSV in one module) read each other; ``runs``:
-#: ``run``, ``cue`` and ``suite`` share the chain and the result folder through each other (issue 22, item 1;
-#: ``runs/`` is being restructured by issue 25's work, so it is left as it is here).
-KNOWN_CYCLE_EDGES: frozenset[tuple[str, str]] = frozenset(
-    {
-        ("washbench.io.input_format", "washbench.io.results"),
-        ("washbench.io.jsbsim_csv", "washbench.io.input_format"),
-        ("washbench.io.readers", "washbench.io.input_format"),
-        ("washbench.io.readers", "washbench.io.jsbsim_csv"),
-        ("washbench.io.readers", "washbench.io.tables"),
-        ("washbench.io.readers", "washbench.io.xplane"),
-        ("washbench.io.resample", "washbench.io.readers"),
-        ("washbench.io.resample", "washbench.io.results"),
-        ("washbench.io.results", "washbench.io.readers"),
-        ("washbench.io.results", "washbench.io.resample"),
-        ("washbench.io.tables", "washbench.io.input_format"),
-        ("washbench.io.xplane", "washbench.io.input_format"),
-        ("washbench.runs.cue", "washbench.runs.pipeline"),
-        ("washbench.runs.cue", "washbench.runs.suite"),
-        ("washbench.runs.pipeline", "washbench.runs.cue"),
-        ("washbench.runs.pipeline", "washbench.runs.suite"),
-        ("washbench.runs.suite", "washbench.runs.pipeline"),
-    }
-)
+#: Known cycles, as the exact edges (importer, imported) that lie on them: none left.
+KNOWN_CYCLE_EDGES: frozenset[tuple[str, str]] = frozenset()
 
-#: Known imports that run up the floors: ``io/results.py`` uses the metric names of ``analysis``.
-KNOWN_UPWARD_EDGES: frozenset[tuple[str, str]] = frozenset(
-    {
-        ("washbench.io.results", "washbench.analysis.metrics"),
-    }
-)
+#: Known imports that run up the floors: none left.
+KNOWN_UPWARD_EDGES: frozenset[tuple[str, str]] = frozenset()
 
 
 def modules(package: Path = PACKAGE) -> dict[str, Path]:

@@ -17,7 +17,9 @@ from flight_helpers import write
 from washbench.errors import WashbenchError
 from washbench.flight.checks import evaluate, measure, oscillation
 from washbench.flight.inputs import surface_deg, surface_norm, unit_shape
-from washbench.flight.manoeuvre import Check, load_manoeuvre, manoeuvre_json_schema
+from washbench.flight.json_schema import manoeuvre_json_schema
+from washbench.flight.manoeuvre import load_manoeuvre
+from washbench.flight.manoeuvre_schema import Check
 
 DT = 1.0 / 120.0
 

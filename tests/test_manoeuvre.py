@@ -11,7 +11,8 @@ import pytest
 from flight_helpers import BUNDLED, manoeuvre_id
 
 from washbench.errors import WashbenchError
-from washbench.flight.manoeuvre import Manoeuvre, load_manoeuvre, manoeuvre_json_schema
+from washbench.flight.json_schema import manoeuvre_json_schema
+from washbench.flight.manoeuvre import Manoeuvre, load_manoeuvre
 from washbench.io.paths import MANOEUVRES_DIR
 from washbench.io.yamlio import read_yaml
 

@@ -41,7 +41,7 @@ from washbench.analysis.omct import FREQUENCIES_RADPS, TEST_NAMES, TESTS_BY_NAME
 from washbench.cli import main
 from washbench.cueing import WASHOUT_NAMES, WashoutParams, load_washout_params
 from washbench.cueing.variants import Washout
-from washbench.io.results import read_traces
+from washbench.io.parquet_files import read_traces
 from washbench.perception.vestibular import VestibularModel
 from washbench.platform import load_platform_limits
 from washbench.runs.omct import CSV_COLUMNS, csv_text, measure, report_text, slowest_decay

@@ -146,7 +146,7 @@ def test_run_summary_is_consistent(run_dir: Path) -> None:
 def test_aircraft_attitude_matches_scipy_rotation() -> None:
     from scipy.spatial.transform import Rotation
 
-    from washbench.runs.pipeline import aircraft_attitude
+    from washbench.runs.chain import aircraft_attitude
 
     rng = np.random.default_rng(0)
     phi, theta, psi = rng.uniform(-180, 180, 500), rng.uniform(-90, 90, 500), rng.uniform(0, 360, 500)

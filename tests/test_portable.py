@@ -14,12 +14,12 @@ import pytest
 from hostile import short
 
 from washbench.review.replay import _has_display
-from washbench.runs import suite
+from washbench.runs import pool, suite
 
 
 def test_suite_runs_with_spawn_where_forkserver_does_not_exist(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(multiprocessing, "get_all_start_methods", lambda: ["spawn"])
-    ctx, initializer = suite.pool_context()
+    ctx, initializer = pool.pool_context()
     assert ctx.get_start_method() == "spawn" and initializer is not None
     # two short flights (what is tested is the start method: every worker imports and loads the kernels itself)
     files = [short(tmp_path, name="spawn_a", seconds=2), short(tmp_path, name="spawn_b", seconds=2)]

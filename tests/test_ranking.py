@@ -4,8 +4,8 @@ import math
 
 import pytest
 
-from washbench.analysis.metrics import MetricRow
 from washbench.analysis.ranking import DOFS, compare, dof_weights, rank, wins
+from washbench.io.metrics_csv import MetricRow
 
 
 def rows_for(washout: str, ie: dict[str, float], npc: float = 1.2, max_error: float = 1.0) -> list[MetricRow]:

@@ -33,7 +33,7 @@ from washbench.analysis.ranking import MOTION_FLOOR
 from washbench.errors import WashbenchError
 from washbench.flight.scripts import bundled_script, fly_script
 from washbench.io.input_format import InputFormat, input_format
-from washbench.io.results import read_metrics_csv
+from washbench.io.metrics_csv import read_metrics_csv
 from washbench.runs.cue import CueOptions, run_cue
 
 G0 = 9.80665
@@ -337,7 +337,7 @@ def test_rest_start_feels_a_mid_manoeuvre_start(trace: dict[str, np.ndarray], tm
     c = {"t_s": t, "f_x_mps2": np.full_like(t, 2.0), "f_y_mps2": np.zeros_like(t), "f_z_mps2": np.full_like(t, -G0)}
     c |= {f"omega_{a}_degps": np.zeros_like(t) for a in "xyz"}
     pq.write_table(pa.table(c), tmp_path / "mid.parquet")
-    from washbench.io.results import read_traces
+    from washbench.io.parquet_files import read_traces
 
     run_cue(tmp_path / "mid.parquet", tmp_path / "steady", options=CueOptions(recording=False, figures=False))
     run_cue(tmp_path / "mid.parquet", tmp_path / "rest",

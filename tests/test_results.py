@@ -8,18 +8,11 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
-from washbench.analysis.metrics import MetricRow
 from washbench.errors import WashbenchError
-from washbench.io.results import (
-    INPUT_COLUMNS,
-    metrics_csv_text,
-    read_metrics_csv,
-    read_motion,
-    read_traces,
-    washout_columns,
-    write_metrics_csv,
-    write_traces,
-)
+from washbench.io.columns import INPUT_COLUMNS, washout_columns
+from washbench.io.metrics_csv import MetricRow, metrics_csv_text, read_metrics_csv, write_metrics_csv
+from washbench.io.motion_file import read_motion
+from washbench.io.parquet_files import read_traces, write_traces
 
 DT = 1 / 120
 
@@ -184,19 +177,27 @@ def test_metrics_csv_exact_round_trip_nan_empty_inf(tmp_path: Path) -> None:
     assert text == metrics_csv_text(rows)
     lines = text.splitlines()
     assert lines[0] == ("washout,dof,npc,integral_error,max_error,cue_correct_frac,cue_scaled_frac,"
-                        "cue_false_frac,cue_missing_frac,msdv_mps15,msdv_aircraft_mps15,false_cue_events")
-    assert lines[2] == "small-angle,sway,,2.0,3.0,,,,,,,"  # no cue classification, no dose: empty fields
+                        "cue_false_frac,cue_missing_frac,msdv_mps15,msdv_aircraft_mps15,false_cue_events,"
+                        "msi_pct,msi_aircraft_pct")
+    assert lines[2] == "small-angle,sway,,2.0,3.0,,,,,,,,,"  # no cue classification, no dose: empty fields
     assert lines[3].split(",")[2] == "inf"
     back = read_metrics_csv(path)
     first5 = lambda r: (r.washout, r.dof, r.npc, r.integral_error, r.max_error)  # noqa: E731
     assert first5(back[0]) == first5(rows[0]) and first5(back[2]) == first5(rows[2])
     assert math.isnan(back[1].npc) and back[1].integral_error == 2.0
     assert [p.name for p in tmp_path.iterdir()] == ["metrics.csv"]  # no temporary files left behind
+    # a file written before the MSI (twelve columns) is still read, its MSI NaN
+    old = tmp_path / "old" / "metrics.csv"
+    old.parent.mkdir()
+    old.write_text("\n".join(",".join(line.split(",")[:12]) for line in lines) + "\n")
+    back_old = read_metrics_csv(old)
+    assert first5(back_old[2]) == first5(rows[2]) and math.isnan(back_old[2].msi_pct)
 
 
 def test_dt_of_a_fixed_step_grid_is_recovered_exactly(tmp_path: Path) -> None:
     """t = k*dt written by a fixed-step simulator gives back dt itself, not the mean step."""
-    from washbench.io.results import INPUT_COLUMNS, read_motion
+    from washbench.io.columns import INPUT_COLUMNS
+    from washbench.io.motion_file import read_motion
 
     for hz in (30, 47, 120, 333, 1000):
         dt = 1.0 / hz

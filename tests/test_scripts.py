@@ -17,8 +17,9 @@ import pytest
 
 from washbench.errors import WashbenchError
 from washbench.flight.scripts import bundled_script, load_script_info
-from washbench.io.results import read_metrics_csv
+from washbench.io.metrics_csv import read_metrics_csv
 from washbench.runs.cue import CueOptions, run_cue
+from washbench.runs.options import load_options
 from washbench.runs.pipeline import run_script
 
 FILES = ["figures", "flight.json", "flight.parquet", "metrics.csv", "ranking.csv", "recording.rrd", "report.md",
@@ -33,10 +34,12 @@ def out(tmp_path_factory: pytest.TempPathFactory) -> Path:
 @pytest.fixture(scope="module")
 def runs(out: Path) -> dict[str, list]:
     return {
-        "ah1s_flight_test": run_script(bundled_script("ah1s_flight_test"), out, max_time_s=6.0),
-        "737_cruise_steady_turn": run_script(bundled_script("737_cruise_steady_turn"), out, max_time_s=4.0),
-        "c172_cruise_8K": run_script(bundled_script("c172_cruise_8K"), out, max_time_s=52.0),
-        "f16_test": run_script(bundled_script("f16_test"), out, max_time_s=140.0),
+        "ah1s_flight_test": run_script(bundled_script("ah1s_flight_test"), out, load_options(max_time_s=6.0)),
+        "737_cruise_steady_turn": run_script(
+            bundled_script("737_cruise_steady_turn"), out, load_options(max_time_s=4.0)
+        ),
+        "c172_cruise_8K": run_script(bundled_script("c172_cruise_8K"), out, load_options(max_time_s=52.0)),
+        "f16_test": run_script(bundled_script("f16_test"), out, load_options(max_time_s=140.0)),
     }
 
 

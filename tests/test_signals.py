@@ -12,7 +12,7 @@ from scipy.spatial.transform import Rotation
 
 from washbench.analysis.signals import KINDS, SignalSpec, generate
 from washbench.cli import main
-from washbench.io.results import read_motion
+from washbench.io.motion_file import read_motion
 
 G = 9.80665
 AXIS_VECTOR = {"roll": (1.0, 0.0, 0.0), "pitch": (0.0, 1.0, 0.0), "yaw": (0.0, 0.0, 1.0)}

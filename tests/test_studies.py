@@ -16,13 +16,12 @@ import pyarrow.parquet as pq
 import pytest
 import yaml
 
-from washbench.analysis.metrics import MetricRow
 from washbench.analysis.ranking import perceived_motion, rank
 from washbench.cli import main
+from washbench.io.metrics_csv import MetricRow, read_metrics_csv
 from washbench.io.paths import DATA_DIR
-from washbench.io.results import read_metrics_csv
 from washbench.review.rrd_read import read_static
-from washbench.runs.pipeline import RunSummary
+from washbench.runs.result_folder import RunSummary
 from washbench.runs.suite import Outcome, write_suite_results
 
 HERE = Path(__file__).parent / "data" / "study"

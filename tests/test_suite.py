@@ -54,7 +54,8 @@ def test_broken_file_is_reported_and_the_others_complete(first: tuple[Path, subp
     assert len(rows) == 2 * 3 * 6
     assert list(rows[0]) == ["aircraft", "manoeuvre", "washout", "dof", "npc", "integral_error", "max_error",
                              "cue_correct_frac", "cue_scaled_frac", "cue_false_frac", "cue_missing_frac",
-                             "msdv_mps15", "msdv_aircraft_mps15", "false_cue_events"]  # fmt: skip
+                             "msdv_mps15", "msdv_aircraft_mps15", "false_cue_events", "msi_pct",
+                             "msi_aircraft_pct"]  # fmt: skip
     assert {r["manoeuvre"] for r in rows} == {"coordinated_turn", "stall_recovery"}
     for name in ("coordinated_turn", "stall_recovery"):
         run = out / "c172p" / name

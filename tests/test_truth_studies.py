@@ -16,10 +16,9 @@ import pyarrow.parquet as pq
 import pytest
 from flight_helpers import write
 
-from washbench.analysis.ranking import rank
+from washbench.analysis.ranking import perceived_motion, rank
 from washbench.cli import main
-from washbench.io.results import read_metrics_csv
-from washbench.runs.pipeline import perceived_motion
+from washbench.io.metrics_csv import read_metrics_csv
 
 TURN = """\
     name: bank_left

@@ -24,14 +24,13 @@ import argparse
 
 import numpy as np
 
-from washbench.analysis.ranking import MOTION_FLOOR, rank
+from washbench.analysis.ranking import MOTION_FLOOR, perceived_motion, rank
 from washbench.cueing import WASHOUT_NAMES, load_washout_params
 from washbench.flight.scripts import bundled_script, fly_script
 from washbench.io.readers import Samples
 from washbench.io.resample import resample, to_motion
 from washbench.platform import load_platform_limits
-from washbench.runs.cue import cue_motion
-from washbench.runs.pipeline import perceived_motion
+from washbench.runs.chain import cue_motion
 
 
 def samples_of(t: np.ndarray, f: np.ndarray, w: np.ndarray) -> Samples:

@@ -372,6 +372,16 @@ def _outputs(args: argparse.Namespace) -> Any:
     return Outputs(recording=not args.no_recording, figures=not args.no_figures)
 
 
+def _run_options(args: argparse.Namespace) -> Any:
+    """The options of ``run`` and ``suite`` (:func:`washbench.runs.options.load_options`: each file read once)."""
+    from washbench.runs.options import load_options
+
+    return load_options(params_path=args.params, platform_path=args.platform, washouts=args.washout,
+                        variants=args.variant, aircraft_dirs=args.aircraft_dir, outputs=_outputs(args),
+                        filter_start=getattr(args, "filter_start", "steady"), max_time_s=args.max_time_s,
+                        rank_by=args.rank_by, vestibular=args.vestibular)  # fmt: skip
+
+
 def _cue(args: argparse.Namespace) -> int:
     from washbench.io.input_format import input_format
     from washbench.runs.cue import CueOptions, run_cue
@@ -452,46 +462,24 @@ def _dispatch(args: argparse.Namespace) -> int:
 
         return validate_command(args.manoeuvres, aircraft_dirs=args.aircraft_dir)
     if args.command == "schema":
-        from washbench.flight.manoeuvre import schema_command
+        from washbench.flight.json_schema import schema_command
 
         return schema_command(args.out)
     if args.command == "run":
         from washbench.runs.pipeline import run_command
 
-        return run_command(
-            args.manoeuvre,
-            args.out,
-            params_path=args.params,
-            platform_path=args.platform,
-            progress=not args.quiet,
-            outputs=_outputs(args),
-            max_time_s=args.max_time_s,
-            filter_start=args.filter_start,
-            washouts=args.washout,
-            variants=args.variant,
-            aircraft_dirs=args.aircraft_dir,
-            rank_by=args.rank_by,
-            vestibular=args.vestibular,
-        )
+        return run_command(args.manoeuvre, args.out, _run_options(args), progress=not args.quiet)
     if args.command == "suite":
         from washbench.runs.suite import suite_command
 
         return suite_command(
             args.inputs,
             args.out,
+            _run_options(args),
             jobs=args.jobs,
-            params_path=args.params,
-            platform_path=args.platform,
             progress=not args.quiet,
-            outputs=_outputs(args),
             jsbsim_scripts=args.jsbsim_scripts,
-            max_time_s=args.max_time_s,
-            aircraft_dirs=args.aircraft_dir,
-            washouts=args.washout,
-            variants=args.variant,
             dask=args.dask,
-            rank_by=args.rank_by,
-            vestibular=args.vestibular,
         )
     if args.command == "omct":
         from washbench.runs.omct import run_omct

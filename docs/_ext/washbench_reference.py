@@ -227,7 +227,7 @@ class SchemaDirective(_RstDirective):
     has_content = False
 
     def rst_lines(self) -> list[str]:
-        from washbench.flight.manoeuvre import manoeuvre_json_schema
+        from washbench.flight.json_schema import manoeuvre_json_schema
 
         return schema_lines(manoeuvre_json_schema(), "Manoeuvre")
 

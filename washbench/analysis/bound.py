@@ -396,7 +396,7 @@ class BoundWashout:
                            "omct, sweep, tune); run and cue feed it sample by sample")  # fmt: skip
 
     def trace(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        from washbench.cueing.rotations import quat_from_euler
+        from washbench.numerics.rotations import quat_from_euler
 
         c = self.context
         res = oracle_bound(f_mps2, omega_radps, c.dt_s, c.limits, c.gravity_mps2, self.params, start_at_rest=True)

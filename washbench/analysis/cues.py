@@ -170,7 +170,7 @@ def classified_rows(
     rows: list, ac_f_mps2: np.ndarray, ac_omega_radps: np.ndarray, sim_f_mps2: np.ndarray,
     sim_omega_radps: np.ndarray, dt_s: float,
 ) -> list:  # fmt: skip
-    """``rows`` (six :class:`washbench.analysis.metrics.MetricRow`, DOFS order) with their cue classification."""
+    """``rows`` (six :class:`washbench.io.metrics_csv.MetricRow`, DOFS order) with their cue classification."""
     import dataclasses
 
     thresholds, rest = dof_thresholds()

@@ -25,9 +25,10 @@ import numpy as np
 from numba import njit, prange
 
 from washbench.analysis.metric_sums import NACC, acc_update, finish
-from washbench.analysis.metrics import DOFS, MetricRow, npc_from_pc
+from washbench.analysis.metrics import DOFS, npc_from_pc
 from washbench.analysis.ranking import dof_weights, perceived_motion, score_of
 from washbench.cueing.kernel import C_KIND, NFIELDS, NSTATE, O_HEAD_F, O_HEAD_OMEGA, O_SAT, SAT_KINDS, step_one
+from washbench.io.metrics_csv import MetricRow
 from washbench.numerics.jitcache import announce_compile, drop_stale_cache
 from washbench.perception.sections import sections_init, sections_step
 

@@ -26,16 +26,16 @@ the studies' evaluation kernel runs per sample.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
+from washbench.io.metrics_csv import MetricRow
 from washbench.numerics.jitcache import announce_compile
 
 FLAT_RTOL = 1e-9
 """A signal whose standard deviation is at most this fraction of its peak |value| is flat (the same value as
 :data:`washbench.analysis.metric_sums.FLAT_RTOL`, which the compiled sums use; not imported from there so that
-importing this module, e.g. for :class:`MetricRow`, does not import numba)."""
+importing this module (DOFS, npc_from_pc: a sweep parsing its grid, a refused input) does not import numba)."""
 
 
 def signal_metrics(x: np.ndarray, y: np.ndarray, dt_s: float) -> tuple[float, float, float]:
@@ -101,30 +101,6 @@ def max_abs_error(x: np.ndarray, y: np.ndarray) -> float:
     """``max |x - y|`` over the trace."""
     x, y = _as_pair(x, y)
     return float(signal_metrics(x, y, 1.0)[2])
-
-
-@dataclass(frozen=True)
-class MetricRow:
-    """One row of ``metrics.csv``: a washout's metrics for one DOF (units: see module docstring).
-
-    The cue classification (:mod:`washbench.analysis.cues`): time fractions ``cue_*_frac`` (NaN where not
-    classified, e.g. a study's evaluation) and the false-cue events as ``start-end@peak;...`` text. On the heave row,
-    the motion sickness dose values (MSDV, m/s^1.5, ISO 2631-1 Wf) of the simulator pilot and of the aircraft pilot
-    (NaN on the other rows).
-    """
-
-    washout: str
-    dof: str
-    npc: float
-    integral_error: float
-    max_error: float
-    cue_correct_frac: float = math.nan
-    cue_scaled_frac: float = math.nan
-    cue_false_frac: float = math.nan
-    cue_missing_frac: float = math.nan
-    msdv_mps15: float = math.nan
-    msdv_aircraft_mps15: float = math.nan
-    false_cue_events: str = ""
 
 
 def dof_metrics(

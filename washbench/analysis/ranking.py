@@ -52,7 +52,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from washbench.analysis.metrics import DOFS, MetricRow, integral_abs_error
+from washbench.analysis.metrics import DOFS, integral_abs_error
+from washbench.io.metrics_csv import MetricRow
 
 TRANSLATIONAL_DOFS = DOFS[:3]  # surge, sway, heave
 ROTATIONAL_DOFS = DOFS[3:]  # roll, pitch, yaw

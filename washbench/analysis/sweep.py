@@ -18,7 +18,7 @@ from washbench.cueing import registry
 from washbench.cueing.params import WashoutParams
 from washbench.cueing.variants import Washout, apply_overrides, check_key, check_kind, parse_value
 from washbench.errors import WashbenchError
-from washbench.io.results import csv_number
+from washbench.io.csv_numbers import csv_number
 
 if TYPE_CHECKING:  # the compiled evaluator (numba) is imported by what evaluates, not by what parses a --set
     from washbench.analysis.evaluate import Evaluation

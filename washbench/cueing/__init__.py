@@ -14,7 +14,7 @@ quaternions scalar first, body->inertial; break frequencies rad/s.
 Modules: ``params`` (cw1.yaml model), ``variants`` (named washouts with their own parameters), ``filters``
 (transfer functions, discretisation), ``kernel`` (the compiled step), ``bank`` (CueingBank, cue_trace).
 Quaternion and Euler kinematics and numba's cache are one floor down, in :mod:`washbench.numerics`
-(``washbench.cueing.rotations`` and ``washbench.cueing.jitcache`` still name the same modules).
+(:mod:`washbench.numerics.rotations`, :mod:`washbench.numerics.jitcache`).
 The bank names are loaded lazily, so importing the package for its parameters stays light.
 """
 

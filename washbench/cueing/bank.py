@@ -101,7 +101,7 @@ from washbench.cueing.params import ADAPTIVE_KINDS, FILTER_STARTS, WashoutParams
 from washbench.cueing.setpoints import SetPointSource
 from washbench.cueing.variants import Washout, as_washouts
 from washbench.errors import WashbenchError
-from washbench.io.results import DT_RANGE_S
+from washbench.io.motion import DT_RANGE_S
 from washbench.numerics.jitcache import announce_compile
 from washbench.platform.limits import PlatformLimits, wheel_jacobian
 
@@ -469,7 +469,7 @@ def cue_trace(
 
     ``washouts``: built-in names (with ``params``) or :class:`Washout` variants. Uses the same compiled step as
     :class:`CueingBank` and gives identical results. Raises WashbenchError for wrong shapes or non-finite samples
-    (naming the first bad sample) and for a step outside ``washbench.io.results.DT_RANGE_S``. Magnitudes are not
+    (naming the first bad sample) and for a step outside ``washbench.io.motion.DT_RANGE_S``. Magnitudes are not
     limited here (the platform stays within its limits whatever the input); the readers refuse physically
     absurd recordings at the file edge.
     ``filter_start``: see :data:`FILTER_STARTS`. ``fields_out``: for one washout, a (N_FIELDS, N) float64 array to

@@ -35,8 +35,8 @@ from scipy import linalg, sparse
 from washbench.cueing.algorithm import SetPoint, WashoutContext
 from washbench.cueing.motion_model import CHANNELS, ChannelModel, channel_inputs, channel_model, discretise_zoh
 from washbench.cueing.optimal import merge_channel_defaults
-from washbench.cueing.rotations import quat_from_euler
 from washbench.io.yamlio import StrictModel
+from washbench.numerics.rotations import quat_from_euler
 from washbench.perception.vestibular import CanalParams, OtolithParams
 from washbench.platform.kinematics import brake_speed
 

@@ -36,8 +36,8 @@ from washbench.cueing.motion_model import (
     discretise_foh,
     with_position_integral,
 )
-from washbench.cueing.rotations import quat_from_euler
 from washbench.io.yamlio import StrictModel
+from washbench.numerics.rotations import quat_from_euler
 from washbench.perception.vestibular import CanalParams, OtolithParams
 
 Weight = Annotated[float, Field(ge=0.0, le=1e9, allow_inf_nan=False)]

@@ -266,6 +266,14 @@ def load_param_file(path: Path | None = None) -> tuple[WashoutParams, tuple[Wash
     """A parameter file's base set and its ``variants:`` section (``None``: the bundled CW1, no variants)."""
     path = DEFAULT_PARAMS_PATH if path is None else Path(path)
     data, lines = read_yaml(path)
+    return param_file_from_data(path, data, lines)
+
+
+def param_file_from_data(path: Path, data: Any, lines: dict[Loc, int]) -> tuple[WashoutParams, tuple[Washout, ...]]:
+    """:func:`load_param_file` of a file already read (``read_yaml``: its data and line map; the top-level mapping
+    is not changed)."""
+    if isinstance(data, dict):
+        data = dict(data)
     if not isinstance(data, dict):
         return validate_data(path, data, lines, WashoutParams), ()
     variants = data.pop("variants", None)
@@ -316,7 +324,13 @@ def select_washouts(
     file's ``variants:`` section): the named built-in washouts (default none), then the file's variants, then
     the command line's. Raises WashbenchError (one line) for any bad name, kind, key or value.
     """
-    base, from_file = load_param_file(params_path)
+    return select_from(washouts, variants, *load_param_file(params_path))
+
+
+def select_from(
+    washouts: Sequence[str] | None, variants: Sequence[str], base: WashoutParams, from_file: tuple[Washout, ...]
+) -> tuple[Washout, ...]:
+    """:func:`select_washouts` with the parameter file already loaded (its base set and ``variants:`` section)."""
     parsed = [parse_variant(v) for v in variants]
     extra = from_file + tuple(resolve(v, base) for v in parsed)
     named = list(dict.fromkeys(washouts)) if washouts else ([] if extra else list(WASHOUT_NAMES))
@@ -331,9 +345,11 @@ __all__ = [
     "builtin",
     "check_key",
     "load_param_file",
+    "param_file_from_data",
     "parse_value",
     "parse_variant",
     "resolve",
+    "select_from",
     "select_washouts",
     "value_of",
 ]

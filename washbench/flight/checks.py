@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from washbench.flight.manoeuvre import HEADING_SIGNALS, HEADING_VALUE_STATS, OSCILLATION_STATS, Check
+from washbench.flight.manoeuvre_schema import HEADING_SIGNALS, HEADING_VALUE_STATS, OSCILLATION_STATS, Check
 
 #: Extrema smaller than this fraction of the largest swing are noise, not an oscillation's peaks.
 PEAK_PROMINENCE = 0.05

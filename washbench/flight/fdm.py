@@ -17,7 +17,8 @@ from typing import Any
 from washbench.errors import WashbenchError
 from washbench.flight.console import quiet_stdout
 from washbench.flight.geo import DEFAULT_LATITUDE_DEG, DEFAULT_LONGITUDE_DEG, LocalFrame
-from washbench.flight.manoeuvre import Hold, Manoeuvre
+from washbench.flight.manoeuvre import Manoeuvre
+from washbench.flight.manoeuvre_schema import Hold
 from washbench.flight.pilot import Pilot
 from washbench.flight.profile import PilotProfile
 from washbench.io.paths import jsbsim_root

@@ -24,13 +24,15 @@ from washbench.errors import WashbenchError
 from washbench.flight.checks import evaluate
 from washbench.flight.columns import COLUMN_NAMES
 from washbench.flight.fdm import make_fdm
-from washbench.flight.manoeuvre import Manoeuvre, Until, load_manoeuvre
+from washbench.flight.manoeuvre import Manoeuvre, load_manoeuvre
+from washbench.flight.manoeuvre_schema import Until
 from washbench.flight.monitor import BIG, Monitor
 from washbench.flight.openloop import OpenLoop
 from washbench.flight.pilot import Pilot
 from washbench.flight.profile import load_profile
 from washbench.io.atomic import atomic_path, write_text_atomic
 from washbench.io.provenance import build_provenance, parquet_metadata
+from washbench.io.result_files import FLIGHT_FILE, FLIGHT_JSON
 
 FT_S2_TO_M_S2 = 0.3048
 R2D = 180.0 / math.pi
@@ -466,7 +468,7 @@ def write_flight(
     """
     import pyarrow as pa
 
-    from washbench.io.results import write_parquet
+    from washbench.io.parquet_files import write_parquet
 
     out = Path(out_dir)
     try:
@@ -478,12 +480,12 @@ def write_flight(
     if provenance:
         meta.update(parquet_metadata(provenance))
     table = table.replace_schema_metadata(meta)
-    with atomic_path(out / "flight.parquet") as tmp:
+    with atomic_path(out / FLIGHT_FILE) as tmp:
         write_parquet(tmp, table)
     summary = flight_summary(result, source)
     if provenance:
         summary["provenance"] = dict(provenance)
-    write_text_atomic(out / "flight.json", json.dumps(summary, indent=2) + "\n")
+    write_text_atomic(out / FLIGHT_JSON, json.dumps(summary, indent=2) + "\n")
 
 
 def fly_command(manoeuvre_path: Path, out_dir: Path, progress: bool = True, aircraft_dirs: Sequence[Path] = ()) -> int:

@@ -28,7 +28,7 @@ from typing import Any
 
 from washbench.errors import WashbenchError
 from washbench.flight.inputs import surface_deg, surface_norm, unit_shape
-from washbench.flight.manoeuvre import ControlInput, Inputs, PropertyInput, Signal
+from washbench.flight.manoeuvre_schema import ControlInput, Inputs, PropertyInput, Signal
 from washbench.flight.pilot import Pilot
 from washbench.flight.profile import PilotProfile, Surface
 

@@ -46,7 +46,7 @@ from __future__ import annotations
 
 import math
 
-from washbench.flight.manoeuvre import Hold, Runway
+from washbench.flight.manoeuvre_schema import Hold, Runway
 from washbench.flight.profile import PilotProfile
 
 D2R = math.pi / 180.0

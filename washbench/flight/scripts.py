@@ -42,6 +42,7 @@ from washbench.flight.fly import FPS_TO_KT, FT_S2_TO_M_S2, R2D, StepHook
 from washbench.flight.manoeuvre import aircraft_path
 from washbench.flight.monitor import Monitor
 from washbench.io.paths import jsbsim_root
+from washbench.io.result_files import FLIGHT_FILE, FLIGHT_JSON
 
 SEGMENT_PREFIX = "run_"
 
@@ -422,7 +423,7 @@ def write_script_flight(out_dir: Path, flight: ScriptFlight, seg: ScriptSegment)
     info = flight.info
     table = pa.table({n: seg.columns[n] for n in SCRIPT_COLUMN_NAMES})
     table = table.replace_schema_metadata({"washbench.script": str(info.path), "washbench.aircraft": info.aircraft})
-    with atomic_path(out_dir / "flight.parquet") as tmp:
+    with atomic_path(out_dir / FLIGHT_FILE) as tmp:
         pq.write_table(table, tmp)
     doc = {
         "name": info.name,
@@ -439,4 +440,4 @@ def write_script_flight(out_dir: Path, flight: ScriptFlight, seg: ScriptSegment)
         "duration_s": float(seg.columns["t_s"][-1]) if seg.n else 0.0,
         "stopped_by_time_limit": flight.stopped_by_limit,
     }
-    write_text_atomic(out_dir / "flight.json", json.dumps(doc, indent=2) + "\n")
+    write_text_atomic(out_dir / FLIGHT_JSON, json.dumps(doc, indent=2) + "\n")

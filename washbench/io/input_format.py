@@ -17,7 +17,7 @@ from pydantic import Field
 
 from washbench.errors import WashbenchError
 from washbench.io import units
-from washbench.io.results import INPUT_COLUMNS
+from washbench.io.columns import INPUT_COLUMNS
 from washbench.io.yamlio import StrictModel, line_of, read_yaml, validate_data
 
 FIELDS = ("t", "f_x", "f_y", "f_z", "omega_x", "omega_y", "omega_z")

@@ -1,6 +1,6 @@
-"""Write a pilot-head motion in the input format of ``washbench cue`` (CSV or Parquet, by the extension).
+"""A pilot-head motion file in the input format of ``washbench cue`` (CSV or Parquet, by the extension): read, written.
 
-Columns :data:`washbench.io.results.INPUT_COLUMNS`: ``t_s``, ``f_{x,y,z}_mps2`` (body specific force),
+Columns :data:`washbench.io.columns.INPUT_COLUMNS`: ``t_s``, ``f_{x,y,z}_mps2`` (body specific force),
 ``omega_{x,y,z}_degps`` (body angular velocity, deg/s). CSV numbers are written in full precision (``repr``),
 so ``read_motion`` gets back exactly what was written. The file is written atomically.
 """
@@ -17,7 +17,10 @@ import pyarrow.parquet as pq
 
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import atomic_path, write_text_atomic
-from washbench.io.results import INPUT_COLUMNS
+from washbench.io.columns import INPUT_COLUMNS
+from washbench.io.motion import Motion
+from washbench.io.readers import read_samples
+from washbench.io.resample import split_resets, to_motion
 
 SUFFIXES = {".csv": "csv", ".parquet": "parquet", ".pq": "parquet"}  # what this writer writes
 
@@ -48,3 +51,17 @@ def write_motion(path: str | Path, t_s: np.ndarray, f_mps2: np.ndarray, omega_ra
     except OSError as exc:
         raise WashbenchError(located(path, f"cannot write: {exc.strerror or exc}")) from None
     return path
+
+
+def read_motion(path: str | Path) -> Motion:
+    """Read a motion trace in washbench's own columns and units (CSV, Parquet, ...) on a uniform grid.
+
+    The plain form of ``washbench cue INPUT`` (no mapping, resampling or splitting; see
+    :mod:`washbench.io.readers` and :mod:`washbench.io.resample` for those). Raises WashbenchError with one
+    line naming the file (and, for text files, the line) for: a missing, unreadable or empty file, an
+    unknown extension, no or one data row, a missing or non-numeric column, missing, NaN or infinite
+    values, time that does not increase, jumps back or is not uniform.
+    """
+    samples = read_samples(Path(path))
+    (only,) = split_resets(samples, split=False)
+    return to_motion(only)

@@ -21,16 +21,21 @@
 from __future__ import annotations
 
 import contextlib
+import functools
 import json
 import os
 import re
 import shutil
 import signal
 import threading
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
+from typing import ParamSpec, TypeVar
 
 from washbench.errors import WashbenchError, located
+
+P = ParamSpec("P")
+R = TypeVar("R")
 
 #: The manifest: which command wrote the folder and every top-level name it wrote.
 MANIFEST = ".washbench.json"
@@ -190,6 +195,22 @@ def signals_held() -> Iterator[None]:
         from washbench.errors import Terminated
 
         raise KeyboardInterrupt if noted[0] == signal.SIGINT else Terminated()
+
+
+def uninterrupted(func: Callable[P, R]) -> Callable[P, R]:
+    """``func`` run under :func:`signals_held`: for the figure writers, whose drawing a Ctrl-C must not cut.
+
+    matplotlib's compiled parts (pybind11) turn a KeyboardInterrupt raised while they convert their arguments into
+    a ``TypeError: incompatible function arguments`` traceback; held back, the signal acts as soon as the figure
+    is written (a few tenths of a second).
+    """
+
+    @functools.wraps(func)
+    def held(*args: P.args, **kwargs: P.kwargs) -> R:
+        with signals_held():
+            return func(*args, **kwargs)
+
+    return held
 
 
 def discard_stage(stage: Path) -> None:

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from washbench.io import units
-from washbench.io.results import Motion
+from washbench.io.motion import Motion
 from washbench.io.units import G0_MPS2
 
 RATE_MIN_HZ, RATE_MAX_HZ = 10.0, 10_000.0

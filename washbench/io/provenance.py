@@ -97,13 +97,16 @@ def software_versions() -> dict[str, str]:
     return out
 
 
-def file_record(path: str | Path, name: str | None = None, values: Mapping[str, Any] | None = None) -> dict[str, Any]:
-    """``{"name", "path", "sha256", "values"}`` of one input file (name and values only when given)."""
+def file_record(
+    path: str | Path, name: str | None = None, values: Mapping[str, Any] | None = None, sha256: str | None = None
+) -> dict[str, Any]:
+    """``{"name", "path", "sha256", "values"}`` of one input file (name and values only when given); ``sha256``:
+    the digest of the bytes already read (:func:`washbench.io.yamlio.read_yaml_digest`), else the file is hashed."""
     rec: dict[str, Any] = {}
     if name is not None:
         rec["name"] = name
     rec["path"] = str(path)
-    rec["sha256"] = sha256_file(path)
+    rec["sha256"] = sha256 or sha256_file(path)
     if values is not None:
         rec["values"] = dict(values)
     return rec
@@ -123,6 +126,7 @@ def build_provenance(
     washouts: Sequence[Any] = (),
     ranking: Mapping[str, Any] | None = None,
     vestibular: Mapping[str, Any] | None = None,
+    digests: Mapping[str, str] | None = None,
 ) -> dict[str, Any]:
     """The provenance of one result (module docstring); no date in it.
 
@@ -134,8 +138,10 @@ def build_provenance(
     ``washouts`` (``washbench.cueing.variants.Washout``: name, kind, params) lists what ran; a variant's complete
     parameter values are recorded where they differ from the file's base set. ``ranking``: the ranking rule
     (:meth:`washbench.analysis.ranking.RankRule.record`); ``vestibular``: the vestibular model
-    (:func:`washbench.perception.vestibular.model_record`: its name and values).
+    (:func:`washbench.perception.vestibular.model_record`: its name and values). ``digests``: path (as given) ->
+    SHA-256 of a file already read (:func:`washbench.io.yamlio.read_yaml_digest`), so it is not read again.
     """
+    digests = digests or {}
     prov: dict[str, Any] = {"software": software_versions()}
     if manoeuvre_path is not None:
         prov["manoeuvre"] = file_record(manoeuvre_path)
@@ -148,11 +154,13 @@ def build_provenance(
         if input_provenance:
             prov["input"]["provenance"] = dict(input_provenance)
     if params is not None and params_path is not None:
-        prov["params"] = file_record(params_path, params.name, params.model_dump(mode="json"))
+        prov["params"] = file_record(params_path, params.name, params.model_dump(mode="json"),
+                                     digests.get(str(params_path)))  # fmt: skip
     if washouts:
         prov["washouts"] = [_washout_record(w, params) for w in washouts]
     if platform is not None and platform_path is not None:
-        prov["platform"] = file_record(platform_path, platform.name, platform.model_dump(mode="json"))
+        prov["platform"] = file_record(platform_path, platform.name, platform.model_dump(mode="json"),
+                                       digests.get(str(platform_path)))  # fmt: skip
     if manoeuvre_path is not None:
         prov["turbulence"] = turbulence_record(turbulence)
     config_used = os.environ.get(CONFIG_USED_ENV)
@@ -163,6 +171,22 @@ def build_provenance(
     if vestibular is not None:
         prov["vestibular"] = dict(vestibular)
     return prov
+
+
+_ORDER = ("software", "manoeuvre", "aircraft", "pilot_profile", "input", "params", "washouts", "platform",
+          "turbulence", "config", "ranking", "vestibular")  # fmt: skip
+"""The keys of :func:`build_provenance`, in the order it writes them."""
+
+
+def merge_provenance(*parts: Mapping[str, Any]) -> dict[str, Any]:
+    """Several :func:`build_provenance` records as one, in :func:`build_provenance`'s key order (a later part wins a
+    key both hold): what one call with all their arguments gives, e.g. a run's records (parameters, washouts,
+    platform: built once per run) and a manoeuvre's."""
+    merged: dict[str, Any] = {}
+    for part in parts:
+        merged |= part
+    known = [k for k in _ORDER if k in merged]
+    return {k: merged[k] for k in [*known, *(k for k in merged if k not in _ORDER)]}
 
 
 def _washout_record(washout: Any, base: Any) -> dict[str, Any]:

@@ -24,8 +24,9 @@ import math
 import numpy as np
 
 from washbench.errors import WashbenchError, located
+from washbench.io.columns import F_COLUMNS, OMEGA_COLUMNS
+from washbench.io.motion import DT_RANGE_S, F_MAX_MPS2, OMEGA_MAX_DEGPS, Motion
 from washbench.io.readers import Samples
-from washbench.io.results import DT_RANGE_S, F_COLUMNS, F_MAX_MPS2, OMEGA_COLUMNS, OMEGA_MAX_DEGPS, Motion
 
 GRID_TOL = 1e-3
 """Samples may lie at most this fraction of a step off the uniform grid t_0 + k dt."""

@@ -1,7 +1,7 @@
 """Units and axes of recorded motion: the one conversion table every reader uses.
 
 Inside washbench a motion trace is time in s, specific force in m/s^2 and angular velocity in deg/s
-(the ``washbench cue`` file convention; :class:`washbench.io.results.Motion` turns the rates into rad/s),
+(the ``washbench cue`` file convention; :class:`washbench.io.motion.Motion` turns the rates into rad/s),
 body axes x forward, y right, z down. A recording made another way names its units per column
 (``--columns t=Time:ms,f_x=ax:g,...``) and its sensor axes (``--axes flu``); :func:`unit_factor` and
 :func:`axes_matrix` give the conversions.

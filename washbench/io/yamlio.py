@@ -342,10 +342,20 @@ def read_yaml(path: Path) -> tuple[Any, dict[Loc, int]]:
 
     Raises WashbenchError for an unreadable, empty or malformed file, or duplicate keys.
     """
+    data, lines, _ = read_yaml_digest(path)
+    return data, lines
+
+
+def read_yaml_digest(path: Path) -> tuple[Any, dict[Loc, int], str]:
+    """:func:`read_yaml` and the SHA-256 (hex) of the bytes parsed: the file read once for its data and its
+    provenance record."""
+    import hashlib
+
     from washbench.io.budget import read_bounded
 
     try:
-        text = read_bounded(path).decode("utf-8")
+        raw = read_bounded(path)
+        text = raw.decode("utf-8")
     except FileNotFoundError:
         raise WashbenchError(located(path, "no such file")) from None
     except IsADirectoryError:
@@ -368,7 +378,7 @@ def read_yaml(path: Path) -> tuple[Any, dict[Loc, int]]:
         raise WashbenchError(located(path, f"invalid YAML: {exc}")) from None
     if data is None:
         raise WashbenchError(located(path, "the file is empty"))
-    return data, _line_map(node)
+    return data, _line_map(node), hashlib.sha256(raw).hexdigest()
 
 
 def _non_finite(data: Any, loc: Loc = ()) -> list[tuple[Loc, float]]:

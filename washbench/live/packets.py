@@ -37,7 +37,7 @@ import struct
 from importlib import resources
 
 from washbench.io.jsbsim_csv import JSBSIM_F
-from washbench.io.results import F_MAX_MPS2, OMEGA_MAX_DEGPS
+from washbench.io.motion import F_MAX_MPS2, OMEGA_MAX_DEGPS
 from washbench.io.units import FT_M, G0_MPS2
 from washbench.live import FORMATS  # noqa: F401 (re-exported: the codecs' formats)
 

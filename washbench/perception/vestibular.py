@@ -101,9 +101,13 @@ DEFAULT_MODEL = "young-meiry"
 
 
 def model_record(name: str | None) -> dict[str, object]:
-    """The provenance record of a model of :data:`MODELS`: ``{"model": name, "values": its parameters}``."""
+    """The provenance record of a model of :data:`MODELS`: ``{"model": name, "values": its parameters}``, and of
+    the motion-sickness models fed by the same head motion (``"sickness"``,
+    :func:`washbench.perception.svc.sickness_record`)."""
+    from washbench.perception.svc import sickness_record
+
     key = DEFAULT_MODEL if name is None else name
-    return {"model": key, "values": model_params(key).model_dump(mode="json")}
+    return {"model": key, "values": model_params(key).model_dump(mode="json"), "sickness": sickness_record()}
 
 
 def model_params(name: str | None) -> VestibularParams:

@@ -20,12 +20,10 @@ import numpy as np
 
 from washbench.analysis.omct import TESTS, Bounds, bounds_at
 from washbench.io.atomic import atomic_path
+from washbench.io.outfolder import uninterrupted
 
 _COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown", "tab:pink", "tab:olive")
 _STYLES = (("-", "o"), ("--", "s"), (":", "^"), ("-.", "D"))  # washouts that coincide stay visible
-_LAYOUT = {"left": 0.092, "right": 0.986, "bottom": 0.087, "top": 0.904, "wspace": 0.181, "hspace": 0.09}
-"""Margins and gaps (fractions of the figure): the widest ``tight_layout`` gives these plots (tick labels up to five
-characters), fixed because ``tight_layout`` costs a whole extra drawing of the figure (half the command's time)."""
 
 
 def _pyplot() -> Any:
@@ -69,63 +67,71 @@ def write_bode_plots(
     files: dict[str, str] = {}
     for test in TESTS:
         pts = [p for p in points if p.test == test.name]
-        if not pts:
-            continue
-        fig, axes = plt.subplots(2, 2, figsize=(11, 7), sharex=True, gridspec_kw=_LAYOUT)
-        (ag, apg), (aph, app) = axes
-        if test.name in bounds:
-            _boundary_lines(ag, aph, bounds[test.name])
-        aircraft_drawn = False
-        for i, name in enumerate(washouts):
-            mine = sorted((p for p in pts if p.washout == name), key=lambda p: p.frequency_radps)
-            if not mine:
-                continue
-            w = np.array([p.frequency_radps for p in mine])
-            lin = np.array([p.linear for p in mine])
-            colour = _COLOURS[i % len(_COLOURS)]
-            _series(ag, aph, w, np.array([p.gain for p in mine]), np.array([p.phase_deg for p in mine]), lin, i,
-                    color=colour, label=name)  # fmt: skip
-            g_est = np.array([p.estimator_gain for p in mine])
-            ph_est = np.array([p.estimator_phase_deg for p in mine])
-            g_meas = np.array([p.gain for p in mine])
-            if np.nanmax(np.abs(g_est * np.exp(1j * np.radians(ph_est)) / (g_meas * np.exp(
-                    1j * np.radians(np.array([p.phase_deg for p in mine])))) - 1.0)) > 1e-3:  # fmt: skip
-                ag.plot(w, g_est, ":", lw=1.0, color=colour, label=f"{name}: cue head estimate (not the test)")
-                aph.plot(w, ph_est, ":", lw=1.0, color=colour)
-            _series(apg, app, w, np.array([p.perceived_gain for p in mine]),
-                    np.array([p.perceived_phase_deg for p in mine]), lin, i, color=colour, label=name)  # fmt: skip
-            for p in mine:  # outside the boundaries: a red ring
-                if p.gain_inside is False:
-                    ag.plot(p.frequency_radps, p.gain, "o", ms=11, mfc="none", mec="red", mew=1.5)
-                if p.phase_inside is False:
-                    aph.plot(p.frequency_radps, p.phase_deg, "o", ms=11, mfc="none", mec="red", mew=1.5)
-            if not aircraft_drawn:
-                ga = np.array([p.aircraft_perceived_gain for p in mine])
-                pa = np.array([p.aircraft_perceived_phase_deg for p in mine])
-                if np.any(ga > 0):
-                    apg.plot(w, ga, "k--", lw=1.5, label="aircraft pilot")
-                    app.plot(w, pa, "k--", lw=1.5, label="aircraft pilot")
-                else:
-                    apg.text(0.02, 0.04, "aircraft pilot: no rotation (gain 0)", transform=apg.transAxes, fontsize=8)
-                aircraft_drawn = True
-        for ax in (ag, apg):
-            ax.set_xscale("log")
-            ax.set_yscale("log")
-            ax.grid(True, which="both", alpha=0.3)
-        for ax in (aph, app):
-            ax.set_xscale("log")
-            ax.grid(True, which="both", alpha=0.3)
-            ax.set_xlabel("frequency (rad/s)")
-        ag.set_ylabel("gain (-)")
-        aph.set_ylabel("phase (deg)")
-        ag.set_title(f"{test.input_axis} -> {test.output_axis}: platform motion at the pilot's head")
-        apg.set_title("perceived (vestibular models)")
-        ag.legend(fontsize=8, loc="best")
-        apg.legend(fontsize=8, loc="best")
-        fig.suptitle(f"OMCT {test.name}  (x: non-linear point; red ring: outside the boundaries)", fontsize=11)
-        name = f"bode_{test.name}.png"
-        with atomic_path(Path(out_dir) / name) as tmp:
-            fig.savefig(tmp, format="png", dpi=90)
-        plt.close(fig)
-        files[test.name] = name
+        if pts:
+            files[test.name] = _bode_plot(plt, Path(out_dir), test, pts, bounds, washouts)
     return files
+
+
+@uninterrupted
+def _bode_plot(
+    plt: Any, out_dir: Path, test: Any, pts: Sequence[Any], bounds: dict[str, Bounds], washouts: Sequence[str]
+) -> str:
+    """Draw and write one test's Bode plot (a Ctrl-C waits until it is written); its file name."""
+    fig, axes = plt.subplots(2, 2, figsize=(11, 7), sharex=True)
+    (ag, apg), (aph, app) = axes
+    if test.name in bounds:
+        _boundary_lines(ag, aph, bounds[test.name])
+    aircraft_drawn = False
+    for i, name in enumerate(washouts):
+        mine = sorted((p for p in pts if p.washout == name), key=lambda p: p.frequency_radps)
+        if not mine:
+            continue
+        w = np.array([p.frequency_radps for p in mine])
+        lin = np.array([p.linear for p in mine])
+        colour = _COLOURS[i % len(_COLOURS)]
+        _series(ag, aph, w, np.array([p.gain for p in mine]), np.array([p.phase_deg for p in mine]), lin, i,
+                color=colour, label=name)  # fmt: skip
+        g_est = np.array([p.estimator_gain for p in mine])
+        ph_est = np.array([p.estimator_phase_deg for p in mine])
+        g_meas = np.array([p.gain for p in mine])
+        if np.nanmax(np.abs(g_est * np.exp(1j * np.radians(ph_est)) / (g_meas * np.exp(
+                1j * np.radians(np.array([p.phase_deg for p in mine])))) - 1.0)) > 1e-3:  # fmt: skip
+            ag.plot(w, g_est, ":", lw=1.0, color=colour, label=f"{name}: cue head estimate (not the test)")
+            aph.plot(w, ph_est, ":", lw=1.0, color=colour)
+        _series(apg, app, w, np.array([p.perceived_gain for p in mine]),
+                np.array([p.perceived_phase_deg for p in mine]), lin, i, color=colour, label=name)  # fmt: skip
+        for p in mine:  # outside the boundaries: a red ring
+            if p.gain_inside is False:
+                ag.plot(p.frequency_radps, p.gain, "o", ms=11, mfc="none", mec="red", mew=1.5)
+            if p.phase_inside is False:
+                aph.plot(p.frequency_radps, p.phase_deg, "o", ms=11, mfc="none", mec="red", mew=1.5)
+        if not aircraft_drawn:
+            ga = np.array([p.aircraft_perceived_gain for p in mine])
+            pa = np.array([p.aircraft_perceived_phase_deg for p in mine])
+            if np.any(ga > 0):
+                apg.plot(w, ga, "k--", lw=1.5, label="aircraft pilot")
+                app.plot(w, pa, "k--", lw=1.5, label="aircraft pilot")
+            else:
+                apg.text(0.02, 0.04, "aircraft pilot: no rotation (gain 0)", transform=apg.transAxes, fontsize=8)
+            aircraft_drawn = True
+    for ax in (ag, apg):
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.grid(True, which="both", alpha=0.3)
+    for ax in (aph, app):
+        ax.set_xscale("log")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.set_xlabel("frequency (rad/s)")
+    ag.set_ylabel("gain (-)")
+    aph.set_ylabel("phase (deg)")
+    ag.set_title(f"{test.input_axis} -> {test.output_axis}: platform motion at the pilot's head")
+    apg.set_title("perceived (vestibular models)")
+    ag.legend(fontsize=8, loc="best")
+    apg.legend(fontsize=8, loc="best")
+    fig.suptitle(f"OMCT {test.name}  (x: non-linear point; red ring: outside the boundaries)", fontsize=11)
+    fig.subplots_adjust(left=0.065, right=0.985, bottom=0.075, top=0.895, wspace=0.16, hspace=0.07)  # as tight
+    name = f"bode_{test.name}.png"
+    with atomic_path(Path(out_dir) / name) as tmp:
+        fig.savefig(tmp, format="png", dpi=90)
+    plt.close(fig)
+    return name

@@ -15,6 +15,7 @@ import numpy as np
 
 from washbench.analysis.cues import FALSE, MISSING, classify, dof_thresholds
 from washbench.analysis.metrics import DOFS
+from washbench.io.outfolder import uninterrupted
 
 FALSE_COLOUR = (0.84, 0.15, 0.16)
 MISSING_COLOUR = (0.72, 0.72, 0.72)
@@ -38,6 +39,7 @@ def cue_classes(perceived: Mapping[str, np.ndarray], washouts: Sequence[str]) ->
     }
 
 
+@uninterrupted
 def cue_lane_figure(
     stem: Path,
     title: str,
@@ -58,7 +60,10 @@ def cue_lane_figure(
     y = 0.0
     t = np.asarray(t_s, dtype=np.float64)
     dt = float(t[1] - t[0]) if t.size > 1 else 1.0
-    for w in washouts:
+    for i, w in enumerate(washouts):
+        if i:  # a rule between two washouts' lanes
+            y += 0.6
+            ax.axhline(y - 0.3, color="0.6", lw=0.6)
         for j, d in enumerate(DOFS):
             row = classes[w][j]
             for cls, colour in ((MISSING, MISSING_COLOUR), (FALSE, FALSE_COLOUR)):
@@ -68,8 +73,6 @@ def cue_lane_figure(
             labels.append(f"{w}  {d}" if j == 0 else d)
             ticks.append(y + 0.5)
             y += 1.0
-        y += 0.6
-        ax.axhline(y - 0.3, color="0.6", lw=0.6)
     ax.set_yticks(ticks, labels, fontsize=7)
     ax.set_ylim(y, -0.2)
     ax.set_xlim(t[0], t[-1] + dt)

@@ -27,11 +27,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from washbench.io.outfolder import uninterrupted
 from washbench.review.numbers import SCORE_FLAG
 from washbench.review.palette import aircraft_color, mpl, palette_name, washout_colors, washout_dashes
 
@@ -228,21 +230,73 @@ def phase_label(name: str, width_in: float) -> str:
     return name[: max(chars - 1, 0)] + "…" if chars >= 4 else ""
 
 
+@dataclass(frozen=True)
+class PlacedLabel:
+    """A phase name placed on the phase lane: ``text`` centred at ``x_in`` inches from the lane's left edge, on
+    ``row`` (0: the whole lane height, inside its box; 1: the upper half; 2: the lower half)."""
+
+    text: str
+    x_in: float
+    row: int
+
+
+def place_phase_labels(boxes: Sequence[tuple[str, float, float]], width_in: float,
+                       gap_in: float = 2 * _CHAR_IN) -> list[PlacedLabel]:  # fmt: skip
+    """Where each phase name goes on a lane ``width_in`` inches wide; ``boxes``: (name, left, right) in inches.
+
+    A name that fits its box (on one line or wrapped onto two, :func:`phase_label`) stays centred in it. A name
+    that does not is written on one line in the upper or lower half of the lane, centred on its box as far as the
+    lane allows and free to run over its neighbours' boxes, wherever it keeps ``gap_in`` from every other name;
+    only where neither half has the room is it shortened to its box (or dropped) as before.
+    """
+    placed: list[PlacedLabel | None] = [None] * len(boxes)
+    taken: dict[int, list[tuple[float, float]]] = {1: [], 2: []}
+
+    def extent(text: str, x: float) -> tuple[float, float]:
+        half = 0.5 * max(len(line) for line in text.split("\n")) * _CHAR_IN
+        return x - half, x + half
+
+    for i, (name, a, b) in enumerate(boxes):
+        text = phase_label(name, b - a)
+        if text == name or text.replace("\n", " ") == name:
+            x = 0.5 * (a + b)
+            placed[i] = PlacedLabel(text, x, 0)
+            for row in taken.values():
+                row.append(extent(text, x))
+    for i, (name, a, b) in enumerate(boxes):
+        if placed[i] is not None:
+            continue
+        half = 0.5 * len(name) * _CHAR_IN
+        x = min(max(0.5 * (a + b), half), width_in - half)
+        lo, hi = x - half - gap_in, x + half + gap_in
+        for row in (1, 2) if 2 * half <= width_in else ():
+            if all(hi <= left or lo >= right for left, right in taken[row]):
+                placed[i] = PlacedLabel(name, x, row)
+                taken[row].append((x - half, x + half))
+                break
+        else:
+            short = phase_label(name, b - a)
+            placed[i] = PlacedLabel(short, 0.5 * (a + b), 0) if short else None
+    return [p for p in placed if p is not None]
+
+
 def _phase_lane(ax: Any, phases: Sequence[tuple[str, float, float]], t0_s: float, t1_s: float,
                 width_in: float) -> None:  # fmt: skip
-    """Phases as labelled boxes on a lane axis (names wrapped, shortened or dropped where the box is too narrow)."""
+    """Phases as labelled boxes on a lane axis (names that do not fit their box staggered above and below,
+    :func:`place_phase_labels`)."""
     ax.set_ylim(0, 1)
     ax.set_yticks([])
     for side in ("top", "right", "left"):
         ax.spines[side].set_visible(False)
     span = max(t1_s - t0_s, 1e-9)
+    boxes = []
     for i, (name, a, b) in enumerate(phases):
         shade = (0.82, 0.86, 0.92) if i % 2 == 0 else (0.90, 0.92, 0.96)
         ax.axvspan(a, b, color=shade, lw=0)
-        label = phase_label(name, (min(b, t1_s) - max(a, t0_s)) / span * width_in)
-        if label:
-            ax.text(0.5 * (a + b), 0.5, label, ha="center", va="center", fontsize=7.5, clip_on=True,
-                    linespacing=1.0)  # fmt: skip
+        boxes.append((name, (max(a, t0_s) - t0_s) / span * width_in, (min(b, t1_s) - t0_s) / span * width_in))
+    for label in place_phase_labels(boxes, width_in):
+        ax.text(t0_s + label.x_in / width_in * span, (0.5, 0.75, 0.25)[label.row], label.text, ha="center",
+                va="center", fontsize=7.5, clip_on=True, linespacing=1.0)  # fmt: skip
     ax.set_ylabel("phase", rotation=0, ha="right", va="center", fontsize=8)
     ax.yaxis.set_label_coords(-0.01, 0.5)
 
@@ -263,6 +317,7 @@ def _shade_phases(ax: Any, phases: Sequence[tuple[str, float, float]]) -> None:
                       autolim=False)  # fmt: skip
 
 
+@uninterrupted
 def perceived_figure(
     stem: Path,
     title: str,
@@ -332,6 +387,7 @@ def _runs(flags: np.ndarray) -> list[tuple[int, int]]:
     return list(zip(edges[::2].tolist(), edges[1::2].tolist(), strict=True))
 
 
+@uninterrupted
 def envelope_figure(
     stem: Path,
     title: str,
@@ -409,6 +465,7 @@ def _sig(x: float, digits: int = 3) -> str:
     return sig(x, digits)
 
 
+@uninterrupted
 def score_heatmap(
     stem: Path,
     rows: Sequence[str],
@@ -454,6 +511,7 @@ def score_heatmap(
     return save_figure(fig, stem, formats)
 
 
+@uninterrupted
 def table4_figure(
     stem: Path,
     rows: Sequence[str],

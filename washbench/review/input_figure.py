@@ -20,6 +20,8 @@ import numpy as np
 
 from washbench.errors import WashbenchError, located
 from washbench.io.input_format import ColumnSource
+from washbench.io.outfolder import uninterrupted
+from washbench.io.result_files import FIGURES_DIR, RUN_FILE, TRACES_FILE
 from washbench.io.units import G0_MPS2, axes_matrix, is_identity_axes
 
 INPUT_STEM = "input"
@@ -61,6 +63,7 @@ def input_labels(
     return out
 
 
+@uninterrupted
 def input_figure(
     stem: Path,
     title: str,
@@ -124,10 +127,10 @@ def input_section(
     (:func:`redraw`); ``image``: the report's way of embedding a figure and linking its PDF. ``into``: the stage
     folder whose ``figures/`` will replace the result's (the figure is drawn, or copied, there).
     """
-    png = folder / "figures" / f"{INPUT_STEM}.png"
+    png = folder / FIGURES_DIR / f"{INPUT_STEM}.png"
     if not png.is_file():
         return []
-    target = (into or folder) / "figures"
+    target = (into or folder) / FIGURES_DIR
     target.mkdir(parents=True, exist_ok=True)
     drawn = redraw(folder, ("png", "pdf"), target) if pdf else None
     if drawn is None and into is not None:
@@ -153,10 +156,10 @@ def redraw(folder: Path, formats: Sequence[str], fig_dir: Path | None = None) ->
 
     import pyarrow.parquet as pq
 
-    from washbench.io.results import AIRCRAFT, TIME_COLUMN, f_columns, omega_columns
+    from washbench.io.columns import AIRCRAFT, TIME_COLUMN, f_columns, omega_columns
 
     try:
-        doc = json.loads((folder / "run.json").read_text())
+        doc = json.loads((folder / RUN_FILE).read_text())
     except (OSError, ValueError):
         return None
     if not isinstance(doc, dict):
@@ -165,7 +168,7 @@ def redraw(folder: Path, formats: Sequence[str], fig_dir: Path | None = None) ->
     if not isinstance(labels, list) or len(labels) != 6:
         return None
     notes = doc.get("conversions", [])
-    where = folder / "run.json"
+    where = folder / RUN_FILE
     for key, value in (("input_labels", labels), ("conversions", notes)):
         if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
             raise WashbenchError(located(where, f"{key}: not as washbench writes it (a list of texts); edited or "
@@ -173,7 +176,7 @@ def redraw(folder: Path, formats: Sequence[str], fig_dir: Path | None = None) ->
     import pyarrow as pa
 
     cols = [TIME_COLUMN, *f_columns(AIRCRAFT), *omega_columns(AIRCRAFT)]
-    traces = folder / "traces.parquet"
+    traces = folder / TRACES_FILE
     try:
         table = pq.read_table(traces, columns=cols)
     except (OSError, KeyError, ValueError, pa.ArrowException) as exc:
@@ -188,14 +191,14 @@ def redraw(folder: Path, formats: Sequence[str], fig_dir: Path | None = None) ->
         raise WashbenchError(located(traces, "the input columns hold values that are not finite; edited or damaged? "
                                              "write it again"))  # fmt: skip
     title = f"{Path(str(doc.get('input', 'input'))).name} {doc.get('segment', '')}".strip()
-    stem = (fig_dir or folder / "figures") / INPUT_STEM
+    stem = (fig_dir or folder / FIGURES_DIR) / INPUT_STEM
     return input_figure(stem, title, arr[:, 0], arr[:, 1:4], arr[:, 4:7], labels, notes, formats)
 
 
 def draw_for_result(folder: Path, title: str, motion: Any, labels: Sequence[str], notes: Sequence[str]) -> Path:
-    """``folder/figures/input.png`` of a cued segment (``motion``: :class:`washbench.io.results.Motion`); a PDF of an
+    """``folder/figures/input.png`` of a cued segment (``motion``: :class:`washbench.io.motion.Motion`); a PDF of an
     earlier ``washbench report`` is removed (it would show other data)."""
-    fig_dir = folder / "figures"
+    fig_dir = folder / FIGURES_DIR
     fig_dir.mkdir(parents=True, exist_ok=True)
     (fig_dir / f"{INPUT_STEM}.pdf").unlink(missing_ok=True)
     w = motion.omega_degps if motion.omega_degps is not None else np.degrees(motion.omega_radps)

@@ -11,7 +11,8 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-from washbench.analysis.metrics import DOFS, MetricRow
+from washbench.analysis.metrics import DOFS
+from washbench.io.metrics_csv import MetricRow
 
 __all__ = ["metrics_table_markdown"]
 

@@ -35,12 +35,9 @@ from washbench.analysis.ranking import (
     undecided,
 )
 from washbench.io.atomic import write_text_atomic
+from washbench.io.result_files import FIGURES_DIR, RECORDING_FILE, REPORT_FILE
 from washbench.review.numbers import SCORE_FLAG, pct, sig
 from washbench.review.result_data import ResultData, load_result
-
-REPORT_FILE = "report.md"
-FIGURES_DIR = "figures"
-SUITE_FILE = "suite.json"
 
 FLAG = SCORE_FLAG
 SCORE_NOTE = (
@@ -103,6 +100,11 @@ def provenance_lines(prov: dict[str, Any] | None, created_utc: str | None) -> li
         names = {"young-meiry": "Meiry-Young otolith, Young-Oman canals (the paper's)",
                  "telban-cardullo": "Telban-Cardullo otolith and canals (NASA CR-2005-213747)"}  # fmt: skip
         rows.append(("vestibular models", names.get(vest["model"], str(vest["model"]))))
+        msi = (vest.get("sickness") or {}).get("msi") or {}
+        if msi.get("model"):
+            rows.append(("sickness models", "MSDV: ISO 2631-1 Wf; MSI: "
+                         + ("6-DOF subjective vertical conflict, In1 (Inoue, Liu and Wada 2023)"
+                            if msi["model"] == "6dof-svc-in1" else str(msi["model"]))))  # fmt: skip
     ranking = prov.get("ranking")
     if isinstance(ranking, dict) and ranking.get("by"):
         rows.append(("ranking rule", f"`--rank-by {ranking['by']}`"))
@@ -279,7 +281,8 @@ def cue_lines(data: ResultData) -> list[str]:
 
 
 def sickness_lines(data: ResultData) -> list[str]:
-    """MSDV (ISO 2631-1 Wf) of the vertical motion at each pilot's head (the heave rows of metrics.csv)."""
+    """MSDV (ISO 2631-1 Wf) of the vertical motion at each pilot's head and the SVC model's MSI (the heave rows of
+    metrics.csv; a result written before the MSI shows the MSDV alone)."""
     heave = [m for m in data.metrics if m.dof == "heave" and not math.isnan(m.msdv_mps15)]
     if not heave:
         return ["_This result was written before the motion sickness dose: `washbench cue` it again for it._", ""]
@@ -288,11 +291,22 @@ def sickness_lines(data: ResultData) -> list[str]:
         "weighted by ISO 2631-1 Wf (peak near 0.16 Hz), over the manoeuvre (docs/fidelity.md). Lower is better; "
         "a simulator pilot above the aircraft pilot gets more vertical low-frequency motion than the flight had.",
         "",
-        "| pilot | MSDV (m/s^1.5) |",
-        "|---|---|",
-        f"| aircraft | {sig(heave[0].msdv_aircraft_mps15)} |",
     ]
-    lines += [f"| {m.washout} | {sig(m.msdv_mps15)} |" for m in heave]
+    if any(not math.isnan(m.msi_pct) for m in heave):
+        lines += [
+            "MSI: motion-sickness incidence (% who would vomit) the 6-DOF subjective vertical conflict model "
+            "(Inoue, Liu and Wada 2023, after Bos and Bles 1998) predicts at the end of the manoeuvre, from all six "
+            "DOFs of the head motion. It builds up with a 12-min second-order lag, so a manoeuvre of minutes gives "
+            "small numbers: compare the pilots, not the value with an exposure of hours (docs/fidelity.md).",
+            "",
+            "| pilot | MSDV (m/s^1.5) | MSI (%) |",
+            "|---|---|---|",
+            f"| aircraft | {sig(heave[0].msdv_aircraft_mps15)} | {sig(heave[0].msi_aircraft_pct)} |",
+        ]
+        lines += [f"| {m.washout} | {sig(m.msdv_mps15)} | {sig(m.msi_pct)} |" for m in heave]
+    else:
+        lines += ["| pilot | MSDV (m/s^1.5) |", "|---|---|", f"| aircraft | {sig(heave[0].msdv_aircraft_mps15)} |"]
+        lines += [f"| {m.washout} | {sig(m.msdv_mps15)} |" for m in heave]
     return [*lines, ""]
 
 
@@ -453,7 +467,7 @@ def result_sections(
         lines += [f"{h} Phases", "", "| phase | start (s) | end (s) |", "|---|---|---|"]
         lines += [f"| {n} | {t0:.2f} | {t1:.2f} |" for n, t0, t1 in data.phases]
         lines.append("")
-    recording = data.folder / "recording.rrd"
+    recording = data.folder / RECORDING_FILE
     if recording.exists():
         rel = _rel(recording, start)
         lines += [f"Recording: [{rel}]({rel}) (`washbench replay {rel}`).", ""]

@@ -10,7 +10,8 @@ import os
 from pathlib import Path
 
 from washbench.errors import WashbenchError, located
-from washbench.review.report import SUITE_FILE, write_result_report
+from washbench.io.result_files import SUITE_FILE
+from washbench.review.report import write_result_report
 from washbench.review.result_data import is_result_folder
 from washbench.review.suite_report import write_suite_report
 

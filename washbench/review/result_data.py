@@ -18,10 +18,9 @@ from typing import Any
 
 import numpy as np
 
-from washbench.analysis.metrics import DOFS, MetricRow, integral_abs_error
+from washbench.analysis.metrics import DOFS, integral_abs_error
 from washbench.errors import WashbenchError, located
-from washbench.io.provenance import read_parquet_provenance
-from washbench.io.results import (
+from washbench.io.columns import (
     AIRCRAFT,
     TIME_COLUMN,
     acc_columns,
@@ -29,13 +28,12 @@ from washbench.io.results import (
     perceived_f_columns,
     perceived_omega_columns,
     pos_columns,
-    read_metrics_csv,
     vel_columns,
     wheel_columns,
 )
-
-METRICS_FILE = "metrics.csv"
-TRACES_FILE = "traces.parquet"
+from washbench.io.metrics_csv import MetricRow, read_metrics_csv
+from washbench.io.provenance import read_parquet_provenance
+from washbench.io.result_files import FLIGHT_JSON, METRICS_FILE, RUN_FILE, TRACES_FILE
 
 
 @dataclass(eq=False)
@@ -45,7 +43,7 @@ class ResultData:
     ``perceived``: source (``aircraft`` or a washout) -> (N, 6) surge, sway, heave [m/s^2], roll, pitch, yaw [deg/s];
     ``usage``: envelope panel -> washout -> (N,) |value| / limit (empty without platform limits);
     ``saturated``: washout -> limit kind -> bool (N,); ``motion``: DOF -> the aircraft pilot's perceived motion
-    (m/s^2*s or deg, :func:`washbench.runs.pipeline.perceived_motion`).
+    (m/s^2*s or deg, :func:`washbench.analysis.ranking.perceived_motion`).
     """
 
     folder: Path
@@ -212,8 +210,8 @@ def load_result(folder: Path, table: Mapping[str, np.ndarray] | None = None, *, 
         raise WashbenchError(located(traces_path, f"{TIME_COLUMN}: not finite and increasing (edited or damaged?)"))
     from washbench.io.readback import FlightDoc, RunDoc, check_provenance
 
-    run = _read_json(folder / "run.json", RunDoc) or {}
-    flight = _read_json(folder / "flight.json", FlightDoc) or {}
+    run = _read_json(folder / RUN_FILE, RunDoc) or {}
+    flight = _read_json(folder / FLIGHT_JSON, FlightDoc) or {}
     dt = float(run.get("dt_s") or flight.get("dt_s") or (t[-1] - t[0]) / (t.shape[0] - 1))
     perceived = {
         src: np.column_stack([table[c] for c in (*perceived_f_columns(src), *perceived_omega_columns(src))])
@@ -224,7 +222,7 @@ def load_result(folder: Path, table: Mapping[str, np.ndarray] | None = None, *, 
         for w in washouts
     }
     if run.get("provenance"):
-        prov = check_provenance(run["provenance"], folder / "run.json")
+        prov = check_provenance(run["provenance"], folder / RUN_FILE)
     else:
         prov = check_provenance(read_parquet_provenance(traces_path), traces_path)
     limits = _limits_from(prov)

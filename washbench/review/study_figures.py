@@ -14,6 +14,7 @@ import numpy as np
 
 from washbench.analysis.sweep import SweepRow, format_value
 from washbench.io.atomic import atomic_path
+from washbench.io.outfolder import uninterrupted
 
 
 def _pyplot():
@@ -57,6 +58,7 @@ def key_label(key: str) -> str:
     return key
 
 
+@uninterrupted
 def sweep_figure(path: Path, keys: Sequence[str], rows: Sequence[SweepRow]) -> None:
     """Mean score over the manoeuvres against each swept key, one line per washout.
 
@@ -101,6 +103,7 @@ def sweep_figure(path: Path, keys: Sequence[str], rows: Sequence[SweepRow]) -> N
     plt.close(fig)
 
 
+@uninterrupted
 def convergence_figure(path: Path, objective: np.ndarray, baseline: float, label: str) -> None:
     """Every evaluation's objective (dots) and the best so far (a step at each improvement) against the evaluation
     number (integer ticks)."""

@@ -28,13 +28,11 @@ from washbench.analysis.ranking import (
 )
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
+from washbench.io.result_files import FIGURES_DIR, METRICS_FILE, RECORDING_FILE, REPORT_FILE, SUITE_FILE
 from washbench.review.numbers import sig
 from washbench.review.report import (
-    FIGURES_DIR,
     FLAG,
-    REPORT_FILE,
     SCORE_NOTE,
-    SUITE_FILE,
     _image,
     _rel,
     provenance_lines,
@@ -84,7 +82,7 @@ def _entries(suite_dir: Path) -> tuple[list[dict[str, Any]], dict[str, Any]]:
             if e.get("result"):
                 suite_member(suite_dir, e["result"], path)
         return entries, doc
-    folders = sorted({p.parent for p in suite_dir.rglob("metrics.csv") if is_result_folder(p.parent)
+    folders = sorted({p.parent for p in suite_dir.rglob(METRICS_FILE) if is_result_folder(p.parent)
                       and not any(q.is_symlink() for q in (p.parent, *p.parent.parents) if q != suite_dir
                                   and q.is_relative_to(suite_dir))})  # fmt: skip
     if not folders:
@@ -198,7 +196,7 @@ def _write_suite_report(
             cells.append(f"{text} {FLAG}" if s > 1.0 else text)
         checks = f"{sum(bool(c.get('passed')) for c in d.checks)}/{len(d.checks)}" if d.checks else "-"
         rel = _rel(d.folder, suite_dir)
-        rec = f"[recording.rrd]({rel}/recording.rrd)" if (d.folder / "recording.rrd").exists() else "-"
+        rec = f"[{RECORDING_FILE}]({rel}/{RECORDING_FILE})" if (d.folder / RECORDING_FILE).exists() else "-"
         aircraft, _, manoeuvre = d.title.partition(" / ")
         lines.append(f"| {aircraft} | {manoeuvre or d.title} | {status} | {checks} | {sig(d.duration_s)} | {best} | "
                      + " | ".join(cells) + f" | [report.md]({rel}/{REPORT_FILE}) | {rec} |")  # fmt: skip

@@ -1,16 +1,11 @@
 """``washbench cue``: washouts, Atlas model, vestibular models and metrics on a recorded trace.
 
-Two layers, so the flight pipeline (which builds washout traces in lockstep with JSBSim) shares
-the post-processing:
-
-* :func:`analyse` (motion + finished washout traces -> perception, metrics, tables);
-* :func:`cue_motion` = ``cueing.cue_trace`` + :func:`analyse` (whole traces in memory);
-* :func:`stream_cue`: the same in one pass over chunks of :data:`CHUNK_ROWS` samples, writing traces.parquet as it
-  goes, the same bits; memory beyond the input is what the review needs of each row (see its docstring);
-* :func:`run_cue` (the CLI), in stages: :func:`read_input` (reading and conversion to washbench units
-  and axes), :func:`prepare_segments` (time resets, window, gaps, uniform grid or resampling,
-  plausibility), :func:`write_outputs` (per segment :func:`stream_cue` and the other files of a
-  ``run`` result folder, all renamed into place together).
+The chain itself (washouts, perception, metrics, the traces table) is :mod:`washbench.runs.chain`, which
+``washbench run`` enters with a flight flown in lockstep and ``cue`` with a recorded file. Here is the command,
+in stages: :func:`read_input` (reading and conversion to washbench units and axes), :func:`prepare_segments` (time
+resets, window, gaps, uniform grid or resampling, plausibility), :func:`write_outputs` (per segment
+:func:`washbench.runs.chain.stream_cue` and the other files of a ``run`` result folder, all renamed into place
+together), :func:`run_cue` (all of it, the whole set published at once).
 """
 
 from __future__ import annotations
@@ -19,387 +14,33 @@ import contextlib
 import math
 import sys
 import time
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from types import SimpleNamespace
-from typing import Any, Protocol
+from typing import Any
 
 import numpy as np
 
-from washbench.analysis.metrics import MetricRow, dof_metrics
+from washbench.analysis.ranking import perceived_motion
 from washbench.errors import WashbenchError, located, printable
 from washbench.io.atomic import atomic_path
+from washbench.io.columns import AIRCRAFT
 from washbench.io.input_format import InputFormat
+from washbench.io.metrics_csv import write_metrics_csv
+from washbench.io.motion import Motion
 from washbench.io.names import check_identifier
+from washbench.io.outfolder import check_out_path, result_set
 from washbench.io.plausibility import Finding, check_arrays
 from washbench.io.progress import Progress
+from washbench.io.provenance import file_record, flat_strings, parquet_metadata, read_parquet_provenance, utc_now
 from washbench.io.publish import result_path
 from washbench.io.readers import Samples, read_samples
 from washbench.io.resample import check_gaps, check_step, resample, split_resets, to_motion, window
-from washbench.io.results import (
-    AIRCRAFT,
-    TIME_COLUMN,
-    Motion,
-    acc_columns,
-    f_columns,
-    omega_columns,
-    omega_platform_columns,
-    perceived_f_columns,
-    perceived_omega_columns,
-    pos_columns,
-    q_columns,
-    sat_column,
-    sp_pos_columns,
-    sp_q_columns,
-    vel_columns,
-    wheel_columns,
-    write_metrics_csv,
-    write_traces,
-)
-from washbench.perception.vestibular import Perceived, VestibularModel, VestibularParams, model_params
-
-TRACES_FILE = "traces.parquet"
-METRICS_FILE = "metrics.csv"
-RECORDING_FILE = "recording.rrd"
-
-_DEG = 180.0 / math.pi
-
-
-class TraceLike(Protocol):
-    """What :func:`analyse` needs of a washout trace (``washbench.cueing.WashoutTrace``), arrays of N rows."""
-
-    pos_m: np.ndarray  # (N, 3) NED [m]
-    vel_mps: np.ndarray  # (N, 3) NED [m/s]
-    acc_mps2: np.ndarray  # (N, 3) NED [m/s^2]
-    q: np.ndarray  # (N, 4) body -> inertial, scalar first
-    omega_radps: np.ndarray  # (N, 3) platform angular velocity, body [rad/s]
-    head_f_mps2: np.ndarray  # (N, 3) simulator pilot's specific force, body [m/s^2]
-    head_omega_radps: np.ndarray  # (N, 3) simulator pilot's angular velocity, body [rad/s]
-    wheel_radps: np.ndarray  # (N, 3)
-    sp_pos_m: np.ndarray  # (N, 3) position set point, NED [m]
-    sp_q: np.ndarray  # (N, 4) attitude set point, body -> inertial
-    saturated: Mapping[str, np.ndarray]  # kind -> bool (N,)
-    saturation_counts: Mapping[str, int]
-
-
-CHUNK_ROWS = 8192
-"""Rows of traces.parquet built and written at a time (one Parquet row group each): the table is never whole in
-memory, whatever the length of the input."""
-
-
-@dataclass(frozen=True, eq=False)
-class CueResult:
-    """Everything ``washbench cue`` computes for one input trace.
-
-    ``perceived``: pilot name (``"aircraft"`` or a washout name) -> perceived motion;
-    ``metrics``: six rows per washout (:mod:`washbench.analysis.metrics`); ``traces``: the washout traces
-    themselves; :meth:`columns` the traces.parquet columns (:mod:`washbench.io.results`) of a range of rows, built
-    on demand so the whole table never has to exist at once.
-    """
-
-    motion: Motion
-    traces: Mapping[str, TraceLike]
-    perceived: Mapping[str, Perceived]
-    metrics: list[MetricRow]
-    arrays: Mapping[str, Mapping[str, np.ndarray]] = field(default_factory=dict, repr=False)
-    """washout -> the trace's fields as checked float64 arrays (:func:`analyse`); else read from ``traces``."""
-
-    @property
-    def n(self) -> int:
-        """Number of samples."""
-        return self.motion.n
-
-    def columns(self, start: int = 0, stop: int | None = None) -> dict[str, np.ndarray]:
-        """The traces.parquet columns, in order, for rows ``start:stop`` (views where no unit changes)."""
-        rows = slice(start, self.n if stop is None else stop)
-        perceived = {p: Perceived(v.f_mps2[rows], v.omega_radps[rows]) for p, v in self.perceived.items()}
-        fields = {}
-        for name, tr in self.traces.items():
-            arr = self.arrays.get(name) or {f: getattr(tr, f) for f in _TRACE_FIELDS}
-            fields[name] = {f: a[rows] for f, a in arr.items()}
-        saturated = {w: {k: np.asarray(v)[rows] for k, v in tr.saturated.items()} for w, tr in self.traces.items()}
-        return _table_rows(self.motion, rows, perceived, fields, saturated)
-
-    def review_table(self) -> dict[str, np.ndarray]:
-        """What the report reads of traces.parquet (:func:`washbench.review.result_data.load_result`), whole:
-        time, every pilot's perceived motion, the platform's envelope fields and the saturation flags."""
-        m = self.motion
-        table: dict[str, np.ndarray] = {TIME_COLUMN: m.t_s}
-        for name, p in self.perceived.items():
-            _put(table, perceived_f_columns(name), p.f_mps2)
-            _put(table, perceived_omega_columns(name), p.omega_radps * _DEG)
-        for name, tr in self.traces.items():
-            if hasattr(tr, "pos_m"):  # (a streamed cue without figures keeps no platform fields)
-                _put(table, pos_columns(name), tr.pos_m)
-                _put(table, vel_columns(name), tr.vel_mps)
-                _put(table, acc_columns(name), tr.acc_mps2)
-                _put(table, omega_platform_columns(name), tr.omega_radps * _DEG)
-                _put(table, wheel_columns(name), tr.wheel_radps)
-            for kind, flags in tr.saturated.items():
-                table[sat_column(name, kind)] = np.asarray(flags)
-        return table
-
-    def column_chunks(self, rows: int = CHUNK_ROWS) -> Iterator[dict[str, np.ndarray]]:
-        """:meth:`columns` for consecutive ranges of ``rows`` rows (at least one range, even for no rows)."""
-        for a in range(0, max(self.n, 1), rows):
-            yield self.columns(a, min(self.n, a + rows))
-
-
-_TRACE_FIELDS = {
-    "pos_m": 3,
-    "vel_mps": 3,
-    "acc_mps2": 3,
-    "q": 4,
-    "omega_radps": 3,
-    "head_f_mps2": 3,
-    "head_omega_radps": 3,
-    "wheel_radps": 3,
-    "sp_pos_m": 3,
-    "sp_q": 4,
-}
-
-
-def _checked_trace(name: str, trace: TraceLike, n: int, first: int = 0) -> dict[str, np.ndarray]:
-    """The trace's arrays as float64, checked for shape and finiteness (a non-finite value is an error; ``first``:
-    the sample number of the trace's first row, for the message)."""
-    out = {}
-    for attr, width in _TRACE_FIELDS.items():
-        a = np.asarray(getattr(trace, attr), dtype=np.float64)
-        if a.shape != (n, width):
-            raise ValueError(f"washout {name!r}: {attr} has shape {a.shape}, expected ({n}, {width})")
-        bad = ~np.isfinite(a)
-        if bad.any():
-            row = first + int(np.argmax(bad.any(axis=1)))
-            raise WashbenchError(f"washout {name!r} produced a non-finite {attr} at sample {row} (t index {row})")
-        out[attr] = a
-    return out
-
-
-def analyse(
-    motion: Motion,
-    traces: Mapping[str, TraceLike],
-    vestibular: VestibularParams | None = None,
-    filter_start: str = "steady",
-) -> CueResult:
-    """Vestibular models for the aircraft pilot and each simulator pilot, metrics, and the traces table.
-
-    ``traces`` maps washout name -> its trace on the same time grid as ``motion``. Perception
-    starts each filter in the steady state of its first sample, or of rest (``filter_start="rest"``;
-    see :mod:`washbench.perception`).
-    """
-    model = VestibularModel(motion.dt_s, vestibular)
-    n = motion.n
-    perceived: dict[str, Perceived] = {AIRCRAFT: model.perceive(motion.f_mps2, motion.omega_radps, filter_start)}
-    checked: dict[str, dict[str, np.ndarray]] = {}
-    for name, trace in traces.items():
-        arr = _checked_trace(name, trace, n)
-        for kind, flags in trace.saturated.items():
-            if np.shape(flags) != (n,):
-                raise ValueError(f"washout {name!r}: saturated[{kind!r}] has shape {np.shape(flags)}, expected ({n},)")
-        perceived[name] = model.perceive(arr["head_f_mps2"], arr["head_omega_radps"], filter_start)
-        checked[name] = arr
-    vertical = {AIRCRAFT: motion.f_mps2[:, 2], **{w: a["head_f_mps2"][:, 2] for w, a in checked.items()}}
-    rows = _metric_rows(perceived, motion.dt_s, vertical)
-    result = CueResult(motion=motion, traces=dict(traces), perceived=perceived, metrics=rows, arrays=checked)
-    result.columns(0, 0)  # an input column that clashes with a result column fails now, before anything is written
-    return result
-
-
-def _metric_rows(
-    perceived: Mapping[str, Perceived], dt_s: float, vertical: Mapping[str, np.ndarray]
-) -> list[MetricRow]:
-    """Six metric rows per washout: each simulator pilot's perceived motion against the aircraft pilot's, the cue
-    classification, and on the heave row the MSDV of each pilot's head (``vertical``: pilot -> body-z specific
-    force (N,), m/s^2)."""
-    import dataclasses
-
-    from washbench.analysis.cues import classified_rows
-    from washbench.perception.sickness import head_msdv
-
-    ac = perceived[AIRCRAFT]
-    msdv_ac = head_msdv(vertical[AIRCRAFT], dt_s)
-    rows: list[MetricRow] = []
-    for name, p in perceived.items():
-        if name != AIRCRAFT:
-            base = dof_metrics(name, ac.f_mps2, ac.omega_radps, p.f_mps2, p.omega_radps, dt_s)
-            msdv = head_msdv(vertical[name], dt_s)
-            rows += [
-                dataclasses.replace(r, msdv_mps15=msdv, msdv_aircraft_mps15=msdv_ac) if r.dof == "heave" else r
-                for r in classified_rows(base, ac.f_mps2, ac.omega_radps, p.f_mps2, p.omega_radps, dt_s)
-            ]
-    return rows
-
-
-def _put(table: dict[str, np.ndarray], names: Sequence[str], values: np.ndarray) -> None:
-    for i, name in enumerate(names):
-        table[name] = values[:, i]
-
-
-def _table_rows(
-    motion: Motion,
-    rows: slice,
-    perceived: Mapping[str, Perceived],
-    fields: Mapping[str, Mapping[str, np.ndarray]],
-    saturated: Mapping[str, Mapping[str, np.ndarray]],
-) -> dict[str, np.ndarray]:
-    """The traces.parquet columns, in order, of the input rows ``rows``: ``perceived`` (every pilot), ``fields``
-    (washout -> trace field -> array) and ``saturated`` (washout -> kind -> flags) hold those rows only."""
-    m = motion
-    table: dict[str, np.ndarray] = {TIME_COLUMN: m.t_s[rows]}
-    _put(table, f_columns(AIRCRAFT), m.f_mps2[rows])
-    omega_deg = m.omega_degps[rows] if m.omega_degps is not None else np.degrees(m.omega_radps[rows])
-    _put(table, omega_columns(AIRCRAFT), omega_deg)
-    ac = perceived[AIRCRAFT]
-    _put(table, perceived_f_columns(AIRCRAFT), ac.f_mps2)
-    _put(table, perceived_omega_columns(AIRCRAFT), ac.omega_radps * _DEG)
-    for name, f in fields.items():
-        p = perceived[name]
-        _put(table, f_columns(name), f["head_f_mps2"])
-        _put(table, omega_columns(name), f["head_omega_radps"] * _DEG)
-        _put(table, perceived_f_columns(name), p.f_mps2)
-        _put(table, perceived_omega_columns(name), p.omega_radps * _DEG)
-        _put(table, pos_columns(name), f["pos_m"])
-        _put(table, vel_columns(name), f["vel_mps"])
-        _put(table, acc_columns(name), f["acc_mps2"])
-        _put(table, q_columns(name), f["q"])
-        _put(table, omega_platform_columns(name), f["omega_radps"] * _DEG)
-        _put(table, wheel_columns(name), f["wheel_radps"])
-        _put(table, sp_pos_columns(name), f["sp_pos_m"])
-        _put(table, sp_q_columns(name), f["sp_q"])
-        for kind, flags in saturated[name].items():
-            table[sat_column(name, kind)] = flags.astype(np.int8)
-    for col, values in m.extra.items():
-        if col in table:
-            raise WashbenchError(f"input column {col!r} clashes with a result column of the same name")
-        table[col] = values[rows]
-    return table
-
-
-def cue_motion(
-    motion: Motion,
-    washouts: Sequence[Any],
-    params: Any,
-    limits: Any,
-    vestibular: VestibularParams | None = None,
-    filter_start: str = "steady",
-) -> CueResult:
-    """Run the washouts (names with ``params``, or Washout variants) and the Atlas model over ``motion``
-    (``cueing.cue_trace``, one compiled call), then :func:`analyse`.
-
-    ``filter_start``: ``steady`` (every filter in the first sample's steady state) or ``rest``.
-    """
-    from washbench.cueing import cue_trace
-
-    traces = cue_trace(motion.f_mps2, motion.omega_radps, motion.dt_s, washouts, params, limits, filter_start)
-    return analyse(motion, traces, vestibular, filter_start)
-
-
-_REVIEW_FIELDS = ("pos_m", "vel_mps", "acc_mps2", "omega_radps", "wheel_radps")
-"""Washout trace fields a streamed cue keeps whole for the report (its envelope figure and time at a limit)."""
-_RECORDING_FIELDS = ("head_f_mps2", "head_omega_radps", "q")
-"""... and for the recording (the simulator pilot's raw motion, the sphere's attitude in the 3D view)."""
-
-
-def stream_cue(
-    motion: Motion,
-    washouts: Sequence[Any],
-    limits: Any,
-    traces_path: Path,
-    metadata: Mapping[bytes, bytes] | None = None,
-    *,
-    filter_start: str = "steady",
-    recording: bool = True,
-    figures: bool = True,
-    chunk_rows: int = CHUNK_ROWS,
-    progress: Progress | None = None,
-    vestibular: VestibularParams | None = None,
-) -> CueResult:
-    """:func:`cue_motion` and the traces.parquet of :func:`write_results` in one pass, ``chunk_rows`` samples at a
-    time (washouts, vestibular models, one Parquet row group per chunk): the same columns and metrics, bit for bit.
-
-    ``washouts``: Washout variants (:func:`washbench.cueing.variants.select_washouts`). ``traces_path`` is written
-    (not atomically: the caller's temporary name). Held whole are only the input, every pilot's perceived motion
-    (for the metrics and figures) and per washout its saturation flags and the trace fields the report's figures
-    (``_REVIEW_FIELDS``, with ``figures`` or ``recording``) and the recording (``_RECORDING_FIELDS``, with
-    ``recording``) show: the returned result's ``traces`` hold those, so :meth:`CueResult.columns` is not available
-    on it (the table is in the file).
-    """
-    from washbench.cueing import CueingBank, WashoutTrace
-    from washbench.io.results import write_trace_chunks
-    from washbench.perception.vestibular import PerceptionStream
-
-    if chunk_rows < 1:
-        raise ValueError(f"chunk_rows must be at least 1, got {chunk_rows}")
-    n = motion.n
-    if n < 1:
-        raise WashbenchError("nothing to cue: the input has no rows")
-    bank = CueingBank(washouts, None, limits, motion.dt_s, filter_start)
-    names = bank.washouts
-    model = VestibularModel(motion.dt_s, vestibular)
-    streams = {p: PerceptionStream(model, filter_start) for p in (AIRCRAFT, *names)}
-    felt = {p: Perceived(np.empty((n, 3)), np.empty((n, 3))) for p in streams}
-    vertical = {p: np.empty(n) for p in streams}  # body-z specific force at each pilot's head (MSDV)
-    keep = (_REVIEW_FIELDS if figures or recording else ()) + (_RECORDING_FIELDS if recording else ())
-    kept = {w: {f: np.empty((n, _TRACE_FIELDS[f])) for f in keep} for w in names}
-    flags: dict[str, dict[str, np.ndarray]] = {w: {} for w in names}
-    buf = np.empty((len(names), min(chunk_rows, n), len(CueingBank.FIELDS)))
-
-    def tables() -> Iterator[dict[str, np.ndarray]]:
-        """Cue the next chunk, keep what the review needs of it, and yield its traces.parquet rows."""
-        for a in range(0, n, chunk_rows):
-            b = min(n, a + chunk_rows)
-            rows = slice(a, b)
-            block = bank.steps(motion.f_mps2[rows], motion.omega_radps[rows], buf if b - a == buf.shape[1] else None)
-            perceived = {AIRCRAFT: streams[AIRCRAFT].perceive(motion.f_mps2[rows], motion.omega_radps[rows])}
-            fields, saturated = {}, {}
-            finite = bool(np.isfinite(block).all())  # one check of the chunk; the failing field named if not
-            for i, w in enumerate(names):
-                tr = WashoutTrace.from_rows(block[i], copy=False)  # views into the reused buffer, used in the chunk
-                fields[w] = {f: getattr(tr, f) for f in _TRACE_FIELDS} if finite else _checked_trace(w, tr, b - a, a)
-                saturated[w] = tr.saturated
-                perceived[w] = streams[w].perceive(fields[w]["head_f_mps2"], fields[w]["head_omega_radps"])
-                vertical[w][rows] = fields[w]["head_f_mps2"][:, 2]
-                for f in keep:
-                    kept[w][f][rows] = fields[w][f]
-                for k, v in tr.saturated.items():
-                    flags[w].setdefault(k, np.empty(n, dtype=bool))[rows] = v
-            for pilot, per in perceived.items():
-                felt[pilot].f_mps2[rows] = per.f_mps2
-                felt[pilot].omega_radps[rows] = per.omega_radps
-            yield _table_rows(motion, rows, perceived, fields, saturated)
-            if progress is not None:
-                progress.update(b)
-
-    write_trace_chunks(traces_path, tables(), metadata)
-    vertical[AIRCRAFT][:] = motion.f_mps2[:, 2]
-    metrics = _metric_rows(felt, motion.dt_s, vertical)
-    counts = bank.saturation_counts()
-    traces = {w: SimpleNamespace(**kept[w], saturated=flags[w], saturation_counts=counts[w]) for w in names}
-    return CueResult(motion=motion, traces=traces, perceived=felt, metrics=metrics)
-
-
-def write_results(out_dir: Path, result: CueResult, provenance: Mapping[str, Any] | None = None) -> tuple[Path, Path]:
-    """Write traces.parquet and metrics.csv into ``out_dir`` (created if missing), both or neither.
-
-    Each file is written to a temporary name and renamed into place only after both are complete.
-    ``provenance`` (:mod:`washbench.io.provenance`, no date) goes into the Parquet key-value metadata.
-    """
-    from washbench.io.provenance import parquet_metadata
-
-    out_dir = Path(out_dir)
-    traces_path, metrics_path = out_dir / TRACES_FILE, out_dir / METRICS_FILE
-    if out_dir.exists() and not out_dir.is_dir():
-        raise WashbenchError(located(out_dir, "output path exists and is not a folder"))
-    try:
-        out_dir.mkdir(parents=True, exist_ok=True)
-        with atomic_path(traces_path) as tmp_traces, atomic_path(metrics_path) as tmp_metrics:
-            write_traces(tmp_traces, result.column_chunks(), parquet_metadata(provenance) if provenance else None)
-            write_metrics_csv(tmp_metrics, result.metrics)
-    except OSError as exc:
-        raise WashbenchError(located(out_dir, f"cannot write results: {exc.strerror or exc}")) from None
-    return traces_path, metrics_path
-
+from washbench.io.result_files import METRICS_FILE, RECORDING_FILE, RUN_FILE, TRACES_FILE
+from washbench.runs.chain import CueResult, aircraft_attitude, stream_cue
+from washbench.runs.options import RunOptions, load_options
+from washbench.runs.outputs import Outputs
+from washbench.runs.result_folder import RunSummary, write_run_json, write_run_recording, write_run_review
 
 # --------------------------------------------------------------------------- the cue command, stage by stage
 
@@ -499,10 +140,8 @@ def prepare_segments(samples: Samples, opts: CueOptions) -> list[Segment]:
     return out
 
 
-def segment_summary(input_path: Path, seg: Segment, result: CueResult, out_dir: Path) -> Any:
+def segment_summary(input_path: Path, seg: Segment, result: CueResult, out_dir: Path) -> RunSummary:
     """The run summary (``run.json``, report) of one cued segment; a crash in the data makes it failed."""
-    from washbench.runs.pipeline import RunSummary, perceived_motion
-
     crash = [f.text for f in seg.findings if f.crash]
     ac = result.perceived[AIRCRAFT]
     return RunSummary(
@@ -522,8 +161,6 @@ def segment_summary(input_path: Path, seg: Segment, result: CueResult, out_dir: 
 def recorded_attitude(motion: Motion) -> np.ndarray:
     """The aircraft's attitude for the recording: from ``phi_deg``/``theta_deg``/``psi_deg`` when the input
     has them, else level (an attitude is not needed by the cueing and is not invented)."""
-    from washbench.runs.pipeline import aircraft_attitude
-
     cols = [motion.extra.get(c) for c in ("phi_deg", "theta_deg", "psi_deg")]
     if all(c is not None and c.dtype.kind == "f" for c in cols):
         return aircraft_attitude(*cols)  # type: ignore[arg-type]
@@ -536,28 +173,24 @@ def write_outputs(
     out_dir: Path,
     input_path: Path,
     segments: Sequence[Segment],
-    washouts: Sequence[Any],
-    limits: Any,
-    opts: CueOptions,
+    run: RunOptions,
     start: float,
     provenance: dict[str, Any] | None = None,
     progress: bool = False,
-) -> list[tuple[Any, CueResult]]:
+) -> list[tuple[RunSummary, CueResult]]:
     """Cueing and outputs: per segment (``out_dir`` itself, or ``out_dir/<segment>/`` when there are several) the
     files of a ``run`` result folder: traces.parquet (written as it is cued, :func:`stream_cue`), metrics.csv,
-    run.json, ranking.csv, report.md and recording.rrd (unless ``opts.recording`` is False). Every file is written
+    run.json, ranking.csv, report.md and recording.rrd (unless ``run.outputs`` says not). Every file is written
     under a temporary name and all are renamed into place together, then ranking.csv and report.md are written
     (atomically) last, so a failure leaves no half-written file. Returns (summary, result) per segment;
-    ``start``: the command's start (``time.perf_counter()``) for run.json's wall time."""
-    from washbench.io.provenance import flat_strings, parquet_metadata, utc_now
-    from washbench.runs.pipeline import write_run_json, write_run_recording
-    from washbench.runs.suite import write_run_review
-
+    ``start``: the command's start (``time.perf_counter()``) for run.json's wall time; ``run``: the washouts, the
+    platform, the filters' start state, the vestibular model and the optional outputs."""
+    recording, figures = run.outputs.recording, run.outputs.figures
     out_dir = Path(out_dir)
     if out_dir.exists() and not out_dir.is_dir():
         raise WashbenchError(located(out_dir, "output path exists and is not a folder"))
     created = utc_now()
-    done: list[tuple[Any, CueResult]] = []
+    done: list[tuple[RunSummary, CueResult]] = []
     shown = Progress("cue", sum(seg.motion.n for seg in segments)) if progress else None
     try:
         with contextlib.ExitStack() as stack:
@@ -567,15 +200,15 @@ def write_outputs(
             for seg in segments:
                 folder = result_path(out_dir, seg.name) if seg.name else out_dir
                 folder.mkdir(parents=True, exist_ok=True)
-                names = (TRACES_FILE, METRICS_FILE, "run.json") + ((RECORDING_FILE,) if opts.recording else ())
+                names = (TRACES_FILE, METRICS_FILE, RUN_FILE) + ((RECORDING_FILE,) if recording else ())
                 tmp = {name: stack.enter_context(atomic_path(folder / name)) for name in names}
                 meta = parquet_metadata(provenance) if provenance else None
                 if shown is not None:
                     shown.offset = offset
                 result = stream_cue(
-                    seg.motion, washouts, limits, tmp[TRACES_FILE], meta,
-                    filter_start=opts.filter_start, recording=opts.recording, figures=opts.figures, progress=shown,
-                    vestibular=model_params(opts.vestibular),
+                    seg.motion, run.washouts, run.limits, tmp[TRACES_FILE], meta,
+                    filter_start=run.filter_start, recording=recording, figures=figures, progress=shown,
+                    vestibular=run.vestibular_params,
                 )  # fmt: skip
                 offset += seg.motion.n
                 summary = segment_summary(input_path, seg, result, folder)
@@ -585,32 +218,52 @@ def write_outputs(
                     "segment": seg.name,
                     "t_start_s": float(seg.motion.t_s[0]),
                     "t_end_s": float(seg.motion.t_s[-1]),
-                    "filter_start": opts.filter_start,
+                    "filter_start": run.filter_start,
                     "conversions": list(seg.notes),
                     "input_labels": list(seg.labels),
                     "warnings": [f.text for f in seg.findings],
                 }
                 if provenance:
                     extra |= {"created_utc": created, "provenance": provenance}
-                write_run_json(tmp["run.json"], summary, time.perf_counter() - start, extra)
-                if opts.recording:
+                write_run_json(tmp[RUN_FILE], summary, time.perf_counter() - start, extra)
+                if recording:
                     title = f"{summary.aircraft} / {summary.manoeuvre}"
                     q = recorded_attitude(seg.motion)
                     props = flat_strings(provenance, created) if provenance else None
-                    write_run_recording(tmp[RECORDING_FILE], title, seg.motion, result, limits, q, [], props)
+                    write_run_recording(tmp[RECORDING_FILE], title, seg.motion, result, run.limits, q, [], props)
                 done.append((summary, result))
         for seg, (summary, result) in zip(segments, done, strict=True):  # last, as a suite's report: each written
-            if not opts.recording:  # atomically once the rest is in place; an earlier recording would mislead
+            if not recording:  # atomically once the rest is in place; an earlier recording would mislead
                 (summary.run_dir / RECORDING_FILE).unlink(missing_ok=True)
-            if opts.figures and seg.labels:  # what was read, linked first in the report
+            if figures and seg.labels:  # what was read, linked first in the report
                 from washbench.review.input_figure import draw_for_result
 
                 title = f"{input_path.name}{f' {seg.name}' if seg.name else ''}"
                 draw_for_result(summary.run_dir, title, seg.motion, seg.labels, seg.notes)
-            write_run_review(summary.run_dir, summary, str(input_path), result.review_table(), opts.figures)
+            write_run_review(summary.run_dir, summary, str(input_path), result.review_table(), figures)
     except OSError as exc:
         raise WashbenchError(located(out_dir, f"cannot write results: {exc.strerror or exc}")) from None
     return done
+
+
+def cue_run_options(
+    opts: CueOptions,
+    washouts: Sequence[str] | None = None,
+    params_path: Path | None = None,
+    platform_path: Path | None = None,
+    variants: Sequence[str] = (),
+) -> RunOptions:
+    """The run's options (:func:`washbench.runs.options.load_options`: each file read once) of a ``cue``."""
+    return load_options(
+        params_path=params_path,
+        platform_path=platform_path,
+        washouts=washouts,
+        variants=variants,
+        outputs=Outputs(recording=opts.recording, figures=opts.figures),
+        filter_start=opts.filter_start,
+        rank_by=opts.rank_by,
+        vestibular=opts.vestibular,
+    )
 
 
 def run_cue(
@@ -622,30 +275,24 @@ def run_cue(
     variants: Sequence[str] = (),
     options: CueOptions | None = None,
     adopt: Sequence[str] = (),
+    run_options: RunOptions | None = None,
 ) -> int:
     """The ``washbench cue`` command: read, convert, cut and check, cue, write; 0, or 1 if the data holds a crash.
 
     ``adopt``: files already in ``out_dir`` that become part of the published set (``washbench live``'s input).
 
     ``washouts``, ``variants`` and ``params_path`` select the washouts
-    (:func:`washbench.cueing.variants.select_washouts`).
+    (:func:`washbench.cueing.variants.select_washouts`); with ``platform_path`` and ``options`` they make the
+    run's options (:func:`cue_run_options`), unless ``run_options`` gives them already loaded.
     Raises WashbenchError (one line) for bad names, parameter files or input; writes nothing then.
     """
-    from washbench.cueing.params import check_filter_start
-    from washbench.cueing.variants import select_washouts
-    from washbench.io.outfolder import check_out_path, result_set
-    from washbench.platform import load_platform_limits
-
     check_out_path(out_dir)
     opts = options or CueOptions()
     for flag, value in (("--max-gap-s", opts.max_gap_s), ("--resample", opts.resample_hz)):
         if value is not None and not (math.isfinite(value) and value > 0.0):
             raise WashbenchError(f"{flag}: expected a positive number, got {value:g}")
     start = time.perf_counter()
-    specs = select_washouts(washouts, variants, params_path)
-    names = [w.name for w in specs]
-    check_filter_start(opts.filter_start)
-    limits = load_platform_limits(platform_path)
+    run = run_options or cue_run_options(opts, washouts, params_path, platform_path, variants)
     samples = read_input(input_path, opts.fmt)
     segments = prepare_segments(samples, opts)
     with result_set(out_dir, "cue", adopt) as stage:  # the whole set replaces the previous one at once
@@ -653,17 +300,13 @@ def run_cue(
             for f in seg.findings:
                 where = f"{input_path}{f' ({seg.name})' if seg.name else ''}"
                 print(f"washbench: warning: {printable(f'{where}: {f.text}')}", file=sys.stderr)
-        from washbench.io.provenance import file_record, read_parquet_provenance
-        from washbench.runs.pipeline import run_provenance
-
-        prov = run_provenance(params_path, platform_path, specs, limits, rank_by=opts.rank_by,
-                              vestibular=opts.vestibular)  # fmt: skip
+        prov = run.provenance_for()
         prov["input"] = file_record(input_path)
         is_parquet = input_path.suffix.lower() in (".parquet", ".pq")
         input_prov = read_parquet_provenance(input_path) if is_parquet else None
         if input_prov:
             prov["input"]["provenance"] = input_prov
-        done = write_outputs(stage, input_path, segments, specs, limits, opts, start, prov, progress=opts.progress)
+        done = write_outputs(stage, input_path, segments, run, start, prov, progress=opts.progress)
     out_dir = Path(out_dir)
     for seg, (summary, result) in zip(segments, done, strict=True):
         m = seg.motion
@@ -671,7 +314,7 @@ def run_cue(
         print(f"{label}: {m.n} rows, {m.duration_s:.3f} s at dt = {m.dt_s:.6g} s ({1.0 / m.dt_s:.6g} Hz)")
         for note in seg.notes:
             print(f"  {note}")
-        for name in names:
+        for name in run.washout_order:
             counts = result.traces[name].saturation_counts
             sat = ", ".join(f"{k} {v}" for k, v in counts.items() if v) or "none"
             print(f"  {name}: saturated samples: {sat}")

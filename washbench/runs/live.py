@@ -34,11 +34,13 @@ from typing import Any
 import numpy as np
 
 from washbench.errors import WashbenchError
+from washbench.io.result_files import RUN_FILE
 from washbench.live import commands
 from washbench.live.endpoints import Sink, bind_udp
 from washbench.live.link import LatencyStats, Link, Out
 from washbench.live.packets import RREF_DATAREFS, RREF_ID0, Decoder, PacketError, decoder, rref_request
 from washbench.live.saved_input import INPUT_FILE, InputWriter
+from washbench.runs.cue import CueOptions, cue_run_options, run_cue
 
 POLL_S = 0.05
 """The loop wakes up at least this often to check the stop conditions."""
@@ -312,7 +314,7 @@ def _add_live_figures(out: Path, input_path: Path, fig: dict[str, Any]) -> None:
     from washbench.io.atomic import write_text_atomic
 
     for folder in (out, *sorted(out.glob("segment_*"))):
-        path = folder / "run.json"
+        path = folder / RUN_FILE
         try:
             doc = json.loads(path.read_text(encoding="utf-8"))
         except (OSError, ValueError):
@@ -333,12 +335,8 @@ def run_live(
     """The ``washbench live`` command; returns the exit status (that of ``washbench cue`` on the saved input, or
     130 / 143 after a Ctrl-C / SIGTERM once the result folder is written)."""
     from washbench.cueing import CueingBank
-    from washbench.cueing.params import check_filter_start
-    from washbench.cueing.variants import select_washouts
     from washbench.io.lock import output_lock
     from washbench.live.viewer import open_viewer
-    from washbench.platform import load_platform_limits
-    from washbench.runs.cue import CueOptions, run_cue
 
     for flag, value in (("--duration", opts.duration_s), ("--idle-timeout", opts.idle_timeout_s),
                         ("--rate-hz", opts.rate_hz), ("--resample", opts.resample_hz)):  # fmt: skip
@@ -346,10 +344,10 @@ def run_live(
             raise WashbenchError(f"{flag}: expected a positive number, got {value:g}")
     if not 0 < opts.rref_hz <= 10000:
         raise WashbenchError(f"--rref-hz: expected 1..10000 Hz, got {opts.rref_hz}")
-    specs = select_washouts(washouts, variants, params_path)
-    names = [w.name for w in specs]
-    check_filter_start(opts.filter_start)
-    limits = load_platform_limits(platform_path)
+    # the options of the final cue, loaded once (each file read once) and used live as well
+    run = cue_run_options(CueOptions(filter_start=opts.filter_start, recording=opts.recording, figures=opts.figures),
+                          washouts, params_path, platform_path, variants)  # fmt: skip
+    specs, limits, names = run.washouts, run.limits, list(run.washout_order)
     dec = decoder(opts.fmt)
     CueingBank(specs, None, limits, 0.01, opts.filter_start).step(np.zeros(3), np.zeros(3))  # compiled before listening
     sink = Sink(opts.sink, opts.sink_format, names)
@@ -404,7 +402,7 @@ def run_live(
     cue_opts = CueOptions(resample_hz=resample, filter_start=opts.filter_start, recording=opts.recording,
                           figures=opts.figures)  # fmt: skip
     fig["resample_hz"] = resample
-    result = run_cue(saved, out, washouts, params_path, platform_path, variants, cue_opts, adopt=(INPUT_FILE,))
+    result = run_cue(saved, out, options=cue_opts, adopt=(INPUT_FILE,), run_options=run)
     _add_live_figures(out, saved, fig)
     if status:
         print(f"washbench: {session.stop}: the result folder holds every sample received", file=sys.stderr)

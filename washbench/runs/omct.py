@@ -29,15 +29,15 @@ from washbench.analysis.signals import amplitude_unit, generate
 from washbench.cueing.variants import Washout
 from washbench.errors import WashbenchError
 from washbench.io.atomic import write_text_atomic
+from washbench.io.csv_numbers import csv_number
 from washbench.io.progress import Progress
-from washbench.io.results import csv_number
+from washbench.io.result_files import REPORT_FILE
 from washbench.io.yamlio import load_yaml_model
 from washbench.perception.vestibular import VestibularModel, VestibularParams
 from washbench.platform.limits import PlatformLimits
 from washbench.review.omct_report import report_text
 
 CSV_FILE = "omct.csv"
-REPORT_FILE = "report.md"
 CSV_COLUMNS: tuple[str, ...] = (
     "washout", "test", "input", "output", "frequency_radps", "amplitude", "amplitude_unit", "gain", "phase_deg",
     "linear", "distortion", "saturated", "gain_inside", "phase_inside",

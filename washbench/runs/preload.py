@@ -2,7 +2,7 @@
 
 Importing this module loads what every run needs and is slow to start: JSBSim, pyarrow and the compiled
 streaming cueing step (numba loads it from its on-disk cache, about 0.4 s); the suite adds matplotlib's Agg canvas
-(``washbench.runs.suite.FIGURE_MODULES``) when it draws figures and rerun when it writes recordings.
+(``washbench.runs.pool.FIGURE_MODULES``) when it draws figures and rerun when it writes recordings.
 Workers forked afterwards start with all of it in memory. Nothing here starts a thread (rerun's
 recording streams are created in the workers), so forking stays safe.
 """

@@ -12,7 +12,7 @@ The rules are :mod:`washbench.analysis.ranking`'s; the rule used is recorded in 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
 from pydantic import Field
 
@@ -50,11 +50,18 @@ def load_rank_rule(params_path: Path | None, rank_by: str | None = None) -> Rank
 
     WashbenchError (file, line, field) for a bad section, or for ``weighted`` without any positive DOF weight.
     """
+    data, lines = read_yaml(Path(params_path)) if params_path is not None else (None, {})
+    return rank_rule_from_data(params_path, data, lines, rank_by)
+
+
+def rank_rule_from_data(
+    params_path: Path | None, data: Any, lines: dict[Any, int], rank_by: str | None = None
+) -> RankRule:
+    """:func:`load_rank_rule` of a parameter file already read (``read_yaml``: its data and line map; ``data`` is
+    ignored without ``params_path``: the bundled file's section is never used)."""
     section = RankingSection()
-    if params_path is not None:
-        data, lines = read_yaml(Path(params_path))
-        if isinstance(data, dict) and "ranking" in data:
-            section = validate_data(Path(params_path), {"ranking": data["ranking"]}, lines, _File).ranking
+    if params_path is not None and isinstance(data, dict) and "ranking" in data:
+        section = validate_data(Path(params_path), {"ranking": data["ranking"]}, lines, _File).ranking
     by = rank_by or section.by
     weights = section.dof_weights.model_dump() if section.dof_weights is not None else {}
     if by == "weighted" and not any(v > 0.0 for v in weights.values()):

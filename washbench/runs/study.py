@@ -13,7 +13,6 @@ from __future__ import annotations
 import math
 import sys
 from collections.abc import Sequence
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -24,6 +23,8 @@ from washbench.cueing.variants import Washout
 from washbench.errors import WashbenchError, located
 from washbench.io.cpus import usable_cpus
 from washbench.io.progress import Progress
+from washbench.io.result_files import FLIGHT_FILE
+from washbench.runs.pool import submit_all, worker_pool
 
 FLIGHTS_DIR = "flights"
 
@@ -77,7 +78,7 @@ def load_flights(
     aircraft_dirs: Sequence[Path] = (),
 ) -> list[StudyFlight]:
     """The study's flights: flown once into ``out_dir/flights/`` or read from ``from_dir``; in manoeuvre order."""
-    from washbench.io.results import read_motion
+    from washbench.io.motion_file import read_motion
 
     ids = _identify(manoeuvres, aircraft_dirs)
     status: dict[tuple[str, str], tuple[bool, str]] = {}
@@ -100,7 +101,7 @@ def load_flights(
                 print(f"  {aircraft}/{name}: {'ok' if ok else 'FAILED (' + reason + ')'}", file=sys.stderr, flush=True)
     flights = []
     for _, aircraft, name in ids:
-        src = root / aircraft / name / "flight.parquet"
+        src = root / aircraft / name / FLIGHT_FILE
         if not src.is_file():
             raise WashbenchError(located(src, f"no flight for {aircraft}/{name} (run or suite it first)"))
         motion = read_motion(src)
@@ -119,23 +120,10 @@ def _map(fn, args: list[tuple], jobs: int | None, dask: str | None) -> list:
     jobs = max(1, min(jobs or usable_cpus(), len(args)))
     if jobs == 1:
         return [fn(*a) for a in args]
-    from washbench.io.outfolder import signals_held
-    from washbench.runs.suite import _signals_held, _stop_pool, _worker_init, pool_context
-
     # As the suite's pool: the workers ignore Ctrl-C (no traceback from each), the main process stops them at once
     # on SIGINT/SIGTERM, a signal while they start is acted on once they exist, and they die with their parent.
-    ctx, initializer = pool_context(main_stops_workers=True)
-    pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_init, initargs=(initializer,))
-    try:
-        with signals_held():  # a signal while the workers start is acted on once they exist
-            futures = [pool.submit(fn, *a) for a in args]
-        results = [f.result() for f in futures]
-    except BaseException:
-        with _signals_held():
-            _stop_pool(pool)
-        raise
-    pool.shutdown(wait=True)
-    return results
+    with worker_pool(jobs) as pool:
+        return [f.result() for f in submit_all(pool, fn, args)]
 
 
 def _evaluate_task(

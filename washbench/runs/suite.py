@@ -28,48 +28,42 @@ The exit status is 0 only if every manoeuvre ran and passed its checks.
 
 from __future__ import annotations
 
-import contextlib
-import csv
-import io
 import math
-import multiprocessing
 import os
-import signal
 import sys
 import time
 import traceback
-from collections.abc import Callable, Iterator, Mapping, Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from collections.abc import Sequence
+from concurrent.futures import as_completed
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 from washbench.analysis.ranking import (
-    DEFAULT_RULE,
     DOFS,
     METRICS,
-    RankRow,
-    RankRule,
     compare,
     rank,
     reference_washout,
     rule_from_record,
 )
+from washbench.cueing import registry
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
 from washbench.io.cpus import usable_cpus
+from washbench.io.csv_numbers import csv_number
 from washbench.io.lock import output_lock
-from washbench.io.outfolder import discard_stage, is_own_hidden, recover, signals_held, swap_in
-from washbench.io.paths import MANOEUVRES_DIR, bundled_names, resolve_manoeuvre
+from washbench.io.outfolder import discard_stage, is_own_hidden, recover, swap_in
 from washbench.io.progress import Progress
 from washbench.io.publish import clean_partials, is_leftover, is_washbench_result, read_marker
-from washbench.io.results import csv_number
-from washbench.runs.outputs import DEFAULT_OUTPUTS, Outputs
-from washbench.runs.pipeline import RUN_MARKER, RunSummary
+from washbench.io.result_files import COMPARISON_FILE, METRICS_FILE, RANKING_FILE, REPORT_FILE, SUITE_FILE, SUITE_FILES
+from washbench.runs.inputs import check_unique_names, find_manoeuvres
+from washbench.runs.options import RunOptions, load_options
+from washbench.runs.pipeline import announce_script, run_manoeuvre, run_script
+from washbench.runs.pool import submit_all, worker_pool
+from washbench.runs.result_folder import RUN_MARKER, RunSummary, csv_text, ranking_table
 
-#: The suite's own files in ``OUT`` (``suite.json`` lists everything a suite wrote at the top level).
-SUITE_FILES = ("metrics.csv", "comparison.csv", "ranking.csv", "report.md")
-SUITE_MARKER = "suite.json"
+#: The file that marks a folder as a suite's (it lists everything a suite wrote at the top level).
+SUITE_MARKER = SUITE_FILE
 
 
 @dataclass
@@ -81,103 +75,20 @@ class Outcome:
     run: RunSummary
 
 
-def find_manoeuvres(inputs: Sequence[Path], scripts: Sequence[Path] = ()) -> list[Path]:
-    """Manoeuvre files and JSBSim scripts from files and folders (folders are searched recursively for
-    ``*.yaml`` manoeuvres and ``*.xml`` JSBSim scripts), then ``scripts``; no inputs at all: the bundled
-    manoeuvres."""
-    from washbench.flight.scripts import is_runscript
-
-    if not inputs and not scripts:
-        inputs = [MANOEUVRES_DIR]
-    found: list[Path] = []
-    for item in map(resolve_manoeuvre, inputs):
-        if item.is_dir():
-            found.extend(sorted(p for p in item.rglob("*.yaml") if p.is_file()))
-            found.extend(sorted(p for p in item.rglob("*.xml") if p.is_file() and is_runscript(p)))
-        elif item.is_file():
-            found.append(item)
-        else:
-            raise WashbenchError(
-                located(item, f"no such file or folder, nor a bundled manoeuvre ({', '.join(bundled_names())})")
-            )
-    found.extend(scripts)
-    unique = list(dict.fromkeys(p.resolve() for p in found))
-    if not unique:
-        raise WashbenchError(located(inputs[0], "no manoeuvre files (*.yaml) or JSBSim scripts (*.xml) found"))
-    return unique
-
-
-def _worker_init(then: Callable[[], None] | None = None) -> None:
-    """In each worker: Ctrl-C is for the main process (it stops the workers); SIGTERM stops a worker at once.
-
-    ``then``: the start method's own initializer (:func:`pool_context`).
-    """
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
-    if then is not None:
-        then()
-
-
-@contextlib.contextmanager
-def _signals_held() -> Iterator[None]:
-    """Ignore SIGINT and SIGTERM for a short critical section (stopping workers, swapping results in)."""
-    saved = {sig: signal.signal(sig, signal.SIG_IGN) for sig in (signal.SIGINT, signal.SIGTERM)}
-    try:
-        yield
-    finally:
-        for sig, handler in saved.items():
-            signal.signal(sig, handler)
-
-
-def _stop_pool(pool: ProcessPoolExecutor) -> None:
-    """Stop every worker now (SIGTERM, then SIGKILL after 5 s) and drop the queued runs."""
-    processes = list((getattr(pool, "_processes", None) or {}).values())  # the executor keeps no public list
-    for p in processes:
-        with contextlib.suppress(Exception):
-            p.terminate()
-    pool.shutdown(wait=False, cancel_futures=True)
-    for p in processes:
-        p.join(5.0)
-        if p.is_alive():
-            p.kill()
-            p.join(5.0)
-
-
-def _run_one(
-    path: str,
-    out_dir: str,
-    params_path: str | None,
-    platform_path: str | None,
-    washouts: tuple[str, ...] | None = None,
-    variants: tuple[str, ...] = (),
-    aircraft_dirs: tuple[str, ...] = (),
-    max_time_s: float | None = None,
-    outputs: Outputs = DEFAULT_OUTPUTS,
-    rank_by: str | None = None,
-    vestibular: str | None = None,
-    plugins: tuple[str, ...] = (),
-) -> list[Outcome]:
+def _run_one(path: str, out_dir: str, options: RunOptions) -> list[Outcome]:
     """Worker: run one manoeuvre or JSBSim script (one outcome per run segment); never raises (failures
-    come back as an Outcome). ``plugins``: the washout plugins' ``FILE.py:NAME`` to load first (a worker process
-    has only what its parent loaded before it started)."""
-    from washbench.cueing import registry
+    come back as an Outcome). The washout plugins of ``options`` (``FILE.py:NAME``) are loaded first (a worker
+    process has only what its parent loaded before it started)."""
     from washbench.flight.scripts import is_script
-    from washbench.runs.pipeline import run_manoeuvre, run_script
 
     start = time.perf_counter()
-    params = Path(params_path) if params_path else None
-    platform = Path(platform_path) if platform_path else None
     try:
-        for spec in plugins:
+        for spec in options.plugins:
             registry.load_plugin(spec)
-        dirs = [Path(d) for d in aircraft_dirs]
-        common = {"params_path": params, "platform_path": platform, "aircraft_dirs": dirs}
-        common |= {"washouts": washouts, "variants": variants, "outputs": outputs, "rank_by": rank_by}
-        common |= {"vestibular": vestibular}
         if is_script(Path(path)):
-            runs = run_script(Path(path), Path(out_dir), max_time_s=max_time_s, **common)
+            runs = run_script(Path(path), Path(out_dir), options)
         else:
-            runs = [run_manoeuvre(Path(path), Path(out_dir), **common)]
+            runs = [run_manoeuvre(Path(path), Path(out_dir), options)]
     except WashbenchError as exc:
         runs = [RunSummary(ok=False, reason=str(exc))]
     except Exception as exc:  # an unexpected bug in one run must not take the suite down
@@ -188,83 +99,26 @@ def _run_one(
     return [Outcome(path=path, wall_s=wall / len(runs), run=r) for r in runs]
 
 
-def _preload() -> None:
-    """Worker initializer where there is no forkserver: load the heavy modules once per worker."""
-    import washbench.runs.preload  # noqa: F401
-
-
-def _die_with_parent() -> None:
-    """Worker initializer: the worker ends when its parent (the process server) does."""
-    from washbench.runs.parent_death import die_with_parent
-
-    die_with_parent()
-
-
-_QUIET_TRACKER = "ignore:resource_tracker:UserWarning"
-
-FIGURE_MODULES = ("matplotlib.figure", "matplotlib.backends.backend_agg")
-"""Preloaded by the process server besides :mod:`washbench.runs.preload` when the runs draw figures."""
-
-
-def pool_context(
-    recording: bool = True, main_stops_workers: bool = False, figures: bool = True
-) -> tuple[multiprocessing.context.BaseContext, Callable[[], None] | None]:
-    """The process pool's start method and worker initializer.
-
-    ``forkserver`` (Linux, macOS) where it exists: workers fork from a server that has already imported the heavy
-    modules (JSBSim, the numba kernels, pyarrow; matplotlib with ``figures``, rerun with ``recording``), so each
-    starts in milliseconds. Elsewhere (Windows)
-    ``spawn``, with every worker importing them once at its start. With ``main_stops_workers`` (the suite, which
-    stops its workers itself on Ctrl-C) the server and its workers ignore SIGINT.
-    """
-    # An interrupted suite stops its workers at once; the resource tracker then removes the pool's semaphores itself
-    # but warns about each on stderr ("leaked semaphore objects"). Its warning filters come from ours when it starts.
-    if _QUIET_TRACKER not in sys.warnoptions:
-        sys.warnoptions.append(_QUIET_TRACKER)
-    if "forkserver" in multiprocessing.get_all_start_methods():
-        ctx = multiprocessing.get_context("forkserver")
-        first = ["washbench.runs.worker_signals"] if main_stops_workers else []
-        optional = [*(FIGURE_MODULES if figures else ()), *(["rerun"] if recording else [])]
-        ctx.set_forkserver_preload([*first, "washbench.runs.preload", *optional])
-        return ctx, _die_with_parent
-    return multiprocessing.get_context("spawn"), _preload
-
-
 def run_suite(
     files: Sequence[Path],
     out_dir: Path,
+    options: RunOptions | None = None,
     *,
     jobs: int | None = None,
-    params_path: Path | None = None,
-    platform_path: Path | None = None,
     progress: bool = True,
-    washouts: Sequence[str] | None = None,
-    variants: Sequence[str] = (),
     dask: str | None = None,
-    aircraft_dirs: Sequence[Path] = (),
-    max_time_s: float | None = None,
-    outputs: Outputs = DEFAULT_OUTPUTS,
-    rank_by: str | None = None,
-    vestibular: str | None = None,
 ) -> list[Outcome]:
     """Run every file in parallel processes (or on the Dask cluster at ``dask``); outcomes in the order of ``files``
-    (a JSBSim script that resets gives one outcome per run segment, in order). ``outputs``: whether the
-    run folders get ``recording.rrd`` and figures (:class:`washbench.runs.outputs.Outputs`).
+    (a JSBSim script that resets gives one outcome per run segment, in order). ``options``: the runs' options
+    (:func:`washbench.runs.options.load_options`, handed to each worker as they are; None: the defaults).
 
     On any exception (KeyboardInterrupt and :class:`washbench.errors.Terminated` included) the local workers are
     stopped before it propagates, so no worker writes anything afterwards.
     """
+    opts = options if options is not None else load_options()
     jobs = max(1, min(jobs or usable_cpus(), len(files)))
     out_dir.mkdir(parents=True, exist_ok=True)
-    dirs = tuple(str(d) for d in aircraft_dirs)
-    params = str(params_path) if params_path else None
-    platform = str(platform_path) if platform_path else None
-    chosen = tuple(washouts) if washouts else None
-    from washbench.cueing import registry
-
-    plugins = registry.plugin_specs()
-    args = [(str(f), str(out_dir), params, platform, chosen, tuple(variants), dirs, max_time_s, outputs, rank_by,
-             vestibular, plugins) for f in files]  # fmt: skip
+    args = [(str(f), str(out_dir), opts) for f in files]
     outcomes: dict[str, list[Outcome]] = {}
     start = time.perf_counter()
     shown = Progress("suite", len(files), "manoeuvres") if progress else None
@@ -284,21 +138,10 @@ def run_suite(
             for a in args:
                 outcomes[a[0]] = _report(_run_one(*a), len(outcomes) + 1, len(files), start, shown)
         else:
-            ctx, initializer = pool_context(outputs.recording, main_stops_workers=True, figures=outputs.figures)
-            pool = ProcessPoolExecutor(
-                max_workers=jobs, mp_context=ctx, initializer=_worker_init, initargs=(initializer,)
-            )
-            try:
-                with signals_held():  # submitting starts the workers (up to ``jobs``)
-                    futures = [pool.submit(_run_one, *a) for a in args]
-                for fut in as_completed(futures):
+            with worker_pool(jobs, recording=opts.outputs.recording, figures=opts.outputs.figures) as pool:
+                for fut in as_completed(submit_all(pool, _run_one, args)):
                     runs = fut.result()
                     outcomes[runs[0].path] = _report(runs, len(outcomes) + 1, len(files), start, shown)
-            except BaseException:
-                with _signals_held():
-                    _stop_pool(pool)
-                raise
-            pool.shutdown(wait=True)
     finally:
         if shown is not None:
             shown.close()
@@ -336,26 +179,20 @@ def _short(path: str) -> str:
         return path
 
 
-def _csv(rows: list[list[str]]) -> str:
-    buf = io.StringIO()
-    csv.writer(buf, lineterminator="\n").writerows(rows)
-    return buf.getvalue()
-
-
 def _runs_with_metrics(outcomes: Sequence[Outcome]) -> list[Outcome]:
     return [o for o in outcomes if o.run.metrics]
 
 
 def metrics_table(outcomes: Sequence[Outcome]) -> str:
     """``metrics.csv`` of the suite (every run that produced metrics, failed checks included)."""
-    from washbench.io.results import METRICS_COLUMNS, METRICS_TEXT_COLUMNS
+    from washbench.io.metrics_csv import METRICS_COLUMNS, METRICS_TEXT_COLUMNS
 
     rows = [["aircraft", "manoeuvre", *METRICS_COLUMNS]]
     for o in _runs_with_metrics(outcomes):
         for m in o.run.metrics:
             cells = [getattr(m, c) if c in METRICS_TEXT_COLUMNS else csv_number(getattr(m, c)) for c in METRICS_COLUMNS]
             rows.append([o.run.aircraft, o.run.manoeuvre, *cells])
-    return _csv(rows)
+    return csv_text(rows)
 
 
 def comparison_table(outcomes: Sequence[Outcome]) -> str:
@@ -373,18 +210,7 @@ def comparison_table(outcomes: Sequence[Outcome]) -> str:
                 + [csv_number(c.values.get(w, math.nan)) for w in washouts]
                 + [csv_number(c.better_than_reference.get(w, math.nan)) for w in others]
             )
-    return _csv(rows)
-
-
-def ranking_table(rankings: dict[tuple[str, str], list[RankRow]], rule: RankRule = DEFAULT_RULE) -> str:
-    """``ranking.csv``: rank, washout and the rule's value (``score``, lower is better) per manoeuvre; ``tied``
-    (true when the rank is shared: values within the tie margin) and ``rule`` (``--rank-by``)."""
-    rows = [["aircraft", "manoeuvre", "rank", "washout", "score", "tied", "rule"]]
-    for (aircraft, manoeuvre), ranking in rankings.items():
-        for r in ranking:
-            tied = "true" if r.tied else "false"
-            rows.append([aircraft, manoeuvre, str(r.rank), r.washout, csv_number(r.score), tied, rule.by])
-    return _csv(rows)
+    return csv_text(rows)
 
 
 def _washouts(outcomes: Sequence[Outcome]) -> list[str]:
@@ -408,9 +234,9 @@ def write_suite_results(
         (o.run.aircraft, o.run.manoeuvre): rank(o.run.metrics, o.run.motion, rule)
         for o in _runs_with_metrics(outcomes)
     }
-    write_text_atomic(out_dir / "metrics.csv", metrics_table(outcomes))
-    write_text_atomic(out_dir / "comparison.csv", comparison_table(outcomes))
-    write_text_atomic(out_dir / "ranking.csv", ranking_table(rankings, rule))
+    write_text_atomic(out_dir / METRICS_FILE, metrics_table(outcomes))
+    write_text_atomic(out_dir / COMPARISON_FILE, comparison_table(outcomes))
+    write_text_atomic(out_dir / RANKING_FILE, ranking_table(rankings, rule))
     entries = [
         {
             "file": _short(o.path),
@@ -431,33 +257,6 @@ def write_suite_results(
     # last: the same document with every top-level entry written (what the next suite may replace)
     top = sorted(e.name for e in out_dir.iterdir() if not e.name.startswith(".") and e.name != SUITE_MARKER)
     write_suite_json(out_dir / SUITE_MARKER, entries, dict(provenance or {}), created, top)
-
-
-def check_unique_names(files: Sequence[Path], aircraft_dirs: Sequence[Path] = ()) -> None:
-    """Refuse two manoeuvre files with the same aircraft and name (they would share a result folder).
-
-    Files that do not load are left for the run to report. Raises WashbenchError naming both files.
-    """
-    from washbench.flight.manoeuvre import load_manoeuvre
-    from washbench.flight.scripts import is_script, load_script_info
-
-    seen: dict[tuple[str, str], Path] = {}
-    for path in files:
-        try:
-            if is_script(path):  # a JSBSim script's result folder is named after its file
-                info = load_script_info(path, aircraft_dirs)
-                key, where = (info.aircraft, info.name), f"{path}: the script's file name:"
-            else:
-                m = load_manoeuvre(path, aircraft_dirs)
-                key, where = (m.aircraft, m.name), m.located(("name",), "")[:-1]
-        except WashbenchError:
-            continue
-        if key in seen:
-            raise WashbenchError(
-                f"{where} '{key[1]}' ({key[0]}) is also the name of {seen[key]}: both would write "
-                f"{key[0]}/{key[1]}/; give each its own name"
-            )
-        seen[key] = path
 
 
 def _is_run_folder(entry: Path, aircraft: str) -> bool:
@@ -497,87 +296,32 @@ def previous_results(out_dir: Path) -> list[Path]:
     return found
 
 
-def write_run_review(
-    run_dir: Path,
-    summary: RunSummary,
-    source: str = "",
-    table: Mapping[str, Any] | None = None,
-    figures: bool = True,
-) -> None:
-    """``ranking.csv`` and ``report.md`` of one result folder (the same tables as a suite's, for one run).
-
-    The one call site for a result folder's report (``washbench run`` and ``washbench cue``); the report and its
-    figures are built from the folder's files (:func:`washbench.review.report.write_result_report`), with the
-    traces.parquet columns taken from ``table`` when the caller still holds them; ``figures=False``: none drawn.
-    """
-    from washbench.review.report import write_result_report
-
-    prov = (read_marker(run_dir, RUN_MARKER) or {}).get("provenance")
-    rule = rule_from_record(prov.get("ranking") if isinstance(prov, dict) else None)
-    rankings = (
-        {(summary.aircraft, summary.manoeuvre): rank(summary.metrics, summary.motion, rule)} if summary.metrics else {}
-    )
-    write_text_atomic(run_dir / "ranking.csv", ranking_table(rankings, rule))
-    write_result_report(run_dir, table, figures=figures)
-
-
 def suite_command(
     inputs: Sequence[Path],
     out_dir: Path,
+    options: RunOptions,
     *,
     jobs: int | None = None,
-    params_path: Path | None = None,
-    platform_path: Path | None = None,
     progress: bool = True,
-    washouts: Sequence[str] | None = None,
-    variants: Sequence[str] = (),
     dask: str | None = None,
-    aircraft_dirs: Sequence[Path] = (),
     jsbsim_scripts: Sequence[str] = (),
-    max_time_s: float | None = None,
-    outputs: Outputs = DEFAULT_OUTPUTS,
-    rank_by: str | None = None,
-    vestibular: str | None = None,
 ) -> int:
     """CLI entry: run the suite, write its results, print where they are; 0 if all succeeded, else 1.
 
-    ``jsbsim_scripts``: names of scripts shipped with JSBSim (``c1723``) run besides ``inputs``. See the module
-    docstring for the output folder policy (lock, whole replacement, interruption).
+    ``options``: the runs' options (:func:`washbench.runs.options.load_options`: a bad parameter, variant or
+    platform file has failed there, before any run). ``jsbsim_scripts``: names of scripts shipped with JSBSim
+    (``c1723``) run besides ``inputs``. See the module docstring for the output folder policy (lock, whole
+    replacement, interruption).
     """
-    from washbench.flight.scripts import bundled_script
+    from washbench.flight.scripts import bundled_script, is_script
 
     if jobs is not None and jobs < 1:
         raise WashbenchError(f"--jobs: expected a whole number of at least 1, got {jobs}")
-    from washbench.runs.pipeline import check_max_time
-
-    check_max_time(max_time_s)
     files = find_manoeuvres(inputs, [bundled_script(n) for n in jsbsim_scripts])
-    # Fail fast on a bad parameter, variant or platform file: every run would fail the same way.
-    from washbench.cueing import load_washout_params
-    from washbench.cueing.params import DEFAULT_PARAMS_PATH
-    from washbench.cueing.variants import select_washouts
-    from washbench.io.provenance import build_provenance
-    from washbench.perception.vestibular import model_record
-    from washbench.platform import load_platform_limits
-    from washbench.platform.limits import DEFAULT_LIMITS_PATH
-    from washbench.runs.rank_rule import load_rank_rule
-
-    provenance = build_provenance(
-        params_path=params_path or DEFAULT_PARAMS_PATH,
-        params=load_washout_params(params_path),
-        washouts=select_washouts(washouts, variants, params_path),
-        platform_path=platform_path or DEFAULT_LIMITS_PATH,
-        platform=load_platform_limits(platform_path),
-        ranking=load_rank_rule(params_path, rank_by).record(),
-        vestibular=model_record(vestibular),
-    )
-    check_unique_names(files, aircraft_dirs)
-    from washbench.flight.scripts import is_script
-    from washbench.runs.pipeline import announce_script
-
+    check_unique_names(files, options.aircraft_dirs)
     for f in files:
         if is_script(f):
-            announce_script(f, max_time_s, aircraft_dirs, washouts, variants, params_path, outputs)
+            announce_script(f, options)
     start = time.perf_counter()
     with output_lock(out_dir):
         # under the lock every leftover is stale; a publication cut by a kill is finished. In a folder that holds
@@ -590,29 +334,14 @@ def suite_command(
         stage = out_dir / f".suite.partial-{os.getpid()}"
         stage.mkdir()
         try:
-            outcomes = run_suite(
-                files,
-                stage,
-                jobs=jobs,
-                params_path=params_path,
-                platform_path=platform_path,
-                progress=progress,
-                washouts=washouts,
-                variants=variants,
-                dask=dask,
-                aircraft_dirs=aircraft_dirs,
-                max_time_s=max_time_s,
-                outputs=outputs,
-                rank_by=rank_by,
-                vestibular=vestibular,
-            )
-            write_suite_results(outcomes, stage, provenance, outputs.figures)
+            outcomes = run_suite(files, stage, options, jobs=jobs, progress=progress, dask=dask)
+            write_suite_results(outcomes, stage, dict(options.provenance), options.outputs.figures)
             swap_in(stage, out_dir, previous)  # journalled, signals held: whole or not at all
         finally:
             discard_stage(stage)  # unless a journal says it is being published (recover finishes it)
     n_ok = sum(o.run.ok for o in outcomes)
     print(
-        f"suite: {n_ok}/{len(outcomes)} runs ok in {time.perf_counter() - start:.1f} s; report: {out_dir / 'report.md'}"
+        f"suite: {n_ok}/{len(outcomes)} runs ok in {time.perf_counter() - start:.1f} s; report: {out_dir / REPORT_FILE}"
     )
     return 0 if n_ok == len(outcomes) else 1
 
@@ -621,8 +350,6 @@ __all__ = [
     "DOFS",
     "METRICS",
     "Outcome",
-    "check_unique_names",
-    "find_manoeuvres",
     "previous_results",
     "run_suite",
     "suite_command",

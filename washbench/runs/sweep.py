@@ -26,6 +26,8 @@ from washbench.cueing.params import WASHOUT_NAMES
 from washbench.errors import WashbenchError
 from washbench.io.atomic import write_text_atomic
 from washbench.io.progress import Progress
+from washbench.runs.inputs import find_manoeuvres
+from washbench.runs.study import evaluate, load_flights
 
 
 def _csv(rows: list[list[str]]) -> str:
@@ -73,7 +75,6 @@ def sweep_command(
     A grid of more than :data:`MAX_POINTS` points (over all washouts) needs ``force`` (``--force``)."""
     from washbench.cueing.variants import load_param_file
     from washbench.platform import load_platform_limits
-    from washbench.runs.suite import find_manoeuvres
 
     start = time.perf_counter()
     if not sets:
@@ -89,7 +90,6 @@ def sweep_command(
     candidates = [w for k in kinds for w in point_washouts(k, base, points)]
     limits = load_platform_limits(platform_path)
     from washbench.io.outfolder import result_set
-    from washbench.runs.study import evaluate, load_flights  # the compiled evaluator: after the checks
 
     with result_set(out_dir, "sweep") as stage:  # the whole set replaces the previous one at once
         flights = load_flights(files, stage, limits, from_dir=from_dir, jobs=jobs, dask=dask, progress=progress,

@@ -32,8 +32,11 @@ from washbench.cueing.params import WashoutParams
 from washbench.cueing.variants import Washout, apply_overrides, check_kind, value_of
 from washbench.errors import WashbenchError
 from washbench.io.atomic import write_text_atomic
+from washbench.io.csv_numbers import csv_number
 from washbench.io.progress import Progress
-from washbench.io.results import csv_number
+from washbench.io.result_files import REPORT_FILE
+from washbench.runs.inputs import find_manoeuvres
+from washbench.runs.study import evaluate, load_flights
 
 
 def params_yaml(params: WashoutParams, header: str) -> str:
@@ -70,7 +73,6 @@ def tune_command(
     """CLI entry of ``washbench tune``; 0 on success (the flights' own check results are reported, not fatal)."""
     from washbench.cueing.variants import load_param_file
     from washbench.platform import load_platform_limits
-    from washbench.runs.suite import find_manoeuvres
 
     start = time.perf_counter()
     kind = check_kind(washout, "--washout")
@@ -124,8 +126,6 @@ def _tune(
     aircraft_dirs: Sequence[Path],
 ) -> tuple[Any, ...]:  # fmt: skip
     """Fly, tune and write into ``out_dir`` (the stage); (best_x, best history row + count, base objective, ...)."""
-    from washbench.runs.study import evaluate, load_flights
-
     flights = load_flights(
         [*train_files, *test_files],
         out_dir,
@@ -290,4 +290,4 @@ def _report(
         a, b = np.mean(pairs, axis=0)
         lines.append(f"Mean score on the {group} manoeuvres: {base.name} {a:.4f}, tuned {b:.4f}.")
     lines += ["", "![convergence](convergence.png)", "", "Tuned parameter file: [tuned.yaml](tuned.yaml).", ""]
-    write_text_atomic(out_dir / "report.md", "\n".join(lines))
+    write_text_atomic(out_dir / REPORT_FILE, "\n".join(lines))

@@ -1,0 +1,212 @@
+"""A result folder of one flight or recorded trace (``run``, ``cue``, a suite's runs): what it says and how its
+files besides the traces are written.
+
+* :class:`RunSummary`: what one result gave (status, metrics, motion per DOF, saturations): ``run.json``
+  (:func:`write_run_json`) and what a suite compares;
+* :func:`run_dir`: where a run's folder goes (``OUT/<aircraft>/<manoeuvre>``), marked by ``run.json``
+  (:data:`RUN_MARKER`);
+* :func:`write_run_recording`: ``recording.rrd`` (the one call of the recording writer);
+* :func:`write_run_review`: ``ranking.csv`` (:func:`ranking_table`) and ``report.md`` with its figures.
+
+The file names are :mod:`washbench.io.result_files`'s; traces.parquet and metrics.csv are written by the chain
+(:mod:`washbench.runs.chain`).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from washbench.analysis.ranking import DEFAULT_RULE, DOFS, RankRow, RankRule, rank, rule_from_record
+from washbench.io.atomic import write_text_atomic
+from washbench.io.csv_numbers import csv_number
+from washbench.io.metrics_csv import MetricRow
+from washbench.io.publish import read_marker, result_path
+from washbench.io.result_files import RANKING_FILE, RUN_FILE
+from washbench.platform.limits import wheel_jacobian
+from washbench.review.metrics_table import metrics_table_markdown
+from washbench.review.report import write_result_report
+
+if TYPE_CHECKING:
+    from washbench.io.motion import Motion
+    from washbench.platform import PlatformLimits
+    from washbench.review.rerun_log import PlatformEnvelope
+    from washbench.runs.chain import CueResult
+
+
+@dataclass(frozen=True)
+class RunSummary:
+    """What one ``washbench run`` gave: status, where, and what the suite needs to compare.
+
+    A run that could not start (bad file) or broke has only ``ok`` False and the ``reason``.
+    """
+
+    ok: bool
+    reason: str = ""
+    aircraft: str = ""
+    manoeuvre: str = ""
+    run_dir: Path | None = None
+    steps: int = 0
+    dt_s: float = 0.0
+    checks_passed: int = 0
+    checks_total: int = 0
+    metrics: list[MetricRow] = field(default_factory=list)
+    motion: dict[str, float] = field(default_factory=dict)  # DOF -> aircraft pilot's perceived motion
+    saturations: dict[str, dict[str, int]] = field(default_factory=dict)
+
+
+def metrics_markdown(title: str, rows: list[MetricRow]) -> str:
+    """The metric table of one run as Markdown, DOF by washout (for the recording)."""
+    return metrics_table_markdown(title, rows)
+
+
+#: The file that marks a folder as a ``washbench run`` result (only such a folder is ever replaced).
+RUN_MARKER = RUN_FILE
+
+
+def run_dir(out_root: Path, aircraft: str, manoeuvre: str) -> Path:
+    """``OUT/<aircraft>/<manoeuvre>``, proven inside ``out_root`` (both names are identifiers)."""
+    return result_path(out_root, aircraft, manoeuvre)
+
+
+def run_marker(aircraft: str, manoeuvre: str) -> dict[str, object]:
+    """What a manoeuvre's run.json must say for its folder to be replaced by a new run of it."""
+    return {"aircraft": aircraft, "manoeuvre": manoeuvre}
+
+
+def write_run_json(path: Path, s: RunSummary, wall_s: float, extra: dict[str, object] | None = None) -> None:
+    """``run.json``: the summary of one result folder (``extra``: more keys, e.g. what ``cue`` read)."""
+    doc: dict[str, object] = {
+        "aircraft": s.aircraft,
+        "manoeuvre": s.manoeuvre,
+        "ok": s.ok,
+        "reason": s.reason,
+        "steps": s.steps,
+        "dt_s": s.dt_s,
+        "wall_s": round(wall_s, 3),
+        "checks_passed": s.checks_passed,
+        "checks_total": s.checks_total,
+        "perceived_motion": {
+            d: {"value": v, "unit": "m/s^2*s" if d in DOFS[:3] else "deg"} for d, v in s.motion.items()
+        },
+        "saturations": s.saturations,
+    }
+    doc |= extra or {}
+    write_text_atomic(path, json.dumps(doc, indent=2) + "\n")
+
+
+def write_run_recording(
+    path: Path,
+    title: str,
+    motion: Motion,
+    result: CueResult,
+    limits: PlatformLimits,
+    aircraft_q: np.ndarray,
+    phases: list[tuple[str, float, float]],
+    properties: dict[str, str] | None = None,
+) -> None:
+    """The recording of one result folder (``run`` and ``cue`` alike): the one call of the recording writer.
+
+    ``aircraft_q`` (N, 4) the aircraft's attitude, body -> NED, scalar first; ``phases`` (name, start, end) [s];
+    ``properties``: the provenance as flat strings (:func:`washbench.io.provenance.flat_strings`).
+    """
+    from washbench.review.rerun_log import MotionSeries, PlatformSeries, RecordingData, write_recording
+
+    ac = result.perceived["aircraft"]
+    washouts: dict[str, MotionSeries] = {}
+    platforms: dict[str, PlatformSeries] = {}
+    for name, tr in result.traces.items():
+        p = result.perceived[name]
+        washouts[name] = MotionSeries(
+            f_mps2=tr.head_f_mps2,
+            omega_radps=tr.head_omega_radps,
+            perceived_f_mps2=p.f_mps2,
+            perceived_omega_radps=p.omega_radps,
+            q=tr.q,
+        )
+        platforms[name] = PlatformSeries(
+            pos_m=tr.pos_m, vel_mps=tr.vel_mps, acc_mps2=tr.acc_mps2, wheel_radps=tr.wheel_radps, saturated=tr.saturated
+        )
+    data = RecordingData(
+        title=title,
+        t_s=motion.t_s,
+        aircraft=MotionSeries(
+            f_mps2=motion.f_mps2,
+            omega_radps=motion.omega_radps,
+            perceived_f_mps2=ac.f_mps2,
+            perceived_omega_radps=ac.omega_radps,
+            q=aircraft_q,
+        ),
+        washouts=washouts,
+        platforms=platforms,
+        envelope=platform_envelope(limits),
+        phases=[(p[0], float(p[1]), float(p[2])) for p in phases],
+        metrics_markdown=metrics_markdown(title, list(result.metrics)),
+    )
+    write_recording(path, data, properties)
+
+
+def platform_envelope(limits: PlatformLimits) -> PlatformEnvelope:
+    """The recording's envelope lines from the platform limits (wheel limit from the rate limit)."""
+    from washbench.review.rerun_log import PlatformEnvelope
+
+    t = limits.translation
+    jac = wheel_jacobian(limits)
+    # the fastest any wheel can turn with the sphere at its angular-rate limit
+    wheel_max = float(np.max(np.linalg.norm(jac, axis=1)) * math.radians(limits.rotation.rate_limit_degps))
+    return PlatformEnvelope(
+        pos_m=t.position_limit_m.xyz,
+        vel_mps=t.velocity_limit_mps.xyz,
+        acc_mps2=t.acceleration_limit_mps2.xyz,
+        wheel_radps=wheel_max,
+        sphere_diameter_m=limits.sphere_diameter_m,
+    )
+
+
+def csv_text(rows: list[list[str]]) -> str:
+    buf = io.StringIO()
+    csv.writer(buf, lineterminator="\n").writerows(rows)
+    return buf.getvalue()
+
+
+def ranking_table(rankings: dict[tuple[str, str], list[RankRow]], rule: RankRule = DEFAULT_RULE) -> str:
+    """``ranking.csv``: rank, washout and the rule's value (``score``, lower is better) per manoeuvre; ``tied``
+    (true when the rank is shared: values within the tie margin) and ``rule`` (``--rank-by``)."""
+    rows = [["aircraft", "manoeuvre", "rank", "washout", "score", "tied", "rule"]]
+    for (aircraft, manoeuvre), ranking in rankings.items():
+        for r in ranking:
+            tied = "true" if r.tied else "false"
+            rows.append([aircraft, manoeuvre, str(r.rank), r.washout, csv_number(r.score), tied, rule.by])
+    return csv_text(rows)
+
+
+def write_run_review(
+    run_dir: Path,
+    summary: RunSummary,
+    source: str = "",
+    table: Mapping[str, Any] | None = None,
+    figures: bool = True,
+) -> None:
+    """``ranking.csv`` and ``report.md`` of one result folder (the same tables as a suite's, for one run).
+
+    The one call site for a result folder's report (``washbench run`` and ``washbench cue``); the report and its
+    figures are built from the folder's files (:func:`washbench.review.report.write_result_report`), with the
+    traces.parquet columns taken from ``table`` when the caller still holds them; ``figures=False``: none drawn.
+    """
+    prov = (read_marker(run_dir, RUN_MARKER) or {}).get("provenance")
+    rule = rule_from_record(prov.get("ranking") if isinstance(prov, dict) else None)
+    rankings = (
+        {(summary.aircraft, summary.manoeuvre): rank(summary.metrics, summary.motion, rule)} if summary.metrics else {}
+    )
+    write_text_atomic(run_dir / RANKING_FILE, ranking_table(rankings, rule))
+    write_result_report(run_dir, table, figures=figures)
+
+
