@@ -154,3 +154,27 @@ def test_bound_replayed_as_a_washout_through_the_platform(limits):
     assert at_rest.cost * (1 - 1e-6) <= replay <= 1.2 * at_rest.cost
     tl = traces["large-angle"]
     assert replay < washout_cost(trajectory_from_trace(tl.acc_mps2, tl.omega_radps, tl.q, dt), f, w, dt, G)
+
+
+def test_bank_with_the_future_steps_a_whole_only_washout_like_the_whole_trace(limits):
+    """``CueingBank(..., future=...)``: the bound's set points computed once from the whole input, then tracked
+    sample by sample (``step``) or in blocks (``steps``): the same bits as ``cue_trace``; without the future the
+    bank refuses it in one line."""
+    from washbench.cueing.bank import CueingBank
+    from washbench.errors import WashbenchError
+
+    a = generate(SignalSpec("doublet", "f_x", 3.0, frequency_hz=0.5, duration_s=2.5, start_s=0.2))
+    f = a.f_mps2
+    w = a.omega_radps + np.array([0.0, 0.0, 0.05])
+    params = load_washout_params()
+    whole = cue_trace(f, w, a.dt_s, ["small-angle", "bound"], params, limits)
+    by_step = CueingBank(["small-angle", "bound"], params, limits, a.dt_s, future=(f, w))
+    rows = np.stack([by_step.step(f[k], w[k]).copy() for k in range(len(f))], axis=1)
+    by_block = CueingBank(["small-angle", "bound"], params, limits, a.dt_s, future=(f, w))
+    blocks = np.concatenate([by_block.steps(f[i : i + 100], w[i : i + 100]) for i in range(0, len(f), 100)], axis=1)
+    for i, name in enumerate(("small-angle", "bound")):
+        np.testing.assert_array_equal(rows[i], blocks[i])
+        np.testing.assert_array_equal(whole[name].pos_m, rows[i][:, 0:3])
+    assert by_step.saturation_counts() == by_block.saturation_counts()
+    with pytest.raises(WashbenchError, match="needs the whole recording"):
+        CueingBank(["bound"], params, limits, a.dt_s)

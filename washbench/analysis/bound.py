@@ -374,15 +374,16 @@ def costs_from_columns(
 
 
 class BoundWashout:
-    """The bound as a washout (kind ``bound``; whole-trace paths only: ``cue_trace``/``cue_motion``, omct, sweep,
-    tune; ``run`` and ``cue`` feed samples in order and get a one-line error): its ``trace`` solves
-    the bound for the whole recording, started centred, level and still, and returns its positions and attitudes
-    (ZYX Euler from the integrated roll, pitch and yaw) as set points, so the platform, head motion, perception,
-    metrics, ranking, report and figures treat it like any washout. It knows the future; ``step`` (a live or
-    lockstep run) cannot and raises."""
+    """The bound as a washout (kind ``bound``, ``whole_only``: it needs the whole recording; ``run`` cues it after
+    the flight on the flight read back, ``cue`` and the whole-trace paths give it the input at once,
+    :class:`washbench.cueing.CueingBank` ``future``): its ``trace`` solves the bound for the whole recording,
+    started centred, level and still, and returns its positions and attitudes (ZYX Euler from the integrated roll,
+    pitch and yaw) as set points, so the platform, head motion, perception, metrics, ranking, report and figures
+    treat it like any washout. It knows the future; ``step`` (a live stream) cannot and raises."""
 
     Params = BoundParams
     name = "bound"
+    whole_only = True
 
     def __init__(self, params: BoundParams | None, context) -> None:
         self.params = params if params is not None else BoundParams()
@@ -392,8 +393,8 @@ class BoundWashout:
         return np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0])
 
     def step(self, f_mps2: np.ndarray, omega_radps: np.ndarray):
-        raise RuntimeError("the oracle bound needs the whole recording (whole-trace paths: cue_trace, cue_motion, "
-                           "omct, sweep, tune); run and cue feed it sample by sample")  # fmt: skip
+        raise RuntimeError("the oracle bound needs the whole recording in advance (run, cue, suite, omct, sweep, "
+                           "tune), not a live stream")  # fmt: skip
 
     def trace(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         from washbench.numerics.rotations import quat_from_euler

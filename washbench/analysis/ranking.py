@@ -26,6 +26,11 @@ Ranking (the scoring rule). For one manoeuvre, washout W gets the score
 
 Lower score is better. The score is objective (computed from the traces only) and is reported next to every rank.
 
+**The oracle bound** (washout :data:`BOUND_WASHOUT`, :mod:`washbench.analysis.bound`) gets its score by the same
+rule but no rank: it is not a washout a simulator could run (it knows the future), and it is optimal for its own
+cost, not for this score. Its row comes last with ``rank`` 0 ("not ranked"); the washouts are ranked among
+themselves as if it were not there.
+
 Other rules (:class:`RankRule`, ``--rank-by`` and the parameter file's ``ranking:`` section), all lower is better:
 
 - ``score``: the rule above (the default).
@@ -59,6 +64,8 @@ TRANSLATIONAL_DOFS = DOFS[:3]  # surge, sway, heave
 ROTATIONAL_DOFS = DOFS[3:]  # roll, pitch, yaw
 METRICS = ("npc", "integral_error", "max_error")
 REFERENCE_WASHOUT = "small-angle"
+BOUND_WASHOUT = "bound"
+"""The oracle bound's name in every output: scored, never ranked (module doc)."""
 
 RANK_BY: tuple[str, ...] = ("score", "false-cue", "weighted")
 """The ranking rules (module docstring)."""
@@ -89,7 +96,8 @@ class ComparisonRow:
 class RankRow:
     """A washout's value of the rule (``score``, lower is better) and rank within one manoeuvre.
 
-    ``tied``: another washout shares this rank (their values differ by less than the tie margin).
+    ``tied``: another washout shares this rank (their values differ by less than the tie margin). ``rank`` 0: not
+    ranked (the oracle bound, :data:`BOUND_WASHOUT`).
     """
 
     washout: str
@@ -160,8 +168,11 @@ def washout_order(rows: Iterable[MetricRow]) -> list[str]:
 
 
 def reference_washout(washouts: Sequence[str]) -> str:
-    """The washout the others are compared with: ``small-angle`` when it runs, otherwise the first listed."""
-    return REFERENCE_WASHOUT if REFERENCE_WASHOUT in washouts or not washouts else washouts[0]
+    """The washout the others are compared with: ``small-angle`` when it runs, otherwise the first listed (the
+    oracle bound only when nothing else ran)."""
+    if REFERENCE_WASHOUT in washouts or not washouts:
+        return REFERENCE_WASHOUT
+    return next((w for w in washouts if w != BOUND_WASHOUT), washouts[0])
 
 
 def compare(rows: Sequence[MetricRow], reference: str | None = None) -> list[ComparisonRow]:
@@ -264,8 +275,8 @@ def rank(rows: Sequence[MetricRow], motion: Mapping[str, float], rule: RankRule 
     Rows come best first; within a tie by value (the shared rank says the order is not a verdict), equal values
     in the order the washouts were listed.
     """
-    washouts = washout_order(rows)
     values, weights = rule_values(rows, motion, rule)
+    washouts = [w for w in washout_order(rows) if w != BOUND_WASHOUT]
     ranks = tie_groups([values[w] for w in washouts], rule.tie_relative, rule.tie_absolute)
     share = {r: ranks.count(r) for r in ranks}
     def value(i: int) -> float:
@@ -273,11 +284,14 @@ def rank(rows: Sequence[MetricRow], motion: Mapping[str, float], rule: RankRule 
         return math.inf if math.isnan(v) else v
 
     ordered = sorted(range(len(washouts)), key=lambda i: (ranks[i], value(i), i))
-    return [
+    out = [
         RankRow(washout=washouts[i], score=values[washouts[i]], rank=ranks[i], weights=weights,
                 tied=share[ranks[i]] > 1)
         for i in ordered
     ]  # fmt: skip
+    if BOUND_WASHOUT in values:  # scored, not ranked (module doc)
+        out.append(RankRow(washout=BOUND_WASHOUT, score=values[BOUND_WASHOUT], rank=0, weights=weights))
+    return out
 
 
 def undecided(ranking: Sequence[RankRow]) -> bool:
@@ -290,6 +304,8 @@ def wins(rankings: Iterable[Sequence[RankRow]]) -> dict[str, int]:
     count: dict[str, int] = {}
     for ranking in rankings:
         for r in ranking:
+            if r.rank < 1:  # the oracle bound: not ranked
+                continue
             count.setdefault(r.washout, 0)
             if r.rank == 1:
                 count[r.washout] += 1

@@ -349,6 +349,11 @@ class CueingBank:
     to the steady state of that sample (``filter_start="rest"``: of rest, see :data:`FILTER_STARTS`).
     ``f_mps2`` and ``omega_radps`` are best given as float64 arrays
     of shape (3,) (anything else is converted, more slowly). Non-finite input raises ValueError.
+
+    ``future``: the whole input (f (N, 3), omega (N, 3)) when it is known before the first step (a recorded flight,
+    ``washbench cue``). Washouts that need the whole recording (``whole_only``, e.g. the oracle bound) compute
+    their set points from it at once and the bank then tracks them sample by sample like any other's; without
+    ``future`` such a washout is refused (WashbenchError).
     """
 
     FIELDS: tuple[str, ...] = FIELDS
@@ -361,6 +366,7 @@ class CueingBank:
         limits: PlatformLimits,
         dt_s: float,
         filter_start: str = "steady",
+        future: tuple[np.ndarray, np.ndarray] | None = None,
     ) -> None:
         self.specs = as_washouts(washouts, params)
         self.washouts = tuple(w.name for w in self.specs)
@@ -372,11 +378,38 @@ class CueingBank:
         self._out = np.zeros((n, NFIELDS))
         self._py = python_sources(self.specs, limits, self.dt_s, filter_start)
         self._started = False
+        self._k = 0  # samples stepped so far
+        self._whole = self._whole_setpoints(future)
+        self._sources = self._py  # every Python washout (its report())
+        self._py = [(i, src) for i, src in self._py if i not in self._whole]
+
+    def _whole_setpoints(self, future: tuple[np.ndarray, np.ndarray] | None) -> dict[int, tuple[np.ndarray, ...]]:
+        """index -> (start pos, start q, pos (N, 3), q (N, 4), flags (N, 2)) of every whole-only washout."""
+        out: dict[int, tuple[np.ndarray, ...]] = {}
+        for i, src in self._py:
+            if not src.whole_only:
+                continue
+            if future is None:
+                raise WashbenchError(f"washout {src.name}: needs the whole recording before its first step (a "
+                                     "recorded flight), not a live or lockstep stream")  # fmt: skip
+            f = np.ascontiguousarray(future[0], dtype=np.float64)
+            w = np.ascontiguousarray(future[1], dtype=np.float64)
+            if f.ndim != 2 or f.shape[1] != 3 or w.shape != f.shape or not len(f):
+                raise ValueError(f"future: f and omega must both be (N, 3), N > 0, got {f.shape} and {w.shape}")
+            p0, q0 = src.start(f[0], w[0])
+            out[i] = (p0, q0, *src.run(f, w, whole=True))
+        return out
+
+    def _whole_block(self, m: int) -> None:
+        if self._k + m > len(next(iter(self._whole.values()))[2]):
+            raise ValueError(f"more samples stepped ({self._k + m}) than the future given to the bank holds")
 
     def _start(self, f: np.ndarray, om: np.ndarray) -> None:
         """Start the Python washouts on the first sample (their start set point into the state)."""
         for i, src in self._py:
             _set_start(self._state[i], *src.start(f, om))
+        for i, (p0, q0, *_) in self._whole.items():
+            _set_start(self._state[i], p0, q0)
         self._started = True
 
     def step(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> np.ndarray:
@@ -389,7 +422,7 @@ class CueingBank:
             f = np.ascontiguousarray(f_mps2, dtype=np.float64).reshape(-1)
             w = np.ascontiguousarray(omega_radps, dtype=np.float64).reshape(-1)
             bank_step(f, w, self._cfg, self._coef, self._state, self._counts, self._out)
-        if self._py:
+        if self._py or self._whole:
             f = np.asarray(f_mps2, dtype=np.float64).reshape(-1)
             w = np.asarray(omega_radps, dtype=np.float64).reshape(-1)
             if not self._started:
@@ -398,6 +431,14 @@ class CueingBank:
                 pos, q, ft, fr = src.step(f, w)
                 c, st = self._cfg[i], self._state[i]
                 setpoint_step(pos, q, ft, fr, c, self._coef[i], st, self._counts[i], self._out[i])
+            if self._whole:
+                self._whole_block(1)
+            for i, (_, _, pos_a, q_a, fl) in self._whole.items():
+                k = self._k
+                c, st = self._cfg[i], self._state[i]
+                setpoint_step(pos_a[k], q_a[k], int(fl[k, 0]), int(fl[k, 1]), c, self._coef[i], st, self._counts[i],
+                              self._out[i])  # fmt: skip
+        self._k += 1
         return self._out
 
     def steps(self, f_mps2: np.ndarray, omega_radps: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
@@ -421,14 +462,23 @@ class CueingBank:
             raise ValueError(f"out must be a C-contiguous float64 array of shape {shape}")
         announce_compile(bank_block)
         bank_block(f, w, self._cfg, self._coef, self._state, self._counts, out)
-        if self._py and f.shape[0]:
+        m = f.shape[0]
+        if (self._py or self._whole) and m:
             if not self._started:
                 self._start(f[0], w[0])
             for i, src in self._py:
                 pos, q, flags = src.run(f, w)
                 setpoint_block(pos, q, flags, self._cfg[i], self._coef[i], self._state[i], self._counts[i], out[i])
-        if f.shape[0]:
+            if self._whole:
+                self._whole_block(m)
+            k = self._k
+            for i, (_, _, pos, q, flags) in self._whole.items():
+                setpoint_block(np.ascontiguousarray(pos[k : k + m]), np.ascontiguousarray(q[k : k + m]),
+                               np.ascontiguousarray(flags[k : k + m]), self._cfg[i], self._coef[i], self._state[i],
+                               self._counts[i], out[i])  # fmt: skip
+        if m:
             self._out[:] = out[:, -1]
+        self._k += m
         return out
 
     def adaptation(self) -> dict[str, dict[str, np.ndarray | float]]:
@@ -446,6 +496,16 @@ class CueingBank:
                     "grad_k": st[S_GRAD + 3 : S_GRAD + 6].copy(),
                     "cost": float(st[S_COST]),
                 }
+        return out
+
+    def algorithm_reports(self) -> dict[str, dict[str, float | int]]:
+        """washout -> what a Python washout reports of itself so far (its algorithm's ``report()``, e.g. the MPC's
+        solves, fallbacks, brakes and solver iterations; numbers only); washouts without ``report()`` are absent."""
+        out: dict[str, dict[str, float | int]] = {}
+        for _, src in self._sources:
+            fn = getattr(src.algo, "report", None)
+            if callable(fn):
+                out[src.name] = {str(k): _number(v) for k, v in dict(fn()).items()}
         return out
 
     def saturation_counts(self) -> dict[str, dict[str, int]]:
@@ -508,6 +568,12 @@ def python_sources(
 ) -> list[tuple[int, SetPointSource]]:
     """(index, source) of every washout of ``specs`` that is a Python algorithm (not compiled)."""
     return [(i, SetPointSource(w, limits, dt, filter_start)) for i, w in enumerate(specs) if w.kind not in _KINDS]
+
+
+def _number(v: object) -> float | int:
+    """A reported statistic as a JSON number: a whole number as int (a count), else float."""
+    x = float(v)  # type: ignore[arg-type]
+    return int(x) if x.is_integer() and abs(x) < 2**53 else x
 
 
 def _set_start(state: np.ndarray, pos: np.ndarray, q: np.ndarray) -> None:

@@ -275,6 +275,8 @@ class MpcWashout:
         settings = {"max_iter": s.max_iter, "eps_abs": s.eps_abs, "eps_rel": s.eps_rel, "polishing": s.polishing}
         settings.update(adaptive_rho=s.adaptive_rho, check_termination=5, verbose=False, warm_starting=True, **extra)
         self.solver.setup(self.P_qp, np.zeros(self.nz), self.A_qp, self.l0, self.u0, **settings)
+        self._lo = self.l0.copy()
+        self._hi = self.u0.copy()
         self.x = np.zeros(self.n)
         self.u = np.zeros(self.m)
         self.solves = 0
@@ -402,8 +404,10 @@ class MpcWashout:
         return x
 
     def _update_bounds(self, r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The constraint bounds for this step (reused arrays: only the dynamics rows and the first angular
+        acceleration rows change from step to step; the others keep :attr:`l0`, :attr:`u0`)."""
         n = self.n
-        lo, hi = self.l0.copy(), self.u0.copy()
+        lo, hi = self._lo, self._hi
         aff = self._gam_r_stack @ r
         aff[:n] += self.phi_p @ self.x
         lo[self._rows_dyn] = aff
@@ -470,16 +474,17 @@ class MpcWashout:
         lo, hi = self._update_bounds(r)
         self.solver.update(q=self._q_map @ r, l=lo, u=hi)
         res = self.solver.solve(raise_error=False)
+        info, z = res.info, res.x
         self.solves += 1
-        self.iterations.append(int(res.info.iter))
-        z = res.x
-        status = res.info.status
+        self.iterations.append(int(info.iter))
+        status = info.status
         ok = status in _ACCEPTED and z is not None and bool(np.all(np.isfinite(z)))
         if ok and status != "solved":
             self.inaccurate += 1
         if not ok:
             return False, np.zeros((self.N, self.m))
-        return True, np.stack([z[self._iu(k) : self._iu(k) + self.m] for k in range(self.N)])
+        # z = [u_0, x_1, u_1, x_2, ...]: the controls are the first m of each stage (copied: z is the solver's)
+        return True, z.reshape(self.N, self.m + self.n)[:, : self.m].copy()
 
     def step(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> SetPoint:
         """Solve the QP for this sample, apply its first move for one sample, return the set point."""

@@ -173,6 +173,12 @@ def is_python(kind: str) -> bool:
     return kind not in WASHOUT_KINDS
 
 
+def whole_only(kind: str, spec: str | None = None) -> bool:
+    """Whether the Python algorithm ``kind`` needs the whole recording (its factory's ``whole_only`` attribute: it
+    has a ``trace`` form and no ``step``, e.g. the oracle bound); compiled kinds never do."""
+    return is_python(kind) and bool(getattr(get(kind, spec).factory, "whole_only", False))
+
+
 def plugin_spec(kind: str) -> str | None:
     """``FILE.py:NAME`` of a plugin loaded from a file, for worker processes (None otherwise)."""
     return _PLUGIN_SPECS.get(kind)
@@ -237,4 +243,5 @@ __all__ = [
     "plugin_spec",
     "plugin_specs",
     "python_kinds",
+    "whole_only",
 ]

@@ -47,6 +47,7 @@ class SetPointSource:
                 raise WashbenchError(self._where("making it") + f": the algorithm has no {method}() method")
         self.has_flags = callable(getattr(self.algo, "flags", None))
         self.has_trace = callable(getattr(self.algo, "trace", None))
+        self.whole_only = bool(getattr(algo.factory, "whole_only", False)) and self.has_trace
 
     def _where(self, what: str | None = None) -> str:
         label = self.name if self.source == "built-in" else f"{self.name} ({self.source})"

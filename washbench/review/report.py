@@ -138,6 +138,10 @@ def _score_cell(score: float, best: bool) -> str:
     return f"{text} {FLAG}" if score > 1.0 else text
 
 
+BOUND_NOTE = ("oracle bound (knows the future), not ranked: optimal for its own perceived-error cost under the "
+              "platform's limits, not for this score")  # fmt: skip
+
+
 def result_rule(data: ResultData) -> RankRule:
     """The ranking rule a result was written with (its provenance's ``ranking``; the default before rules)."""
     prov = data.provenance
@@ -145,7 +149,10 @@ def result_rule(data: ResultData) -> RankRule:
 
 
 def rank_cell(r: RankRow) -> str:
-    """A rank as shown: ``1`` or, when shared (a tie within the margin), ``1 (tie)``."""
+    """A rank as shown: ``1`` or, when shared (a tie within the margin), ``1 (tie)``; ``-`` for the oracle bound
+    (scored, not ranked)."""
+    if r.rank < 1:
+        return "-"
     return f"{r.rank} (tie)" if r.tied else str(r.rank)
 
 
@@ -174,6 +181,9 @@ def ranking_lines(data: ResultData, ranking: list[RankRow], rule: RankRule = DEF
     unit = "false-cue time (DOF lengths)" if rule.by == "false-cue" else "score (-)"
     flag = rule.by != "false-cue"
     notes = {r.washout: end_stop_note(data, r.washout) for r in ranking}
+    for r in ranking:
+        if r.rank < 1:  # the oracle bound
+            notes[r.washout] = "; ".join(x for x in (BOUND_NOTE, notes[r.washout]) if x)
 
     def value(r: RankRow) -> str:
         return _score_cell(r.score, r.rank == 1) if flag else sig(r.score)
@@ -436,6 +446,12 @@ def result_sections(
     rule = result_rule(data)
     ranking = rank(data.metrics, data.motion, rule) if data.metrics else []
     lines += [f"{h} Ranking", "", *ranking_lines(data, ranking, rule)]
+    from washbench.review.bound_section import algorithm_lines, bound_lines
+
+    if bounded := bound_lines(data.folder):
+        lines += [f"{h} Against the oracle bound", "", *bounded]
+    if solver := algorithm_lines(data.folder):
+        lines += [f"{h} Solver statistics", "", *solver]
     lines += [f"{h} Perceived motion", ""]
     lines += [
         "Aircraft pilot (wide solid line) against each washout's simulator pilot (each its own colour and dash); "

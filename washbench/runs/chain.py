@@ -99,6 +99,8 @@ class CueResult:
     metrics: list[MetricRow]
     arrays: Mapping[str, Mapping[str, np.ndarray]] = field(default_factory=dict, repr=False)
     """washout -> the trace's fields as checked float64 arrays (:func:`analyse`); else read from ``traces``."""
+    algorithms: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
+    """washout -> what a Python washout reports of itself (:meth:`washbench.cueing.CueingBank.algorithm_reports`)."""
 
     @property
     def n(self) -> int:
@@ -330,7 +332,7 @@ def stream_cue(
     n = motion.n
     if n < 1:
         raise WashbenchError("nothing to cue: the input has no rows")
-    bank = CueingBank(washouts, None, limits, motion.dt_s, filter_start)
+    bank = CueingBank(washouts, None, limits, motion.dt_s, filter_start, future=(motion.f_mps2, motion.omega_radps))
     names = bank.washouts
     model = VestibularModel(motion.dt_s, vestibular)
     streams = {p: PerceptionStream(model, filter_start) for p in (AIRCRAFT, *names)}
@@ -375,7 +377,7 @@ def stream_cue(
     metrics = _metric_rows(felt, motion.dt_s, vertical, {p: st.msi_pct for p, st in sick.items()})
     counts = bank.saturation_counts()
     traces = {w: SimpleNamespace(**kept[w], saturated=flags[w], saturation_counts=counts[w]) for w in names}
-    return CueResult(motion=motion, traces=traces, perceived=felt, metrics=metrics)
+    return CueResult(motion=motion, traces=traces, perceived=felt, metrics=metrics, algorithms=bank.algorithm_reports())
 
 
 def write_results(out_dir: Path, result: CueResult, provenance: Mapping[str, Any] | None = None) -> tuple[Path, Path]:
@@ -434,6 +436,7 @@ def lockstep_washouts(
         np.degrees(omega_radps, out=omega_deg)
         rows.append(step(f_mps2, np.radians(omega_deg)).copy())
 
+    lockstep.reports = bank.algorithm_reports  # type: ignore[attr-defined]
     return rows, lockstep
 
 
@@ -462,6 +465,7 @@ def lockstep_blocks(
         rows.append(bank.steps(f_mps2, np.radians(np.degrees(omega_radps))))
         done[0] += f_mps2.shape[0]
 
+    lockstep.reports = bank.algorithm_reports  # type: ignore[attr-defined]
     return rows, lockstep
 
 

@@ -222,7 +222,13 @@ def write_outputs(
                     "conversions": list(seg.notes),
                     "input_labels": list(seg.labels),
                     "warnings": [f.text for f in seg.findings],
+                    "algorithms": dict(result.algorithms),
                 }
+                from washbench.runs.bound_stage import bound_outputs
+
+                bound = bound_outputs(folder, tmp[TRACES_FILE], seg.motion.dt_s, run.washouts, run.limits,
+                                      run.vestibular_params)  # fmt: skip
+                extra |= {"bound": bound} if bound else {}
                 if provenance:
                     extra |= {"created_utc": created, "provenance": provenance}
                 write_run_json(tmp[RUN_FILE], summary, time.perf_counter() - start, extra)

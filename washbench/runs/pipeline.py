@@ -43,7 +43,6 @@ from washbench.review.numbers import pct, sig
 from washbench.runs.chain import (
     LOCKSTEP_BLOCK,
     aircraft_attitude,
-    from_lockstep,
     lockstep_blocks,
     lockstep_washouts,
     sample_count,
@@ -87,8 +86,10 @@ def run_manoeuvre(
     clean_partials(final.parent)
 
     from washbench.flight.fly import fly, write_flight
+    from washbench.runs.bound_stage import split_whole
 
-    rows, lockstep = lockstep_blocks(opts.washouts, opts.limits, manoeuvre.dt_s, opts.filter_start)
+    stepped = split_whole(opts.washouts)[0]  # a whole-only washout (the bound) is cued after the flight
+    rows, lockstep = lockstep_blocks(stepped, opts.limits, manoeuvre.dt_s, opts.filter_start)
     partial = partial_dir(final)  # before flying: a file in the way of OUT/<aircraft>/ fails now
     published = False
     try:
@@ -114,7 +115,7 @@ def run_manoeuvre(
             checks_total=len(flight.checks),
         )
         ac_q = aircraft_attitude(cols["phi_deg"], cols["theta_deg"], cols["psi_deg"])
-        extra = {"created_utc": created, "provenance": prov}
+        extra = {"created_utc": created, "provenance": prov, "algorithms": lockstep.reports()}
         summary = write_cued_folder(partial, summary, rows, opts, ac_q, flight.phases, start, extra, prov)
         publish_dir(partial, final, RUN_MARKER, marker)
         published = True
@@ -145,12 +146,17 @@ def write_cued_folder(
     (:func:`washbench.runs.chain.from_lockstep`) on the flight read back (as ``washbench cue`` reads it),
     traces.parquet, metrics.csv, recording.rrd, run.json, ranking.csv, report.md and figures/. Returns ``summary``
     completed with the steps, metrics and saturations. ``provenance`` (no date) goes into traces.parquet's
-    metadata; ``extra`` into run.json."""
+    metadata; ``extra`` into run.json. A washout that needs the whole recording (the oracle bound) is cued here
+    on the flight read back, and with the bound ``bound.csv`` is written (:mod:`washbench.runs.bound_stage`)."""
     from washbench.io.motion_file import read_motion
+    from washbench.runs.bound_stage import bound_outputs, lockstep_result
 
     motion = read_motion(folder / FLIGHT_FILE)
-    result = from_lockstep(motion, rows, options.washout_order, options.vestibular_params, options.filter_start)
-    write_results(folder, result, provenance)
+    result = lockstep_result(motion, rows, options)
+    traces_path, _ = write_results(folder, result, provenance)
+    bound = bound_outputs(folder, traces_path, motion.dt_s, options.washouts, options.limits,
+                          options.vestibular_params)  # fmt: skip
+    extra = {**(extra or {}), "bound": bound} if bound else extra
     if options.outputs.recording:
         title = f"{summary.aircraft} / {summary.manoeuvre}"
         props = flat_strings(provenance, str((extra or {}).get("created_utc") or "")) if provenance else None
@@ -192,10 +198,15 @@ def run_script(script_path: Path, out_root: Path, options: RunOptions | None = N
     check_replaceable(final, RUN_MARKER, marker, nested=True)
     clean_partials(final.parent)
     banks: list[list[np.ndarray]] = []
+    hooks: list[Any] = []
+    from washbench.runs.bound_stage import split_whole
+
+    stepped = split_whole(opts.washouts)[0]  # a whole-only washout (the bound) is cued after the flight
 
     def segment_hook(i: int, dt_s: float) -> Any:
-        rows, hook = lockstep_washouts(opts.washouts, opts.limits, dt_s, opts.filter_start)
+        rows, hook = lockstep_washouts(stepped, opts.limits, dt_s, opts.filter_start)
         banks.append(rows)
+        hooks.append(hook)
         return hook
 
     start = time.perf_counter()
@@ -205,7 +216,7 @@ def run_script(script_path: Path, out_root: Path, options: RunOptions | None = N
     several = len(flight.segments) > 1
     summaries = []
     try:
-        for seg, rows in zip(flight.segments, banks, strict=True):
+        for seg, rows, hook in zip(flight.segments, banks, hooks, strict=True):
             folder = partial / seg.name if several else partial
             folder.mkdir(exist_ok=True)
             write_script_flight(folder, flight, seg)
@@ -222,7 +233,7 @@ def run_script(script_path: Path, out_root: Path, options: RunOptions | None = N
             cols = seg.columns
             ac_q = aircraft_attitude(cols["phi_deg"], cols["theta_deg"], cols["psi_deg"])
             extra = {"script": str(info.path), "segment": seg.name, "stopped_by_time_limit": flight.stopped_by_limit}
-            extra |= {"created_utc": created, "provenance": prov}
+            extra |= {"created_utc": created, "provenance": prov, "algorithms": hook.reports()}
             summaries.append(write_cued_folder(folder, summary, rows, opts, ac_q, [], start, extra, prov))
         publish_dir(partial, final, RUN_MARKER, marker, nested=True)
     finally:

@@ -184,7 +184,8 @@ def ranking_table(rankings: dict[tuple[str, str], list[RankRow]], rule: RankRule
     for (aircraft, manoeuvre), ranking in rankings.items():
         for r in ranking:
             tied = "true" if r.tied else "false"
-            rows.append([aircraft, manoeuvre, str(r.rank), r.washout, csv_number(r.score), tied, rule.by])
+            place = str(r.rank) if r.rank else ""  # empty: the oracle bound, scored but not ranked
+            rows.append([aircraft, manoeuvre, place, r.washout, csv_number(r.score), tied, rule.by])
     return csv_text(rows)
 
 

@@ -47,7 +47,9 @@ def params_yaml(params: WashoutParams, header: str) -> str:
             return {k: off(x) for k, x in v.items()}
         return "off" if v is None else v
 
-    body = yaml.safe_dump(off(params.model_dump(mode="json")), sort_keys=False, default_flow_style=None)
+    data = off(params.model_dump(mode="json"))
+    data.update(data.pop("sections", None) or {})  # the Python algorithms' sections as top-level keys (optimal:, mpc:)
+    body = yaml.safe_dump(data, sort_keys=False, default_flow_style=None)
     comment = "".join(f"# {line}\n" if line else "#\n" for line in header.splitlines())
     return comment + body
 
