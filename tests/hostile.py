@@ -71,3 +71,20 @@ def live_processes(pgid: int) -> list[str]:
         if group == pgid and state != "Z":
             found.append(f"{entry.name} {stat[: stat.rindex(')') + 1]} {state}")
     return found
+
+
+def long_suite(root: Path, *, output: int | None = subprocess.PIPE) -> subprocess.Popen[str]:
+    """``washbench suite`` of two 900 s manoeuvres (never finished while a test waits) into ``root/out`` with
+    ``--jobs 2``, in its own process group (every process it starts can be found); ``output``: where its stdout
+    and stderr go."""
+    folder = root / "m"
+    folder.mkdir()
+    for i in range(2):
+        short(folder, name=f"long_{i}", seconds=900)
+    return subprocess.Popen(
+        [sys.executable, "-m", "washbench", "suite", str(folder), "--out", str(root / "out"), "--jobs", "2", "--quiet"],
+        stdout=output,
+        stderr=output,
+        text=True,
+        start_new_session=True,
+    )

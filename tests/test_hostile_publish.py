@@ -20,7 +20,7 @@ import time
 from pathlib import Path
 
 import pytest
-from hostile import assert_clean_error, live_processes, short, tree, washbench
+from hostile import assert_clean_error, live_processes, long_suite, short, tree, washbench
 
 from washbench.io.outfolder import JOURNAL_PREFIX, MANIFEST, OLD_PREFIX, STAGE_PREFIX
 from washbench.io.paths import MANOEUVRES_DIR
@@ -166,18 +166,8 @@ def test_examples_on_a_full_disk_is_one_line_and_a_rerun_then_works(tmp_path: Pa
 def test_a_suite_signalled_as_its_workers_start_stops_in_one_line(tmp_path: Path) -> None:
     """SIGINT the moment the process server exists (the workers are being started): one line, status 130, no
     process left, nothing new in --out (the race the first round found at 0.35 s)."""
-    folder = tmp_path / "m"
-    folder.mkdir()
-    for i in range(2):
-        short(folder, name=f"long_{i}", seconds=900)
+    proc = long_suite(tmp_path)
     out = tmp_path / "out"
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "washbench", "suite", str(folder), "--out", str(out), "--jobs", "2", "--quiet"],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        start_new_session=True,
-    )
     deadline = time.monotonic() + 60
     while len(live_processes(proc.pid)) < 2 and proc.poll() is None and time.monotonic() < deadline:
         time.sleep(0.001)

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from hostile import assert_clean_error, live_processes, short, tree, washbench
+from hostile import assert_clean_error, live_processes, long_suite, short, tree, washbench
 
 from washbench.analysis.signals import SignalSpec, generate
 from washbench.io.motion_file import write_motion
@@ -550,17 +550,8 @@ def test_a_publication_cut_by_a_kill_is_finished_by_the_next_run(tmp_path: Path)
 
 
 def test_workers_end_when_the_suite_is_killed(tmp_path: Path) -> None:
-    folder = tmp_path / "m"
-    folder.mkdir()
-    for i in range(2):
-        short(folder, name=f"long_{i}", seconds=900)
+    proc = long_suite(tmp_path, output=subprocess.DEVNULL)
     out = tmp_path / "out"
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "washbench", "suite", str(folder), "--out", str(out), "--jobs", "2", "--quiet"],
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-        start_new_session=True,
-    )
     deadline = time.monotonic() + 60
     while len(live_processes(proc.pid)) < 4 and time.monotonic() < deadline:  # main, server, 2 workers
         time.sleep(0.1)

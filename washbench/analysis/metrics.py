@@ -29,9 +29,22 @@ import math
 
 import numpy as np
 
-from washbench.analysis.metric_sums import FLAT_RTOL, signal_metrics
 from washbench.io.metrics_csv import MetricRow
 from washbench.numerics.jitcache import announce_compile
+
+FLAT_RTOL = 1e-9
+"""A signal whose standard deviation is at most this fraction of its peak |value| is flat (the same value as
+:data:`washbench.analysis.metric_sums.FLAT_RTOL`, which the compiled sums use; not imported from there so that
+importing this module (DOFS, npc_from_pc: a sweep parsing its grid, a refused input) does not import numba)."""
+
+
+def signal_metrics(x: np.ndarray, y: np.ndarray, dt_s: float) -> tuple[float, float, float]:
+    """:func:`washbench.analysis.metric_sums.signal_metrics` (PC, integral and max of ``|x - y|``), imported at the
+    first call: numba (about 0.3 s of start-up) is paid only by a command that computes a metric."""
+    from washbench.analysis.metric_sums import signal_metrics as compiled
+
+    announce_compile(compiled)
+    return compiled(x, y, dt_s)
 
 NPC_K = 1.0
 """The K of Eq. 21 used in the paper."""
@@ -61,7 +74,6 @@ def is_flat(x: np.ndarray, rtol: float = FLAT_RTOL) -> bool:
 def pearson(x: np.ndarray, y: np.ndarray) -> float:
     """Pearson correlation PC (Eq. 20) in [-1, 1]; ``nan`` if either signal is flat (see :func:`is_flat`)."""
     x, y = _as_pair(x, y)
-    announce_compile(signal_metrics)
     return float(signal_metrics(x, y, 1.0)[0])
 
 
@@ -82,14 +94,12 @@ def npc(x: np.ndarray, y: np.ndarray, k: float = NPC_K) -> float:
 def integral_abs_error(x: np.ndarray, y: np.ndarray, dt_s: float) -> float:
     """Eq. 22: ``integral |x - y| dt`` over the trace, trapezoid rule on a uniform grid of step ``dt_s`` [s]."""
     x, y = _as_pair(x, y)
-    announce_compile(signal_metrics)
     return float(signal_metrics(x, y, float(dt_s))[1])
 
 
 def max_abs_error(x: np.ndarray, y: np.ndarray) -> float:
     """``max |x - y|`` over the trace."""
     x, y = _as_pair(x, y)
-    announce_compile(signal_metrics)
     return float(signal_metrics(x, y, 1.0)[2])
 
 
@@ -113,7 +123,6 @@ def dof_metrics(
         a = np.ascontiguousarray(np.asarray(a, dtype=np.float64).T) * scale  # (3, N): contiguous per axis
         s = np.ascontiguousarray(np.asarray(s, dtype=np.float64).T) * scale
         for axis in range(3):
-            announce_compile(signal_metrics)
             pc, integral, max_error = signal_metrics(*_as_pair(a[axis], s[axis]), float(dt_s))
             rows.append(
                 MetricRow(

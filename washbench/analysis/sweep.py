@@ -11,15 +11,17 @@ from __future__ import annotations
 import itertools
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from washbench.analysis.evaluate import Evaluation
 from washbench.analysis.metrics import DOFS
 from washbench.cueing import registry
 from washbench.cueing.params import WashoutParams
 from washbench.cueing.variants import Washout, apply_overrides, check_key, check_kind, parse_value
 from washbench.errors import WashbenchError
 from washbench.io.csv_numbers import csv_number
+
+if TYPE_CHECKING:  # the compiled evaluator (numba) is imported by what evaluates, not by what parses a --set
+    from washbench.analysis.evaluate import Evaluation
 
 
 @dataclass(frozen=True)

@@ -97,7 +97,7 @@ from washbench.cueing.kernel import (
     setpoint_step,
     setpoint_trace,
 )
-from washbench.cueing.params import ADAPTIVE_KINDS, WashoutParams
+from washbench.cueing.params import ADAPTIVE_KINDS, FILTER_STARTS, WashoutParams, check_filter_start  # noqa: F401
 from washbench.cueing.setpoints import SetPointSource
 from washbench.cueing.variants import Washout, as_washouts
 from washbench.errors import WashbenchError
@@ -122,18 +122,6 @@ def _check_dt(dt_s: float) -> float:
     if not (math.isfinite(dt) and lo <= dt <= hi):
         raise WashbenchError(f"time step must be a positive number of seconds, {lo:g}..{hi:g} s, got {dt_s!r}")
     return dt
-
-
-FILTER_STARTS = ("steady", "rest")
-"""Start states: ``steady`` of the first sample (a recording that begins in steady flight), or ``rest`` (the
-simulator level and still, f = [0, 0, -g]: the first sample is a change, as for a recording begun mid-manoeuvre)."""
-
-
-def check_filter_start(start: str) -> str:
-    """``start`` if it is one of :data:`FILTER_STARTS`, else WashbenchError."""
-    if start not in FILTER_STARTS:
-        raise WashbenchError(f"unknown filter start {start!r} (valid: {', '.join(FILTER_STARTS)})")
-    return start
 
 
 def _off(limit: float | None) -> float:

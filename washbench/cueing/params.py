@@ -13,6 +13,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BeforeValidator, Field
 
+from washbench.errors import WashbenchError
 from washbench.io.paths import DATA_DIR
 from washbench.io.yamlio import StrictModel, validate_data
 
@@ -180,3 +181,16 @@ class WashoutParams(StrictModel):
 def load_base_params(path: Path, data: Any, lines: dict[Any, int]) -> WashoutParams:
     """Validate parsed YAML ``data`` (without its ``variants:`` section) into a WashoutParams."""
     return validate_data(path, data, lines, WashoutParams)
+
+
+FILTER_STARTS = ("steady", "rest")
+"""Start states: ``steady`` of the first sample (a recording that begins in steady flight), or ``rest`` (the
+simulator level and still, f = [0, 0, -g]: the first sample is a change, as for a recording begun mid-manoeuvre)."""
+
+
+def check_filter_start(start: str) -> str:
+    """``start`` if it is one of :data:`FILTER_STARTS`, else WashbenchError (checked before
+    anything is read: the compiled bank, and numba, are imported only once there is work for them)."""
+    if start not in FILTER_STARTS:
+        raise WashbenchError(f"unknown filter start {start!r} (valid: {', '.join(FILTER_STARTS)})")
+    return start

@@ -32,9 +32,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from washbench.io.units import G0_MPS2
+from washbench.numerics.lazyjit import lazy_njit  # numba imported at the first compiled call, not here
 
 WF_PARAMS = {
     "f1_hz": 0.08, "q1": 1.0 / math.sqrt(2.0),
@@ -96,7 +96,7 @@ def sos_filter(sos: np.ndarray, x: np.ndarray) -> np.ndarray:
     return y
 
 
-@njit(cache=True)
+@lazy_njit(cache=True)
 def _biquad(b0: float, b1: float, b2: float, a1: float, a2: float, x: np.ndarray) -> np.ndarray:
     y = np.empty_like(x)
     z1 = 0.0

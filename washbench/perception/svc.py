@@ -46,9 +46,9 @@ import math
 from dataclasses import astuple, dataclass
 
 import numpy as np
-from numba import njit
 
 from washbench.io.units import G0_MPS2
+from washbench.numerics.lazyjit import lazy_njit  # numba imported at the first compiled call, not here
 
 
 @dataclass(frozen=True)
@@ -135,14 +135,14 @@ def steady_state(f_mps2: np.ndarray, p: SvcParams = IN1) -> np.ndarray:
     return x
 
 
-@njit(cache=True)
+@lazy_njit(cache=True)
 def _cross(a: np.ndarray, ia: int, b: np.ndarray, ib: int, out: np.ndarray, io: int, sign: float) -> None:
     out[io] += sign * (a[ia + 1] * b[ib + 2] - a[ia + 2] * b[ib + 1])
     out[io + 1] += sign * (a[ia + 2] * b[ib] - a[ia] * b[ib + 2])
     out[io + 2] += sign * (a[ia] * b[ib + 1] - a[ia + 1] * b[ib])
 
 
-@njit(cache=True)
+@lazy_njit(cache=True)
 def _deriv(x: np.ndarray, u: np.ndarray, prm: np.ndarray, out: np.ndarray, tmp: np.ndarray) -> None:
     """dx/dt into ``out`` for input ``u = [omega (3), f (3)]`` (``prm``: :func:`_coefficients`)."""
     ka, kw, kwc, kvc, kac = prm[0], prm[1], prm[2], prm[3], prm[4]
@@ -184,7 +184,7 @@ def _coefficients(p: SvcParams) -> np.ndarray:
     ])  # fmt: skip
 
 
-@njit(cache=True)
+@lazy_njit(cache=True)
 def _run(
     x: np.ndarray, u_prev: np.ndarray, u: np.ndarray, dt: float, prm: np.ndarray, g0: float,
     msi: np.ndarray, conflict: np.ndarray,

@@ -101,7 +101,7 @@ def load_options(
     Raises WashbenchError (one line: file, line, field) for a bad parameter file, variant, platform file, ranking
     section, filter start or ``--max-time-s``: before anything is flown or written.
     """
-    from washbench.cueing.bank import check_filter_start  # (loads the compiled kernels: not on the import path)
+    from washbench.cueing.params import check_filter_start  # (light: the compiled bank is imported once there is work)
 
     check_filter_start(filter_start)
     check_max_time(max_time_s)
