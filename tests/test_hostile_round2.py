@@ -584,17 +584,7 @@ def _server_started(pgid: int) -> bool:
 def test_a_suite_killed_while_its_server_starts_leaves_no_process(tmp_path: Path) -> None:
     """Killed while its process server is still importing JSBSim and numba (seconds under load): the server, once
     started, finds its parent gone and ends at once (the parent-death request alone would come too late)."""
-    folder = tmp_path / "m"
-    folder.mkdir()
-    for i in range(2):
-        short(folder, name=f"long_{i}", seconds=900)
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "washbench", "suite", str(folder), "--out", str(tmp_path / "out"), "--jobs", "2",
-         "--quiet"],
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-        start_new_session=True,
-    )  # fmt: skip
+    proc = long_suite(tmp_path, output=subprocess.DEVNULL)
     deadline = time.monotonic() + 60
     while not _server_started(proc.pid) and time.monotonic() < deadline:
         time.sleep(0.005)
