@@ -577,14 +577,25 @@ def _signal_in_finalizer(unraisable: object) -> None:
     import threading
 
     signum = signal.SIGINT if isinstance(exc, KeyboardInterrupt) else signal.SIGTERM
+    _PENDING.append(signum)  # a command that ends before the timer fires still reports it (main)
     while True:
         try:
-            timer = threading.Timer(0.01, os.kill, (os.getpid(), signum))
+            timer = threading.Timer(0.01, _send_again, (signum,))
             timer.daemon = True
             timer.start()
             return
         except (KeyboardInterrupt, Terminated):  # signalled again in here: still one to send
             continue
+
+
+#: Signals swallowed in a finalizer and not yet sent again (see :func:`_signal_in_finalizer`).
+_PENDING: list[int] = []
+
+
+def _send_again(signum: int) -> None:
+    if _PENDING:
+        _PENDING.clear()
+        os.kill(os.getpid(), signum)
 
 
 def _quiet_broken_pipe() -> int:
@@ -637,6 +648,10 @@ def main(argv: list[str] | None = None) -> int:
             _load_plugins(args)
             status = _dispatch(args)
             sys.stdout.flush()
+            if _PENDING:  # signalled at the very end (swallowed in a finalizer): the work is done, say so anyway
+                last = _PENDING[-1]
+                _PENDING.clear()
+                raise KeyboardInterrupt if last == signal.SIGINT else Terminated()
             return status
         except WashbenchError as exc:
             print(f"washbench: error: {printable(str(exc))}", file=sys.stderr)
