@@ -48,7 +48,10 @@ _LAZY = {"CueingBank", "WashoutTrace", "cue_trace"}
 
 def __getattr__(name: str) -> Any:
     if name in _LAZY:
-        from washbench.cueing import bank
+        from washbench.io.outfolder import signals_held
+
+        with signals_held():  # a SIGINT/SIGTERM in the middle of this import was lost (acts once it is done)
+            from washbench.cueing import bank
 
         return getattr(bank, name)
     raise AttributeError(f"module 'washbench.cueing' has no attribute {name!r}")
