@@ -16,6 +16,7 @@ import signal
 import socket
 import subprocess
 import sys
+import tempfile
 import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -557,6 +558,7 @@ def test_workers_end_when_the_suite_is_killed(tmp_path: Path) -> None:
         time.sleep(0.1)
     assert len(live_processes(proc.pid)) >= 4
     time.sleep(1.0)
+    pids = {line.split()[0] for line in live_processes(proc.pid)}
     proc.kill()
     proc.wait()
     deadline = time.monotonic() + 10
@@ -567,6 +569,18 @@ def test_workers_end_when_the_suite_is_killed(tmp_path: Path) -> None:
     sizes = digest(stage[0]) if stage else {}
     time.sleep(1.0)
     assert (digest(stage[0]) if stage else {}) == sizes  # nobody writes into the stage any more
+    # the killed workers' JSBSim scratch folders (no exit handler ran) go with the next process that makes one
+    from washbench.flight.jsbsim_xml import _SCRATCH_PREFIX
+
+    scratch = Path(tempfile.gettempdir())
+
+    def killed_scratch() -> list[Path]:
+        return [d for d in scratch.glob(f"{_SCRATCH_PREFIX}*") if d.name[len(_SCRATCH_PREFIX) :].split("-")[0] in pids]
+
+    assert killed_scratch()
+    code = "from washbench.flight.jsbsim_xml import scratch_output_dir; scratch_output_dir()"
+    subprocess.run([sys.executable, "-c", code], check=True, timeout=60)
+    assert killed_scratch() == []
 
 
 

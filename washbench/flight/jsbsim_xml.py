@@ -84,18 +84,56 @@ def read_xml(path: str | Path) -> ET.Element:
 _SCRATCH: tuple[int, str] | None = None
 
 
+_SCRATCH_PREFIX = "washbench-jsbsim-out-"
+
+
+def _remove_dead_scratch() -> None:
+    """Remove the scratch folders of processes that no longer run (killed with SIGKILL: no exit handler ran),
+    this user's only."""
+    import shutil
+
+    for entry in Path(tempfile.gettempdir()).glob(f"{_SCRATCH_PREFIX}*-*"):
+        pid = entry.name[len(_SCRATCH_PREFIX) :].split("-", 1)[0]
+        try:
+            if not pid.isdigit() or entry.is_symlink() or entry.stat().st_uid != os.getuid():
+                continue
+        except OSError:
+            continue
+        if not _running(int(pid)):
+            shutil.rmtree(entry, ignore_errors=True)
+
+
+def _running(pid: int) -> bool:
+    """Whether process ``pid`` runs (a zombie, dead but not yet reaped, does not)."""
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+        return stat[stat.rindex(")") + 2 :].split()[0] != "Z"
+    except FileNotFoundError:
+        return False
+    except (OSError, ValueError, IndexError):  # no /proc (macOS): ask the kernel
+        try:
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            return False
+        except OSError:
+            return True
+        return True
+
+
 def scratch_output_dir() -> str:
     """A private temporary folder of this process for JSBSim's output path (``FGFDMExec.set_output_path``).
 
     Created on first use (per process: a forked worker gets its own), removed when the process ends (a pool
-    worker's exit included); whatever JSBSim writes there (``simulation/write-state-file``) is thrown away.
+    worker's exit included; a process killed with SIGKILL leaves its folder, removed by the next process that
+    creates one); whatever JSBSim writes there (``simulation/write-state-file``) is thrown away.
     """
     global _SCRATCH
     if _SCRATCH is None or _SCRATCH[0] != os.getpid():
         import multiprocessing.util
         import shutil
 
-        path = tempfile.mkdtemp(prefix="washbench-jsbsim-out-")
+        _remove_dead_scratch()
+        path = tempfile.mkdtemp(prefix=f"{_SCRATCH_PREFIX}{os.getpid()}-")
         _SCRATCH = (os.getpid(), path)
         # run at exit by the main process (atexit) and by multiprocessing workers alike
         multiprocessing.util.Finalize(None, shutil.rmtree, args=(path,), kwargs={"ignore_errors": True},
