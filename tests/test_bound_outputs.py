@@ -3,8 +3,8 @@ MPC in ``omct``, ``sweep`` and ``tune``.
 
 The bound's cost is at most every washout's on the same cost (if a washout beats it, one of them is wrong: the check
 fails). Checked here on a short real JSBSim flight through the suite's files; on every bundled manoeuvre by
-``WASHBENCH_BOUND_SUITE=<a suite folder run with --washout bound>`` or ``WASHBENCH_SLOW=1`` (flies them all: about
-25 minutes on two cores).
+``WASHBENCH_BOUND_SUITE=<a suite folder run with --washout bound>`` or ``WASHBENCH_SLOW=1`` (flies them all: 3.5
+minutes on two cores), which ``.ci/run`` runs as a step after the README's test command.
 """
 
 from __future__ import annotations
@@ -266,7 +266,7 @@ def test_mpc_omct_measures_its_unconstrained_law_at_the_omct_amplitudes() -> Non
 
 @pytest.mark.skipif(not (os.environ.get("WASHBENCH_BOUND_SUITE") or os.environ.get("WASHBENCH_SLOW")),
                     reason="every bundled manoeuvre: WASHBENCH_BOUND_SUITE=<suite folder> or WASHBENCH_SLOW=1 "
-                    "(about 25 minutes)")  # fmt: skip
+                    "(3.5 min on two cores; .ci/run runs it)")  # fmt: skip
 def test_bound_below_every_washout_on_every_bundled_manoeuvre(tmp_path: Path) -> None:
     given = os.environ.get("WASHBENCH_BOUND_SUITE")
     out = Path(given) if given else None
