@@ -2,8 +2,9 @@
 
     python tools/mpc_position_figure.py RUN_DIR OUT.png [--washouts small-angle unrestricted optimal mpc bound]
 
-Each washout's legend entry gives its time with the stage at its position limit (its ``sat_pos`` column); the oracle
-bound (if the run has it: ``--washout bound``) is drawn dotted.
+Each washout's legend entry gives its time with the stage on a position limit, from the positions themselves (any
+axis within 0.5 % of its travel limit: a limiter braking there (``sat_pos``) and a constraint met with equality (the
+MPC, the bound) count alike); the oracle bound (if the run has it: ``--washout bound``) is drawn dotted.
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ import argparse
 from pathlib import Path
 
 import matplotlib
+import numpy as np
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
@@ -30,9 +32,14 @@ def main() -> None:
     ts = t.column("t_s").to_numpy()
     dt = float(ts[1] - ts[0])
     washouts = [w for w in args.washouts if f"{w}.pos_x_m" in t.column_names]
-    label = {w: f"{w} ({t.column(f'{w}.sat_pos').to_numpy().sum() * dt:.1f} s at a limit)" for w in washouts}
+    lim = np.asarray(load_platform_limits().translation.position_limit_m.xyz, dtype=float)
+
+    def on_limit_s(w: str) -> float:
+        pos = np.column_stack([t.column(f"{w}.pos_{a}_m").to_numpy() for a in "xyz"])
+        return float(np.any(np.abs(pos) >= 0.995 * lim, axis=1).sum() * dt)
+
+    label = {w: f"{w} ({on_limit_s(w):.1f} s on a position limit)" for w in washouts}
     style = {"mpc": {"lw": 1.6, "color": "tab:red"}, "bound": {"lw": 1.1, "color": "0.35", "ls": ":"}}
-    lim = load_platform_limits().translation.position_limit_m.xyz
     fig, axes = plt.subplots(3, 1, figsize=(10, 7.5), sharex=True)
     for i, (ax, name) in enumerate(zip(axes, ("x (north)", "y (east)", "z (down)"), strict=True)):
         for w in washouts:
