@@ -55,14 +55,7 @@ def read_xml(path: str | Path) -> ET.Element:
     from washbench.io.budget import read_bounded
 
     path = Path(path)
-    try:
-        data = read_bounded(path, MAX_XML_BYTES)
-    except FileNotFoundError:
-        raise WashbenchError(located(path, "no such file")) from None
-    except IsADirectoryError:
-        raise WashbenchError(located(path, "is a folder, not a file")) from None
-    except OSError as exc:
-        raise WashbenchError(located(path, f"cannot read: {exc.strerror or exc}")) from None
+    data = read_bounded(path, MAX_XML_BYTES)
     if not data.strip():
         raise WashbenchError(located(path, "the file is empty"))
     builder = ET.TreeBuilder()

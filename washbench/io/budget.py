@@ -32,9 +32,17 @@ def check_samples(n: float, what: str, where: str | Path | None = None) -> int:
 
 
 def read_bounded(path: str | Path, limit: int = MAX_YAML_BYTES) -> bytes:
-    """The bytes of ``path``, at most ``limit`` (OSError passes through; WashbenchError if it is longer)."""
-    with open(path, "rb") as fh:
-        data = fh.read(limit + 1)
+    """The bytes of ``path``, at most ``limit``; WashbenchError (one line naming the file) if it is longer, missing,
+    a folder, or cannot be read."""
+    try:
+        with open(path, "rb") as fh:
+            data = fh.read(limit + 1)
+    except FileNotFoundError:
+        raise WashbenchError(located(path, "no such file")) from None
+    except IsADirectoryError:
+        raise WashbenchError(located(path, "is a folder, not a file")) from None
+    except OSError as exc:
+        raise WashbenchError(located(path, f"cannot read: {exc.strerror or exc}")) from None
     if len(data) > limit:
         raise WashbenchError(located(path, f"larger than {limit // (1024 * 1024)} MB: not a washbench input file"))
     return data

@@ -353,15 +353,11 @@ def read_yaml_digest(path: Path) -> tuple[Any, dict[Loc, int], str]:
 
     from washbench.io.budget import read_bounded
 
+    raw = read_bounded(path)
     try:
-        raw = read_bounded(path)
         text = raw.decode("utf-8")
-    except FileNotFoundError:
-        raise WashbenchError(located(path, "no such file")) from None
-    except IsADirectoryError:
-        raise WashbenchError(located(path, "is a folder, not a file")) from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise WashbenchError(located(path, f"cannot read: {getattr(exc, 'strerror', None) or exc}")) from None
+    except UnicodeDecodeError as exc:
+        raise WashbenchError(located(path, f"cannot read: {exc}")) from None
     try:
         try:
             node, data = _parse(text, _UniqueKeyLoader)
