@@ -102,7 +102,8 @@ S_TH = S_AD + 15  # d(theta_sp)/dk: attitude sensitivity, body axes, 3x3 row-maj
 S_SFX = S_AD + 24  # the sensitivity high-pass filters' states (3 filters x 2)
 S_GRAD = S_AD + 30  # the last step's gradient dJ/dp (3), dJ/dk (3)
 S_COST = S_AD + 36  # the last step's cost J
-NSTATE = S_AD + 37
+S_DW = S_AD + 37  # the last step's tilt-rate sensitivities d(w_t)/dk, 3x3 row-major [i, j] = component i of column j
+NSTATE = S_AD + 46
 
 
 @njit(cache=True)
@@ -254,33 +255,32 @@ def _adapt(c, coef, state, fs, ws, u, g_s, f_lp, wt_raw, wt, sat_tilt, a_hp, q_s
     nf = norm3(f_lp)
     ng = norm3(g_s)
     before = c[C_LP_BEFORE] != 0.0 and nf >= c[C_FREEFALL] and ng > 0.0
-    dw = np.zeros((3, 3))  # [i, j]: component i of dw_t/dk_j
+    for m in range(9):  # [i, j] at S_DW + 3 i + j: component i of dw_t/dk_j (in the state: no allocation per step)
+        state[S_DW + m] = 0.0
     for j in range(3):
         kj = state[S_GK + j]
-        dw[j, j] = wt_raw[j] / kj if kj > 0.0 else 0.0
+        state[S_DW + 4 * j] = wt_raw[j] / kj if kj > 0.0 else 0.0
         if before:
             th = (state[S_TH + j], state[S_TH + 3 + j], state[S_TH + 6 + j])
             dc = cross(cross(g_s, th), f_lp)
             for i in range(3):
-                dw[i, j] += state[S_GK + i] * dc[i] / (nf * ng)
+                state[S_DW + 3 * i + j] += state[S_GK + i] * dc[i] / (nf * ng)
     if sat_tilt:  # through the limit: the norm limit's Jacobian (vmax/|v|)(I - v v^T/|v|^2); the axis limit's zeros
         vmax = c[C_TILT_RATE]
         n = norm3(wt_raw)
         for j in range(3):
-            col = (dw[0, j], dw[1, j], dw[2, j])
+            col = (state[S_DW + j], state[S_DW + 3 + j], state[S_DW + 6 + j])
             if c[C_TILT_AXIS] != 0.0:
                 for i in range(3):
                     if wt[i] != wt_raw[i]:
-                        dw[i, j] = 0.0
+                        state[S_DW + 3 * i + j] = 0.0
             elif n > 0.0:
                 d = (col[0] * wt_raw[0] + col[1] * wt_raw[1] + col[2] * wt_raw[2]) / (n * n)
                 for i in range(3):
-                    dw[i, j] = (vmax / n) * (col[i] - wt_raw[i] * d)
+                    state[S_DW + 3 * i + j] = (vmax / n) * (col[i] - wt_raw[i] * d)
     # gradients
-    gp_l = [0.0, 0.0, 0.0]
-    gk_l = [0.0, 0.0, 0.0]
     for j in range(3):
-        gp_l[j] = (
+        state[S_GRAD + j] = (
             -c[C_WF] * e_fi[j] * state[S_SA + j]
             + c[C_WX] * state[S_PSP + j] * state[S_SX + j]
             + c[C_WV] * state[S_VSP + j] * state[S_SV + j]
@@ -288,16 +288,11 @@ def _adapt(c, coef, state, fs, ws, u, g_s, f_lp, wt_raw, wt, sat_tilt, a_hp, q_s
         )
         th = (state[S_TH + j], state[S_TH + 3 + j], state[S_TH + 6 + j])
         df = cross(f_s, th)  # d(f_S)/dk_j: f_S(theta + d) = f_S + f_S x d
-        gk_l[j] = (
+        state[S_GRAD + 3 + j] = (
             -c[C_WF] * (e_f[0] * df[0] + e_f[1] * df[1] + e_f[2] * df[2])
-            - c[C_WW] * (e_w[0] * dw[0, j] + e_w[1] * dw[1, j] + e_w[2] * dw[2, j])
+            - c[C_WW] * (e_w[0] * state[S_DW + j] + e_w[1] * state[S_DW + 3 + j] + e_w[2] * state[S_DW + 6 + j])
             + c[C_WKG] * (state[S_GK + j] - c[C_TILT_K])
         )
-    gp = (gp_l[0], gp_l[1], gp_l[2])
-    gk = (gk_l[0], gk_l[1], gk_l[2])
-    for j in range(3):
-        state[S_GRAD + j] = gp[j]
-        state[S_GRAD + 3 + j] = gk[j]
     cost = 0.0
     for j in range(3):
         cost += c[C_WF] * e_f[j] * e_f[j] + c[C_WW] * e_w[j] * e_w[j]
@@ -309,11 +304,11 @@ def _adapt(c, coef, state, fs, ws, u, g_s, f_lp, wt_raw, wt, sat_tilt, a_hp, q_s
         th = (state[S_TH + j], state[S_TH + 3 + j], state[S_TH + 6 + j])
         rot = cross(w_s, th)
         for i in range(3):
-            state[S_TH + 3 * i + j] = th[i] - rot[i] * dt + dw[i, j] * dt
+            state[S_TH + 3 * i + j] = th[i] - rot[i] * dt + state[S_DW + 3 * i + j] * dt
     # steepest descent, clipped to the bounds
     for j in range(3):
-        state[S_GP + j] = min(c[C_PHI], max(c[C_PLO], state[S_GP + j] - c[C_GP] * gp[j] * dt))
-        state[S_GK + j] = min(c[C_KHI], max(c[C_KLO], state[S_GK + j] - c[C_GK] * gk[j] * dt))
+        state[S_GP + j] = min(c[C_PHI], max(c[C_PLO], state[S_GP + j] - c[C_GP] * state[S_GRAD + j] * dt))
+        state[S_GK + j] = min(c[C_KHI], max(c[C_KLO], state[S_GK + j] - c[C_GK] * state[S_GRAD + 3 + j] * dt))
 
 
 @njit(cache=True)
