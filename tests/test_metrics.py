@@ -101,3 +101,11 @@ def test_bad_shapes_raise() -> None:
         npc(np.zeros(3), np.zeros(4))
     with pytest.raises(ValueError):
         integral_abs_error(np.zeros(1), np.zeros(1), 0.1)
+
+
+def test_the_flatness_tolerance_is_one_value_in_both_modules() -> None:
+    """``analysis.metrics`` keeps its own copy of the compiled sums' flatness tolerance (importing those imports
+    numba); the copy must not drift from the value the compiled pass uses."""
+    from washbench.analysis import metric_sums, metrics
+
+    assert metrics.FLAT_RTOL == metric_sums.FLAT_RTOL
