@@ -131,3 +131,23 @@ def test_the_report_names_an_end_stop_next_to_the_score_it_dominates() -> None:
     note = end_stop_note(data, "a")
     assert note == "end stop: stage at its position limit for 5.40 s (54 %), the score reflects its hard stops"
     assert end_stop_note(data, "b") == "" and end_stop_note(data, "c") == ""
+
+
+@pytest.mark.parametrize("alpha", [255, 128])
+def test_png_bytes_decode_to_the_pixels_given(alpha: int) -> None:
+    """The figures' PNG writer read back by Pillow (an independent decoder): same pixels, the resolution, RGB when
+    every pixel is opaque, RGBA otherwise."""
+    import io
+
+    from PIL import Image
+
+    from washbench.review.png import png_bytes
+
+    rgba = np.random.default_rng(3).integers(0, 256, size=(37, 53, 4), dtype=np.uint8)
+    rgba[:, :, 3] = 255
+    rgba[5, 7, 3] = alpha
+    image = Image.open(io.BytesIO(png_bytes(rgba, 110.0)))
+    assert image.mode == ("RGB" if alpha == 255 else "RGBA")
+    assert image.info["dpi"] == pytest.approx((110.0, 110.0), abs=0.01)
+    back = np.asarray(image.convert("RGBA"))
+    assert np.array_equal(back, rgba)
