@@ -26,7 +26,7 @@ same files: no dates or random ids are written into the PNG or PDF.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -103,12 +103,14 @@ def _new_figure(
 def _stacked_layout(
     key: tuple[Any, ...], size_in: tuple[float, float], margins_in: tuple[float, float, float, float],
     ratios: Sequence[float],
-) -> tuple[Any, Any]:  # fmt: skip
-    """A figure of panels stacked on one shared time axis, laid out once per process and reused.
+) -> tuple[Any, Any, bool]:  # fmt: skip
+    """A figure of panels stacked on one shared time axis, laid out once per process and reused; and whether it is
+    new (then the caller styles its ticks and grid, which a reused one keeps).
 
     Building the axes and their ticks costs more than drawing the data; a worker that draws many results reuses the
     layout it already built for the same ``key`` (size, margins and panel ratios), emptied of the previous data:
-    lines, patches, texts, collections, legends, titles, tick choices and data limits. Same data, same pixels.
+    lines, patches, texts, collections, titles, tick choices and data limits (the legend stays while it is the same,
+    :func:`_top_legend`). Same data, same pixels.
     """
     cached = _LAYOUT_CACHE.pop(key, None)
     if cached is None:
@@ -125,8 +127,6 @@ def _stacked_layout(
             _LAYOUT_CACHE.pop(next(iter(_LAYOUT_CACHE)))
     else:
         fig, axes = cached
-        for legend in list(fig.legends):
-            legend.remove()
         for ax in axes:
             for artist in [*ax.lines, *ax.patches, *ax.texts, *ax.collections]:
                 artist.remove()
@@ -139,7 +139,7 @@ def _stacked_layout(
             ax.yaxis.set_major_locator(_auto_locator())
             ax.yaxis.set_major_formatter(_auto_formatter())
     _LAYOUT_CACHE[key] = (fig, axes)
-    return fig, axes
+    return fig, axes, cached is None
 
 
 def _auto_locator() -> Any:
@@ -163,9 +163,17 @@ _LEGEND_ROW = 6
 """Entries in one legend row; more (the aircraft and six or more washouts) go on two rows in a smaller font."""
 
 
-def _top_legend(fig: Any, handles: list[Any]) -> None:
+def _top_legend(fig: Any, handles: Callable[[], list[Any]], key: tuple[Any, ...]) -> None:
     """The legend above the panels (under the figure's top edge): one row, or two when there are more than
-    :data:`_LEGEND_ROW` entries (so that every name stays inside the picture)."""
+    :data:`_LEGEND_ROW` entries (so that every name stays inside the picture). ``handles`` makes the entries;
+    ``key`` says all they depend on: a reused figure keeps its legend while the key is the same (laying a legend out
+    costs a tenth of the figure)."""
+    if fig.legends and getattr(fig, "_washbench_legend", None) == key:
+        return
+    for legend in list(fig.legends):
+        legend.remove()
+    fig._washbench_legend = key
+    handles = handles()
     two = len(handles) > _LEGEND_ROW
     fig.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, 1.0 - 0.02 / fig.get_figheight()),
                ncol=math.ceil(len(handles) / 2) if two else len(handles), fontsize=7.0 if two else 8.5,
@@ -352,7 +360,7 @@ def perceived_figure(
     colors, dashes = washout_colors(washouts, pal), washout_dashes(washouts)
     ac_color = mpl(aircraft_color(pal))
     ratios = (0.35, *[1.0] * 6) if phases else (1.0,) * 6
-    fig, axes = _stacked_layout(("perceived", ratios), PERCEIVED_SIZE_IN, PERCEIVED_MARGINS_IN, ratios)
+    fig, axes, new = _stacked_layout(("perceived", ratios), PERCEIVED_SIZE_IN, PERCEIVED_MARGINS_IN, ratios)
     width_px = _plot_width_px(PERCEIVED_SIZE_IN, PERCEIVED_MARGINS_IN)
     t0, t1 = float(t_s[0]), float(t_s[-1])
     if phases:
@@ -373,16 +381,20 @@ def perceived_figure(
         tt, yy = minmax_decimate(t_s, perceived["aircraft"][:, i], width_px)
         ax.plot(tt, yy, color=ac_color, lw=1.7, zorder=3)
         ax.set_ylabel(f"{dof}\n({unit})", fontsize=9)
-        ax.tick_params(labelsize=8)
-        ax.grid(True, color=(0.9, 0.9, 0.9), lw=0.5)
+        if new:  # a reused layout keeps its tick and grid style
+            ax.tick_params(labelsize=8)
+            ax.grid(True, color=(0.9, 0.9, 0.9), lw=0.5)
         ax.margins(x=0)
     panels[-1].set_xlabel("time (s)", fontsize=9)
     panels[-1].set_xlim(t0, t1)
-    handles = [Line2D([], [], color=ac_color, lw=1.7, label="aircraft pilot")]
-    handles += [Line2D([], [], color=mpl(colors[w]), lw=1.2, ls=dashes[w], label=w) for w in washouts]
-    if thresholds is not None:
-        handles.append(Patch(facecolor=_THRESHOLD_FILL, edgecolor=_THRESHOLD_COLOR, lw=0.6, label="not felt"))
-    _top_legend(fig, handles)
+    def handles() -> list[Any]:
+        out = [Line2D([], [], color=ac_color, lw=1.7, label="aircraft pilot")]
+        out += [Line2D([], [], color=mpl(colors[w]), lw=1.2, ls=dashes[w], label=w) for w in washouts]
+        if thresholds is not None:
+            out.append(Patch(facecolor=_THRESHOLD_FILL, edgecolor=_THRESHOLD_COLOR, lw=0.6, label="not felt"))
+        return out
+
+    _top_legend(fig, handles, (pal, tuple(washouts), thresholds is not None))
     axes[0].set_title(f"{title}: perceived motion", fontsize=11)
     return save_figure(fig, stem, formats)
 
@@ -423,7 +435,7 @@ def envelope_figure(
     size_in = (8.6, 1.55 * len(usage) + 0.9 + 0.2 * n_lanes)
     margins_in = (max(0.85, label_in + 0.45), 0.12, 0.62, 0.45)
     ratios = (*[1.0] * len(usage), 0.12 * n_lanes + 0.25)
-    fig, axes = _stacked_layout(("envelope", size_in, margins_in, ratios), size_in, margins_in, ratios)
+    fig, axes, new = _stacked_layout(("envelope", size_in, margins_in, ratios), size_in, margins_in, ratios)
     width_px = _plot_width_px(size_in, margins_in)
     dt = float(t_s[1] - t_s[0]) if t_s.shape[0] > 1 else 0.0
     for ax, (label, per) in zip(axes, usage.items(), strict=False):
@@ -437,8 +449,9 @@ def envelope_figure(
                 top = max(top, float(np.nanmax(u)))
         ax.set_ylim(0.0, 1.08 * top)
         ax.set_ylabel(f"{label}\n(of limit)", fontsize=9)
-        ax.tick_params(labelsize=8)
-        ax.grid(True, color=(0.9, 0.9, 0.9), lw=0.5)
+        if new:  # a reused layout keeps its tick and grid style
+            ax.tick_params(labelsize=8)
+            ax.grid(True, color=(0.9, 0.9, 0.9), lw=0.5)
     lane_ax = axes[-1]
     if lanes:
         # a limit active for a few samples is still drawn visibly wide (0.3 % of the manoeuvre)
@@ -456,12 +469,16 @@ def envelope_figure(
         lane_ax.set_yticks([])
         lane_ax.text(0.5, 0.5, "no limit reached", transform=lane_ax.transAxes, ha="center", va="center", fontsize=8)
     lane_ax.set_ylabel("limit\nactive", fontsize=9)
-    lane_ax.tick_params(axis="x", labelsize=8)
+    if new:
+        lane_ax.tick_params(axis="x", labelsize=8)
     lane_ax.set_xlabel("time (s)", fontsize=9)
     lane_ax.set_xlim(float(t_s[0]), float(t_s[-1]))
-    handles = [Line2D([], [], color=mpl(colors[w]), lw=1.2, ls=dashes[w], label=w) for w in washouts]
-    handles.append(Line2D([], [], color=(0.3, 0.3, 0.3), lw=0.9, ls=(0, (2.0, 2.0)), label="limit"))
-    _top_legend(fig, handles)
+
+    def handles() -> list[Any]:
+        out = [Line2D([], [], color=mpl(colors[w]), lw=1.2, ls=dashes[w], label=w) for w in washouts]
+        return [*out, Line2D([], [], color=(0.3, 0.3, 0.3), lw=0.9, ls=(0, (2.0, 2.0)), label="limit")]
+
+    _top_legend(fig, handles, (pal, tuple(washouts)))
     axes[0].set_title(f"{title}: platform envelope", fontsize=11)
     return save_figure(fig, stem, formats)
 
