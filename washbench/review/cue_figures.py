@@ -16,6 +16,7 @@ import numpy as np
 from washbench.analysis.cues import FALSE, MISSING, classify, dof_thresholds
 from washbench.analysis.metrics import DOFS
 from washbench.io.outfolder import uninterrupted
+from washbench.review.figures import collector_paused
 
 FALSE_COLOUR = (0.84, 0.15, 0.16)
 MISSING_COLOUR = (0.72, 0.72, 0.72)
@@ -40,6 +41,7 @@ def cue_classes(perceived: Mapping[str, np.ndarray], washouts: Sequence[str]) ->
 
 
 @uninterrupted
+@collector_paused
 def cue_lane_figure(
     stem: Path,
     title: str,
