@@ -151,3 +151,38 @@ def test_png_bytes_decode_to_the_pixels_given(alpha: int) -> None:
     assert image.info["dpi"] == pytest.approx((110.0, 110.0), abs=0.01)
     back = np.asarray(image.convert("RGBA"))
     assert np.array_equal(back, rgba)
+
+
+@pytest.mark.parametrize("with_nan", [False, True])
+def test_minmax_decimation_is_each_buckets_first_minimum_and_maximum_in_time_order(with_nan: bool) -> None:
+    """Against a plain loop over the buckets (ties on purpose: the first of equal values is kept), finite traces
+    (the fast path) and traces with NaNs (kept out of the min/max) alike."""
+    from washbench.review.figures import minmax_decimate
+
+    rng = np.random.default_rng(7)
+    for _ in range(60):
+        n, buckets = int(rng.integers(3, 3000)), int(rng.integers(1, 400))
+        t = np.cumsum(rng.random(n))
+        y = rng.integers(-3, 4, n).astype(float)
+        if with_nan:
+            y[rng.random(n) < 0.2] = np.nan
+        tt, yy = minmax_decimate(t, y, buckets)
+        if n <= 2 * buckets:
+            assert tt is t and yy is y
+            continue
+        size = -(-n // buckets)
+        exp_t, exp_y = [], []
+        for a in range(0, n, size):
+            chunk = y[a : a + size]
+            finite = [i for i in range(len(chunk)) if not np.isnan(chunk[i])]
+            if not finite:  # a bucket of NaNs stays NaN
+                exp_t += [t[a], t[a]]
+                exp_y += [np.nan, np.nan]
+                continue
+            lo = min(finite, key=lambda i: (chunk[i], i))
+            hi = min(finite, key=lambda i: (-chunk[i], i))
+            for i in sorted((lo, hi)):
+                exp_t.append(t[a + i])
+                exp_y.append(chunk[i])
+        assert np.array_equal(tt, exp_t)
+        assert np.array_equal(yy, exp_y, equal_nan=True)

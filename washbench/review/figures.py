@@ -244,6 +244,17 @@ def minmax_decimate(t: np.ndarray, y: np.ndarray, buckets: int = 1500) -> tuple[
         return t, y
     size = math.ceil(n / buckets)
     buckets = math.ceil(n / size)
+    if np.isfinite(y).all():  # the usual case: argmin/argmax on a view of the samples, no copies
+        full = n // size
+        yb = y[: full * size].reshape(full, size)
+        lo, hi = yb.argmin(axis=1), yb.argmax(axis=1)
+        if full < buckets:  # the last, shorter bucket
+            rest = y[full * size :]
+            lo = np.append(lo, rest.argmin())
+            hi = np.append(hi, rest.argmax())
+        start = np.arange(buckets) * size
+        idx = np.column_stack([start + np.minimum(lo, hi), start + np.maximum(lo, hi)]).ravel()
+        return t[idx], y[idx]
     pad = size * buckets - n
     yp = np.concatenate([y, np.full(pad, y[-1])]).reshape(buckets, size)
     tp = np.concatenate([t, np.full(pad, t[-1])]).reshape(buckets, size)
@@ -359,6 +370,18 @@ def _shade_phases(ax: Any, phases: Sequence[tuple[str, float, float]]) -> None:
                       autolim=False)  # fmt: skip
 
 
+def _band(ax: Any, lo: float, hi: float) -> None:
+    """The not-felt band ``lo..hi`` across the panel, drawn as ``axhspan`` draws it, without its data-limit update
+    (the threshold lines drawn with it span the same values; the update cost as much as drawing the band)."""
+    from matplotlib.axis import GRIDLINE_INTERPOLATION_STEPS
+    from matplotlib.patches import Rectangle
+
+    band = Rectangle((0.0, lo), 1.0, hi - lo, facecolor=_THRESHOLD_FILL, edgecolor="none", zorder=1)
+    band.set_transform(ax.get_yaxis_transform(which="grid"))
+    band.get_path()._interpolation_steps = GRIDLINE_INTERPOLATION_STEPS
+    ax.add_artist(band)
+
+
 @uninterrupted
 @collector_paused
 def perceived_figure(
@@ -401,7 +424,7 @@ def perceived_figure(
         _shade_phases(ax, phases)
         if thresholds is not None:
             lo, hi = rest[i] - thresholds[i], rest[i] + thresholds[i]
-            ax.axhspan(lo, hi, facecolor=_THRESHOLD_FILL, edgecolor="none", zorder=1)
+            _band(ax, lo, hi)
             ax.plot([t0, t1, np.nan, t0, t1], [lo, lo, np.nan, hi, hi], color=_THRESHOLD_COLOR, lw=0.6, zorder=1)
         for w in washouts:
             tt, yy = minmax_decimate(t_s, perceived[w][:, i], width_px)
