@@ -345,7 +345,7 @@ def _phase_lane(ax: Any, phases: Sequence[tuple[str, float, float]], t0_s: float
     boxes = []
     for i, (name, a, b) in enumerate(phases):
         shade = (0.82, 0.86, 0.92) if i % 2 == 0 else (0.90, 0.92, 0.96)
-        ax.axvspan(a, b, color=shade, lw=0)
+        _span(ax, a, b, color=shade, lw=0)
         boxes.append((name, (max(a, t0_s) - t0_s) / span * width_in, (min(b, t1_s) - t0_s) / span * width_in))
     for label in place_phase_labels(boxes, width_in):
         ax.text(t0_s + label.x_in / width_in * span, (0.5, 0.75, 0.25)[label.row], label.text, ha="center",
@@ -368,6 +368,26 @@ def _shade_phases(ax: Any, phases: Sequence[tuple[str, float, float]]) -> None:
     starts = [[(t0, 0.0), (t0, 1.0)] for _, t0, _ in phases]
     ax.add_collection(LineCollection(starts, colors=[(0.6, 0.6, 0.6)], linewidths=0.5, zorder=0.5, transform=trans),
                       autolim=False)  # fmt: skip
+
+
+def _line(ax: Any, x: Any, y: Any, **style: Any) -> None:
+    """A data line, as ``ax.plot(x, y, **style)`` draws it (Line2D, data limits updated) without plot()'s argument
+    parsing, which cost a tenth of a reused figure; the caller asks for the autoscaling it needs."""
+    from matplotlib.lines import Line2D
+
+    ax.add_line(Line2D(x, y, **style))
+
+
+def _span(ax: Any, t0_s: float, t1_s: float, **style: Any) -> None:
+    """A box over the whole height of a panel from ``t0_s`` to ``t1_s``, drawn as ``axvspan`` draws it, without its
+    data-limit update (the panels' time limits are set, never autoscaled)."""
+    from matplotlib.axis import GRIDLINE_INTERPOLATION_STEPS
+    from matplotlib.patches import Rectangle
+
+    box = Rectangle((t0_s, 0.0), t1_s - t0_s, 1.0, **style)
+    box.set_transform(ax.get_xaxis_transform(which="grid"))
+    box.get_path()._interpolation_steps = GRIDLINE_INTERPOLATION_STEPS
+    ax.add_artist(box)
 
 
 def _band(ax: Any, lo: float, hi: float) -> None:
@@ -425,12 +445,13 @@ def perceived_figure(
         if thresholds is not None:
             lo, hi = rest[i] - thresholds[i], rest[i] + thresholds[i]
             _band(ax, lo, hi)
-            ax.plot([t0, t1, np.nan, t0, t1], [lo, lo, np.nan, hi, hi], color=_THRESHOLD_COLOR, lw=0.6, zorder=1)
+            _line(ax, [t0, t1, np.nan, t0, t1], [lo, lo, np.nan, hi, hi], color=_THRESHOLD_COLOR, lw=0.6, zorder=1)
         for w in washouts:
             tt, yy = minmax_decimate(t_s, perceived[w][:, i], width_px)
-            ax.plot(tt, yy, color=mpl(colors[w]), lw=1.0, ls=dashes[w], zorder=2)
+            _line(ax, tt, yy, color=mpl(colors[w]), lw=1.0, ls=dashes[w], zorder=2)
         tt, yy = minmax_decimate(t_s, perceived["aircraft"][:, i], width_px)
-        ax.plot(tt, yy, color=ac_color, lw=1.7, zorder=3)
+        _line(ax, tt, yy, color=ac_color, lw=1.7, zorder=3)
+        ax.autoscale(axis="y")  # the y limits from the lines' data, at drawing (as plot() asks)
         ax.set_ylabel(f"{dof}\n({unit})", fontsize=9)
         if new:  # a reused layout keeps its tick and grid style
             ax.tick_params(labelsize=8)
@@ -496,7 +517,7 @@ def envelope_figure(
         top = 1.0
         for w, u in per.items():
             tt, yy = minmax_decimate(t_s, u, width_px)
-            ax.plot(tt, yy, color=mpl(colors[w]), lw=1.0, ls=dashes[w], zorder=2)
+            _line(ax, tt, yy, color=mpl(colors[w]), lw=1.0, ls=dashes[w], zorder=2)
             if u.size and np.isfinite(u).any():
                 top = max(top, float(np.nanmax(u)))
         ax.set_ylim(0.0, 1.08 * top)
