@@ -28,14 +28,14 @@ def traces(n: int, seed: int) -> dict[str, np.ndarray]:
     return {"aircraft": base, **{w: base + 0.1 * i for i, w in enumerate(NAMES[:3])}}
 
 
-def draw(folder: Path, seed: int, n: int = 5000) -> bytes:
+def draw(folder: Path, seed: int, n: int = 5000, washouts: tuple[str, ...] = tuple(NAMES[:3])) -> bytes:
     t = np.arange(n) / 120.0
-    perceived = traces(n, seed)
+    perceived = {k: v for k, v in traces(n, seed).items() if k == "aircraft" or k in washouts}
     phases = [("level", 0.0, 10.0), ("roll in", 10.0, 20.0), ("clean climb", 20.0, t[-1])]
     (png,) = perceived_figure(folder / "perceived", "test", t, perceived, phases=phases, thresholds=[0.1] * 6,
                               rest=list(perceived["aircraft"][0]))  # fmt: skip
-    usage = {"position": {w: np.abs(perceived[w][:, 0]) for w in NAMES[:3]}}
-    saturated = {"small-angle": {"pos": np.arange(n) % 500 < 3}}
+    usage = {"position": {w: np.abs(perceived[w][:, 0]) for w in washouts}}
+    saturated = {washouts[0]: {"pos": np.arange(n) % 500 < 3}}
     (env,) = envelope_figure(folder / "envelope", "test", t, usage, saturated, phases=phases)
     return png.read_bytes() + env.read_bytes()
 
@@ -48,6 +48,47 @@ def test_a_reused_layout_draws_the_same_pixels_as_a_fresh_one(tmp_path: Path) ->
     again = draw(tmp_path, seed=1)
     assert first == again
     assert other != first
+
+
+def test_a_reused_layout_changes_its_legend_with_the_washouts(tmp_path: Path) -> None:
+    """The legend stays on a reused layout only while its entries are the same: other washouts give the pixels a
+    fresh layout gives them, and the first washouts again their first pixels."""
+    from washbench.review import figures
+
+    three, two = tuple(NAMES[:3]), ("large-angle", "unrestricted")
+    first = draw(tmp_path, seed=1, washouts=three)
+    other = draw(tmp_path, seed=1, washouts=two)
+    again = draw(tmp_path, seed=1, washouts=three)
+    figures._LAYOUT_CACHE.clear()
+    fresh = draw(tmp_path, seed=1, washouts=two)
+    assert first == again and other == fresh and other != first
+
+
+def test_figure_writers_pause_the_garbage_collector_and_restore_it() -> None:
+    """collector_paused: off while the writer runs, then as it was (on or off), also when the writer fails."""
+    import gc
+
+    from washbench.review.figures import collector_paused
+
+    seen = []
+
+    @collector_paused
+    def writer(fail: bool) -> None:
+        seen.append(gc.isenabled())
+        if fail:
+            raise ValueError("drawing failed")
+
+    was = gc.isenabled()
+    try:
+        for enabled in (True, False):
+            (gc.enable if enabled else gc.disable)()
+            writer(False)
+            with pytest.raises(ValueError, match="drawing failed"):
+                writer(True)
+            assert gc.isenabled() == enabled
+        assert seen == [False] * 4
+    finally:
+        (gc.enable if was else gc.disable)()
 
 
 def test_every_washout_has_its_own_colour_and_line_style_in_each_palette() -> None:
