@@ -471,11 +471,28 @@ def perceived_figure(
     return save_figure(fig, stem, formats)
 
 
-def _runs(flags: np.ndarray) -> list[tuple[int, int]]:
-    """(start, end) index pairs of the runs of True in a boolean array (end exclusive)."""
+def run_edges(flags: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Start and end indices (end exclusive) of the runs of True in a boolean array, as two int arrays."""
     f = np.concatenate([[False], np.asarray(flags, dtype=bool), [False]])
     edges = np.flatnonzero(np.diff(f.astype(np.int8)))
-    return list(zip(edges[::2].tolist(), edges[1::2].tolist(), strict=True))
+    return edges[::2], edges[1::2]
+
+
+def bars(ax: Any, x0: np.ndarray, width: np.ndarray, y0: float, height: float, **style: Any) -> None:
+    """Boxes ``x0 .. x0 + width`` by ``y0 .. y0 + height`` (data units) as one collection, drawn as ``broken_barh``
+    draws them, built from arrays (broken_barh converts every box's two numbers one by one: a tenth of a second
+    for a 30-minute trace's runs) and without a data-limit update (the lane panels' limits are set)."""
+    from matplotlib.collections import PolyCollection
+
+    x0 = np.asarray(x0, dtype=np.float64)
+    x1 = x0 + np.asarray(width, dtype=np.float64)
+    y1 = y0 + height
+    verts = np.empty((x0.shape[0], 4, 2))
+    verts[:, 0, 0] = verts[:, 1, 0] = x0
+    verts[:, 2, 0] = verts[:, 3, 0] = x1
+    verts[:, 0, 1] = verts[:, 3, 1] = y0
+    verts[:, 1, 1] = verts[:, 2, 1] = y1
+    ax.add_collection(PolyCollection(verts, **style), autolim=False)
 
 
 @uninterrupted
@@ -531,8 +548,8 @@ def envelope_figure(
         min_width = max(dt, 0.003 * float(t_s[-1] - t_s[0]))
         for j, (w, _, flags) in enumerate(lanes):
             y = len(lanes) - 1 - j
-            segs = [(t_s[a], max((b - a) * dt, min_width)) for a, b in _runs(flags)]
-            lane_ax.broken_barh(segs, (y - 0.35, 0.7), color=mpl(colors[w]), lw=0)
+            a, b = run_edges(flags)
+            bars(lane_ax, t_s[a], np.maximum((b - a) * dt, min_width), y - 0.35, 0.7, color=mpl(colors[w]), lw=0)
         lane_ax.set_yticks(range(len(lanes)))
         lane_ax.set_yticklabels([SATURATION_LABELS.get(k, k) for _, k, _ in reversed(lanes)], fontsize=7.5)
         for tick, (w, _, _) in zip(lane_ax.get_yticklabels(), reversed(lanes), strict=True):
