@@ -459,6 +459,7 @@ def perceived_figure(
         ax.margins(x=0)
     panels[-1].set_xlabel("time (s)", fontsize=9)
     panels[-1].set_xlim(t0, t1)
+
     def handles() -> list[Any]:
         out = [Line2D([], [], color=ac_color, lw=1.7, label="aircraft pilot")]
         out += [Line2D([], [], color=mpl(colors[w]), lw=1.2, ls=dashes[w], label=w) for w in washouts]
