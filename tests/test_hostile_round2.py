@@ -435,7 +435,7 @@ def test_run_signalled_as_its_recording_lands_keeps_the_previous_result(tmp_path
         proc = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         deadline = time.monotonic() + 120
         while proc.poll() is None and time.monotonic() < deadline:
-            if any(p.name == "recording.rrd" for p in (out / "c172p").glob(".short.partial-*/recording.rrd")):
+            if any((out / "c172p").glob(STAGE_PREFIX + "*/short/recording.rrd")):
                 proc.send_signal(sig)
                 break
             time.sleep(0.002)
@@ -446,9 +446,9 @@ def test_run_signalled_as_its_recording_lands_keeps_the_previous_result(tmp_path
 
 
 def test_run_and_suite_on_a_full_disk_name_the_published_file(tmp_path: Path) -> None:
-    """``run`` and ``suite`` build in hidden partial folders: a recording that cannot be written is named where
-    it was going (``OUT/c172p/short/recording.rrd``), never ``.short.partial-PID`` or ``.suite.partial-PID``, in
-    the error line and in the suite's published failure reason."""
+    """``run`` and ``suite`` build in hidden stage folders: a recording that cannot be written is named where
+    it was going (``OUT/c172p/short/recording.rrd``), never in ``.washbench-stage-PID``, in the error line and in
+    the suite's published failure reason."""
     m = short(tmp_path, seconds=1)
     common = ["--washout", "small-angle", "--quiet", "--no-figures"]
     limit = _file_size_limit(300_000)  # the traces (~80 kB) pass, the recording (~700 kB) does not
@@ -456,7 +456,7 @@ def test_run_and_suite_on_a_full_disk_name_the_published_file(tmp_path: Path) ->
     proc = subprocess.run([sys.executable, "-m", "washbench", "run", str(m), "--out", str(out), *common],
                           capture_output=True, text=True, timeout=120, preexec_fn=limit)  # fmt: skip
     assert_clean_error(proc, f"{out / 'c172p' / 'short' / 'recording.rrd'}: cannot write")
-    assert "partial" not in proc.stderr
+    assert "partial" not in proc.stderr and STAGE_PREFIX not in proc.stderr
     out = tmp_path / "suite"
     proc = subprocess.run([sys.executable, "-m", "washbench", "suite", str(m), "--out", str(out), "--jobs", "1",
                            *common], capture_output=True, text=True, timeout=120, preexec_fn=limit)  # fmt: skip
@@ -565,7 +565,7 @@ def test_workers_end_when_the_suite_is_killed(tmp_path: Path) -> None:
     while (left := live_processes(proc.pid)) and time.monotonic() < deadline:
         time.sleep(0.1)
     assert left == []
-    stage = list(out.glob(".suite.partial-*"))
+    stage = list(out.glob(STAGE_PREFIX + "*"))
     sizes = digest(stage[0]) if stage else {}
     time.sleep(1.0)
     assert (digest(stage[0]) if stage else {}) == sizes  # nobody writes into the stage any more
