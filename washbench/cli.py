@@ -386,6 +386,7 @@ def _run_options(args: argparse.Namespace) -> Any:
 def _cue(args: argparse.Namespace) -> int:
     from washbench.io.input_format import input_format
     from washbench.runs.cue import CueOptions, run_cue
+    from washbench.runs.options import load_options
 
     opts = CueOptions(
         fmt=input_format(args.columns, args.input_format, args.axes, args.delimiter, args.decimal, args.jsbsim_dt),
@@ -394,24 +395,14 @@ def _cue(args: argparse.Namespace) -> int:
         split=not args.no_split,
         start_s=args.start_s,
         end_s=args.end_s,
-        filter_start=args.filter_start,
         strict=args.strict,
-        recording=not args.no_recording,
-        figures=not args.no_figures,
-        rank_by=args.rank_by,
-        vestibular=args.vestibular,
         progress=not args.quiet,
         force=args.force,
     )
-    return run_cue(
-        args.input,
-        args.out,
-        washouts=args.washout,
-        params_path=args.params,
-        platform_path=args.platform,
-        variants=args.variant,
-        options=opts,
-    )
+    run = load_options(params_path=args.params, platform_path=args.platform, washouts=args.washout,
+                       variants=args.variant, outputs=_outputs(args), filter_start=args.filter_start,
+                       rank_by=args.rank_by, vestibular=args.vestibular)  # fmt: skip
+    return run_cue(args.input, args.out, opts, run)
 
 
 def _aircraft_dir_option(p: argparse.ArgumentParser) -> None:
