@@ -28,6 +28,7 @@ from hostile import assert_clean_error, live_processes, long_suite, short, tree,
 from washbench.analysis.signals import SignalSpec, generate
 from washbench.io.motion_file import write_motion
 from washbench.io.outfolder import JOURNAL_PREFIX, MANIFEST, OLD_PREFIX, STAGE_PREFIX, recover
+from washbench.io.paths import MANOEUVRES_DIR
 
 JSBSIM_C172X = "c172x"
 
@@ -387,11 +388,11 @@ def test_a_disk_too_full_for_the_lock_names_the_folder(motion: Path, tmp_path: P
 
 FINALIZER_SIGNAL = """
 import os, signal, sys, time
-from washbench import cli
 from washbench.errors import Terminated
+from washbench.io import interrupts
 
-signal.signal(signal.SIGTERM, cli._terminate)
-sys.unraisablehook = cli._signal_in_finalizer
+signal.signal(signal.SIGTERM, interrupts.terminate)
+sys.unraisablehook = interrupts.signal_in_finalizer
 
 
 class Stream:  # as the rerun SDK's RecordingStream: work done in __del__
@@ -420,6 +421,45 @@ def test_a_signal_raised_inside_a_finalizer_still_stops_the_command(tmp_path: Pa
     proc = subprocess.run([sys.executable, "-c", FINALIZER_SIGNAL], capture_output=True, text=True, timeout=30)
     assert proc.stdout.strip() == "terminated in the command", (proc.stdout, proc.stderr)
     assert "Exception ignored" not in proc.stderr and "Traceback" not in proc.stderr, proc.stderr
+
+
+SIGNAL_WHILE_THE_CLI_LOADS = """
+import os, signal, sys, time
+
+sys.argv = ["washbench", "validate", sys.argv[1]]
+from washbench import __main__ as console
+
+
+class Stream:  # work in a finalizer while washbench.cli is imported, as importlib's module-lock weakref callbacks do
+    def __del__(self):
+        os.kill(os.getpid(), signal.SIGINT)
+        t = time.monotonic()
+        while time.monotonic() - t < 0.2:  # the handler runs in here, its KeyboardInterrupt is swallowed
+            pass
+
+
+class Finder:
+    def find_spec(self, name, path=None, target=None):
+        if name == "washbench.cli":
+            sys.meta_path.remove(self)
+            Stream()
+        return None
+
+
+sys.meta_path.insert(0, Finder())
+sys.exit(console.entry())
+"""
+
+
+def test_a_ctrl_c_swallowed_while_the_cli_loads_still_stops_the_command(tmp_path: Path) -> None:
+    """A Ctrl-C in the first fraction of a second, raised inside a finalizer while ``washbench.cli`` is imported,
+    was swallowed ("Exception ignored") and the command ran to its end with status 0: the console entry installs
+    the hook that sends it again before importing the CLI, so it ends the command (one line, 130)."""
+    manoeuvre = str(MANOEUVRES_DIR / "c172" / "takeoff.yaml")
+    proc = subprocess.run([sys.executable, "-c", SIGNAL_WHILE_THE_CLI_LOADS, manoeuvre], capture_output=True,
+                          text=True, timeout=60)  # fmt: skip
+    assert proc.returncode == 130, (proc.returncode, proc.stdout, proc.stderr)
+    assert proc.stderr.strip() == "washbench: interrupted" and proc.stdout == "", (proc.stdout, proc.stderr)
 
 
 def test_run_signalled_as_its_recording_lands_keeps_the_previous_result(tmp_path: Path) -> None:
