@@ -1,6 +1,8 @@
 """The one way washbench publishes results: built in a hidden stage, then swapped in whole, under the lock.
 
-Every command that writes results publishes them through this module, in one of two forms:
+Every command that writes a result folder or a set of them publishes it through this module (a single file a
+command is asked for, such as ``signal``'s CSV or ``schema --out``, is written atomically by
+:mod:`washbench.io.atomic`), in one of two forms:
 
 * :func:`result_set`, a whole ``--out`` owned by one command (``cue``, ``fly``, ``sweep``, ``tune``, ``omct``;
   ``examples`` and ``report`` use the same steps on a folder of the user's and on a result folder):
