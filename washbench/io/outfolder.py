@@ -38,18 +38,15 @@ spelt in :mod:`washbench.io.result_files`.
 from __future__ import annotations
 
 import contextlib
-import functools
 import json
 import os
 import re
 import shutil
-import signal
-import threading
 from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
-from typing import ParamSpec, TypeVar
 
 from washbench.errors import WashbenchError, located
+from washbench.io.interrupts import signals_held, uninterrupted  # (defined there; kept importable from here)
 from washbench.io.lock import output_lock
 from washbench.io.result_files import (
     JOURNAL_PREFIX,
@@ -62,9 +59,6 @@ from washbench.io.result_files import (
     is_own_hidden,
     publication_pid,
 )
-
-P = ParamSpec("P")
-R = TypeVar("R")
 
 _TMP = re.compile(r"^\..+\.tmp$")
 
@@ -205,46 +199,6 @@ def owned_entries(out_dir: Path, command: str, adopt: Sequence[str] = ()) -> lis
                                          "not replaced; move it away or choose an empty or new --out"))  # fmt: skip
         found.append(entry)
     return found
-
-
-@contextlib.contextmanager
-def signals_held() -> Iterator[None]:
-    """Hold SIGINT and SIGTERM back for a short critical section: noted, and acted on (KeyboardInterrupt or
-    :class:`washbench.errors.Terminated`) once it is over; never lost, never in the middle."""
-    if threading.current_thread() is not threading.main_thread():  # handlers run in the main thread only
-        yield
-        return
-    noted: list[int] = []
-
-    def note(signum: int, frame: object) -> None:
-        noted.append(signum)
-
-    saved = {sig: signal.signal(sig, note) for sig in (signal.SIGINT, signal.SIGTERM)}
-    try:
-        yield
-    finally:
-        for sig, handler in saved.items():
-            signal.signal(sig, handler)
-    if noted:
-        from washbench.errors import Terminated
-
-        raise KeyboardInterrupt if noted[0] == signal.SIGINT else Terminated()
-
-
-def uninterrupted(func: Callable[P, R]) -> Callable[P, R]:
-    """``func`` run under :func:`signals_held`: for the figure writers, whose drawing a Ctrl-C must not cut.
-
-    matplotlib's compiled parts (pybind11) turn a KeyboardInterrupt raised while they convert their arguments into
-    a ``TypeError: incompatible function arguments`` traceback; held back, the signal acts as soon as the figure
-    is written (a few tenths of a second).
-    """
-
-    @functools.wraps(func)
-    def held(*args: P.args, **kwargs: P.kwargs) -> R:
-        with signals_held():
-            return func(*args, **kwargs)
-
-    return held
 
 
 def discard_stage(stage: Path) -> None:
