@@ -16,7 +16,6 @@ import signal
 import socket
 import subprocess
 import sys
-import tempfile
 import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -612,14 +611,14 @@ def test_workers_end_when_the_suite_is_killed(tmp_path: Path) -> None:
     # the killed workers' JSBSim scratch folders (no exit handler ran) go with the next process that makes one
     from washbench.flight.jsbsim_xml import _SCRATCH_PREFIX
 
-    scratch = Path(tempfile.gettempdir())
+    scratch = tmp_path / "tmp"  # the suite's TMPDIR (hostile.long_suite)
 
     def killed_scratch() -> list[Path]:
         return [d for d in scratch.glob(f"{_SCRATCH_PREFIX}*") if d.name[len(_SCRATCH_PREFIX) :].split("-")[0] in pids]
 
     assert killed_scratch()
     code = "from washbench.flight.jsbsim_xml import scratch_output_dir; scratch_output_dir()"
-    subprocess.run([sys.executable, "-c", code], check=True, timeout=60)
+    subprocess.run([sys.executable, "-c", code], check=True, timeout=60, env={**os.environ, "TMPDIR": str(scratch)})
     assert killed_scratch() == []
 
 

@@ -48,7 +48,7 @@ def wait_for_no_process(pgid: int, timeout_s: float = 10.0) -> list[str]:
 def manoeuvres(tmp_path_factory: pytest.TempPathFactory) -> Path:
     folder = tmp_path_factory.mktemp("long")
     for i in range(3):
-        short(folder, name=f"long_{i}", seconds=900)  # far longer than any test waits: always stopped mid-flight
+        short(folder, name=f"long_{i}", seconds=3600)  # far longer than any test waits: always stopped mid-flight
     return folder
 
 
