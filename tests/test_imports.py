@@ -10,11 +10,19 @@ What is still knotted is listed below, edge by edge. The test fails when a cycle
 is not listed, and when a listed one has gone (take it off the list): the lists can only shrink.
 
 ``python tests/test_imports.py`` prints the wings' graph and any cycle.
+
+Where an import goes: in the module's header, unless deferring it into a function keeps a heavy third-party
+dependency off the path of a command that does not need it. Such an import says so on its line,
+``# deferred: <dependency>`` (a name in ``DEFERRED_FOR``), and the claim is checked: the imported module must bring
+in, through the imports of its header, a washbench module that imports that dependency and that the importing
+module's header does not already load. ``# deferred: signals`` marks the one other reason: the import runs where a
+Ctrl-C or SIGTERM arriving during it is handled (``washbench.__main__``).
 """
 
 from __future__ import annotations
 
 import ast
+import re
 import sys
 from collections import defaultdict
 from pathlib import Path
@@ -45,6 +53,15 @@ KNOWN_CYCLE_EDGES: frozenset[tuple[str, str]] = frozenset()
 
 #: Known imports that run up the floors: none left.
 KNOWN_UPWARD_EDGES: frozenset[tuple[str, str]] = frozenset()
+
+#: The heavy dependencies a washbench import inside a function may be deferred for (``# deferred: <name>``).
+DEFERRED_FOR = (
+    "matplotlib", "rerun", "jsbsim", "numba", "pyarrow", "numpy", "pydantic", "dask", "osqp", "clarabel",
+    "scipy.signal", "scipy.linalg", "scipy.optimize", "scipy.sparse",
+)  # fmt: skip
+#: The deferral that names no dependency: the import must run under the command's signal handling.
+DEFERRED_FOR_SIGNALS = "signals"
+DEFERRED_TAG = re.compile(r"# deferred: ([A-Za-z_][\w.]*)(?:\s|$)")
 
 
 def modules(package: Path = PACKAGE) -> dict[str, Path]:
@@ -147,6 +164,119 @@ def upward_edges(edges: dict[str, set[str]]) -> set[tuple[str, str]]:
     }
 
 
+def _is_type_checking(node: ast.AST) -> bool:
+    return isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test)
+
+
+def _imported_names(node: ast.Import | ast.ImportFrom, package: str) -> list[str]:
+    """Dotted names an import statement loads: ``from scipy import sparse`` -> ``scipy``, ``scipy.sparse``."""
+    if isinstance(node, ast.Import):
+        return [alias.name for alias in node.names]
+    if node.level:
+        base = package.split(".")[: len(package.split(".")) - node.level + 1]
+        source = ".".join(base + ([node.module] if node.module else []))
+    else:
+        source = node.module or ""
+    return [source, *(f"{source}.{alias.name}" for alias in node.names)]
+
+
+def header_imports(known: dict[str, Path]) -> dict[str, set[str]]:
+    """Module -> every dotted name its header imports (what runs at import: not in functions, not TYPE_CHECKING)."""
+    out: dict[str, set[str]] = {}
+    for name, path in known.items():
+        package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+        found: set[str] = set()
+        stack = list(ast.parse(path.read_text(encoding="utf-8")).body)
+        while stack:
+            node = stack.pop()
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda)) or _is_type_checking(node):
+                continue
+            if isinstance(node, (ast.Import, ast.ImportFrom)):
+                found.update(_imported_names(node, package))
+            stack.extend(ast.iter_child_nodes(node))
+        out[name] = found
+    return out
+
+
+def lazy_names(known: dict[str, Path]) -> dict[tuple[str, str], str]:
+    """(package, name) -> the submodule it comes from, for names a package's ``__init__`` provides lazily
+    (declared under ``if TYPE_CHECKING:`` there, loaded by its module ``__getattr__``)."""
+    out = {}
+    for name, path in known.items():
+        if path.name != "__init__.py":
+            continue
+        for node in ast.parse(path.read_text(encoding="utf-8")).body:
+            if _is_type_checking(node):
+                for sub in ast.walk(node):
+                    if isinstance(sub, ast.ImportFrom) and sub.module and not sub.level:
+                        out.update({(name, alias.name): sub.module for alias in sub.names})
+    return out
+
+
+def _loaded_by(module: str, known: dict[str, Path], header: dict[str, set[str]]) -> set[str]:
+    """The washbench modules importing ``module`` loads: its header's imports, followed, and their packages."""
+    seen: set[str] = set()
+    todo = [module]
+    while todo:
+        m = todo.pop()
+        if m in seen or m not in known:
+            continue
+        seen.add(m)
+        parts = m.split(".")
+        todo.extend(".".join(parts[:i]) for i in range(1, len(parts)))  # a package's __init__ runs first
+        todo.extend(n for n in (_nearest(t, known) for t in header[m] if t.startswith("washbench")) if n)
+    return seen
+
+
+def deferred_imports(known: dict[str, Path]) -> list[tuple[str, int, str, list[str], str | None]]:
+    """Every import of a washbench module inside a function: (file, line, importer, targets, ``# deferred:`` tag)."""
+    lazy = lazy_names(known)
+    root = known["washbench"].parents[1]
+    out = []
+    for name, path in known.items():
+        package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+        lines = path.read_text(encoding="utf-8").splitlines()
+        tree = ast.parse("\n".join(lines))
+        functions = [n for n in ast.walk(tree) if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda))]
+        for node in {id(n): n for f in functions for n in ast.walk(f)}.values():
+            if not isinstance(node, (ast.Import, ast.ImportFrom)):
+                continue
+            names = _imported_names(node, package)
+            if not any(n == "washbench" or n.startswith("washbench.") for n in names):
+                continue
+            targets = set()
+            for n in names[1:] if isinstance(node, ast.ImportFrom) else names:
+                source, _, attr = n.rpartition(".")
+                n = lazy.get((source, attr), n)
+                targets.add(n if n in known else _nearest(n, known) or n)
+            text = " ".join(lines[node.lineno - 1 : node.end_lineno])
+            tag = DEFERRED_TAG.search(text)
+            out.append((str(path.relative_to(root)), node.lineno, name, sorted(targets),
+                        tag.group(1) if tag else None))  # fmt: skip
+    return sorted(out)
+
+
+def deferral_problems(known: dict[str, Path]) -> list[str]:
+    """What is wrong with the package's imports inside functions (the module docstring's rule), one line each."""
+    header = header_imports(known)
+    problems = []
+    for file, line, importer, targets, tag in deferred_imports(known):
+        where = f"{file}:{line}: {', '.join(targets)}"
+        if tag is None:
+            problems.append(f"{where}: move it to the header, or mark it '# deferred: <dependency>'")
+        elif tag == DEFERRED_FOR_SIGNALS:
+            continue
+        elif tag not in DEFERRED_FOR:
+            problems.append(f"{where}: '# deferred: {tag}' is not a heavy dependency of DEFERRED_FOR")
+        else:
+            already = _loaded_by(importer, known, header)
+            brought = set().union(*(_loaded_by(t, known, header) for t in targets)) - already
+            if not any(n == tag or n.startswith(f"{tag}.") for m in brought for n in header[m]):
+                problems.append(f"{where}: deferred for {tag}, but it brings in no module that imports {tag}"
+                                f" and {importer} does not already load: move it to the header")  # fmt: skip
+    return problems
+
+
 KNOWN = modules()
 EDGES = import_edges(KNOWN)
 
@@ -190,6 +320,32 @@ def test_the_checks_catch_a_cycle_and_an_upward_import() -> None:
     assert upward_edges(fake) == {("washbench.io.a", "washbench.runs.x")}
 
 
+def test_imports_in_functions_are_deferred_for_a_heavy_dependency() -> None:
+    """A washbench import inside a function is marked ``# deferred: <dependency>``, and the mark is true."""
+    assert len(deferred_imports(KNOWN)) > 20  # the parser sees them (the CLI's commands, the compiled kernels)
+    assert deferral_problems(KNOWN) == []
+
+
+def test_the_deferral_check_catches_an_unmarked_or_false_deferral(tmp_path: Path) -> None:
+    """On a made-up package: an unmarked import, a false claim and an unknown name are each reported."""
+    pkg = tmp_path / "washbench"
+    (pkg / "kern").mkdir(parents=True)
+    (pkg / "__init__.py").write_text("")
+    (pkg / "kern" / "__init__.py").write_text("")
+    (pkg / "kern" / "fast.py").write_text("from numba import njit\n")
+    (pkg / "kern" / "slow.py").write_text("import json\n")
+    (pkg / "use.py").write_text(
+        "def a():\n    from washbench.kern import fast  # deferred: numba\n"
+        "def b():\n    from washbench.kern import slow  # deferred: numba\n"
+        "def c():\n    import washbench.kern.slow\n"
+        "def d():\n    from washbench.kern.fast import njit  # deferred: speed\n"
+    )
+    found = deferral_problems(modules(pkg))
+    assert [p.split(": ")[0] for p in found] == ["washbench/use.py:4", "washbench/use.py:6", "washbench/use.py:8"]
+    assert "brings in no module that imports numba" in found[0] and "move it to the header" in found[1]
+    assert "not a heavy dependency" in found[2]
+
+
 if __name__ == "__main__":
     wings: dict[str, set[str]] = defaultdict(set)
     for a, bs in EDGES.items():
@@ -200,3 +356,5 @@ if __name__ == "__main__":
         print(f"floor {FLOORS[w]:>2}  {w:<13} -> {', '.join(sorted(wings.get(w, ()), key=lambda k: -FLOORS[k]))}")
     for a, b in sorted(cycle_edges(EDGES)):
         print(f"cycle edge: {a} -> {b}")
+    for problem in deferral_problems(KNOWN):
+        print(problem)
