@@ -21,7 +21,7 @@ def entry() -> int:
     signal.signal(signal.SIGTERM, interrupts.terminate)  # the CLI installs the same for the command
     sys.unraisablehook = interrupts.signal_in_finalizer
     try:
-        from washbench.cli import main
+        from washbench.cli import main  # deferred: signals
 
         return main()
     except KeyboardInterrupt:  # before the CLI's own handling starts (importing, parsing the arguments)

@@ -15,11 +15,18 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from washbench import __version__
 from washbench.cli_examples import add_examples, subcommands
+from washbench.cueing import registry
 from washbench.cueing.params import WASHOUT_KINDS
 from washbench.errors import Terminated, WashbenchError, printable
 from washbench.io import config as project_config
 from washbench.io import interrupts
+from washbench.io.examples import copy_examples
+from washbench.io.paths import resolve_manoeuvre
+from washbench.live import FORMATS
+from washbench.review.replay import replay_command
+from washbench.runs.outputs import Outputs
 
 _VARIANT_HELP = "add a washout NAME of KIND with dotted-key overrides of the parameter file, repeatable"
 
@@ -270,7 +277,6 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _live_parsers(sub: Any) -> None:
     """``washbench live`` and ``washbench send`` (docs/live.md)."""
-    from washbench.live import FORMATS
 
     p = sub.add_parser("live", help="run the washouts live on a flight simulator's UDP output; drive a platform")
     p.add_argument("--listen", metavar="HOST:PORT", help="where to receive the simulator's datagrams")
@@ -304,11 +310,11 @@ def _live_parsers(sub: Any) -> None:
 
 
 def _live(args: argparse.Namespace) -> int:
-    from washbench.live.endpoints import parse_address
-    from washbench.runs.live import LiveOptions, run_live
+    from washbench.live.endpoints import parse_address  # deferred: numba
+    from washbench.runs.live import LiveOptions, run_live  # deferred: numba
 
     if args.print_flightgear_protocol:
-        from washbench.live.packets import flightgear_protocol
+        from washbench.live.packets import flightgear_protocol  # deferred: numpy
 
         print(flightgear_protocol(), end="")
         return 0
@@ -327,8 +333,8 @@ def _live(args: argparse.Namespace) -> int:
 
 
 def _send(args: argparse.Namespace) -> int:
-    from washbench.live.endpoints import parse_address
-    from washbench.runs.send import run_send
+    from washbench.live.endpoints import parse_address  # deferred: numba
+    from washbench.runs.send import run_send  # deferred: pyarrow
 
     to = parse_address(args.to, "--to") if args.to else None
     listen = parse_address(args.listen, "--listen") if args.listen else None
@@ -369,14 +375,12 @@ def _output_options(p: Any) -> None:
 
 
 def _outputs(args: argparse.Namespace) -> Any:
-    from washbench.runs.outputs import Outputs
-
     return Outputs(recording=not args.no_recording, figures=not args.no_figures)
 
 
 def _run_options(args: argparse.Namespace) -> Any:
     """The options of ``run`` and ``suite`` (:func:`washbench.runs.options.load_options`: each file read once)."""
-    from washbench.runs.options import load_options
+    from washbench.runs.options import load_options  # deferred: numpy
 
     return load_options(params_path=args.params, platform_path=args.platform, washouts=args.washout,
                         variants=args.variant, aircraft_dirs=args.aircraft_dir, outputs=_outputs(args),
@@ -385,9 +389,9 @@ def _run_options(args: argparse.Namespace) -> Any:
 
 
 def _cue(args: argparse.Namespace) -> int:
-    from washbench.io.input_format import input_format
-    from washbench.runs.cue import CueOptions, run_cue
-    from washbench.runs.options import load_options
+    from washbench.io.input_format import input_format  # deferred: numpy
+    from washbench.runs.cue import CueOptions, run_cue  # deferred: pyarrow
+    from washbench.runs.options import load_options  # deferred: numpy
 
     opts = CueOptions(
         fmt=input_format(args.columns, args.input_format, args.axes, args.delimiter, args.decimal, args.jsbsim_dt),
@@ -422,8 +426,6 @@ def _version_line() -> str:
     import platform
     from importlib.metadata import PackageNotFoundError, version
 
-    from washbench import __version__
-
     def dist(name: str) -> str:
         try:
             return version(name)
@@ -438,8 +440,6 @@ def _version_line() -> str:
 
 def _dispatch(args: argparse.Namespace) -> int:
     if hasattr(args, "manoeuvre") or hasattr(args, "manoeuvres"):
-        from washbench.io.paths import resolve_manoeuvre  # a bundled name such as c172/takeoff
-
         if hasattr(args, "manoeuvre"):
             args.manoeuvre = resolve_manoeuvre(args.manoeuvre)
         else:
@@ -447,23 +447,23 @@ def _dispatch(args: argparse.Namespace) -> int:
     if args.command == "cue":
         return _cue(args)
     if args.command == "fly":
-        from washbench.flight.fly import fly_command
+        from washbench.flight.fly import fly_command  # deferred: numpy
 
         return fly_command(args.manoeuvre, args.out, progress=not args.quiet, aircraft_dirs=args.aircraft_dir)
     if args.command == "validate":
-        from washbench.flight.validate import validate_command
+        from washbench.flight.validate import validate_command  # deferred: numpy
 
         return validate_command(args.manoeuvres, aircraft_dirs=args.aircraft_dir)
     if args.command == "schema":
-        from washbench.flight.json_schema import schema_command
+        from washbench.flight.json_schema import schema_command  # deferred: pydantic
 
         return schema_command(args.out)
     if args.command == "run":
-        from washbench.runs.pipeline import run_command
+        from washbench.runs.pipeline import run_command  # deferred: pyarrow
 
         return run_command(args.manoeuvre, args.out, _run_options(args), progress=not args.quiet)
     if args.command == "suite":
-        from washbench.runs.suite import suite_command
+        from washbench.runs.suite import suite_command  # deferred: pyarrow
 
         return suite_command(
             args.inputs,
@@ -475,7 +475,7 @@ def _dispatch(args: argparse.Namespace) -> int:
             dask=args.dask,
         )
     if args.command == "omct":
-        from washbench.runs.omct import run_omct
+        from washbench.runs.omct import run_omct  # deferred: pyarrow
 
         run_omct(
             args.out,
@@ -490,7 +490,7 @@ def _dispatch(args: argparse.Namespace) -> int:
         )
         return 0
     if args.command == "signal":
-        from washbench.runs.omct import signal_command
+        from washbench.runs.omct import signal_command  # deferred: pyarrow
 
         return signal_command(
             args.kind,
@@ -505,18 +505,14 @@ def _dispatch(args: argparse.Namespace) -> int:
     if args.command in ("sweep", "tune"):
         return _study(args)
     if args.command == "examples":
-        from washbench.io.examples import copy_examples
-
         return copy_examples(args.folder)
     if args.command == "report":
-        from washbench.review.report_command import report_command
+        from washbench.review.report_command import report_command  # deferred: numpy
 
         return report_command(args.results, args.palette)
     if args.command in ("live", "send"):
         return _live(args) if args.command == "live" else _send(args)
     if args.command == "replay":
-        from washbench.review.replay import replay_command
-
         return replay_command(args.recording, web=args.web)
     raise AssertionError(f"unhandled command {args.command}")  # unreachable: argparse restricts choices
 
@@ -532,12 +528,12 @@ def _study(args: argparse.Namespace) -> int:
         aircraft_dirs=args.aircraft_dir,
     )
     if args.command == "sweep":
-        from washbench.runs.sweep import sweep_command
+        from washbench.runs.sweep import sweep_command  # deferred: numba
 
         return sweep_command(
             args.manoeuvres, args.out, washouts=args.washout, sets=args.sets, force=args.force, **common
         )
-    from washbench.runs.tune import tune_command
+    from washbench.runs.tune import tune_command  # deferred: numba
 
     return tune_command(
         args.manoeuvres,
@@ -566,8 +562,6 @@ def _load_plugins(args: argparse.Namespace) -> None:
     """Load every ``--washout-plugin`` before anything reads a parameter file or a washout name."""
     specs = getattr(args, "washout_plugin", None) or []
     if specs:
-        from washbench.cueing import registry
-
         for spec in specs:
             registry.load_plugin(spec)
 

@@ -40,6 +40,7 @@ from scipy import sparse
 
 from washbench.cueing.motion_model import discretise_foh
 from washbench.io.yamlio import StrictModel
+from washbench.numerics.rotations import quat_from_euler
 from washbench.perception.vestibular import VestibularModel, VestibularParams, canal_tf, otolith_tf
 from washbench.platform.limits import PlatformLimits
 
@@ -397,8 +398,6 @@ class BoundWashout:
                            "tune), not a live stream")  # fmt: skip
 
     def trace(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        from washbench.numerics.rotations import quat_from_euler
-
         c = self.context
         res = oracle_bound(f_mps2, omega_radps, c.dt_s, c.limits, c.gravity_mps2, self.params, start_at_rest=True)
         ang = res.trajectory.angles

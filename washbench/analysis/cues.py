@@ -32,6 +32,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from washbench.perception.thresholds import STANDARD_GRAVITY_MPS2, ZACHARIAS
+
 CLASSES: tuple[str, ...] = ("none", "correct", "scaled", "false", "missing")
 NONE, CORRECT, SCALED, FALSE, MISSING = range(5)
 
@@ -154,7 +156,6 @@ def parse_events(text: str, dof: str) -> tuple[FalseCueEvent, ...]:
 
 def dof_thresholds() -> tuple[tuple[float, ...], tuple[float, ...]]:
     """Zacharias thresholds per DOF (m/s^2 for surge, sway, heave; deg/s for roll, pitch, yaw) and resting values."""
-    from washbench.perception.thresholds import STANDARD_GRAVITY_MPS2, ZACHARIAS
 
     th = ZACHARIAS
     thresholds = (th.f_x_mps2, th.f_y_mps2, th.f_z_mps2, th.omega_x_degps, th.omega_y_degps, th.omega_z_degps)

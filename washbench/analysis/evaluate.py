@@ -27,10 +27,12 @@ from numba import njit, prange
 from washbench.analysis.metric_sums import NACC, acc_update, finish
 from washbench.analysis.metrics import DOFS, npc_from_pc
 from washbench.analysis.ranking import dof_weights, perceived_motion, score_of
+from washbench.cueing.bank import build_arrays, cue_trace
 from washbench.cueing.kernel import C_KIND, NFIELDS, NSTATE, O_HEAD_F, O_HEAD_OMEGA, O_SAT, SAT_KINDS, step_one
 from washbench.io.metrics_csv import MetricRow
 from washbench.numerics.jitcache import announce_compile, drop_stale_cache
 from washbench.perception.sections import sections_init, sections_step
+from washbench.perception.vestibular import VestibularModel
 
 PLATFORM_SAT = tuple(SAT_KINDS.index(k) for k in ("pos", "vel", "acc", "rate", "angacc"))
 """Indices of the platform's own limits among the saturation kinds (the tilt-rate and rotational limits are the
@@ -147,8 +149,6 @@ class FlightEvaluator:
     """
 
     def __init__(self, f_mps2: np.ndarray, omega_radps: np.ndarray, dt_s: float, limits: object) -> None:
-        from washbench.perception.vestibular import VestibularModel
-
         self.f = np.ascontiguousarray(f_mps2, dtype=np.float64)
         self.om = np.ascontiguousarray(omega_radps, dtype=np.float64)
         if self.f.ndim != 2 or self.f.shape[1] != 3 or self.om.shape != self.f.shape or len(self.f) < 2:
@@ -172,7 +172,6 @@ class FlightEvaluator:
 
     def arrays(self, washouts: Sequence[object]) -> tuple[np.ndarray, np.ndarray]:
         """The compiled configuration and filters of the candidates (Washout objects)."""
-        from washbench.cueing.bank import build_arrays
 
         return build_arrays(washouts, self.limits, self.dt_s)  # type: ignore[arg-type]
 
@@ -193,8 +192,6 @@ class FlightEvaluator:
             announce_compile(evaluate_batch)
             evaluate_batch(self.f, self.om, cfg, coef, self.oto, self.can, self.ac_perceived, self.dt_s, acc, counts)
         if python:
-            from washbench.cueing.bank import cue_trace
-
             if len(washouts) != m:
                 raise ValueError("a Python algorithm's candidate needs its Washout")
             for i in python:

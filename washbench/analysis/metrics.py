@@ -41,7 +41,7 @@ importing this module (DOFS, npc_from_pc: a sweep parsing its grid, a refused in
 def signal_metrics(x: np.ndarray, y: np.ndarray, dt_s: float) -> tuple[float, float, float]:
     """:func:`washbench.analysis.metric_sums.signal_metrics` (PC, integral and max of ``|x - y|``), imported at the
     first call: numba (about 0.3 s of start-up) is paid only by a command that computes a metric."""
-    from washbench.analysis.metric_sums import signal_metrics as compiled
+    from washbench.analysis.metric_sums import signal_metrics as compiled  # deferred: numba
 
     announce_compile(compiled)
     return compiled(x, y, dt_s)

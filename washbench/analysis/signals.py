@@ -38,6 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from washbench.errors import WashbenchError
+from washbench.io.budget import check_samples
 
 G0_MPS2 = 9.80665  # standard gravity: the level-flight specific force of the signals
 AXES: tuple[str, ...] = ("f_x", "f_y", "f_z", "roll", "pitch", "yaw")
@@ -122,7 +123,6 @@ def check_spec(spec: SignalSpec) -> SignalSpec:
     duration = _positive("--duration-s", spec.duration_s)
     if duration * rate < 1.0:
         raise WashbenchError(f"--duration-s {duration} s is shorter than one sample at {rate} Hz")
-    from washbench.io.budget import check_samples
 
     check_samples(duration * rate + 1.0, f"--duration-s {duration:g} at --rate-hz {rate:g}")
     if not (math.isfinite(spec.start_s) and spec.start_s >= 0.0):

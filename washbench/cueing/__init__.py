@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING, Any
 from washbench.cueing.params import WASHOUT_KINDS, WASHOUT_NAMES, WashoutParams
 from washbench.cueing.registry import check_washouts
 from washbench.cueing.variants import load_washout_params
+from washbench.io.outfolder import signals_held
 from washbench.numerics.jitcache import configure_cache
 
 configure_cache()  # before any jitted module is imported (numba reads its cache folder at decoration)
@@ -48,10 +49,8 @@ _LAZY = {"CueingBank", "WashoutTrace", "cue_trace"}
 
 def __getattr__(name: str) -> Any:
     if name in _LAZY:
-        from washbench.io.outfolder import signals_held
-
         with signals_held():  # a SIGINT/SIGTERM in the middle of this import was lost (acts once it is done)
-            from washbench.cueing import bank
+            from washbench.cueing import bank  # deferred: numba
 
         return getattr(bank, name)
     raise AttributeError(f"module 'washbench.cueing' has no attribute {name!r}")

@@ -30,8 +30,9 @@ from typing import Any
 from pydantic import BaseModel
 
 from washbench.cueing.params import WASHOUT_KINDS
-from washbench.errors import WashbenchError
+from washbench.errors import WashbenchError, located
 from washbench.io.names import identifier_problem
+from washbench.io.yamlio import line_of
 
 ENTRY_POINT_GROUP = "washbench.washouts"
 
@@ -61,8 +62,6 @@ class Algorithm:
 
         WashbenchError ``WHERE[:LINE]: KIND.FIELD: problem``; ``lines`` (a YAML line map, optional) gives the line.
         """
-        from washbench.errors import located
-        from washbench.io.yamlio import line_of
 
         if self.params_model is None:
             if section:

@@ -40,7 +40,7 @@ from washbench.cueing.params import (
 )
 from washbench.errors import WashbenchError, located
 from washbench.io.names import identifier_problem
-from washbench.io.yamlio import Loc, line_of, read_yaml, validate_data
+from washbench.io.yamlio import Loc, _problem, line_of, read_yaml, validate_data
 
 RESERVED_NAMES = registry.RESERVED_NAMES
 
@@ -183,7 +183,6 @@ def apply_overrides(
     try:
         return WashoutParams.model_validate_json(json.dumps(data, allow_nan=True))
     except pydantic.ValidationError as exc:
-        from washbench.io.yamlio import _problem  # the same wording as for the file itself
 
         err = exc.errors(include_url=False)[0]
         loc = tuple(str(p) for p in err["loc"] if isinstance(p, str))

@@ -33,6 +33,7 @@ import numpy as np
 from scipy.optimize import curve_fit
 
 from washbench.errors import WashbenchError
+from washbench.flight.jsbsim_xml import scratch_output_dir
 from washbench.io.paths import find_aircraft
 from washbench.io.yamlio import StrictModel, load_yaml_model
 
@@ -55,7 +56,6 @@ def aircraft_root(name: str) -> Path:
 def make_fdm(name: str, loading: Loading | None = None) -> jsbsim.FGFDMExec:
     """A loaded, silent FDM for aircraft ``name`` at dt = 1/120 s, optionally reloaded to a gross weight."""
     os.environ.setdefault("JSBSIM_DEBUG", "0")
-    from washbench.flight.jsbsim_xml import scratch_output_dir
 
     fdm = jsbsim.FGFDMExec(None)
     fdm.set_debug_level(0)

@@ -17,6 +17,7 @@ from typing import Any
 from washbench.errors import WashbenchError
 from washbench.flight.console import quiet_stdout
 from washbench.flight.geo import DEFAULT_LATITUDE_DEG, DEFAULT_LONGITUDE_DEG, LocalFrame
+from washbench.flight.jsbsim_xml import aircraft_for_jsbsim, scratch_output_dir
 from washbench.flight.manoeuvre import Manoeuvre
 from washbench.flight.manoeuvre_schema import Hold
 from washbench.flight.pilot import Pilot
@@ -48,8 +49,6 @@ def make_fdm(m: Manoeuvre, profile: PilotProfile) -> tuple[Any, Setup]:
     """
     os.environ["JSBSIM_DEBUG"] = "0"
     import jsbsim
-
-    from washbench.flight.jsbsim_xml import aircraft_for_jsbsim, scratch_output_dir
 
     root = m.aircraft_files.root
     fdm = jsbsim.FGFDMExec(str(jsbsim_root()), None)

@@ -31,6 +31,7 @@ from washbench.flight.openloop import OpenLoop
 from washbench.flight.pilot import Pilot
 from washbench.flight.profile import load_profile
 from washbench.io.atomic import atomic_path, write_text_atomic
+from washbench.io.outfolder import result_set
 from washbench.io.provenance import build_provenance, parquet_metadata
 from washbench.io.result_files import FLIGHT_FILE, FLIGHT_JSON
 
@@ -468,7 +469,7 @@ def write_flight(
     """
     import pyarrow as pa
 
-    from washbench.io.parquet_files import write_parquet
+    from washbench.io.parquet_files import write_parquet  # deferred: pyarrow
 
     out = Path(out_dir)
     try:
@@ -493,7 +494,6 @@ def fly_command(manoeuvre_path: Path, out_dir: Path, progress: bool = True, airc
 
     The output folder is checked (and locked) before flying, so a bad ``--out`` costs no flight.
     """
-    from washbench.io.outfolder import result_set
 
     m = load_manoeuvre(manoeuvre_path, aircraft_dirs)
     with result_set(out_dir, "fly") as stage:  # the whole set replaces the previous one at once

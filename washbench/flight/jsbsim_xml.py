@@ -29,6 +29,7 @@ import xml.parsers.expat as expat
 from pathlib import Path
 
 from washbench.errors import WashbenchError, located, printable
+from washbench.io.budget import read_bounded
 
 #: Largest XML file read (JSBSim's biggest aircraft file is about 1 MB).
 MAX_XML_BYTES = 32 * 1024 * 1024
@@ -52,7 +53,6 @@ def _plain_entity(
 
 def read_xml(path: str | Path) -> ET.Element:
     """The root element of XML file ``path``; WashbenchError (file, line, what) if it is not plain, well-formed XML."""
-    from washbench.io.budget import read_bounded
 
     path = Path(path)
     data = read_bounded(path, MAX_XML_BYTES)

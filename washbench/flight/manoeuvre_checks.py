@@ -18,6 +18,7 @@ from washbench.errors import WashbenchError, located
 from washbench.flight.columns import COLUMN_NAMES, RUNWAY_COLUMNS
 from washbench.flight.console import quiet_stdout
 from washbench.flight.inputs import shape_extent
+from washbench.flight.jsbsim_xml import aircraft_for_jsbsim, scratch_output_dir
 from washbench.flight.manoeuvre_schema import (
     EVENT_STATS,
     HEADING_SIGNALS,
@@ -399,8 +400,6 @@ def _check_properties(m: ManoeuvreFields, files: AircraftFiles, where: Where) ->
     import tempfile
 
     import jsbsim  # imported only when an input names a property
-
-    from washbench.flight.jsbsim_xml import aircraft_for_jsbsim, scratch_output_dir
 
     os.environ["JSBSIM_DEBUG"] = "0"
     fdm = jsbsim.FGFDMExec(str(jsbsim_root()), None)

@@ -39,9 +39,13 @@ from washbench.errors import WashbenchError, located
 from washbench.flight.columns import FLIGHT_COLUMNS
 from washbench.flight.console import quiet_stdout
 from washbench.flight.fly import FPS_TO_KT, FT_S2_TO_M_S2, R2D, StepHook
+from washbench.flight.jsbsim_xml import aircraft_for_jsbsim, read_xml, script_for_jsbsim
 from washbench.flight.manoeuvre import aircraft_path
 from washbench.flight.monitor import Monitor
+from washbench.io.atomic import atomic_path, write_text_atomic
+from washbench.io.budget import check_samples
 from washbench.io.paths import jsbsim_root
+from washbench.io.progress import duration_text
 from washbench.io.result_files import FLIGHT_FILE, FLIGHT_JSON
 
 SEGMENT_PREFIX = "run_"
@@ -157,7 +161,6 @@ class ScriptPlan:
 
     def text(self) -> str:
         """One line: what will be flown, how big and how long, and how to change it."""
-        from washbench.io.progress import duration_text
 
         mb = self.size_bytes / 1e6
         line = (
@@ -247,7 +250,6 @@ def load_script_info(path: str | Path, aircraft_dirs: Sequence[Path] = ()) -> Sc
 
     The aircraft is looked up along washbench's search path (``aircraft_dirs``, an ``aircraft/`` folder next
     to the script, washbench's bundled aircraft, JSBSim's own)."""
-    from washbench.flight.jsbsim_xml import read_xml
 
     path = Path(path)
     root = read_xml(path)
@@ -295,8 +297,6 @@ def _make_fdm(info: ScriptInfo, output_dir: Path) -> object:
     temporary folder), so JSBSim writes no file and opens no socket; output is also switched off."""
     import jsbsim
 
-    from washbench.flight.jsbsim_xml import aircraft_for_jsbsim, script_for_jsbsim
-
     root = aircraft_for_jsbsim(info.aircraft_root, info.aircraft, output_dir / "aircraft")
     script = script_for_jsbsim(info.path.resolve(), output_dir)
     with quiet_stdout():
@@ -328,7 +328,6 @@ def fly_script(
     ``hook(k, f_mps2, omega_radps)`` called once per recorded sample of it, in order (eyepoint specific
     force m/s^2 and body rates rad/s, body axes x forward, y right, z down).
     """
-    from washbench.io.budget import check_samples
 
     info = load_script_info(path, aircraft_dirs)
     span_s = min(info.end_s, math.inf if max_time_s is None else max_time_s)
@@ -417,8 +416,6 @@ def write_script_flight(out_dir: Path, flight: ScriptFlight, seg: ScriptSegment)
 
     import pyarrow as pa
     import pyarrow.parquet as pq
-
-    from washbench.io.atomic import atomic_path, write_text_atomic
 
     info = flight.info
     table = pa.table({n: seg.columns[n] for n in SCRIPT_COLUMN_NAMES})

@@ -14,6 +14,8 @@ from pathlib import Path
 
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
+from washbench.io.lock import output_lock
+from washbench.io.outfolder import recover, staged
 from washbench.io.paths import AIRCRAFT_DIR, MANOEUVRES_DIR, PROFILE_NAME
 
 
@@ -36,8 +38,6 @@ def copy_examples(dest: Path) -> int:
     Built in a hidden stage folder inside ``dest`` and published whole (:mod:`washbench.io.outfolder`), under
     ``dest``'s lock: a full disk or a signal leaves nothing half-copied, so a rerun works.
     """
-    from washbench.io.lock import output_lock
-    from washbench.io.outfolder import recover, staged
 
     if dest.exists() and not dest.is_dir():
         raise WashbenchError(located(dest, "exists and is not a folder"))

@@ -17,6 +17,7 @@ import pyarrow.csv as pacsv
 import pyarrow.parquet as pq
 
 from washbench.errors import WashbenchError, located
+from washbench.io.budget import MAX_SAMPLES, MAX_TEXT_BYTES
 from washbench.io.input_format import DELIMITERS
 
 TEXT_SUFFIXES = (".csv", ".tsv", ".txt")
@@ -92,7 +93,6 @@ def header(path: Path, delimiter: str | None) -> tuple[int, list[str], str]:
 def _check_text_size(path: Path) -> None:
     """Stream the (decompressed) text once, refusing it beyond the allocation bound before it is parsed: a small
     gzip file expanding to gigabytes, or millions of blank lines, costs a second and no memory."""
-    from washbench.io.budget import MAX_SAMPLES, MAX_TEXT_BYTES
 
     size = lines = 0
     try:

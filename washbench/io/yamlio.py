@@ -28,6 +28,7 @@ import yaml
 from pydantic import BaseModel, ConfigDict
 
 from washbench.errors import WashbenchError, located
+from washbench.io.budget import read_bounded
 
 M = TypeVar("M", bound=BaseModel)
 
@@ -350,8 +351,6 @@ def read_yaml_digest(path: Path) -> tuple[Any, dict[Loc, int], str]:
     """:func:`read_yaml` and the SHA-256 (hex) of the bytes parsed: the file read once for its data and its
     provenance record."""
     import hashlib
-
-    from washbench.io.budget import read_bounded
 
     raw = read_bounded(path)
     try:

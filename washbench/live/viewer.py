@@ -24,6 +24,8 @@ from typing import Any
 import numpy as np
 
 from washbench.cueing.kernel import O_HEAD_F, O_HEAD_OMEGA, O_POS
+from washbench.perception.vestibular import PerceptionStream, VestibularModel
+from washbench.review.replay import _die_with_parent, _has_display, find_rerun
 
 RATE_HZ = 30.0
 _HEAD = np.r_[O_HEAD_F : O_HEAD_F + 3, O_HEAD_OMEGA : O_HEAD_OMEGA + 3]
@@ -44,7 +46,7 @@ def live_blueprint(names: Sequence[str]) -> Any:
     the recording's colours and names) and each platform's position, all scrolling with the time cursor."""
     import rerun.blueprint as rrb
 
-    from washbench.review.rerun_log import DOFS, TIMELINE, perceived_path, platform_path, raw_path
+    from washbench.review.rerun_log import DOFS, TIMELINE, perceived_path, platform_path, raw_path  # deferred: rerun
 
     window = rrb.VisibleTimeRange(TIMELINE, start=rrb.TimeRangeBoundary.cursor_relative(seconds=-WINDOW_S),
                                   end=rrb.TimeRangeBoundary.cursor_relative())  # fmt: skip
@@ -62,8 +64,8 @@ def send_styles(rec: Any, names: Sequence[str]) -> None:
     """The series' names, colours and widths, as in a recording (static)."""
     import rerun as rr
 
-    from washbench.review.blueprint import AIRCRAFT_WIDTH, AXIS_COLORS, WASHOUT_WIDTH, source_colors
-    from washbench.review.rerun_log import AIRCRAFT, DOFS, perceived_path, platform_path, raw_path
+    from washbench.review.blueprint import AIRCRAFT_WIDTH, AXIS_COLORS, WASHOUT_WIDTH, source_colors  # deferred: rerun
+    from washbench.review.rerun_log import AIRCRAFT, DOFS, perceived_path, platform_path, raw_path  # deferred: rerun
 
     style = rr.SeriesLines(colors=source_colors(list(names)), names=[AIRCRAFT, *names],
                            widths=[AIRCRAFT_WIDTH] + [WASHOUT_WIDTH] * len(names))  # fmt: skip
@@ -101,7 +103,6 @@ class LiveViewer:
             return
         if new_segment or not self._streams or dt_s != self._dt:
             self._flush()
-            from washbench.perception.vestibular import PerceptionStream, VestibularModel
 
             model = VestibularModel(dt_s)
             self._streams = [PerceptionStream(model, self.filter_start) for _ in range(1 + len(self.names))]
@@ -118,7 +119,13 @@ class LiveViewer:
             return
         import rerun as rr
 
-        from washbench.review.rerun_log import DOFS, TIMELINE, perceived_path, platform_path, raw_path
+        from washbench.review.rerun_log import (  # deferred: rerun
+            DOFS,
+            TIMELINE,
+            perceived_path,
+            platform_path,
+            raw_path,
+        )
 
         buf, self._buf = self._buf, []
         motion = np.array([s for s, _ in buf])
@@ -163,7 +170,6 @@ class LiveViewer:
 
 def open_viewer(names: Sequence[str], limits: Any, filter_start: str = "steady") -> LiveViewer | None:
     """Start the viewer, or print one line and return None where it cannot open a window."""
-    from washbench.review.replay import _die_with_parent, _has_display, find_rerun
 
     if not _has_display():
         print("live: no display (DISPLAY / WAYLAND_DISPLAY unset): the live viewer is off; the result folder's "

@@ -52,6 +52,8 @@ from pydantic import Field
 
 from washbench.io.units import G0_MPS2
 from washbench.io.yamlio import StrictModel
+from washbench.numerics.jitcache import announce_compile
+from washbench.perception.svc import sickness_record
 from washbench.perception.thresholds import Thresholds, apply_deadband
 
 
@@ -104,7 +106,6 @@ def model_record(name: str | None) -> dict[str, object]:
     """The provenance record of a model of :data:`MODELS`: ``{"model": name, "values": its parameters}``, and of
     the motion-sickness models fed by the same head motion (``"sickness"``,
     :func:`washbench.perception.svc.sickness_record`)."""
-    from washbench.perception.svc import sickness_record
 
     key = DEFAULT_MODEL if name is None else name
     return {"model": key, "values": model_params(key).model_dump(mode="json"), "sickness": sickness_record()}
@@ -238,8 +239,7 @@ class DiscreteModel:
 
         The same compiled step as :meth:`apply`: feeding a trace in chunks gives the same bits as feeding it whole.
         """
-        from washbench.numerics.jitcache import announce_compile
-        from washbench.perception.sections import sections_run
+        from washbench.perception.sections import sections_run  # deferred: numba
 
         announce_compile(sections_run)
         b, phi, _ = self.arrays()
@@ -252,8 +252,7 @@ class DiscreteModel:
         Returns float64 of the same shape. One compiled pass per column (:mod:`washbench.perception.sections`),
         the same step the studies' evaluation kernel takes per sample.
         """
-        from washbench.numerics.jitcache import announce_compile
-        from washbench.perception.sections import sections_apply, sections_apply_from
+        from washbench.perception.sections import sections_apply, sections_apply_from  # deferred: numba
 
         announce_compile(sections_apply if start is None else sections_apply_from)
         u = np.asarray(u, dtype=np.float64)

@@ -16,7 +16,7 @@ import numpy as np
 from washbench.analysis.cues import FALSE, MISSING, classify, dof_thresholds
 from washbench.analysis.metrics import DOFS
 from washbench.io.outfolder import uninterrupted
-from washbench.review.figures import collector_paused
+from washbench.review.figures import _new_figure, bars, collector_paused, run_edges, save_figure
 
 FALSE_COLOUR = (0.84, 0.15, 0.16)
 MISSING_COLOUR = (0.72, 0.72, 0.72)
@@ -43,8 +43,6 @@ def cue_lane_figure(
 ) -> list[Path]:
     """Write the lane figure (``stem.png``, and PDF if asked); ``classes``: washout -> (6, N) from cue_classes."""
     from matplotlib.patches import Patch
-
-    from washbench.review.figures import _new_figure, bars, run_edges, save_figure
 
     washouts = list(classes)
     n_lanes = len(washouts) * len(DOFS)

@@ -35,9 +35,11 @@ from typing import Any, ParamSpec, TypeVar
 
 import numpy as np
 
+from washbench.io.atomic import atomic_path, write_bytes_atomic
 from washbench.io.outfolder import uninterrupted
-from washbench.review.numbers import SCORE_FLAG
+from washbench.review.numbers import SCORE_FLAG, sig
 from washbench.review.palette import aircraft_color, mpl, palette_name, washout_colors, washout_dashes
+from washbench.review.png import png_bytes
 
 FIGURE_FORMATS = ("png", "pdf")
 """The formats a figure can be written in: STEM.png (embedded in report.md) and STEM.pdf (vector, for papers).
@@ -211,8 +213,6 @@ def _top_legend(fig: Any, handles: Callable[[], list[Any]], key: tuple[Any, ...]
 def save_figure(fig: Any, stem: Path, formats: Sequence[str] = ("png",)) -> list[Path]:
     """Write ``stem.<format>`` for each of ``formats`` (:data:`FIGURE_FORMATS`), PNG first, atomically and
     deterministically (no date, no software stamp); return the paths in that order."""
-    from washbench.io.atomic import atomic_path, write_bytes_atomic
-    from washbench.review.png import png_bytes
 
     unknown = [f for f in formats if f not in FIGURE_FORMATS]
     if unknown or "png" not in formats:
@@ -575,8 +575,6 @@ def envelope_figure(
 
 
 def _sig(x: float, digits: int = 3) -> str:
-    from washbench.review.numbers import sig
-
     return sig(x, digits)
 
 

@@ -19,11 +19,12 @@ from typing import Any
 import numpy as np
 
 from washbench.errors import WashbenchError, located
+from washbench.io.columns import AIRCRAFT, TIME_COLUMN, f_columns, omega_columns
 from washbench.io.input_format import ColumnSource
 from washbench.io.outfolder import uninterrupted
 from washbench.io.result_files import FIGURES_DIR, RUN_FILE, TRACES_FILE
 from washbench.io.units import G0_MPS2, axes_matrix, is_identity_axes
-from washbench.review.figures import collector_paused
+from washbench.review.figures import collector_paused, minmax_decimate, save_figure
 
 INPUT_STEM = "input"
 """The figure's file name (``figures/input.png``)."""
@@ -85,8 +86,6 @@ def input_figure(
     """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
-
-    from washbench.review.figures import minmax_decimate, save_figure
 
     fig = Figure(figsize=(11.0, 8.6))
     FigureCanvasAgg(fig)
@@ -157,8 +156,6 @@ def redraw(folder: Path, formats: Sequence[str], fig_dir: Path | None = None) ->
     import json
 
     import pyarrow.parquet as pq
-
-    from washbench.io.columns import AIRCRAFT, TIME_COLUMN, f_columns, omega_columns
 
     try:
         doc = json.loads((folder / RUN_FILE).read_text())

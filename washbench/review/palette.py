@@ -21,6 +21,8 @@ from __future__ import annotations
 import os
 from collections.abc import Sequence
 
+from washbench.errors import WashbenchError
+
 RGB = tuple[int, int, int]
 Dash = tuple[float, tuple[float, ...] | None]
 """A matplotlib line style: (offset, on-off sequence in points), ``(0, None)`` for solid."""
@@ -75,7 +77,6 @@ def palette_name(name: str | None = None) -> str:
     Raises :class:`washbench.errors.WashbenchError` (a ValueError's one-line message) naming the choices for an
     unknown name.
     """
-    from washbench.errors import WashbenchError
 
     chosen = name or os.environ.get(PALETTE_ENV, "").strip() or "default"
     if chosen not in PALETTES:

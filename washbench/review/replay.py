@@ -189,7 +189,7 @@ def replay_command(paths: Path | list[Path], web: bool) -> int:
         return _replay(files[0], web)
     import tempfile
 
-    from washbench.review.compare import write_comparison
+    from washbench.review.compare import write_comparison  # deferred: rerun
 
     with tempfile.TemporaryDirectory(prefix="washbench-compare-") as tmp:
         out = Path(tmp) / "comparison.rrd"

@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from washbench.analysis.cues import SCALE_BAND, parse_events
 from washbench.analysis.metrics import DOFS
 from washbench.analysis.ranking import (
     DEFAULT_RULE,
@@ -35,7 +36,13 @@ from washbench.analysis.ranking import (
     undecided,
 )
 from washbench.io.atomic import write_text_atomic
+from washbench.io.outfolder import discard_stage, make_stage, replace_entries
 from washbench.io.result_files import FIGURES_DIR, RECORDING_FILE, REPORT_FILE
+from washbench.perception.thresholds import ZACHARIAS
+from washbench.review.bound_section import algorithm_lines, bound_lines
+from washbench.review.cue_figures import cue_classes, cue_lane_figure
+from washbench.review.figures import SATURATION_LABELS, envelope_figure, perceived_figure
+from washbench.review.input_figure import input_section
 from washbench.review.numbers import SCORE_FLAG, pct, sig
 from washbench.review.result_data import ResultData, load_result
 
@@ -261,7 +268,6 @@ def metric_tables(data: ResultData) -> list[str]:
 
 def cue_lines(data: ResultData) -> list[str]:
     """Time fractions of correct, scaled, false and missing cues per washout and DOF, and the false-cue events."""
-    from washbench.analysis.cues import SCALE_BAND, parse_events
 
     rows = [m for m in data.metrics if not math.isnan(m.cue_false_frac)]
     if not rows:
@@ -322,7 +328,6 @@ def sickness_lines(data: ResultData) -> list[str]:
 
 def saturation_lines(data: ResultData) -> list[str]:
     """Time at each limit per washout, in seconds and percent of the manoeuvre."""
-    from washbench.review.figures import SATURATION_LABELS
 
     kinds = list(dict.fromkeys(k for w in data.washouts for k, f in data.saturated.get(w, {}).items() if f.any()))
     if not kinds:
@@ -359,7 +364,6 @@ def perception_thresholds(data: ResultData) -> tuple[tuple[float, ...], tuple[fl
     runway): a steady cue the pilot has been exposed to is not a change felt, so the band "not felt" lies around it
     (for a level start about (0, 0, -g, 0, 0, 0); a descent or a climb starts with its own surge).
     """
-    from washbench.perception.thresholds import ZACHARIAS
 
     th = ZACHARIAS
     thresholds = (th.f_x_mps2, th.f_y_mps2, th.f_z_mps2, th.omega_x_degps, th.omega_y_degps, th.omega_z_degps)
@@ -386,7 +390,6 @@ def result_figures(
     ``palette``: :data:`washbench.review.palette.PALETTES` (None: ``$WASHBENCH_PALETTE`` or the default).
     A PDF left from an earlier ``washbench report`` in the result folder is removed when none is drawn.
     """
-    from washbench.review.figures import envelope_figure, perceived_figure
 
     fig_dir = (into or data.folder) / FIGURES_DIR
     fig_dir.mkdir(exist_ok=True)
@@ -408,8 +411,6 @@ def result_figures(
         palette=palette,
     )[0]
     if data.washouts and all(w in data.perceived for w in data.washouts):
-        from washbench.review.cue_figures import cue_classes, cue_lane_figure
-
         classes = cue_classes(data.perceived, data.washouts)
         out["cues"] = cue_lane_figure(fig_dir / "cues", data.title, data.t_s, classes, formats=formats)[0]
     if data.usage:
@@ -446,7 +447,6 @@ def result_sections(
     rule = result_rule(data)
     ranking = rank(data.metrics, data.motion, rule) if data.metrics else []
     lines += [f"{h} Ranking", "", *ranking_lines(data, ranking, rule)]
-    from washbench.review.bound_section import algorithm_lines, bound_lines
 
     if bounded := bound_lines(data.folder):
         lines += [f"{h} Against the oracle bound", "", *bounded]
@@ -504,7 +504,6 @@ def write_result_report(
     ``table``: the traces.parquet columns already in memory (not read again); ``pdf``: PDF figures besides the PNG;
     ``figures=False``: none drawn (``--no-figures``; figures of an earlier run in the folder are removed).
     """
-    from washbench.io.outfolder import discard_stage, make_stage, replace_entries
 
     data = load_result(Path(result_dir), table, series=figures)
     stage = make_stage(data.folder)  # report.md and figures/ replace the previous ones together (links never followed)
@@ -526,7 +525,6 @@ def _write_result_report(data: ResultData, stage: Path, pdf: bool, figures: bool
         f"washouts: {', '.join(data.washouts)}.",
         "",
     ]
-    from washbench.review.input_figure import input_section
 
     lines += input_section(data.folder, pdf, _image, stage) if figures else []  # a cue result: the input as read, first
     lines += provenance_lines(data.provenance, data.created_utc)

@@ -10,7 +10,10 @@ import os
 from pathlib import Path
 
 from washbench.errors import WashbenchError, located
+from washbench.io.lock import output_lock
+from washbench.io.outfolder import recover
 from washbench.io.result_files import SUITE_FILE
+from washbench.review.palette import PALETTE_ENV, palette_name
 from washbench.review.report import write_result_report
 from washbench.review.result_data import is_result_folder
 from washbench.review.suite_report import write_suite_report
@@ -20,12 +23,9 @@ def report_command(results_dir: Path, palette: str | None = None) -> int:
     """``washbench report DIR``: write report.md and the figures (PNG and PDF) again from a result or suite folder's
     files. ``palette`` (:data:`washbench.review.palette.PALETTES`) is set for this process as
     ``$WASHBENCH_PALETTE`` would be (every figure of a suite is drawn with it)."""
-    from washbench.review.palette import PALETTE_ENV, palette_name
 
     if palette is not None:
         os.environ[PALETTE_ENV] = palette_name(palette)
-    from washbench.io.lock import output_lock
-    from washbench.io.outfolder import recover
 
     folder = Path(results_dir)
     if not folder.is_dir():

@@ -48,6 +48,7 @@ from pathlib import Path
 import numpy as np
 import rerun as rr
 
+from washbench.analysis.cues import FALSE, classify, dof_thresholds, false_events
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import atomic_path
 from washbench.perception.thresholds import STANDARD_GRAVITY_MPS2, ZACHARIAS, Thresholds
@@ -555,7 +556,6 @@ def cue_lane_path(data: RecordingData, washout: str) -> str:
 def _send_cues(rec: rr.RecordingStream, data: RecordingData) -> None:
     """Per washout a lane "false: surge+roll" while false cues last (:mod:`washbench.analysis.cues`), and one
     ``/events/false_cues`` line per false-cue event (start, end, DOF, peak)."""
-    from washbench.analysis.cues import FALSE, classify, dof_thresholds, false_events
 
     t_s = np.asarray(data.t_s, dtype=np.float64)
     dt = float(t_s[1] - t_s[0]) if t_s.size > 1 else 1.0

@@ -33,7 +33,9 @@ from washbench.io.columns import (
 )
 from washbench.io.metrics_csv import MetricRow, read_metrics_csv
 from washbench.io.provenance import read_parquet_provenance
+from washbench.io.readback import FlightDoc, RunDoc, check_provenance, read_doc
 from washbench.io.result_files import FLIGHT_JSON, METRICS_FILE, RUN_FILE, TRACES_FILE
+from washbench.platform.limits import PlatformLimits, wheel_jacobian
 
 
 @dataclass(eq=False)
@@ -81,7 +83,6 @@ def is_result_folder(folder: Path) -> bool:
 
 def _read_json(path: Path, model: Any) -> dict[str, Any] | None:
     """``path`` checked as strictly as a user's file (:mod:`washbench.io.readback`), or None when absent."""
-    from washbench.io.readback import read_doc
 
     return read_doc(path, model)
 
@@ -105,8 +106,6 @@ def _limits_from(prov: dict[str, Any] | None) -> Any:
         return None
     from pydantic import ValidationError
 
-    from washbench.platform.limits import PlatformLimits
-
     try:
         return PlatformLimits.model_validate_json(json.dumps(values))  # JSON mode: arrays are tuples
     except ValidationError:
@@ -120,7 +119,6 @@ def envelope_usage(table: dict[str, np.ndarray], washouts: list[str], limits: An
     limits, :func:`washbench.platform.kinematics.track_rotation`) over its limit, 0 at the first sample. The wheel
     limit is the fastest any wheel turns with the sphere at its rate limit (as in the recording).
     """
-    from washbench.platform.limits import wheel_jacobian
 
     t = limits.translation
     rate_limit_degps = limits.rotation.rate_limit_degps
@@ -208,7 +206,6 @@ def load_result(folder: Path, table: Mapping[str, np.ndarray] | None = None, *, 
         raise WashbenchError(located(traces_path, "fewer than 2 samples"))
     if not (np.all(np.isfinite(t)) and np.all(np.diff(t) > 0)):
         raise WashbenchError(located(traces_path, f"{TIME_COLUMN}: not finite and increasing (edited or damaged?)"))
-    from washbench.io.readback import FlightDoc, RunDoc, check_provenance
 
     run = _read_json(folder / RUN_FILE, RunDoc) or {}
     flight = _read_json(folder / FLIGHT_JSON, FlightDoc) or {}

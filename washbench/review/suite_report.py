@@ -28,7 +28,10 @@ from washbench.analysis.ranking import (
 )
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
+from washbench.io.outfolder import discard_stage, make_stage, replace_entries
+from washbench.io.readback import SuiteDoc, read_doc, suite_member
 from washbench.io.result_files import FIGURES_DIR, METRICS_FILE, RECORDING_FILE, REPORT_FILE, SUITE_FILE
+from washbench.review.figures import score_heatmap, table4_figure
 from washbench.review.numbers import sig
 from washbench.review.report import (
     FLAG,
@@ -72,7 +75,6 @@ def write_suite_json(
 
 def _entries(suite_dir: Path) -> tuple[list[dict[str, Any]], dict[str, Any]]:
     """The manoeuvre entries and the suite document (suite.json, or found result folders without it)."""
-    from washbench.io.readback import SuiteDoc, read_doc, suite_member
 
     path = suite_dir / SUITE_FILE
     doc = read_doc(path, SuiteDoc)  # checked as strictly as a user's file
@@ -97,8 +99,6 @@ def write_suite_report(suite_dir: Path, *, regenerate_results: bool = False, fig
     and every figure as PNG and PDF; otherwise the PNG figures the runs wrote are linked and the suite's are PNG.
     """
 
-    from washbench.io.outfolder import discard_stage, make_stage, replace_entries
-
     suite_dir = Path(suite_dir)
     entries, doc = _entries(suite_dir)
     stage = make_stage(suite_dir)  # report.md and figures/ replace the previous ones together (links never followed)
@@ -114,7 +114,6 @@ def _write_suite_report(
     suite_dir: Path, stage: Path, entries: list[dict[str, Any]], doc: dict[str, Any], regenerate_results: bool,
     figures: bool,
 ) -> None:  # fmt: skip
-    from washbench.review.figures import score_heatmap, table4_figure
 
     results: list[tuple[dict[str, Any], ResultData | None]] = []
     for e in entries:
@@ -236,7 +235,6 @@ def _write_suite_report(
 
 def _existing_figures(d: ResultData) -> dict[str, Path]:
     """The result's figures as its report links them (drawn again, with its report, when missing)."""
-    from washbench.review.report import write_result_report
 
     def found() -> dict[str, Path]:
         paths = {name: d.folder / FIGURES_DIR / f"{name}.png" for name in ("perceived", "envelope", "cues")}

@@ -25,6 +25,11 @@ from pathlib import Path
 from typing import Any
 
 from washbench.analysis.ranking import BOUND_WASHOUT
+from washbench.cueing.registry import whole_only
+from washbench.io.atomic import write_text_atomic
+from washbench.io.columns import acc_columns, f_columns, omega_columns, omega_platform_columns, q_columns
+from washbench.io.csv_numbers import csv_number
+from washbench.runs.chain import analyse, from_lockstep, stacked_rows
 
 BOUND_FILE = "bound.csv"
 BOUND_COLUMNS = ("washout", "cost", "cost_bound", "cost_still", "recovered")
@@ -34,7 +39,6 @@ bound's optimum J_bound, a still platform's J_still (the same on every row) and 
 
 def split_whole(specs: Sequence[Any]) -> tuple[list[Any], list[Any]]:
     """The washouts (``Washout`` variants) that run sample by sample, and those that need the whole recording."""
-    from washbench.cueing.registry import whole_only
 
     whole = [s for s in specs if whole_only(s.kind, s.source)]
     return [s for s in specs if s not in whole], whole
@@ -45,7 +49,7 @@ def with_whole(
 ) -> dict[str, Any]:
     """``traces`` (the lockstep's) and the whole-only washouts cued on ``motion`` (the flight read back), in the
     order ``order`` (every washout's name, as listed)."""
-    from washbench.cueing import cue_trace
+    from washbench.cueing import cue_trace  # deferred: numba
 
     if not whole:
         return dict(traces)
@@ -58,8 +62,7 @@ def lockstep_result(motion: Any, rows: list[Any], options: Any) -> Any:
     """:func:`washbench.runs.chain.from_lockstep` with the whole-only washouts of ``options`` (a
     :class:`washbench.runs.options.RunOptions`; they were not in the lockstep) cued here on ``motion``, the flight
     read back, and put in their listed order."""
-    from washbench.cueing import WashoutTrace
-    from washbench.runs.chain import analyse, from_lockstep, stacked_rows
+    from washbench.cueing import WashoutTrace  # deferred: numba
 
     stepped, whole = split_whole(options.washouts)
     if not whole:
@@ -90,10 +93,7 @@ def bound_outputs(
         return None
     import pyarrow.parquet as pq
 
-    from washbench.analysis.bound import BoundParams, costs_from_columns  # scipy: only when the bound runs
-    from washbench.io.atomic import write_text_atomic
-    from washbench.io.columns import acc_columns, f_columns, omega_columns, omega_platform_columns, q_columns
-    from washbench.io.csv_numbers import csv_number
+    from washbench.analysis.bound import BoundParams, costs_from_columns  # deferred: scipy.sparse
 
     params = BoundParams.model_validate(spec.params.sections.get(BOUND_WASHOUT) or {})
     names = [s.name for s in specs]

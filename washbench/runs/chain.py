@@ -289,7 +289,7 @@ def cue_motion(
 
     ``filter_start``: ``steady`` (every filter in the first sample's steady state) or ``rest``.
     """
-    from washbench.cueing import cue_trace
+    from washbench.cueing import cue_trace  # deferred: numba
 
     traces = cue_trace(motion.f_mps2, motion.omega_radps, motion.dt_s, washouts, params, limits, filter_start)
     return analyse(motion, traces, vestibular, filter_start)
@@ -325,7 +325,7 @@ def stream_cue(
     ``recording``) show: the returned result's ``traces`` hold those, so :meth:`CueResult.columns` is not available
     on it (the table is in the file).
     """
-    from washbench.cueing import CueingBank, WashoutTrace
+    from washbench.cueing import CueingBank, WashoutTrace  # deferred: numba
 
     if chunk_rows < 1:
         raise ValueError(f"chunk_rows must be at least 1, got {chunk_rows}")
@@ -423,7 +423,7 @@ def lockstep_washouts(
 ) -> tuple[list[np.ndarray], Any]:
     """A washout bank (selected :class:`washbench.cueing.variants.Washout` s) run in lockstep with a flight:
     (the rows it fills, the flight's step hook)."""
-    from washbench.cueing import CueingBank
+    from washbench.cueing import CueingBank  # deferred: numba
 
     bank = CueingBank(specs, None, limits, dt_s, filter_start)
     rows: list[np.ndarray] = []
@@ -451,7 +451,7 @@ def lockstep_blocks(
     """:func:`lockstep_washouts` for ``fly``'s block hook: the washouts take the flight's samples a block at a
     time (``CueingBank.steps``, one compiled call per block); ``rows`` gets one (washouts, M, fields) block per
     call (:func:`sample_count`, :func:`stacked_rows`)."""
-    from washbench.cueing import CueingBank
+    from washbench.cueing import CueingBank  # deferred: numba
 
     bank = CueingBank(specs, None, limits, dt_s, filter_start)
     rows: list[np.ndarray] = []
@@ -495,7 +495,7 @@ def from_lockstep(
     """The chain entered with a flight flown in lockstep: the washout traces the lockstep filled (``rows`` of
     :func:`lockstep_blocks` or :func:`lockstep_washouts`, emptied here; ``washouts`` their names in order) on
     ``motion`` (the flight as read back from ``flight.parquet``), through :func:`analyse`."""
-    from washbench.cueing import WashoutTrace
+    from washbench.cueing import WashoutTrace  # deferred: numba
 
     block = stacked_rows(rows)  # (washouts, N, fields); the lockstep's blocks are freed
     traces = {w: WashoutTrace.from_rows(block[i]) for i, w in enumerate(washouts)}  # contiguous columns

@@ -37,6 +37,8 @@ from washbench.io.publish import result_path
 from washbench.io.readers import Samples, read_samples
 from washbench.io.resample import check_gaps, check_step, resample, split_resets, to_motion, window
 from washbench.io.result_files import METRICS_FILE, RECORDING_FILE, RUN_FILE, TRACES_FILE
+from washbench.review.input_figure import draw_for_result, input_labels
+from washbench.runs.bound_stage import bound_outputs
 from washbench.runs.chain import CueResult, aircraft_attitude, stream_cue
 from washbench.runs.options import RunOptions, load_options
 from washbench.runs.result_folder import RunSummary, write_run_json, write_run_recording, write_run_review
@@ -101,7 +103,6 @@ def prepare_segments(samples: Samples, opts: CueOptions) -> list[Segment]:
     Resampling is held to what the grid check holds the data to (a step of 1 Hz .. 10 kHz, the median step
     here), and to at most :data:`MAX_GROWTH` times the rows read unless ``opts.force``.
     """
-    from washbench.review.input_figure import input_labels
 
     parts = split_resets(samples, split=opts.split)
     fmt = opts.fmt
@@ -223,7 +224,6 @@ def write_outputs(
                     "warnings": [f.text for f in seg.findings],
                     "algorithms": dict(result.algorithms),
                 }
-                from washbench.runs.bound_stage import bound_outputs
 
                 bound = bound_outputs(folder, tmp[TRACES_FILE], seg.motion.dt_s, run.washouts, run.limits,
                                       run.vestibular_params)  # fmt: skip
@@ -241,7 +241,6 @@ def write_outputs(
             if not recording:  # atomically once the rest is in place; an earlier recording would mislead
                 (summary.run_dir / RECORDING_FILE).unlink(missing_ok=True)
             if figures and seg.labels:  # what was read, linked first in the report
-                from washbench.review.input_figure import draw_for_result
 
                 title = f"{input_path.name}{f' {seg.name}' if seg.name else ''}"
                 draw_for_result(summary.run_dir, title, seg.motion, seg.labels, seg.notes)

@@ -7,6 +7,8 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from washbench.errors import WashbenchError, located
+from washbench.flight.manoeuvre import load_manoeuvre
+from washbench.flight.scripts import is_runscript, is_script, load_script_info
 from washbench.io.paths import MANOEUVRES_DIR, bundled_names, resolve_manoeuvre
 
 
@@ -14,7 +16,6 @@ def find_manoeuvres(inputs: Sequence[Path], scripts: Sequence[Path] = ()) -> lis
     """Manoeuvre files and JSBSim scripts from files and folders (folders are searched recursively for
     ``*.yaml`` manoeuvres and ``*.xml`` JSBSim scripts), then ``scripts``; no inputs at all: the bundled
     manoeuvres."""
-    from washbench.flight.scripts import is_runscript
 
     if not inputs and not scripts:
         inputs = [MANOEUVRES_DIR]
@@ -41,8 +42,6 @@ def check_unique_names(files: Sequence[Path], aircraft_dirs: Sequence[Path] = ()
 
     Files that do not load are left for the run to report. Raises WashbenchError naming both files.
     """
-    from washbench.flight.manoeuvre import load_manoeuvre
-    from washbench.flight.scripts import is_script, load_script_info
 
     seen: dict[tuple[str, str], Path] = {}
     for path in files:

@@ -33,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from washbench.cueing import CueingBank
 from washbench.errors import WashbenchError
 from washbench.io.atomic import write_text_atomic
 from washbench.io.lock import output_lock
@@ -44,6 +45,7 @@ from washbench.live.endpoints import Sink, bind_udp
 from washbench.live.link import LatencyStats, Link, Out
 from washbench.live.packets import RREF_DATAREFS, RREF_ID0, Decoder, PacketError, decoder, rref_request
 from washbench.live.saved_input import INPUT_FILE, InputWriter
+from washbench.live.viewer import open_viewer
 from washbench.runs.cue import CueOptions, run_cue
 from washbench.runs.options import load_options
 from washbench.runs.outputs import Outputs
@@ -123,8 +125,6 @@ class Session:
         """Save, cue and command one sample."""
         s = o.sample
         if o.new_segment or self.bank is None:
-            from washbench.cueing import CueingBank
-
             self.bank = CueingBank(self.specs, None, self.limits, self.link.dt_s, self.opts.filter_start)
         f, w = self._f, self._w
         f[0], f[1], f[2] = s[1], s[2], s[3]
@@ -336,9 +336,6 @@ def run_live(
 ) -> int:
     """The ``washbench live`` command; returns the exit status (that of ``washbench cue`` on the saved input, or
     130 / 143 after a Ctrl-C / SIGTERM once the result folder is written)."""
-    from washbench.cueing import CueingBank
-    from washbench.live.viewer import open_viewer
-
     for flag, value in (("--duration", opts.duration_s), ("--idle-timeout", opts.idle_timeout_s),
                         ("--rate-hz", opts.rate_hz), ("--resample", opts.resample_hz)):  # fmt: skip
         if value is not None and not (math.isfinite(value) and value > 0.0):

@@ -39,6 +39,7 @@ from washbench.io.yamlio import load_yaml_model
 from washbench.perception.vestibular import VestibularModel, VestibularParams
 from washbench.platform import load_platform_limits
 from washbench.platform.limits import PlatformLimits
+from washbench.review.bode import write_bode_plots
 from washbench.review.omct_report import report_text
 
 CSV_FILE = "omct.csv"
@@ -135,7 +136,7 @@ def measure(
     ``amplitude_scale`` multiplies every input amplitude (1: the amplitudes of :func:`omct.amplitude`), to
     probe where a washout stops being linear.
     """
-    from washbench.cueing import cue_trace
+    from washbench.cueing import cue_trace  # deferred: numba
 
     if not entries:
         raise WashbenchError("no washout selected")
@@ -308,8 +309,6 @@ def run_entries(
         )
         files: dict[str, str] = {}
         if plots:
-            from washbench.review.bode import write_bode_plots
-
             files = write_bode_plots(stage, points, boundary.bounds() if boundary else {}, [e.name for e in entries])
         write_text_atomic(stage / CSV_FILE, csv_text(points))
         write_text_atomic(stage / REPORT_FILE, report_text(points, settings, entries, boundary, files))

@@ -19,7 +19,7 @@ from typing import Any
 
 from washbench.analysis.ranking import RankRule
 from washbench.cueing import registry
-from washbench.cueing.params import DEFAULT_PARAMS_PATH, WashoutParams
+from washbench.cueing.params import DEFAULT_PARAMS_PATH, WashoutParams, check_filter_start
 from washbench.cueing.variants import Washout, param_file_from_data, select_from
 from washbench.errors import WashbenchError
 from washbench.io.provenance import build_provenance, merge_provenance
@@ -101,7 +101,6 @@ def load_options(
     Raises WashbenchError (one line: file, line, field) for a bad parameter file, variant, platform file, ranking
     section, filter start or ``--max-time-s``: before anything is flown or written.
     """
-    from washbench.cueing.params import check_filter_start  # (light: the compiled bank is imported once there is work)
 
     check_filter_start(filter_start)
     check_max_time(max_time_s)

@@ -33,6 +33,17 @@ import numpy as np
 
 from washbench.analysis.ranking import perceived_motion
 from washbench.errors import WashbenchError, located
+from washbench.flight.fly import fly, write_flight
+from washbench.flight.manoeuvre import load_manoeuvre
+from washbench.flight.scripts import (
+    DEFAULT_MAX_TIME_S,
+    fly_script,
+    is_script,
+    load_script_info,
+    plan_limit_s,
+    script_plan,
+    write_script_flight,
+)
 from washbench.io.budget import check_samples
 from washbench.io.lock import output_lock
 from washbench.io.motion_file import read_motion
@@ -41,6 +52,7 @@ from washbench.io.provenance import flat_strings, utc_now
 from washbench.io.publish import check_replaceable
 from washbench.io.result_files import FLIGHT_FILE, RECORDING_FILE, REPORT_FILE, RUN_FILE
 from washbench.review.numbers import pct, sig
+from washbench.runs.bound_stage import bound_outputs, lockstep_result, split_whole
 from washbench.runs.chain import (
     LOCKSTEP_BLOCK,
     aircraft_attitude,
@@ -75,7 +87,6 @@ def run_manoeuvre(
     with ``ok`` False and the reason. The result folder replaces only a previous ``washbench run`` result of the
     same manoeuvre (recognised by its run.json).
     """
-    from washbench.flight.manoeuvre import load_manoeuvre
 
     opts = options if options is not None else load_options()
     # every input and the result place first: a bad one fails before anything is flown
@@ -83,9 +94,6 @@ def run_manoeuvre(
     prov = opts.provenance_for(manoeuvre_path, manoeuvre.environment.turbulence, manoeuvre.aircraft_files)
     final = run_dir(Path(out_root), manoeuvre.aircraft, manoeuvre.name)
     marker = run_marker(manoeuvre.aircraft, manoeuvre.name)
-
-    from washbench.flight.fly import fly, write_flight
-    from washbench.runs.bound_stage import split_whole
 
     stepped = split_whole(opts.washouts)[0]  # a whole-only washout (the bound) is cued after the flight
     # entered before flying: a folder or file in the way fails now, not after
@@ -139,7 +147,6 @@ def write_cued_folder(
     completed with the steps, metrics and saturations. ``provenance`` (no date) goes into traces.parquet's
     metadata; ``extra`` into run.json. A washout that needs the whole recording (the oracle bound) is cued here
     on the flight read back, and with the bound ``bound.csv`` is written (:mod:`washbench.runs.bound_stage`)."""
-    from washbench.runs.bound_stage import bound_outputs, lockstep_result
 
     motion = read_motion(folder / FLIGHT_FILE)
     result = lockstep_result(motion, rows, options)
@@ -175,7 +182,6 @@ def run_script(script_path: Path, out_root: Path, options: RunOptions | None = N
     (None: the script's own end, at most
     :data:`washbench.flight.scripts.DEFAULT_MAX_TIME_S`).
     """
-    from washbench.flight.scripts import DEFAULT_MAX_TIME_S, fly_script, load_script_info, write_script_flight
 
     opts = options if options is not None else load_options()
     info = load_script_info(script_path, opts.aircraft_dirs)
@@ -188,7 +194,6 @@ def run_script(script_path: Path, out_root: Path, options: RunOptions | None = N
     marker = {"aircraft": info.aircraft}  # one run.json, or one per run of a script that resets
     banks: list[list[np.ndarray]] = []
     hooks: list[Any] = []
-    from washbench.runs.bound_stage import split_whole
 
     stepped = split_whole(opts.washouts)[0]  # a whole-only washout (the bound) is cued after the flight
 
@@ -231,7 +236,6 @@ def announce_script(path: Path, options: RunOptions) -> None:
     """Before a long JSBSim script run (or one the default cap cuts short): one line on standard error with the
     simulated time, the steps, the expected size and wall time, and the cap (:func:`washbench.flight.scripts.
     script_plan`)."""
-    from washbench.flight.scripts import load_script_info, plan_limit_s, script_plan
 
     max_time_s = options.max_time_s
     info = load_script_info(path, options.aircraft_dirs)
@@ -248,7 +252,6 @@ def run_command(manoeuvre_path: Path, out_root: Path, options: RunOptions, *, pr
 
     Holds the lock of ``out_root`` (:func:`washbench.io.lock.output_lock`) while it runs.
     """
-    from washbench.flight.scripts import is_script
 
     start = time.perf_counter()
     with output_lock(out_root):  # held while it runs: a second writer gets one line at once

@@ -21,6 +21,8 @@ from concurrent.futures import Future, ProcessPoolExecutor
 from typing import Any
 
 from washbench.io.outfolder import signals_held
+from washbench.runs import parent_death
+from washbench.runs.parent_death import note_main_pid
 
 _QUIET_TRACKER = "ignore:resource_tracker:UserWarning"
 
@@ -66,12 +68,11 @@ def stop_pool(pool: ProcessPoolExecutor) -> None:
 
 def _preload() -> None:
     """Worker initializer where there is no forkserver: load the heavy modules once per worker."""
-    import washbench.runs.preload  # noqa: F401
+    import washbench.runs.preload  # deferred: jsbsim  # noqa: F401
 
 
 def _die_with_parent() -> None:
     """Worker initializer: the worker ends when its parent (the process server) does."""
-    from washbench.runs import parent_death
 
     parent_death.die_with_parent(parent_death.SERVER_PID)  # the server's PID: ends at once if it died meanwhile
 
@@ -96,7 +97,6 @@ def pool_context(
         first = ["washbench.runs.worker_signals"] if main_stops_workers else []
         optional = [*(FIGURE_MODULES if figures else ()), *(["rerun"] if recording else [])]
         ctx.set_forkserver_preload([*first, "washbench.runs.preload", *optional])
-        from washbench.runs.parent_death import note_main_pid
 
         note_main_pid()  # the server (started with the pool) must die with this process
         return ctx, _die_with_parent

@@ -118,7 +118,12 @@ def write_run_recording(
     ``aircraft_q`` (N, 4) the aircraft's attitude, body -> NED, scalar first; ``phases`` (name, start, end) [s];
     ``properties``: the provenance as flat strings (:func:`washbench.io.provenance.flat_strings`).
     """
-    from washbench.review.rerun_log import MotionSeries, PlatformSeries, RecordingData, write_recording
+    from washbench.review.rerun_log import (  # deferred: rerun
+        MotionSeries,
+        PlatformSeries,
+        RecordingData,
+        write_recording,
+    )
 
     ac = result.perceived["aircraft"]
     washouts: dict[str, MotionSeries] = {}
@@ -156,7 +161,7 @@ def write_run_recording(
 
 def platform_envelope(limits: PlatformLimits) -> PlatformEnvelope:
     """The recording's envelope lines from the platform limits (wheel limit from the rate limit)."""
-    from washbench.review.rerun_log import PlatformEnvelope
+    from washbench.review.rerun_log import PlatformEnvelope  # deferred: rerun
 
     t = limits.translation
     jac = wheel_jacobian(limits)

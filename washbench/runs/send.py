@@ -23,8 +23,11 @@ from pathlib import Path
 import numpy as np
 
 from washbench.errors import WashbenchError
+from washbench.flight.fly import fly
+from washbench.flight.manoeuvre import load_manoeuvre
 from washbench.io.paths import resolve_manoeuvre
 from washbench.io.readers import read_samples
+from washbench.live.endpoints import bind_udp
 from washbench.live.packets import (
     ENCODERS,
     FORMATS,
@@ -95,8 +98,6 @@ class Sender:
         self.subscribers: dict[tuple[str, int], dict[int, int]] = {}  # address -> {id: dataref index}
         self.had_subscriber = False
         if fmt == "xplane-rref":
-            from washbench.live.endpoints import bind_udp
-
             self.sock = bind_udp(listen or ("127.0.0.1", 49000), "--listen")
             self.sock.setblocking(False)
             self.to = None
@@ -213,8 +214,6 @@ def run_send(
 
 def _fly_and_send(path: Path, sender: Sender, pacer: Pacer, aircraft_dirs: tuple[Path, ...]) -> None:
     """Fly the manoeuvre with JSBSim, each step paced to (``--speed`` times) real time and sent as it is final."""
-    from washbench.flight.fly import fly
-    from washbench.flight.manoeuvre import load_manoeuvre
     m = load_manoeuvre(resolve_manoeuvre(path), aircraft_dirs)
     dt = m.dt_s
     r2d = 180.0 / np.pi

@@ -21,11 +21,14 @@ import numpy as np
 from washbench.analysis.evaluate import Evaluation, FlightEvaluator
 from washbench.cueing.variants import Washout
 from washbench.errors import WashbenchError, located
+from washbench.flight.fly import fly, write_flight
+from washbench.flight.manoeuvre import load_manoeuvre
 from washbench.io.cpus import usable_cpus
 from washbench.io.motion_file import read_motion
 from washbench.io.outfolder import STAGE_PREFIX
 from washbench.io.progress import Progress
 from washbench.io.result_files import FLIGHT_FILE
+from washbench.runs.cluster import client, dask_map
 from washbench.runs.pool import submit_all, worker_pool
 
 FLIGHTS_DIR = "flights"
@@ -45,8 +48,6 @@ class StudyFlight:
 
 def _fly_one(path: str, flights_dir: str, aircraft_dirs: tuple[str, ...] = ()) -> tuple[str, str, bool, str]:
     """Worker: fly one manoeuvre (no washouts, no recording) and write its flight; (aircraft, name, ok, reason)."""
-    from washbench.flight.fly import fly, write_flight
-    from washbench.flight.manoeuvre import load_manoeuvre
 
     m = load_manoeuvre(Path(path), [Path(d) for d in aircraft_dirs])
     result = fly(m)
@@ -56,7 +57,6 @@ def _fly_one(path: str, flights_dir: str, aircraft_dirs: tuple[str, ...] = ()) -
 
 def _identify(paths: Sequence[Path], aircraft_dirs: Sequence[Path]) -> list[tuple[str, str, str]]:
     """(path, aircraft, name) of every manoeuvre file, validated (bad files stop the study before any work)."""
-    from washbench.flight.manoeuvre import load_manoeuvre
 
     out = []
     for p in paths:
@@ -112,8 +112,6 @@ def load_flights(
 def _map(fn, args: list[tuple], jobs: int | None, dask: str | None) -> list:
     """``fn(*a)`` for each ``a``: on the Dask cluster, in forked worker processes, or here (one job)."""
     if dask:
-        from washbench.runs.cluster import dask_map
-
         return list(dask_map(dask, fn, args))
     jobs = max(1, min(jobs or usable_cpus(), len(args)))
     if jobs == 1:
@@ -159,7 +157,6 @@ def evaluate(
             if progress is not None:
                 progress.update(steps)
         return out
-    from washbench.runs.cluster import client
 
     c = client(dask)
     n_workers = max(1, len(c.scheduler_info().get("workers", {})))

@@ -51,6 +51,7 @@ from washbench.analysis.ranking import (
 )
 from washbench.cueing import registry
 from washbench.errors import WashbenchError, located
+from washbench.flight.scripts import bundled_script, is_script
 from washbench.io.atomic import write_text_atomic
 from washbench.io.cpus import usable_cpus
 from washbench.io.csv_numbers import csv_number
@@ -72,6 +73,7 @@ from washbench.io.result_files import (
     publication_pid,
 )
 from washbench.review.suite_report import write_suite_json, write_suite_report
+from washbench.runs.cluster import dask_map
 from washbench.runs.inputs import check_unique_names, find_manoeuvres
 from washbench.runs.options import RunOptions, load_options
 from washbench.runs.pipeline import announce_script, run_manoeuvre, run_script
@@ -95,7 +97,6 @@ def _run_one(path: str, out_dir: str, options: RunOptions) -> list[Outcome]:
     """Worker: run one manoeuvre or JSBSim script (one outcome per run segment); never raises (failures
     come back as an Outcome). The washout plugins of ``options`` (``FILE.py:NAME``) are loaded first (a worker
     process has only what its parent loaded before it started)."""
-    from washbench.flight.scripts import is_script
 
     start = time.perf_counter()
     try:
@@ -146,8 +147,6 @@ def run_suite(
         )
     try:
         if dask:
-            from washbench.runs.cluster import dask_map
-
             for runs in dask_map(dask, _run_one, args):
                 outcomes[runs[0].path] = _report(runs, len(outcomes) + 1, len(files), start, shown)
         elif jobs == 1:
@@ -324,7 +323,6 @@ def suite_command(
     (``c1723``) run besides ``inputs``. See the module docstring for the output folder policy (lock, whole
     replacement, interruption).
     """
-    from washbench.flight.scripts import bundled_script, is_script
 
     if jobs is not None and jobs < 1:
         raise WashbenchError(f"--jobs: expected a whole number of at least 1, got {jobs}")

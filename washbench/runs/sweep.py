@@ -29,6 +29,7 @@ from washbench.io.atomic import write_text_atomic
 from washbench.io.outfolder import result_set
 from washbench.io.progress import Progress
 from washbench.platform import load_platform_limits
+from washbench.review.study_figures import sweep_figure
 from washbench.runs.inputs import find_manoeuvres
 from washbench.runs.study import StudyFlight, evaluate, load_flights
 
@@ -145,7 +146,6 @@ def sweep_command(
         rows.sort(key=lambda r: (r.index, r.aircraft, r.manoeuvre))  # grid point by grid point
         write_text_atomic(stage / "sweep.csv", _csv(sweep_csv(keys, rows)))
         write_text_atomic(stage / "sweep_metrics.csv", _csv(sweep_metrics_csv(keys, rows)))
-        from washbench.review.study_figures import sweep_figure
 
         sweep_figure(stage / "sweep.png", keys, rows)
     out_dir = Path(out_dir)

@@ -37,6 +37,7 @@ from washbench.io.outfolder import result_set
 from washbench.io.progress import Progress
 from washbench.io.result_files import REPORT_FILE
 from washbench.platform import load_platform_limits
+from washbench.review.study_figures import convergence_figure
 from washbench.runs.inputs import find_manoeuvres
 from washbench.runs.study import evaluate, load_flights
 
@@ -254,7 +255,6 @@ def _report(
     seed: int,
     weight: float,
 ) -> None:
-    from washbench.review.study_figures import convergence_figure
 
     objective = np.array([h[3] for h in history])
     convergence_figure(out_dir / "convergence.png", objective, base_obj, base.name)
