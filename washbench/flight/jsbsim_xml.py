@@ -29,7 +29,7 @@ import xml.parsers.expat as expat
 from pathlib import Path
 
 from washbench.errors import WashbenchError, located, printable
-from washbench.io.budget import read_bounded
+from washbench.io import budget
 
 #: Largest XML file read (JSBSim's biggest aircraft file is about 1 MB).
 MAX_XML_BYTES = 32 * 1024 * 1024
@@ -55,7 +55,7 @@ def read_xml(path: str | Path) -> ET.Element:
     """The root element of XML file ``path``; WashbenchError (file, line, what) if it is not plain, well-formed XML."""
 
     path = Path(path)
-    data = read_bounded(path, MAX_XML_BYTES)
+    data = budget.read_bounded(path, MAX_XML_BYTES)
     if not data.strip():
         raise WashbenchError(located(path, "the file is empty"))
     builder = ET.TreeBuilder()

@@ -28,7 +28,7 @@ import yaml
 from pydantic import BaseModel, ConfigDict
 
 from washbench.errors import WashbenchError, located
-from washbench.io.budget import read_bounded
+from washbench.io import budget
 
 M = TypeVar("M", bound=BaseModel)
 
@@ -352,7 +352,7 @@ def read_yaml_digest(path: Path) -> tuple[Any, dict[Loc, int], str]:
     provenance record."""
     import hashlib
 
-    raw = read_bounded(path)
+    raw = budget.read_bounded(path)
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as exc:

@@ -41,11 +41,11 @@ from washbench.io.outfolder import owned_entries
 from washbench.io.resample import suggest_rate, uniform_step
 from washbench.io.result_files import RUN_FILE
 from washbench.live import commands
+from washbench.live import viewer as live_viewer
 from washbench.live.endpoints import Sink, bind_udp
 from washbench.live.link import LatencyStats, Link, Out
 from washbench.live.packets import RREF_DATAREFS, RREF_ID0, Decoder, PacketError, decoder, rref_request
 from washbench.live.saved_input import INPUT_FILE, InputWriter
-from washbench.live.viewer import open_viewer
 from washbench.runs.cue import CueOptions, run_cue
 from washbench.runs.options import load_options
 from washbench.runs.outputs import Outputs
@@ -356,7 +356,7 @@ def run_live(
             output_lock(opts.out) as out:  # fmt: skip
         owned_entries(out, "cue", (INPUT_FILE,))  # a folder holding someone else's files is refused before listening
         writer = InputWriter(out / INPUT_FILE)
-        viewer = open_viewer(names, limits, opts.filter_start) if opts.viewer else None
+        viewer = live_viewer.open_viewer(names, limits, opts.filter_start) if opts.viewer else None
         to = f"udp://{opts.sink[0]}:{opts.sink[1]} ({opts.sink_format})" if opts.sink else "nowhere (no --sink)"
         print(f"live: listening on udp://{opts.listen[0]}:{opts.listen[1]} for {opts.fmt} packets; washouts "
               f"{', '.join(names)}; commands to {to}")  # fmt: skip

@@ -36,7 +36,6 @@ from washbench.errors import WashbenchError, located
 from washbench.flight.fly import fly, write_flight
 from washbench.flight.manoeuvre import load_manoeuvre
 from washbench.flight.scripts import (
-    DEFAULT_MAX_TIME_S,
     fly_script,
     is_script,
     load_script_info,
@@ -186,8 +185,8 @@ def run_script(script_path: Path, out_root: Path, options: RunOptions | None = N
     opts = options if options is not None else load_options()
     info = load_script_info(script_path, opts.aircraft_dirs)
     max_time_s = opts.max_time_s
-    if max_time_s is None and info.end_s > DEFAULT_MAX_TIME_S:  # announced by the commands (script_plan)
-        max_time_s = DEFAULT_MAX_TIME_S
+    if max_time_s is None and info.end_s > plan_limit_s(None):  # announced by the commands (script_plan)
+        max_time_s = plan_limit_s(None)
     prov = opts.provenance_for(script_path)
     created = utc_now()
     final = run_dir(Path(out_root), info.aircraft, info.name)
