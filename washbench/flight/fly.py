@@ -28,7 +28,7 @@ from washbench.flight.manoeuvre import Manoeuvre, load_manoeuvre
 from washbench.flight.manoeuvre_schema import Until
 from washbench.flight.monitor import BIG, Monitor
 from washbench.flight.openloop import OpenLoop
-from washbench.flight.pilot import Pilot
+from washbench.flight.pilot import INPUTS_OFFSET, OUTPUTS_OFFSET, PACK_INPUTS, UNPACK_OUTPUTS, Pilot
 from washbench.flight.profile import load_profile
 from washbench.io.atomic import atomic_path, write_text_atomic
 from washbench.io.provenance import build_provenance, parquet_metadata
@@ -190,7 +190,9 @@ def fly(
 
     pilot = Pilot(profile, m.runway, dt)
     pilot.set_controls(ail_w.get_double_value(), elev_w.get_double_value(), rud_w.get_double_value())
-    pilot_step = pilot.step
+    pilot_buf, pilot_w, pilot_kernel = pilot.buffer, pilot.w, pilot.kernel
+    pack_inputs, unpack_outputs = PACK_INPUTS, UNPACK_OUTPUTS
+    brakes = pilot.brakes  # changes only at a phase start
     monitor = Monitor.for_profile(profile)
     openloop = OpenLoop(fdm, profile, pilot)
     probe_gets = [n.get_double_value for n in _nodes(fdm, tuple(probes))]
@@ -331,21 +333,25 @@ def fly(
                 flapc_w.set_double_value(pilot.flaps_cmd)
                 lbrk_w.set_double_value(pilot.brakes)
                 rbrk_w.set_double_value(pilot.brakes)
+                brakes = pilot.brakes
                 if progress:  # a line at each phase start (in place on a terminal)
                     _progress(m.name, iphase, nphases, phase.name, t, tty)
 
         if final:
             ail, elev, rud, thr = pilot.aileron, pilot.elevator, pilot.rudder, pilot.throttle
         else:
-            pilot_step(phi, theta, psi, p, q, r, beta, vc, vg, trk, hdot, h, agl, x_rw * 3.2808399,
-                       y_rw * 3.2808399, wow, nz_last, alpha, vt_get(), fy_last)  # fmt: skip
-            ail, elev, rud, thr = pilot.aileron, pilot.elevator, pilot.rudder, pilot.throttle
+            # Pilot.step inlined: the inputs packed into the pilot's slots, one compiled call, the commands unpacked
+            pack_inputs(pilot_buf, INPUTS_OFFSET, phi, theta, psi, p, q, r, beta, vc, vg, trk, hdot, h, agl,
+                        x_rw * 3.2808399, y_rw * 3.2808399, 1.0 if wow else 0.0, nz_last, alpha, vt_get(),
+                        fy_last)  # fmt: skip
+            pilot_kernel(pilot_w)
+            ail, elev, rud, steer, thr = unpack_outputs(pilot_buf, OUTPUTS_OFFSET)
             if openloop.active:  # the phase's open-loop inputs, on top of or instead of the pilot's commands
                 ail, elev, rud, thr = openloop.apply((k - phase_k0) * dt, ail, elev, rud, thr)
             ail_set(ail)
             elev_set(elev)
             rud_set(rud)
-            steer_set(pilot.steer)
+            steer_set(steer)
             thr_set(thr)
             if k % mix_every == 0:
                 mix_w.set_double_value(float(np.interp(h, mix_h_ft, mix_norm)))
@@ -359,7 +365,7 @@ def fly(
         fy_last = ay * FT_S2_TO_M_S2
         # raw values in JSBSim's units; converted column by column after the loop (same bits, fewer operations)
         rows_extend(pack(k, ax, ay, az, p, q, r, phi, theta, psi, alpha, beta, vc, vg, h, agl, hdot, north, east, lat,
-                     lon, x_rw, y_rw, nz, ail, elev, rud, thr, flap_get(), pilot.brakes, rpm_get(), wow,
+                     lon, x_rw, y_rw, nz, ail, elev, rud, thr, flap_get(), brakes, rpm_get(), wow,
                      iphase if not final else nphases - 1))  # fmt: skip
         if step_hook is not None:
             step_hook(k, np.array((ax * FT_S2_TO_M_S2, fy_last, az * FT_S2_TO_M_S2)), np.array((p, q, r)))
