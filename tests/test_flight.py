@@ -357,3 +357,22 @@ def test_the_compiled_pilot_step_gives_the_bits_of_the_interpreted_one(flights: 
     assert {s.split()[0] for s in covered} == {f"lat{i}" for i in range(5)}, covered
     assert {s.split()[1] for s in covered} == {f"pitch{i}" for i in (1, 2, 3, 4, 6, 7, 8)}, covered
     assert {s.split()[2] for s in covered} == {"wow0", "wow1"}, covered
+
+
+def test_a_flight_longer_than_the_rows_first_allocated_records_the_same_bits(
+    flights: dict[str, FlightResult], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The recorded rows grow (doubling) when a flight outlasts the first allocation: flown again with room for 100
+    rows at first (six doublings), the same manoeuvre records the same columns and summary, bit for bit."""
+    import washbench.flight.fly as fly_module
+
+    path = C172 / "elevator_doublet.yaml"
+    monkeypatch.setattr(fly_module, "_ROWS_FIRST", 100)
+    again = fly(load_manoeuvre(path))
+    before = flights[manoeuvre_id(path)]
+    assert len(again.t_s) > 100 * 2**5
+    assert list(again.columns) == list(before.columns)
+    for name, column in before.columns.items():
+        assert again.columns[name].dtype == column.dtype and again.columns[name].tobytes() == column.tobytes(), name
+    assert (again.status, again.phases, again.checks, again.events) == (before.status, before.phases, before.checks,
+                                                                         before.events)  # fmt: skip
