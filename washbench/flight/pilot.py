@@ -367,7 +367,9 @@ for _i, _name in enumerate(PARAMS + STATE):
 def compiled_step() -> Any:
     """:func:`pilot_step`'s numba dispatcher (compiled, or loaded from numba's cache, at its first call; announced)."""
     from washbench.numerics.jitcache import announce_compile
+    from washbench.numerics.numbastart import prepare
 
+    prepare()  # numba's first import without the scipy BLAS probe
     fn = pilot_step
     if isinstance(fn, LazyJit):
         fn = fn.compiled()

@@ -139,11 +139,21 @@ def new_slots() -> tuple[bytearray, np.ndarray]:
     return buffer, np.frombuffer(buffer, dtype=np.float64)
 
 
+_cache_checked = False
+
+
 def compiled_flight_step() -> object:
     """:func:`flight_step`'s numba dispatcher (compiled, or loaded from numba's cache, at its first call; announced)."""
     from washbench.numerics.jitcache import announce_compile
     from washbench.numerics.lazyjit import LazyJit
+    from washbench.numerics.numbastart import prepare
 
+    prepare()  # numba's first import without the scipy BLAS probe
+    global _cache_checked
+    if not _cache_checked:  # here, not at import: it imports numba (0.4 s) and fly's module is imported by validate
+        # the compiled step inlines the pilot's: its cache is stale when pilot.py changes
+        drop_stale_cache(__file__, [Path(__file__).resolve().parent / "pilot.py"])
+        _cache_checked = True
     fn = flight_step
     if isinstance(fn, LazyJit):
         fn = fn.compiled()
@@ -343,7 +353,3 @@ def flight_step(f: np.ndarray, pw: np.ndarray, rows: np.ndarray) -> int:
     f[F_NROWS] = k + 1
     f[F_PENDING] = 1.0
     return code
-
-
-# the compiled step inlines the pilot's: its cache is stale when pilot.py changes
-drop_stale_cache(__file__, [Path(__file__).resolve().parent / "pilot.py"])
