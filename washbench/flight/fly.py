@@ -164,7 +164,8 @@ def fly(
     structure = _nodes(fdm, tuple(f"contact/unit[{i}]/WOW" for i in profile.geometry.structure_contacts))
     struct_gets = [n.get_double_value for n in structure]
 
-    pilot = Pilot(profile, m.runway, dt)
+    fw, pilot_slots = st.new_slots()  # the loop's slots (washbench.flight.stepper), then the pilot's
+    pilot = Pilot(profile, m.runway, dt, pilot_slots)
     pilot.set_controls(ail_w.get_double_value(), elev_w.get_double_value(), rud_w.get_double_value())
     monitor = Monitor.for_profile(profile)
     openloop = OpenLoop(fdm, profile, pilot)
@@ -176,8 +177,7 @@ def fly(
     padded = [*struct_gets, _zero, _zero, _zero, _zero]
     s0, s1, s2, s3 = *padded[:3], (_summed(struct_gets[3:]) if len(struct_gets) > 4 else padded[3])
 
-    # the loop's slots (washbench.flight.stepper): constants, then the state the Python loop kept before
-    fbuf, fw = st.new_slots()
+    # the loop's slots: constants, then the state the Python loop kept before
     fw[st.F_DT] = dt
     fw[st.F_LAT0], fw[st.F_LON0] = frame.lat0, frame.lon0
     fw[st.F_MLAT], fw[st.F_MLON] = frame.m_per_rad_lat, frame.m_per_rad_lon
@@ -200,7 +200,6 @@ def fly(
     fw[st.F_MODE] = st.MODE_STEP
     rows = np.empty((_ROWS_FIRST, len(COLUMN_NAMES)))  # the raw rows (columns converted after the loop), grown x2
     step = st.compiled_flight_step()
-    pw = pilot.w
     run = fdm.run
     pack_step, unpack_commands = st.PACK_STEP, st.UNPACK_COMMANDS
     inputs_at, commands_at = st.INPUTS_OFFSET, st.COMMANDS_OFFSET
@@ -220,11 +219,11 @@ def fly(
 
     while True:
         # what the last step produced (completes its row) and the state now: one pack, one compiled call
-        pack_step(fbuf, inputs_at, ax_get(), ay_get(), az_get(), nz_get(), flap_get(), rpm_get(), phi_get(),
+        pack_step(fw, inputs_at, ax_get(), ay_get(), az_get(), nz_get(), flap_get(), rpm_get(), phi_get(),
                   theta_get(), psi_get(), p_get(), q_get(), r_get(), alpha_get(), beta_get(), vc_get(), vg_get(),
                   trk_get(), hdot_get(), h_get(), agl_get(), lat_get(), lon_get(), wow_get(), vt_get(), s0(), s1(),
                   s2(), s3())  # fmt: skip
-        code = step(fw, pw, rows)
+        code = step(fw, rows)
         if code:  # something for Python: in the order the loop did it
             if code & (st.C_SAMPLE | st.C_BLOCK | st.C_NZ | st.C_PROGRESS):  # the last row is complete
                 j = int(fw[st.F_DONE_ROW])
@@ -242,7 +241,7 @@ def fly(
                 grown = np.empty((2 * rows.shape[0], rows.shape[1]))
                 grown[: rows.shape[0]] = rows
                 rows = grown
-                code = step(fw, pw, rows)
+                code = step(fw, rows)
             k = int(fw[st.F_SAMPLE])
             t = k * dt
             if code & st.C_TOUCHDOWN:
@@ -288,29 +287,29 @@ def fly(
                     if progress:  # a line at each phase start (in place on a terminal)
                         _progress(m.name, iphase, nphases, phase.name, t, tty)
                 fw[st.F_MODE] = st.MODE_RESUME
-                code = step(fw, pw, rows)  # the pilot's step and the row
+                code = step(fw, rows)  # the pilot's step and the row
                 fw[st.F_MODE] = st.MODE_STEP
                 if iphase == nphases:  # the last sample: no command sent, one more step for its accelerations
                     run()
                     for get, out in zip(probe_gets, probe_rows, strict=True):
                         out.append(get())
-                    pack_step(fbuf, inputs_at, ax_get(), ay_get(), az_get(), nz_get(), flap_get(), rpm_get(),
+                    pack_step(fw, inputs_at, ax_get(), ay_get(), az_get(), nz_get(), flap_get(), rpm_get(),
                               *[0.0] * (st.NSLOTS - st.I_PHI))  # fmt: skip
                     fw[st.F_MODE] = st.MODE_FINISH
-                    code = step(fw, pw, rows)
+                    code = step(fw, rows)
                     if code & st.C_SAMPLE:
                         _sample_hook(step_hook, rows, int(fw[st.F_DONE_ROW]))
                     if code & st.C_BLOCK:
                         k_sent = _send_block(block_hook, rows, k_sent, int(fw[st.F_DONE_ROW]) + 1)
                     break
             if code & st.C_OPENLOOP:  # the phase's open-loop inputs, on top of or instead of the pilot's commands
-                ail, elev, rud, _, thr = unpack_commands(fbuf, commands_at)
+                ail, elev, rud, _, thr = unpack_commands(fw, commands_at)
                 commands = openloop.apply((k - phase_k0) * dt, ail, elev, rud, thr)
                 fw[st.F_AIL], fw[st.F_ELEV], fw[st.F_RUD], fw[st.F_THR] = commands
                 rows[k, _AIL : _AIL + 4] = commands
             if code & st.C_MIX:
                 mix_w.set_double_value(float(np.interp(float(fw[st.I_H]), mix_h_ft, mix_norm)))
-        ail, elev, rud, steer, thr = unpack_commands(fbuf, commands_at)
+        ail, elev, rud, steer, thr = unpack_commands(fw, commands_at)
         ail_set(ail)
         elev_set(elev)
         rud_set(rud)

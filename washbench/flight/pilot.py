@@ -128,11 +128,19 @@ class Pilot:
     ``brakes`` change only at phase starts.
     """
 
-    def __init__(self, profile: PilotProfile, runway: Runway | None, dt_s: float) -> None:
-        self.buffer = bytearray(NSLOTS * 8)
-        """The slots' memory (native float64): :data:`PACK_INPUTS` and :data:`UNPACK_OUTPUTS` work on it."""
-        self.w = np.frombuffer(self.buffer, dtype=np.float64)
-        """The slots as the array :func:`pilot_step` takes (the same memory)."""
+    def __init__(
+        self, profile: PilotProfile, runway: Runway | None, dt_s: float, slots: np.ndarray | None = None
+    ) -> None:
+        """``slots``: a C-contiguous float64 array of :data:`NSLOTS` to keep the slots in (fly's loop gives the tail
+        of its own slots, so that one compiled call takes both); else the pilot allocates its own."""
+        if slots is None:
+            slots = np.zeros(NSLOTS)
+        if slots.dtype != np.float64 or slots.shape != (NSLOTS,) or not slots.flags.c_contiguous:
+            raise ValueError(f"pilot slots must be a C-contiguous float64 array of {NSLOTS}")
+        self.w = slots
+        """The slots as the array :func:`pilot_step` takes."""
+        self.buffer = slots
+        """The same memory for :data:`PACK_INPUTS` and :data:`UNPACK_OUTPUTS` (offsets from the first slot)."""
         self.kernel = compiled_step()
         g = profile.gains
         self.dt = dt_s

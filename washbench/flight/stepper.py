@@ -26,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
+from washbench.flight.pilot import NSLOTS as PILOT_NSLOTS
 from washbench.flight.pilot import (
     S_AILERON,
     S_ELEVATOR,
@@ -98,6 +99,7 @@ SLOTS: tuple[str, ...] = (
 ) = range(98)
 # fmt: on
 NSLOTS = len(SLOTS)
+"""The loop's own slots; the pilot's (:data:`washbench.flight.pilot.NSLOTS`) follow them in the same array."""
 EVENT_SLOTS = {"liftoff": F_EV_LIFTOFF, "touchdown": F_EV_TOUCHDOWN, "stopped": F_EV_STOPPED, "stall": F_EV_STALL}
 """The flag slot of each event (``u_event`` holds one of these slots, or -1)."""
 
@@ -133,10 +135,11 @@ C_MIX = 4096  # set the mixture from the schedule
  R_PHASE) = range(33)  # fmt: skip
 
 
-def new_slots() -> tuple[bytearray, np.ndarray]:
-    """Zeroed slots: their memory (for :data:`PACK_STEP`, :data:`UNPACK_COMMANDS`) and the array on it."""
-    buffer = bytearray(NSLOTS * 8)
-    return buffer, np.frombuffer(buffer, dtype=np.float64)
+def new_slots() -> tuple[np.ndarray, np.ndarray]:
+    """Zeroed slots: the loop's and the pilot's after them (for :data:`PACK_STEP`, :data:`UNPACK_COMMANDS` and the
+    compiled step), and the pilot's part (a view, for :class:`washbench.flight.pilot.Pilot`)."""
+    slots = np.zeros(NSLOTS + PILOT_NSLOTS)
+    return slots, slots[NSLOTS:]
 
 
 _cache_checked = False
@@ -162,8 +165,8 @@ def compiled_flight_step() -> object:
 
 
 @lazy_njit(cache=True)
-def flight_step(f: np.ndarray, pw: np.ndarray, rows: np.ndarray) -> int:
-    """One step of fly's loop on the slots ``f``, the pilot's slots ``pw`` and the raw rows; returns the code bits.
+def flight_step(f: np.ndarray, rows: np.ndarray) -> int:
+    """One step of fly's loop on the slots ``f`` (the pilot's after the loop's) and the raw rows; returns the code.
 
     With a row pending (the previous step's), it is completed first from the inputs ``ax`` .. ``rpm``
     (``done_row``), then checked (load factor in flight). ``MODE_STEP`` then does the whole sample ``nrows``;
@@ -171,6 +174,7 @@ def flight_step(f: np.ndarray, pw: np.ndarray, rows: np.ndarray) -> int:
     """
     code = 0
     mode = f[F_MODE]
+    pw = f[NSLOTS:]
     if f[F_PENDING] != 0.0:
         j = int(f[F_NROWS]) - 1
         ay = f[I_AY]
