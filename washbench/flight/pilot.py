@@ -1,4 +1,10 @@
-"""The scripted pilot: cascaded PI loops run at every JSBSim step, in plain Python floats.
+"""The scripted pilot: cascaded PI loops run at every JSBSim step, compiled (:func:`pilot_step`, numba).
+
+Its parameters, state and the inputs of a step live in one float64 array (:data:`PARAMS`, :data:`STATE`,
+:data:`INPUTS`), so a step is one compiled call on it (fly's loop makes it part of its own compiled step,
+:mod:`washbench.flight.stepper`); :class:`Pilot` keeps the Python interface (``begin_phase``, ``step``, the
+commands as attributes). The arithmetic is that of the former plain-Python pilot, operation for operation: the
+flights are the same bits.
 
 Loops (angles in rad, rates in rad/s, speeds in kt, heights in ft):
 
