@@ -391,7 +391,7 @@ def compiled_step() -> Any:
     return fn
 
 
-@lazy_njit(cache=True)
+@lazy_njit(cache=True, _nrt=False)
 def pilot_step(w: np.ndarray) -> None:
     """One control update on the slots ``w`` (:data:`PARAMS`, :data:`STATE`, :data:`INPUTS`): reads the inputs, updates
     the state and the outputs in place.

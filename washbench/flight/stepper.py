@@ -164,9 +164,12 @@ def compiled_flight_step() -> object:
     return fn
 
 
-@lazy_njit(cache=True)
+@lazy_njit(cache=True, _nrt=False)
 def flight_step(f: np.ndarray, rows: np.ndarray) -> int:
     """One step of fly's loop on the slots ``f`` (the pilot's after the loop's) and the raw rows; returns the code.
+
+    Compiled without numba's reference counting (``_nrt=False``, as the pilot's step): it allocates nothing and
+    its arrays outlive the call, and the call from Python then skips a reference-count object per array argument.
 
     With a row pending (the previous step's), it is completed first from the inputs ``ax`` .. ``rpm``
     (``done_row``), then checked (load factor in flight). ``MODE_STEP`` then does the whole sample ``nrows``;
