@@ -577,10 +577,11 @@ def _check_input(f, om):
             raise ValueError("cueing input: non-finite specific force or angular velocity")
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def bank_step(f, om, cfg, coef, state, counts, out):
     """Streaming form: advance every washout of the bank by one sample (f, om: (3,) float64): :func:`bank_block` on
-    a block of one sample."""
+    a block of one sample. Without reference counting, as :func:`bank_block` (the call from Python then makes no
+    reference-count object for its seven arrays)."""
     _check_input(f, om)
     bank_block(f.reshape((1, 3)), om.reshape((1, 3)), cfg, coef, state, counts, out.reshape((out.shape[0], 1, NFIELDS)))
 
