@@ -2,7 +2,8 @@
 
 They live beside ``washbench/`` in the source tree (where a user looks for them) and are copied into
 ``washbench/data/`` of the built package, so an installed washbench finds them from any folder
-(``washbench.io.paths``). Everything else is in ``pyproject.toml``.
+(``washbench.io.paths``). Also the core-metadata ``License`` field (``pyproject.toml`` says why it is not a PEP 639
+expression there). Everything else is in ``pyproject.toml``.
 """
 
 from __future__ import annotations
@@ -33,4 +34,7 @@ class BuildPyWithData(build_py):
             shutil.copytree(src, dest, ignore=shutil.ignore_patterns("__pycache__", "*.py[cod]"))
 
 
-setup(cmdclass={"build_py": BuildPyWithData})
+#: The licence, an SPDX identifier, as the core-metadata ``License`` field that ``pip show`` prints from pip 23 on.
+LICENSE = "Apache-2.0"
+
+setup(cmdclass={"build_py": BuildPyWithData}, license=LICENSE)

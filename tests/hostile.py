@@ -2,8 +2,12 @@
 
 from __future__ import annotations
 
+import atexit
+import os
+import shutil
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 #: A short level flight (one phase of ``{seconds}`` s); ``{name}`` and ``{extra}`` (top-level lines) vary.
@@ -74,17 +78,24 @@ def live_processes(pgid: int) -> list[str]:
 
 
 def long_suite(root: Path, *, output: int | None = subprocess.PIPE) -> subprocess.Popen[str]:
-    """``washbench suite`` of two 900 s manoeuvres (never finished while a test waits) into ``root/out`` with
+    """``washbench suite`` of two 3600 s manoeuvres (never finished while a test waits) into ``root/out`` with
     ``--jobs 2``, in its own process group (every process it starts can be found); ``output``: where its stdout
-    and stderr go."""
+    and stderr go. Its temporary folder (``TMPDIR``) is ``root/tmp``, its own: the JSBSim scratch folders its
+    workers make, and leave when killed, are not cleaned by a process of a test running beside it (``root/tmp``
+    links to it)."""
     folder = root / "m"
     folder.mkdir()
     for i in range(2):
-        short(folder, name=f"long_{i}", seconds=900)
+        short(folder, name=f"long_{i}", seconds=3600)
+    # a short path: the suite's process server listens on a Unix socket in TMPDIR (at most 107 bytes of path)
+    scratch = tempfile.mkdtemp(prefix="wb-")
+    atexit.register(shutil.rmtree, scratch, True)
+    (root / "tmp").symlink_to(scratch)
     return subprocess.Popen(
         [sys.executable, "-m", "washbench", "suite", str(folder), "--out", str(root / "out"), "--jobs", "2", "--quiet"],
         stdout=output,
         stderr=output,
         text=True,
         start_new_session=True,
+        env={**os.environ, "TMPDIR": scratch},
     )

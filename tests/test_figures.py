@@ -28,14 +28,14 @@ def traces(n: int, seed: int) -> dict[str, np.ndarray]:
     return {"aircraft": base, **{w: base + 0.1 * i for i, w in enumerate(NAMES[:3])}}
 
 
-def draw(folder: Path, seed: int, n: int = 5000) -> bytes:
+def draw(folder: Path, seed: int, n: int = 5000, washouts: tuple[str, ...] = tuple(NAMES[:3])) -> bytes:
     t = np.arange(n) / 120.0
-    perceived = traces(n, seed)
+    perceived = {k: v for k, v in traces(n, seed).items() if k == "aircraft" or k in washouts}
     phases = [("level", 0.0, 10.0), ("roll in", 10.0, 20.0), ("clean climb", 20.0, t[-1])]
     (png,) = perceived_figure(folder / "perceived", "test", t, perceived, phases=phases, thresholds=[0.1] * 6,
                               rest=list(perceived["aircraft"][0]))  # fmt: skip
-    usage = {"position": {w: np.abs(perceived[w][:, 0]) for w in NAMES[:3]}}
-    saturated = {"small-angle": {"pos": np.arange(n) % 500 < 3}}
+    usage = {"position": {w: np.abs(perceived[w][:, 0]) for w in washouts}}
+    saturated = {washouts[0]: {"pos": np.arange(n) % 500 < 3}}
     (env,) = envelope_figure(folder / "envelope", "test", t, usage, saturated, phases=phases)
     return png.read_bytes() + env.read_bytes()
 
@@ -48,6 +48,47 @@ def test_a_reused_layout_draws_the_same_pixels_as_a_fresh_one(tmp_path: Path) ->
     again = draw(tmp_path, seed=1)
     assert first == again
     assert other != first
+
+
+def test_a_reused_layout_changes_its_legend_with_the_washouts(tmp_path: Path) -> None:
+    """The legend stays on a reused layout only while its entries are the same: other washouts give the pixels a
+    fresh layout gives them, and the first washouts again their first pixels."""
+    from washbench.review import figures
+
+    three, two = tuple(NAMES[:3]), ("large-angle", "unrestricted")
+    first = draw(tmp_path, seed=1, washouts=three)
+    other = draw(tmp_path, seed=1, washouts=two)
+    again = draw(tmp_path, seed=1, washouts=three)
+    figures._LAYOUT_CACHE.clear()
+    fresh = draw(tmp_path, seed=1, washouts=two)
+    assert first == again and other == fresh and other != first
+
+
+def test_figure_writers_pause_the_garbage_collector_and_restore_it() -> None:
+    """collector_paused: off while the writer runs, then as it was (on or off), also when the writer fails."""
+    import gc
+
+    from washbench.review.figures import collector_paused
+
+    seen = []
+
+    @collector_paused
+    def writer(fail: bool) -> None:
+        seen.append(gc.isenabled())
+        if fail:
+            raise ValueError("drawing failed")
+
+    was = gc.isenabled()
+    try:
+        for enabled in (True, False):
+            (gc.enable if enabled else gc.disable)()
+            writer(False)
+            with pytest.raises(ValueError, match="drawing failed"):
+                writer(True)
+            assert gc.isenabled() == enabled
+        assert seen == [False] * 4
+    finally:
+        (gc.enable if was else gc.disable)()
 
 
 def test_every_washout_has_its_own_colour_and_line_style_in_each_palette() -> None:
@@ -131,3 +172,58 @@ def test_the_report_names_an_end_stop_next_to_the_score_it_dominates() -> None:
     note = end_stop_note(data, "a")
     assert note == "end stop: stage at its position limit for 5.40 s (54 %), the score reflects its hard stops"
     assert end_stop_note(data, "b") == "" and end_stop_note(data, "c") == ""
+
+
+@pytest.mark.parametrize("alpha", [255, 128])
+def test_png_bytes_decode_to_the_pixels_given(alpha: int) -> None:
+    """The figures' PNG writer read back by Pillow (an independent decoder): same pixels, the resolution, RGB when
+    every pixel is opaque, RGBA otherwise."""
+    import io
+
+    from PIL import Image
+
+    from washbench.review.png import png_bytes
+
+    rgba = np.random.default_rng(3).integers(0, 256, size=(37, 53, 4), dtype=np.uint8)
+    rgba[:, :, 3] = 255
+    rgba[5, 7, 3] = alpha
+    image = Image.open(io.BytesIO(png_bytes(rgba, 110.0)))
+    assert image.mode == ("RGB" if alpha == 255 else "RGBA")
+    assert image.info["dpi"] == pytest.approx((110.0, 110.0), abs=0.01)
+    back = np.asarray(image.convert("RGBA"))
+    assert np.array_equal(back, rgba)
+
+
+@pytest.mark.parametrize("with_nan", [False, True])
+def test_minmax_decimation_is_each_buckets_first_minimum_and_maximum_in_time_order(with_nan: bool) -> None:
+    """Against a plain loop over the buckets (ties on purpose: the first of equal values is kept), finite traces
+    (the fast path) and traces with NaNs (kept out of the min/max) alike."""
+    from washbench.review.figures import minmax_decimate
+
+    rng = np.random.default_rng(7)
+    for _ in range(60):
+        n, buckets = int(rng.integers(3, 3000)), int(rng.integers(1, 400))
+        t = np.cumsum(rng.random(n))
+        y = rng.integers(-3, 4, n).astype(float)
+        if with_nan:
+            y[rng.random(n) < 0.2] = np.nan
+        tt, yy = minmax_decimate(t, y, buckets)
+        if n <= 2 * buckets:
+            assert tt is t and yy is y
+            continue
+        size = -(-n // buckets)
+        exp_t, exp_y = [], []
+        for a in range(0, n, size):
+            chunk = y[a : a + size]
+            finite = [i for i in range(len(chunk)) if not np.isnan(chunk[i])]
+            if not finite:  # a bucket of NaNs stays NaN
+                exp_t += [t[a], t[a]]
+                exp_y += [np.nan, np.nan]
+                continue
+            lo = min(finite, key=lambda i: (chunk[i], i))
+            hi = min(finite, key=lambda i: (-chunk[i], i))
+            for i in sorted((lo, hi)):
+                exp_t.append(t[a + i])
+                exp_y.append(chunk[i])
+        assert np.array_equal(tt, exp_t)
+        assert np.array_equal(yy, exp_y, equal_nan=True)

@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 
 from hostile import assert_clean_error, short, tree, washbench
 
 from washbench.io.lock import output_lock
-from washbench.io.result_files import RUN_FILES
+from washbench.io.outfolder import recover_shared
+from washbench.io.result_files import JOURNAL_PREFIX, OLD_PREFIX, RUN_FILES, STAGE_PREFIX
 
 
 def test_run_replaces_only_its_own_previous_result(tmp_path: Path) -> None:
@@ -23,9 +25,12 @@ def test_run_replaces_only_its_own_previous_result(tmp_path: Path) -> None:
 
     # a leftover of an interrupted run (its process is gone) is cleaned; a previous result is replaced
     out2 = tmp_path / "out2"
-    leftover = out2 / "c172p" / ".short.partial-999999999"
+    leftover = out2 / "c172p" / ".short.partial-999999999"  # as an older version left it
     leftover.mkdir(parents=True)
     (leftover / "flight.json").write_text("{")
+    (out2 / "c172p" / f"{STAGE_PREFIX}999999999" / "short").mkdir(parents=True)  # killed while building
+    (out2 / "c172p" / f"{STAGE_PREFIX}999999999" / "short" / "flight.json").write_text("{")
+    (out2 / "c172p" / f"{OLD_PREFIX}999999998").mkdir()  # killed as it deleted the result it replaced
     previous = out2 / "c172p" / "short"
     previous.mkdir()
     (previous / "run.json").write_text(json.dumps({"aircraft": "c172p", "manoeuvre": "short", "ok": False}))
@@ -38,6 +43,33 @@ def test_run_replaces_only_its_own_previous_result(tmp_path: Path) -> None:
     assert set(RUN_FILES) <= set(files) and "stale.txt" not in files and not any(f.startswith(".") for f in files)
     run = json.loads((previous / "run.json").read_text())
     assert (run["aircraft"], run["manoeuvre"], run["ok"]) == ("c172p", "short", True)
+
+
+def test_a_shared_folder_is_recovered_only_of_dead_processes_leftovers(tmp_path: Path) -> None:
+    """``OUT/<aircraft>/``, where runs (and a suite's workers, side by side) publish their folders: a run killed in
+    the middle of its swap is finished from its journal (the new folder in place, the old one gone); what a live
+    process is building stays; a user's file of a leftover's name, and the user's files, stay."""
+    shared = tmp_path / "c172p"
+    dead, live = 999999999, os.getpid()
+    stage, old = shared / f"{STAGE_PREFIX}{dead}", shared / f"{OLD_PREFIX}{dead}"
+    (stage / "turn").mkdir(parents=True)
+    (stage / "turn" / "run.json").write_text("new")  # the new result, not yet moved in
+    (shared / "turn").mkdir()
+    (shared / "turn" / "run.json").write_text("old")  # the previous one, not yet moved out
+    old.mkdir()
+    doc = {"stage": stage.name, "old": old.name, "previous": ["turn"], "new": ["turn"]}
+    (shared / f"{JOURNAL_PREFIX}{dead}").write_text(json.dumps(doc))
+    (shared / f"{STAGE_PREFIX}{live}" / "level").mkdir(parents=True)  # being built by a running process
+    (shared / ".draft.partial-12").write_text("a file of the user's, named like an old leftover")
+    (shared / "notes.txt").write_text("mine")
+    recover_shared(shared)
+    assert tree(shared) == sorted([
+        ".draft.partial-12", f"{STAGE_PREFIX}{live}", f"{STAGE_PREFIX}{live}/level", "notes.txt", "turn",
+        "turn/run.json",
+    ])  # fmt: skip
+    assert (shared / "turn" / "run.json").read_text() == "new"
+    recover_shared(shared, only_dead=False)  # under the lock, nobody else publishing: every leftover goes
+    assert tree(shared) == [".draft.partial-12", "notes.txt", "turn", "turn/run.json"]
 
 
 def test_suite_output_folder_holds_exactly_that_suite(tmp_path: Path) -> None:

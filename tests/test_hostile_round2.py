@@ -16,7 +16,6 @@ import signal
 import socket
 import subprocess
 import sys
-import tempfile
 import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -28,6 +27,7 @@ from hostile import assert_clean_error, live_processes, long_suite, short, tree,
 from washbench.analysis.signals import SignalSpec, generate
 from washbench.io.motion_file import write_motion
 from washbench.io.outfolder import JOURNAL_PREFIX, MANIFEST, OLD_PREFIX, STAGE_PREFIX, recover
+from washbench.io.paths import MANOEUVRES_DIR
 
 JSBSIM_C172X = "c172x"
 
@@ -387,11 +387,11 @@ def test_a_disk_too_full_for_the_lock_names_the_folder(motion: Path, tmp_path: P
 
 FINALIZER_SIGNAL = """
 import os, signal, sys, time
-from washbench import cli
 from washbench.errors import Terminated
+from washbench.io import interrupts
 
-signal.signal(signal.SIGTERM, cli._terminate)
-sys.unraisablehook = cli._signal_in_finalizer
+signal.signal(signal.SIGTERM, interrupts.terminate)
+sys.unraisablehook = interrupts.signal_in_finalizer
 
 
 class Stream:  # as the rerun SDK's RecordingStream: work done in __del__
@@ -422,6 +422,45 @@ def test_a_signal_raised_inside_a_finalizer_still_stops_the_command(tmp_path: Pa
     assert "Exception ignored" not in proc.stderr and "Traceback" not in proc.stderr, proc.stderr
 
 
+SIGNAL_WHILE_THE_CLI_LOADS = """
+import os, signal, sys, time
+
+sys.argv = ["washbench", "validate", sys.argv[1]]
+from washbench import __main__ as console
+
+
+class Stream:  # work in a finalizer while washbench.cli is imported, as importlib's module-lock weakref callbacks do
+    def __del__(self):
+        os.kill(os.getpid(), signal.SIGINT)
+        t = time.monotonic()
+        while time.monotonic() - t < 0.2:  # the handler runs in here, its KeyboardInterrupt is swallowed
+            pass
+
+
+class Finder:
+    def find_spec(self, name, path=None, target=None):
+        if name == "washbench.cli":
+            sys.meta_path.remove(self)
+            Stream()
+        return None
+
+
+sys.meta_path.insert(0, Finder())
+sys.exit(console.entry())
+"""
+
+
+def test_a_ctrl_c_swallowed_while_the_cli_loads_still_stops_the_command(tmp_path: Path) -> None:
+    """A Ctrl-C in the first fraction of a second, raised inside a finalizer while ``washbench.cli`` is imported,
+    was swallowed ("Exception ignored") and the command ran to its end with status 0: the console entry installs
+    the hook that sends it again before importing the CLI, so it ends the command (one line, 130)."""
+    manoeuvre = str(MANOEUVRES_DIR / "c172" / "takeoff.yaml")
+    proc = subprocess.run([sys.executable, "-c", SIGNAL_WHILE_THE_CLI_LOADS, manoeuvre], capture_output=True,
+                          text=True, timeout=60)  # fmt: skip
+    assert proc.returncode == 130, (proc.returncode, proc.stdout, proc.stderr)
+    assert proc.stderr.strip() == "washbench: interrupted" and proc.stdout == "", (proc.stdout, proc.stderr)
+
+
 def test_run_signalled_as_its_recording_lands_keeps_the_previous_result(tmp_path: Path) -> None:
     """The real case (timing-dependent, so twice per signal): the previous result folder stays, one line, no
     traceback, status 130/143."""
@@ -435,7 +474,7 @@ def test_run_signalled_as_its_recording_lands_keeps_the_previous_result(tmp_path
         proc = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         deadline = time.monotonic() + 120
         while proc.poll() is None and time.monotonic() < deadline:
-            if any(p.name == "recording.rrd" for p in (out / "c172p").glob(".short.partial-*/recording.rrd")):
+            if any((out / "c172p").glob(STAGE_PREFIX + "*/short/recording.rrd")):
                 proc.send_signal(sig)
                 break
             time.sleep(0.002)
@@ -446,9 +485,9 @@ def test_run_signalled_as_its_recording_lands_keeps_the_previous_result(tmp_path
 
 
 def test_run_and_suite_on_a_full_disk_name_the_published_file(tmp_path: Path) -> None:
-    """``run`` and ``suite`` build in hidden partial folders: a recording that cannot be written is named where
-    it was going (``OUT/c172p/short/recording.rrd``), never ``.short.partial-PID`` or ``.suite.partial-PID``, in
-    the error line and in the suite's published failure reason."""
+    """``run`` and ``suite`` build in hidden stage folders: a recording that cannot be written is named where
+    it was going (``OUT/c172p/short/recording.rrd``), never in ``.washbench-stage-PID``, in the error line and in
+    the suite's published failure reason."""
     m = short(tmp_path, seconds=1)
     common = ["--washout", "small-angle", "--quiet", "--no-figures"]
     limit = _file_size_limit(300_000)  # the traces (~80 kB) pass, the recording (~700 kB) does not
@@ -456,7 +495,7 @@ def test_run_and_suite_on_a_full_disk_name_the_published_file(tmp_path: Path) ->
     proc = subprocess.run([sys.executable, "-m", "washbench", "run", str(m), "--out", str(out), *common],
                           capture_output=True, text=True, timeout=120, preexec_fn=limit)  # fmt: skip
     assert_clean_error(proc, f"{out / 'c172p' / 'short' / 'recording.rrd'}: cannot write")
-    assert "partial" not in proc.stderr
+    assert "partial" not in proc.stderr and STAGE_PREFIX not in proc.stderr
     out = tmp_path / "suite"
     proc = subprocess.run([sys.executable, "-m", "washbench", "suite", str(m), "--out", str(out), "--jobs", "1",
                            *common], capture_output=True, text=True, timeout=120, preexec_fn=limit)  # fmt: skip
@@ -565,21 +604,21 @@ def test_workers_end_when_the_suite_is_killed(tmp_path: Path) -> None:
     while (left := live_processes(proc.pid)) and time.monotonic() < deadline:
         time.sleep(0.1)
     assert left == []
-    stage = list(out.glob(".suite.partial-*"))
+    stage = list(out.glob(STAGE_PREFIX + "*"))
     sizes = digest(stage[0]) if stage else {}
     time.sleep(1.0)
     assert (digest(stage[0]) if stage else {}) == sizes  # nobody writes into the stage any more
     # the killed workers' JSBSim scratch folders (no exit handler ran) go with the next process that makes one
     from washbench.flight.jsbsim_xml import _SCRATCH_PREFIX
 
-    scratch = Path(tempfile.gettempdir())
+    scratch = tmp_path / "tmp"  # the suite's TMPDIR (hostile.long_suite)
 
     def killed_scratch() -> list[Path]:
         return [d for d in scratch.glob(f"{_SCRATCH_PREFIX}*") if d.name[len(_SCRATCH_PREFIX) :].split("-")[0] in pids]
 
     assert killed_scratch()
     code = "from washbench.flight.jsbsim_xml import scratch_output_dir; scratch_output_dir()"
-    subprocess.run([sys.executable, "-c", code], check=True, timeout=60)
+    subprocess.run([sys.executable, "-c", code], check=True, timeout=60, env={**os.environ, "TMPDIR": str(scratch)})
     assert killed_scratch() == []
 
 

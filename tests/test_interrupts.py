@@ -13,6 +13,8 @@ from pathlib import Path
 import pytest
 from hostile import live_processes, short, tree
 
+from washbench.io.result_files import STAGE_PREFIX
+
 
 def previous_suite(out: Path) -> list[str]:
     """A folder holding a previous suite's results (what an interrupted suite must leave untouched)."""
@@ -46,7 +48,7 @@ def wait_for_no_process(pgid: int, timeout_s: float = 10.0) -> list[str]:
 def manoeuvres(tmp_path_factory: pytest.TempPathFactory) -> Path:
     folder = tmp_path_factory.mktemp("long")
     for i in range(3):
-        short(folder, name=f"long_{i}", seconds=900)  # far longer than any test waits: always stopped mid-flight
+        short(folder, name=f"long_{i}", seconds=3600)  # far longer than any test waits: always stopped mid-flight
     return folder
 
 
@@ -94,3 +96,26 @@ def test_run_terminated_in_flight_removes_its_half_built_folder(manoeuvres: Path
     # progress lines come first (stderr is not a terminal); the interruption is the one last line
     assert err.strip().splitlines()[-1] == "washbench: terminated" and "Traceback" not in err, err
     assert tree(out) == []
+
+
+def test_what_a_run_killed_outright_leaves_goes_with_the_next_run(manoeuvres: Path, tmp_path: Path) -> None:
+    """SIGKILL (no handler runs) while a run builds its folder: its hidden stage stays in ``OUT/c172p/``; the next
+    run into the same ``OUT`` removes it (its process is gone) and publishes beside the earlier result."""
+    out = tmp_path / "out"
+    first = start("run", short(tmp_path, name="earlier", seconds=1), "--out", out, "--quiet")
+    assert first.wait(timeout=120) == 0
+    proc = start("run", manoeuvres / "long_0.yaml", "--out", out, "--quiet")
+    deadline = time.monotonic() + 60
+    while not list((out / "c172p").glob(f"{STAGE_PREFIX}*/long_0")) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    time.sleep(0.5)  # flying, the stage made
+    proc.kill()
+    proc.wait(timeout=30)
+    assert [p.name for p in (out / "c172p").iterdir() if p.name.startswith(STAGE_PREFIX)] == [
+        f"{STAGE_PREFIX}{proc.pid}"
+    ]
+    nxt = start("run", short(tmp_path, name="level", seconds=1), "--out", out, "--quiet")
+    _, err = nxt.communicate(timeout=120)
+    assert nxt.returncode == 0, err
+    assert sorted(p.name for p in (out / "c172p").iterdir()) == ["earlier", "level"]
+    assert sorted(p.name for p in out.iterdir()) == ["c172p"]  # the killed run's lock file went with it too

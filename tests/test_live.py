@@ -32,6 +32,8 @@ from washbench.live import commands, packets
 from washbench.live.link import HIST_MAX_US, LatencyStats, Link
 from washbench.runs.cue import CueOptions, run_cue
 from washbench.runs.live import INPUT_FILE, LiveOptions, run_live
+from washbench.runs.options import load_options
+from washbench.runs.outputs import Outputs
 
 DT = 1.0 / 120.0
 N = 360
@@ -86,7 +88,7 @@ def assert_equals_cue(out: Path, tmp_path: Path, folders: tuple[str, ...] = ("",
     """Each result folder equals ``washbench cue`` of the saved input, bit for bit."""
     ref = tmp_path / "cue_of_saved"
     resample = run_json(out, folders[0])["live"]["resample_hz"]
-    run_cue(out / INPUT_FILE, ref, options=CueOptions(recording=False, figures=False, resample_hz=resample))
+    run_cue(out / INPUT_FILE, ref, CueOptions(resample_hz=resample), load_options(outputs=Outputs(False, False)))
     for f in folders:
         a = pq.read_table(out / f / "traces.parquet")
         b = pq.read_table(ref / f / "traces.parquet")
@@ -307,7 +309,7 @@ def test_washbench_format_result_equals_cue_of_the_original_file(tmp_path: Path)
     status, out = live(tmp_path, "washbench", port)
     th.join(10)
     assert status == 0
-    run_cue(src, tmp_path / "orig", options=CueOptions(recording=False, figures=False))
+    run_cue(src, tmp_path / "orig", run=load_options(outputs=Outputs(recording=False, figures=False)))
     a = pq.read_table(out / "traces.parquet")
     b = pq.read_table(tmp_path / "orig" / "traces.parquet")
     assert a.drop_columns(["live_held"]).equals(b)
@@ -657,6 +659,7 @@ def test_a_viewer_closed_while_running(tmp_path: Path, monkeypatch: pytest.Monke
                 time.sleep(0.003)
                 if k == 180:
                     made[0].proc.kill()
+                    made[0].proc.wait()  # ended before the next sample, however loaded the machine
 
     th = in_thread(go)
     opts = LiveOptions(listen=("127.0.0.1", port), fmt="washbench", out=tmp_path / "o", idle_timeout_s=0.6,
@@ -673,7 +676,7 @@ def test_a_viewer_closed_while_running(tmp_path: Path, monkeypatch: pytest.Monke
     series = read_scalar_series(rrd)
     t, surge = series["/raw/surge"]
     assert 1 <= len(t) < 180 and surge.shape == (len(t), 4)  # at most 30 rows a second, none after the close
-    assert t[-1] <= m[200][0]  # (the process takes a moment to be seen ended)
+    assert t[-1] <= m[200][0]  # seen ended at the next sample (rows at most 30 a second)
     # the values at each logged time are those of the result (the same step, the same filters chunk by chunk)
     table = pq.read_table(tmp_path / "o" / "traces.parquet").to_pydict()
     row_of = {round(v, 9): i for i, v in enumerate(table["t_s"])}

@@ -35,6 +35,8 @@ from washbench.flight.scripts import bundled_script, fly_script
 from washbench.io.input_format import InputFormat, input_format
 from washbench.io.metrics_csv import read_metrics_csv
 from washbench.runs.cue import CueOptions, run_cue
+from washbench.runs.options import RunOptions, load_options
+from washbench.runs.outputs import Outputs
 
 G0 = 9.80665
 FT = 0.3048
@@ -57,10 +59,19 @@ def columns6(trace: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.n
     return trace["t_s"], f, w
 
 
+def lean(**kw: object) -> RunOptions:
+    """The run's options without recording or figures: these tests read the numbers."""
+    return load_options(outputs=Outputs(recording=False, figures=False), **kw)  # type: ignore[arg-type]
+
+
+def no_recording() -> RunOptions:
+    return load_options(outputs=Outputs(recording=False))
+
+
 def cue_dir(inp: Path, out: Path, capsys: pytest.CaptureFixture[str] | None = None, **kw: object) -> dict:
     # no figures: these tests read the numbers (the figures of a cue are tested in test_report.py)
-    opts = CueOptions(start_s=kw.pop("start_s", START_S), recording=False, figures=False, **kw)  # type: ignore[arg-type]
-    code = run_cue(inp, out, options=opts)
+    opts = CueOptions(start_s=kw.pop("start_s", START_S), **kw)  # type: ignore[arg-type]
+    code = run_cue(inp, out, opts, lean())
     doc = json.loads((out / "run.json").read_text())
     doc["exit"] = code
     doc["metrics"] = {(r.washout, r.dof): r for r in read_metrics_csv(out / "metrics.csv")}
@@ -235,7 +246,7 @@ def warnings_of(cols: dict[str, np.ndarray], tmp_path: Path, capsys: pytest.Capt
     p = tmp_path / "w.parquet"
     pq.write_table(pa.table(cols), p)
     capsys.readouterr()
-    run_cue(p, tmp_path / "wout", options=CueOptions(recording=False, figures=False, **kw))  # type: ignore[arg-type]
+    run_cue(p, tmp_path / "wout", CueOptions(**kw), lean())  # type: ignore[arg-type]
     return capsys.readouterr().err
 
 
@@ -290,7 +301,7 @@ def test_crash_in_the_data_is_reported_not_scored(trace: dict[str, np.ndarray], 
     c["f_z_mps2"][-5:] = -1100.0
     p = tmp_path / "crash.parquet"
     pq.write_table(pa.table(c), p)
-    assert run_cue(p, tmp_path / "out", options=CueOptions(recording=False)) == 1
+    assert run_cue(p, tmp_path / "out", run=no_recording()) == 1
     doc = json.loads((tmp_path / "out" / "run.json").read_text())
     assert not doc["ok"] and "crash or spike" in doc["reason"]
     assert "FAILED" in (tmp_path / "out" / "report.md").read_text()
@@ -306,25 +317,25 @@ def test_time_problems(trace: dict[str, np.ndarray], tmp_path: Path) -> None:
     with pytest.raises(WashbenchError, match=r"drop\.parquet: t_s: row 301: time step is not uniform.*--resample 120"):
         run_cue(tmp_path / "drop.parquet", tmp_path / "o1", options=CueOptions(start_s=None))
     assert (
-        run_cue(tmp_path / "drop.parquet", tmp_path / "o2", options=CueOptions(resample_hz=120, recording=False)) == 0
+        run_cue(tmp_path / "drop.parquet", tmp_path / "o2", CueOptions(resample_hz=120), no_recording()) == 0
     )
     keep[400:430] = False
     pq.write_table(pa.table({k: v[keep] for k, v in c.items()}), tmp_path / "gap.parquet")
     with pytest.raises(WashbenchError, match=r"row 400: gap of 0.258332 s from .* longer than the largest allowed"):
         run_cue(tmp_path / "gap.parquet", tmp_path / "o3", options=CueOptions(resample_hz=120))
-    assert run_cue(tmp_path / "gap.parquet", tmp_path / "o4", options=CueOptions(resample_hz=120, max_gap_s=0.3,
-                                                                                   recording=False)) == 0  # fmt: skip
+    assert run_cue(tmp_path / "gap.parquet", tmp_path / "o4", CueOptions(resample_hz=120, max_gap_s=0.3),
+                   no_recording()) == 0  # fmt: skip
     # +-1 us jitter and Unix-epoch time are on the grid (within 1e-3 of a step): accepted as they are
     rng = np.random.default_rng(3)
     jit = dict(c, t_s=c["t_s"] + 1_764_600_000.0 + rng.uniform(-1e-6, 1e-6, n))
     pq.write_table(pa.table(jit), tmp_path / "epoch.parquet")
-    assert run_cue(tmp_path / "epoch.parquet", tmp_path / "o5", options=CueOptions(recording=False)) == 0
+    assert run_cue(tmp_path / "epoch.parquet", tmp_path / "o5", run=no_recording()) == 0
     # a time reset splits into segments (own subfolders), or is refused with --no-split
     two = {k: np.concatenate([v, v]) for k, v in c.items()}
     pq.write_table(pa.table(two), tmp_path / "reset.parquet")
     with pytest.raises(WashbenchError, match=rf"row {n + 1}: time jumps back from .* \(a reset\?\)"):
         run_cue(tmp_path / "reset.parquet", tmp_path / "o6", options=CueOptions(split=False))
-    assert run_cue(tmp_path / "reset.parquet", tmp_path / "o7", options=CueOptions(recording=False)) == 0
+    assert run_cue(tmp_path / "reset.parquet", tmp_path / "o7", run=no_recording()) == 0
     a, b = (read_metrics_csv(tmp_path / "o7" / s / "metrics.csv") for s in ("segment_1", "segment_2"))
     assert a == b  # the same data cued twice, each from its own start
     assert sorted(p.name for p in (tmp_path / "o7").iterdir()) == [".washbench.json", "segment_1", "segment_2"]
@@ -339,9 +350,8 @@ def test_rest_start_feels_a_mid_manoeuvre_start(trace: dict[str, np.ndarray], tm
     pq.write_table(pa.table(c), tmp_path / "mid.parquet")
     from washbench.io.parquet_files import read_traces
 
-    run_cue(tmp_path / "mid.parquet", tmp_path / "steady", options=CueOptions(recording=False, figures=False))
-    run_cue(tmp_path / "mid.parquet", tmp_path / "rest",
-            options=CueOptions(recording=False, figures=False, filter_start="rest"))  # fmt: skip
+    run_cue(tmp_path / "mid.parquet", tmp_path / "steady", run=lean())
+    run_cue(tmp_path / "mid.parquet", tmp_path / "rest", run=lean(filter_start="rest"))
     steady = read_traces(tmp_path / "steady" / "traces.parquet")["aircraft.perceived_f_x_mps2"]
     rest = read_traces(tmp_path / "rest" / "traces.parquet")["aircraft.perceived_f_x_mps2"]
     assert np.allclose(steady, 2.0)

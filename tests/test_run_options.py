@@ -62,8 +62,8 @@ def test_cue_reads_the_parameter_file_once(params: Path, reads: Counter[Path], t
     signal = tmp_path / "sine.csv"
     signal_command("sine", "roll", 5.0, 0.5, 2.0, 100.0, 0.5, signal)
     reads.clear()
-    opts = CueOptions(recording=False, figures=False, progress=False)
-    assert run_cue(signal, tmp_path / "cue", washouts=["small-angle"], params_path=params, options=opts) == 0
+    run = load_options(params_path=params, washouts=["small-angle"], outputs=Outputs(recording=False, figures=False))
+    assert run_cue(signal, tmp_path / "cue", CueOptions(progress=False), run) == 0
     assert reads[params.resolve()] == 1  # parsed and hashed from the same bytes
     assert reads[DEFAULT_LIMITS_PATH.resolve()] == 1
     ranking = (tmp_path / "cue" / "ranking.csv").read_text().splitlines()

@@ -18,8 +18,9 @@ import pytest
 from washbench.errors import WashbenchError
 from washbench.flight.scripts import bundled_script, load_script_info
 from washbench.io.metrics_csv import read_metrics_csv
-from washbench.runs.cue import CueOptions, run_cue
+from washbench.runs.cue import run_cue
 from washbench.runs.options import load_options
+from washbench.runs.outputs import Outputs
 from washbench.runs.pipeline import run_script
 
 FILES = ["figures", "flight.json", "flight.parquet", "metrics.csv", "ranking.csv", "recording.rrd", "report.md",
@@ -64,7 +65,7 @@ def test_one_run_gives_a_full_result_folder(name: str, aircraft: str, runs: dict
 def test_run_equals_cue_of_its_flight(runs: dict[str, list], out: Path, tmp_path: Path) -> None:
     """As for manoeuvres: cueing flight.parquet gives the lockstep run's metrics bit for bit."""
     folder = out / "ah1s" / "ah1s_flight_test"
-    assert run_cue(folder / "flight.parquet", tmp_path / "cue", options=CueOptions(recording=False)) == 0
+    assert run_cue(folder / "flight.parquet", tmp_path / "cue", run=load_options(outputs=Outputs(recording=False))) == 0
     assert (tmp_path / "cue" / "metrics.csv").read_bytes() == (folder / "metrics.csv").read_bytes()
 
 

@@ -1,7 +1,10 @@
 """``python -m washbench`` and the ``washbench`` console script.
 
 The command-line module is imported inside :func:`entry`, so a Ctrl-C or SIGTERM that arrives while it loads
-(the first fraction of a second) still ends in one line and status 130 or 143, not an import traceback.
+(the first fraction of a second) still ends in one line and status 130 or 143, not an import traceback. The
+SIGTERM handler and the hook that sends again a signal swallowed in a finalizer (:mod:`washbench.io.interrupts`,
+on the lowest floor) are installed first: importlib runs weakref callbacks while modules load, and a Ctrl-C raised
+in one was swallowed ("Exception ignored") and the command went on.
 """
 
 from __future__ import annotations
@@ -9,15 +12,14 @@ from __future__ import annotations
 import signal
 import sys
 
-
-def _terminated(signum: int, frame: object) -> None:
-    print("washbench: terminated", file=sys.stderr)
-    raise SystemExit(143)
+from washbench.errors import Terminated
+from washbench.io import interrupts
 
 
 def entry() -> int:
     """Import the CLI and run it; the console script's entry point."""
-    signal.signal(signal.SIGTERM, _terminated)  # until the CLI installs its own handler
+    signal.signal(signal.SIGTERM, interrupts.terminate)  # the CLI installs the same for the command
+    sys.unraisablehook = interrupts.signal_in_finalizer
     try:
         from washbench.cli import main
 
@@ -25,6 +27,9 @@ def entry() -> int:
     except KeyboardInterrupt:  # before the CLI's own handling starts (importing, parsing the arguments)
         print("washbench: interrupted", file=sys.stderr)
         return 130
+    except Terminated:
+        print("washbench: terminated", file=sys.stderr)
+        return 143
 
 
 if __name__ == "__main__":

@@ -19,6 +19,7 @@ from washbench.cli_examples import add_examples, subcommands
 from washbench.cueing.params import WASHOUT_KINDS
 from washbench.errors import Terminated, WashbenchError, printable
 from washbench.io import config as project_config
+from washbench.io import interrupts
 
 _VARIANT_HELP = "add a washout NAME of KIND with dotted-key overrides of the parameter file, repeatable"
 
@@ -386,6 +387,7 @@ def _run_options(args: argparse.Namespace) -> Any:
 def _cue(args: argparse.Namespace) -> int:
     from washbench.io.input_format import input_format
     from washbench.runs.cue import CueOptions, run_cue
+    from washbench.runs.options import load_options
 
     opts = CueOptions(
         fmt=input_format(args.columns, args.input_format, args.axes, args.delimiter, args.decimal, args.jsbsim_dt),
@@ -394,24 +396,14 @@ def _cue(args: argparse.Namespace) -> int:
         split=not args.no_split,
         start_s=args.start_s,
         end_s=args.end_s,
-        filter_start=args.filter_start,
         strict=args.strict,
-        recording=not args.no_recording,
-        figures=not args.no_figures,
-        rank_by=args.rank_by,
-        vestibular=args.vestibular,
         progress=not args.quiet,
         force=args.force,
     )
-    return run_cue(
-        args.input,
-        args.out,
-        washouts=args.washout,
-        params_path=args.params,
-        platform_path=args.platform,
-        variants=args.variant,
-        options=opts,
-    )
+    run = load_options(params_path=args.params, platform_path=args.platform, washouts=args.washout,
+                       variants=args.variant, outputs=_outputs(args), filter_start=args.filter_start,
+                       rank_by=args.rank_by, vestibular=args.vestibular)  # fmt: skip
+    return run_cue(args.input, args.out, opts, run)
 
 
 def _aircraft_dir_option(p: argparse.ArgumentParser) -> None:
@@ -560,44 +552,6 @@ def _study(args: argparse.Namespace) -> int:
     )
 
 
-def _terminate(signum: int, frame: object) -> None:
-    raise Terminated()
-
-
-def _signal_in_finalizer(unraisable: object) -> None:
-    """``sys.unraisablehook``: a Ctrl-C or SIGTERM whose exception was raised inside a finalizer (``__del__``, e.g.
-    the rerun SDK's RecordingStream as a recording is closed) is swallowed by Python with an "Exception ignored"
-    traceback, and the command would go on as if never signalled (and publish). The signal is sent again a few
-    milliseconds later, from a timer thread, so that it acts in the command itself (one line, 130 or 143, the
-    previous results left as they were)."""
-    exc = getattr(unraisable, "exc_value", None)
-    if not isinstance(exc, (KeyboardInterrupt, Terminated)):
-        sys.__unraisablehook__(unraisable)  # type: ignore[arg-type]
-        return
-    import threading
-
-    signum = signal.SIGINT if isinstance(exc, KeyboardInterrupt) else signal.SIGTERM
-    _PENDING.append(signum)  # a command that ends before the timer fires still reports it (main)
-    while True:
-        try:
-            timer = threading.Timer(0.01, _send_again, (signum,))
-            timer.daemon = True
-            timer.start()
-            return
-        except (KeyboardInterrupt, Terminated):  # signalled again in here: still one to send
-            continue
-
-
-#: Signals swallowed in a finalizer and not yet sent again (see :func:`_signal_in_finalizer`).
-_PENDING: list[int] = []
-
-
-def _send_again(signum: int) -> None:
-    if _PENDING:
-        _PENDING.clear()
-        os.kill(os.getpid(), signum)
-
-
 def _quiet_broken_pipe() -> int:
     """Standard output was closed early (``washbench validate ... | head -1``): exit quietly, like a Unix tool."""
     try:
@@ -640,18 +594,15 @@ def main(argv: list[str] | None = None) -> int:
     env_before = os.environ.pop(project_config.CONFIG_USED_ENV, None)
     if config is not None:  # recorded in the provenance, also by worker processes
         os.environ[project_config.CONFIG_USED_ENV] = str(config.path)
-    signal.signal(signal.SIGTERM, _terminate)
-    hook, sys.unraisablehook = sys.unraisablehook, _signal_in_finalizer
+    signal.signal(signal.SIGTERM, interrupts.terminate)
+    hook, sys.unraisablehook = sys.unraisablehook, interrupts.signal_in_finalizer
     try:
         try:
             _check_paths(args)
             _load_plugins(args)
             status = _dispatch(args)
             sys.stdout.flush()
-            if _PENDING:  # signalled at the very end (swallowed in a finalizer): the work is done, say so anyway
-                last = _PENDING[-1]
-                _PENDING.clear()
-                raise KeyboardInterrupt if last == signal.SIGINT else Terminated()
+            interrupts.raise_pending()  # signalled at the very end (swallowed in a finalizer): done, say so anyway
             return status
         except WashbenchError as exc:
             print(f"washbench: error: {printable(str(exc))}", file=sys.stderr)

@@ -37,7 +37,7 @@ def copy_examples(dest: Path) -> int:
     ``dest``'s lock: a full disk or a signal leaves nothing half-copied, so a rerun works.
     """
     from washbench.io.lock import output_lock
-    from washbench.io.outfolder import discard_stage, make_stage, recover, swap_in
+    from washbench.io.outfolder import recover, staged
 
     if dest.exists() and not dest.is_dir():
         raise WashbenchError(located(dest, "exists and is not a folder"))
@@ -46,17 +46,13 @@ def copy_examples(dest: Path) -> int:
         for top in ("manoeuvres", "aircraft"):
             if (dest / top).exists() or (dest / top).is_symlink():
                 raise WashbenchError(located(dest / top, "already exists; nothing copied (examples never overwrite)"))
-        stage = make_stage(dest)
-        try:
-            pairs = example_files(stage)
-            for src, dst in pairs:
-                dst.parent.mkdir(parents=True, exist_ok=True)
-                write_text_atomic(dst, src.read_text())
-            swap_in(stage, dest, [])
-        except OSError as exc:
-            raise WashbenchError(located(dest, f"cannot write ({exc.strerror or exc})")) from None
-        finally:
-            discard_stage(stage)
+        with staged(dest, []) as stage:
+            try:
+                for src, dst in example_files(stage):
+                    dst.parent.mkdir(parents=True, exist_ok=True)
+                    write_text_atomic(dst, src.read_text())
+            except OSError as exc:
+                raise WashbenchError(located(dest, f"cannot write ({exc.strerror or exc})")) from None
     pairs = example_files(dest)
     n_m = sum(1 for _, d in pairs if d.suffix == ".yaml" and "manoeuvres" in d.parts)
     print(f"{n_m} manoeuvres and {len(pairs) - n_m} pilot profiles copied to {dest}")

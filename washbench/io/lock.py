@@ -21,8 +21,7 @@ from pathlib import Path
 
 from washbench.errors import WashbenchError, located
 from washbench.io.publish import prepare_output_dir
-
-LOCK_NAME = ".washbench.lock"
+from washbench.io.result_files import LOCK_NAME
 
 
 def _open_lock(out_dir: Path, path: Path) -> int:

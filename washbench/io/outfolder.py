@@ -1,65 +1,76 @@
-"""One way to own, build and publish an output folder: every command that writes a result set into ``--out``.
+"""The one way washbench publishes results: built in a hidden stage, then swapped in whole, under the lock.
 
-:func:`result_set` is what ``cue``, ``fly``, ``sweep``, ``tune``, ``omct`` and ``examples`` write through (and
-``report`` through :func:`replace_entries`; ``run`` and ``suite`` share the lock, :func:`recover` and
-:func:`swap_in`):
+Every command that writes a result folder or a set of them publishes it through this module (a single file a
+command is asked for, such as ``signal``'s CSV or ``schema --out``, is written atomically by
+:mod:`washbench.io.atomic`), in one of two forms:
 
-1. the lock (:func:`washbench.io.lock.output_lock`: created with ``O_CREAT|O_EXCL|O_NOFOLLOW``, a link refused);
-2. :func:`recover`: what a killed command left is removed (hidden stage and old folders, ``.*.tmp`` files,
-   ``.NAME.partial-PID`` folders), or, if it was killed in the middle of publishing, the publication finished
-   from its journal, so the folder holds one whole result set, never a mix;
-3. :func:`owned_entries`: everything in the folder must be listed in the manifest ``.washbench.json`` a
-   previous run of the same command wrote; anything else (a user's file of the same name as a result, a
-   symbolic link) is refused with one line before any work, and left untouched;
-4. the command writes into a fresh hidden stage folder ``OUT/.washbench-stage-PID`` (inside ``--out``, so no
-   link in ``--out`` is ever followed: every file is created inside a folder washbench just made);
-5. :func:`swap_in`: with SIGINT and SIGTERM held back, a journal is written, the previous entries are renamed
-   into a hidden old folder, the new ones renamed into place, the journal removed, the old folder deleted
-   (``shutil.rmtree`` never follows links). A signal during the swap takes effect once the set is whole.
+* :func:`result_set`, a whole ``--out`` owned by one command (``cue``, ``fly``, ``sweep``, ``tune``, ``omct``;
+  ``examples`` and ``report`` use the same steps on a folder of the user's and on a result folder):
+
+  1. the lock (:func:`washbench.io.lock.output_lock`: created with ``O_CREAT|O_EXCL|O_NOFOLLOW``, a link refused);
+  2. :func:`recover`: what a killed command left is removed (hidden stage and old folders, ``.*.tmp`` files,
+     legacy ``.NAME.partial-PID`` folders), or, if it was killed in the middle of publishing, the publication
+     finished from its journal, so the folder holds one whole result set, never a mix;
+  3. :func:`owned_entries`: everything in the folder must be listed in the manifest ``.washbench.json`` a
+     previous run of the same command wrote; anything else (a user's file of the same name as a result, a
+     symbolic link) is refused with one line before any work, and left untouched;
+  4. :func:`staged`: the command writes into a fresh hidden stage folder ``OUT/.washbench-stage-PID`` (inside
+     ``--out``, so no link in ``--out`` is ever followed: every file is created inside a folder washbench just
+     made), and then
+  5. :func:`swap_in`: with SIGINT and SIGTERM held back, a journal is written, the previous entries are renamed
+     into a hidden old folder, the new ones renamed into place, the journal removed, the old folder deleted
+     (``shutil.rmtree`` never follows links). A signal during the swap takes effect once the set is whole.
+
+* :func:`result_entry`, one named entry in a folder that holds other results too: ``washbench run``'s
+  ``OUT/<aircraft>/<manoeuvre>`` in an ``OUT`` that gathers many runs, and each run of a suite (whose worker
+  processes publish side by side into the same ``<aircraft>/`` folder). The same steps, for one entry: what
+  stands at its place must be a washbench result of the same thing (else one line, before any work); what
+  interrupted publications left in the shared folder is recovered by :func:`recover_shared` (only those of
+  processes no longer running, since several may publish there at once: a journal rolled forward, stage and
+  old folders removed); the entry is built in ``<aircraft>/.washbench-stage-PID/<manoeuvre>`` and swapped in by
+  the same journalled :func:`swap_in`, replacing only the previous entry of that name.
+
+A ``washbench suite`` is a result set too (:func:`staged` under the lock, after :func:`recover`), marked by its
+``suite.json`` rather than a manifest; its runs are result entries inside its stage. The hidden names are
+spelt in :mod:`washbench.io.result_files`.
 """
 
 from __future__ import annotations
 
 import contextlib
-import functools
 import json
 import os
 import re
 import shutil
-import signal
-import threading
 from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
-from typing import ParamSpec, TypeVar
 
 from washbench.errors import WashbenchError, located
+from washbench.io.interrupts import signals_held, uninterrupted  # (defined there; kept importable from here)
+from washbench.io.lock import output_lock
+from washbench.io.result_files import (
+    JOURNAL_PREFIX,
+    LOCK_NAME,
+    MANIFEST,
+    OLD_PREFIX,
+    PROBE_PREFIX,
+    STAGE_PREFIX,
+    is_legacy_leftover,
+    is_own_hidden,
+    publication_pid,
+)
 
-P = ParamSpec("P")
-R = TypeVar("R")
-
-#: The manifest: which command wrote the folder and every top-level name it wrote.
-MANIFEST = ".washbench.json"
-STAGE_PREFIX = ".washbench-stage-"
-OLD_PREFIX = ".washbench-old-"
-JOURNAL_PREFIX = ".washbench-swap-"
 _TMP = re.compile(r"^\..+\.tmp$")
-_LEGACY = re.compile(r"^\..+\.(?:partial|old)-\d+$")
+
+__all__ = [
+    "JOURNAL_PREFIX", "MANIFEST", "OLD_PREFIX", "STAGE_PREFIX", "check_out_path", "discard_stage", "is_own_hidden",
+    "make_stage", "owned_entries", "recover", "recover_shared", "replace_entries", "result_entry", "result_set",
+    "signals_held", "staged", "swap_in", "uninterrupted", "unstaged_error",
+]  # fmt: skip
 
 
 def _why(exc: OSError) -> str:
     return exc.strerror or type(exc).__name__
-
-
-def is_own_hidden(name: str) -> bool:
-    """Names washbench keeps in an output folder besides the results (lock, manifest, leftovers)."""
-    from washbench.io.lock import LOCK_NAME
-
-    return (
-        name in (LOCK_NAME, MANIFEST)
-        or name.startswith((STAGE_PREFIX, OLD_PREFIX, JOURNAL_PREFIX, ".washbench-probe-"))
-        or _TMP.match(name) is not None
-        or _LEGACY.match(name) is not None
-    )
 
 
 def remove_tree(path: Path) -> None:
@@ -87,14 +98,14 @@ def recover(out_dir: Path, *, only_washbench: bool = False) -> None:
     for entry in list(out_dir.iterdir()):
         name = entry.name
         if only_washbench:
-            if name.startswith((STAGE_PREFIX, OLD_PREFIX, ".washbench-probe-", ".suite.partial-", ".suite.old-")):
+            if name.startswith((STAGE_PREFIX, OLD_PREFIX, PROBE_PREFIX, ".suite.partial-", ".suite.old-")):
                 remove_tree(entry)
             continue
-        if name.startswith((STAGE_PREFIX, OLD_PREFIX, ".washbench-probe-")) or _LEGACY.match(name) or _TMP.match(name):
+        if name.startswith((STAGE_PREFIX, OLD_PREFIX, PROBE_PREFIX)) or is_legacy_leftover(name) or _TMP.match(name):
             remove_tree(entry)
         elif name in listed and entry.is_dir() and not entry.is_symlink():
             for sub in list(entry.iterdir()):
-                if _TMP.match(sub.name) or _LEGACY.match(sub.name):
+                if _TMP.match(sub.name) or is_legacy_leftover(sub.name):
                     remove_tree(sub)
 
 
@@ -175,8 +186,6 @@ def owned_entries(out_dir: Path, command: str, adopt: Sequence[str] = ()) -> lis
                 "replaced; choose another --out"))  # fmt: skip
         listed = set(manifest[1])
     found: list[Path] = []
-    from washbench.io.lock import LOCK_NAME
-
     for entry in sorted(out_dir.iterdir()):
         if is_own_hidden(entry.name) and (manifest is not None or entry.name == LOCK_NAME):
             continue  # in a folder without a manifest, a hidden file is the user's unless it is the lock
@@ -190,46 +199,6 @@ def owned_entries(out_dir: Path, command: str, adopt: Sequence[str] = ()) -> lis
                                          "not replaced; move it away or choose an empty or new --out"))  # fmt: skip
         found.append(entry)
     return found
-
-
-@contextlib.contextmanager
-def signals_held() -> Iterator[None]:
-    """Hold SIGINT and SIGTERM back for a short critical section: noted, and acted on (KeyboardInterrupt or
-    :class:`washbench.errors.Terminated`) once it is over; never lost, never in the middle."""
-    if threading.current_thread() is not threading.main_thread():  # handlers run in the main thread only
-        yield
-        return
-    noted: list[int] = []
-
-    def note(signum: int, frame: object) -> None:
-        noted.append(signum)
-
-    saved = {sig: signal.signal(sig, note) for sig in (signal.SIGINT, signal.SIGTERM)}
-    try:
-        yield
-    finally:
-        for sig, handler in saved.items():
-            signal.signal(sig, handler)
-    if noted:
-        from washbench.errors import Terminated
-
-        raise KeyboardInterrupt if noted[0] == signal.SIGINT else Terminated()
-
-
-def uninterrupted(func: Callable[P, R]) -> Callable[P, R]:
-    """``func`` run under :func:`signals_held`: for the figure writers, whose drawing a Ctrl-C must not cut.
-
-    matplotlib's compiled parts (pybind11) turn a KeyboardInterrupt raised while they convert their arguments into
-    a ``TypeError: incompatible function arguments`` traceback; held back, the signal acts as soon as the figure
-    is written (a few tenths of a second).
-    """
-
-    @functools.wraps(func)
-    def held(*args: P.args, **kwargs: P.kwargs) -> R:
-        with signals_held():
-            return func(*args, **kwargs)
-
-    return held
 
 
 def discard_stage(stage: Path) -> None:
@@ -297,33 +266,125 @@ def check_out_path(out: str | Path) -> Path:
 
 
 @contextlib.contextmanager
+def staged(
+    out_dir: Path, previous: Sequence[Path], before_swap: Callable[[Path], None] | None = None
+) -> Iterator[Path]:
+    """Yield a fresh stage folder inside ``out_dir`` (:func:`make_stage`); once the body is done, replace the
+    ``previous`` entries of ``out_dir`` by everything in the stage (:func:`swap_in`: journalled, signals held).
+
+    ``before_swap(stage)`` runs just before the swap (a manifest written, a last check). On an exception (a signal
+    included) nothing is published and the stage is removed; a WashbenchError then names its files where they were
+    going (:func:`unstaged_error`), not in the hidden stage. Call it holding the lock of ``out_dir`` (or, for a
+    result entry, of the output folder above it).
+    """
+    stage = make_stage(out_dir)
+    try:
+        yield stage
+        if before_swap is not None:
+            before_swap(stage)
+        swap_in(stage, out_dir, previous)
+    except WashbenchError as exc:  # name the files where they were going, not the hidden stage
+        raise unstaged_error(exc, stage, out_dir) from None
+    finally:
+        discard_stage(stage)
+
+
+@contextlib.contextmanager
 def result_set(out: str | Path, command: str, adopt: Sequence[str] = ()) -> Iterator[Path]:
     """Own ``out`` for one result set of ``command``; yield the stage folder to write the set into.
 
     Lock, recover, refuse foreign entries (before the caller does any work), build in the stage, then publish
-    the whole set at once with its manifest (:func:`swap_in`). On an exception (a signal included) nothing is
+    the whole set at once with its manifest (:func:`staged`). On an exception (a signal included) nothing is
     published and the previous set stays as it was; a folder created here is removed again if left empty.
     ``adopt``: files the command already wrote into ``out`` for this set (``washbench live``'s saved input):
     moved into the set when it is published, left where they are otherwise.
     """
-    from washbench.io.lock import output_lock
-
     with output_lock(check_out_path(out)) as out_dir:
         foreign = read_manifest(out_dir) is None  # not (yet) washbench's: only its own .washbench-* leftovers go
         recover(out_dir, only_washbench=foreign)
         previous = owned_entries(out_dir, command, adopt)
-        stage = make_stage(out_dir)
-        try:
-            yield stage
+
+        def finish(stage: Path) -> None:
             for name in adopt:
                 if (out_dir / name).is_file():
                     os.replace(out_dir / name, stage / name)
             write_manifest(stage, command)
-            swap_in(stage, out_dir, previous)
-        except WashbenchError as exc:  # name the files where they were going, not the hidden stage
-            raise unstaged_error(exc, stage, out_dir) from None
-        finally:
-            discard_stage(stage)
+
+        with staged(out_dir, previous, finish) as stage:
+            yield stage
+
+
+def _pid_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True  # a process of another user's
+    return True
+
+
+def recover_shared(folder: Path, *, only_dead: bool = True) -> None:
+    """Finish or remove what interrupted publications of result entries left in ``folder``, a folder several
+    entries (and several processes publishing them) share: ``OUT/<aircraft>/``.
+
+    A journal ``.washbench-swap-PID`` is rolled forward (:func:`recover`'s way: the entry it was swapping in
+    was complete), then stage and old folders (``.washbench-stage-PID``, ``.washbench-old-PID``) and the legacy
+    ``.NAME.partial-PID``/``.NAME.old-PID`` folders are removed. ``only_dead`` (the default: a suite's workers
+    publish side by side): only those of processes no longer running; without it all (for a caller that holds
+    the lock of the output folder and knows nobody else publishes there). Nothing else is touched.
+    """
+    try:
+        entries = sorted(folder.iterdir())
+    except OSError:
+        return
+    for entry in entries:
+        pid = publication_pid(entry.name)
+        if pid is None or (only_dead and _pid_alive(pid)):
+            continue
+        if entry.name == f"{JOURNAL_PREFIX}{pid}":
+            _roll_forward(folder, entry)
+    for entry in sorted(folder.iterdir()):
+        pid = publication_pid(entry.name)
+        if pid is None or (only_dead and _pid_alive(pid)):
+            continue
+        if is_legacy_leftover(entry.name) and (entry.is_symlink() or not entry.is_dir()):
+            continue  # a legacy leftover was always a folder: a file of such a name is the user's
+        remove_tree(entry)
+
+
+@contextlib.contextmanager
+def result_entry(final: Path, check: Callable[[Path], None]) -> Iterator[Path]:
+    """Build the result entry ``final`` (a folder, ``OUT/<aircraft>/<manoeuvre>``) in a folder that holds other
+    results too, and publish it whole; yield the folder to build it in.
+
+    Before the caller does any work: ``check(final)`` raises WashbenchError (one line) unless what stands at
+    ``final`` may be replaced (a washbench result of the same thing); the folder above it is created (a file in
+    the way fails now); what interrupted publications of dead processes left there is recovered
+    (:func:`recover_shared`). The entry is built in ``.washbench-stage-PID/<name>`` beside its place and swapped
+    in by :func:`staged` (journalled, signals held), after ``check`` once more, replacing only a previous entry
+    of that name. On an exception (a signal included) nothing is published, the previous entry stays, and a
+    folder created here is removed again if left empty. The caller holds the lock of the output folder.
+    """
+    parent = final.parent
+    check(final)
+    existed = parent.is_dir()
+    try:
+        parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise WashbenchError(located(parent, f"cannot create a result folder: {_why(exc)}")) from None
+    published = False
+    try:
+        recover_shared(parent)
+        with staged(parent, [final], lambda _: check(final)) as stage:
+            entry = stage / final.name
+            entry.mkdir()
+            yield entry
+        published = True
+    finally:
+        if not published and not existed:
+            with contextlib.suppress(OSError):
+                parent.rmdir()  # only if empty
 
 
 _TMP_PART = re.compile(r"/\.([^/]+?)\.[A-Za-z0-9_]{8}\.tmp\b")

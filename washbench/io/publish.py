@@ -1,12 +1,11 @@
-"""Where results go: output folders checked before any work, result paths proven inside ``--out``, and
-folders published whole, replacing only a previous result that washbench itself wrote.
+"""Where results may go, checked before any work: output folders that can be written, result paths proven inside
+``--out``, and whether what stands where a result goes is a washbench result it may replace.
 
-A result folder is built under a hidden temporary name beside its final place
-(``.NAME.partial-PID``), then renamed into place (:func:`publish_dir`). What already stands at the final
-place is replaced only if it is a washbench result of the same thing, recognised by its marker file
-(``run.json`` for ``washbench run``, whose ``aircraft`` and ``manoeuvre`` must match); anything else is
-left alone and the run fails with one line. Leftovers of an interrupted run (``.NAME.partial-PID``,
-``.NAME.old-PID``) are removed by :func:`clean_partials` at the next run into the same place.
+These are checks only. Publishing, the one way every command puts its results in place (built in a hidden
+stage, then swapped in whole), is :mod:`washbench.io.outfolder`'s. What stands where a result goes is replaced
+only if it is a washbench result of the same thing, recognised by its marker file (``run.json`` for
+``washbench run``, whose ``aircraft`` and ``manoeuvre`` must match: :func:`check_replaceable`); anything else is
+left alone and the command fails with one line.
 """
 
 from __future__ import annotations
@@ -14,16 +13,13 @@ from __future__ import annotations
 import contextlib
 import json
 import os
-import re
-import shutil
 import tempfile
 from collections.abc import Mapping
 from pathlib import Path
 
 from washbench.errors import WashbenchError, located
 from washbench.io.names import identifier_problem
-
-_LEFTOVER = re.compile(r"^\.(?P<name>.+)\.(?:partial|old)-(?P<pid>\d+)$")
+from washbench.io.result_files import PROBE_PREFIX, publication_pid
 
 
 def _why(exc: OSError) -> str:
@@ -48,7 +44,7 @@ def prepare_output_dir(path: str | Path) -> Path:
     except OSError as exc:
         raise WashbenchError(located(path, f"cannot create the output folder: {_why(exc)}")) from None
     try:
-        fd, probe = tempfile.mkstemp(prefix=".washbench-probe-", dir=path)
+        fd, probe = tempfile.mkstemp(prefix=PROBE_PREFIX, dir=path)
     except OSError as exc:
         raise WashbenchError(located(path, f"cannot write into the output folder: {_why(exc)}")) from None
     os.close(fd)
@@ -112,7 +108,7 @@ def is_washbench_result(folder: str | Path, marker: str, expect: Mapping[str, ob
         return True
     if not nested or folder.is_symlink() or not folder.is_dir():
         return False
-    subs = [e for e in folder.iterdir() if not is_leftover(e.name)]
+    subs = [e for e in folder.iterdir() if publication_pid(e.name) is None]  # not a publication's leftover
     return bool(subs) and all(is_washbench_result(e, marker, expect) for e in subs)
 
 
@@ -123,79 +119,3 @@ def check_replaceable(final: str | Path, marker: str, expect: Mapping[str, objec
         what = ", ".join(f"{k} {v}" for k, v in expect.items())
         problem = f"exists and is not a washbench result of {what} (no matching {marker}): not replaced"
         raise WashbenchError(located(final, f"{problem}; move it away or choose another --out"))
-
-
-def partial_dir(final: str | Path) -> Path:
-    """Create and return an empty hidden folder ``.NAME.partial-PID`` beside ``final`` to build a result in."""
-    final = Path(final)
-    partial = final.with_name(f".{final.name}.partial-{os.getpid()}")
-    shutil.rmtree(partial, ignore_errors=True)
-    try:
-        partial.mkdir(parents=True)
-    except OSError as exc:
-        raise WashbenchError(located(partial.parent, f"cannot create a result folder: {_why(exc)}")) from None
-    return partial
-
-
-def publish_dir(
-    partial: str | Path, final: str | Path, marker: str, expect: Mapping[str, object], nested: bool = False
-) -> None:
-    """Rename the finished folder ``partial`` to ``final``, replacing a previous washbench result there.
-
-    What stands at ``final`` is replaced only if :func:`is_washbench_result` recognises it; anything else
-    raises WashbenchError and is left untouched (``partial`` is then removed by the caller).
-    """
-    partial, final = Path(partial), Path(final)
-    check_replaceable(final, marker, expect, nested)
-    old = final.with_name(f".{final.name}.old-{os.getpid()}")
-    try:
-        if final.exists():
-            os.replace(final, old)
-        os.replace(partial, final)
-    except OSError as exc:
-        raise WashbenchError(located(final, f"cannot publish the result folder: {_why(exc)}")) from None
-    shutil.rmtree(old, ignore_errors=True)
-
-
-def is_leftover(name: str) -> bool:
-    """Whether ``name`` is a leftover of an interrupted run (``.NAME.partial-PID`` or ``.NAME.old-PID``)."""
-    return _LEFTOVER.match(name) is not None
-
-
-def _pid_alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    return True
-
-
-def clean_partials(folder: str | Path, *, only_dead: bool = True) -> list[Path]:
-    """Remove leftovers of interrupted runs in ``folder`` (``.NAME.partial-PID``, ``.NAME.old-PID``).
-
-    With ``only_dead`` (the default) only those of processes no longer running; without it all of them
-    (for a caller that holds the folder's :func:`washbench.io.lock.output_lock`). Returns what was removed.
-    """
-    folder = Path(folder)
-    removed: list[Path] = []
-    try:
-        entries = list(folder.iterdir())
-    except OSError:
-        return removed
-    for entry in entries:
-        match = _LEFTOVER.match(entry.name)
-        if match is None or entry.is_symlink() or not entry.is_dir():
-            continue
-        if only_dead and _pid_alive(int(match.group("pid"))):
-            continue
-        shutil.rmtree(entry, ignore_errors=True)
-        removed.append(entry)
-    return removed
-
-
-def remove_if_empty(folder: str | Path) -> None:
-    """Remove ``folder`` if it exists and is empty (e.g. an ``OUT/<aircraft>/`` left by a failed run)."""
-    with contextlib.suppress(OSError):
-        Path(folder).rmdir()

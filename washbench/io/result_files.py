@@ -13,9 +13,17 @@ A result folder of one flight or recorded trace (``washbench run``, ``cue``; a s
 
 A suite's folder adds, at its top: ``metrics.csv``, ``comparison.csv``, ``ranking.csv``, ``report.md``,
 ``figures/`` and ``suite.json`` (written last; it marks the folder as a suite's).
+
+Besides the results, washbench keeps hidden names in an output folder (:func:`is_own_hidden`): the lock
+``.washbench.lock``, the manifest ``.washbench.json`` and what a publication in progress uses
+(:mod:`washbench.io.outfolder`): ``.washbench-stage-PID/``, ``.washbench-old-PID/`` and the journal
+``.washbench-swap-PID``; also ``.NAME.XXXXXXXX.tmp`` (an atomic write in progress) and, from older versions,
+``.NAME.partial-PID`` and ``.NAME.old-PID``.
 """
 
 from __future__ import annotations
+
+import re
 
 FLIGHT_JSON = "flight.json"
 FLIGHT_FILE = "flight.parquet"
@@ -35,3 +43,39 @@ RUN_FILES = (FLIGHT_JSON, FLIGHT_FILE, TRACES_FILE, METRICS_FILE, RECORDING_FILE
 
 SUITE_FILES = (METRICS_FILE, COMPARISON_FILE, RANKING_FILE, REPORT_FILE)
 """A suite's own files at its top (besides ``figures/`` and ``suite.json``, which ``suite.json`` lists)."""
+
+LOCK_NAME = ".washbench.lock"
+"""The lock of an output folder (:mod:`washbench.io.lock`)."""
+MANIFEST = ".washbench.json"
+"""The manifest: which command wrote the folder and every top-level name it wrote (:mod:`washbench.io.outfolder`)."""
+STAGE_PREFIX = ".washbench-stage-"
+OLD_PREFIX = ".washbench-old-"
+JOURNAL_PREFIX = ".washbench-swap-"
+PROBE_PREFIX = ".washbench-probe-"
+
+_TMP = re.compile(r"^\..+\.tmp$")
+_LEGACY = re.compile(r"^\..+\.(?:partial|old)-(?P<pid>\d+)$")
+_PUBLISHING = re.compile(r"^\.washbench-(?:stage|old|swap)-(?P<pid>\d+)(?:\.tmp)?$")
+
+
+def is_own_hidden(name: str) -> bool:
+    """Names washbench keeps in an output folder besides the results (lock, manifest, leftovers)."""
+    return (
+        name in (LOCK_NAME, MANIFEST)
+        or name.startswith((STAGE_PREFIX, OLD_PREFIX, JOURNAL_PREFIX, PROBE_PREFIX))
+        or _TMP.match(name) is not None
+        or _LEGACY.match(name) is not None
+    )
+
+
+def is_legacy_leftover(name: str) -> bool:
+    """``.NAME.partial-PID`` or ``.NAME.old-PID``: what an interrupted run of an older version left."""
+    return _LEGACY.match(name) is not None
+
+
+def publication_pid(name: str) -> int | None:
+    """The process ID in the name of a publication's leftover (``.washbench-stage-PID``, ``.washbench-old-PID``,
+    the journal ``.washbench-swap-PID`` and its ``.tmp``, a legacy ``.NAME.partial-PID``), or None for any
+    other name."""
+    match = _PUBLISHING.match(name) or _LEGACY.match(name)
+    return int(match.group("pid")) if match else None

@@ -16,17 +16,10 @@ import numpy as np
 from washbench.analysis.cues import FALSE, MISSING, classify, dof_thresholds
 from washbench.analysis.metrics import DOFS
 from washbench.io.outfolder import uninterrupted
+from washbench.review.figures import collector_paused
 
 FALSE_COLOUR = (0.84, 0.15, 0.16)
 MISSING_COLOUR = (0.72, 0.72, 0.72)
-
-
-def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
-    """(start, stop) index pairs of the True runs of ``mask`` (stop exclusive)."""
-    if not mask.any():
-        return []
-    d = np.diff(np.concatenate([[0], mask.astype(np.int8), [0]]))
-    return list(zip(np.flatnonzero(d == 1).tolist(), np.flatnonzero(d == -1).tolist(), strict=True))
 
 
 def cue_classes(perceived: Mapping[str, np.ndarray], washouts: Sequence[str]) -> dict[str, np.ndarray]:
@@ -40,6 +33,7 @@ def cue_classes(perceived: Mapping[str, np.ndarray], washouts: Sequence[str]) ->
 
 
 @uninterrupted
+@collector_paused
 def cue_lane_figure(
     stem: Path,
     title: str,
@@ -50,7 +44,7 @@ def cue_lane_figure(
     """Write the lane figure (``stem.png``, and PDF if asked); ``classes``: washout -> (6, N) from cue_classes."""
     from matplotlib.patches import Patch
 
-    from washbench.review.figures import _new_figure, save_figure
+    from washbench.review.figures import _new_figure, bars, run_edges, save_figure
 
     washouts = list(classes)
     n_lanes = len(washouts) * len(DOFS)
@@ -67,9 +61,9 @@ def cue_lane_figure(
         for j, d in enumerate(DOFS):
             row = classes[w][j]
             for cls, colour in ((MISSING, MISSING_COLOUR), (FALSE, FALSE_COLOUR)):
-                spans = [(t[a], (t[b - 1] - t[a]) + dt) for a, b in _runs(row == cls)]
-                if spans:
-                    ax.broken_barh(spans, (y + 0.1, 0.8), facecolors=[colour], linewidth=0)
+                a, b = run_edges(row == cls)
+                if a.size:
+                    bars(ax, t[a], (t[b - 1] - t[a]) + dt, y + 0.1, 0.8, facecolors=[colour], linewidth=0)
             labels.append(f"{w}  {d}" if j == 0 else d)
             ticks.append(y + 0.5)
             y += 1.0

@@ -23,6 +23,7 @@ from washbench.io.input_format import ColumnSource
 from washbench.io.outfolder import uninterrupted
 from washbench.io.result_files import FIGURES_DIR, RUN_FILE, TRACES_FILE
 from washbench.io.units import G0_MPS2, axes_matrix, is_identity_axes
+from washbench.review.figures import collector_paused
 
 INPUT_STEM = "input"
 """The figure's file name (``figures/input.png``)."""
@@ -64,6 +65,7 @@ def input_labels(
 
 
 @uninterrupted
+@collector_paused
 def input_figure(
     stem: Path,
     title: str,

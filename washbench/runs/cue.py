@@ -39,7 +39,6 @@ from washbench.io.resample import check_gaps, check_step, resample, split_resets
 from washbench.io.result_files import METRICS_FILE, RECORDING_FILE, RUN_FILE, TRACES_FILE
 from washbench.runs.chain import CueResult, aircraft_attitude, stream_cue
 from washbench.runs.options import RunOptions, load_options
-from washbench.runs.outputs import Outputs
 from washbench.runs.result_folder import RunSummary, write_run_json, write_run_recording, write_run_review
 
 # --------------------------------------------------------------------------- the cue command, stage by stage
@@ -47,7 +46,12 @@ from washbench.runs.result_folder import RunSummary, write_run_json, write_run_r
 
 @dataclass(frozen=True)
 class CueOptions:
-    """Everything ``washbench cue`` is told besides the input, washouts and parameter files."""
+    """What only ``washbench cue`` is told: how to read, cut and put on a grid the recorded input.
+
+    Everything a cue shares with ``run`` (the washouts, parameter and platform files, the filters' start state,
+    the optional outputs, the ranking rule, the vestibular model) is the run's options, :class:`RunOptions`
+    (:func:`washbench.runs.options.load_options`), given to :func:`run_cue` beside these.
+    """
 
     fmt: InputFormat = field(default_factory=InputFormat)
     resample_hz: float | None = None
@@ -55,12 +59,7 @@ class CueOptions:
     split: bool = True
     start_s: float | None = None
     end_s: float | None = None
-    filter_start: str = "steady"
     strict: bool = False
-    recording: bool = True
-    figures: bool = True
-    rank_by: str | None = None  # the ranking rule (--rank-by; None: the parameter file's)
-    vestibular: str | None = None  # the vestibular model (--vestibular; None: young-meiry)
     progress: bool = True
     force: bool = False
     """Resample even when that makes more than :data:`MAX_GROWTH` times the input's rows."""
@@ -252,44 +251,19 @@ def write_outputs(
     return done
 
 
-def cue_run_options(
-    opts: CueOptions,
-    washouts: Sequence[str] | None = None,
-    params_path: Path | None = None,
-    platform_path: Path | None = None,
-    variants: Sequence[str] = (),
-) -> RunOptions:
-    """The run's options (:func:`washbench.runs.options.load_options`: each file read once) of a ``cue``."""
-    return load_options(
-        params_path=params_path,
-        platform_path=platform_path,
-        washouts=washouts,
-        variants=variants,
-        outputs=Outputs(recording=opts.recording, figures=opts.figures),
-        filter_start=opts.filter_start,
-        rank_by=opts.rank_by,
-        vestibular=opts.vestibular,
-    )
-
-
 def run_cue(
     input_path: Path,
     out_dir: Path,
-    washouts: Sequence[str] | None = None,
-    params_path: Path | None = None,
-    platform_path: Path | None = None,
-    variants: Sequence[str] = (),
     options: CueOptions | None = None,
+    run: RunOptions | None = None,
     adopt: Sequence[str] = (),
-    run_options: RunOptions | None = None,
 ) -> int:
     """The ``washbench cue`` command: read, convert, cut and check, cue, write; 0, or 1 if the data holds a crash.
 
+    ``options``: how the input is read and prepared (None: the defaults); ``run``: the run's options, as ``run``
+    and ``suite`` are given them (:func:`washbench.runs.options.load_options`: the washouts, the platform, the
+    filters' start state, the optional outputs, the ranking rule, the vestibular model; None: the defaults).
     ``adopt``: files already in ``out_dir`` that become part of the published set (``washbench live``'s input).
-
-    ``washouts``, ``variants`` and ``params_path`` select the washouts
-    (:func:`washbench.cueing.variants.select_washouts`); with ``platform_path`` and ``options`` they make the
-    run's options (:func:`cue_run_options`), unless ``run_options`` gives them already loaded.
     Raises WashbenchError (one line) for bad names, parameter files or input; writes nothing then.
     """
     check_out_path(out_dir)
@@ -298,7 +272,7 @@ def run_cue(
         if value is not None and not (math.isfinite(value) and value > 0.0):
             raise WashbenchError(f"{flag}: expected a positive number, got {value:g}")
     start = time.perf_counter()
-    run = run_options or cue_run_options(opts, washouts, params_path, platform_path, variants)
+    run = run if run is not None else load_options()
     samples = read_input(input_path, opts.fmt)
     segments = prepare_segments(samples, opts)
     with result_set(out_dir, "cue", adopt) as stage:  # the whole set replaces the previous one at once

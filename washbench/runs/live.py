@@ -44,7 +44,9 @@ from washbench.live.endpoints import Sink, bind_udp
 from washbench.live.link import LatencyStats, Link, Out
 from washbench.live.packets import RREF_DATAREFS, RREF_ID0, Decoder, PacketError, decoder, rref_request
 from washbench.live.saved_input import INPUT_FILE, InputWriter
-from washbench.runs.cue import CueOptions, cue_run_options, run_cue
+from washbench.runs.cue import CueOptions, run_cue
+from washbench.runs.options import load_options
+from washbench.runs.outputs import Outputs
 
 POLL_S = 0.05
 """The loop wakes up at least this often to check the stop conditions."""
@@ -344,8 +346,9 @@ def run_live(
     if not 0 < opts.rref_hz <= 10000:
         raise WashbenchError(f"--rref-hz: expected 1..10000 Hz, got {opts.rref_hz}")
     # the options of the final cue, loaded once (each file read once) and used live as well
-    run = cue_run_options(CueOptions(filter_start=opts.filter_start, recording=opts.recording, figures=opts.figures),
-                          washouts, params_path, platform_path, variants)  # fmt: skip
+    run = load_options(params_path=params_path, platform_path=platform_path, washouts=washouts, variants=variants,
+                       outputs=Outputs(recording=opts.recording, figures=opts.figures),
+                       filter_start=opts.filter_start)  # fmt: skip
     specs, limits, names = run.washouts, run.limits, list(run.washout_order)
     dec = decoder(opts.fmt)
     CueingBank(specs, None, limits, 0.01, opts.filter_start).step(np.zeros(3), np.zeros(3))  # compiled before listening
@@ -396,10 +399,9 @@ def run_live(
     if resample and not opts.resample_hz:
         print(f"  the source's clock is not on a uniform grid: cued with --resample {resample:g} "
               f"(washbench cue {saved} --resample {resample:g} gives the same)")  # fmt: skip
-    cue_opts = CueOptions(resample_hz=resample, filter_start=opts.filter_start, recording=opts.recording,
-                          figures=opts.figures)  # fmt: skip
+    cue_opts = CueOptions(resample_hz=resample)
     fig["resample_hz"] = resample
-    result = run_cue(saved, out, options=cue_opts, adopt=(INPUT_FILE,), run_options=run)
+    result = run_cue(saved, out, cue_opts, run, adopt=(INPUT_FILE,))
     _add_live_figures(out, saved, fig)
     if status:
         print(f"washbench: {session.stop}: the result folder holds every sample received", file=sys.stderr)

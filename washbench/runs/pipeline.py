@@ -8,8 +8,9 @@ After the flight the vestibular models, the metrics and the tables are the same 
 ``flight.parquet`` and read back, so ``washbench fly`` then ``washbench cue`` gives the same
 numbers bit for bit.
 
-Output, published as a whole folder (built under a temporary name, then renamed into place, so
-an interrupted run never leaves a half-written folder that looks complete)::
+Output, one result entry of ``OUT`` published whole (:func:`washbench.io.outfolder.result_entry`: built in a
+hidden stage beside its place, then swapped in, so an interrupted run never leaves a half-written folder that
+looks complete; it replaces only a previous ``washbench run`` result of the same manoeuvre)::
 
     OUT/<aircraft>/<manoeuvre>/
         flight.json      manoeuvre, phases, checks (as from washbench fly)
@@ -22,9 +23,7 @@ an interrupted run never leaves a half-written folder that looks complete)::
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
-import shutil
 import sys
 import time
 from pathlib import Path
@@ -37,8 +36,9 @@ from washbench.errors import WashbenchError, located
 from washbench.io.budget import check_samples
 from washbench.io.lock import output_lock
 from washbench.io.motion_file import read_motion
+from washbench.io.outfolder import result_entry
 from washbench.io.provenance import flat_strings, utc_now
-from washbench.io.publish import check_replaceable, clean_partials, partial_dir, publish_dir, remove_if_empty
+from washbench.io.publish import check_replaceable
 from washbench.io.result_files import FLIGHT_FILE, RECORDING_FILE, REPORT_FILE, RUN_FILE
 from washbench.review.numbers import pct, sig
 from washbench.runs.chain import (
@@ -83,17 +83,14 @@ def run_manoeuvre(
     prov = opts.provenance_for(manoeuvre_path, manoeuvre.environment.turbulence, manoeuvre.aircraft_files)
     final = run_dir(Path(out_root), manoeuvre.aircraft, manoeuvre.name)
     marker = run_marker(manoeuvre.aircraft, manoeuvre.name)
-    check_replaceable(final, RUN_MARKER, marker)  # before flying: a folder in the way fails now, not after
-    clean_partials(final.parent)
 
     from washbench.flight.fly import fly, write_flight
     from washbench.runs.bound_stage import split_whole
 
     stepped = split_whole(opts.washouts)[0]  # a whole-only washout (the bound) is cued after the flight
-    rows, lockstep = lockstep_blocks(stepped, opts.limits, manoeuvre.dt_s, opts.filter_start)
-    partial = partial_dir(final)  # before flying: a file in the way of OUT/<aircraft>/ fails now
-    published = False
-    try:
+    # entered before flying: a folder or file in the way fails now, not after
+    with result_entry(final, lambda place: check_replaceable(place, RUN_MARKER, marker)) as folder:
+        rows, lockstep = lockstep_blocks(stepped, opts.limits, manoeuvre.dt_s, opts.filter_start)
         start = time.perf_counter()
         created = utc_now()
         flight = fly(manoeuvre, block_hook=lockstep, block_size=LOCKSTEP_BLOCK, progress=progress)
@@ -101,7 +98,7 @@ def run_manoeuvre(
         if sample_count(rows) != n:
             raise RuntimeError(f"washouts ran {sample_count(rows)} steps for {n} recorded samples")
         flight_prov = {k: v for k, v in prov.items() if k in _FLIGHT_PROVENANCE}
-        write_flight(partial, flight, str(manoeuvre_path), flight_prov)
+        write_flight(folder, flight, str(manoeuvre_path), flight_prov)
         if n < 2:
             raise WashbenchError(located(manoeuvre_path, f"the flight recorded {n} sample(s): nothing to cue"))
         cols = flight.columns
@@ -117,18 +114,7 @@ def run_manoeuvre(
         )
         ac_q = aircraft_attitude(cols["phi_deg"], cols["theta_deg"], cols["psi_deg"])
         extra = {"created_utc": created, "provenance": prov, "algorithms": lockstep.reports()}
-        summary = write_cued_folder(partial, summary, rows, opts, ac_q, flight.phases, start, extra, prov)
-        publish_dir(partial, final, RUN_MARKER, marker)
-        published = True
-    except WashbenchError as exc:  # name the files where they were going, not the hidden partial folder
-        from washbench.io.outfolder import unstaged_error
-
-        raise unstaged_error(exc, partial, final) from None
-    finally:
-        with contextlib.suppress(FileNotFoundError):
-            shutil.rmtree(partial)
-        if not published:
-            remove_if_empty(final.parent)
+        summary = write_cued_folder(folder, summary, rows, opts, ac_q, flight.phases, start, extra, prov)
     return summary
 
 
@@ -184,8 +170,9 @@ def run_script(script_path: Path, out_root: Path, options: RunOptions | None = N
     """Fly a JSBSim script (:mod:`washbench.flight.scripts`) with the washouts in lockstep, one result per run.
 
     Writes ``OUT/<aircraft>/<script>/`` (one run) or ``OUT/<aircraft>/<script>/<run_i>/`` (a script that
-    resets), published as one folder. A crash still writes what was flown, with ``ok`` False and the reason.
-    ``options.max_time_s`` caps the simulated time (None: the script's own end, at most
+    resets), published whole as one result entry (:func:`washbench.io.outfolder.result_entry`). A crash still
+    writes what was flown, with ``ok`` False and the reason. ``options.max_time_s`` caps the simulated time
+    (None: the script's own end, at most
     :data:`washbench.flight.scripts.DEFAULT_MAX_TIME_S`).
     """
     from washbench.flight.scripts import DEFAULT_MAX_TIME_S, fly_script, load_script_info, write_script_flight
@@ -199,8 +186,6 @@ def run_script(script_path: Path, out_root: Path, options: RunOptions | None = N
     created = utc_now()
     final = run_dir(Path(out_root), info.aircraft, info.name)
     marker = {"aircraft": info.aircraft}  # one run.json, or one per run of a script that resets
-    check_replaceable(final, RUN_MARKER, marker, nested=True)
-    clean_partials(final.parent)
     banks: list[list[np.ndarray]] = []
     hooks: list[Any] = []
     from washbench.runs.bound_stage import split_whole
@@ -213,15 +198,15 @@ def run_script(script_path: Path, out_root: Path, options: RunOptions | None = N
         hooks.append(hook)
         return hook
 
-    start = time.perf_counter()
-    flight = fly_script(script_path, max_time_s=max_time_s, segment_hook=segment_hook,
-                        aircraft_dirs=opts.aircraft_dirs)  # fmt: skip
-    partial = partial_dir(final)
-    several = len(flight.segments) > 1
     summaries = []
-    try:
+    # entered before flying: a folder or file in the way fails now, not after
+    with result_entry(final, lambda place: check_replaceable(place, RUN_MARKER, marker, nested=True)) as built:
+        start = time.perf_counter()
+        flight = fly_script(script_path, max_time_s=max_time_s, segment_hook=segment_hook,
+                            aircraft_dirs=opts.aircraft_dirs)  # fmt: skip
+        several = len(flight.segments) > 1
         for seg, rows, hook in zip(flight.segments, banks, hooks, strict=True):
-            folder = partial / seg.name if several else partial
+            folder = built / seg.name if several else built
             folder.mkdir(exist_ok=True)
             write_script_flight(folder, flight, seg)
             summary = RunSummary(
@@ -239,11 +224,6 @@ def run_script(script_path: Path, out_root: Path, options: RunOptions | None = N
             extra = {"script": str(info.path), "segment": seg.name, "stopped_by_time_limit": flight.stopped_by_limit}
             extra |= {"created_utc": created, "provenance": prov, "algorithms": hook.reports()}
             summaries.append(write_cued_folder(folder, summary, rows, opts, ac_q, [], start, extra, prov))
-        publish_dir(partial, final, RUN_MARKER, marker, nested=True)
-    finally:
-        with contextlib.suppress(FileNotFoundError):
-            shutil.rmtree(partial)
-        remove_if_empty(final.parent)
     return summaries
 
 

@@ -1,7 +1,8 @@
 """``washbench suite``: many manoeuvres in parallel processes, then a comparison of the washouts.
 
 Each manoeuvre runs through :func:`washbench.runs.pipeline.run_manoeuvre` in its own worker process
-and writes ``<aircraft>/<manoeuvre>/`` (published atomically as a whole folder). A manoeuvre
+and writes ``<aircraft>/<manoeuvre>/`` (published whole, as ``washbench run`` publishes it:
+:func:`washbench.io.outfolder.result_entry`). A manoeuvre
 that fails (bad file, crash, divergence, failed check, or an unexpected error) is reported with its
 reason; the others still complete and are kept. Then the suite writes, each file atomically:
 
@@ -15,8 +16,9 @@ reason; the others still complete and are kept. Then the suite writes, each file
 - ``OUT/suite.json`` (written last): every manoeuvre file with its status and reason, the suite's provenance, and
   what the suite wrote at the top level (how the next suite recognises it).
 
-The output folder holds exactly one suite's results. The suite builds them in a hidden folder inside
-``OUT`` (``OUT/.suite.partial-PID/``) and, once complete, replaces the previous results as a whole: the
+The output folder holds exactly one suite's results. The suite builds them in a hidden stage inside
+``OUT`` (``OUT/.washbench-stage-PID/``) and, once complete, replaces the previous results as a whole
+(:func:`washbench.io.outfolder.staged`, the one way washbench publishes: journalled, signals held): the
 previous suite's files and every ``washbench run`` result folder. Anything in ``OUT`` that washbench did
 not write makes the suite refuse to start (nothing is ever deleted that washbench did not write). An
 interrupted or failed suite leaves the previous results untouched. A lock on ``OUT`` keeps a second
@@ -54,11 +56,21 @@ from washbench.io.cpus import usable_cpus
 from washbench.io.csv_numbers import csv_number
 from washbench.io.lock import output_lock
 from washbench.io.metrics_csv import METRICS_COLUMNS, METRICS_TEXT_COLUMNS
-from washbench.io.outfolder import discard_stage, is_own_hidden, recover, swap_in
+from washbench.io.outfolder import recover, recover_shared, staged
 from washbench.io.progress import Progress
 from washbench.io.provenance import utc_now
-from washbench.io.publish import clean_partials, is_leftover, is_washbench_result, read_marker
-from washbench.io.result_files import COMPARISON_FILE, METRICS_FILE, RANKING_FILE, REPORT_FILE, SUITE_FILE, SUITE_FILES
+from washbench.io.publish import is_washbench_result, read_marker
+from washbench.io.result_files import (
+    COMPARISON_FILE,
+    METRICS_FILE,
+    RANKING_FILE,
+    REPORT_FILE,
+    STAGE_PREFIX,
+    SUITE_FILE,
+    SUITE_FILES,
+    is_own_hidden,
+    publication_pid,
+)
 from washbench.review.suite_report import write_suite_json, write_suite_report
 from washbench.runs.inputs import check_unique_names, find_manoeuvres
 from washbench.runs.options import RunOptions, load_options
@@ -154,7 +166,7 @@ def run_suite(
 
 def _destination(out_dir: Path) -> Path:
     """Where the results end up: the suite folder, not the hidden one they are built in."""
-    return out_dir.parent if is_leftover(out_dir.name) else out_dir
+    return out_dir.parent if out_dir.name.startswith(STAGE_PREFIX) else out_dir
 
 
 def _report(runs: list[Outcome], done: int, total: int, start: float, progress: Progress | None) -> list[Outcome]:
@@ -274,7 +286,7 @@ def previous_results(out_dir: Path) -> list[Path]:
     found: list[Path] = []
     for entry in sorted(out_dir.iterdir()):
         name = entry.name
-        if is_own_hidden(name) or is_leftover(name):
+        if is_own_hidden(name):
             continue
         if entry.is_symlink():  # never followed, never replaced (nor anything deleted through it)
             raise WashbenchError(located(entry, "is a symbolic link: washbench never follows or replaces a link in "
@@ -283,7 +295,7 @@ def previous_results(out_dir: Path) -> list[Path]:
             found.append(entry)
             continue
         if entry.is_dir():
-            subs = [e for e in entry.iterdir() if not is_leftover(e.name)]
+            subs = [e for e in entry.iterdir() if publication_pid(e.name) is None]
             if subs and all(_is_run_folder(e, name) for e in subs):  # an empty folder is the user's
                 found.append(entry)
                 continue
@@ -327,20 +339,15 @@ def suite_command(
         # no suite (no suite.json), only washbench's own leftovers: a hidden file there is the user's.
         recover(out_dir, only_washbench=read_marker(out_dir, SUITE_MARKER) is None)
         previous = previous_results(out_dir)
-        for entry in previous:
+        for entry in previous:  # what runs killed while publishing into OUT/<aircraft>/ left (all stale here)
             if entry.is_dir() and not entry.is_symlink():
-                clean_partials(entry, only_dead=False)
-        stage = out_dir / f".suite.partial-{os.getpid()}"
-        stage.mkdir()
-        try:
+                recover_shared(entry, only_dead=False)
+        with staged(out_dir, previous) as stage:  # swapped in whole (journalled, signals held), or not at all
             outcomes = run_suite(files, stage, options, jobs=jobs, progress=progress, dask=dask)
             for o in outcomes:  # a failure names the files where they were going, not the hidden stage
                 if not o.run.ok and str(stage) in o.run.reason:
                     o.run = dataclasses.replace(o.run, reason=o.run.reason.replace(str(stage), str(out_dir)))
             write_suite_results(outcomes, stage, dict(options.provenance), options.outputs.figures)
-            swap_in(stage, out_dir, previous)  # journalled, signals held: whole or not at all
-        finally:
-            discard_stage(stage)  # unless a journal says it is being published (recover finishes it)
     n_ok = sum(o.run.ok for o in outcomes)
     print(
         f"suite: {n_ok}/{len(outcomes)} runs ok in {time.perf_counter() - start:.1f} s; report: {out_dir / REPORT_FILE}"

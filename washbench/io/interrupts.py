@@ -1,0 +1,114 @@
+"""SIGINT and SIGTERM as exceptions in the main thread, held back over a critical section, and a signal that
+Python swallowed sent again.
+
+:func:`terminate` is the SIGTERM handler (it raises :class:`washbench.errors.Terminated`, so cleanup code runs as
+for Ctrl-C). :func:`signal_in_finalizer` is the ``sys.unraisablehook``: a KeyboardInterrupt or Terminated raised
+while Python runs a finalizer (a ``__del__``, such as the rerun SDK's RecordingStream as a recording is closed, or
+a weakref callback, such as importlib's module locks while ``washbench.cli`` loads) is swallowed by Python with an
+"Exception ignored" traceback, and the command would go on as if never signalled (and publish); the hook sends
+the signal again a few milliseconds later, so that it acts in the command itself (one line, 130 or 143).
+
+:func:`signals_held` (and :func:`uninterrupted`, for a function) holds both back for a short critical section
+(the swap that publishes results, a figure being drawn, worker processes being started): noted, and acted on once
+it is over.
+
+On the lowest floor (stdlib and :mod:`washbench.errors` only): ``washbench/__main__.py`` installs both before it
+imports the command line, so a Ctrl-C in the first fraction of a second is never lost either.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import functools
+import os
+import signal
+import sys
+import threading
+from collections.abc import Callable, Iterator
+from typing import ParamSpec, TypeVar
+
+from washbench.errors import Terminated
+
+P = ParamSpec("P")
+R = TypeVar("R")
+
+#: Signals swallowed in a finalizer and not yet sent again (see :func:`signal_in_finalizer`).
+PENDING: list[int] = []
+
+
+def terminate(signum: int, frame: object) -> None:
+    """The SIGTERM handler: raise :class:`washbench.errors.Terminated` in the main thread."""
+    raise Terminated()
+
+
+def signal_in_finalizer(unraisable: object) -> None:
+    """``sys.unraisablehook``: a KeyboardInterrupt or Terminated raised inside a finalizer is noted in
+    :data:`PENDING` and its signal sent again 10 ms later from a timer thread; anything else goes to Python's own
+    hook."""
+    exc = getattr(unraisable, "exc_value", None)
+    if not isinstance(exc, (KeyboardInterrupt, Terminated)):
+        sys.__unraisablehook__(unraisable)  # type: ignore[arg-type]
+        return
+    signum = signal.SIGINT if isinstance(exc, KeyboardInterrupt) else signal.SIGTERM
+    PENDING.append(signum)  # a command that ends before the timer fires still reports it (cli.main)
+    while True:
+        try:
+            timer = threading.Timer(0.01, _send_again, (signum,))
+            timer.daemon = True
+            timer.start()
+            return
+        except (KeyboardInterrupt, Terminated):  # signalled again in here: still one to send
+            continue
+
+
+def _send_again(signum: int) -> None:
+    if PENDING:
+        PENDING.clear()
+        os.kill(os.getpid(), signum)
+
+
+def raise_pending() -> None:
+    """Raise KeyboardInterrupt or Terminated now if a signal swallowed in a finalizer has not been sent again yet
+    (a command that finished its work before the timer fired: it still ends as signalled)."""
+    if PENDING:
+        last = PENDING[-1]
+        PENDING.clear()
+        raise KeyboardInterrupt if last == signal.SIGINT else Terminated()
+
+
+@contextlib.contextmanager
+def signals_held() -> Iterator[None]:
+    """Hold SIGINT and SIGTERM back for a short critical section: noted, and acted on (KeyboardInterrupt or
+    :class:`washbench.errors.Terminated`) once it is over; never lost, never in the middle."""
+    if threading.current_thread() is not threading.main_thread():  # handlers run in the main thread only
+        yield
+        return
+    noted: list[int] = []
+
+    def note(signum: int, frame: object) -> None:
+        noted.append(signum)
+
+    saved = {sig: signal.signal(sig, note) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for sig, handler in saved.items():
+            signal.signal(sig, handler)
+    if noted:
+        raise KeyboardInterrupt if noted[0] == signal.SIGINT else Terminated()
+
+
+def uninterrupted(func: Callable[P, R]) -> Callable[P, R]:
+    """``func`` run under :func:`signals_held`: for the figure writers, whose drawing a Ctrl-C must not cut.
+
+    matplotlib's compiled parts (pybind11) turn a KeyboardInterrupt raised while they convert their arguments into
+    a ``TypeError: incompatible function arguments`` traceback; held back, the signal acts as soon as the figure
+    is written (a few tenths of a second).
+    """
+
+    @functools.wraps(func)
+    def held(*args: P.args, **kwargs: P.kwargs) -> R:
+        with signals_held():
+            return func(*args, **kwargs)
+
+    return held
