@@ -376,3 +376,15 @@ def test_a_flight_longer_than_the_rows_first_allocated_records_the_same_bits(
         assert again.columns[name].dtype == column.dtype and again.columns[name].tobytes() == column.tobytes(), name
     assert (again.status, again.phases, again.checks, again.events) == (before.status, before.phases, before.checks,
                                                                          before.events)  # fmt: skip
+
+
+def test_the_compiled_step_uses_the_loops_unit_factors_and_the_monitors_bound() -> None:
+    """flight.stepper keeps its own copies of fly's unit factors (fly imports it): they must not drift."""
+    import washbench.flight.fly as fly_module
+    import washbench.flight.monitor as monitor
+    import washbench.flight.stepper as stepper
+
+    assert (stepper.FT_S2_TO_M_S2, stepper.R2D, stepper.FPS_TO_KT) == (
+        fly_module.FT_S2_TO_M_S2, fly_module.R2D, fly_module.FPS_TO_KT)  # fmt: skip
+    assert stepper.BIG == monitor.BIG
+    assert len(stepper.SLOTS) == stepper.NSLOTS and stepper.I_STRUCT3 == stepper.NSLOTS - 1

@@ -26,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
+from washbench.flight.monitor import BIG
 from washbench.flight.pilot import NSLOTS as PILOT_NSLOTS
 from washbench.flight.pilot import (
     S_AILERON,
@@ -58,10 +59,9 @@ from washbench.flight.pilot import (
 from washbench.numerics.jitcache import drop_stale_cache
 from washbench.numerics.lazyjit import lazy_njit  # numba imported at the first step, not here
 
-FT_S2_TO_M_S2 = 0.3048
+FT_S2_TO_M_S2 = 0.3048  # as washbench.flight.fly (which imports this module)
 R2D = 180.0 / math.pi
 FPS_TO_KT = 3600.0 * 0.3048 / 1852.0
-BIG = 1.0e7  # as washbench.flight.monitor.BIG
 NSTRUCT = 4
 """Airframe contact points read into their own slots; more are summed in Python into the last one."""
 
