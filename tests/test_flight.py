@@ -309,3 +309,82 @@ def test_pilot_without_load_factor_limits_commands_as_with_limits_that_never_bin
             outs.append((pilot.aileron, pilot.elevator, pilot.rudder, pilot.steer, pilot.throttle))
         assert outs[0] == outs[1], f"step {k}"
     assert not c["wow"].any() and c["nz"].max() > 1.3  # in the air throughout (protection on), pulling in the turn
+
+
+def test_the_compiled_pilot_step_gives_the_bits_of_the_interpreted_one(flights: dict[str, FlightResult]) -> None:
+    """numba must not change a command by one bit (no fused multiply-add, libm's pow, sin, tan, asin and Python's
+    float modulo): every bundled flight's recorded states, phase by phase, go through the compiled step and through
+    the same function interpreted by CPython on a list of Python floats; every slot (commands, integrators,
+    filters) must be equal bit for bit after every step."""
+    from washbench.flight.pilot import STATE, X_PHI, Pilot, compiled_step
+    from washbench.flight.profile import load_profile
+
+    interpreted = compiled_step().py_func
+    covered: set[str] = set()
+    for path in BUNDLED:
+        m = load_manoeuvre(path)
+        profile = load_profile(m.aircraft_files.profile)
+        c = flights[manoeuvre_id(path)].columns
+        compiled, plain = Pilot(profile, m.runway, m.dt_s), Pilot(profile, m.runway, m.dt_s)
+        for pilot in (compiled, plain):
+            pilot.set_controls(float(c["aileron"][0]), float(c["elevator"][0]), float(c["rudder"][0]))
+        rad = {k: np.radians(c[k]) for k in ("phi_deg", "theta_deg", "psi_deg", "alpha_deg", "beta_deg")}
+        w = {k: np.radians(c[k]) for k in ("omega_x_degps", "omega_y_degps", "omega_z_degps")}
+        phase = -1
+        for k in range(len(c["t_s"])):
+            if c["phase"][k] != phase:
+                phase = int(c["phase"][k])
+                for pilot in (compiled, plain):
+                    pilot.begin_phase(m.phases[phase].hold, float(rad["theta_deg"][k]), float(c["throttle"][k]),
+                                      float(c["flaps_deg"][k]))  # fmt: skip
+                covered.add(f"lat{compiled.lat_mode:g} pitch{compiled.pitch_mode:g} wow{c['wow'][k]}")
+            state = [float(x) for x in (
+                rad["phi_deg"][k], rad["theta_deg"][k], rad["psi_deg"][k], w["omega_x_degps"][k],
+                w["omega_y_degps"][k], w["omega_z_degps"][k], rad["beta_deg"][k], c["vc_kts"][k],
+                c["gs_kts"][k] * 1.68781, rad["psi_deg"][k], c["climb_fpm"][k] / 60.0, c["altitude_ft"][k],
+                c["h_agl_ft"][k], c["runway_x_m"][k] / FT, c["runway_y_m"][k] / FT, c["wow"][k], c["nz"][k],
+                rad["alpha_deg"][k], c["vc_kts"][k] * 1.06, c["f_y_mps2"][k])]  # fmt: skip
+            compiled.step(*state[:15], bool(state[15]), *state[16:])
+            slots = plain.w.tolist()  # Python floats: CPython's arithmetic
+            slots[X_PHI:] = state
+            interpreted(slots)
+            plain.w[:] = slots
+            if compiled.w.tobytes() != plain.w.tobytes():
+                differ = [n for n in STATE if getattr(compiled, n) != getattr(plain, n)]
+                raise AssertionError(f"{manoeuvre_id(path)} step {k}: {', '.join(differ)} differ")
+    # the flights exercise every lateral mode and every pitch mode but the pitch-rate one (no bundled manoeuvre
+    # holds a pitch rate), in the air and on the ground
+    assert {s.split()[0] for s in covered} == {f"lat{i}" for i in range(5)}, covered
+    assert {s.split()[1] for s in covered} == {f"pitch{i}" for i in (1, 2, 3, 4, 6, 7, 8)}, covered
+    assert {s.split()[2] for s in covered} == {"wow0", "wow1"}, covered
+
+
+def test_a_flight_longer_than_the_rows_first_allocated_records_the_same_bits(
+    flights: dict[str, FlightResult], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The recorded rows grow (doubling) when a flight outlasts the first allocation: flown again with room for 100
+    rows at first (six doublings), the same manoeuvre records the same columns and summary, bit for bit."""
+    import washbench.flight.fly as fly_module
+
+    path = C172 / "elevator_doublet.yaml"
+    monkeypatch.setattr(fly_module, "_ROWS_FIRST", 100)
+    again = fly(load_manoeuvre(path))
+    before = flights[manoeuvre_id(path)]
+    assert len(again.t_s) > 100 * 2**5
+    assert list(again.columns) == list(before.columns)
+    for name, column in before.columns.items():
+        assert again.columns[name].dtype == column.dtype and again.columns[name].tobytes() == column.tobytes(), name
+    assert (again.status, again.phases, again.checks, again.events) == (before.status, before.phases, before.checks,
+                                                                         before.events)  # fmt: skip
+
+
+def test_the_compiled_step_uses_the_loops_unit_factors_and_the_monitors_bound() -> None:
+    """flight.stepper keeps its own copies of fly's unit factors (fly imports it): they must not drift."""
+    import washbench.flight.fly as fly_module
+    import washbench.flight.monitor as monitor
+    import washbench.flight.stepper as stepper
+
+    assert (stepper.FT_S2_TO_M_S2, stepper.R2D, stepper.FPS_TO_KT) == (
+        fly_module.FT_S2_TO_M_S2, fly_module.R2D, fly_module.FPS_TO_KT)  # fmt: skip
+    assert stepper.BIG == monitor.BIG
+    assert len(stepper.SLOTS) == stepper.NSLOTS and stepper.I_STRUCT3 == stepper.NSLOTS - 1

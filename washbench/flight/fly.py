@@ -5,13 +5,19 @@ Time base: sample ``k`` is the state at ``t = k * dt``. JSBSim's eyepoint accele
 step, so they lag one frame: the value read after step ``k + 1`` belongs to sample ``k``.
 The loop therefore reads the state at ``k``, runs the pilot, steps the FDM, then reads the
 accelerations and completes row ``k``.
+
+Per step, the Python loop reads the JSBSim properties (the accelerations the last step produced and the state
+now) into the slots of :mod:`washbench.flight.stepper` with one ``struct.pack_into``, makes one compiled call
+(which completes the last row, runs the monitor's checks, the events, the phase's end conditions and the
+scripted pilot, and writes the new row into a preallocated array), writes the five commands and steps JSBSim.
+What needs Python (a phase start, an event's time, a failure's message, open-loop inputs, the mixture schedule,
+the hooks, progress) is asked for by the call's return code. Measured by ``bench/marginal_bench.py``.
 """
 
 from __future__ import annotations
 
 import json
 import math
-import struct
 import sys
 import time
 from collections.abc import Callable, Mapping, Sequence
@@ -21,12 +27,13 @@ from pathlib import Path
 import numpy as np
 
 from washbench.errors import WashbenchError
+from washbench.flight import stepper as st
 from washbench.flight.checks import evaluate
 from washbench.flight.columns import COLUMN_NAMES
 from washbench.flight.fdm import make_fdm
 from washbench.flight.manoeuvre import Manoeuvre, load_manoeuvre
 from washbench.flight.manoeuvre_schema import Until
-from washbench.flight.monitor import BIG, Monitor
+from washbench.flight.monitor import Monitor
 from washbench.flight.openloop import OpenLoop
 from washbench.flight.pilot import Pilot
 from washbench.flight.profile import load_profile
@@ -81,8 +88,11 @@ CONTROL_PROPERTIES = (
     "fcs/right-brake-cmd-norm",
 )
 
-#: One recorded row (the flight.parquet columns, raw, before the unit conversion of :func:`_columns`).
-_ROW = struct.Struct(f"={len(COLUMN_NAMES)}d")
+_ROWS_FIRST = 1 << 14
+"""Rows allocated at the start (2 min 16 s at 120 Hz); the array doubles when full."""
+_NZ, _AIL = COLUMN_NAMES.index("nz"), COLUMN_NAMES.index("aileron")
+_TOTAL_SLOTS = (st.I_PHI, st.I_THETA, st.I_P, st.I_Q, st.I_R, st.I_VC, st.I_H, st.I_AGL, st.I_ALPHA)
+"""The state summed for the monitor's non-finite check, in the order the compiled step sums it."""
 
 
 @dataclass
@@ -123,40 +133,6 @@ def _nodes(fdm: object, names: tuple[str, ...]) -> list[object]:
     return [pm.get_node(n) for n in names]
 
 
-def _end_reached(u: Until, t_phase: float, turned: float, rolled: float, pitched: float, vc: float, h: float,
-                 agl: float, phi: float, theta: float, alpha: float, events: set[str]) -> bool:  # fmt: skip
-    """Whether any end condition of the phase holds (angles in deg, heights in ft).
-
-    ``turned``, ``rolled`` and ``pitched`` are magnitudes since the phase began: of the heading
-    change, and of the integrals of the body rates p and q.
-    """
-    if u.duration_s is not None and t_phase >= u.duration_s - 1e-9:
-        return True
-    if u.event is not None and u.event in events:
-        return True
-    return (
-        (u.turned_deg is not None and turned >= u.turned_deg)
-        or (u.rolled_deg is not None and rolled >= u.rolled_deg)
-        or (u.pitched_deg is not None and pitched >= u.pitched_deg)
-        or (u.airspeed_above_kts is not None and vc >= u.airspeed_above_kts)
-        or (u.airspeed_below_kts is not None and vc <= u.airspeed_below_kts)
-        or (u.altitude_above_ft is not None and h >= u.altitude_above_ft)
-        or (u.altitude_below_ft is not None and h <= u.altitude_below_ft)
-        or (u.agl_above_ft is not None and agl >= u.agl_above_ft)
-        or (u.agl_below_ft is not None and agl <= u.agl_below_ft)
-        or (u.bank_above_deg is not None and abs(phi) >= u.bank_above_deg)
-        or (u.pitch_above_deg is not None and theta >= u.pitch_above_deg)
-        or (u.pitch_below_deg is not None and theta <= u.pitch_below_deg)
-        or (u.alpha_above_deg is not None and alpha >= u.alpha_above_deg)
-    )
-
-
-def _duration_only(u: Until) -> float | None:
-    """``duration_s - 1e-9`` (the threshold :func:`_end_reached` uses) if the phase ends only by its duration."""
-    others = u.model_dump(exclude={"duration_s", "timeout_s"}, exclude_none=True)
-    return u.duration_s - 1e-9 if u.duration_s is not None and not others else None
-
-
 def fly(
     manoeuvre: Manoeuvre,
     step_hook: StepHook | None = None,
@@ -189,48 +165,52 @@ def fly(
     structure = _nodes(fdm, tuple(f"contact/unit[{i}]/WOW" for i in profile.geometry.structure_contacts))
     struct_gets = [n.get_double_value for n in structure]
 
-    pilot = Pilot(profile, m.runway, dt)
+    fw, pilot_slots = st.new_slots()  # the loop's slots (washbench.flight.stepper), then the pilot's
+    pilot = Pilot(profile, m.runway, dt, pilot_slots)
     pilot.set_controls(ail_w.get_double_value(), elev_w.get_double_value(), rud_w.get_double_value())
-    pilot_step = pilot.step
     monitor = Monitor.for_profile(profile)
     openloop = OpenLoop(fdm, profile, pilot)
     probe_gets = [n.get_double_value for n in _nodes(fdm, tuple(probes))]
     probe_rows: list[list[float]] = [[] for _ in probe_gets]
     frame = setup.frame
-    lat0, lon0, mlat, mlon = frame.lat0, frame.lon0, frame.m_per_rad_lat, frame.m_per_rad_lon
-    has_runway = setup.threshold_ne_m is not None
-    rw_c = math.cos(setup.runway_heading_rad or 0.0)
-    rw_s = math.sin(setup.runway_heading_rad or 0.0)
-    nan, pi, two_pi = math.nan, math.pi, 2 * math.pi
     mix_h_ft, mix_norm = zip(*profile.engine.mixture_schedule, strict=True)  # interpolated once a second
-    mix_every = max(1, round(1.0 / dt))
-    cg_h = profile.geometry.cg_height_on_ground_ft
-    alpha_stall_deg = profile.limits.alpha_stall_deg
+    # airframe contact points: four slots (unused ones read 0; more than four summed into the last)
+    padded = [*struct_gets, _zero, _zero, _zero, _zero]
+    s0, s1, s2, s3 = *padded[:3], (_summed(struct_gets[3:]) if len(struct_gets) > 4 else padded[3])
 
-    rows = bytearray()  # the recorded rows, ncol float64 each (native byte order)
-    rows_extend = rows.extend
-    pack = _ROW.pack  # struct packs a row of floats several times faster than array('d').extend converts one
+    # the loop's slots: constants, then the state the Python loop kept before
+    fw[st.F_DT] = dt
+    fw[st.F_LAT0], fw[st.F_LON0] = frame.lat0, frame.lon0
+    fw[st.F_MLAT], fw[st.F_MLON] = frame.m_per_rad_lat, frame.m_per_rad_lon
+    fw[st.F_HAS_RUNWAY] = setup.threshold_ne_m is not None
+    fw[st.F_RW_C] = math.cos(setup.runway_heading_rad or 0.0)
+    fw[st.F_RW_S] = math.sin(setup.runway_heading_rad or 0.0)
+    fw[st.F_VNE], fw[st.F_H_COLLAPSED], fw[st.F_ALPHA_MAX] = monitor.vne, monitor.h_collapsed, monitor.alpha_max
+    fw[st.F_NZ_MAX], fw[st.F_NZ_MIN], fw[st.F_SINK_MAX] = monitor.nz_max, monitor.nz_min, monitor.sink_max
+    fw[st.F_CG_H] = profile.geometry.cg_height_on_ground_ft
+    fw[st.F_ALPHA_STALL_DEG] = profile.limits.alpha_stall_deg
+    fw[st.F_MIX_EVERY] = max(1, round(1.0 / dt))
+    fw[st.F_BLOCK_SIZE] = block_size if block_hook is not None else 1 << 62
+    fw[st.F_EVERY_SAMPLE] = step_hook is not None
+    fw[st.F_PROGRESS] = progress
+    fw[st.F_IPHASE] = -1.0
+    was_wow = wow_get() > 0.5
+    fw[st.F_WAS_WOW] = was_wow
+    fw[st.F_LIFTED] = not was_wow  # an air start has no lift-off to report
+    fw[st.F_NZ_LAST] = 1.0  # load factor of the last sample (before the first step: level flight or at rest)
+    fw[st.F_MODE] = st.MODE_STEP
+    rows = np.empty((_ROWS_FIRST, len(COLUMN_NAMES)))  # the raw rows (columns converted after the loop), grown x2
+    step = st.compiled_flight_step()
     run = fdm.run
-    nz_max, nz_min = monitor.nz_max, monitor.nz_min
-    vne, h_collapsed, alpha_max = monitor.vne, monitor.h_collapsed, monitor.alpha_max
-    ncol = len(COLUMN_NAMES)
+    pack_step, unpack_commands = st.PACK_STEP, st.UNPACK_COMMANDS
+    inputs_at, commands_at = st.INPUTS_OFFSET, st.COMMANDS_OFFSET
+
     phases_out: list[tuple[str, float, float]] = []
     events: dict[str, list[float]] = {"touchdown_times_s": [], "touchdown_sinks_fps": [], "liftoff_times_s": []}
     reason = ""
     iphase = -1
     phase_k0 = 0
     u: Until | None = None
-    end_s: float | None = None
-    psi_prev = p_prev = q_prev = 0.0
-    turned = 0.0
-    rolled = pitched = 0.0  # integrals of the body rates p and q over the phase, rad (trapezoidal rule)
-    phase_events: set[str] = set()
-    was_wow = wow_get() > 0.5
-    airborne_since = 0.0
-    lifted = not was_wow  # an air start has no lift-off to report
-    nz_last = 1.0  # load factor of the last sample (before the first step: level flight or at rest)
-    fy_last = 0.0  # and its lateral specific force, m/s^2
-    k = 0
     k_sent = 0  # samples handed to block_hook so far
     # progress: overwritten in place on a terminal; otherwise (a log file, CI) a line per phase and every 5 s
     tty = progress and sys.stderr.isatty()
@@ -239,152 +219,118 @@ def fly(
     nphases = len(m.phases)
 
     while True:
-        t = k * dt
-        phi, theta, psi = phi_get(), theta_get(), psi_get()
-        p, q, r = p_get(), q_get(), r_get()
-        alpha, beta, vc = alpha_get(), beta_get(), vc_get()
-        vg, trk, hdot = vg_get(), trk_get(), hdot_get()
-        h, agl, lat, lon = h_get(), agl_get(), lat_get(), lon_get()
-        wow = wow_get() > 0.5
-        north = (lat - lat0) * mlat  # LocalFrame and the runway frame, inline (hot path)
-        east = (lon - lon0) * mlon
-        if has_runway:
-            x_rw = north * rw_c + east * rw_s
-            y_rw = -north * rw_s + east * rw_c
-        else:
-            x_rw = y_rw = nan
-        sw = 0.0
-        for g in struct_gets:
-            sw += g()
-
-        total = phi + theta + p + q + r + vc + h + agl + alpha
-        # the monitor's state checks, inlined (hot path); it is asked for the cause only when one fails
-        problem = None
-        if (not -BIG < total < BIG or sw > 0.0 or vc > vne or agl < h_collapsed
-                or (not wow and (alpha > alpha_max or alpha < -alpha_max))):  # fmt: skip
-            problem = monitor.state(total, vc, alpha, agl, wow, sw)
-        # events at this sample
-        if wow and not was_wow:
-            sink = -hdot
-            events["touchdown_times_s"].append(t)
-            events["touchdown_sinks_fps"].append(sink)
-            phase_events.add("touchdown")
-            problem = problem or monitor.touchdown(sink)
-        if not wow:
-            if was_wow:
-                airborne_since = t
-                lifted = False
-            if not lifted and agl - cg_h > 3.0 and t - airborne_since >= 0.5:
-                lifted = True
+        # what the last step produced (completes its row) and the state now: one pack, one compiled call
+        pack_step(fw, inputs_at, ax_get(), ay_get(), az_get(), nz_get(), flap_get(), rpm_get(), phi_get(),
+                  theta_get(), psi_get(), p_get(), q_get(), r_get(), alpha_get(), beta_get(), vc_get(), vg_get(),
+                  trk_get(), hdot_get(), h_get(), agl_get(), lat_get(), lon_get(), wow_get(), vt_get(), s0(), s1(),
+                  s2(), s3())  # fmt: skip
+        code = step(fw, rows)
+        if code:  # something for Python: in the order the loop did it
+            if code & (st.C_SAMPLE | st.C_BLOCK | st.C_NZ | st.C_PROGRESS):  # the last row is complete
+                j = int(fw[st.F_DONE_ROW])
+                if code & st.C_SAMPLE:
+                    _sample_hook(step_hook, rows, j)
+                if code & st.C_BLOCK:
+                    k_sent = _send_block(block_hook, rows, k_sent, j + 1)
+                if code & st.C_NZ:
+                    reason = f"t={j * dt:.2f} s: {monitor.load_factor(float(rows[j, _NZ]))}"
+                    break
+                if code & st.C_PROGRESS and time.monotonic() > next_report:
+                    next_report = time.monotonic() + report_every_s
+                    _progress(m.name, iphase, nphases, m.phases[iphase].name, j * dt, tty)
+            if code & st.C_FULL:
+                grown = np.empty((2 * rows.shape[0], rows.shape[1]))
+                grown[: rows.shape[0]] = rows
+                rows = grown
+                code = step(fw, rows)
+            k = int(fw[st.F_SAMPLE])
+            t = k * dt
+            if code & st.C_TOUCHDOWN:
+                events["touchdown_times_s"].append(t)
+                events["touchdown_sinks_fps"].append(-float(fw[st.I_HDOT]))
+            if code & st.C_LIFTOFF:
                 events["liftoff_times_s"].append(t)
-                phase_events.add("liftoff")
-        elif vg * FPS_TO_KT < 1.0:
-            phase_events.add("stopped")
-        if alpha * R2D >= alpha_stall_deg:
-            phase_events.add("stall")
-        was_wow = wow
-        if problem:
-            reason = f"t={t:.2f} s: {problem}"
-            break
-
-        # phase sequencing
-        if iphase >= 0:
-            d = psi - psi_prev
-            if d > pi:
-                d -= two_pi
-            elif d < -pi:
-                d += two_pi
-            turned += d
-            rolled += 0.5 * (p_prev + p) * dt
-            pitched += 0.5 * (q_prev + q) * dt
-        psi_prev = psi
-        p_prev, q_prev = p, q
-        advance = iphase < 0
-        if u is not None:
-            t_phase = (k - phase_k0) * dt
-            if end_s is not None:  # a phase that ends only after a duration (most): no call needed
-                advance = t_phase >= end_s
-            elif _end_reached(u, t_phase, abs(turned) * R2D, abs(rolled) * R2D, abs(pitched) * R2D, vc, h, agl,
-                              phi * R2D, theta * R2D, alpha * R2D, phase_events):  # fmt: skip
-                advance = True
-            elif u.duration_s is None and t_phase >= u.timeout_s:
+            if code & (st.C_STATE | st.C_HARD):
+                problem = None
+                if code & st.C_STATE:
+                    phi, theta, p, q, r, vc, h, agl, alpha = (float(fw[i]) for i in _TOTAL_SLOTS)
+                    total = phi + theta + p + q + r + vc + h + agl + alpha
+                    problem = monitor.state(total, vc, alpha, agl, bool(fw[st.I_WOW] > 0.5), float(fw[st.F_SW]))
+                if code & st.C_TOUCHDOWN:
+                    problem = problem or monitor.touchdown(-float(fw[st.I_HDOT]))
+                reason = f"t={t:.2f} s: {problem}"
+                break
+            if code & st.C_TIMEOUT:
                 reason = (
                     f"t={t:.2f} s: phase '{m.phases[iphase].name}' did not reach its end condition "
-                    f"within {u.timeout_s:g} s"
+                    f"within {u.timeout_s:g} s"  # type: ignore[union-attr]
                 )
                 break
-        final = False
-        if advance:
-            if iphase >= 0:
-                phases_out.append((m.phases[iphase].name, phase_k0 * dt, t))
-            iphase += 1
-            if iphase == nphases:
-                final = True
-            else:
-                phase = m.phases[iphase]
-                u = phase.until
-                end_s = _duration_only(u)
-                phase_k0 = k
-                turned = rolled = pitched = 0.0
-                phase_events = set()
-                pilot.begin_phase(phase.hold, theta, thr_w.get_double_value(), flap_get())
-                openloop.begin_phase(phase.inputs, phase.name)
-                flapc_w.set_double_value(pilot.flaps_cmd)
-                lbrk_w.set_double_value(pilot.brakes)
-                rbrk_w.set_double_value(pilot.brakes)
-                if progress:  # a line at each phase start (in place on a terminal)
-                    _progress(m.name, iphase, nphases, phase.name, t, tty)
-
-        if final:
-            ail, elev, rud, thr = pilot.aileron, pilot.elevator, pilot.rudder, pilot.throttle
-        else:
-            pilot_step(phi, theta, psi, p, q, r, beta, vc, vg, trk, hdot, h, agl, x_rw * 3.2808399,
-                       y_rw * 3.2808399, wow, nz_last, alpha, vt_get(), fy_last)  # fmt: skip
-            ail, elev, rud, thr = pilot.aileron, pilot.elevator, pilot.rudder, pilot.throttle
-            if openloop.active:  # the phase's open-loop inputs, on top of or instead of the pilot's commands
-                ail, elev, rud, thr = openloop.apply((k - phase_k0) * dt, ail, elev, rud, thr)
-            ail_set(ail)
-            elev_set(elev)
-            rud_set(rud)
-            steer_set(pilot.steer)
-            thr_set(thr)
-            if k % mix_every == 0:
-                mix_w.set_double_value(float(np.interp(h, mix_h_ft, mix_norm)))
+            if code & st.C_ADVANCE:
+                if iphase >= 0:
+                    phases_out.append((m.phases[iphase].name, phase_k0 * dt, t))
+                iphase += 1
+                if iphase == nphases:
+                    fw[st.F_FINAL] = 1.0
+                    fw[st.F_ROW_PHASE] = nphases - 1
+                else:
+                    phase = m.phases[iphase]
+                    u = phase.until
+                    phase_k0 = k
+                    _begin_phase(fw, u, iphase, k)
+                    pilot.begin_phase(phase.hold, float(fw[st.I_THETA]), thr_w.get_double_value(), flap_get())
+                    openloop.begin_phase(phase.inputs, phase.name)
+                    flapc_w.set_double_value(pilot.flaps_cmd)
+                    lbrk_w.set_double_value(pilot.brakes)
+                    rbrk_w.set_double_value(pilot.brakes)
+                    fw[st.F_BRAKES] = pilot.brakes
+                    fw[st.F_OPENLOOP] = openloop.active
+                    if progress:  # a line at each phase start (in place on a terminal)
+                        _progress(m.name, iphase, nphases, phase.name, t, tty)
+                fw[st.F_MODE] = st.MODE_RESUME
+                code = step(fw, rows)  # the pilot's step and the row
+                fw[st.F_MODE] = st.MODE_STEP
+                if iphase == nphases:  # the last sample: no command sent, one more step for its accelerations
+                    run()
+                    for get, out in zip(probe_gets, probe_rows, strict=True):
+                        out.append(get())
+                    pack_step(fw, inputs_at, ax_get(), ay_get(), az_get(), nz_get(), flap_get(), rpm_get(),
+                              *[0.0] * (st.NSLOTS - st.I_PHI))  # fmt: skip
+                    fw[st.F_MODE] = st.MODE_FINISH
+                    code = step(fw, rows)
+                    if code & st.C_SAMPLE:
+                        _sample_hook(step_hook, rows, int(fw[st.F_DONE_ROW]))
+                    if code & st.C_BLOCK:
+                        k_sent = _send_block(block_hook, rows, k_sent, int(fw[st.F_DONE_ROW]) + 1)
+                    break
+            if code & st.C_OPENLOOP:  # the phase's open-loop inputs, on top of or instead of the pilot's commands
+                ail, elev, rud, _, thr = unpack_commands(fw, commands_at)
+                commands = openloop.apply((k - phase_k0) * dt, ail, elev, rud, thr)
+                fw[st.F_AIL], fw[st.F_ELEV], fw[st.F_RUD], fw[st.F_THR] = commands
+                rows[k, _AIL : _AIL + 4] = commands
+            if code & st.C_MIX:
+                mix_w.set_double_value(float(np.interp(float(fw[st.I_H]), mix_h_ft, mix_norm)))
+        ail, elev, rud, steer, thr = unpack_commands(fw, commands_at)
+        ail_set(ail)
+        elev_set(elev)
+        rud_set(rud)
+        steer_set(steer)
+        thr_set(thr)
         run()
         if probe_gets:
             for get, out in zip(probe_gets, probe_rows, strict=True):
                 out.append(get())
-        ax, ay, az = ax_get(), ay_get(), az_get()
-        nz = nz_get()
-        nz_last = nz
-        fy_last = ay * FT_S2_TO_M_S2
-        # raw values in JSBSim's units; converted column by column after the loop (same bits, fewer operations)
-        rows_extend(pack(k, ax, ay, az, p, q, r, phi, theta, psi, alpha, beta, vc, vg, h, agl, hdot, north, east, lat,
-                     lon, x_rw, y_rw, nz, ail, elev, rud, thr, flap_get(), pilot.brakes, rpm_get(), wow,
-                     iphase if not final else nphases - 1))  # fmt: skip
-        if step_hook is not None:
-            step_hook(k, np.array((ax * FT_S2_TO_M_S2, fy_last, az * FT_S2_TO_M_S2)), np.array((p, q, r)))
-        if block_hook is not None and k + 1 - k_sent == block_size:
-            k_sent = _send_block(block_hook, rows, k_sent, ncol)
-        if final:
-            break
-        if not wow and (nz > nz_max or nz < nz_min):
-            reason = f"t={t:.2f} s: {monitor.load_factor(nz)}"
-            break
-        k += 1
-        if progress and k % 600 == 0 and time.monotonic() > next_report:
-            next_report = time.monotonic() + report_every_s
-            _progress(m.name, iphase, nphases, m.phases[iphase].name, t, tty)
 
-    if block_hook is not None and len(rows) // _ROW.size > k_sent:
-        _send_block(block_hook, rows, k_sent, ncol)
+    nrows = int(fw[st.F_NROWS])
+    if block_hook is not None and nrows > k_sent:
+        _send_block(block_hook, rows, k_sent, nrows)
     if reason and 0 <= iphase < nphases:  # the phase the flight stopped in, up to the last recorded sample
-        phases_out.append((m.phases[iphase].name, phase_k0 * dt, max(len(rows) // _ROW.size - 1, 0) * dt))
+        phases_out.append((m.phases[iphase].name, phase_k0 * dt, max(nrows - 1, 0) * dt))
     if tty:
         sys.stderr.write("\r\033[K")
         sys.stderr.flush()
 
-    columns = _columns(np.frombuffer(rows, dtype=np.float64).reshape(-1, ncol), dt)
+    columns = _columns(rows[:nrows], dt)
     results = evaluate(list(m.checks), columns, phases_out, events, dt) if not reason else []
     checks = [(c.name, c.measured, c.limit, c.passed) for c in results]
     for (phase_name, axis), steps in openloop.clipped.items():  # asked beyond the surface travel: not flown as asked
@@ -403,12 +349,58 @@ def fly(
     return FlightResult(m.name, m.aircraft, dt, columns, phases_out, checks, status, reason, events, probed)
 
 
-def _send_block(hook: BlockHook, rows: bytearray, k0: int, ncol: int) -> int:
-    """Give ``hook`` the recorded samples from ``k0`` on (f in m/s^2, omega in rad/s); return the new count."""
-    with memoryview(rows) as view:
-        raw = np.frombuffer(view[k0 * _ROW.size :], dtype=np.float64).reshape(-1, ncol).copy()
+def _send_block(hook: BlockHook, rows: np.ndarray, k0: int, n: int) -> int:
+    """Give ``hook`` the recorded samples ``k0 .. n - 1`` (f in m/s^2, omega in rad/s); return ``n``."""
+    raw = rows[k0:n].copy()
     hook(k0, raw[:, 1:4] * FT_S2_TO_M_S2, raw[:, 4:7])
-    return k0 + raw.shape[0]
+    return n
+
+
+def _sample_hook(hook: StepHook, rows: np.ndarray, k: int) -> None:
+    """Give ``hook`` sample ``k``: f in m/s^2 and omega in rad/s, body axes."""
+    ax, ay, az, p, q, r = rows[k, 1:7].tolist()
+    hook(k, np.array((ax * FT_S2_TO_M_S2, ay * FT_S2_TO_M_S2, az * FT_S2_TO_M_S2)), np.array((p, q, r)))
+
+
+def _zero() -> float:
+    """An unused contact point's slot."""
+    return 0.0
+
+
+def _summed(gets: list[Callable[[], float]]) -> Callable[[], float]:
+    """The contact points beyond the fourth, read as one sum (only its sign counts: any contact > 0 fails)."""
+
+    def read() -> float:
+        total = 0.0
+        for g in gets:
+            total += g()
+        return total
+
+    return read
+
+
+def _nan_if_none(x: float | None) -> float:
+    return math.nan if x is None else x
+
+
+def _begin_phase(fw: np.ndarray, u: Until, iphase: int, k: int) -> None:
+    """Set the slots of a phase starting at sample ``k``: its end conditions (NaN: not given, which no comparison
+    meets), a cleared event set and cleared integrals of the heading change and the body rates."""
+    fw[st.F_IPHASE] = fw[st.F_ROW_PHASE] = iphase
+    fw[st.F_PHASE_K0] = k
+    fw[st.U_DURATION] = u.duration_s - 1e-9 if u.duration_s is not None else math.nan
+    fw[st.U_EVENT] = st.EVENT_SLOTS[u.event] if u.event is not None else -1
+    for slot, value in ((st.U_TURNED, u.turned_deg), (st.U_ROLLED, u.rolled_deg), (st.U_PITCHED, u.pitched_deg),
+                        (st.U_VC_ABOVE, u.airspeed_above_kts), (st.U_VC_BELOW, u.airspeed_below_kts),
+                        (st.U_H_ABOVE, u.altitude_above_ft), (st.U_H_BELOW, u.altitude_below_ft),
+                        (st.U_AGL_ABOVE, u.agl_above_ft), (st.U_AGL_BELOW, u.agl_below_ft),
+                        (st.U_BANK_ABOVE, u.bank_above_deg), (st.U_PITCH_ABOVE, u.pitch_above_deg),
+                        (st.U_PITCH_BELOW, u.pitch_below_deg), (st.U_ALPHA_ABOVE, u.alpha_above_deg)):  # fmt: skip
+        fw[slot] = _nan_if_none(value)
+    fw[st.U_TIMEOUT] = u.timeout_s if u.duration_s is None else math.nan
+    fw[st.F_TURNED] = fw[st.F_ROLLED] = fw[st.F_PITCHED] = 0.0
+    for slot in st.EVENT_SLOTS.values():
+        fw[slot] = 0.0
 
 
 #: Factor from the raw value recorded per step to each flight.parquet column (None: taken as it is).

@@ -39,7 +39,8 @@ def configure_cache() -> None:
     """
     if os.environ.get("NUMBA_CACHE_DIR"):
         return
-    if all(_writable(_PACKAGE_DIR / sub) for sub in ("numerics", "cueing", "platform", "perception", "analysis")):
+    jitted = ("numerics", "flight", "cueing", "platform", "perception", "analysis")
+    if all(_writable(_PACKAGE_DIR / sub) for sub in jitted):
         return
     import platformdirs
 
