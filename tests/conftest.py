@@ -6,10 +6,21 @@ verdict as the run before it (a failure found by a random search is kept as an e
 The tests run in parallel (pytest-xdist, ``-n auto --dist loadfile`` in ``pyproject.toml``): one worker per CPU this
 process may use (the count ``washbench`` itself uses for ``--jobs``: affinity and cgroup quota), at most
 :data:`MAX_WORKERS`, each test file on one worker (its module fixtures set up once). ``-n 0`` runs them in this process.
+Before the workers' first test, ``tests/warm_kernels.py`` fills numba's cache once (started while the workers start
+and collect), so that after a fresh clone the workers do not each compile the same kernels.
 """
 
 from __future__ import annotations
 
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import pytest
 from hypothesis import settings
 
 from washbench.io.cpus import usable_cpus
@@ -19,8 +30,62 @@ settings.load_profile("washbench")
 
 #: Workers at most: many tests start suites of two processes of their own, and each worker holds JSBSim and numba.
 MAX_WORKERS = 4
+#: The folder of the kernels' warm-up (``tests/warm_kernels.py``), passed from the controller to its workers.
+WARM_ENV = "WASHBENCH_TESTS_WARM_FOLDER"
+WARM_WAIT_S = 600.0
 
 
-def pytest_xdist_auto_num_workers(config: object) -> int:
+def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
     """``-n auto``: the CPUs this process may use (not the machine's), at most :data:`MAX_WORKERS`."""
     return min(usable_cpus(), MAX_WORKERS)
+
+
+def pytest_sessionstart(session: pytest.Session) -> None:
+    """In the controller of parallel workers (before they start: xdist's own hook runs last), start the warm-up."""
+    config = session.config
+    if hasattr(config, "workerinput") or not getattr(config.option, "numprocesses", None):
+        return
+    folder = Path(tempfile.mkdtemp(prefix="wb-warm-"))
+    script = Path(__file__).with_name("warm_kernels.py")
+    proc = subprocess.Popen([sys.executable, str(script), str(folder)])
+    config.stash[_WARM] = (folder, proc)
+    os.environ[WARM_ENV] = f"{folder}{os.pathsep}{proc.pid}"  # the workers, started after this hook, inherit it
+
+
+def pytest_sessionfinish(session: pytest.Session) -> None:
+    warm = session.config.stash.get(_WARM, None)
+    if warm is not None:
+        folder, proc = warm
+        if proc.poll() is None:
+            proc.kill()
+        proc.wait()
+        shutil.rmtree(folder, ignore_errors=True)
+
+
+_WARM = pytest.StashKey[tuple[Path, subprocess.Popen]]()
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _kernels_warm(request: pytest.FixtureRequest) -> None:
+    """A worker's first test waits until the warm-up is done (it never fails a test: see warm_kernels.py)."""
+    warm = os.environ.get(WARM_ENV)
+    if warm is None or not hasattr(request.config, "workerinput"):
+        return
+    folder, pid = warm.rsplit(os.pathsep, 1)
+    deadline = time.monotonic() + WARM_WAIT_S
+    while not (Path(folder) / "done").exists() and _running(int(pid)) and time.monotonic() < deadline:
+        time.sleep(0.05)
+
+
+def _running(pid: int) -> bool:
+    """Whether process ``pid`` still runs (a zombie, ended but not yet waited for, counts as ended)."""
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except (OSError, IndexError):
+        try:
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            return False
+        except PermissionError:
+            return True
+        return True

@@ -1,0 +1,64 @@
+"""Compile washbench's numba kernels once, before parallel test workers need them (``tests/conftest.py``).
+
+    python tests/warm_kernels.py FOLDER
+
+After a fresh clone or an upgrade the numba cache is empty, and each pytest-xdist worker would compile the same
+kernels at the same time (about 20 s of CPU each). This script runs real commands side by side into ``FOLDER``
+(numba compiles one kernel at a time in a process, so separate processes share the work): ``washbench fly`` of a
+1 s flight (the flight step), the washout bank's lockstep and streaming steps, and a ``washbench cue`` of a 1 s
+input with every compiled washout (the whole-trace kernel, the adaptive washouts, perception, metrics, the sickness
+models); once the first two are done, a ``washbench run`` of the flight (what is left: the recording's thinning).
+Then it writes ``FOLDER/done`` with their exit statuses; the workers wait for that file before their first test.
+With the cache already filled, the commands load it (about 3 s in all). A failure here fails nothing: the tests
+that need a kernel compile it themselves and report what is wrong.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+MANOEUVRE = """\
+name: warm
+aircraft: c172p
+start:
+  air: {altitude_ft: 3000, airspeed_kts: 90, heading_deg: 360}
+phases:
+  - name: level
+    hold: {wings_level: true, altitude_ft: 3000, airspeed_kts: 90}
+    until: {duration_s: 1}
+"""
+COMPILED_WASHOUTS = ("small-angle", "large-angle", "unrestricted", "adaptive", "adaptive-large-angle",
+                     "adaptive-unrestricted")  # fmt: skip
+
+
+def main(folder: Path) -> int:
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "warm.yaml").write_text(MANOEUVRE)
+    rows = ["t_s,f_x_mps2,f_y_mps2,f_z_mps2,omega_x_degps,omega_y_degps,omega_z_degps"]
+    rows += [f"{k / 120!r},{0.5 if k > 30 else 0.0},0.0,-9.80665,{2.0 if k > 60 else 0.0},0.0,0.0" for k in range(120)]
+    (folder / "warm.csv").write_text("\n".join(rows) + "\n")
+    washbench = [sys.executable, "-m", "washbench"]
+    washouts = [a for w in COMPILED_WASHOUTS for a in ("--washout", w)]
+    block = "from washbench.cueing.bank import _warm_up, warm_up_block; warm_up_block(); _warm_up()"
+    first = [  # side by side: the kernels compile in separate processes (numba compiles one at a time per process)
+        [*washbench, "fly", str(folder / "warm.yaml"), "--out", str(folder / "fly"), "--quiet"],  # the flight step
+        [sys.executable, "-c", block],  # the lockstep and streaming washout steps
+        [*washbench, "cue", str(folder / "warm.csv"), "--out", str(folder / "cue"), "--no-figures", "--no-recording",
+         *washouts],  # the whole-trace washouts, perception, metrics, sickness
+    ]  # fmt: skip
+    then = [*washbench, "run", str(folder / "warm.yaml"), "--out", str(folder / "run"), "--no-figures", "--quiet"]
+    statuses: list[int | None] = []
+    try:
+        procs = [subprocess.Popen(c, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL) for c in first]
+        statuses = [p.wait() for p in procs[:2]]  # what is left for a run (the recording's thinning): from the cache
+        statuses.append(subprocess.run(then, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL).returncode)
+        statuses.append(procs[2].wait())
+    finally:
+        (folder / "done").write_text(" ".join(map(str, statuses)) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main(Path(sys.argv[1])))
