@@ -57,8 +57,10 @@ DOFS = ("surge", "sway", "heave", "roll", "pitch", "yaw")
 
 
 def _as_pair(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    x = np.asarray(x, dtype=np.float64)
-    y = np.asarray(y, dtype=np.float64)
+    # contiguous and writable, the one array type the compiled sums are compiled for (a column of a table would
+    # otherwise compile them again for strided arrays after an install); the values are the same
+    x = np.require(x, np.float64, ("C", "W"))
+    y = np.require(y, np.float64, ("C", "W"))
     if x.ndim != 1 or x.shape != y.shape or x.size < 2:
         raise ValueError(f"expected two 1-D signals of equal length >= 2, got shapes {x.shape} and {y.shape}")
     return x, y

@@ -259,7 +259,9 @@ class DiscreteModel:
         if u.ndim not in (1, 2) or u.shape[0] == 0:
             raise ValueError(f"expected a non-empty (N,) or (N, m) array, got shape {u.shape}")
         b, phi, steady = self.arrays()
-        u2 = u if u.ndim == 2 else u.reshape(-1, 1)
+        # C order and writable, the one array type the compiled passes are compiled for (column-major, strided and
+        # read-only inputs would each compile them again after an install); the values are the same
+        u2 = np.require(u if u.ndim == 2 else u.reshape(-1, 1), np.float64, ("C", "W"))
         if start is None:
             y = sections_apply(b, phi, steady, u2)
         else:
