@@ -19,23 +19,15 @@ import subprocess
 import sys
 from pathlib import Path
 
-MANOEUVRE = """\
-name: warm
-aircraft: c172p
-start:
-  air: {altitude_ft: 3000, airspeed_kts: 90, heading_deg: 360}
-phases:
-  - name: level
-    hold: {wings_level: true, altitude_ft: 3000, airspeed_kts: 90}
-    until: {duration_s: 1}
-"""
+from hostile import short  # this script's folder, tests/, is first on sys.path
+
 COMPILED_WASHOUTS = ("small-angle", "large-angle", "unrestricted", "adaptive", "adaptive-large-angle",
                      "adaptive-unrestricted")  # fmt: skip
 
 
 def main(folder: Path) -> int:
     folder.mkdir(parents=True, exist_ok=True)
-    (folder / "warm.yaml").write_text(MANOEUVRE)
+    short(folder, name="warm", seconds=1)  # warm.yaml, the tests' short level flight
     rows = ["t_s,f_x_mps2,f_y_mps2,f_z_mps2,omega_x_degps,omega_y_degps,omega_z_degps"]
     rows += [f"{k / 120!r},{0.5 if k > 30 else 0.0},0.0,-9.80665,{2.0 if k > 60 else 0.0},0.0,0.0" for k in range(120)]
     (folder / "warm.csv").write_text("\n".join(rows) + "\n")
