@@ -853,18 +853,18 @@ def test_report_on_tampered_result_files_rebuilds_or_refuses_cleanly(cued: Path,
         elif target == "provenance":
             d = json.loads((folder / "run.json").read_text())
             prov = d["provenance"]
-            sub = sorted(prov)[hash(key) % len(prov)]
+            sub = sorted(prov)[keys.index(key) % len(prov)]
             prov[sub] = value
             (folder / "run.json").write_text(json.dumps(d))
         elif target == "flight.json":
             (folder / "flight.json").write_text(json.dumps({"phases": value, "checks": [value], "dt_s": value}))
         elif target == "metrics.csv":
             lines = (folder / "metrics.csv").read_text().splitlines()
-            lines[1 + hash(key) % (len(lines) - 1)] = ",".join([str(value)] * (3 if drop else 6))
+            lines[1 + keys.index(key) % (len(lines) - 1)] = ",".join([str(value)] * (3 if drop else 6))
             (folder / "metrics.csv").write_text("\n".join(lines) + "\n")
         else:
             table = pq.read_table(folder / "traces.parquet")
-            name = table.column_names[hash(key) % table.num_columns]
+            name = table.column_names[keys.index(key) % table.num_columns]
             col = pa.array([str(value)] * table.num_rows) if drop else pa.array(np.full(table.num_rows, np.nan))
             pq.write_table(table.set_column(table.column_names.index(name), name, col), folder / "traces.parquet")
         try:

@@ -18,6 +18,7 @@ A plugin's kind is its ``washout_name`` attribute if it has one, else ``NAME``. 
 from __future__ import annotations
 
 import functools
+import hashlib
 import importlib
 import importlib.metadata
 import importlib.util
@@ -118,7 +119,8 @@ def load_plugin(spec: str) -> Algorithm:
     for kind, loaded in _PLUGIN_SPECS.items():
         if loaded == text:
             return _LOADED[kind]
-    module_name = f"washbench_plugin_{abs(hash(str(path.resolve())))}"
+    # the same name in every process (str hashes are salted per process): a worker loads the module the parent did
+    module_name = f"washbench_plugin_{hashlib.sha256(str(path.resolve()).encode()).hexdigest()[:16]}"
     try:
         mod_spec = importlib.util.spec_from_file_location(module_name, path)
         if mod_spec is None or mod_spec.loader is None:
