@@ -43,8 +43,9 @@ class StrictModel(BaseModel):
     """
 
     model_config = ConfigDict(
-        extra="forbid", strict=True, frozen=True, allow_inf_nan=False, use_attribute_docstrings=True
-    )
+        extra="forbid", strict=True, frozen=True, allow_inf_nan=False, defer_build=True
+    )  # built at a model's first use, so a command builds only what it reads; the attribute docstrings are read by
+    # ``washbench schema`` alone (washbench.flight.json_schema)
 
     def model_copy(self, *, update: Mapping[str, Any] | None = None, deep: bool = False) -> Self:
         """A copy; with ``update``, a new validated instance (raises ``pydantic.ValidationError``)."""
