@@ -97,6 +97,18 @@ def _needs_compile(dispatcher: object) -> tuple[bool, str | None]:
     return False, None
 
 
+def _cache_place(folder: str | None) -> str:
+    """Where the kernels' cache files go, for the announcement: ``NUMBA_CACHE_DIR`` when set; numba's default, the
+    ``__pycache__`` folder next to each source, named as the package folder's; else the folder itself."""
+    if folder is None:
+        return "memory only"
+    if os.environ.get("NUMBA_CACHE_DIR"):
+        return os.environ["NUMBA_CACHE_DIR"]
+    if Path(folder).is_relative_to(_PACKAGE_DIR):
+        return f"the __pycache__ folders under {_PACKAGE_DIR}"
+    return folder
+
+
 def announce_compile(*dispatchers: object) -> None:
     """Print one line to stderr, once per process, if any of these jitted functions is about to be compiled.
 
@@ -113,7 +125,7 @@ def announce_compile(*dispatchers: object) -> None:
             _announced = True
             print(
                 "washbench: compiling the numerical kernels for this machine (first use after an install or upgrade, "
-                f"10-30 s; kept in {folder or 'memory only'} for later commands)",
+                f"10-30 s; kept in {_cache_place(folder)} for later commands)",
                 file=sys.stderr,
                 flush=True,
             )
