@@ -80,7 +80,13 @@ def _copy(folder: Path, dest: Path) -> Path:
 
 
 def _staged(out: Path) -> int:
-    return sum(1 for s in out.glob(STAGE_PREFIX + "*") for p in s.rglob("*") if p.is_file())
+    """Files in the command's staging folders now; a folder swapped in or removed while they are counted (the set
+    just published) counts what was seen of it."""
+    count = 0
+    for stage in out.glob(STAGE_PREFIX + "*"):
+        for folder, _, names in os.walk(stage):  # os.walk skips a folder gone meanwhile (rglob raised)
+            count += sum(1 for name in names if os.path.isfile(os.path.join(folder, name)))
+    return count
 
 
 @pytest.mark.parametrize("command", ["sweep", "tune", "omct"])
