@@ -79,9 +79,10 @@ def in_thread(fn: Callable[[], None]) -> threading.Thread:
 
 
 def live(tmp_path: Path, fmt: str, port: int, name: str = "live", **kw: object) -> tuple[int, Path]:
+    outputs = Outputs(recording=bool(kw.pop("recording", False)), figures=False)
     opts = LiveOptions(listen=("127.0.0.1", port), fmt=fmt, out=tmp_path / name, idle_timeout_s=0.6, viewer=False,
-                       recording=kw.pop("recording", False), figures=False, **kw)  # type: ignore[arg-type]  # fmt: skip
-    return run_live(opts, washouts=None), tmp_path / name
+                       **kw)  # type: ignore[arg-type]  # fmt: skip
+    return run_live(opts, load_options(outputs=outputs)), tmp_path / name
 
 
 def assert_equals_cue(out: Path, tmp_path: Path, folders: tuple[str, ...] = ("",)) -> None:
@@ -449,11 +450,17 @@ def test_send_command_to_the_live_command(tmp_path: Path) -> None:
     th = in_thread(go)
     out = tmp_path / "live"
     status = main(["live", "--listen", f"127.0.0.1:{port}", "--format", "flightgear", "--out", str(out),
-                   "--idle-timeout", "0.6", "--no-viewer", "--no-recording", "--no-figures"])  # fmt: skip
+                   "--idle-timeout", "0.6", "--no-viewer", "--no-recording", "--no-figures", "--washout", "large-angle",
+                   "--vestibular", "telban-cardullo", "--rank-by", "false-cue", "--filter-start", "rest"])  # fmt: skip
     th.join(10)
     assert status == 0
     doc = run_json(out)
     assert doc["live"]["counts"]["cued"] == 240
+    # the run's options as washbench cue takes them, in the final cue's result
+    prov = doc["provenance"]
+    assert prov["vestibular"]["model"] == "telban-cardullo" and prov["ranking"]["by"] == "false-cue"
+    assert doc["filter_start"] == "rest" and list(doc["saturations"]) == ["large-angle"]
+    assert not (out / "recording.rrd").exists() and not (out / "figures").exists()
     wall = doc["live"]["wall_s"]
     assert wall > 240 * DT / 4.0  # paced: 2 s of flight at 4 x real time take at least 0.5 s
     np.testing.assert_allclose(saved(out), np.array(m), rtol=1e-15, atol=1e-14)
@@ -663,8 +670,8 @@ def test_a_viewer_closed_while_running(tmp_path: Path, monkeypatch: pytest.Monke
 
     th = in_thread(go)
     opts = LiveOptions(listen=("127.0.0.1", port), fmt="washbench", out=tmp_path / "o", idle_timeout_s=0.6,
-                       viewer=True, recording=False, figures=False, rate_hz=120.0)  # fmt: skip
-    status = run_live(opts)
+                       viewer=True, rate_hz=120.0)  # fmt: skip
+    status = run_live(opts, load_options(outputs=Outputs(recording=False, figures=False)))
     th.join(10)
     assert status == 0 and made and made[0].closed
     assert capsys.readouterr().err.count("the viewer was closed") == 1

@@ -57,7 +57,7 @@ def _washout_options(p: argparse.ArgumentParser, variants: bool = True) -> None:
 
 
 def _rank_option(p: argparse.ArgumentParser) -> None:
-    """--rank-by and --vestibular (cue, run, suite), recorded in the provenance (docs/fidelity.md)."""
+    """--rank-by and --vestibular (cue, live, run, suite), recorded in the provenance (docs/fidelity.md)."""
     p.add_argument("--rank-by", choices=("score", "false-cue", "weighted"),
                    help="ranking rule (default: the parameter file's ranking: section, else score); weighted uses "
                    "its ranking.dof_weights")  # fmt: skip
@@ -297,6 +297,7 @@ def _live_parsers(sub: Any) -> None:
     _washout_options(p)
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
     p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
+    _rank_option(p)
     _output_options(p)
 
     p = sub.add_parser("send", help="send a recorded file or a JSBSim flight over UDP as a flight simulator would")
@@ -326,10 +327,9 @@ def _live(args: argparse.Namespace) -> int:
         sink=parse_address(args.sink, "--sink") if args.sink else None, sink_format=args.sink_format,
         duration_s=args.duration, idle_timeout_s=args.idle_timeout, rate_hz=args.rate_hz, resample_hz=args.resample,
         xplane=parse_address(args.xplane, "--xplane"), rref_hz=args.rref_hz, viewer=not args.no_viewer,
-        recording=not args.no_recording, figures=not args.no_figures, filter_start=args.filter_start,
         realtime=args.realtime,
     )  # fmt: skip
-    return run_live(opts, args.washout, args.params, args.platform, args.variant)
+    return run_live(opts, _run_options(args))
 
 
 def _send(args: argparse.Namespace) -> int:
@@ -379,19 +379,20 @@ def _outputs(args: argparse.Namespace) -> Any:
 
 
 def _run_options(args: argparse.Namespace) -> Any:
-    """The options of ``run`` and ``suite`` (:func:`washbench.runs.options.load_options`: each file read once)."""
+    """The options of ``run``, ``suite``, ``cue`` and ``live`` (:func:`washbench.runs.options.load_options`: each
+    file read once); what a command has no flag for is the default."""
     from washbench.runs.options import load_options  # deferred: numpy
 
     return load_options(params_path=args.params, platform_path=args.platform, washouts=args.washout,
-                        variants=args.variant, aircraft_dirs=args.aircraft_dir, outputs=_outputs(args),
-                        filter_start=getattr(args, "filter_start", "steady"), max_time_s=args.max_time_s,
-                        rank_by=args.rank_by, vestibular=args.vestibular)  # fmt: skip
+                        variants=args.variant, aircraft_dirs=getattr(args, "aircraft_dir", ()), outputs=_outputs(args),
+                        filter_start=getattr(args, "filter_start", "steady"),
+                        max_time_s=getattr(args, "max_time_s", None), rank_by=args.rank_by,
+                        vestibular=args.vestibular)  # fmt: skip
 
 
 def _cue(args: argparse.Namespace) -> int:
     from washbench.io.input_format import input_format  # deferred: numpy
     from washbench.runs.cue import CueOptions, run_cue  # deferred: pyarrow
-    from washbench.runs.options import load_options  # deferred: numpy
 
     opts = CueOptions(
         fmt=input_format(args.columns, args.input_format, args.axes, args.delimiter, args.decimal, args.jsbsim_dt),
@@ -404,10 +405,7 @@ def _cue(args: argparse.Namespace) -> int:
         progress=not args.quiet,
         force=args.force,
     )
-    run = load_options(params_path=args.params, platform_path=args.platform, washouts=args.washout,
-                       variants=args.variant, outputs=_outputs(args), filter_start=args.filter_start,
-                       rank_by=args.rank_by, vestibular=args.vestibular)  # fmt: skip
-    return run_cue(args.input, args.out, opts, run)
+    return run_cue(args.input, args.out, opts, _run_options(args))
 
 
 def _aircraft_dir_option(p: argparse.ArgumentParser) -> None:

@@ -47,8 +47,7 @@ from washbench.live.link import LatencyStats, Link, Out
 from washbench.live.packets import RREF_DATAREFS, RREF_ID0, Decoder, PacketError, decoder, rref_request
 from washbench.live.saved_input import INPUT_FILE, InputWriter
 from washbench.runs.cue import CueOptions, run_cue
-from washbench.runs.options import load_options
-from washbench.runs.outputs import Outputs
+from washbench.runs.options import RunOptions, load_options
 
 POLL_S = 0.05
 """The loop wakes up at least this often to check the stop conditions."""
@@ -56,7 +55,8 @@ POLL_S = 0.05
 
 @dataclass(frozen=True)
 class LiveOptions:
-    """Everything ``washbench live`` is told besides the washouts, parameter and platform files."""
+    """Everything ``washbench live`` is told besides what a run is told (:class:`~washbench.runs.options.RunOptions`:
+    the washouts, the parameter and platform files, the outputs, the filters' start, the ranking)."""
 
     listen: tuple[str, int]
     fmt: str
@@ -70,9 +70,6 @@ class LiveOptions:
     xplane: tuple[str, int] = ("127.0.0.1", 49000)
     rref_hz: int = 60
     viewer: bool = True
-    recording: bool = True
-    figures: bool = True
-    filter_start: str = "steady"
     realtime: bool = False
 
 
@@ -99,9 +96,9 @@ def stop_on_signals() -> Iterator[list[int]]:
 class Session:
     """One live session: the socket, the link, the saved input, the bank, the sink and the figures."""
 
-    def __init__(self, opts: LiveOptions, dec: Decoder, specs: Sequence[Any], limits: Any, sock: socket.socket,
-                 writer: InputWriter, sink: Sink, viewer: Any) -> None:  # fmt: skip
-        self.opts, self.dec, self.specs, self.limits = opts, dec, specs, limits
+    def __init__(self, opts: LiveOptions, dec: Decoder, specs: Sequence[Any], limits: Any, filter_start: str,
+                 sock: socket.socket, writer: InputWriter, sink: Sink, viewer: Any) -> None:  # fmt: skip
+        self.opts, self.dec, self.specs, self.limits, self.filter_start = opts, dec, specs, limits, filter_start
         self.sock, self.writer, self.sink, self.viewer = sock, writer, sink, viewer
         dt = 1.0 / opts.rate_hz if opts.rate_hz else None
         self.link = Link(dt, dec.lag_shift)
@@ -125,7 +122,7 @@ class Session:
         """Save, cue and command one sample."""
         s = o.sample
         if o.new_segment or self.bank is None:
-            self.bank = CueingBank(self.specs, None, self.limits, self.link.dt_s, self.opts.filter_start)
+            self.bank = CueingBank(self.specs, None, self.limits, self.link.dt_s, self.filter_start)
         f, w = self._f, self._w
         f[0], f[1], f[2] = s[1], s[2], s[3]
         w[0], w[1], w[2] = s[4], s[5], s[6]
@@ -327,28 +324,24 @@ def _add_live_figures(out: Path, input_path: Path, fig: dict[str, Any]) -> None:
         write_text_atomic(path, json.dumps(doc, indent=2) + "\n")
 
 
-def run_live(
-    opts: LiveOptions,
-    washouts: Sequence[str] | None = None,
-    params_path: Path | None = None,
-    platform_path: Path | None = None,
-    variants: Sequence[str] = (),
-) -> int:
+def run_live(opts: LiveOptions, run: RunOptions | None = None) -> int:
     """The ``washbench live`` command; returns the exit status (that of ``washbench cue`` on the saved input, or
-    130 / 143 after a Ctrl-C / SIGTERM once the result folder is written)."""
+    130 / 143 after a Ctrl-C / SIGTERM once the result folder is written).
+
+    ``run``: the options of the final cue (:func:`~washbench.runs.options.load_options`, each file read once), used
+    live as well; None: the defaults (the bundled files and washouts, recording and figures).
+    """
     for flag, value in (("--duration", opts.duration_s), ("--idle-timeout", opts.idle_timeout_s),
                         ("--rate-hz", opts.rate_hz), ("--resample", opts.resample_hz)):  # fmt: skip
         if value is not None and not (math.isfinite(value) and value > 0.0):
             raise WashbenchError(f"{flag}: expected a positive number, got {value:g}")
     if not 0 < opts.rref_hz <= 10000:
         raise WashbenchError(f"--rref-hz: expected 1..10000 Hz, got {opts.rref_hz}")
-    # the options of the final cue, loaded once (each file read once) and used live as well
-    run = load_options(params_path=params_path, platform_path=platform_path, washouts=washouts, variants=variants,
-                       outputs=Outputs(recording=opts.recording, figures=opts.figures),
-                       filter_start=opts.filter_start)  # fmt: skip
-    specs, limits, names = run.washouts, run.limits, list(run.washout_order)
+    if run is None:
+        run = load_options()
+    specs, limits, names, filter_start = run.washouts, run.limits, list(run.washout_order), run.filter_start
     dec = decoder(opts.fmt)
-    CueingBank(specs, None, limits, 0.01, opts.filter_start).step(np.zeros(3), np.zeros(3))  # compiled before listening
+    CueingBank(specs, None, limits, 0.01, filter_start).step(np.zeros(3), np.zeros(3))  # compiled before listening
     sink = Sink(opts.sink, opts.sink_format, names)
     t_wall = time.perf_counter()
     # a Ctrl-C or SIGTERM from the moment the port is bound only stops the loop: the result is written first
@@ -356,7 +349,7 @@ def run_live(
             output_lock(opts.out) as out:  # fmt: skip
         owned_entries(out, "cue", (INPUT_FILE,))  # a folder holding someone else's files is refused before listening
         writer = InputWriter(out / INPUT_FILE)
-        viewer = live_viewer.open_viewer(names, limits, opts.filter_start) if opts.viewer else None
+        viewer = live_viewer.open_viewer(names, limits, filter_start) if opts.viewer else None
         to = f"udp://{opts.sink[0]}:{opts.sink[1]} ({opts.sink_format})" if opts.sink else "nowhere (no --sink)"
         print(f"live: listening on udp://{opts.listen[0]}:{opts.listen[1]} for {opts.fmt} packets; washouts "
               f"{', '.join(names)}; commands to {to}")  # fmt: skip
@@ -365,7 +358,7 @@ def run_live(
         for note in dec.notes:
             print(f"  {note}")
         sys.stdout.flush()
-        session = Session(opts, dec, specs, limits, sock, writer, sink, viewer)
+        session = Session(opts, dec, specs, limits, filter_start, sock, writer, sink, viewer)
         gc.collect()
         gc.freeze()  # what exists now is never scanned again: shorter collector pauses in the loop
         before = realtime_priority() if opts.realtime else None
