@@ -4,7 +4,7 @@ Hypothesis runs derandomized: each property test draws the same examples in ever
 verdict as the run before it (a failure found by a random search is kept as an explicit ``@example``).
 
 The tests run in parallel (pytest-xdist, ``-n auto --dist loadfile`` in ``pyproject.toml``): one worker per CPU this
-process may use (the count ``washbench`` itself uses for ``--jobs``: affinity and cgroup quota), at most
+process may use (the count ``washbench`` itself uses for ``--jobs``: affinity and cgroup quota) and one more, at most
 :data:`MAX_WORKERS`, each test file on one worker (its module fixtures set up once). ``-n 0`` runs them in this process.
 Before the workers' first test, ``tests/warm_kernels.py`` fills numba's cache once (started while the workers start
 and collect), so that after a fresh clone the workers do not each compile the same kernels.
@@ -30,14 +30,19 @@ settings.load_profile("washbench")
 
 #: Workers at most: many tests start suites of two processes of their own, and each worker holds JSBSim and numba.
 MAX_WORKERS = 4
+#: Workers beyond the CPUs: the tests spend about an eighth of their time waiting (for a signal to land, a process to
+#: start or a viewer to close), and one more worker fills it. On 2 CPUs, with the kernels cached: 2 workers took
+#: 222-233 s, 3 workers 210-217 s, 4 workers 231 s (more CPU lost to switching than waiting saved).
+EXTRA_WORKERS = 1
 #: The folder of the kernels' warm-up (``tests/warm_kernels.py``), passed from the controller to its workers.
 WARM_ENV = "WASHBENCH_TESTS_WARM_FOLDER"
 WARM_WAIT_S = 600.0
 
 
 def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
-    """``-n auto``: the CPUs this process may use (not the machine's), at most :data:`MAX_WORKERS`."""
-    return min(usable_cpus(), MAX_WORKERS)
+    """``-n auto``: the CPUs this process may use (not the machine's) and :data:`EXTRA_WORKERS`, at most
+    :data:`MAX_WORKERS`."""
+    return min(usable_cpus() + EXTRA_WORKERS, MAX_WORKERS)
 
 
 def pytest_sessionstart(session: pytest.Session) -> None:
