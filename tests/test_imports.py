@@ -22,6 +22,7 @@ Ctrl-C or SIGTERM arriving during it is handled (``washbench.__main__``).
 from __future__ import annotations
 
 import ast
+import functools
 import re
 import sys
 from collections import defaultdict
@@ -277,30 +278,36 @@ def deferral_problems(known: dict[str, Path]) -> list[str]:
     return problems
 
 
-KNOWN = modules()
-EDGES = import_edges(KNOWN)
+@functools.cache
+def graph() -> tuple[dict[str, Path], dict[str, set[str]]]:
+    """The package's modules and their import edges, read when a test first needs them (1 s: not while every test
+    worker collects)."""
+    known = modules()
+    return known, import_edges(known)
 
 
 def test_the_graph_is_read() -> None:
     """The parser sees the package: many modules, many edges, imports inside functions included."""
+    KNOWN, EDGES = graph()
     assert len(KNOWN) > 80 and sum(len(b) for b in EDGES.values()) > 200
     assert "washbench.runs.pipeline" in EDGES["washbench.cli"]  # imported inside _dispatch
     assert "washbench.numerics.rotations" in EDGES["washbench.platform.kinematics"]
 
 
 def test_every_wing_has_a_floor() -> None:
+    KNOWN, _ = graph()
     missing = sorted({wing(m) for m in KNOWN} - set(FLOORS))
     assert missing == [], f"give these a floor in FLOORS (and docs/architecture.md): {missing}"
 
 
 def test_no_new_import_cycle() -> None:
-    found = cycle_edges(EDGES)
+    found = cycle_edges(graph()[1])
     assert sorted(found - KNOWN_CYCLE_EDGES) == [], "new import cycle"
     assert sorted(KNOWN_CYCLE_EDGES - found) == [], "cycle gone: take these edges off KNOWN_CYCLE_EDGES"
 
 
 def test_no_new_import_up_the_floors() -> None:
-    found = upward_edges(EDGES)
+    found = upward_edges(graph()[1])
     assert sorted(found - KNOWN_UPWARD_EDGES) == [], "import up the floors (docs/architecture.md)"
     assert sorted(KNOWN_UPWARD_EDGES - found) == [], "gone: take these edges off KNOWN_UPWARD_EDGES"
 
@@ -322,6 +329,7 @@ def test_the_checks_catch_a_cycle_and_an_upward_import() -> None:
 
 def test_imports_in_functions_are_deferred_for_a_heavy_dependency() -> None:
     """A washbench import inside a function is marked ``# deferred: <dependency>``, and the mark is true."""
+    KNOWN, _ = graph()
     assert len(deferred_imports(KNOWN)) > 20  # the parser sees them (the CLI's commands, the compiled kernels)
     assert deferral_problems(KNOWN) == []
 
@@ -347,6 +355,7 @@ def test_the_deferral_check_catches_an_unmarked_or_false_deferral(tmp_path: Path
 
 
 if __name__ == "__main__":
+    KNOWN, EDGES = graph()
     wings: dict[str, set[str]] = defaultdict(set)
     for a, bs in EDGES.items():
         for b in bs:
