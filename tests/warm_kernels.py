@@ -6,9 +6,14 @@ After a fresh clone or an upgrade the numba cache is empty, and each pytest-xdis
 kernels at the same time (about 20 s of CPU each). This script runs real commands side by side into ``FOLDER``
 (numba compiles one kernel at a time in a process, so separate processes share the work): ``washbench fly`` of a
 1 s flight (the flight step), the washout bank's lockstep and streaming steps, and a ``washbench cue`` of a 1 s
-input with every compiled washout (the whole-trace kernel, the adaptive washouts, perception, metrics, the sickness
-models); once the first two are done, a ``washbench run`` of the flight (what is left: the recording's thinning).
-Then it writes ``FOLDER/done`` with their exit statuses; the workers wait for that file before their first test.
+input with every compiled washout (streamed: the adaptive washouts, perception, metrics, the sickness models); once
+the first two are done, a ``washbench run`` of the flight (what is left: the recording's thinning). Then it writes
+``FOLDER/done`` with their exit statuses; the workers wait for that file before their first test.
+
+What is left for the tests to compile (about 15 s of CPU: the whole-trace kernel ``bank_trace`` and the set-point
+path through ``cue_trace``, a study's ``evaluate_batch``) is left to them: compiling it here as well (a ``cue_trace``
+beside the first three, a ``sweep`` beside the ``run``) made a cold test run slower, 220 s against 202 s, since
+the workers wait for the warm-up.
 With the cache already filled, the commands load it (about 3 s in all). A failure here fails nothing: the tests
 that need a kernel compile it themselves and report what is wrong.
 
@@ -48,7 +53,7 @@ def main(folder: Path) -> int:
         [*washbench, "fly", str(folder / "warm.yaml"), "--out", str(folder / "fly"), "--quiet"],  # the flight step
         [sys.executable, "-c", block],  # the lockstep and streaming washout steps
         [*washbench, "cue", str(folder / "warm.csv"), "--out", str(folder / "cue"), "--no-figures", "--no-recording",
-         *washouts],  # the whole-trace washouts, perception, metrics, sickness
+         *washouts],  # the streamed washouts, perception, metrics, sickness
     ]  # fmt: skip
     then = [*washbench, "run", str(folder / "warm.yaml"), "--out", str(folder / "run"), "--no-figures", "--quiet"]
     statuses: list[int | None] = []
