@@ -26,13 +26,14 @@ from washbench.analysis.metric_sums import signal_metrics  # noqa: E402
 from washbench.cueing.bank import _warm_up, warm_up_block  # noqa: E402
 from washbench.cueing.kernel import bank_block, bank_step  # noqa: E402
 from washbench.numerics.jitcache import announce_compile  # noqa: E402
-from washbench.perception.sections import sections_apply, sections_apply_from, sections_run  # noqa: E402
+from washbench.perception.sections import sections_apply  # noqa: E402
 from washbench.review.thinning import _changes, _keep  # noqa: E402
 
-# One line for the whole suite when a kernel its workers run is not compiled yet (after an install or upgrade):
-# the workers fork from here and inherit that it was said.
-announce_compile(bank_block, bank_step, sections_apply, sections_apply_from, sections_run, signal_metrics, _keep,
-                 _changes)  # fmt: skip
+# One line for the whole suite when a kernel every run takes is not compiled yet (after an install or upgrade):
+# the workers fork from here and inherit that it was said. Only those: a kernel a suite may never run (the
+# streamed perception of a cue, the perception from a later start) would never be compiled, so it would be
+# announced at every suite; a worker that needs one announces it where it is used.
+announce_compile(bank_block, bank_step, sections_apply, signal_metrics, _keep, _changes)
 
 # Only the serial steps are run here: a parallel (prange) kernel would start numba's OpenMP threads, and a process
 # using GNU OpenMP must not fork. The block step is the lockstep's; the per-sample step, JSBSim scripts'.
