@@ -64,6 +64,39 @@ def test_a_reused_layout_changes_its_legend_with_the_washouts(tmp_path: Path) ->
     assert first == again and other == fresh and other != first
 
 
+def test_a_reused_envelope_layout_refitted_to_other_lanes_draws_a_fresh_ones_pixels(tmp_path: Path) -> None:
+    """The envelope figure's height and left margin follow its limit lanes; a worker's layout is refitted to them.
+    Each figure, drawn after one with other lanes (more, fewer, none, longer labels), has the bytes of the same
+    figure drawn on a fresh layout."""
+    from washbench.review import figures
+
+    n = 4000
+    t = np.arange(n) / 120.0
+    base = np.abs(traces(n, 3)["aircraft"])
+    panels = ["position", "velocity", "acceleration", "sphere rate", "sphere ang. acc.", "wheel speed"]
+    usage = {label: {w: base[:, i] * (1 + 0.2 * j) for j, w in enumerate(NAMES[:3])} for i, label in enumerate(panels)}
+    pulse = np.arange(n) % 700 < 40
+    lanes = [
+        {},  # "no limit reached"
+        {w: {"acc": pulse, "angacc": ~pulse, "tilt_rate": pulse} for w in NAMES[:3]},
+        {NAMES[0]: {"pos": pulse, "tilt_rate": ~pulse}, NAMES[2]: {"angacc": pulse, "rot_rate": pulse}},
+        {NAMES[1]: {"acc": pulse}},
+    ]
+
+    def envelope(saturated: dict[str, dict[str, np.ndarray]], name: str) -> bytes:
+        (png,) = envelope_figure(tmp_path / name, "test", t, usage, saturated, phases=[("all", 0.0, t[-1])])
+        return png.read_bytes()
+
+    fresh = []
+    for i, saturated in enumerate(lanes):
+        figures._LAYOUT_CACHE.clear()
+        fresh.append(envelope(saturated, f"fresh{i}"))
+    assert len(set(fresh)) == len(lanes)
+    figures._LAYOUT_CACHE.clear()
+    for i in [0, 1, 0, 2, 3, 1, 3, 0, 2, 0]:
+        assert envelope(lanes[i], f"reused{i}") == fresh[i], i
+
+
 def test_figure_writers_pause_the_garbage_collector_and_restore_it() -> None:
     """collector_paused: off while the writer runs, then as it was (on or off), also when the writer fails."""
     import gc

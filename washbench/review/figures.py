@@ -121,10 +121,8 @@ def _new_figure(
     if margins_in is None:
         fig = Figure(figsize=(width_in, height_in), layout="constrained")
     else:
-        left, right, top, bottom = margins_in
         fig = Figure(figsize=(width_in, height_in))
-        fig.subplots_adjust(left=left / width_in, right=1.0 - right / width_in, top=1.0 - top / height_in,
-                            bottom=bottom / height_in, hspace=0.16)  # fmt: skip
+        fig.subplots_adjust(**_subplot_fractions((width_in, height_in), margins_in))
     FigureCanvasAgg(fig)
     return fig
 
@@ -137,21 +135,17 @@ def _stacked_layout(
     new (then the caller styles its ticks and grid, which a reused one keeps).
 
     Building the axes and their ticks costs more than drawing the data; a worker that draws many results reuses the
-    layout it already built for the same ``key`` (size, margins and panel ratios), emptied of the previous data:
-    lines, patches, texts, collections, titles, tick choices and data limits (the legend stays while it is the same,
-    :func:`_top_legend`). Same data, same pixels.
+    layout it already built for the same ``key`` and number of panels, emptied of the previous data: lines, patches,
+    texts, collections, titles, tick choices and data limits (the legend stays while it is the same,
+    :func:`_top_legend`), and refitted to this figure's size, margins and panel ratios when they differ (the
+    envelope figure's height and left margin follow its limit lanes). Same data, same pixels.
     """
-    cached = _LAYOUT_CACHE.pop(key, None)
+    cache_key = (*key, len(ratios))
+    cached = _LAYOUT_CACHE.pop(cache_key, None)
     if cached is None:
         fig = _new_figure(size_in[0], size_in[1], margins_in)
         axes = fig.subplots(len(ratios), 1, sharex=True, gridspec_kw={"height_ratios": list(ratios)})
-        # Axis labels at fixed places (y: ending 0.32 in inside the figure's left edge, x: 0.24 in under the axis)
-        # instead of matplotlib measuring every tick label of every shared panel before each drawing to place them.
-        for ax in axes:
-            box = ax.get_position()
-            width_in, height_in = box.width * size_in[0], box.height * size_in[1]
-            ax.yaxis.set_label_coords(-(margins_in[0] - 0.32) / width_in, 0.5)
-            ax.xaxis.set_label_coords(0.5, -0.24 / height_in)
+        _label_places(axes, size_in, margins_in)
         if len(_LAYOUT_CACHE) >= _LAYOUT_CACHE_SIZE:
             _LAYOUT_CACHE.pop(next(iter(_LAYOUT_CACHE)))
     else:
@@ -164,11 +158,37 @@ def _stacked_layout(
             ax.set_xlabel("")
             ax.relim()
             ax.ignore_existing_data_limits = True
+            ax.set_xlim(0.0, 1.0)  # a fresh axes' view: a panel without data keeps it (spines end on the view)
+            ax.set_ylim(0.0, 1.0)
             ax.set_autoscale_on(True)
             ax.yaxis.set_major_locator(_auto_locator())
             ax.yaxis.set_major_formatter(_auto_formatter())
-    _LAYOUT_CACHE[key] = (fig, axes)
+        if fig._washbench_geometry != (size_in, margins_in, tuple(ratios)):
+            fig.set_size_inches(size_in, forward=False)
+            axes[0].get_subplotspec().get_gridspec().set_height_ratios(list(ratios))
+            fig.subplots_adjust(**_subplot_fractions(size_in, margins_in))  # places every panel again
+            _label_places(axes, size_in, margins_in)
+    fig._washbench_geometry = (size_in, margins_in, tuple(ratios))
+    _LAYOUT_CACHE[cache_key] = (fig, axes)
     return fig, axes, cached is None
+
+
+def _subplot_fractions(size_in: tuple[float, float], margins_in: tuple[float, float, float, float]) -> dict[str, float]:
+    """``Figure.subplots_adjust`` arguments for fixed margins (left, right, top, bottom) [in] on a figure of
+    ``size_in`` (width, height) [in]."""
+    (width_in, height_in), (left, right, top, bottom) = size_in, margins_in
+    return {"left": left / width_in, "right": 1.0 - right / width_in, "top": 1.0 - top / height_in,
+            "bottom": bottom / height_in, "hspace": 0.16}  # fmt: skip
+
+
+def _label_places(axes: Any, size_in: tuple[float, float], margins_in: tuple[float, float, float, float]) -> None:
+    """Axis labels at fixed places (y: ending 0.32 in inside the figure's left edge, x: 0.24 in under the axis)
+    instead of matplotlib measuring every tick label of every shared panel before each drawing to place them."""
+    for ax in axes:
+        box = ax.get_position()
+        width_in, height_in = box.width * size_in[0], box.height * size_in[1]
+        ax.yaxis.set_label_coords(-(margins_in[0] - 0.32) / width_in, 0.5)
+        ax.xaxis.set_label_coords(0.5, -0.24 / height_in)
 
 
 def _auto_locator() -> Any:
@@ -197,6 +217,7 @@ def _top_legend(fig: Any, handles: Callable[[], list[Any]], key: tuple[Any, ...]
     :data:`_LEGEND_ROW` entries (so that every name stays inside the picture). ``handles`` makes the entries;
     ``key`` says all they depend on: a reused figure keeps its legend while the key is the same (laying a legend out
     costs a tenth of the figure)."""
+    key = (*key, fig.get_figheight())  # the legend's anchor is placed in figure fractions
     if fig.legends and getattr(fig, "_washbench_legend", None) == key:
         return
     for legend in list(fig.legends):
@@ -431,7 +452,7 @@ def perceived_figure(
     colors, dashes = washout_colors(washouts, pal), washout_dashes(washouts)
     ac_color = mpl(aircraft_color(pal))
     ratios = (0.35, *[1.0] * 6) if phases else (1.0,) * 6
-    fig, axes, new = _stacked_layout(("perceived", ratios), PERCEIVED_SIZE_IN, PERCEIVED_MARGINS_IN, ratios)
+    fig, axes, new = _stacked_layout(("perceived",), PERCEIVED_SIZE_IN, PERCEIVED_MARGINS_IN, ratios)
     width_px = _plot_width_px(PERCEIVED_SIZE_IN, PERCEIVED_MARGINS_IN)
     t0, t1 = float(t_s[0]), float(t_s[-1])
     if phases:
@@ -526,7 +547,7 @@ def envelope_figure(
     size_in = (8.6, 1.55 * len(usage) + 0.9 + 0.2 * n_lanes)
     margins_in = (max(0.85, label_in + 0.45), 0.12, 0.62, 0.45)
     ratios = (*[1.0] * len(usage), 0.12 * n_lanes + 0.25)
-    fig, axes, new = _stacked_layout(("envelope", size_in, margins_in, ratios), size_in, margins_in, ratios)
+    fig, axes, new = _stacked_layout(("envelope",), size_in, margins_in, ratios)
     width_px = _plot_width_px(size_in, margins_in)
     dt = float(t_s[1] - t_s[0]) if t_s.shape[0] > 1 else 0.0
     for ax, (label, per) in zip(axes, usage.items(), strict=False):
