@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from washbench.flight.manoeuvre_schema import HEADING_SIGNALS, HEADING_VALUE_STATS, OSCILLATION_STATS, Check
+from washbench.numerics.peaks import find_peaks
 
 #: Extrema smaller than this fraction of the largest swing are noise, not an oscillation's peaks.
 PEAK_PROMINENCE = 0.05
@@ -44,8 +45,6 @@ def oscillation(x: np.ndarray, dt_s: float) -> Oscillation:
     swing mid-times, and the damping ratio zeta = sigma / sqrt(sigma^2 + omega_d^2) with
     omega_d = 2 pi / period (a growing oscillation gives a negative ratio).
     """
-    from scipy.signal import find_peaks
-
     nan = math.nan
     x = np.asarray(x, dtype=float)
     if x.size < 5 or not np.all(np.isfinite(x)):
@@ -54,8 +53,8 @@ def oscillation(x: np.ndarray, dt_s: float) -> Oscillation:
     if span <= 0.0:
         return Oscillation(nan, nan, nan, 0)
     prom = PEAK_PROMINENCE * span
-    hi, _ = find_peaks(x, prominence=prom)
-    lo, _ = find_peaks(-x, prominence=prom)
+    hi = find_peaks(x, prom)  # scipy.signal.find_peaks's peaks, without its import (0.8 s)
+    lo = find_peaks(-x, prom)
     idx = np.sort(np.concatenate([hi, lo]))
     is_max = np.isin(idx, hi)
     keep: list[int] = []  # alternate maxima and minima: of a run of the same kind keep the extreme one
