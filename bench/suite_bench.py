@@ -35,15 +35,18 @@ def main() -> None:
     from washbench.runs.inputs import find_manoeuvres
     from washbench.runs.options import load_options
     from washbench.runs.outputs import Outputs
-    from washbench.runs.suite import run_suite, write_suite_results
+    from washbench.runs.suite import run_suite, suite_pool, write_suite_results
 
     outputs = Outputs(recording=not args.no_recording, figures=not args.no_figures)
+    options = load_options(outputs=outputs)
 
     files = find_manoeuvres(args.inputs)
     with tempfile.TemporaryDirectory() as tmp:
         start = time.perf_counter()
-        outcomes = run_suite(files, Path(tmp), load_options(outputs=outputs), jobs=args.jobs, progress=False)
-        write_suite_results(outcomes, Path(tmp), figures=outputs.figures)
+        # as `washbench suite` does it: the workers that ran the manoeuvres draw the suite report's figures
+        with suite_pool(options, args.jobs) as pool:
+            outcomes = run_suite(files, Path(tmp), options, jobs=args.jobs, progress=False, pool=pool)
+            write_suite_results(outcomes, Path(tmp), figures=outputs.figures, pool=pool)
         suite_s = time.perf_counter() - start
     failed = [o for o in outcomes if not o.run.ok]
     work = [(o.path, o.run.steps) for o in outcomes if o.run.steps]

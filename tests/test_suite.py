@@ -105,6 +105,8 @@ def test_report_command_rebuilds_the_suite_report(
     assert proc.returncode == 0, proc.stderr
     assert without_pdf_links((copy / "report.md").read_text()) == (out / "report.md").read_text()
     assert (copy / "c172p" / "stall_recovery" / "figures" / "perceived.png").is_file()
+    for name in ("scores", "table4"):  # the suite's workers drew them; the report command, in its own process
+        assert (copy / "figures" / f"{name}.png").read_bytes() == (out / "figures" / f"{name}.png").read_bytes()
     assert check_images(copy / "report.md", vector=True) == 2 + 2 * 2  # every figure now with its PDF
     for name in ("coordinated_turn", "stall_recovery"):
         assert check_images(copy / "c172p" / name / "report.md", vector=True) == 3

@@ -9,7 +9,8 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from concurrent.futures import Executor, Future
 from pathlib import Path
 from typing import Any
 
@@ -92,27 +93,40 @@ def _entries(suite_dir: Path) -> tuple[list[dict[str, Any]], dict[str, Any]]:
     return [{"file": "", "result": _rel(f, suite_dir)} for f in folders], {}
 
 
-def write_suite_report(suite_dir: Path, *, regenerate_results: bool = False, figures: bool = True) -> Path:
+def write_suite_report(
+    suite_dir: Path, *, regenerate_results: bool = False, figures: bool = True, pool: Executor | None = None
+) -> Path:
     """Write the suite's ``report.md`` and ``figures/`` from the suite folder's files; return the report's path.
 
     ``regenerate_results`` (``washbench report``): first write every result folder's own report and figures again,
     and every figure as PNG and PDF; otherwise the PNG figures the runs wrote are linked and the suite's are PNG.
+    ``pool``: the suite's worker processes, idle once the runs are done: they draw the score and Table 4 figures
+    side by side while this process writes the text (it then never imports matplotlib); None: drawn here.
     """
 
     suite_dir = Path(suite_dir)
     entries, doc = _entries(suite_dir)
     stage = make_stage(suite_dir)  # report.md and figures/ replace the previous ones together (links never followed)
     try:
-        _write_suite_report(suite_dir, stage, entries, doc, regenerate_results, figures)
+        _write_suite_report(suite_dir, stage, entries, doc, regenerate_results, figures, pool)
         replace_entries(suite_dir, stage, [REPORT_FILE, FIGURES_DIR])
     finally:
         discard_stage(stage)
     return suite_dir / REPORT_FILE
 
 
+def _draw(pool: Executor | None, draw: Callable[..., list[Path]], *args: Any, **kwargs: Any) -> Future[list[Path]]:
+    """``draw(*args, **kwargs)`` in ``pool``, or here and now (its result or error in a done future)."""
+    if pool is not None:
+        return pool.submit(draw, *args, **kwargs)
+    done: Future[list[Path]] = Future()
+    done.set_result(draw(*args, **kwargs))
+    return done
+
+
 def _write_suite_report(
     suite_dir: Path, stage: Path, entries: list[dict[str, Any]], doc: dict[str, Any], regenerate_results: bool,
-    figures: bool,
+    figures: bool, pool: Executor | None = None,
 ) -> None:  # fmt: skip
 
     results: list[tuple[dict[str, Any], ResultData | None]] = []
@@ -135,14 +149,14 @@ def _write_suite_report(
     if figures:
         fig_dir.mkdir()
     formats = ("png", "pdf") if regenerate_results else ("png",)
-    drawn: dict[str, Path] = {}
+    drawing: dict[str, Future[list[Path]]] = {}  # the figures' paths, PNG first, once drawn
     labels = [d.title + (" (FAILED)" if d.ok is False else "") + _tie_label(rankings[id(d)]) for d in loaded]
     if loaded and figures:
         scores = np.full((len(loaded), len(washouts)), math.nan)
         for r, d in enumerate(loaded):
             for row in rankings[id(d)]:
                 scores[r, washouts.index(row.washout)] = row.score
-        drawn["scores"] = score_heatmap(fig_dir / "scores", labels, washouts, scores, formats=formats)[0]
+        drawing["scores"] = _draw(pool, score_heatmap, fig_dir / "scores", labels, washouts, scores, formats=formats)
         others = [w for w in washouts if w != reference]
         if others:
             better = {w: np.full((len(loaded), len(METRICS) * len(DOFS)), math.nan) for w in others}
@@ -153,9 +167,10 @@ def _write_suite_report(
                     for w, diff in c.better_than_reference.items():
                         if math.isfinite(diff) and ref != 0:
                             better[w][r, col] = 100.0 * diff / ref
-            drawn["table4"] = table4_figure(
-                fig_dir / "table4", labels, reference, better, DOFS, METRICS, formats=formats
-            )[0]
+            drawing["table4"] = _draw(
+                pool, table4_figure, fig_dir / "table4", labels, reference, better, DOFS, METRICS, formats=formats
+            )
+    drawn = {name: fig_dir / f"{name}.png" for name in drawing}  # where each figure's PNG goes
 
     ok = [e for e, d in results if e.get("ok", d.ok if d else False)]
     lines = ["# washbench suite report", ""]
@@ -230,6 +245,8 @@ def _write_suite_report(
         if d.ok is False:
             lines += [f"> **FAILED**: {d.reason or 'a check failed'}", ""]
         lines += result_sections(d, _existing_figures(d) if figures else {}, suite_dir, 3, brief=True)
+    for future in drawing.values():  # drawn (or failed: raised here) before the report that shows them
+        future.result()
     write_text_atomic(stage / REPORT_FILE, "\n".join(lines).rstrip() + "\n")
 
 

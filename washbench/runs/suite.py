@@ -30,6 +30,7 @@ The exit status is 0 only if every manoeuvre ran and passed its checks.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
 import os
@@ -37,7 +38,8 @@ import sys
 import time
 import traceback
 from collections.abc import Sequence
-from concurrent.futures import as_completed
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from contextlib import nullcontext
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -124,16 +126,19 @@ def run_suite(
     jobs: int | None = None,
     progress: bool = True,
     dask: str | None = None,
+    pool: ProcessPoolExecutor | None = None,
 ) -> list[Outcome]:
     """Run every file in parallel processes (or on the Dask cluster at ``dask``); outcomes in the order of ``files``
     (a JSBSim script that resets gives one outcome per run segment, in order). ``options``: the runs' options
     (:func:`washbench.runs.options.load_options`, handed to each worker as they are; None: the defaults).
+    ``pool``: the worker processes to run them in (:func:`suite_pool`, kept for the report); None: a pool of
+    ``jobs`` started here and stopped on return.
 
     On any exception (KeyboardInterrupt and :class:`washbench.errors.Terminated` included) the local workers are
     stopped before it propagates, so no worker writes anything afterwards.
     """
     opts = options if options is not None else load_options()
-    jobs = max(1, min(jobs or usable_cpus(), len(files)))
+    jobs = _jobs(jobs, len(files))
     out_dir.mkdir(parents=True, exist_ok=True)
     args = [(str(f), str(out_dir), opts) for f in files]
     outcomes: dict[str, list[Outcome]] = {}
@@ -153,7 +158,9 @@ def run_suite(
             for a in args:
                 outcomes[a[0]] = _report(_run_one(*a), len(outcomes) + 1, len(files), start, shown)
         else:
-            with worker_pool(jobs, recording=opts.outputs.recording, figures=opts.outputs.figures) as pool:
+            with contextlib.ExitStack() as own:
+                if pool is None:
+                    pool = own.enter_context(suite_pool(opts, jobs))
                 for fut in as_completed(submit_all(pool, _run_one, args)):
                     runs = fut.result()
                     outcomes[runs[0].path] = _report(runs, len(outcomes) + 1, len(files), start, shown)
@@ -161,6 +168,16 @@ def run_suite(
         if shown is not None:
             shown.close()
     return [o for a in args for o in outcomes[a[0]]]
+
+
+def _jobs(jobs: int | None, n_files: int) -> int:
+    """Worker processes for ``n_files`` runs: ``jobs`` (None: the usable CPUs), at most one per file, at least 1."""
+    return max(1, min(jobs or usable_cpus(), n_files))
+
+
+def suite_pool(options: RunOptions, jobs: int) -> contextlib.AbstractContextManager[ProcessPoolExecutor]:
+    """The suite's worker processes (:func:`washbench.runs.pool.worker_pool`), loaded for ``options``' outputs."""
+    return worker_pool(jobs, recording=options.outputs.recording, figures=options.outputs.figures)
 
 
 def _destination(out_dir: Path) -> Path:
@@ -232,12 +249,14 @@ def _washouts(outcomes: Sequence[Outcome]) -> list[str]:
 
 
 def write_suite_results(
-    outcomes: Sequence[Outcome], out_dir: Path, provenance: dict[str, object] | None = None, figures: bool = True
-) -> None:
+    outcomes: Sequence[Outcome], out_dir: Path, provenance: dict[str, object] | None = None, figures: bool = True,
+    pool: ProcessPoolExecutor | None = None,
+) -> None:  # fmt: skip
     """Write metrics.csv, comparison.csv, ranking.csv, suite.json and (last) report.md with its figures (unless
     ``figures`` is False), atomically.
 
-    The report is built from the files (:mod:`washbench.review.suite_report`), as ``washbench report`` builds it.
+    The report is built from the files (:mod:`washbench.review.suite_report`), as ``washbench report`` builds it;
+    ``pool``: the suite's workers, which then draw its figures (None: drawn in this process).
     """
     rule = rule_from_record((provenance or {}).get("ranking"))
     rankings = {
@@ -263,7 +282,7 @@ def write_suite_results(
     ]
     created = utc_now()
     write_suite_json(out_dir / SUITE_MARKER, entries, dict(provenance or {}), created)
-    write_suite_report(out_dir, figures=figures)
+    write_suite_report(out_dir, figures=figures, pool=pool)
     # last: the same document with every top-level entry written (what the next suite may replace)
     top = sorted(e.name for e in out_dir.iterdir() if not e.name.startswith(".") and e.name != SUITE_MARKER)
     write_suite_json(out_dir / SUITE_MARKER, entries, dict(provenance or {}), created, top)
@@ -340,12 +359,16 @@ def suite_command(
         for entry in previous:  # what runs killed while publishing into OUT/<aircraft>/ left (all stale here)
             if entry.is_dir() and not entry.is_symlink():
                 recover_shared(entry, only_dead=False)
-        with staged(out_dir, previous) as stage:  # swapped in whole (journalled, signals held), or not at all
-            outcomes = run_suite(files, stage, options, jobs=jobs, progress=progress, dask=dask)
+        n_jobs = _jobs(jobs, len(files))
+        local = dask is None and n_jobs > 1
+        # swapped in whole (journalled, signals held), or not at all; the workers, idle after the runs, draw the
+        # suite's figures too
+        with staged(out_dir, previous) as stage, (suite_pool(options, n_jobs) if local else nullcontext()) as pool:
+            outcomes = run_suite(files, stage, options, jobs=n_jobs, progress=progress, dask=dask, pool=pool)
             for o in outcomes:  # a failure names the files where they were going, not the hidden stage
                 if not o.run.ok and str(stage) in o.run.reason:
                     o.run = dataclasses.replace(o.run, reason=o.run.reason.replace(str(stage), str(out_dir)))
-            write_suite_results(outcomes, stage, dict(options.provenance), options.outputs.figures)
+            write_suite_results(outcomes, stage, dict(options.provenance), options.outputs.figures, pool)
     n_ok = sum(o.run.ok for o in outcomes)
     print(
         f"suite: {n_ok}/{len(outcomes)} runs ok in {time.perf_counter() - start:.1f} s; report: {out_dir / REPORT_FILE}"
