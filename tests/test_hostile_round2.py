@@ -461,6 +461,38 @@ def test_a_ctrl_c_swallowed_while_the_cli_loads_still_stops_the_command(tmp_path
     assert proc.stderr.strip() == "washbench: interrupted" and proc.stdout == "", (proc.stdout, proc.stderr)
 
 
+SIGNAL_AS_AN_EXTENSION_LOADS = """
+import os, signal, sys
+
+sys.argv = ["washbench", "validate", sys.argv[1]]
+from washbench import __main__ as console
+
+
+class Finder:  # a Ctrl-C while pydantic-core (Rust, pyo3) initialises: it imports datetime then
+    def find_spec(self, name, path=None, target=None):
+        if name == "datetime":
+            sys.meta_path.remove(self)
+            os.kill(os.getpid(), signal.SIGINT)
+        return None
+
+
+assert "datetime" not in sys.modules
+sys.meta_path.insert(0, Finder())
+sys.exit(console.entry())
+"""
+
+
+def test_a_ctrl_c_while_an_extension_module_initialises_is_one_line(tmp_path: Path) -> None:
+    """A Ctrl-C that lands inside an extension module's initialisation while the CLI loads (pydantic-core importing
+    datetime) made pyo3 panic: a Rust backtrace, a Python traceback and status 1. It is held back until the CLI has
+    loaded, then ends the command (one line, 130)."""
+    manoeuvre = str(MANOEUVRES_DIR / "c172" / "takeoff.yaml")
+    proc = subprocess.run([sys.executable, "-c", SIGNAL_AS_AN_EXTENSION_LOADS, manoeuvre], capture_output=True,
+                          text=True, timeout=60)  # fmt: skip
+    assert proc.returncode == 130, (proc.returncode, proc.stdout, proc.stderr)
+    assert proc.stderr.strip() == "washbench: interrupted" and proc.stdout == "", (proc.stdout, proc.stderr)
+
+
 def test_run_signalled_as_its_recording_lands_keeps_the_previous_result(tmp_path: Path) -> None:
     """The real case (timing-dependent, so twice per signal): the previous result folder stays, one line, no
     traceback, status 130/143."""

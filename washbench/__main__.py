@@ -1,7 +1,9 @@
 """``python -m washbench`` and the ``washbench`` console script.
 
-The command-line module is imported inside :func:`entry`, so a Ctrl-C or SIGTERM that arrives while it loads
-(the first fraction of a second) still ends in one line and status 130 or 143, not an import traceback. The
+The command-line module is imported inside :func:`entry`, with SIGINT and SIGTERM held back until it has loaded
+(:func:`washbench.io.interrupts.signals_held`), so a Ctrl-C or SIGTERM that arrives while it loads (the first
+fraction of a second) still ends in one line and status 130 or 143, not an import traceback or an extension
+module's panic. The
 SIGTERM handler and the hook that sends again a signal swallowed in a finalizer (:mod:`washbench.io.interrupts`,
 on the lowest floor) are installed first: importlib runs weakref callbacks while modules load, and a Ctrl-C raised
 in one was swallowed ("Exception ignored") and the command went on.
@@ -21,7 +23,11 @@ def entry() -> int:
     signal.signal(signal.SIGTERM, interrupts.terminate)  # the CLI installs the same for the command
     sys.unraisablehook = interrupts.signal_in_finalizer
     try:
-        from washbench.cli import main  # deferred: signals
+        # a Ctrl-C or SIGTERM while the CLI loads is noted and acted on once it has loaded: raised inside an
+        # extension module's initialisation (pydantic-core importing datetime), it ended the process in a Rust
+        # panic (status 1) instead of this one line
+        with interrupts.signals_held():
+            from washbench.cli import main  # deferred: signals
 
         return main()
     except KeyboardInterrupt:  # before the CLI's own handling starts (importing, parsing the arguments)
