@@ -135,7 +135,8 @@ def run_suite(
     ``jobs`` started here and stopped on return.
 
     On any exception (KeyboardInterrupt and :class:`washbench.errors.Terminated` included) the local workers are
-    stopped before it propagates, so no worker writes anything afterwards.
+    stopped before it propagates, so no worker writes anything afterwards (a ``pool`` passed in: by the
+    :func:`suite_pool` block that holds it, as :func:`suite_command` does).
     """
     opts = options if options is not None else load_options()
     jobs = _jobs(jobs, len(files))
