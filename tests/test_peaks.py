@@ -18,6 +18,7 @@ def signals() -> list[np.ndarray]:
         damped + 0.01 * rng.normal(size=t.size),
         np.round(damped * 20) / 20,  # quantised: flat runs of every length, at peaks and in valleys
         np.cumsum(rng.normal(size=500)),
+        rng.normal(size=20000),  # white noise: a third of the samples are peaks, most of them barely prominent
         rng.integers(0, 4, size=400).astype(float),  # plateaus everywhere, also at both ends
         np.array([1.0, 1.0, 2.0, 2.0, 2.0, 1.0, 3.0, 3.0]),  # a flat peak, and a plateau at the end
         np.array([0.0, 1.0]),

@@ -31,18 +31,47 @@ def local_maxima(x: np.ndarray) -> np.ndarray:
     return ((starts[inner] + ends[inner]) // 2).astype(np.int64)
 
 
+def _nearest_higher(values: list[float], order: range) -> list[int]:
+    """For each index, in ``order``'s direction, the index of the nearest earlier sample strictly higher than it
+    (-1 where there is none): one pass with a stack of the samples still waiting for a higher one."""
+    nearest = [-1] * len(values)
+    stack: list[int] = []
+    for i in order:
+        v = values[i]
+        while stack and values[stack[-1]] <= v:
+            stack.pop()
+        if stack:
+            nearest[i] = stack[-1]
+        stack.append(i)
+    return nearest
+
+
 def prominences(x: np.ndarray, peaks: np.ndarray) -> np.ndarray:
-    """Prominence of each of ``peaks`` (indices into the 1-D array ``x``), same units as ``x`` (module docstring)."""
+    """Prominence of each of ``peaks`` (indices into the 1-D array ``x``), same units as ``x`` (module docstring).
+
+    The bases' ranges come from one pass each way over the samples (the nearest strictly higher sample on each
+    side), their minima from ``np.minimum.reduceat``: linear in the samples, where searching from every peak was
+    quadratic on a noisy trace (28,000 peaks in 100,000 samples: 3 s).
+    """
     x = np.asarray(x, dtype=np.float64)
-    out = np.empty(len(peaks), dtype=np.float64)
-    for j, p in enumerate(np.asarray(peaks, dtype=np.int64)):
-        height = x[p]
-        higher_left = np.flatnonzero(x[:p] > height)
-        left = higher_left[-1] + 1 if higher_left.size else 0
-        higher_right = np.flatnonzero(x[p + 1 :] > height)
-        right = p + higher_right[0] if higher_right.size else x.size - 1
-        out[j] = height - max(float(np.min(x[left : p + 1])), float(np.min(x[p : right + 1])))
-    return out
+    peaks = np.asarray(peaks, dtype=np.int64)
+    if peaks.size == 0:
+        return np.zeros(0, dtype=np.float64)
+    values = x.tolist()
+    n = len(values)
+    left_higher = np.array(_nearest_higher(values, range(n)), dtype=np.int64)[peaks]
+    right_higher = np.array(_nearest_higher(values, range(n - 1, -1, -1)), dtype=np.int64)[peaks]
+    right_higher[right_higher < 0] = n
+    padded = np.append(x, 0.0)  # reduceat's indices may then be n (the end of the last range)
+
+    def range_min(start: np.ndarray, stop: np.ndarray) -> np.ndarray:  # min of x[start:stop], each non-empty
+        bounds = np.empty(2 * start.size, dtype=np.int64)
+        bounds[0::2], bounds[1::2] = start, stop
+        return np.minimum.reduceat(padded, bounds)[0::2]
+
+    left_min = range_min(left_higher + 1, peaks + 1)
+    right_min = range_min(peaks, right_higher)
+    return x[peaks] - np.maximum(left_min, right_min)
 
 
 def find_peaks(x: np.ndarray, prominence: float) -> np.ndarray:
