@@ -74,7 +74,7 @@ _THRESHOLD_COLOR = (0.45, 0.45, 0.45)
 _THRESHOLD_FILL = (0.0, 0.0, 0.0, 0.07)
 _PHASE_SHADE = (0.0, 0.0, 0.0, 0.05)
 _CHAR_IN = 7.5 * 0.56 / 72.0  # mean width of a phase-label character (DejaVu Sans at 7.5 pt) [in]
-_LAYOUT_CACHE: dict[tuple[Any, ...], tuple[Any, Any]] = {}
+_LAYOUT_CACHE: dict[tuple[str, int], tuple[Any, Any]] = {}
 _LAYOUT_CACHE_SIZE = 6
 
 P = ParamSpec("P")
@@ -128,20 +128,20 @@ def _new_figure(
 
 
 def _stacked_layout(
-    key: tuple[Any, ...], size_in: tuple[float, float], margins_in: tuple[float, float, float, float],
+    kind: str, size_in: tuple[float, float], margins_in: tuple[float, float, float, float],
     ratios: Sequence[float],
 ) -> tuple[Any, Any, bool]:  # fmt: skip
     """A figure of panels stacked on one shared time axis, laid out once per process and reused; and whether it is
     new (then the caller styles its ticks and grid, which a reused one keeps).
 
     Building the axes and their ticks costs more than drawing the data; a worker that draws many results reuses the
-    layout it already built for the same ``key`` and number of panels, emptied of the previous data: lines, patches,
-    texts, collections, titles, tick choices and data limits (the legend stays while it is the same,
+    layout it already built for the same ``kind`` of figure and number of panels, emptied of the previous data:
+    lines, patches, texts, collections, titles, tick choices and data limits (the legend stays while it is the same,
     :func:`_top_legend`), and refitted to this figure's size, margins and panel ratios when they differ (the
     envelope figure's height and left margin follow its limit lanes). Same data, same pixels.
     """
-    cache_key = (*key, len(ratios))
-    cached = _LAYOUT_CACHE.pop(cache_key, None)
+    key = (kind, len(ratios))
+    cached = _LAYOUT_CACHE.pop(key, None)
     if cached is None:
         fig = _new_figure(size_in[0], size_in[1], margins_in)
         axes = fig.subplots(len(ratios), 1, sharex=True, gridspec_kw={"height_ratios": list(ratios)})
@@ -169,7 +169,7 @@ def _stacked_layout(
             fig.subplots_adjust(**_subplot_fractions(size_in, margins_in))  # places every panel again
             _label_places(axes, size_in, margins_in)
     fig._washbench_geometry = (size_in, margins_in, tuple(ratios))
-    _LAYOUT_CACHE[cache_key] = (fig, axes)
+    _LAYOUT_CACHE[key] = (fig, axes)
     return fig, axes, cached is None
 
 
@@ -452,7 +452,7 @@ def perceived_figure(
     colors, dashes = washout_colors(washouts, pal), washout_dashes(washouts)
     ac_color = mpl(aircraft_color(pal))
     ratios = (0.35, *[1.0] * 6) if phases else (1.0,) * 6
-    fig, axes, new = _stacked_layout(("perceived",), PERCEIVED_SIZE_IN, PERCEIVED_MARGINS_IN, ratios)
+    fig, axes, new = _stacked_layout("perceived", PERCEIVED_SIZE_IN, PERCEIVED_MARGINS_IN, ratios)
     width_px = _plot_width_px(PERCEIVED_SIZE_IN, PERCEIVED_MARGINS_IN)
     t0, t1 = float(t_s[0]), float(t_s[-1])
     if phases:
@@ -547,7 +547,7 @@ def envelope_figure(
     size_in = (8.6, 1.55 * len(usage) + 0.9 + 0.2 * n_lanes)
     margins_in = (max(0.85, label_in + 0.45), 0.12, 0.62, 0.45)
     ratios = (*[1.0] * len(usage), 0.12 * n_lanes + 0.25)
-    fig, axes, new = _stacked_layout(("envelope",), size_in, margins_in, ratios)
+    fig, axes, new = _stacked_layout("envelope", size_in, margins_in, ratios)
     width_px = _plot_width_px(size_in, margins_in)
     dt = float(t_s[1] - t_s[0]) if t_s.shape[0] > 1 else 0.0
     for ax, (label, per) in zip(axes, usage.items(), strict=False):
