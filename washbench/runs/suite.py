@@ -39,7 +39,6 @@ import time
 import traceback
 from collections.abc import Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
-from contextlib import nullcontext
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -361,10 +360,10 @@ def suite_command(
             if entry.is_dir() and not entry.is_symlink():
                 recover_shared(entry, only_dead=False)
         n_jobs = _jobs(jobs, len(files))
-        local = dask is None and n_jobs > 1
-        # swapped in whole (journalled, signals held), or not at all; the workers, idle after the runs, draw the
-        # suite's figures too
-        with staged(out_dir, previous) as stage, (suite_pool(options, n_jobs) if local else nullcontext()) as pool:
+        # the local workers, idle after the runs, draw the suite's figures too
+        workers = suite_pool(options, n_jobs) if dask is None and n_jobs > 1 else contextlib.nullcontext()
+        # swapped in whole (journalled, signals held), or not at all
+        with staged(out_dir, previous) as stage, workers as pool:
             outcomes = run_suite(files, stage, options, jobs=n_jobs, progress=progress, dask=dask, pool=pool)
             for o in outcomes:  # a failure names the files where they were going, not the hidden stage
                 if not o.run.ok and str(stage) in o.run.reason:
