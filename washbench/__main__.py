@@ -15,11 +15,12 @@ import signal
 import sys
 
 from washbench.errors import Terminated
-from washbench.io import interrupts
+from washbench.io import collector, interrupts
 
 
 def entry() -> int:
     """Import the CLI and run it; the console script's entry point."""
+    collector.tune()  # before the imports, which allocate most of the objects the collector would scan
     signal.signal(signal.SIGTERM, interrupts.terminate)  # the CLI installs the same for the command
     sys.unraisablehook = interrupts.signal_in_finalizer
     try:

@@ -20,6 +20,7 @@ from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import Future, ProcessPoolExecutor
 from typing import Any
 
+from washbench.io import collector
 from washbench.io.outfolder import signals_held
 from washbench.runs import parent_death
 from washbench.runs.parent_death import note_main_pid
@@ -33,12 +34,15 @@ FIGURE_MODULES = ("matplotlib.figure", "matplotlib.backends.backend_agg")
 def _worker_init(then: Callable[[], None] | None = None) -> None:
     """In each worker: Ctrl-C is for the main process (it stops the workers); SIGTERM stops a worker at once.
 
-    ``then``: the start method's own initializer (:func:`pool_context`).
+    ``then``: the start method's own initializer (:func:`pool_context`). Then what the worker has loaded (the
+    process server's preloaded modules, forked) is frozen: the worker's collector never scans it
+    (:mod:`washbench.io.collector`).
     """
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     if then is not None:
         then()
+    collector.freeze_loaded()
 
 
 @contextlib.contextmanager
