@@ -35,9 +35,13 @@ def png_bytes(rgba: np.ndarray, dpi: float) -> bytes:
     height, width = rgba.shape[:2]
     opaque = bool(rgba[:, :, 3].min() == 255)
     pixels = rgba[:, :, :3] if opaque else rgba
-    rows = np.zeros((height, 1 + width * pixels.shape[2]), dtype=np.uint8)  # a 0 byte (filter: none) per row
-    rows[:, 1:] = pixels.reshape(height, -1)
+    channels = pixels.shape[2]
+    rows = np.empty((height, 1 + width * channels), dtype=np.uint8)
+    rows[:, 0] = 0  # filter: none
+    packed = rows[:, 1:].reshape(height, width, channels, copy=False)  # a view (else an error, never a lost copy)
+    for c in range(channels):  # (6x faster than one copy of the (H, W, 3) view, which numpy does byte by byte)
+        packed[:, :, c] = pixels[:, :, c]
     ppm = int(dpi / 0.0254 + 0.5)  # pixels per metre, rounded as Pillow rounds it
     header = struct.pack(">IIBBBBB", width, height, 8, 2 if opaque else 6, 0, 0, 0)
     return b"".join((_SIGNATURE, _chunk(b"IHDR", header), _chunk(b"pHYs", struct.pack(">IIB", ppm, ppm, 1)),
-                     _chunk(b"IDAT", zlib.compress(rows.tobytes(), ZLIB_LEVEL)), _chunk(b"IEND", b"")))  # fmt: skip
+                     _chunk(b"IDAT", zlib.compress(rows, ZLIB_LEVEL)), _chunk(b"IEND", b"")))  # fmt: skip
