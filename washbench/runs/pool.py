@@ -107,6 +107,18 @@ def pool_context(
     return multiprocessing.get_context("spawn"), _preload
 
 
+def start_server(recording: bool = True, figures: bool = True) -> None:
+    """Start the process server now (where the start method is ``forkserver``; else nothing), so that it loads its
+    modules (:func:`pool_context`, about a second) while this process goes on with other work; the
+    :func:`worker_pool` opened later with the same outputs forks its workers from it."""
+    ctx, _ = pool_context(recording, main_stops_workers=True, figures=figures)
+    if ctx.get_start_method() == "forkserver":
+        from multiprocessing import forkserver
+
+        with signals_held():  # a signal while the server process starts is acted on once it exists
+            forkserver.ensure_running()
+
+
 @contextlib.contextmanager
 def worker_pool(jobs: int, *, recording: bool = True, figures: bool = True) -> Iterator[ProcessPoolExecutor]:
     """A pool of ``jobs`` worker processes the main process stops itself (module docstring).

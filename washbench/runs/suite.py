@@ -78,7 +78,7 @@ from washbench.runs.cluster import dask_map
 from washbench.runs.inputs import check_unique_names, find_manoeuvres
 from washbench.runs.options import RunOptions, load_options
 from washbench.runs.pipeline import announce_script, run_manoeuvre, run_script
-from washbench.runs.pool import submit_all, worker_pool
+from washbench.runs.pool import start_server, submit_all, worker_pool
 from washbench.runs.result_folder import RUN_MARKER, RunSummary, csv_text, ranking_table
 
 #: The file that marks a folder as a suite's (it lists everything a suite wrote at the top level).
@@ -346,6 +346,9 @@ def suite_command(
     if jobs is not None and jobs < 1:
         raise WashbenchError(f"--jobs: expected a whole number of at least 1, got {jobs}")
     files = find_manoeuvres(inputs, [bundled_script(n) for n in jsbsim_scripts])
+    n_jobs = _jobs(jobs, len(files))
+    if dask is None and n_jobs > 1:  # the workers' server loads JSBSim, the kernels, ... while the files are checked
+        start_server(options.outputs.recording, options.outputs.figures)
     check_unique_names(files, options.aircraft_dirs)
     for f in files:
         if is_script(f):
@@ -359,7 +362,6 @@ def suite_command(
         for entry in previous:  # what runs killed while publishing into OUT/<aircraft>/ left (all stale here)
             if entry.is_dir() and not entry.is_symlink():
                 recover_shared(entry, only_dead=False)
-        n_jobs = _jobs(jobs, len(files))
         # the local workers, idle after the runs, draw the suite's figures too
         workers = suite_pool(options, n_jobs) if dask is None and n_jobs > 1 else contextlib.nullcontext()
         # swapped in whole (journalled, signals held), or not at all
