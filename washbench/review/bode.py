@@ -35,7 +35,8 @@ def _pyplot() -> Any:
     return plt
 
 
-def _boundary_lines(ax_gain: Any, ax_phase: Any, b: Bounds) -> None:
+def _boundary_lines(ax_gain: Any, ax_phase: Any, b: Bounds) -> bool:
+    """Draw the boundaries ``b``; whether a gain boundary was drawn (a value the log gain axis shows)."""
     w = np.geomspace(b.frequency_radps[0], b.frequency_radps[-1], 200)
     vals = np.array([[np.nan if v is None else v for v in bounds_at(b, x)] for x in w], dtype=float)
     for ax, lo, hi in ((ax_gain, vals[:, 0], vals[:, 1]), (ax_phase, vals[:, 2], vals[:, 3])):
@@ -44,6 +45,7 @@ def _boundary_lines(ax_gain: Any, ax_phase: Any, b: Bounds) -> None:
                 ax.plot(w, line, "k--", lw=1.0, label="_bound")
         if np.isfinite(lo).any() and np.isfinite(hi).any():
             ax.fill_between(w, lo, hi, color="0.85", zorder=0)
+    return bool(np.any(vals[:, :2] > 0))
 
 
 def _series(
@@ -72,6 +74,17 @@ def write_bode_plots(
     return files
 
 
+def _differs(gain: np.ndarray, phase_deg: np.ndarray, ref_gain: np.ndarray, ref_phase_deg: np.ndarray) -> bool:
+    """Whether the response ``gain``, ``phase_deg`` differs from ``ref_gain``, ``ref_phase_deg`` by more than 0.1 %
+    at some frequency (complex ratio); a point whose ratio is undefined (0/0, NaN) is left out, one where only the
+    reference is 0 differs. No warning either way (a washout that passes nothing on gives such points)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.abs(gain * np.exp(1j * np.radians(phase_deg)) / (ref_gain * np.exp(1j * np.radians(ref_phase_deg)))
+                       - 1.0)  # fmt: skip
+    defined = ratio[~np.isnan(ratio)]
+    return bool(defined.size) and bool(defined.max() > 1e-3)
+
+
 @uninterrupted
 def _bode_plot(
     plt: Any, out_dir: Path, test: Any, pts: Sequence[Any], bounds: dict[str, Bounds], washouts: Sequence[str]
@@ -79,8 +92,9 @@ def _bode_plot(
     """Draw and write one test's Bode plot (a Ctrl-C waits until it is written); its file name."""
     fig, axes = plt.subplots(2, 2, figsize=(11, 7), sharex=True)
     (ag, apg), (aph, app) = axes
+    positive = {ag: False, apg: False}  # whether the gain panel has a value a log axis can show
     if test.name in bounds:
-        _boundary_lines(ag, aph, bounds[test.name])
+        positive[ag] = _boundary_lines(ag, aph, bounds[test.name])
     aircraft_drawn = False
     for i, name in enumerate(washouts):
         mine = sorted((p for p in pts if p.washout == name), key=lambda p: p.frequency_radps)
@@ -89,17 +103,20 @@ def _bode_plot(
         w = np.array([p.frequency_radps for p in mine])
         lin = np.array([p.linear for p in mine])
         colour = _COLOURS[i % len(_COLOURS)]
-        _series(ag, aph, w, np.array([p.gain for p in mine]), np.array([p.phase_deg for p in mine]), lin, i,
-                color=colour, label=name)  # fmt: skip
+        g_meas = np.array([p.gain for p in mine])
+        g_perc = np.array([p.perceived_gain for p in mine])
+        positive[ag] |= bool(np.any(g_meas > 0))
+        positive[apg] |= bool(np.any(g_perc > 0))
+        # a washout that passes nothing of this test on has no point a log axis can show: its legend says so
+        _series(ag, aph, w, g_meas, np.array([p.phase_deg for p in mine]), lin, i, color=colour,
+                label=name if np.any(g_meas > 0) else f"{name}: no motion (gain 0)")  # fmt: skip
         g_est = np.array([p.estimator_gain for p in mine])
         ph_est = np.array([p.estimator_phase_deg for p in mine])
-        g_meas = np.array([p.gain for p in mine])
-        if np.nanmax(np.abs(g_est * np.exp(1j * np.radians(ph_est)) / (g_meas * np.exp(
-                1j * np.radians(np.array([p.phase_deg for p in mine])))) - 1.0)) > 1e-3:  # fmt: skip
+        if _differs(g_est, ph_est, g_meas, np.array([p.phase_deg for p in mine])):
             ag.plot(w, g_est, ":", lw=1.0, color=colour, label=f"{name}: cue head estimate (not the test)")
             aph.plot(w, ph_est, ":", lw=1.0, color=colour)
-        _series(apg, app, w, np.array([p.perceived_gain for p in mine]),
-                np.array([p.perceived_phase_deg for p in mine]), lin, i, color=colour, label=name)  # fmt: skip
+        _series(apg, app, w, g_perc, np.array([p.perceived_phase_deg for p in mine]), lin, i, color=colour,
+                label=name if np.any(g_perc > 0) else f"{name}: nothing perceived (gain 0)")  # fmt: skip
         for p in mine:  # outside the boundaries: a red ring
             if p.gain_inside is False:
                 ag.plot(p.frequency_radps, p.gain, "o", ms=11, mfc="none", mec="red", mew=1.5)
@@ -109,6 +126,7 @@ def _bode_plot(
             ga = np.array([p.aircraft_perceived_gain for p in mine])
             pa = np.array([p.aircraft_perceived_phase_deg for p in mine])
             if np.any(ga > 0):
+                positive[apg] = True
                 apg.plot(w, ga, "k--", lw=1.5, label="aircraft pilot")
                 app.plot(w, pa, "k--", lw=1.5, label="aircraft pilot")
             else:
@@ -116,7 +134,8 @@ def _bode_plot(
             aircraft_drawn = True
     for ax in (ag, apg):
         ax.set_xscale("log")
-        ax.set_yscale("log")
+        if positive[ax]:  # else a log axis has nothing to show (and matplotlib warns): left linear, at 0
+            ax.set_yscale("log")
         ax.grid(True, which="both", alpha=0.3)
     for ax in (aph, app):
         ax.set_xscale("log")
