@@ -259,3 +259,63 @@ def test_minmax_decimation_is_each_buckets_first_minimum_and_maximum_in_time_ord
                 exp_y.append(chunk[i])
         assert np.array_equal(tt, exp_t)
         assert np.array_equal(yy, exp_y, equal_nan=True)
+
+
+def _cells_figure(folder: Path, name: str, one_artist: bool, constrained: bool) -> list[Path]:
+    """A heatmap with text in every cell (numbers, signs, a dash, a warning sign, bold ones, an empty one), drawn with
+    one matplotlib Text per cell or with one CellTexts, PNG and PDF."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    from matplotlib.font_manager import FontProperties
+
+    from washbench.review.cell_text import CellTexts
+    from washbench.review.figures import save_figure
+
+    rng = np.random.default_rng(11)
+    values = np.round(rng.standard_normal((9, 7)) * 300.0)
+    fig = Figure(figsize=(6.3, 4.1), layout="constrained" if constrained else None)
+    FigureCanvasAgg(fig)
+    ax = fig.subplots()
+    ax.imshow(values, cmap="RdYlGn", aspect="auto")
+    ax.set_yticks(range(9), [f"row {r}" for r in range(9)])
+    normal, bold = FontProperties(size=6.5), FontProperties(size=8, weight="bold")
+    cells, texts, fonts = [], [], []
+    for r, c in itertools.product(range(9), range(7)):
+        v = values[r, c]
+        text = "" if (r, c) == (4, 4) else "-" if (r, c) == (2, 3) else f"{v:+.0f}" + (" ⚠" if v > 250 else "")
+        cells.append((c, r))
+        texts.append(text)
+        fonts.append(bold if (r + c) % 5 == 0 else normal)
+    if one_artist:
+        ax.add_artist(CellTexts(cells, texts, fonts))
+    else:
+        for (c, r), text, font in zip(cells, texts, fonts, strict=True):
+            ax.text(c, r, text, ha="center", va="center", fontproperties=font, clip_on=False, in_layout=False)
+    return save_figure(fig, folder / name, ("png", "pdf"))
+
+
+@pytest.mark.parametrize("constrained", [False, True])
+def test_cell_texts_draw_the_bytes_matplotlib_texts_draw(tmp_path: Path, constrained: bool) -> None:
+    """The one-artist cell texts (Table 4's 792 numbers, the score heatmap's) give the same PNG and PDF bytes as one
+    matplotlib Text per cell, centred, unclipped, outside the layout; with fixed margins and the constrained
+    layout."""
+    texts = _cells_figure(tmp_path, "texts", one_artist=False, constrained=constrained)
+    cells = _cells_figure(tmp_path, "cells", one_artist=True, constrained=constrained)
+    for a, b in zip(texts, cells, strict=True):
+        assert a.read_bytes() == b.read_bytes(), b.name
+
+
+def test_cell_texts_refuse_what_they_do_not_draw_as_a_text_would() -> None:
+    from matplotlib.font_manager import FontProperties
+
+    from washbench.review.cell_text import CellTexts
+
+    font = FontProperties(size=8)
+    with pytest.raises(ValueError, match="plain one-line"):
+        CellTexts([(0, 0)], ["$x$"], font)
+    with pytest.raises(ValueError, match="plain one-line"):
+        CellTexts([(0, 0)], ["a\nb"], font)
+    with pytest.raises(ValueError, match="2 points for 1 texts"):
+        CellTexts([(0, 0), (1, 0)], ["a"], font)
+    with pytest.raises(ValueError, match="1 fonts for 2 texts"):
+        CellTexts([(0, 0), (1, 0)], ["a", "b"], [font])

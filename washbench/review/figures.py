@@ -595,11 +595,6 @@ def envelope_figure(
     return save_figure(fig, stem, formats)
 
 
-_CELL_TEXT = {"clip_on": False, "in_layout": False}
-"""A table cell's text (inside its axes, so neither clipped nor laid out, and drawn the same): the layout engine
-measured each of Table 4's 800 texts and every text built its own clip transform, half of the figure's time."""
-
-
 def _sig(x: float, digits: int = 3) -> str:
     return sig(x, digits)
 
@@ -618,7 +613,10 @@ def score_heatmap(
     ``scores`` (R, W), NaN where a washout did not run. Returns the paths (PNG first).
     """
     from matplotlib.colors import LinearSegmentedColormap, TwoSlopeNorm
+    from matplotlib.font_manager import FontProperties
     from matplotlib.patches import Rectangle
+
+    from washbench.review.cell_text import CellTexts  # deferred: matplotlib
 
     scores = np.asarray(scores, dtype=np.float64).reshape(len(rows), len(washouts))
     finite = scores[np.isfinite(scores)]
@@ -629,17 +627,20 @@ def score_heatmap(
     fig = _new_figure(1.6 + 1.35 * len(washouts), 1.3 + 0.32 * len(rows))
     ax = fig.subplots()
     image = ax.imshow(np.ma.masked_invalid(scores), cmap=cmap, norm=norm, aspect="auto")
+    normal, bold = FontProperties(size=8), FontProperties(size=8, weight="bold")
+    cells, texts, fonts = [], [], []
     for r in range(len(rows)):
         row = scores[r]
         best = np.nanmin(row) if np.isfinite(row).any() else math.nan
         for c in range(len(washouts)):
             v = row[c]
-            text = "-" if not math.isfinite(v) else _sig(v) + (f" {SCORE_FLAG}" if v > 1.0 else "")
             is_best = math.isfinite(v) and v == best
-            ax.text(c, r, text, ha="center", va="center", fontsize=8, fontweight="bold" if is_best else "normal",
-                    **_CELL_TEXT)
+            cells.append((c, r))
+            texts.append("-" if not math.isfinite(v) else _sig(v) + (f" {SCORE_FLAG}" if v > 1.0 else ""))
+            fonts.append(bold if is_best else normal)
             if is_best:
                 ax.add_patch(Rectangle((c - 0.5, r - 0.5), 1, 1, fill=False, lw=1.6, ec="black"))
+    ax.add_artist(CellTexts(cells, texts, fonts))
     ax.set_xticks(range(len(washouts)), washouts, fontsize=8.5)
     ax.xaxis.tick_top()
     ax.set_yticks(range(len(rows)), rows, fontsize=8)
@@ -671,6 +672,9 @@ def table4_figure(
     its value.
     """
     from matplotlib.colors import SymLogNorm
+    from matplotlib.font_manager import FontProperties
+
+    from washbench.review.cell_text import CellTexts  # deferred: matplotlib
 
     others = list(better_pct)
     ncol = len(metrics) * len(dofs)
@@ -682,14 +686,13 @@ def table4_figure(
     vmax = max(100.0, float(finite.max()))
     norm = SymLogNorm(linthresh=10.0, linscale=1.0, vmin=-vmax, vmax=vmax, base=10)
     image = None
+    font = FontProperties(size=6.5)
     for ax, w in zip(axes, others, strict=True):
         values = values_of[w]
         image = ax.imshow(np.ma.masked_invalid(values), cmap=cmap, norm=norm, aspect="auto")
-        for r in range(len(rows)):
-            for c in range(ncol):
-                v = values[r, c]
-                text = "-" if not math.isfinite(v) else f"{v:+.0f}" if abs(v) >= 0.5 else "0"
-                ax.text(c, r, text, ha="center", va="center", fontsize=6.5, **_CELL_TEXT)
+        cells = [(c, r) for r in range(len(rows)) for c in range(ncol)]
+        texts = ["-" if not math.isfinite(v) else f"{v:+.0f}" if abs(v) >= 0.5 else "0" for v in values.ravel()]
+        ax.add_artist(CellTexts(cells, texts, font))
         ax.set_xticks(range(ncol), [d for _ in metrics for d in dofs], fontsize=7, rotation=90)
         ax.set_yticks(range(len(rows)), rows, fontsize=7.5)
         for g in range(1, len(metrics)):
