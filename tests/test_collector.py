@@ -8,6 +8,9 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
+from washbench.io import collector
 from washbench.runs.pool import worker_pool
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -55,3 +58,26 @@ def test_a_pool_worker_never_scans_what_its_process_server_loaded() -> None:
         threshold = pool.submit(gc.get_threshold).result(timeout=120)
     assert frozen > 100_000
     assert threshold[0] > 700  # CPython's default
+
+
+def test_figure_writers_pause_the_garbage_collector_and_restore_it() -> None:
+    """collector.paused: off while the writer runs, then as it was (on or off), also when the writer fails."""
+    seen = []
+
+    @collector.paused
+    def writer(fail: bool) -> None:
+        seen.append(gc.isenabled())
+        if fail:
+            raise ValueError("drawing failed")
+
+    was = gc.isenabled()
+    try:
+        for enabled in (True, False):
+            (gc.enable if enabled else gc.disable)()
+            writer(False)
+            with pytest.raises(ValueError, match="drawing failed"):
+                writer(True)
+            assert gc.isenabled() == enabled
+        assert seen == [False] * 4
+    finally:
+        (gc.enable if was else gc.disable)()

@@ -96,33 +96,6 @@ def test_a_reused_envelope_layout_refitted_to_other_lanes_draws_a_fresh_ones_pix
         assert envelope(lanes[i], f"reused{i}") == fresh[i], i
 
 
-def test_figure_writers_pause_the_garbage_collector_and_restore_it() -> None:
-    """collector_paused: off while the writer runs, then as it was (on or off), also when the writer fails."""
-    import gc
-
-    from washbench.review.figures import collector_paused
-
-    seen = []
-
-    @collector_paused
-    def writer(fail: bool) -> None:
-        seen.append(gc.isenabled())
-        if fail:
-            raise ValueError("drawing failed")
-
-    was = gc.isenabled()
-    try:
-        for enabled in (True, False):
-            (gc.enable if enabled else gc.disable)()
-            writer(False)
-            with pytest.raises(ValueError, match="drawing failed"):
-                writer(True)
-            assert gc.isenabled() == enabled
-        assert seen == [False] * 4
-    finally:
-        (gc.enable if was else gc.disable)()
-
-
 def test_every_washout_has_its_own_colour_and_line_style_in_each_palette() -> None:
     for pal in PALETTES:
         colors = washout_colors(NAMES, pal)

@@ -15,8 +15,9 @@ import numpy as np
 
 from washbench.analysis.cues import FALSE, MISSING, classify, dof_thresholds
 from washbench.analysis.metrics import DOFS
+from washbench.io import collector
 from washbench.io.outfolder import uninterrupted
-from washbench.review.figures import _new_figure, bars, collector_paused, run_edges, save_figure
+from washbench.review.figures import _new_figure, bars, run_edges, save_figure
 
 FALSE_COLOUR = (0.84, 0.15, 0.16)
 MISSING_COLOUR = (0.72, 0.72, 0.72)
@@ -33,7 +34,7 @@ def cue_classes(perceived: Mapping[str, np.ndarray], washouts: Sequence[str]) ->
 
 
 @uninterrupted
-@collector_paused
+@collector.paused
 def cue_lane_figure(
     stem: Path,
     title: str,

@@ -25,16 +25,15 @@ same files: no dates or random ids are written into the PNG or PDF.
 
 from __future__ import annotations
 
-import functools
-import gc
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, ParamSpec, TypeVar
+from typing import Any
 
 import numpy as np
 
+from washbench.io import collector
 from washbench.io.atomic import atomic_path, write_bytes_atomic
 from washbench.io.outfolder import uninterrupted
 from washbench.review.numbers import SCORE_FLAG, sig
@@ -77,33 +76,8 @@ _CHAR_IN = 7.5 * 0.56 / 72.0  # mean width of a phase-label character (DejaVu Sa
 _LAYOUT_CACHE: dict[tuple[str, int], tuple[Any, Any]] = {}
 _LAYOUT_CACHE_SIZE = 6
 
-P = ParamSpec("P")
-R = TypeVar("R")
-
 PERCEIVED_SIZE_IN = (8.6, 11.0)
 PERCEIVED_MARGINS_IN = (0.85, 0.12, 0.62, 0.45)
-
-
-def collector_paused(func: Callable[P, R]) -> Callable[P, R]:
-    """``func`` (a figure writer) run with Python's cyclic garbage collector paused, then restored as it was.
-
-    Drawing a figure allocates some 10^5 short-lived container objects (artists, transforms, paths); with the
-    collector on, that sets off generation-2 collections that walk every object of the process (a flight's, a
-    cue's) about once per figure: 0.03 to 0.1 s of CPU per figure measured (issue 21). Paused, the garbage is
-    collected afterwards by the collector's own schedule; reference counting frees the rest at once as usual.
-    """
-
-    @functools.wraps(func)
-    def paused(*args: P.args, **kwargs: P.kwargs) -> R:
-        was = gc.isenabled()
-        gc.disable()
-        try:
-            return func(*args, **kwargs)
-        finally:
-            if was:
-                gc.enable()
-
-    return paused
 
 
 def _new_figure(
@@ -424,7 +398,7 @@ def _band(ax: Any, lo: float, hi: float) -> None:
 
 
 @uninterrupted
-@collector_paused
+@collector.paused
 def perceived_figure(
     stem: Path,
     title: str,
@@ -518,7 +492,7 @@ def bars(ax: Any, x0: np.ndarray, width: np.ndarray, y0: float, height: float, *
 
 
 @uninterrupted
-@collector_paused
+@collector.paused
 def envelope_figure(
     stem: Path,
     title: str,

@@ -19,12 +19,13 @@ from typing import Any
 import numpy as np
 
 from washbench.errors import WashbenchError, located
+from washbench.io import collector
 from washbench.io.columns import AIRCRAFT, TIME_COLUMN, f_columns, omega_columns
 from washbench.io.input_format import ColumnSource
 from washbench.io.outfolder import uninterrupted
 from washbench.io.result_files import FIGURES_DIR, RUN_FILE, TRACES_FILE
 from washbench.io.units import G0_MPS2, axes_matrix, is_identity_axes
-from washbench.review.figures import collector_paused, minmax_decimate, save_figure
+from washbench.review.figures import minmax_decimate, save_figure
 
 INPUT_STEM = "input"
 """The figure's file name (``figures/input.png``)."""
@@ -66,7 +67,7 @@ def input_labels(
 
 
 @uninterrupted
-@collector_paused
+@collector.paused
 def input_figure(
     stem: Path,
     title: str,
