@@ -347,7 +347,8 @@ def suite_command(
         raise WashbenchError(f"--jobs: expected a whole number of at least 1, got {jobs}")
     files = find_manoeuvres(inputs, [bundled_script(n) for n in jsbsim_scripts])
     n_jobs = _jobs(jobs, len(files))
-    if dask is None and n_jobs > 1:  # the workers' server loads JSBSim, the kernels, ... while the files are checked
+    local_pool = dask is None and n_jobs > 1
+    if local_pool:  # the workers' server loads JSBSim, the kernels, ... while the files are checked
         start_server(options.outputs.recording, options.outputs.figures)
     check_unique_names(files, options.aircraft_dirs)
     for f in files:
@@ -363,7 +364,7 @@ def suite_command(
             if entry.is_dir() and not entry.is_symlink():
                 recover_shared(entry, only_dead=False)
         # the local workers, idle after the runs, draw the suite's figures too
-        workers = suite_pool(options, n_jobs) if dask is None and n_jobs > 1 else contextlib.nullcontext()
+        workers = suite_pool(options, n_jobs) if local_pool else contextlib.nullcontext()
         # swapped in whole (journalled, signals held), or not at all
         with staged(out_dir, previous) as stage, workers as pool:
             outcomes = run_suite(files, stage, options, jobs=n_jobs, progress=progress, dask=dask, pool=pool)
