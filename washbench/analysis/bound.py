@@ -40,7 +40,6 @@ from scipy import sparse
 
 from washbench.cueing.motion_model import discretise_foh
 from washbench.io.yamlio import StrictModel
-from washbench.numerics.rotations import quat_from_euler
 from washbench.perception.vestibular import VestibularModel, VestibularParams, canal_tf, otolith_tf
 from washbench.platform.limits import PlatformLimits
 
@@ -52,6 +51,9 @@ class BoundParams(StrictModel):
     """w_f, per (m/s^2)^2 of perceived specific-force error"""
     rate_weight: Annotated[float, Field(ge=0.0, le=1e9)] = 10.0
     """w_w, per (rad/s)^2 of perceived angular-velocity error"""
+    jerk_weight: Annotated[float, Field(ge=0.0, le=1e3)] = 1e-5
+    """w_j, per (m/s^3)^2 of the stage's jerk ((a_k - a_{k-1}) / dt): keeps the replay from chattering (CHOSEN, its
+    effect in docs/optimal-mpc.md)"""
     eps: Annotated[float, Field(gt=0.0, le=1e-2)] = 1e-8
     """the interior-point solver's (Clarabel) gap and feasibility tolerances"""
     max_iter: Annotated[int, Field(ge=10, le=10_000)] = 200
@@ -265,6 +267,13 @@ def _solve_channel(
                         pr.append(v(k, f"{pre}{i}"))
                         pc.append(v(k, f"{pre}{j}"))
                         pv.append(m[i, j])
+    if has_f and params.jerk_weight > 0.0 and n > 1:  # w_j dt sum ((a_k - a_{k-1}) / dt)^2
+        cj = 2.0 * params.jerk_weight / dt
+        for k in range(1, n):
+            i, j = v(k - 1, "a"), v(k, "a")
+            pr += [i, j, i]
+            pc += [i, j, j]
+            pv += [cj, cj, -cj]
     P = sparse.csc_matrix((pv, (pr, pc)), shape=(nz, nz))
     lo_a, hi_a = np.array(lo), np.array(hi)
     is_eq = lo_a == hi_a
@@ -389,20 +398,33 @@ class BoundWashout:
     def __init__(self, params: BoundParams | None, context) -> None:
         self.params = params if params is not None else BoundParams()
         self.context = context
+        self.solved: dict[str, float] = {}
+
+    def report(self) -> dict[str, float]:
+        """The replay's solves: 1 per stage solved (the attitude's four channels, the translation), 0 otherwise."""
+        return dict(self.solved)
 
     def start(self, f_mps2: np.ndarray, omega_radps: np.ndarray):
-        return np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0])
+        return np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0])  # the plan starts level (oracle_bound start_at_rest)
 
     def step(self, f_mps2: np.ndarray, omega_radps: np.ndarray):
         raise RuntimeError("the oracle bound needs the whole recording in advance (run, cue, suite, omct, sweep, "
                            "tune), not a live stream")  # fmt: skip
 
     def trace(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The replay's set points (:mod:`washbench.analysis.bound_replay`): positions (N, 3) m, attitudes (N, 4)."""
+        from washbench.analysis.bound_replay import attitudes, translation_plan
+
         c = self.context
-        res = oracle_bound(f_mps2, omega_radps, c.dt_s, c.limits, c.gravity_mps2, self.params, start_at_rest=True)
-        ang = res.trajectory.angles
-        q = np.array([quat_from_euler(float(a), float(b), float(y)) for a, b, y in ang])
-        return res.trajectory.pos.copy(), q
+        f = np.asarray(f_mps2, dtype=np.float64)
+        res = oracle_bound(f, omega_radps, c.dt_s, c.limits, c.gravity_mps2, self.params, start_at_rest=True)
+        traj = res.trajectory
+        q_sp, q = attitudes(traj.angles, traj.omega[:, 2], c.dt_s, c.limits)
+        pos, status = translation_plan(f, q, c.dt_s, c.limits, c.gravity_mps2, self.params.jerk_weight,
+                                       filter_start=c.filter_start)  # fmt: skip
+        self.solved = {f"{k}_solved": float(v == "Solved") for k, v in res.statuses.items()}
+        self.solved["translation_solved"] = float(status == "Solved")
+        return pos, q_sp
 
 
 __all__ = [

@@ -1,4 +1,4 @@
-"""The report's lines on the oracle bound (``bound.csv``) and on the Python washouts' own statistics (``run.json``:
+"""The report's lines on the ceiling (``ceiling.csv``) and on the Python washouts' own statistics (``run.json``:
 ``algorithms``, e.g. the MPC's solves and fallbacks), from a result folder's files (docs/optimal-mpc.md)."""
 
 from __future__ import annotations
@@ -10,25 +10,29 @@ from pathlib import Path
 
 from washbench.review.numbers import sig
 
-BOUND_FILE = "bound.csv"
+CEILING_FILE = "ceiling.csv"
 
-BOUND_CAVEAT = (
-    "The bound is the platform motion that minimises this cost (each pilot's perceived specific force and angular "
-    "velocity through the vestibular models, squared error, rotation weighted {rate:g} against force {force:g}) under "
-    "the platform's limits with the whole flight known in advance: no washout can do better **on this cost**. It is "
-    "optimal for this cost only, not for every metric: its score and metrics above (the `bound` rows: its motion "
-    "replayed through the platform model from rest, so its cost there is a little above the optimum) can be beaten "
-    "by a washout on a metric it does not minimise."
+CEILING_NOTE = (
+    "The ceiling is the least relative error that **any** motion of this platform could reach on this flight, with "
+    "the whole flight known: a certified lower bound on the ranking's own measure, per degree of freedom and for the "
+    "{measure} (a convex relaxation of everything the platform model can fly, docs/metrics.md: no washout can score "
+    "below it). It is loose where the relaxation is generous (tilt that costs no rotational cue, each DOF with the "
+    "whole of gravity), so the truly best motion lies between the ceiling and the `bound` row (an achieved motion, "
+    "planned with the whole flight known and replayed through the platform model). Recovered = (still - value) / "
+    "(still - ceiling): the share of what a platform standing still leaves that a washout recovers (100 %: the "
+    "ceiling; below 0: worse than standing still)."
 )
 
+_ORDER = ("score", "surge", "sway", "heave", "roll", "pitch", "yaw")
 
-def _read_bound(folder: Path) -> list[dict[str, str]]:
-    path = folder / BOUND_FILE
+
+def _read_ceiling(folder: Path) -> list[dict[str, str]]:
+    path = folder / CEILING_FILE
     if not path.is_file():
         return []
     try:
         with path.open(newline="") as f:
-            return [r for r in csv.DictReader(f) if r.get("washout")]
+            return [r for r in csv.DictReader(f) if r.get("washout") and r.get("dof")]
     except (OSError, csv.Error, UnicodeDecodeError):
         return []
 
@@ -53,53 +57,62 @@ def recovered_text(recovered: float) -> str:
     return "-" if not math.isfinite(recovered) else f"{100.0 * recovered:.0f} %"
 
 
-def bound_lines(folder: Path) -> list[str]:
-    """"This washout recovers X % of what is recoverable on this platform": every washout's cost beside the
-    bound's, from ``bound.csv``; empty when the bound did not run."""
-    rows = _read_bound(folder)
-    if not rows:
+def read_ceiling(folder: Path) -> dict[str, dict[str, dict[str, float]]]:
+    """``ceiling.csv`` of a result folder: washout -> dof (``score`` and the six DOFs) -> ``relative_error``,
+    ``ceiling``, ``recovered`` (NaN where empty); empty when the bound did not run."""
+    out: dict[str, dict[str, dict[str, float]]] = {}
+    for r in _read_ceiling(folder):
+        out.setdefault(r["washout"], {})[r["dof"]] = {k: _float(r.get(k)) for k in ("relative_error", "ceiling",
+                                                                                      "recovered")}  # fmt: skip
+    return out
+
+
+def _cell(cells: dict[str, float] | None) -> str:
+    if not cells or not math.isfinite(cells["relative_error"]):
+        return "-"
+    return f"{sig(cells['relative_error'])} ({recovered_text(cells['recovered'])})"
+
+
+def bound_lines(folder: Path, order: list[str] | None = None) -> list[str]:
+    """Every washout's relative error and recovered fraction, in total and per DOF, beside the ceiling, from
+    ``ceiling.csv``, the washouts in ``order`` (the ranking's; default the file's); empty when the bound did not
+    run."""
+    table = read_ceiling(folder)
+    if not table:
         return []
-    j_bound = _float(rows[0].get("cost_bound"))
-    j_still = _float(rows[0].get("cost_still"))
     rec = _run_json(folder).get("bound") or {}
-    weights = rec.get("weights") or {"force": 1.0, "rate": 10.0}
+    measure = str(rec.get("measure") or "score")
+    names = [w for w in (order or []) if w in table] + [w for w in table if w not in (order or [])]
+    first = next(iter(table.values()))
+    dofs = [d for d in _ORDER if d in first and math.isfinite(first[d]["ceiling"])]
     lines = [
-        "| washout | cost J (-) | recovers (of what is recoverable on this platform) |",
-        "|---|---|---|",
-    ]
-    above = []
-    for r in rows:
-        j = _float(r.get("cost"))
-        name = r["washout"]
-        label = f"{name} (replayed)" if name == "bound" else name
-        lines.append(f"| {label} | {sig(j)} | {recovered_text(_float(r.get('recovered')))} |")
-        if math.isfinite(j) and j < j_bound * (1.0 - 1e-6):
-            above.append(name)
-    lines += [
-        f"| **oracle bound** (optimum) | **{sig(j_bound)}** | 100 % |",
-        f"| _platform standing still_ | {sig(j_still)} | 0 % |",
+        "Relative error (recovered): per DOF the integral error over what the aircraft pilot felt there (1 = standing "
+        f"still), and the {measure}; DOFs the aircraft pilot did not feel are left out.",
         "",
+        "| washout | " + " | ".join(dofs) + " |",
+        "|---|" + "---|" * len(dofs),
     ]
-    best = [(r["washout"], _float(r.get("recovered"))) for r in rows if r["washout"] != "bound"]
-    best = [b for b in best if math.isfinite(b[1])]
-    if best:
-        name, frac = max(best, key=lambda b: b[1])
-        share = sig(100 * j_bound / j_still)
-        lines += [f"**{name} recovers {recovered_text(frac)} of what is recoverable on this platform** "
-                  f"(recovered = (J_still - J) / (J_still - J_bound); the bound's cost is {share} % of a still "
-                  "platform's).", ""]  # fmt: skip
-    elif j_still > 0 and math.isfinite(j_bound):
-        lines += ["Nothing is recoverable on this platform: the bound is no better than standing still.", ""]
+    for n in names:
+        label = f"{n} (replayed plan)" if n == "bound" else n
+        lines.append(f"| {label} | " + " | ".join(_cell(table[n].get(d)) for d in dofs) + " |")
+    lines.append("| **ceiling** | " + " | ".join(f"**{sig(first[d]['ceiling'])}** (100 %)" for d in dofs) + " |")
+    lines += ["| _platform standing still_ | " + " | ".join("1 (0 %)" for _ in dofs) + " |", ""]
+    ranked = [(n, table[n]["score"]["recovered"]) for n in names if n != "bound" and "score" in table[n]]
+    ranked = [r for r in ranked if math.isfinite(r[1])]
+    if ranked:
+        name, frac = max(ranked, key=lambda r: r[1])
+        lines += [f"**{name} recovers {recovered_text(frac)} of what this platform could recover on this flight** "
+                  f"(the ceiling's {measure}: {sig(first['score']['ceiling'])}).", ""]  # fmt: skip
     status = rec.get("solver_status") or {}
     bad = {k: v for k, v in status.items() if v != "Solved"}
     if bad:
-        lines += ["**The bound's solver did not converge on every channel** (" +
-                  ", ".join(f"{k}: {v}" for k, v in bad.items()) + "): its cost is not a proven bound.", ""]
-    if above:
-        lines += [f"**{', '.join(above)} below the bound**: one of them is wrong (the bound is a lower bound on "
-                  "every washout's cost).", ""]  # fmt: skip
-    force, rate = float(weights.get("force", 1.0)), float(weights.get("rate", 10.0))
-    return [*lines, BOUND_CAVEAT.format(force=force, rate=rate), ""]
+        lines += ["**The ceiling's solver did not converge on every DOF** (" +
+                  ", ".join(f"{k}: {v}" for k, v in bad.items()) + "): those ceilings are not certified.", ""]
+    below = rec.get("below_ceiling") or []
+    if below:
+        lines += [f"**{', '.join(below)} below the ceiling**: a defect (the ceiling is a lower bound on every "
+                  "motion of this platform); please report it.", ""]  # fmt: skip
+    return [*lines, CEILING_NOTE.format(measure=measure), ""]
 
 
 def _stat(v: object) -> str:
@@ -127,4 +140,4 @@ def algorithm_lines(folder: Path) -> list[str]:
     return lines
 
 
-__all__ = ["BOUND_CAVEAT", "algorithm_lines", "bound_lines", "recovered_text"]
+__all__ = ["CEILING_NOTE", "algorithm_lines", "bound_lines", "read_ceiling", "recovered_text"]

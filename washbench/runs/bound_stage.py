@@ -1,13 +1,16 @@
-"""The oracle bound and the Python washouts' own statistics in the outputs of ``run``, ``cue`` and ``suite``.
+"""The ceiling, the bound's replay and the Python washouts' own statistics in the outputs of ``run``, ``cue`` and
+``suite``.
 
-``--washout bound`` (opt-in, docs/optimal-mpc.md) adds, once the whole motion is known:
+``--washout bound`` (opt-in, docs/optimal-mpc.md, docs/metrics.md) adds, once the whole motion is known:
 
-- the bound's motion replayed through the platform model like any washout (:class:`washbench.analysis.bound.
-  BoundWashout`): its rows in ``metrics.csv``, its score in ``ranking.csv`` (no rank: it knows the future, and it is
-  optimal for its own cost, not for the score) and its columns in ``traces.parquet``;
-- ``bound.csv``: every washout's value of the bound's cost J (:func:`washbench.analysis.bound.washout_cost`) beside
-  the bound's own optimum and a still platform's, and the fraction of the recoverable cost it recovers,
-  ``recovered = (J_still - J) / (J_still - J_bound)``; the same in ``run.json`` (``bound``) and the report.
+- the bound's replay (:class:`washbench.analysis.bound.BoundWashout`, :mod:`washbench.analysis.bound_replay`): a
+  physical platform motion planned with the whole flight known, replayed through the platform model like any
+  washout: its rows in ``metrics.csv``, its score in ``ranking.csv`` (no rank: it knows the future) and its columns
+  in ``traces.parquet``;
+- ``ceiling.csv``: the ceiling of the flight on the ranking's own measure (:mod:`washbench.analysis.ceiling`: the
+  least relative error, per DOF and in the score, that any motion of the platform model can reach, certified) and
+  every washout's relative errors and recovered fractions beside it; the same in ``run.json`` (``bound``) and the
+  report.
 
 A ``run`` flies its washouts in lockstep with JSBSim; a washout that needs the whole recording
 (:func:`washbench.cueing.registry.whole_only`) is cued after the flight, on the flight read back
@@ -27,15 +30,17 @@ from typing import Any
 from washbench.analysis.ranking import BOUND_WASHOUT
 from washbench.cueing.registry import whole_only
 from washbench.io.atomic import write_text_atomic
-from washbench.io.columns import acc_columns, f_columns, omega_columns, omega_platform_columns, q_columns
 from washbench.io.csv_numbers import csv_number
 from washbench.runs.chain import analyse, from_lockstep, stacked_rows
 
-BOUND_FILE = "bound.csv"
-BOUND_COLUMNS = ("washout", "cost", "cost_bound", "cost_still", "recovered")
-"""``bound.csv``: per washout (the bound's replay through the platform included, as ``bound``) its cost J, the
-bound's optimum J_bound, a still platform's J_still (the same on every row) and the recovered fraction."""
-
+CEILING_FILE = "ceiling.csv"
+CEILING_COLUMNS = ("washout", "dof", "relative_error", "ceiling", "recovered")
+"""``ceiling.csv``: per washout (the bound's replay included, as ``bound``) one row for the ranking's value
+(``dof`` ``score``) and one per degree of freedom: its relative error (E_d / M_d, the score's terms), the ceiling
+there (the least any motion of this platform can reach, :mod:`washbench.analysis.ceiling`) and the fraction of what
+a still platform leaves to recover that it recovers, ``(still - value) / (still - ceiling)`` (still: 1 per DOF, the
+sum of the weights for the score). Empty cells: a DOF the aircraft pilot did not feel (no weight), or a rule with
+no ceiling (``false-cue``)."""
 
 def split_whole(specs: Sequence[Any]) -> tuple[list[Any], list[Any]]:
     """The washouts (``Washout`` variants) that run sample by sample, and those that need the whole recording."""
@@ -80,50 +85,87 @@ def bound_spec(specs: Sequence[Any]) -> Any | None:
 
 
 def bound_outputs(
-    folder: Path, traces_path: Path, dt_s: float, specs: Sequence[Any], limits: Any, vestibular: Any = None
+    folder: Path,
+    result: Any,
+    specs: Sequence[Any],
+    limits: Any,
+    vestibular: Any = None,
+    rule: Any = None,
+    filter_start: str = "steady",
 ) -> dict[str, Any] | None:
-    """When the bound runs: compute every washout's cost from ``traces_path`` (a finished traces.parquet), write
-    ``folder/bound.csv`` (atomically) and return the ``bound`` record for run.json; else None.
-
-    The bound is solved again here with a free start (any position, attitude and rate within the limits), which
-    every washout's trajectory satisfies: J_bound <= J of every washout. Its cost weights are the parameter file's
-    ``bound:`` section; ``vestibular`` the run's vestibular model (None: the default)."""
+    """When the bound runs: compute the ceiling of the flight (:func:`washbench.analysis.ceiling.ceiling`) on the
+    ranking's own measure, write ``folder/ceiling.csv`` (atomically) with every washout's relative errors, the
+    ceiling and the recovered fractions (total and per DOF), and return the ``bound`` record for run.json; else
+    None. ``result``: the run's :class:`washbench.runs.chain.CueResult` (metrics and the aircraft pilot's perceived
+    motion); ``rule``: the run's ranking rule (None: the default score)."""
     spec = bound_spec(specs)
     if spec is None:
         return None
-    import pyarrow.parquet as pq
+    from washbench.analysis.ceiling import ceiling  # deferred: scipy.sparse, clarabel
+    from washbench.analysis.metrics import DOFS
+    from washbench.analysis.ranking import DEFAULT_RULE, MOTION_FLOOR, perceived_motion, rule_values
 
-    from washbench.analysis.bound import BoundParams, costs_from_columns  # deferred: scipy.sparse
-
-    params = BoundParams.model_validate(spec.params.sections.get(BOUND_WASHOUT) or {})
+    rule = DEFAULT_RULE if rule is None else rule
+    dt_s = result.motion.dt_s
+    ac = result.perceived["aircraft"]
+    motion = perceived_motion(ac.f_mps2, ac.omega_radps, dt_s)
+    # the relaxation must hold every washout's head: the largest head offset any of them uses
+    offsets = [tuple(s.params.head.offset_m) for s in specs if hasattr(s.params, "head")]
+    offset = max(offsets, key=lambda o: math.hypot(*o)) if offsets else (0.0, 0.0, 0.0)
+    ceil = ceiling(ac.f_mps2, ac.omega_radps, dt_s, limits, spec.params.gravity_mps2, vestibular, filter_start,
+                   offset)  # fmt: skip
+    floor = ceil.relative(motion)
+    values, weights = rule_values(result.metrics, motion, rule)
+    scored = rule.by != "false-cue"
+    still = sum(weights.values()) if scored else math.nan
+    total_ceiling = sum(weights[d] * floor[d] for d in DOFS if weights[d] > 0.0) if scored else math.nan
+    by_key = {(r.washout, r.dof): r for r in result.metrics}
     names = [s.name for s in specs]
-    wanted = [*f_columns("aircraft"), *omega_columns("aircraft")]
+
+    def recovered(value: float, top: float, low: float) -> float:
+        span = top - low
+        return (top - value) / span if math.isfinite(value) and span > 0.0 else math.nan
+
+    table: dict[str, dict[str, dict[str, float]]] = {}
     for n in names:
-        wanted += [*acc_columns(n), *omega_platform_columns(n), *q_columns(n)]
-    table = pq.read_table(traces_path, columns=wanted)
-    cols = {c: table.column(c).to_numpy() for c in table.column_names}
-    res, costs = costs_from_columns(cols, dt_s, limits, spec.params.gravity_mps2, params, vestibular)
-    costs = {n: costs[n] for n in names}
-    recovered = {n: res.recovered(c) for n, c in costs.items()}
-    lines = [",".join(BOUND_COLUMNS)]
-    for n in names:
-        cells = (costs[n], res.cost, res.cost_still, recovered[n])
-        lines.append(",".join([n, *(csv_number(float(x)) for x in cells)]))
-    write_text_atomic(folder / BOUND_FILE, "\n".join(lines) + "\n")
+        rows = {"score": {"relative_error": values[n], "ceiling": total_ceiling,
+                          "recovered": recovered(values[n], still, total_ceiling)}}  # fmt: skip
+        for d in DOFS:
+            felt = motion[d] >= MOTION_FLOOR[d]
+            rel = by_key[(n, d)].integral_error / motion[d] if felt else math.nan
+            low = floor[d] if felt else math.nan
+            rows[d] = {"relative_error": rel, "ceiling": low, "recovered": recovered(rel, 1.0, low)}
+        table[n] = rows
+    lines = [",".join(CEILING_COLUMNS)]
+    for n, rows in table.items():
+        for dof, cells in rows.items():
+            lines.append(",".join([n, dof, *(csv_number(float(cells[c])) if math.isfinite(cells[c]) else ""
+                                             for c in CEILING_COLUMNS[2:])]))  # fmt: skip
+    write_text_atomic(folder / CEILING_FILE, "\n".join(lines) + "\n")
 
     def num(x: float) -> float | None:
         return float(x) if math.isfinite(x) else None
 
+    below = sorted({n for n, rows in table.items() for cells in rows.values()
+                    if math.isfinite(cells["relative_error"]) and math.isfinite(cells["ceiling"])
+                    and cells["relative_error"] < cells["ceiling"] - 1e-9 * max(1.0, cells["ceiling"])})  # fmt: skip
     return {
-        "cost_bound": res.cost,
-        "cost_still": res.cost_still,
-        "channel_costs": res.channel_costs,
-        "solver_status": res.statuses,
-        "weights": {"force": params.force_weight, "rate": params.rate_weight},
-        "costs": costs,
-        "recovered": {n: num(v) for n, v in recovered.items()},
-        "above_bound": [n for n, c in costs.items() if c < res.cost * (1.0 - 1e-6)],
+        "measure": rule.by,
+        "ceiling": {"score": num(total_ceiling), **{d: num(floor[d]) for d in DOFS}},
+        "floor_integral_error": {d: num(ceil.floor[d]) for d in DOFS},
+        "solver_status": ceil.status,
+        "relative_error": {n: {k: num(v["relative_error"]) for k, v in rows.items()} for n, rows in table.items()},
+        "recovered": {n: {k: num(v["recovered"]) for k, v in rows.items()} for n, rows in table.items()},
+        "below_ceiling": below,
     }
 
 
-__all__ = ["BOUND_COLUMNS", "BOUND_FILE", "bound_outputs", "bound_spec", "lockstep_result", "split_whole", "with_whole"]
+__all__ = [
+    "CEILING_COLUMNS",
+    "CEILING_FILE",
+    "bound_outputs",
+    "bound_spec",
+    "lockstep_result",
+    "split_whole",
+    "with_whole",
+]

@@ -225,8 +225,8 @@ def write_outputs(
                     "algorithms": dict(result.algorithms),
                 }
 
-                bound = bound_outputs(folder, tmp[TRACES_FILE], seg.motion.dt_s, run.washouts, run.limits,
-                                      run.vestibular_params)  # fmt: skip
+                bound = bound_outputs(folder, result, run.washouts, run.limits, run.vestibular_params,
+                                      run.rank_rule, run.filter_start)  # fmt: skip
                 extra |= {"bound": bound} if bound else {}
                 if provenance:
                     extra |= {"created_utc": created, "provenance": provenance}

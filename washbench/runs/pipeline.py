@@ -145,13 +145,13 @@ def write_cued_folder(
     traces.parquet, metrics.csv, recording.rrd, run.json, ranking.csv, report.md and figures/. Returns ``summary``
     completed with the steps, metrics and saturations. ``provenance`` (no date) goes into traces.parquet's
     metadata; ``extra`` into run.json. A washout that needs the whole recording (the oracle bound) is cued here
-    on the flight read back, and with the bound ``bound.csv`` is written (:mod:`washbench.runs.bound_stage`)."""
+    on the flight read back, and with the bound ``ceiling.csv`` is written (:mod:`washbench.runs.bound_stage`)."""
 
     motion = read_motion(folder / FLIGHT_FILE)
     result = lockstep_result(motion, rows, options)
-    traces_path, _ = write_results(folder, result, provenance)
-    bound = bound_outputs(folder, traces_path, motion.dt_s, options.washouts, options.limits,
-                          options.vestibular_params)  # fmt: skip
+    write_results(folder, result, provenance)
+    bound = bound_outputs(folder, result, options.washouts, options.limits, options.vestibular_params,
+                          options.rank_rule, options.filter_start)  # fmt: skip
     extra = {**(extra or {}), "bound": bound} if bound else extra
     if options.outputs.recording:
         title = f"{summary.aircraft} / {summary.manoeuvre}"

@@ -1,0 +1,178 @@
+"""The bound's replay: a physical Atlas motion planned with the whole flight known (the ``bound`` washout).
+
+Two stages, each a convex programme:
+
+1. **Attitude.** The linearised bound (:func:`washbench.analysis.bound.oracle_bound`, started level, centred and
+   still) plans the body rates of roll, pitch **and yaw** (tilt coordination in roll and pitch, the canals in all
+   three). The rates are integrated as the sphere integrates them (:func:`washbench.platform.kinematics.
+   track_rotation`, every rate and angular-acceleration limit kept), so the attitude ``R_k`` used below is the one
+   the platform will fly.
+2. **Translation, in the right frame.** With the attitude known, the simulator pilot's specific force
+   ``f_k = R_k^T (a_k - g_I)`` is linear in the stage's inertial acceleration ``a_k``: the stage's plan minimises
+   the ranking's own measure for specific force (the integral of |perceived error| over the felt DOFs, which the
+   score weighs equally within its group, :mod:`washbench.analysis.ranking`) plus a small jerk penalty
+   ``w_j dt sum |(a_k - a_{k-1}) / dt|^2`` (``BoundParams.jerk_weight``: no chatter), under the stage's exact
+   limits (0.1 % inside, position, velocity and acceleration per inertial axis, the discrete integrator
+   ``v_k = v_{k-1} + a_k dt``, ``p_k = p_{k-1} + v_k dt``), from rest at the centre and back at rest at the end.
+
+The replay is an achieved motion, not a bound: its score is an upper estimate of the best a washout with the whole
+flight known could do, the ceiling (:mod:`washbench.analysis.ceiling`) a certified lower one.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy import sparse
+
+from washbench.analysis.lp_rows import Rows, trapezoid
+from washbench.analysis.ranking import MOTION_FLOOR, perceived_motion
+from washbench.io.units import G0_MPS2
+from washbench.perception.vestibular import VestibularModel, VestibularParams, otolith_model
+from washbench.platform.limits import PlatformLimits
+
+UNFELT_WEIGHT = 0.01
+"""The weight of a specific-force DOF the aircraft pilot did not feel (the score gives it none; a little keeps the
+replay from moving freely there). CHOSEN."""
+
+
+def attitudes(angles: np.ndarray, yaw_rate: np.ndarray, dt_s: float, limits: PlatformLimits) -> tuple[np.ndarray, ...]:
+    """The attitude set points (N, 4), body to inertial, scalar first, of the planned roll and pitch angles (the
+    tilt: gravity in body axes is then the plan's, ``g [-sin theta, sin phi cos theta, cos phi cos theta]``) with the
+    heading the planned yaw rate (N,) rad/s turns (ZYX Euler angles), and the attitudes the sphere flies for them
+    (the platform's own rotation tracking, every limit kept, started still at the first set point)."""
+    from washbench.numerics.rotations import quat_from_euler  # deferred: numba
+    from washbench.platform.kinematics import track_rotation
+
+    rot = limits.rotation
+    w_max = math.radians(rot.rate_limit_degps)
+    alpha = math.radians(rot.acceleration_limit_degps2)
+    n = angles.shape[0]
+    yaw = np.cumsum(yaw_rate) * dt_s
+    q_sp = np.array([quat_from_euler(float(angles[k, 0]), float(angles[k, 1]), float(yaw[k])) for k in range(n)])
+    q = tuple(float(x) for x in q_sp[0])
+    w_prev = (0.0, 0.0, 0.0)
+    prev_sp = q
+    out = np.empty((n, 4))
+    q = (1.0, 0.0, 0.0, 0.0)
+    w_prev = (0.0, 0.0, 0.0)
+    prev_sp = q
+    for k in range(n):
+        sp = (float(q_sp[k, 0]), float(q_sp[k, 1]), float(q_sp[k, 2]), float(q_sp[k, 3]))
+        q, w_prev, _, _ = track_rotation(q, w_prev, prev_sp, sp, w_max, alpha, rot.catch_up_fraction, dt_s)
+        prev_sp = sp
+        out[k] = q
+    return q_sp, out
+
+
+def _rotation_matrices(q: np.ndarray) -> np.ndarray:
+    """R (N, 3, 3) body to inertial of quaternions (N, 4), scalar first."""
+    w, x, y, z = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
+    return np.stack(
+        [
+            np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], axis=-1),
+            np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], axis=-1),
+            np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], axis=-1),
+        ],
+        axis=1,
+    )
+
+
+def translation_plan(
+    f_air: np.ndarray,
+    q: np.ndarray,
+    dt_s: float,
+    limits: PlatformLimits,
+    gravity_mps2: float,
+    jerk_weight: float,
+    vestibular: VestibularParams | None = None,
+    filter_start: str = "steady",
+) -> tuple[np.ndarray, str]:
+    """Stage 2 (module docstring): the stage's positions (N, 3) m, NED, for the attitudes ``q`` (N, 4), and the
+    solver's status. ``f_air`` (N, 3) m/s^2 the aircraft pilot's specific force."""
+    import clarabel
+
+    vest = vestibular if vestibular is not None else VestibularParams()
+    n = f_air.shape[0]
+    dt = float(dt_s)
+    g = float(gravity_mps2)
+    model = VestibularModel(dt, vest)
+    ref = model.perceive(f_air, np.zeros_like(f_air), filter_start).f_mps2
+    felt = perceived_motion(ref, np.zeros_like(ref), dt)
+    oto = otolith_model(vest.otolith, dt)
+    b, phi, steady = oto.arrays()
+    ns = len(phi)
+    rmat = _rotation_matrices(q)  # (N, 3, 3): body -> inertial
+    gam = g * rmat[:, 2, :]  # R^T g_I: gravity in body axes (N, 3)
+    names = ("a", "v", "p", "t")
+    off = {nm: 3 * i * n for i, nm in enumerate(names)}
+    x0 = 3 * len(names) * n
+    nvar = x0 + 3 * ns * n
+
+    def idx(nm: str, ax: int) -> np.ndarray:
+        return off[nm] + ax * n + np.arange(n)
+
+    rows = Rows()
+    lim = limits.translation
+    relax = 0.999
+    k = np.arange(1, n)
+    for ax in range(3):
+        a, v, p = idx("a", ax), idx("v", ax), idx("p", ax)
+        rows.box(a, -lim.acceleration_limit_mps2.xyz[ax] * relax, lim.acceleration_limit_mps2.xyz[ax] * relax)
+        rows.box(v, -lim.velocity_limit_mps.xyz[ax] * relax, lim.velocity_limit_mps.xyz[ax] * relax)
+        rows.box(p, -lim.position_limit_m.xyz[ax] * relax, lim.position_limit_m.xyz[ax] * relax)
+        rows.add([(v[k], 1.0), (v[k - 1], -1.0), (a[k], -dt)], np.zeros(n - 1), equal=True)
+        rows.add([(p[k], 1.0), (p[k - 1], -1.0), (v[k], -dt)], np.zeros(n - 1), equal=True)
+        rows.add([(v[:1], 1.0), (a[:1], -dt)], np.zeros(1), equal=True)  # from rest, centred
+        rows.add([(p[:1], 1.0), (v[:1], -dt)], np.zeros(1), equal=True)
+        rows.add([(v[-1:], 1.0)], np.zeros(1), equal=True)  # at rest at the end
+    rest = filter_start == "rest"
+    cost = np.zeros(nvar)
+    trap = trapezoid(n, dt)
+    for bx in range(3):  # body axis: h_k = sum_j R_k[j, bx] a_k,j - gamma_k,bx
+        h_terms = [(idx("a", j), rmat[:, j, bx]) for j in range(3)]
+        h_const = -gam[:, bx]
+        for s in range(ns):
+            xs = x0 + (bx * ns + s) * n + np.arange(n)
+            if rest:
+                u_r = (0.0, 0.0, -G0_MPS2)[bx]
+                rhs0 = phi[s] * steady[s] * u_r + b[s, 1] * u_r + b[s, 0] * h_const[0]
+                rows.add([(xs[:1], 1.0), *[(i[:1], -b[s, 0] * c[:1]) for i, c in h_terms]], np.array([rhs0]), True)
+            else:
+                rows.add([(xs[:1], 1.0), *[(i[:1], -steady[s] * c[:1]) for i, c in h_terms]],
+                         np.array([steady[s] * h_const[0]]), True)  # fmt: skip
+            terms = [(xs[k], 1.0), (xs[k - 1], -phi[s])]
+            terms += [(i[k], -b[s, 0] * c[k]) for i, c in h_terms]
+            terms += [(i[k - 1], -b[s, 1] * c[k - 1]) for i, c in h_terms]
+            rows.add(terms, b[s, 0] * h_const[k] + b[s, 1] * h_const[k - 1], True)
+        y_terms = [(x0 + (bx * ns + s) * n + np.arange(n), 1.0) for s in range(ns)]
+        t = idx("t", bx)
+        rows.add([*y_terms, (t, -1.0)], ref[:, bx].copy(), equal=False)
+        rows.add([*[(i, -c) for i, c in y_terms], (t, -1.0)], -ref[:, bx], equal=False)
+        dof = ("surge", "sway", "heave")[bx]
+        weight = 1.0 if felt[dof] >= MOTION_FLOOR[dof] else UNFELT_WEIGHT
+        cost[t] = weight * trap
+    a_mat, b_vec, n_eq, n_le = rows.matrices(nvar)
+    pr, pc, pv = [], [], []
+    if jerk_weight > 0.0 and n > 1:
+        cj = 2.0 * jerk_weight / dt
+        for ax in range(3):
+            a = idx("a", ax)
+            pr += [a[:-1], a[1:], a[:-1]]
+            pc += [a[:-1], a[1:], a[1:]]
+            pv += [np.full(n - 1, cj)] * 2 + [np.full(n - 1, -cj)]
+    pmat = (sparse.csc_matrix((np.concatenate(pv), (np.concatenate(pr), np.concatenate(pc))), shape=(nvar, nvar))
+            if pr else sparse.csc_matrix((nvar, nvar)))  # fmt: skip
+    settings = clarabel.DefaultSettings()
+    settings.verbose = False
+    settings.max_iter = 200
+    settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = 1e-8
+    cones = [clarabel.ZeroConeT(n_eq), clarabel.NonnegativeConeT(n_le)]
+    sol = clarabel.DefaultSolver(sparse.triu(pmat, format="csc"), cost, a_mat, b_vec, cones, settings).solve()
+    z = np.asarray(sol.x, dtype=np.float64)
+    pos = np.column_stack([z[idx("p", ax)] for ax in range(3)])
+    return pos, str(sol.status)
+
+
+__all__ = ["UNFELT_WEIGHT", "attitudes", "translation_plan"]

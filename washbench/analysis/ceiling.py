@@ -1,0 +1,261 @@
+"""The ceiling: a certified lower bound on the ranking's own measure, over every motion the Atlas model can make.
+
+The ranking scores a washout by ``score = sum_d w_d E_d / M_d`` (:mod:`washbench.analysis.ranking`): ``E_d`` the
+integral of |perceived error| in DOF d (trapezoid rule), ``M_d`` the aircraft pilot's own perceived motion there,
+``w_d`` weights from ``M_d`` alone. The weights and ``M_d`` do not depend on the platform, and the score is a sum
+over DOFs, so
+
+    min over platform motions of score  >=  sum_d w_d min_d E_d / M_d
+
+and each ``min_d E_d`` is bounded below by a linear programme over a **relaxation** of what the platform can do
+in that DOF. A relaxation contains every head-motion trace the platform model can produce; its minimum is therefore
+at most every washout's ``E_d``, whatever the washout (classical, optimal, MPC, a plugin, the bound's own replay).
+The ceiling of a DOF is ``r_d = min E_d / M_d``; the ceiling of the score is ``sum_d w_d r_d``.
+
+The relaxation of one DOF (docs/metrics.md, "The ceiling", derives each line). Body axes (x forward, y right,
+z down), inertial NED, the Atlas stage's limits per inertial axis ``p_max, v_max, a_max`` (m, m/s, m/s^2), the
+sphere's rate and angular-acceleration limits ``w_max`` (rad/s), ``alpha_max`` (rad/s^2), step ``dt``:
+
+* rotation (roll, pitch, yaw; the canal input is the head's angular velocity ``omega``, the platform's body rate):
+  ``|omega_k| <= w_max``, ``|omega_k - omega_{k-1}| <= alpha_max dt`` (one component of the sphere's norm limits);
+* specific force (surge, sway, heave; the otolith input is ``f = R^T (a - g_I)``): ``f_k = b_k - gamma_k`` with
+
+  - ``gamma = R^T g_I`` (gravity in body axes): ``|gamma_k| <= g``, ``|gamma_k - gamma_{k-1}| <= 2 g sin(w_max dt
+    / 2)`` (a unit vector turned by at most ``w_max dt`` per step);
+  - ``b = R^T a`` (the stage's acceleration in body axes), ``V = R^T v``, ``P = R^T p``: ``|b_k| <= |a_max|``,
+    ``|V_k| <= |v_max|``, ``|P_k| <= |p_max|`` (norms of the limit boxes' corners), and the stage's integrator
+    in the turning frame, ``V_k = V_{k-1} + b_k dt + e_k``, ``P_k = P_{k-1} + V_k dt + d_k`` with
+    ``|e_k| <= 2 sin(w_max dt / 2) |v_max|`` and ``|d_k| <= 2 sin(w_max dt / 2) |p_max|`` (what the frame's turn
+    over one step can add), the stage starting centred and at rest (``P_{-1} = V_{-1} = 0``, as the model starts);
+  - a head away from the sphere's centre (``r`` != 0) adds ``dw/dt x r + w x (w x r)``: a term of norm at most
+    ``|r| (alpha_max + w_max^2)``;
+
+* the vestibular model's sections (:class:`washbench.perception.vestibular.DiscreteModel`) exactly as the metrics
+  apply them, started as the metrics start them (the steady state of the first sample, or a pilot at rest).
+
+What it does not charge (so where it is loose, docs/metrics.md): tilting costs no rotational cue (gravity's
+direction and the canal input are separate variables), every DOF may use the whole of gravity and of the stage,
+and the turning frame's terms are bounded by the largest turn, not by the turn actually made.
+
+The LPs are solved by Clarabel (interior point); the bound taken is the dual objective (weak duality: a valid
+lower bound of the LP whatever the solver's last iterate), made a little smaller for its tolerance.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import sparse
+
+from washbench.analysis.lp_rows import Rows as _Rows
+from washbench.analysis.lp_rows import trapezoid as _trapezoid
+from washbench.analysis.metrics import DOFS
+from washbench.io.units import G0_MPS2
+from washbench.perception.vestibular import (
+    DiscreteModel,
+    VestibularParams,
+    canal_model,
+    otolith_model,
+)
+from washbench.platform.limits import PlatformLimits
+
+CEILING_TOL = 1e-9
+"""The interior-point solver's gap and feasibility tolerances (relative)."""
+
+
+@dataclass(frozen=True)
+class Ceiling:
+    """The ceiling of one flight: per DOF the least integral error any platform motion can reach (``floor``, in
+    the units of ``metrics.csv``: m/s^2*s, deg) and its solver status."""
+
+    floor: dict[str, float]
+    status: dict[str, str]
+
+    def relative(self, motion: Mapping[str, float]) -> dict[str, float]:
+        """``r_d = floor_d / M_d`` (NaN where the DOF was not felt: ``M_d`` 0)."""
+        return {d: (self.floor[d] / motion[d] if motion.get(d, 0.0) > 0.0 else math.nan) for d in DOFS}
+
+
+def _sections(model: DiscreteModel) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    b, phi, steady = model.arrays()
+    return b, phi, steady
+
+
+def _perception_rows(
+    rows: _Rows,
+    u: np.ndarray,
+    x0: int,
+    t0: int,
+    n: int,
+    model: DiscreteModel,
+    reference: np.ndarray,
+    scale: float,
+    rest_input: float | None,
+) -> None:
+    """The model's sections driven by input variables ``u`` (indices, length n) with states at ``x0 + s n + k``,
+    and ``t_k >= |scale * y_k - reference_k|`` with ``t`` at ``t0 + k``."""
+    b, phi, steady = _sections(model)
+    ns = len(phi)
+    k = np.arange(1, n)
+    for s in range(ns):
+        xs = x0 + s * n + np.arange(n)
+        if rest_input is None:  # x_0 = steady u_0
+            rows.add([(xs[:1], 1.0), (u[:1], -steady[s])], np.zeros(1), equal=True)
+        else:  # from the rest state, the input ramping from rest to u_0 over the step before the first sample
+            rhs = np.array([phi[s] * steady[s] * rest_input + b[s, 1] * rest_input])
+            rows.add([(xs[:1], 1.0), (u[:1], -b[s, 0])], rhs, equal=True)
+        rows.add([(xs[k], 1.0), (xs[k - 1], -phi[s]), (u[k], -b[s, 0]), (u[k - 1], -b[s, 1])], np.zeros(n - 1),
+                 equal=True)  # fmt: skip
+    t = t0 + np.arange(n)
+    y_terms = [(x0 + s * n + np.arange(n), scale) for s in range(ns)]
+    rows.add([*y_terms, (t, -1.0)], reference.copy(), equal=False)
+    rows.add([*[(i, -c) for i, c in y_terms], (t, -1.0)], -reference, equal=False)
+
+
+def _solve(c: np.ndarray, rows: _Rows, nvar: int) -> tuple[float, str]:
+    import clarabel
+
+    a, b, n_eq, n_le = rows.matrices(nvar)
+    settings = clarabel.DefaultSettings()
+    settings.verbose = False
+    settings.max_iter = 200
+    settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = CEILING_TOL
+    settings.tol_ktratio = 1e-8
+    cones = [clarabel.ZeroConeT(n_eq), clarabel.NonnegativeConeT(n_le)]
+    p = sparse.csc_matrix((nvar, nvar))
+    sol = clarabel.DefaultSolver(p, c, a, b, cones, settings).solve()
+    status = str(sol.status)
+    if status != "Solved":
+        return math.nan, status
+    dual = float(sol.obj_val_dual)
+    # the dual objective is a lower bound of the LP; the tolerance may still leave it a hair above the optimum
+    return max(0.0, dual - CEILING_TOL * max(1.0, abs(dual))), status
+
+
+def translational_floor(
+    reference: np.ndarray,
+    axis: int,
+    dt_s: float,
+    limits: PlatformLimits,
+    gravity_mps2: float,
+    model: DiscreteModel,
+    rest_start: bool,
+    head_offset_m: float = 0.0,
+) -> tuple[float, str]:
+    """The least integral of |perceived specific-force error| (m/s^2*s) on body axis ``axis`` over the relaxation
+    (module docstring); ``reference`` (N,) the aircraft pilot's perceived specific force on that axis, m/s^2."""
+    n = len(reference)
+    dt = float(dt_s)
+    g = float(gravity_mps2)
+    t = limits.translation
+    rot = limits.rotation
+    w_max = math.radians(rot.rate_limit_degps)
+    alpha = math.radians(rot.acceleration_limit_degps2)
+    chord = 2.0 * math.sin(min(w_max * dt, math.pi) / 2.0)
+    a_bar = math.hypot(*t.acceleration_limit_mps2.xyz)
+    v_bar = math.hypot(*t.velocity_limit_mps.xyz)
+    p_bar = math.hypot(*t.position_limit_m.xyz)
+    o_bar = abs(head_offset_m) * (alpha + w_max * w_max)
+    ns = len(model.phi)
+    names = ["f", "gam", "V", "P", "o", "t"]
+    off = {nm: i * n for i, nm in enumerate(names)}
+    x0 = len(names) * n
+    nvar = x0 + ns * n
+    idx = {nm: off[nm] + np.arange(n) for nm in names}
+    rows = _Rows()
+    k = np.arange(1, n)
+    # b = f + gamma - o (the stage's acceleration in body axes)
+    f, gam, vv, pp, o = idx["f"], idx["gam"], idx["V"], idx["P"], idx["o"]
+    rows.box(gam, -g, g)
+    rows.box(o, -o_bar, o_bar)
+    rows.add([(gam[k], 1.0), (gam[k - 1], -1.0)], np.full(n - 1, g * chord), equal=False)
+    rows.add([(gam[k], -1.0), (gam[k - 1], 1.0)], np.full(n - 1, g * chord), equal=False)
+    rows.add([(f, 1.0), (gam, 1.0), (o, -1.0)], np.full(n, a_bar), equal=False)
+    rows.add([(f, -1.0), (gam, -1.0), (o, 1.0)], np.full(n, a_bar), equal=False)
+    rows.box(vv, -v_bar, v_bar)
+    rows.box(pp, -p_bar, p_bar)
+    ev = chord * v_bar
+    ep = chord * p_bar
+    # V_k - V_{k-1} - dt b_k in [-ev, ev], V_{-1} = 0 (and its first step: the frame has not turned a moving stage)
+    for sign in (1.0, -1.0):
+        rows.add([(vv[k], sign), (vv[k - 1], -sign), (f[k], -sign * dt), (gam[k], -sign * dt), (o[k], sign * dt)],
+                 np.full(n - 1, ev), equal=False)  # fmt: skip
+        rows.add([(pp[k], sign), (pp[k - 1], -sign), (vv[k], -sign * dt)], np.full(n - 1, ep), equal=False)
+    rows.add([(vv[:1], 1.0), (f[:1], -dt), (gam[:1], -dt), (o[:1], dt)], np.zeros(1), equal=True)
+    rows.add([(pp[:1], 1.0), (vv[:1], -dt)], np.zeros(1), equal=True)
+    rest_input = float(np.array((0.0, 0.0, -G0_MPS2))[axis]) if rest_start else None
+    _perception_rows(rows, f, x0, off["t"], n, model, np.asarray(reference, dtype=np.float64), 1.0, rest_input)
+    c = np.zeros(nvar)
+    c[idx["t"]] = _trapezoid(n, dt)
+    return _solve(c, rows, nvar)
+
+
+def rotational_floor(
+    reference_radps: np.ndarray,
+    dt_s: float,
+    limits: PlatformLimits,
+    model: DiscreteModel,
+    rest_start: bool,
+) -> tuple[float, str]:
+    """The least integral of |perceived angular-velocity error| (deg) on one body axis over the relaxation;
+    ``reference_radps`` (N,) the aircraft pilot's perceived angular velocity on that axis, rad/s."""
+    n = len(reference_radps)
+    dt = float(dt_s)
+    rot = limits.rotation
+    slack = 1.0 + 1e-9  # the platform's rounding
+    w_max = math.radians(rot.rate_limit_degps) * slack
+    dw = math.radians(rot.acceleration_limit_degps2) * dt * slack
+    ns = len(model.phi)
+    w = np.arange(n)
+    t0 = n
+    x0 = 2 * n
+    nvar = x0 + ns * n
+    rows = _Rows()
+    k = np.arange(1, n)
+    rows.box(w, -w_max, w_max)
+    rows.add([(w[k], 1.0), (w[k - 1], -1.0)], np.full(n - 1, dw), equal=False)
+    rows.add([(w[k], -1.0), (w[k - 1], 1.0)], np.full(n - 1, dw), equal=False)
+    deg = math.degrees(1.0)
+    ref_deg = np.degrees(np.asarray(reference_radps, dtype=np.float64))
+    _perception_rows(rows, w, x0, t0, n, model, ref_deg, deg, 0.0 if rest_start else None)
+    c = np.zeros(nvar)
+    c[t0 : t0 + n] = _trapezoid(n, dt)
+    return _solve(c, rows, nvar)
+
+
+def ceiling(
+    perceived_f_mps2: np.ndarray,
+    perceived_omega_radps: np.ndarray,
+    dt_s: float,
+    limits: PlatformLimits,
+    gravity_mps2: float,
+    vestibular: VestibularParams | None = None,
+    filter_start: str = "steady",
+    head_offset_m: tuple[float, float, float] = (0.0, 0.0, 0.0),
+) -> Ceiling:
+    """The ceiling of a flight from the aircraft pilot's perceived motion (N, 3) each (module docstring).
+
+    Raises ValueError for perception thresholds (a dead band makes the error non-convex in the head motion: the
+    ceiling is not defined for them)."""
+    vest = vestibular if vestibular is not None else VestibularParams()
+    if vest.thresholds is not None:
+        raise ValueError("the ceiling is not defined with perception thresholds (a dead band)")
+    oto = otolith_model(vest.otolith, dt_s)
+    can = canal_model(vest.canals, dt_s)
+    rest = filter_start == "rest"
+    r = math.hypot(*head_offset_m)
+    floor: dict[str, float] = {}
+    status: dict[str, str] = {}
+    for axis, dof in enumerate(DOFS[:3]):
+        floor[dof], status[dof] = translational_floor(
+            perceived_f_mps2[:, axis], axis, dt_s, limits, gravity_mps2, oto, rest, r
+        )
+    for axis, dof in enumerate(DOFS[3:]):
+        floor[dof], status[dof] = rotational_floor(perceived_omega_radps[:, axis], dt_s, limits, can, rest)
+    return Ceiling(floor=floor, status=status)
+
+
+__all__ = ["CEILING_TOL", "Ceiling", "ceiling", "rotational_floor", "translational_floor"]
