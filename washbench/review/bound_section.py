@@ -73,10 +73,10 @@ def _cell(cells: dict[str, float] | None) -> str:
     return f"{sig(cells['relative_error'])} ({recovered_text(cells['recovered'])})"
 
 
-def bound_lines(folder: Path, order: list[str] | None = None) -> list[str]:
+def bound_lines(folder: Path, order: list[str] | None = None, explain: bool = True) -> list[str]:
     """Every washout's relative error and recovered fraction, in total and per DOF, beside the ceiling, from
     ``ceiling.csv``, the washouts in ``order`` (the ranking's; default the file's); empty when the bound did not
-    run."""
+    run. ``explain=False`` (the suite report, which explains once): without :data:`CEILING_NOTE`."""
     table = read_ceiling(folder)
     if not table:
         return []
@@ -89,6 +89,8 @@ def bound_lines(folder: Path, order: list[str] | None = None) -> list[str]:
         "Relative error (recovered): per DOF the integral error over what the aircraft pilot felt there (1 = standing "
         f"still), and the {measure}; DOFs the aircraft pilot did not feel are left out.",
         "",
+    ] if explain else []
+    lines += [
         "| washout | " + " | ".join(dofs) + " |",
         "|---|" + "---|" * len(dofs),
     ]
@@ -112,7 +114,7 @@ def bound_lines(folder: Path, order: list[str] | None = None) -> list[str]:
     if below:
         lines += [f"**{', '.join(below)} below the ceiling**: a defect (the ceiling is a lower bound on every "
                   "motion of this platform); please report it.", ""]  # fmt: skip
-    return [*lines, CEILING_NOTE.format(measure=measure), ""]
+    return [*lines, CEILING_NOTE.format(measure=measure), ""] if explain else lines
 
 
 def _stat(v: object) -> str:

@@ -180,9 +180,11 @@ def end_stop_note(data: ResultData, washout: str) -> str:
             f"({pct(100.0 * steps / data.n, False)}), the score reflects its hard stops")  # fmt: skip
 
 
-def ranking_lines(data: ResultData, ranking: list[RankRow], rule: RankRule = DEFAULT_RULE) -> list[str]:
+def ranking_lines(
+    data: ResultData, ranking: list[RankRow], rule: RankRule = DEFAULT_RULE, explain: bool = True
+) -> list[str]:
     """Ranking table (rank, washout, the rule's value, and a note where end stops dominate), the rule with its tie
-    margin and the DOF weights used."""
+    margin and the DOF weights used. ``explain=False`` (the suite report, which explains once): the weights only."""
     if not ranking:
         return []
     unit = "false-cue time (DOF lengths)" if rule.by == "false-cue" else "score (-)"
@@ -202,6 +204,12 @@ def ranking_lines(data: ResultData, ranking: list[RankRow], rule: RankRule = DEF
         lines = [f"| rank | washout | {unit} |", "|---|---|---|"]
         lines += [f"| {rank_cell(r)} | {r.washout} | {value(r)} |" for r in ranking]
     weights = ranking[0].weights
+    if not explain:
+        if undecided(ranking):
+            lines += ["", "**The first place is a tie**."]
+        if rule.by != "false-cue":
+            lines += ["", "Weights: " + ", ".join(f"{d} {sig(weights[d], 2)}" for d in DOFS) + "."]
+        return [*lines, ""]
     lines += ["", f"Ranked by {rule.label()}."]
     if undecided(ranking):
         lines += ["", "**The first place is a tie**: the best values differ by less than the tie margin."]
@@ -266,23 +274,47 @@ def metric_tables(data: ResultData) -> list[str]:
     return lines
 
 
-def cue_lines(data: ResultData) -> list[str]:
-    """Time fractions of correct, scaled, false and missing cues per washout and DOF, and the false-cue events."""
+CUE_NOTE = (
+    "Percent of the manoeuvre's time (docs/fidelity.md): a cue is correct when both pilots feel the DOF (above "
+    f"the Zacharias threshold) in the same direction with a magnitude ratio within {SCALE_BAND[0]:g}-"
+    f"{SCALE_BAND[1]:g}, scaled outside that ratio, false when the simulator pilot feels motion the aircraft "
+    "pilot does not or in the opposite direction, missing when the aircraft pilot feels motion the simulator "
+    "pilot does not."
+)
+
+MSDV_NOTE = (
+    "Motion sickness dose value MSDV = sqrt(integral a_w^2 dt) of the vertical acceleration at the head, "
+    "weighted by ISO 2631-1 Wf (peak near 0.16 Hz), over the manoeuvre (docs/fidelity.md). Lower is better; "
+    "a simulator pilot above the aircraft pilot gets more vertical low-frequency motion than the flight had."
+)
+
+MSI_NOTE = (
+    "MSI: motion-sickness incidence (% who would vomit) the 6-DOF subjective vertical conflict model "
+    "(Inoue, Liu and Wada 2023, after Bos and Bles 1998) predicts at the end of the manoeuvre, from all six "
+    "DOFs of the head motion. It builds up with a 12-min second-order lag, so a manoeuvre of minutes gives "
+    "small numbers: compare the pilots, not the value with an exposure of hours (docs/fidelity.md)."
+)
+
+PERCEIVED_NOTE = (
+    "Aircraft pilot (wide solid line) against each washout's simulator pilot (each its own colour and dash); "
+    "grey band: the perception thresholds (Zacharias 1978) around the pilot's resting value (what was perceived "
+    "at the start), what lies inside it is not felt; shaded: the phases."
+)
+
+
+def cue_lines(data: ResultData, explain: bool = True) -> list[str]:
+    """Time fractions of correct, scaled, false and missing cues per washout and DOF, and the false-cue events
+    (``explain=False``: without :data:`CUE_NOTE`)."""
 
     rows = [m for m in data.metrics if not math.isnan(m.cue_false_frac)]
     if not rows:
         return ["_This result was written before the cue classification: `washbench cue` it again for it._", ""]
-    lines = [
-        "Percent of the manoeuvre's time (docs/fidelity.md): a cue is correct when both pilots feel the DOF (above "
-        f"the Zacharias threshold) in the same direction with a magnitude ratio within {SCALE_BAND[0]:g}-"
-        f"{SCALE_BAND[1]:g}, scaled outside that ratio, false when the simulator pilot feels motion the aircraft "
-        "pilot does not or in the opposite direction, missing when the aircraft pilot feels motion the simulator "
-        "pilot does not.",
-        "",
+    lines = [CUE_NOTE, ""] if explain else []
+    lines += [] if not explain else [
         "| washout | DOF | correct (%) | scaled (%) | false (%) | missing (%) | false-cue events |",
         "|---|---|---|---|---|---|---|",
     ]
-    for m in rows:
+    for m in rows if explain else []:  # the suite report: the total here, the table in the result's own report
         events = parse_events(m.false_cue_events, m.dof)
         longest = max(events, key=lambda e: e.end_s - e.start_s, default=None)
         ev = f"{len(events)}" + (f" (longest {sig(longest.start_s)}-{sig(longest.end_s)} s, peak "
@@ -291,30 +323,22 @@ def cue_lines(data: ResultData) -> list[str]:
         lines.append(f"| {m.washout} | {m.dof} | " + " | ".join(sig(100.0 * c) for c in cells) + f" | {ev} |")
     washouts = dict.fromkeys(r.washout for r in rows)
     false_time = {w: sum(m.cue_false_frac for m in rows if m.washout == w) for w in washouts}
-    lines += ["", "False-cue time (sum over DOFs, manoeuvre lengths): "
+    lines += [""] if explain else ["False-cue time per DOF and events: in the result's own report.", ""]
+    lines += ["False-cue time (sum over DOFs, manoeuvre lengths): "
               + ", ".join(f"{w} {sig(v)}" for w, v in false_time.items()) + ".", ""]  # fmt: skip
     return lines
 
 
-def sickness_lines(data: ResultData) -> list[str]:
+def sickness_lines(data: ResultData, explain: bool = True) -> list[str]:
     """MSDV (ISO 2631-1 Wf) of the vertical motion at each pilot's head and the SVC model's MSI (the heave rows of
-    metrics.csv; a result written before the MSI shows the MSDV alone)."""
+    metrics.csv; a result written before the MSI shows the MSDV alone); ``explain=False``: without the notes."""
     heave = [m for m in data.metrics if m.dof == "heave" and not math.isnan(m.msdv_mps15)]
     if not heave:
         return ["_This result was written before the motion sickness dose: `washbench cue` it again for it._", ""]
-    lines = [
-        "Motion sickness dose value MSDV = sqrt(integral a_w^2 dt) of the vertical acceleration at the head, "
-        "weighted by ISO 2631-1 Wf (peak near 0.16 Hz), over the manoeuvre (docs/fidelity.md). Lower is better; "
-        "a simulator pilot above the aircraft pilot gets more vertical low-frequency motion than the flight had.",
-        "",
-    ]
+    lines = [MSDV_NOTE, ""] if explain else []
     if any(not math.isnan(m.msi_pct) for m in heave):
+        lines += [MSI_NOTE, ""] if explain else []
         lines += [
-            "MSI: motion-sickness incidence (% who would vomit) the 6-DOF subjective vertical conflict model "
-            "(Inoue, Liu and Wada 2023, after Bos and Bles 1998) predicts at the end of the manoeuvre, from all six "
-            "DOFs of the head motion. It builds up with a 12-min second-order lag, so a manoeuvre of minutes gives "
-            "small numbers: compare the pilots, not the value with an exposure of hours (docs/fidelity.md).",
-            "",
             "| pilot | MSDV (m/s^1.5) | MSI (%) |",
             "|---|---|---|",
             f"| aircraft | {sig(heave[0].msdv_aircraft_mps15)} | {sig(heave[0].msi_aircraft_pct)} |",
@@ -446,26 +470,21 @@ def result_sections(
     lines: list[str] = []
     rule = result_rule(data)
     ranking = rank(data.metrics, data.motion, rule) if data.metrics else []
-    lines += [f"{h} Ranking", "", *ranking_lines(data, ranking, rule)]
+    lines += [f"{h} Ranking", "", *ranking_lines(data, ranking, rule, explain=not brief)]
 
-    if bounded := bound_lines(data.folder, [r.washout for r in ranking]):
+    if bounded := bound_lines(data.folder, [r.washout for r in ranking], explain=not brief):
         lines += [f"{h} Against the ceiling", "", *bounded]
     if solver := algorithm_lines(data.folder):
         lines += [f"{h} Solver statistics", "", *solver]
     lines += [f"{h} Perceived motion", ""]
-    lines += [
-        "Aircraft pilot (wide solid line) against each washout's simulator pilot (each its own colour and dash); "
-        "grey band: the perception thresholds (Zacharias 1978) around the pilot's resting value (what was perceived "
-        "at the start), what lies inside it is not felt; shaded: the phases.",
-        "",
-    ]
+    lines += [PERCEIVED_NOTE, ""] if not brief else []
     lines += (
         _image(figures["perceived"], start, "perceived motion", vector) if "perceived" in figures else [NO_FIGURES, ""]
     )
-    lines += [f"{h} Cues: correct, scaled, false, missing", "", *cue_lines(data)]
+    lines += [f"{h} Cues: correct, scaled, false, missing", "", *cue_lines(data, explain=not brief)]
     if "cues" in figures:
         lines += _image(figures["cues"], start, "false and missing cues", vector)
-    lines += [f"{h} Motion sickness dose", "", *sickness_lines(data)]
+    lines += [f"{h} Motion sickness dose", "", *sickness_lines(data, explain=not brief)]
     lines += [f"{h} Metrics", "", *metric_tables(data)]
     lines += [f"{h} Platform", ""]
     if brief:

@@ -25,17 +25,21 @@ from washbench.analysis.ranking import (
     reference_washout,
     rule_from_record,
     undecided,
-    wins,
 )
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
 from washbench.io.outfolder import discard_stage, make_stage, replace_entries
 from washbench.io.readback import SuiteDoc, read_doc, suite_member
 from washbench.io.result_files import FIGURES_DIR, METRICS_FILE, RECORDING_FILE, REPORT_FILE, SUITE_FILE
+from washbench.review.bound_section import CEILING_NOTE, read_ceiling
 from washbench.review.figures import score_heatmap, table4_figure
 from washbench.review.numbers import sig
 from washbench.review.report import (
+    CUE_NOTE,
     FLAG,
+    MSDV_NOTE,
+    MSI_NOTE,
+    PERCEIVED_NOTE,
     SCORE_NOTE,
     _image,
     _rel,
@@ -44,6 +48,7 @@ from washbench.review.report import (
     write_result_report,
 )
 from washbench.review.result_data import ResultData, is_result_folder, load_result
+from washbench.review.verdict import Entry, verdict_lines
 
 _HOW_TO_READ = [
     "Metrics compare the aircraft pilot's perceived motion with each simulator pilot's, per degree of freedom: NPC",
@@ -176,6 +181,12 @@ def _write_suite_report(
     lines = ["# washbench suite report", ""]
     lines.append(f"{len(ok)} of {len(results)} manoeuvres ran and passed their checks.")
     lines.append("")
+    verdict = [
+        Entry(label=d.title, group=d.title.partition(" / ")[2] or d.title, ranking=rankings[id(d)],
+              metrics=d.metrics, motion=d.motion, ceiling=read_ceiling(d.folder))
+        for d in loaded
+    ]  # fmt: skip
+    lines += verdict_lines(verdict, washouts, reference)
     failed = [(e, d) for e, d in results if not e.get("ok", d.ok if d else False)]
     if failed:
         lines += ["## Failures", ""]
@@ -216,14 +227,11 @@ def _write_suite_report(
                      + " | ".join(cells) + f" | [report.md]({rel}/{REPORT_FILE}) | {rec} |")  # fmt: skip
     lines.append("")
     if rankings:
-        count = wins(rankings.values())
-        lines += ["Manoeuvres won (a shared first place counts for each): "
-                  + ", ".join(f"{w} {n}" for w, n in count.items()) + ".", ""]  # fmt: skip
         n_tied = sum(1 for r in rankings.values() if undecided(r))
         n_any = sum(1 for r in rankings.values() if any(x.tied for x in r))
-        lines += [f"Ranked by {rule.label()}. **{n_tied} of {len(rankings)} rankings are decided by less than that "
-                  f"margin** (first place shared); {n_any} have a tie at some rank. Shared ranks are marked "
-                  "\"(tie)\" in the reports, `tied` in `ranking.csv` and \"tie:\" in the score figure's row "
+        lines += [f"Ranked by {rule.label()}. First place shared (decided by less than that margin): {n_tied} of "
+                  f"{len(rankings)} manoeuvres; a tie at some rank: {n_any} of {len(rankings)}. Shared ranks are "
+                  "marked \"(tie)\" in the reports, `tied` in `ranking.csv` and \"tie:\" in the score figure's row "
                   "labels.", ""]  # fmt: skip
     if any_above:
         lines += [SCORE_NOTE, ""]
@@ -236,7 +244,10 @@ def _write_suite_report(
                   f"{reference} value (positive, green: better). Absolute differences are in "
                   "`comparison.csv`.", ""]  # fmt: skip
         lines += _image(suite_dir / drawn["table4"].relative_to(stage), suite_dir, "Table 4", regenerate_results)
-    lines += ["## How to read the numbers", "", *_HOW_TO_READ]
+    lines += ["## How to read the numbers", "", *_HOW_TO_READ, f"Ranked by {rule.label()}.", "",
+              PERCEIVED_NOTE, "", CUE_NOTE, "", MSDV_NOTE, "", MSI_NOTE, ""]  # fmt: skip
+    if any(e.ceiling for e in verdict):
+        lines += [CEILING_NOTE.format(measure=rule.by), ""]
     for d in loaded:
         rel = _rel(d.folder, suite_dir)
         lines += [f"## {d.title}", ""]
