@@ -54,7 +54,7 @@ class BoundParams(StrictModel):
     jerk_weight: Annotated[float, Field(ge=0.0, le=1e3)] = 1e-5
     """w_j, per (m/s^3)^2 of the stage's jerk ((a_k - a_{k-1}) / dt): keeps the replay from chattering (CHOSEN, its
     effect in docs/optimal-mpc.md)"""
-    eps: Annotated[float, Field(gt=0.0, le=1e-2)] = 1e-8
+    eps: Annotated[float, Field(gt=0.0, le=1e-2)] = 1e-6
     """the interior-point solver's (Clarabel) gap and feasibility tolerances"""
     max_iter: Annotated[int, Field(ge=10, le=10_000)] = 200
 
@@ -165,9 +165,12 @@ def _solve_channel(
     vest: VestibularParams,
     start_at_rest: bool = False,
 ) -> tuple[dict[str, np.ndarray], str]:
-    """One channel's QP. Per sample k the variables are [a, w, ang, p, v, z_o (2), z_c (3)] restricted to those the
-    channel has; four more start variables ang_-1, p_-1, v_-1, w_-1. Returns the optimal sequences and the status."""
+    """One channel's QP. Per sample k the variables are a, w, ang, p, v, z_o (2), z_c (3), restricted to those the
+    channel has (each a block of n), and the start variables ang_-1, p_-1, v_-1, w_-1. Returns the optimal sequences
+    and the status. The rows are built a block of samples at a time (:class:`washbench.analysis.lp_rows.Rows`)."""
     import clarabel
+
+    from washbench.analysis.lp_rows import Rows
 
     has_f = r_f is not None
     has_w = r_w is not None
@@ -177,121 +180,98 @@ def _solve_channel(
     no = 2 if has_f else 0
     nc = 3 if has_w else 0
     names += [f"zo{i}" for i in range(no)] + [f"zc{i}" for i in range(nc)]
-    nv = len(names)
-    col = {n: i for i, n in enumerate(names)}
     n = len(r_f) if has_f else len(r_w)
+    idx = {name: i * n + np.arange(n) for i, name in enumerate(names)}
     starts = (["ang"] if tilt else []) + (["p", "v"] if has_f else []) + (["w"] if has_w else [])
-    s0 = n * nv
+    s0 = len(names) * n
     scol = {name: s0 + i for i, name in enumerate(starts)}
     nz = s0 + len(starts)
+    k1 = np.arange(1, n)
 
-    def v(k: int, name: str) -> int:
-        return k * nv + col[name] if k >= 0 else scol[name]
+    def prev(name: str) -> np.ndarray:
+        """x_{k-1} for k = 0..n-1 (the start variable at k = 0)."""
+        return np.concatenate([[scol[name]], idx[name][:-1]])
 
-    rows: list[int] = []
-    cols: list[int] = []
-    vals: list[float] = []
-    lo: list[float] = []
-    hi: list[float] = []
-    r = 0
-
-    def eq(terms: list[tuple[int, float]], rhs: float) -> None:
-        nonlocal r
-        for c_, v_ in terms:
-            rows.append(r)
-            cols.append(c_)
-            vals.append(v_)
-        lo.append(rhs)
-        hi.append(rhs)
-        r += 1
-
-    def box(c_: int, bound: float) -> None:
-        eq([(c_, 1.0)], 0.0)
-        lo[-1], hi[-1] = -bound, bound
-
+    rows = Rows()
+    zero = np.zeros(n)
+    if has_f:
+        rows.add([(idx["v"], 1.0), (prev("v"), -1.0), (idx["a"], -dt)], zero.copy(), equal=True)
+        rows.add([(idx["p"], 1.0), (prev("p"), -1.0), (idx["v"], -dt)], zero.copy(), equal=True)
+    if tilt:
+        rows.add([(idx["ang"], 1.0), (prev("ang"), -1.0), (idx["w"], -dt)], zero.copy(), equal=True)
     oto = _vest_discrete(*otolith_tf(vest.otolith), dt) if has_f else None
     can = _vest_discrete(*canal_tf(vest.canals), dt) if has_w else None
 
-    def head_terms(k: int, which: str) -> list[tuple[int, float]]:
-        """The simulator head signal of sample k as terms: force a + sign g ang, or rate w."""
+    def head(which: str, sel: np.ndarray | slice) -> list[tuple[np.ndarray, float]]:
+        """The simulator head signal as terms: force a + sign g ang, or rate w."""
         if which == "f":
-            return [(v(k, "a"), 1.0)] + ([(v(k, "ang"), sign * g)] if tilt else [])
-        return [(v(k, "w"), 1.0)]
+            return [(idx["a"][sel], 1.0)] + ([(idx["ang"][sel], sign * g)] if tilt else [])
+        return [(idx["w"][sel], 1.0)]
 
-    for k in range(n):
-        if has_f:
-            eq([(v(k, "v"), 1.0), (v(k - 1, "v"), -1.0), (v(k, "a"), -dt)], 0.0)
-            eq([(v(k, "p"), 1.0), (v(k - 1, "p"), -1.0), (v(k, "v"), -dt)], 0.0)
-        if tilt:
-            eq([(v(k, "ang"), 1.0), (v(k - 1, "ang"), -1.0), (v(k, "w"), -dt)], 0.0)
-        for which, model, nzv, ref, pre in (("f", oto, no, r_f, "zo"), ("w", can, nc, r_w, "zc")):
-            if model is None:
-                continue
-            phi, g0, g1, _, steady = model
-            for i in range(nzv):
-                if k == 0:  # z_0 = steady * (h_0 - r_0)
-                    terms = [(v(0, f"{pre}{i}"), 1.0)] + [(c_, -steady[i, 0] * w_) for c_, w_ in head_terms(0, which)]
-                    eq(terms, -steady[i, 0] * ref[0])
-                else:
-                    terms = [(v(k, f"{pre}{i}"), 1.0)]
-                    terms += [(v(k - 1, f"{pre}{j}"), -phi[i, j]) for j in range(nzv) if phi[i, j] != 0.0]
-                    terms += [(c_, -g0[i, 0] * w_) for c_, w_ in head_terms(k - 1, which)]
-                    terms += [(c_, -g1[i, 0] * w_) for c_, w_ in head_terms(k, which)]
-                    eq(terms, -(g0[i, 0] * ref[k - 1] + g1[i, 0] * ref[k]))
-        if has_f:
-            box(v(k, "a"), lim["a"])
-            box(v(k, "p"), lim["p"])
-            box(v(k, "v"), lim["v"])
-        if has_w:
-            box(v(k, "w"), lim["w"])
-            eq([(v(k, "w"), 1.0), (v(k - 1, "w"), -1.0)], 0.0)
-            lo[-1], hi[-1] = -lim["dw"], lim["dw"]
+    for which, model, nzv, ref, pre in (("f", oto, no, r_f, "zo"), ("w", can, nc, r_w, "zc")):
+        if model is None:
+            continue
+        phi, g0, g1, _, steady = model
+        ref = np.asarray(ref, dtype=np.float64)
+        for i in range(nzv):
+            z = idx[f"{pre}{i}"]
+            # z_0 = steady * (h_0 - r_0)
+            rows.add([(z[:1], 1.0), *[(c_, -steady[i, 0] * w_) for c_, w_ in head(which, slice(0, 1))]],
+                     np.array([-steady[i, 0] * ref[0]]), equal=True)  # fmt: skip
+            terms = [(z[k1], 1.0)]
+            terms += [(idx[f"{pre}{j}"][k1 - 1], -phi[i, j]) for j in range(nzv) if phi[i, j] != 0.0]
+            terms += [(c_, -g0[i, 0] * w_) for c_, w_ in head(which, slice(0, n - 1))]
+            terms += [(c_, -g1[i, 0] * w_) for c_, w_ in head(which, slice(1, n))]
+            rows.add(terms, -(g0[i, 0] * ref[:-1] + g1[i, 0] * ref[1:]), equal=True)
+    if has_f:
+        rows.box(idx["a"], -lim["a"], lim["a"])
+        rows.box(idx["p"], -lim["p"], lim["p"])
+        rows.box(idx["v"], -lim["v"], lim["v"])
+    if has_w:
+        rows.box(idx["w"], -lim["w"], lim["w"])
+        rows.add([(idx["w"], 1.0), (prev("w"), -1.0)], np.full(n, lim["dw"]), equal=False)
+        rows.add([(idx["w"], -1.0), (prev("w"), 1.0)], np.full(n, lim["dw"]), equal=False)
     for name in starts:
-        box(scol[name], math.pi if name == "ang" else lim[name])
-        if start_at_rest or name == "v":  # the Atlas stage always starts at rest in translation
-            lo[-1] = hi[-1] = 0.0
+        fixed = start_at_rest or name == "v"  # the Atlas stage always starts at rest in translation
+        bound = 0.0 if fixed else (math.pi if name == "ang" else lim[name])
+        if fixed:
+            rows.add([(np.array([scol[name]]), 1.0)], np.zeros(1), equal=True)
+        else:
+            rows.box(np.array([scol[name]]), -bound, bound)
     if start_at_rest and has_f:  # the replay also ends at rest: the stage can stop within its travel at the end
-        box(v(n - 1, "v"), 0.0)
-    A = sparse.csc_matrix((vals, (rows, cols)), shape=(r, nz))
-    # cost: dt (w_f (C_o z_o)^2 + w_w (C_c z_c)^2) per sample
+        rows.add([(idx["v"][-1:], 1.0)], np.zeros(1), equal=True)
+    a_mat, b_vec, n_eq, n_le = rows.matrices(nz)
+    # cost: dt (w_f (C_o z_o)^2 + w_w (C_c z_c)^2) per sample (Clarabel minimises 1/2 z' P z; P's upper triangle)
     pr, pc, pv = [], [], []
     for model, nzv, pre, wgt in ((oto, no, "zo", params.force_weight), (can, nc, "zc", params.rate_weight)):
         if model is None:
             continue
         c = model[3]
-        m = 2.0 * dt * wgt * (c.T @ c)  # OSQP minimises 1/2 z' P z
-        for k in range(n):
-            for i in range(nzv):
-                for j in range(i, nzv):
-                    if m[i, j] != 0.0:
-                        pr.append(v(k, f"{pre}{i}"))
-                        pc.append(v(k, f"{pre}{j}"))
-                        pv.append(m[i, j])
+        m = 2.0 * dt * wgt * (c.T @ c)
+        for i in range(nzv):
+            for j in range(i, nzv):
+                if m[i, j] != 0.0:
+                    pr.append(idx[f"{pre}{i}"])
+                    pc.append(idx[f"{pre}{j}"])
+                    pv.append(np.full(n, m[i, j]))
     if has_f and params.jerk_weight > 0.0 and n > 1:  # w_j dt sum ((a_k - a_{k-1}) / dt)^2
         cj = 2.0 * params.jerk_weight / dt
-        for k in range(1, n):
-            i, j = v(k - 1, "a"), v(k, "a")
-            pr += [i, j, i]
-            pc += [i, j, j]
-            pv += [cj, cj, -cj]
-    P = sparse.csc_matrix((pv, (pr, pc)), shape=(nz, nz))
-    lo_a, hi_a = np.array(lo), np.array(hi)
-    is_eq = lo_a == hi_a
-    A_eq, A_in = A[np.flatnonzero(is_eq)], A[np.flatnonzero(~is_eq)]
-    # Clarabel: A x + s = b, s in cones: equalities (zero cone), then A x <= hi and -A x <= -lo (non-negative cone)
-    A_all = sparse.vstack([A_eq, A_in, -A_in], format="csc")
-    b_all = np.concatenate([lo_a[is_eq], hi_a[~is_eq], -lo_a[~is_eq]])
+        a_i = idx["a"]
+        pr += [a_i[:-1], a_i[1:], a_i[:-1]]
+        pc += [a_i[:-1], a_i[1:], a_i[1:]]
+        pv += [np.full(n - 1, cj), np.full(n - 1, cj), np.full(n - 1, -cj)]
+    P = sparse.csc_matrix((np.concatenate(pv), (np.concatenate(pr), np.concatenate(pc))), shape=(nz, nz))
     settings = clarabel.DefaultSettings()
     settings.verbose = False
     settings.max_iter = params.max_iter
     settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = params.eps
-    cones = [clarabel.ZeroConeT(A_eq.shape[0]), clarabel.NonnegativeConeT(2 * A_in.shape[0])]
-    sol = clarabel.DefaultSolver(sparse.triu(P, format="csc"), np.zeros(nz), A_all, b_all, cones, settings).solve()
+    cones = [clarabel.ZeroConeT(n_eq), clarabel.NonnegativeConeT(n_le)]
+    sol = clarabel.DefaultSolver(sparse.triu(P, format="csc"), np.zeros(nz), a_mat, b_vec, cones, settings).solve()
     status = str(sol.status)
-    z = np.asarray(sol.x, dtype=np.float64)
-    out = {name: z[col[name] : n * nv : nv] for name in names if not name.startswith("z")}
+    x = np.asarray(sol.x, dtype=np.float64)
+    out = {name: x[idx[name]] for name in names if not name.startswith("z")}
     for name in starts:
-        out[f"{name}_start"] = np.array([z[scol[name]]])
+        out[f"{name}_start"] = np.array([x[scol[name]]])
     return out, status
 
 
@@ -304,8 +284,12 @@ def oracle_bound(
     params: BoundParams | None = None,
     vestibular: VestibularParams | None = None,
     start_at_rest: bool = False,
+    channels: tuple[str, ...] = ("pitch", "roll", "heave", "yaw"),
 ) -> BoundResult:
     """The bound on a flight's aircraft head motion f_air (N, 3) m/s^2, w_air (N, 3) rad/s (see the module).
+
+    ``channels``: the channels solved (the others left still and costed as such); the replay's attitude stage
+    (:mod:`washbench.analysis.bound_replay`) needs pitch, roll and yaw only.
 
     The platform starts at rest in translation, anywhere within its travel, at any attitude and rate; with
     ``start_at_rest`` centred, level and still, and at rest in translation at the end (what :class:`BoundWashout`
@@ -335,6 +319,8 @@ def oracle_bound(
         ("heave", 2, None, 0.0),
         ("yaw", None, 2, 0.0),
     ):
+        if name not in channels:
+            continue
         lim = {"w": w_max, "dw": dw}
         if ax is not None:
             lim.update(p=t.position_limit_m.xyz[ax] * relax, v=t.velocity_limit_mps.xyz[ax] * relax,
@@ -417,7 +403,8 @@ class BoundWashout:
 
         c = self.context
         f = np.asarray(f_mps2, dtype=np.float64)
-        res = oracle_bound(f, omega_radps, c.dt_s, c.limits, c.gravity_mps2, self.params, start_at_rest=True)
+        res = oracle_bound(f, omega_radps, c.dt_s, c.limits, c.gravity_mps2, self.params, start_at_rest=True,
+                           channels=("pitch", "roll", "yaw"))  # fmt: skip
         traj = res.trajectory
         q_sp, q = attitudes(traj.angles, traj.omega[:, 2], c.dt_s, c.limits)
         pos, status = translation_plan(f, q, c.dt_s, c.limits, c.gravity_mps2, self.params.jerk_weight,

@@ -32,6 +32,10 @@ from washbench.io.units import G0_MPS2
 from washbench.perception.vestibular import VestibularModel, VestibularParams, otolith_model
 from washbench.platform.limits import PlatformLimits
 
+REPLAY_TOL = 1e-6
+"""The replay's translation solve: gap and feasibility tolerances (an achieved motion, not a bound: the platform
+model keeps every limit whatever the plan)."""
+
 UNFELT_WEIGHT = 0.01
 """The weight of a specific-force DOF the aircraft pilot did not feel (the score gives it none; a little keeps the
 replay from moving freely there). CHOSEN."""
@@ -167,7 +171,7 @@ def translation_plan(
     settings = clarabel.DefaultSettings()
     settings.verbose = False
     settings.max_iter = 200
-    settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = 1e-8
+    settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = REPLAY_TOL
     cones = [clarabel.ZeroConeT(n_eq), clarabel.NonnegativeConeT(n_le)]
     sol = clarabel.DefaultSolver(sparse.triu(pmat, format="csc"), cost, a_mat, b_vec, cones, settings).solve()
     z = np.asarray(sol.x, dtype=np.float64)
@@ -175,4 +179,4 @@ def translation_plan(
     return pos, str(sol.status)
 
 
-__all__ = ["UNFELT_WEIGHT", "attitudes", "translation_plan"]
+__all__ = ["REPLAY_TOL", "UNFELT_WEIGHT", "attitudes", "translation_plan"]

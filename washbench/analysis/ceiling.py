@@ -62,8 +62,11 @@ from washbench.perception.vestibular import (
 )
 from washbench.platform.limits import PlatformLimits
 
-CEILING_TOL = 1e-9
+CEILING_TOL = 1e-7
 """The interior-point solver's gap and feasibility tolerances (relative)."""
+
+EXACT = "Exact"
+"""The status of a DOF whose ceiling is 0 by a motion the relaxation holds that equals the aircraft's (no LP)."""
 
 
 @dataclass(frozen=True)
@@ -133,6 +136,37 @@ def _solve(c: np.ndarray, rows: _Rows, nvar: int) -> tuple[float, str]:
     dual = float(sol.obj_val_dual)
     # the dual objective is a lower bound of the LP; the tolerance may still leave it a hair above the optimum
     return max(0.0, dual - CEILING_TOL * max(1.0, abs(dual))), status
+
+
+def _follows_exactly_rotation(w_air: np.ndarray, dt: float, limits: PlatformLimits) -> bool:
+    """True when the aircraft's own rate on this axis (N,) rad/s is within the relaxation's rows: the platform's head
+    rate can equal it, so the least error is 0 exactly (the same model, the same start)."""
+    rot = limits.rotation
+    w_max = math.radians(rot.rate_limit_degps)
+    dw = math.radians(rot.acceleration_limit_degps2) * dt
+    return bool(np.all(np.abs(w_air) <= w_max) and np.all(np.abs(np.diff(w_air)) <= dw))
+
+
+def _follows_exactly_force(f_air: np.ndarray, dt: float, limits: PlatformLimits, gravity_mps2: float) -> bool:
+    """True when the relaxation holds a motion whose specific force on this axis equals the aircraft's (N,) m/s^2:
+    gravity's component turned towards ``-f`` as fast as the rows allow, the stage making up the rest, its velocity
+    and position (the integrator with no turning terms) within the norms. The least error is then 0 exactly."""
+    g = float(gravity_mps2)
+    t = limits.translation
+    chord = 2.0 * math.sin(min(math.radians(limits.rotation.rate_limit_degps) * dt, math.pi) / 2.0)
+    step = g * chord
+    target = np.clip(-np.asarray(f_air, dtype=np.float64), -g, g)
+    gam = np.empty_like(target)
+    gk = target[0]
+    for k in range(len(target)):
+        gk = gk + min(max(target[k] - gk, -step), step)
+        gam[k] = gk
+    b = f_air + gam
+    v = np.cumsum(b) * dt
+    p = np.cumsum(v) * dt
+    return bool(np.all(np.abs(b) <= math.hypot(*t.acceleration_limit_mps2.xyz))
+                and np.all(np.abs(v) <= math.hypot(*t.velocity_limit_mps.xyz))
+                and np.all(np.abs(p) <= math.hypot(*t.position_limit_m.xyz)))  # fmt: skip
 
 
 def translational_floor(
@@ -235,8 +269,13 @@ def ceiling(
     vestibular: VestibularParams | None = None,
     filter_start: str = "steady",
     head_offset_m: tuple[float, float, float] = (0.0, 0.0, 0.0),
+    f_mps2: np.ndarray | None = None,
+    omega_radps: np.ndarray | None = None,
 ) -> Ceiling:
     """The ceiling of a flight from the aircraft pilot's perceived motion (N, 3) each (module docstring).
+
+    ``f_mps2``, ``omega_radps`` (N, 3): the aircraft pilot's head motion itself, when known: a DOF where the
+    relaxation holds a motion equal to it has the ceiling 0 without a programme (status ``Exact``).
 
     Raises ValueError for perception thresholds (a dead band makes the error non-convex in the head motion: the
     ceiling is not defined for them)."""
@@ -250,12 +289,18 @@ def ceiling(
     floor: dict[str, float] = {}
     status: dict[str, str] = {}
     for axis, dof in enumerate(DOFS[:3]):
+        if f_mps2 is not None and _follows_exactly_force(f_mps2[:, axis], dt_s, limits, gravity_mps2):
+            floor[dof], status[dof] = 0.0, EXACT
+            continue
         floor[dof], status[dof] = translational_floor(
             perceived_f_mps2[:, axis], axis, dt_s, limits, gravity_mps2, oto, rest, r
         )
     for axis, dof in enumerate(DOFS[3:]):
+        if omega_radps is not None and _follows_exactly_rotation(omega_radps[:, axis], dt_s, limits):
+            floor[dof], status[dof] = 0.0, EXACT
+            continue
         floor[dof], status[dof] = rotational_floor(perceived_omega_radps[:, axis], dt_s, limits, can, rest)
     return Ceiling(floor=floor, status=status)
 
 
-__all__ = ["CEILING_TOL", "Ceiling", "ceiling", "rotational_floor", "translational_floor"]
+__all__ = ["CEILING_TOL", "EXACT", "Ceiling", "ceiling", "rotational_floor", "translational_floor"]

@@ -106,7 +106,7 @@ def bound_lines(folder: Path, order: list[str] | None = None, explain: bool = Tr
         lines += [f"**{name} recovers {recovered_text(frac)} of what this platform could recover on this flight** "
                   f"(the ceiling's {measure}: {sig(first['score']['ceiling'])}).", ""]  # fmt: skip
     status = rec.get("solver_status") or {}
-    bad = {k: v for k, v in status.items() if v != "Solved"}
+    bad = {k: v for k, v in status.items() if v not in ("Solved", "Exact")}
     if bad:
         lines += ["**The ceiling's solver did not converge on every DOF** (" +
                   ", ".join(f"{k}: {v}" for k, v in bad.items()) + "): those ceilings are not certified.", ""]

@@ -112,8 +112,9 @@ def bound_outputs(
     # the relaxation must hold every washout's head: the largest head offset any of them uses
     offsets = [tuple(s.params.head.offset_m) for s in specs if hasattr(s.params, "head")]
     offset = max(offsets, key=lambda o: math.hypot(*o)) if offsets else (0.0, 0.0, 0.0)
+    head = result.motion  # the aircraft pilot's head motion: a DOF it can follow exactly needs no programme
     ceil = ceiling(ac.f_mps2, ac.omega_radps, dt_s, limits, spec.params.gravity_mps2, vestibular, filter_start,
-                   offset)  # fmt: skip
+                   offset, head.f_mps2, head.omega_radps)  # fmt: skip
     floor = ceil.relative(motion)
     values, weights = rule_values(result.metrics, motion, rule)
     scored = rule.by != "false-cue"
