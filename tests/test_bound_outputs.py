@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 import pyarrow.parquet as pq
 import pytest
+from ceiling_helpers import DOFS, check_ceiling_below_every_washout, read_csv
 
 from washbench.cueing.params import DEFAULT_PARAMS_PATH
 from washbench.io.paths import MANOEUVRES_DIR
@@ -55,45 +56,6 @@ phases:
 def washbench(*args: str | Path) -> subprocess.CompletedProcess[str]:
     return subprocess.run([sys.executable, "-m", "washbench", *map(str, args)], capture_output=True, text=True,
                           timeout=1800)  # fmt: skip
-
-
-def read_csv(path: Path) -> list[dict[str, str]]:
-    with path.open(newline="") as f:
-        return list(csv.DictReader(f))
-
-
-DOFS = ("surge", "sway", "heave", "roll", "pitch", "yaw")
-
-
-def check_ceiling_below_every_washout(run_dir: Path) -> dict[str, float]:
-    """Every washout's score and relative error per DOF (ceiling.csv, the replay included) at or above the ceiling,
-    every recovered fraction at most 1, the ceiling's solver converged on every DOF and nothing flagged below it
-    (run.json), and ceiling.csv's values those of ranking.csv and metrics.csv. Returns washout -> score."""
-    rows = read_csv(run_dir / "ceiling.csv")
-    assert rows, run_dir
-    ranking = {r["washout"]: float(r["score"]) for r in read_csv(run_dir / "ranking.csv")}
-    errors = {(r["washout"], r["dof"]): float(r["integral_error"]) for r in read_csv(run_dir / "metrics.csv")}
-    motion = {d: v["value"] for d, v in json.loads((run_dir / "run.json").read_text())["perceived_motion"].items()}
-    scores = {}
-    for r in rows:
-        if r["dof"] == "score":
-            assert float(r["relative_error"]) == ranking[r["washout"]]  # the ranking's own measure
-            scores[r["washout"]] = float(r["relative_error"])
-        elif r["relative_error"]:
-            rel = errors[(r["washout"], r["dof"])] / float(motion[r["dof"]])
-            assert float(r["relative_error"]) == pytest.approx(rel, rel=1e-12)
-        if not r["ceiling"]:
-            continue
-        ceiling, value = float(r["ceiling"]), float(r["relative_error"])
-        assert 0.0 <= ceiling <= 1.0 + 1e-9, (run_dir, r)
-        # the LPs are solved to 1e-9 and their dual objective taken: a washout below by more is a defect
-        assert ceiling <= value + 1e-9, f"{run_dir}: {r['washout']} {r['dof']} ({value}) beats the ceiling ({ceiling})"
-        if r["recovered"]:
-            assert float(r["recovered"]) <= 1.0 + 1e-9
-    doc = json.loads((run_dir / "run.json").read_text())["bound"]
-    assert set(doc["solver_status"].values()) <= {"Solved", "Exact"}, doc["solver_status"]
-    assert doc["below_ceiling"] == []
-    return scores
 
 
 @pytest.fixture(scope="module")

@@ -51,9 +51,13 @@ class BoundParams(StrictModel):
     """w_f, per (m/s^2)^2 of perceived specific-force error"""
     rate_weight: Annotated[float, Field(ge=0.0, le=1e9)] = 10.0
     """w_w, per (rad/s)^2 of perceived angular-velocity error"""
-    jerk_weight: Annotated[float, Field(ge=0.0, le=1e3)] = 1e-5
+    jerk_weight: Annotated[float, Field(ge=0.0, le=1e3)] = 1e-3
     """w_j, per (m/s^3)^2 of the stage's jerk ((a_k - a_{k-1}) / dt): keeps the replay from chattering (CHOSEN, its
     effect in docs/optimal-mpc.md)"""
+    position_weight: Annotated[float, Field(ge=0.0, le=1e3)] = 0.01
+    """w_p, per m^2 s of the stage's distance from its centre: keeps the replay centred where the measure gains
+    little (a DOF the pilot does not feel, a steady force of millimetres per second squared) (CHOSEN,
+    docs/yardstick.md)"""
     eps: Annotated[float, Field(gt=0.0, le=1e-2)] = 1e-6
     """the interior-point solver's (Clarabel) gap and feasibility tolerances"""
     max_iter: Annotated[int, Field(ge=10, le=10_000)] = 200
@@ -408,7 +412,8 @@ class BoundWashout:
         traj = res.trajectory
         q_sp, q = attitudes(traj.angles, traj.omega[:, 2], c.dt_s, c.limits)
         pos, status = translation_plan(f, q, c.dt_s, c.limits, c.gravity_mps2, self.params.jerk_weight,
-                                       filter_start=c.filter_start)  # fmt: skip
+                                       filter_start=c.filter_start,
+                                       position_weight=self.params.position_weight)  # fmt: skip
         self.solved = {f"{k}_solved": float(v == "Solved") for k, v in res.statuses.items()}
         self.solved["translation_solved"] = float(status == "Solved")
         return pos, q_sp

@@ -13,7 +13,8 @@ Two stages, each a convex programme:
    score weighs equally within its group, :mod:`washbench.analysis.ranking`) plus a small jerk penalty
    ``w_j dt sum |(a_k - a_{k-1}) / dt|^2`` (``BoundParams.jerk_weight``: no chatter), under the stage's exact
    limits (0.1 % inside, position, velocity and acceleration per inertial axis, the discrete integrator
-   ``v_k = v_{k-1} + a_k dt``, ``p_k = p_{k-1} + v_k dt``), from rest at the centre and back at rest at the end.
+   ``v_k = v_{k-1} + a_k dt``, ``p_k = p_{k-1} + v_k dt``), from rest at the centre, with a small centring penalty
+   ``w_p dt sum |p_k|^2`` (``BoundParams.position_weight``) where the measure gains little.
 
 The replay is an achieved motion, not a bound: its score is an upper estimate of the best a washout with the whole
 flight known could do, the ceiling (:mod:`washbench.analysis.ceiling`) a certified lower one.
@@ -92,9 +93,11 @@ def translation_plan(
     jerk_weight: float,
     vestibular: VestibularParams | None = None,
     filter_start: str = "steady",
+    position_weight: float = 0.0,
 ) -> tuple[np.ndarray, str]:
     """Stage 2 (module docstring): the stage's positions (N, 3) m, NED, for the attitudes ``q`` (N, 4), and the
-    solver's status. ``f_air`` (N, 3) m/s^2 the aircraft pilot's specific force."""
+    solver's status. ``f_air`` (N, 3) m/s^2 the aircraft pilot's specific force; ``jerk_weight`` per (m/s^3)^2,
+    ``position_weight`` per m^2 s (``w_p dt sum |p_k|^2``: centring)."""
     import clarabel
 
     vest = vestibular if vestibular is not None else VestibularParams()
@@ -130,7 +133,6 @@ def translation_plan(
         rows.add([(p[k], 1.0), (p[k - 1], -1.0), (v[k], -dt)], np.zeros(n - 1), equal=True)
         rows.add([(v[:1], 1.0), (a[:1], -dt)], np.zeros(1), equal=True)  # from rest, centred
         rows.add([(p[:1], 1.0), (v[:1], -dt)], np.zeros(1), equal=True)
-        rows.add([(v[-1:], 1.0)], np.zeros(1), equal=True)  # at rest at the end
     rest = filter_start == "rest"
     cost = np.zeros(nvar)
     trap = trapezoid(n, dt)
@@ -166,6 +168,12 @@ def translation_plan(
             pr += [a[:-1], a[1:], a[:-1]]
             pc += [a[:-1], a[1:], a[1:]]
             pv += [np.full(n - 1, cj)] * 2 + [np.full(n - 1, -cj)]
+    if position_weight > 0.0:
+        for ax in range(3):
+            p_i = idx("p", ax)
+            pr.append(p_i)
+            pc.append(p_i)
+            pv.append(np.full(n, 2.0 * position_weight * dt))
     pmat = (sparse.csc_matrix((np.concatenate(pv), (np.concatenate(pr), np.concatenate(pc))), shape=(nvar, nvar))
             if pr else sparse.csc_matrix((nvar, nvar)))  # fmt: skip
     settings = clarabel.DefaultSettings()
