@@ -131,6 +131,13 @@ def translation_plan(
         rows.box(p, -lim.position_limit_m.xyz[ax] * relax, lim.position_limit_m.xyz[ax] * relax)
         rows.add([(v[k], 1.0), (v[k - 1], -1.0), (a[k], -dt)], np.zeros(n - 1), equal=True)
         rows.add([(p[k], 1.0), (p[k - 1], -1.0), (v[k], -dt)], np.zeros(n - 1), equal=True)
+        # always able to stop within the travel (the tracker's braking bound, brake_speed): braking from v covers
+        # v^2 / (2 a_max) <= c |v| with c = v_max / (2 a_max) (+ one step for the discrete integrator), so
+        # |p + c v| <= p_max keeps every plan inside what the platform tracks without clipping
+        c_brake = lim.velocity_limit_mps.xyz[ax] / (2.0 * lim.acceleration_limit_mps2.xyz[ax]) + dt
+        p_lim = lim.position_limit_m.xyz[ax] * relax
+        rows.add([(p, 1.0), (v, c_brake)], np.full(n, p_lim), equal=False)
+        rows.add([(p, -1.0), (v, -c_brake)], np.full(n, p_lim), equal=False)
         rows.add([(v[:1], 1.0), (a[:1], -dt)], np.zeros(1), equal=True)  # from rest, centred
         rows.add([(p[:1], 1.0), (v[:1], -dt)], np.zeros(1), equal=True)
     rest = filter_start == "rest"
