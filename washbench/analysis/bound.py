@@ -402,20 +402,13 @@ class BoundWashout:
                            "tune), not a live stream")  # fmt: skip
 
     def trace(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The replay's set points (:mod:`washbench.analysis.bound_replay`): positions (N, 3) m, attitudes (N, 4)."""
-        from washbench.analysis.bound_replay import attitudes, translation_plan
+        """The replay's set points (:func:`washbench.analysis.bound_replay.replay`): positions (N, 3) m, attitudes
+        (N, 4), scalar first."""
+        from washbench.analysis.bound_replay import replay
 
         c = self.context
-        f = np.asarray(f_mps2, dtype=np.float64)
-        res = oracle_bound(f, omega_radps, c.dt_s, c.limits, c.gravity_mps2, self.params, start_at_rest=True,
-                           channels=("pitch", "roll", "yaw"))  # fmt: skip
-        traj = res.trajectory
-        q_sp, q = attitudes(traj.angles, traj.omega[:, 2], c.dt_s, c.limits)
-        pos, status = translation_plan(f, q, c.dt_s, c.limits, c.gravity_mps2, self.params.jerk_weight,
-                                       filter_start=c.filter_start,
-                                       position_weight=self.params.position_weight)  # fmt: skip
-        self.solved = {f"{k}_solved": float(v == "Solved") for k, v in res.statuses.items()}
-        self.solved["translation_solved"] = float(status == "Solved")
+        pos, q_sp, self.solved = replay(f_mps2, omega_radps, c.dt_s, c.limits, c.gravity_mps2, self.params,
+                                        c.filter_start)  # fmt: skip
         return pos, q_sp
 
 

@@ -42,25 +42,18 @@ UNFELT_WEIGHT = 0.01
 replay from moving freely there). CHOSEN."""
 
 
-def attitudes(angles: np.ndarray, yaw_rate: np.ndarray, dt_s: float, limits: PlatformLimits) -> tuple[np.ndarray, ...]:
-    """The attitude set points (N, 4), body to inertial, scalar first, of the planned roll and pitch angles (the
-    tilt: gravity in body axes is then the plan's, ``g [-sin theta, sin phi cos theta, cos phi cos theta]``) with the
-    heading the planned yaw rate (N,) rad/s turns (ZYX Euler angles), and the attitudes the sphere flies for them
-    (the platform's own rotation tracking, every limit kept, started still at the first set point)."""
-    from washbench.numerics.rotations import quat_from_euler  # deferred: numba
-    from washbench.platform.kinematics import track_rotation
+def track_attitudes(q_sp: np.ndarray, dt_s: float, limits: PlatformLimits) -> np.ndarray:
+    """The attitudes (N, 4) the sphere flies for the attitude set points ``q_sp`` (N, 4), scalar first: the platform's
+    own rotation tracking (:func:`washbench.platform.kinematics.track_rotation`, every limit kept), started still at
+    the first set point, as the platform starts a washout whose start is that attitude."""
+    from washbench.platform.kinematics import track_rotation  # deferred: numba
 
     rot = limits.rotation
     w_max = math.radians(rot.rate_limit_degps)
     alpha = math.radians(rot.acceleration_limit_degps2)
-    n = angles.shape[0]
-    yaw = np.cumsum(yaw_rate) * dt_s
-    q_sp = np.array([quat_from_euler(float(angles[k, 0]), float(angles[k, 1]), float(yaw[k])) for k in range(n)])
-    q = tuple(float(x) for x in q_sp[0])
-    w_prev = (0.0, 0.0, 0.0)
-    prev_sp = q
+    n = q_sp.shape[0]
     out = np.empty((n, 4))
-    q = (1.0, 0.0, 0.0, 0.0)
+    q = tuple(float(x) for x in q_sp[0])
     w_prev = (0.0, 0.0, 0.0)
     prev_sp = q
     for k in range(n):
@@ -68,7 +61,18 @@ def attitudes(angles: np.ndarray, yaw_rate: np.ndarray, dt_s: float, limits: Pla
         q, w_prev, _, _ = track_rotation(q, w_prev, prev_sp, sp, w_max, alpha, rot.catch_up_fraction, dt_s)
         prev_sp = sp
         out[k] = q
-    return q_sp, out
+    return out
+
+
+def attitudes(angles: np.ndarray, yaw_rate: np.ndarray, dt_s: float, limits: PlatformLimits) -> tuple[np.ndarray, ...]:
+    """The attitude set points (N, 4) of the planned roll and pitch angles with the heading the planned yaw rate
+    (N,) rad/s turns (ZYX Euler angles), and the attitudes the sphere flies for them (:func:`track_attitudes`)."""
+    from washbench.numerics.rotations import quat_from_euler  # deferred: numba
+
+    yaw = np.cumsum(yaw_rate) * dt_s
+    q_sp = np.array([quat_from_euler(float(a), float(b), float(y))
+                     for (a, b), y in zip(angles[:, :2], yaw, strict=True)])  # fmt: skip
+    return q_sp, track_attitudes(q_sp, dt_s, limits)
 
 
 def _rotation_matrices(q: np.ndarray) -> np.ndarray:
@@ -194,4 +198,32 @@ def translation_plan(
     return pos, str(sol.status)
 
 
-__all__ = ["REPLAY_TOL", "UNFELT_WEIGHT", "attitudes", "translation_plan"]
+def replay(
+    f_mps2: np.ndarray,
+    omega_radps: np.ndarray,
+    dt_s: float,
+    limits: PlatformLimits,
+    gravity_mps2: float,
+    params: object,
+    filter_start: str = "steady",
+) -> tuple[np.ndarray, np.ndarray, dict[str, float]]:
+    """The replay's set points for a flight's aircraft head motion (N, 3) each: positions (N, 3) m, NED; attitudes
+    (N, 4), scalar first; and the solves (1 per stage solved). ``params``: :class:`washbench.analysis.bound.
+    BoundParams`. Both stages on the flight's own grid (a plan on a coarser grid, interpolated back, was tried:
+    planned at 60 Hz for a 120 Hz flight, the short rudder doublet's replay scored 0.129 instead of 0.054)."""
+    from washbench.analysis.bound import oracle_bound
+
+    f = np.asarray(f_mps2, dtype=np.float64)
+    w = np.asarray(omega_radps, dtype=np.float64)
+    res = oracle_bound(f, w, dt_s, limits, gravity_mps2, params, start_at_rest=True,
+                       channels=("pitch", "roll", "yaw"))  # fmt: skip
+    traj = res.trajectory
+    q_sp, q = attitudes(traj.angles, traj.omega[:, 2], dt_s, limits)
+    pos, status = translation_plan(f, q, dt_s, limits, gravity_mps2, params.jerk_weight, filter_start=filter_start,
+                                   position_weight=params.position_weight)  # fmt: skip
+    solved = {f"{k}_solved": float(v == "Solved") for k, v in res.statuses.items()}
+    solved["translation_solved"] = float(status == "Solved")
+    return pos, q_sp, solved
+
+
+__all__ = ["REPLAY_TOL", "UNFELT_WEIGHT", "attitudes", "replay", "track_attitudes", "translation_plan"]

@@ -100,6 +100,7 @@ def bound_outputs(
     motion); ``rule``: the run's ranking rule (None: the default score)."""
     spec = bound_spec(specs)
     if spec is None:
+        (folder / CEILING_FILE).unlink(missing_ok=True)  # an earlier run's ceiling would not be this run's
         return None
     from washbench.analysis.ceiling import ceiling  # deferred: scipy.sparse, clarabel
     from washbench.analysis.metrics import DOFS
