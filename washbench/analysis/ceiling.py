@@ -150,23 +150,32 @@ def _follows_exactly_rotation(w_air: np.ndarray, dt: float, limits: PlatformLimi
 def _follows_exactly_force(f_air: np.ndarray, dt: float, limits: PlatformLimits, gravity_mps2: float) -> bool:
     """True when the relaxation holds a motion whose specific force on this axis equals the aircraft's (N,) m/s^2:
     gravity's component turned towards ``-f`` as fast as the rows allow, the stage making up the rest, its velocity
-    and position (the integrator with no turning terms) within the norms. The least error is then 0 exactly."""
+    and position in the turning frame pulled towards zero by as much as the turning terms allow (``e_k``, ``d_k``),
+    and every row then checked. The least error is then 0 exactly."""
     g = float(gravity_mps2)
     t = limits.translation
     chord = 2.0 * math.sin(min(math.radians(limits.rotation.rate_limit_degps) * dt, math.pi) / 2.0)
+    a_bar = math.hypot(*t.acceleration_limit_mps2.xyz)
+    v_bar = math.hypot(*t.velocity_limit_mps.xyz)
+    p_bar = math.hypot(*t.position_limit_m.xyz)
+    ev, ep = chord * v_bar, chord * p_bar
     step = g * chord
     target = np.clip(-np.asarray(f_air, dtype=np.float64), -g, g)
-    gam = np.empty_like(target)
-    gk = target[0]
+    gk, vk, pk = float(target[0]), 0.0, 0.0
     for k in range(len(target)):
-        gk = gk + min(max(target[k] - gk, -step), step)
-        gam[k] = gk
-    b = f_air + gam
-    v = np.cumsum(b) * dt
-    p = np.cumsum(v) * dt
-    return bool(np.all(np.abs(b) <= math.hypot(*t.acceleration_limit_mps2.xyz))
-                and np.all(np.abs(v) <= math.hypot(*t.velocity_limit_mps.xyz))
-                and np.all(np.abs(p) <= math.hypot(*t.position_limit_m.xyz)))  # fmt: skip
+        gk = gk + min(max(float(target[k]) - gk, -step), step)
+        b = float(f_air[k]) + gk
+        if abs(b) > a_bar:
+            return False
+        vk = vk + b * dt
+        if k > 0:  # the turning terms (none on the first step from rest)
+            vk -= min(max(vk, -ev), ev)
+        pk = pk + vk * dt
+        if k > 0:
+            pk -= min(max(pk, -ep), ep)
+        if abs(vk) > v_bar or abs(pk) > p_bar:
+            return False
+    return True
 
 
 def translational_floor(
