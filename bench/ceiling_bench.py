@@ -23,7 +23,8 @@ from pathlib import Path
 import numpy as np
 from baseline import c172p_in_air, run_cpu_s
 
-from washbench.analysis.bound import BoundParams, BoundWashout, oracle_bound
+from washbench.analysis.bound import BoundParams, oracle_bound
+from washbench.analysis.bound_replay import BoundWashout
 from washbench.analysis.ceiling import ceiling
 from washbench.cueing.algorithm import WashoutContext
 from washbench.flight.fly import fly

@@ -38,6 +38,7 @@ import numpy as np
 from pydantic import Field
 from scipy import sparse
 
+from washbench.analysis.lp_rows import Rows
 from washbench.cueing.motion_model import discretise_foh
 from washbench.io.yamlio import StrictModel
 from washbench.perception.vestibular import VestibularModel, VestibularParams, canal_tf, otolith_tf
@@ -174,7 +175,6 @@ def _solve_channel(
     and the status. The rows are built a block of samples at a time (:class:`washbench.analysis.lp_rows.Rows`)."""
     import clarabel
 
-    from washbench.analysis.lp_rows import Rows
 
     has_f = r_f is not None
     has_w = r_w is not None
@@ -373,49 +373,9 @@ def costs_from_columns(
     return res, costs
 
 
-class BoundWashout:
-    """The bound as a washout (kind ``bound``, ``whole_only``: it needs the whole recording; ``run`` cues it after
-    the flight on the flight read back, ``cue`` and the whole-trace paths give it the input at once,
-    :class:`washbench.cueing.CueingBank` ``future``): its ``trace`` solves the bound for the whole recording,
-    started centred, level and still, and returns its positions and attitudes (ZYX Euler from the integrated roll,
-    pitch and yaw) as set points, so the platform, head motion, perception, metrics, ranking, report and figures
-    treat it like any washout. It knows the future; ``step`` (a live stream) cannot and raises."""
-
-    Params = BoundParams
-    name = "bound"
-    whole_only = True
-
-    def __init__(self, params: BoundParams | None, context) -> None:
-        self.params = params if params is not None else BoundParams()
-        self.context = context
-        self.solved: dict[str, float] = {}
-
-    def report(self) -> dict[str, float]:
-        """The replay's solves: 1 per stage solved (the attitude's four channels, the translation), 0 otherwise."""
-        return dict(self.solved)
-
-    def start(self, f_mps2: np.ndarray, omega_radps: np.ndarray):
-        return np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0])  # the plan starts level (oracle_bound start_at_rest)
-
-    def step(self, f_mps2: np.ndarray, omega_radps: np.ndarray):
-        raise RuntimeError("the oracle bound needs the whole recording in advance (run, cue, suite, omct, sweep, "
-                           "tune), not a live stream")  # fmt: skip
-
-    def trace(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The replay's set points (:func:`washbench.analysis.bound_replay.replay`): positions (N, 3) m, attitudes
-        (N, 4), scalar first."""
-        from washbench.analysis.bound_replay import replay
-
-        c = self.context
-        pos, q_sp, self.solved = replay(f_mps2, omega_radps, c.dt_s, c.limits, c.gravity_mps2, self.params,
-                                        c.filter_start)  # fmt: skip
-        return pos, q_sp
-
-
 __all__ = [
     "BoundParams",
     "BoundResult",
-    "BoundWashout",
     "Trajectory",
     "costs_from_columns",
     "linear_head_motion",

@@ -27,6 +27,7 @@ import math
 import numpy as np
 from scipy import sparse
 
+from washbench.analysis.bound import BoundParams, oracle_bound
 from washbench.analysis.lp_rows import Rows, trapezoid
 from washbench.analysis.ranking import MOTION_FLOOR, perceived_motion
 from washbench.io.units import G0_MPS2
@@ -204,15 +205,13 @@ def replay(
     dt_s: float,
     limits: PlatformLimits,
     gravity_mps2: float,
-    params: object,
+    params: BoundParams,
     filter_start: str = "steady",
 ) -> tuple[np.ndarray, np.ndarray, dict[str, float]]:
     """The replay's set points for a flight's aircraft head motion (N, 3) each: positions (N, 3) m, NED; attitudes
     (N, 4), scalar first; and the solves (1 per stage solved). ``params``: :class:`washbench.analysis.bound.
     BoundParams`. Both stages on the flight's own grid (a plan on a coarser grid, interpolated back, was tried:
     planned at 60 Hz for a 120 Hz flight, the short rudder doublet's replay scored 0.129 instead of 0.054)."""
-    from washbench.analysis.bound import oracle_bound
-
     f = np.asarray(f_mps2, dtype=np.float64)
     w = np.asarray(omega_radps, dtype=np.float64)
     res = oracle_bound(f, w, dt_s, limits, gravity_mps2, params, start_at_rest=True,
@@ -226,4 +225,41 @@ def replay(
     return pos, q_sp, solved
 
 
-__all__ = ["REPLAY_TOL", "UNFELT_WEIGHT", "attitudes", "replay", "track_attitudes", "translation_plan"]
+class BoundWashout:
+    """The bound as a washout (kind ``bound``, ``whole_only``: it needs the whole recording; ``run`` cues it after
+    the flight on the flight read back, ``cue`` and the whole-trace paths give it the input at once,
+    :class:`washbench.cueing.CueingBank` ``future``): its ``trace`` solves the bound for the whole recording,
+    started centred, level and still, and returns its positions and attitudes (ZYX Euler from the integrated roll,
+    pitch and yaw) as set points, so the platform, head motion, perception, metrics, ranking, report and figures
+    treat it like any washout. It knows the future; ``step`` (a live stream) cannot and raises."""
+
+    Params = BoundParams
+    name = "bound"
+    whole_only = True
+
+    def __init__(self, params: BoundParams | None, context) -> None:
+        self.params = params if params is not None else BoundParams()
+        self.context = context
+        self.solved: dict[str, float] = {}
+
+    def report(self) -> dict[str, float]:
+        """The replay's solves: 1 per stage solved (the attitude's four channels, the translation), 0 otherwise."""
+        return dict(self.solved)
+
+    def start(self, f_mps2: np.ndarray, omega_radps: np.ndarray):
+        return np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0])  # the plan starts level (oracle_bound start_at_rest)
+
+    def step(self, f_mps2: np.ndarray, omega_radps: np.ndarray):
+        raise RuntimeError("the oracle bound needs the whole recording in advance (run, cue, suite, omct, sweep, "
+                           "tune), not a live stream")  # fmt: skip
+
+    def trace(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The replay's set points (:func:`replay`): positions (N, 3) m, attitudes
+        (N, 4), scalar first."""
+        c = self.context
+        pos, q_sp, self.solved = replay(f_mps2, omega_radps, c.dt_s, c.limits, c.gravity_mps2, self.params,
+                                        c.filter_start)  # fmt: skip
+        return pos, q_sp
+
+
+__all__ = ["REPLAY_TOL", "UNFELT_WEIGHT", "BoundWashout", "attitudes", "replay", "track_attitudes", "translation_plan"]

@@ -44,7 +44,7 @@ BUILTIN_PYTHON: dict[str, str] = {
     "optimal": "washbench.cueing.optimal:OptimalWashout",
     "mpc": "washbench.cueing.mpc:MpcWashout",
     # the oracle bound replayed as a washout (whole recordings only); by name, so cueing imports no analysis module
-    "bound": "washbench.analysis.bound:BoundWashout",
+    "bound": "washbench.analysis.bound_replay:BoundWashout",
 }
 """Built-in Python algorithms: kind -> ``module:attribute`` of the factory (imported on first use)."""
 

@@ -3,7 +3,7 @@
 
 ``--washout bound`` (opt-in, docs/optimal-mpc.md, docs/metrics.md) adds, once the whole motion is known:
 
-- the bound's replay (:class:`washbench.analysis.bound.BoundWashout`, :mod:`washbench.analysis.bound_replay`): a
+- the bound's replay (:class:`washbench.analysis.bound_replay.BoundWashout`, :mod:`washbench.analysis.bound_replay`): a
   physical platform motion planned with the whole flight known, replayed through the platform model like any
   washout: its rows in ``metrics.csv``, its score in ``ranking.csv`` (no rank: it knows the future) and its columns
   in ``traces.parquet``;
@@ -27,7 +27,8 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from washbench.analysis.ranking import BOUND_WASHOUT
+from washbench.analysis.metrics import DOFS
+from washbench.analysis.ranking import BOUND_WASHOUT, DEFAULT_RULE, MOTION_FLOOR, perceived_motion, rule_values
 from washbench.cueing.registry import whole_only
 from washbench.io.atomic import write_text_atomic
 from washbench.io.csv_numbers import csv_number
@@ -102,9 +103,7 @@ def bound_outputs(
     if spec is None:
         (folder / CEILING_FILE).unlink(missing_ok=True)  # an earlier run's ceiling would not be this run's
         return None
-    from washbench.analysis.ceiling import ceiling  # deferred: scipy.sparse, clarabel
-    from washbench.analysis.metrics import DOFS
-    from washbench.analysis.ranking import DEFAULT_RULE, MOTION_FLOOR, perceived_motion, rule_values
+    from washbench.analysis.ceiling import ceiling  # deferred: scipy.sparse
 
     rule = DEFAULT_RULE if rule is None else rule
     dt_s = result.motion.dt_s
