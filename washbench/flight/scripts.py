@@ -20,7 +20,8 @@ and cause.
 
 The scripts shipped in the jsbsim package (``jsbsim.get_default_root_dir()/scripts``) are found by name
 (:func:`bundled_script`); their aircraft are JSBSim's own. The script's ``<output>`` directives are
-switched off (they would write into the current folder), and its console messages are silenced.
+neutralised (they would write into the current folder or open sockets; :mod:`washbench.flight.jsbsim_xml`), and
+its console messages are silenced.
 """
 
 from __future__ import annotations
@@ -293,8 +294,9 @@ def _structure_contacts(fdm: object) -> list[object]:
 
 def _make_fdm(info: ScriptInfo, output_dir: Path) -> object:
     """The FDM with the script loaded and initialised. The script's and the aircraft's ``<output>`` directives
-    are taken out before JSBSim reads them (:mod:`washbench.flight.jsbsim_xml`: copies in ``output_dir``, a
-    temporary folder), so JSBSim writes no file and opens no socket; output is also switched off."""
+    are neutralised before JSBSim reads them (:mod:`washbench.flight.jsbsim_xml`: copies in ``output_dir``, a
+    temporary folder, each directive a CSV file there logging nothing; the properties they create stay for the
+    script's events), and output is switched off, so JSBSim writes nothing and opens no socket."""
     import jsbsim
 
     root = aircraft_for_jsbsim(info.aircraft_root, info.aircraft, output_dir / "aircraft")
