@@ -182,3 +182,14 @@ def test_a_script_that_sets_an_output_property_flies_as_plain_jsbsim(tmp_path: P
     assert t[-1] == pytest.approx(plain.get_sim_time(), abs=2.5 * flight["dt_s"])
     assert abs(len(t) - steps) <= 2
     assert not list(work.rglob("*.csv")) or all("out" in p.relative_to(work).parts for p in work.rglob("*.csv"))
+
+
+def test_a_script_event_jsbsim_cannot_do_is_a_failed_run_not_a_traceback(tmp_path: Path) -> None:
+    """JSBSim's ``737_cruise_steady_turn_simplex.xml`` sets ``simulation/do_simplex_trim``, which this JSBSim build
+    lacks: plain JSBSim raises from ``run()`` at 0.1 s. washbench keeps what was flown and says why, in one line."""
+    (s,) = run_script(bundled_script("737_cruise_steady_turn_simplex"), tmp_path, load_options(max_time_s=2.0))
+    assert not s.ok
+    assert "JSBSim stopped the script" in s.reason and "simulation/do_simplex_trim" in s.reason
+    assert "\n" not in s.reason
+    flight = json.loads((tmp_path / "737" / "737_cruise_steady_turn_simplex" / "flight.json").read_text())
+    assert flight["status"] == "failed"

@@ -388,7 +388,12 @@ def _fly(
             if total >= limit_steps:
                 flight.stopped_by_limit = True
                 break
-            if not run():
+            try:
+                going = run()
+            except Exception as exc:  # JSBSim raises on a script event it cannot do (a property its build lacks)
+                close(rows, "failed", f"t={t:.2f} s: JSBSim stopped the script: {str(exc).strip()}")
+                return flight
+            if not going:
                 break  # the script's end: the last state has no pilot acceleration of its own
             total += 1
             if fdm.get_sim_time() < t_sim - 0.5 * dt:  # type: ignore[attr-defined]
