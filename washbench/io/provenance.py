@@ -11,7 +11,9 @@ One JSON-able dict (:func:`build_provenance`) records
 - ``params`` and ``platform``: the parameter set's and platform's name (the ``name`` key of the YAML file), the path
   and SHA-256 of the file actually used (the bundled ``cw1.yaml`` / ``atlas.yaml`` when none was given) and the
   values read from it (so a result can be re-examined without the file);
-- ``washouts``: the washouts that ran, name and kind, and a variant's own parameter values;
+- ``washouts``: the washouts that ran, name and kind, and a variant's own parameter values; for a plugin, which
+  code ran (``plugin``: its file or module, class, SHA-256, the installed entry point a file replaced, and its
+  parameter values);
 - ``turbulence``: severity and seed of the manoeuvre's turbulence (``None`` without turbulence);
 - ``config``: the project configuration file the command found (``washbench.toml`` or a ``pyproject.toml`` with
   ``[tool.washbench]``, see :mod:`washbench.io.config`), its path and SHA-256; left out when there was none.
@@ -127,6 +129,7 @@ def build_provenance(
     ranking: Mapping[str, Any] | None = None,
     vestibular: Mapping[str, Any] | None = None,
     digests: Mapping[str, str] | None = None,
+    plugins: Mapping[str, Mapping[str, Any]] | None = None,
 ) -> dict[str, Any]:
     """The provenance of one result (module docstring); no date in it.
 
@@ -140,6 +143,8 @@ def build_provenance(
     (:meth:`washbench.analysis.ranking.RankRule.record`); ``vestibular``: the vestibular model
     (:func:`washbench.perception.vestibular.model_record`: its name and values). ``digests``: path (as given) ->
     SHA-256 of a file already read (:func:`washbench.io.yamlio.read_yaml_digest`), so it is not read again.
+    ``plugins``: washout name -> what a plugin washout ran (:func:`washbench.cueing.registry.identity`: file or
+    module, class, SHA-256, parameter values), recorded as that washout's ``plugin``.
     """
     digests = digests or {}
     prov: dict[str, Any] = {"software": software_versions()}
@@ -157,7 +162,7 @@ def build_provenance(
         prov["params"] = file_record(params_path, params.name, params.model_dump(mode="json"),
                                      digests.get(str(params_path)))  # fmt: skip
     if washouts:
-        prov["washouts"] = [_washout_record(w, params) for w in washouts]
+        prov["washouts"] = [_washout_record(w, params, (plugins or {}).get(w.name)) for w in washouts]
     if platform is not None and platform_path is not None:
         prov["platform"] = file_record(platform_path, platform.name, platform.model_dump(mode="json"),
                                        digests.get(str(platform_path)))  # fmt: skip
@@ -189,10 +194,12 @@ def merge_provenance(*parts: Mapping[str, Any]) -> dict[str, Any]:
     return {k: merged[k] for k in [*known, *(k for k in merged if k not in _ORDER)]}
 
 
-def _washout_record(washout: Any, base: Any) -> dict[str, Any]:
+def _washout_record(washout: Any, base: Any, plugin: Mapping[str, Any] | None = None) -> dict[str, Any]:
     rec: dict[str, Any] = {"name": washout.name, "kind": washout.kind}
     if base is None or washout.params != base:
         rec["values"] = washout.params.model_dump(mode="json")
+    if plugin is not None:
+        rec["plugin"] = dict(plugin)
     return rec
 
 

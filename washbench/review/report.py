@@ -76,6 +76,21 @@ def _rel(path: Path, start: Path) -> str:
 # --------------------------------------------------------------------------------------------- pieces of a report
 
 
+def plugin_text(rec: dict[str, Any]) -> str:
+    """What a plugin washout ran, for the report's provenance table (:func:`washbench.cueing.registry.identity`)."""
+    where = rec.get("path") if rec.get("from") == "file" else rec.get("module")
+    text = f"`{rec.get('object', '?')}` from {rec.get('from', '?')} `{where or '?'}`"
+    if rec.get("distribution"):
+        text += f" ({rec['distribution']} {rec.get('version', '?')})"
+    if rec.get("sha256"):
+        text += f" (SHA-256 `{rec['sha256']}`)"
+    if rec.get("shadows"):
+        text += f"; replaces the installed {rec['shadows']}"
+    values = rec.get("values") or {}
+    text += "; values " + (", ".join(f"`{k}={v}`" for k, v in values.items()) if values else "none")
+    return text
+
+
 def provenance_lines(prov: dict[str, Any] | None, created_utc: str | None) -> list[str]:
     """The provenance as a two-column Markdown table (what produced the result)."""
     if not prov:
@@ -101,6 +116,9 @@ def provenance_lines(prov: dict[str, Any] | None, created_utc: str | None) -> li
             in w else "") for w in prov["washouts"]
         ]  # fmt: skip
         rows.append(("washouts", ", ".join(runs)))
+        for w in prov["washouts"]:
+            if isinstance(w.get("plugin"), dict):
+                rows.append((f"plugin {w['name']}", plugin_text(w["plugin"])))
     file_row("platform", prov.get("platform"))
     vest = prov.get("vestibular")
     if isinstance(vest, dict) and vest.get("model"):

@@ -122,6 +122,7 @@ def load_options(
         ranking=rule.record(),
         vestibular=model_record(vestibular),
         digests={str(source): params_sha, str(platform_source): platform_sha},  # not read again to hash them
+        plugins={w.name: rec for w in chosen if (rec := registry.identity(w.kind, w.params)) is not None},
     )
     return RunOptions(
         params_path=params_path,
