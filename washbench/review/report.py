@@ -110,6 +110,10 @@ def provenance_lines(prov: dict[str, Any] | None, created_utc: str | None) -> li
     if inp and (inp.get("provenance") or {}).get("manoeuvre"):
         file_row("input's manoeuvre file", inp["provenance"]["manoeuvre"])
     file_row("washout parameters", prov.get("params"))
+    defaults = (prov.get("params") or {}).get("defaults")
+    if isinstance(defaults, dict) and defaults.get("sections"):
+        rows.append(("parameters not in that file", ", ".join(f"`{k}`" for k in defaults["sections"])
+                     + f" from `{defaults.get('path', '?')}` (SHA-256 `{defaults.get('sha256', '?')}`)"))  # fmt: skip
     if prov.get("washouts"):
         runs = [
             f"{w['name']}" + ("" if w["name"] == w["kind"] else f" ({w['kind']})") + (" with its own values" if "values"
