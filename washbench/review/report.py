@@ -124,6 +124,7 @@ def provenance_lines(prov: dict[str, Any] | None, created_utc: str | None) -> li
             if isinstance(w.get("plugin"), dict):
                 rows.append((f"plugin {w['name']}", plugin_text(w["plugin"])))
     file_row("platform", prov.get("platform"))
+    file_row("configuration file", prov.get("config"))
     vest = prov.get("vestibular")
     if isinstance(vest, dict) and vest.get("model"):
         names = {"young-meiry": "Meiry-Young otolith, Young-Oman canals (the paper's)",
