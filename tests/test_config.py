@@ -71,7 +71,8 @@ def test_defaults_from_washbench_toml_found_upwards_and_a_flag_wins(tmp_path: Pa
     assert prov["config"] == {"path": str(config), "sha256": sha256_file(config)}
     # and in the report, as docs/how-to/configuration.md says (issue 38, item 5)
     digest = hashlib.sha256(config.read_bytes()).hexdigest()
-    assert f"| configuration file | `{config}` (SHA-256 `{digest}`) |" in (project / "results" / "report.md").read_text()
+    report = (project / "results" / "report.md").read_text()
+    assert f"| configuration file | `{config}` (SHA-256 `{digest}`) |" in report
     # a flag wins over the file
     proc = washbench(
         project / "logs", "cue", "small.csv", "--out", "here", "--params", str(DATA_DIR / "cw1.yaml"),
