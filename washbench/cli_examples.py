@@ -28,7 +28,7 @@ EXAMPLES: dict[str, tuple[str, ...]] = {
         "washbench fly manoeuvres/my_turn.yaml --out out/try --aircraft-dir ~/aircraft",
     ),
     "validate": (
-        "washbench validate manoeuvres/*.yaml",
+        "washbench validate c172 columbia400/takeoff",
         "washbench validate my_turn.yaml --aircraft-dir ~/aircraft",
     ),
     "schema": (
