@@ -251,8 +251,8 @@ def identity(kind: str, params: Any = None) -> dict[str, Any] | None:
 
     A file plugin: ``{"from": "file", "path", "object", "sha256"}`` (the file as loaded, its bytes' SHA-256); with
     ``"shadows"`` naming an installed entry point of the same name, which the file replaced in this run. An entry
-    point: ``{"from": "entry point", "module", "object", "distribution", "version", "path", "sha256"}`` (the
-    module's file). Both with ``"values"``: the plugin's parameters as its ``Params`` validated them from the
+    point: ``{"from": "entry point", "module", "object", "distribution", "version", "sha256"}`` (of the module's
+    file). Both with ``"values"``: the plugin's parameters as its ``Params`` validated them from the
     ``kind`` section of ``params`` (``WashoutParams``; defaults filled in; ``{}`` without ``Params``).
     """
     if not is_python(kind) or kind in BUILTIN_PYTHON:
@@ -273,8 +273,7 @@ def identity(kind: str, params: Any = None) -> dict[str, Any] | None:
         rec = {"from": "entry point", "module": module.strip(), "object": attr.strip(), **_distribution(entry)}
         mod = sys.modules.get(module.strip())
         file = getattr(mod, "__file__", None)
-        if file:
-            rec["path"] = str(file)
+        if file:  # the module's file (named by module and distribution: its place differs from machine to machine)
             rec["sha256"] = _sha256(file)
     else:  # registered some other way (a test's): its source as the registry knows it
         rec = {"from": algo.source}

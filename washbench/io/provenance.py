@@ -11,6 +11,9 @@ One JSON-able dict (:func:`build_provenance`) records
 - ``params`` and ``platform``: the parameter set's and platform's name (the ``name`` key of the YAML file), the path
   and SHA-256 of the file actually used (the bundled ``cw1.yaml`` / ``atlas.yaml`` when none was given) and the
   values read from it (so a result can be re-examined without the file);
+- a file shipped with washbench or JSBSim is named as bundled, the same on every machine
+  (``washbench:data/cw1.yaml``, ``jsbsim:aircraft/c172x/c172x.xml``, :func:`bundled_name`), with ``bundled``: the
+  package and version; any other file by its path as given;
 - ``washouts``: the washouts that ran, name and kind, and a variant's own parameter values; for a plugin, which
   code ran (``plugin``: its file or module, class, SHA-256, the installed entry point a file replaced, and its
   parameter values);
@@ -99,15 +102,48 @@ def software_versions() -> dict[str, str]:
     return out
 
 
+def bundled_name(path: str | Path) -> tuple[str, str] | None:
+    """``(package, name)`` of a file shipped with washbench or JSBSim, else None.
+
+    A bundled file is named the same on every machine and in a checkout as in an installed wheel:
+    ``washbench:data/cw1.yaml``, ``washbench:aircraft/c172p/pilot.yaml``, ``washbench:manoeuvres/c172/takeoff.yaml``,
+    ``jsbsim:aircraft/c172x/c172x.xml`` (not the absolute path of the machine that made the result).
+    """
+    from washbench.io.paths import AIRCRAFT_DIR, DATA_DIR, MANOEUVRES_DIR, jsbsim_root
+
+    try:
+        resolved = Path(path).resolve()
+    except OSError:
+        return None
+    places = (("washbench", AIRCRAFT_DIR, "aircraft/"), ("washbench", MANOEUVRES_DIR, "manoeuvres/"),
+              ("washbench", DATA_DIR, "data/"), ("jsbsim", jsbsim_root(), ""))  # fmt: skip
+    for package, root, prefix in places:
+        try:
+            rel = resolved.relative_to(root.resolve())
+        except ValueError:
+            continue
+        return package, f"{package}:{prefix}{rel.as_posix()}"
+    return None
+
+
 def file_record(
     path: str | Path, name: str | None = None, values: Mapping[str, Any] | None = None, sha256: str | None = None
 ) -> dict[str, Any]:
     """``{"name", "path", "sha256", "values"}`` of one input file (name and values only when given); ``sha256``:
-    the digest of the bytes already read (:func:`washbench.io.yamlio.read_yaml_digest`), else the file is hashed."""
+    the digest of the bytes already read (:func:`washbench.io.yamlio.read_yaml_digest`), else the file is hashed.
+
+    A file shipped with washbench or JSBSim is named as bundled (:func:`bundled_name`, e.g.
+    ``washbench:data/cw1.yaml``) with ``"bundled"``: the package and its version; any other file by its path as
+    given."""
     rec: dict[str, Any] = {}
     if name is not None:
         rec["name"] = name
-    rec["path"] = str(path)
+    bundled = bundled_name(path)
+    if bundled is None:
+        rec["path"] = str(path)
+    else:
+        rec["path"] = bundled[1]
+        rec["bundled"] = f"{bundled[0]} {software_versions().get(bundled[0], '?')}"
     rec["sha256"] = sha256 or sha256_file(path)
     if values is not None:
         rec["values"] = dict(values)

@@ -100,7 +100,8 @@ def provenance_lines(prov: dict[str, Any] | None, created_utc: str | None) -> li
     def file_row(label: str, rec: dict[str, Any] | None) -> None:
         if rec:
             name = f"**{rec['name']}**, " if rec.get("name") else ""
-            rows.append((label, f"{name}`{rec.get('path', '?')}` (SHA-256 `{rec.get('sha256', '?')}`)"))
+            shipped = f"bundled with {rec['bundled']}, " if rec.get("bundled") else ""
+            rows.append((label, f"{name}`{rec.get('path', '?')}` ({shipped}SHA-256 `{rec.get('sha256', '?')}`)"))
 
     file_row("manoeuvre file", prov.get("manoeuvre"))
     file_row("aircraft model", prov.get("aircraft"))
