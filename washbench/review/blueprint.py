@@ -18,6 +18,10 @@ from dataclasses import dataclass
 
 import rerun.blueprint as rrb
 
+from washbench.review.palette import AIRCRAFT_COLOR as AIRCRAFT_RGB
+from washbench.review.palette import EXTRA_COLORS as EXTRA_RGB
+from washbench.review.palette import WASHOUT_COLORS as FIXED_RGB
+
 __all__ = [
     "AIRCRAFT_COLOR",
     "AIRCRAFT_WIDTH",
@@ -30,23 +34,15 @@ __all__ = [
     "source_colors",
 ]
 
-AIRCRAFT_COLOR = (200, 0, 160)
+AIRCRAFT_COLOR = AIRCRAFT_RGB
 """The aircraft pilot's colour (magenta): visible on white and on the viewer's near-black background."""
 AIRCRAFT_WIDTH = 2.5
 WASHOUT_WIDTH = 1.5
-WASHOUT_COLORS: dict[str, tuple[int, int, int]] = {
-    "small-angle": (31, 119, 180),  # blue
-    "large-angle": (255, 127, 14),  # orange
-    "unrestricted": (44, 160, 44),  # green
-}
-EXTRA_COLORS: tuple[tuple[int, int, int], ...] = (
-    (23, 190, 207),  # cyan
-    (140, 86, 75),  # brown
-    (188, 189, 34),  # olive
-    (255, 200, 0),  # gold
-    (40, 60, 140),  # navy
-)
-"""Colours for washout names other than the three above, taken in the order the recording lists them."""
+WASHOUT_COLORS: dict[str, tuple[int, int, int]] = dict(FIXED_RGB)
+"""The fixed colours (small-angle blue, large-angle orange, unrestricted green, the bound grey): the figures'
+default palette (:mod:`washbench.review.palette`), one set of colours for the recording and the figures."""
+EXTRA_COLORS: tuple[tuple[int, int, int], ...] = EXTRA_RGB
+"""Colours for the other washout names, taken in the order the recording lists them."""
 LIMIT_COLOR = (128, 128, 128)
 THRESHOLD_COLOR = (128, 128, 128)
 AXIS_COLORS = ((220, 60, 60), (60, 170, 60), (70, 120, 230))
@@ -56,8 +52,8 @@ AXIS_COLORS = ((220, 60, 60), (60, 170, 60), (70, 120, 230))
 def series_color(source: str, washouts: Sequence[str] = ()) -> tuple[int, int, int]:
     """Fixed RGB colour of ``"aircraft"`` or a washout name.
 
-    The three named washouts have their own colours; any other name takes a spare colour by its position among the
-    other names in ``washouts`` (cycling after five).
+    The named washouts have their own colours; any other name takes a spare colour by its position among the
+    other names in ``washouts`` (cycling after :data:`EXTRA_COLORS`).
     """
     if source == "aircraft":
         return AIRCRAFT_COLOR

@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from washbench.analysis.cues import SCALE_BAND, parse_events
+from washbench.analysis.cues import SCALE_BAND, dof_thresholds, parse_events
 from washbench.analysis.metrics import DOFS
 from washbench.analysis.ranking import (
     DEFAULT_RULE,
@@ -38,7 +38,6 @@ from washbench.analysis.ranking import (
 from washbench.io.atomic import write_text_atomic
 from washbench.io.outfolder import discard_stage, make_stage, replace_entries
 from washbench.io.result_files import FIGURES_DIR, RECORDING_FILE, REPORT_FILE
-from washbench.perception.thresholds import ZACHARIAS
 from washbench.review.bound_section import algorithm_lines, bound_lines
 from washbench.review.cue_figures import cue_classes, cue_lane_figure
 from washbench.review.figures import SATURATION_LABELS, envelope_figure, perceived_figure
@@ -382,17 +381,15 @@ def check_lines(data: ResultData) -> list[str]:
 
 
 def perception_thresholds(data: ResultData) -> tuple[tuple[float, ...], tuple[float, ...]]:
-    """Zacharias thresholds and the resting values they are taken around, per DOF (m/s^2, deg/s).
+    """Zacharias thresholds and the resting values they are taken around, per DOF (m/s^2, deg/s): those of the cue
+    classification (:func:`washbench.analysis.cues.dof_thresholds`: (0, 0, -g, 0, 0, 0)), so the figure's "not felt"
+    band, the report's time beyond the threshold, the cue lanes, ``metrics.csv``'s cue columns and the recording's
+    threshold lines say the same. (The first sample, taken before, is a transient where a flight starts untrimmed,
+    as JSBSim's scripts do: the band then sat beside the curves.) ``data`` is not used (kept for the callers)."""
 
-    The resting value is what the aircraft pilot perceives at the first sample (trimmed flight, or standing on the
-    runway): a steady cue the pilot has been exposed to is not a change felt, so the band "not felt" lies around it
-    (for a level start about (0, 0, -g, 0, 0, 0); a descent or a climb starts with its own surge).
-    """
-
-    th = ZACHARIAS
-    thresholds = (th.f_x_mps2, th.f_y_mps2, th.f_z_mps2, th.omega_x_degps, th.omega_y_degps, th.omega_z_degps)
-    rest = tuple(float(v) for v in data.perceived["aircraft"][0])
-    return thresholds, rest
+    del data
+    thresholds, rest = dof_thresholds()
+    return tuple(thresholds), tuple(rest)
 
 
 def time_above_threshold(data: ResultData) -> dict[str, float]:

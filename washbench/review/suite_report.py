@@ -124,6 +124,15 @@ def _draw(pool: Executor | None, draw: Callable[..., list[Path]], *args: Any, **
     return done
 
 
+def tie_counts(n_tied: int, n_rankings: int, n_any: int) -> str:
+    """The suite report's sentence on ties: how many of ``n_rankings`` have first place shared (decided by less than
+    the rule's margin) and how many a tie at any rank, with the verb agreeing with each count."""
+    are = "is" if n_tied == 1 else "are"
+    have = "has" if n_any == 1 else "have"
+    return (f"**{n_tied} of {n_rankings} rankings {are} decided by less than that margin** (first place shared); "
+            f"{n_any} {have} a tie at some rank.")  # fmt: skip
+
+
 def _write_suite_report(
     suite_dir: Path, stage: Path, entries: list[dict[str, Any]], doc: dict[str, Any], regenerate_results: bool,
     figures: bool, pool: Executor | None = None,
@@ -221,8 +230,7 @@ def _write_suite_report(
                   + ", ".join(f"{w} {n}" for w, n in count.items()) + ".", ""]  # fmt: skip
         n_tied = sum(1 for r in rankings.values() if undecided(r))
         n_any = sum(1 for r in rankings.values() if any(x.tied for x in r))
-        lines += [f"Ranked by {rule.label()}. **{n_tied} of {len(rankings)} rankings are decided by less than that "
-                  f"margin** (first place shared); {n_any} have a tie at some rank. Shared ranks are marked "
+        lines += [f"Ranked by {rule.label()}. {tie_counts(n_tied, len(rankings), n_any)} Shared ranks are marked "
                   "\"(tie)\" in the reports, `tied` in `ranking.csv` and \"tie:\" in the score figure's row "
                   "labels.", ""]  # fmt: skip
     if any_above:
