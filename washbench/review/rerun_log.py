@@ -643,6 +643,8 @@ def _layout(data: RecordingData, perceived: list[np.ndarray], raw: list[np.ndarr
         camera=scene3d.camera(offsets, data.envelope.sphere_diameter_m),
         envelope_quantities=tuple((q, unit) for q, _, unit in ENVELOPE_QUANTITIES),
         limits_text=tuple(f"+-{_limit_text(data.envelope.axes(f))} {unit}" for _, f, unit in ENVELOPE_QUANTITIES),
+        hidden_lanes=tuple(washout_lane_path(data, w) for w in data.washouts),
+        cue_lanes=tuple(cue_lane_path(data, w) for w in data.washouts),
     )
 
 

@@ -156,7 +156,8 @@ def write_cued_folder(
     if options.outputs.recording:
         title = f"{summary.aircraft} / {summary.manoeuvre}"
         props = flat_strings(provenance, str((extra or {}).get("created_utc") or "")) if provenance else None
-        write_run_recording(folder / RECORDING_FILE, title, motion, result, options.limits, aircraft_q, phases, props)
+        write_run_recording(folder / RECORDING_FILE, title, motion, result, options.limits, aircraft_q, phases, props,
+                            options.rank_rule)
     ac = result.perceived["aircraft"]
     summary = dataclasses.replace(
         summary,
