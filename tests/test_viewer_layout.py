@@ -20,7 +20,15 @@ from washbench.analysis.metrics import DOFS
 from washbench.analysis.ranking import RankRow
 from washbench.io.metrics_csv import MetricRow
 from washbench.review.metrics_table import metrics_table_markdown
-from washbench.review.rerun_log import cue_lane_path, washout_lane_path, write_recording
+from washbench.review.rerun_log import (
+    FALSE_CUE_COLOR,
+    LIMIT_LANE_COLOR,
+    cue_lane_path,
+    phase_lane_path,
+    series_color,
+    washout_lane_path,
+    write_recording,
+)
 from washbench.review.rrd_read import read_blueprint_components, read_static
 
 SEVEN = ("small-angle", "large-angle", "unrestricted", "adaptive-large-angle", "optimal", "mpc", "bound")
@@ -112,3 +120,28 @@ def test_the_metrics_panel_ranks_and_keeps_the_bound_a_reference() -> None:
         assert "**" not in bound  # the bound is never "best"
         (best,) = [line for line in lines if line.startswith("| small-angle")]
         assert best.count("**") == 2 * len(DOFS)  # the best washout in every DOF
+
+
+def test_lane_bars_take_fixed_colours_apart_from_the_washouts(recording: tuple[Path, object]) -> None:
+    """Limit bars one neutral grey, false-cue bars the cue figure's red, phases blue-grey: none a washout colour
+    (rerun's colours by label looked like washout colours)."""
+    path, data = recording
+    colours = read_static(path, "StateConfiguration:colors")
+    values = read_static(path, "StateConfiguration:values")
+    washout = {_rgba(series_color(w, list(data.washouts))) for w in data.washouts} | {_rgba(series_color("aircraft"))}
+    limit_lanes = [p for p in colours if p.startswith("/limits/")]
+    assert len(limit_lanes) == len(data.washouts)  # make_data: every washout reaches its "pos" and "rate" limits
+    for p in limit_lanes:
+        assert set(colours[p]) == {_rgba(LIMIT_LANE_COLOR)} and set(values[p]) == {"pos", "rate"}
+    for w in data.washouts:
+        p = cue_lane_path(data, w)
+        if p in colours:
+            assert set(colours[p]) == {_rgba(FALSE_CUE_COLOR)} and all(v.startswith("false: ") for v in values[p])
+    assert set(colours[phase_lane_path()]).isdisjoint(washout)
+    for p in colours:
+        assert set(colours[p]).isdisjoint(washout), p
+
+
+def _rgba(rgb: tuple[int, int, int]) -> int:
+    r, g, b = rgb
+    return (r << 24) | (g << 16) | (b << 8) | 0xFF
