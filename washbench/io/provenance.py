@@ -41,6 +41,7 @@ from pathlib import Path
 from typing import Any
 
 from washbench.io.config import CONFIG_USED_ENV
+from washbench.io.paths import AIRCRAFT_DIR, DATA_DIR, MANOEUVRES_DIR, jsbsim_root
 
 PARQUET_KEY = b"washbench.provenance"
 """Key of the provenance JSON in a Parquet file's key-value metadata."""
@@ -109,8 +110,6 @@ def bundled_name(path: str | Path) -> tuple[str, str] | None:
     ``washbench:data/cw1.yaml``, ``washbench:aircraft/c172p/pilot.yaml``, ``washbench:manoeuvres/c172/takeoff.yaml``,
     ``jsbsim:aircraft/c172x/c172x.xml`` (not the absolute path of the machine that made the result).
     """
-    from washbench.io.paths import AIRCRAFT_DIR, DATA_DIR, MANOEUVRES_DIR, jsbsim_root
-
     try:
         resolved = Path(path).resolve()
     except OSError:
