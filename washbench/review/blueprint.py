@@ -145,9 +145,14 @@ takes about 40 px of the 1080 px window, a motion panel needs about 110 px to sh
 PANEL_SHARE = 2.0
 
 
+LANE_VIEW_SHARE = 1.2
+"""A lane view's title bar and time axis, against a motion panel's 2.0: with it one lane shows whole in a 720 px
+window (screenshots of the Columbia aerobatics at 1280x720: with 0.7 only the axis showed)."""
+
+
 def lane_share(n_lanes: int) -> float:
-    """The row share of a lane view of ``n_lanes`` lanes (its title bar and time axis: one lane more)."""
-    return LANE_SHARE * (n_lanes + 1)
+    """The row share of a lane view of ``n_lanes`` lanes (its title bar and time axis included)."""
+    return LANE_VIEW_SHARE + LANE_SHARE * n_lanes
 
 
 
@@ -174,7 +179,7 @@ def build_blueprint(layout: Layout) -> rrb.Blueprint:
             time_ranges=_all_data(),
         ),
         rrb.TextDocumentView(origin="/metrics", name="Metrics: ranking and metrics"),
-        row_shares=[2.2, 0.7 + 0.26 * n_legend, 3.6],  # the legend as tall as its lines, the rest for the tables
+        row_shares=[2.2, 0.9 + 0.26 * n_legend, 3.6],  # the legend as tall as its lines, the rest for the tables
     )
     phase_only = [*layout.hidden_lanes, *layout.cue_lanes]  # the motion tabs: the phase lane, the panels the room
     perceived = rrb.Vertical(
@@ -204,7 +209,7 @@ def build_blueprint(layout: Layout) -> rrb.Blueprint:
     envelope = rrb.Vertical(
         _lanes(layout, "/limits", "Limits reached (one lane per washout and limit kind)"),
         *usage,
-        row_shares=[lane_share(max(len(layout.limit_lanes), 1))] + [PANEL_SHARE] * len(usage),
+        row_shares=[1.0 + 0.45 * len(layout.limit_lanes) + 0.4 * len(layout.washouts)] + [PANEL_SHARE] * len(usage),
         name="Platform envelope",
     )
     per_washout = [

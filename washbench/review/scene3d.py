@@ -100,9 +100,10 @@ LABEL_ROW_STEP_M = 1.6
 
 
 def label_rows(n_objects: int) -> int:
-    """Rows the objects' labels are staggered over: one up to four objects, two up to six, three beyond (with
-    eight, a label as long as ``adaptive-large-angle`` is wider than two objects' spacing in the side view)."""
-    return 1 if n_objects <= 4 else 2 if n_objects <= 6 else 3
+    """Rows the objects' labels are staggered over: one up to three objects, two up to six, three beyond (in a
+    1280x720 window the labels of four objects touch; with eight, a label as long as ``adaptive-large-angle`` is
+    wider than two objects' spacing in the side view)."""
+    return 1 if n_objects <= 3 else 2 if n_objects <= 6 else 3
 
 
 def object_offsets(n_washouts: int, travel_m: np.ndarray, diameter_m: float) -> np.ndarray:
