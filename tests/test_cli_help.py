@@ -6,6 +6,7 @@ from __future__ import annotations
 import shlex
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -52,3 +53,18 @@ def test_top_level_help_names_the_docs() -> None:
     proc = subprocess.run([sys.executable, "-m", "washbench", "--help"], capture_output=True, text=True, check=True)
     assert "docs/tutorial/getting-started.md" in proc.stdout
     assert "docs/reference/commands.md" in proc.stdout
+
+
+RUN_AS_WRITTEN = [("validate", 0), ("examples", 0), ("examples", 1)]
+"""Examples that need no file of the user's: each must work as written, in a shell, in an empty folder (the
+first example of ``validate --help`` named ``manoeuvres/*.yaml``, which is nowhere: issue 38, item 6)."""
+
+
+@pytest.mark.parametrize(("command", "index"), RUN_AS_WRITTEN)
+def test_examples_that_need_no_file_of_yours_run_as_written(command: str, index: int, tmp_path: Path) -> None:
+    line = EXAMPLES[command][index]
+    washbench = f"{shlex.quote(sys.executable)} -m washbench"
+    script = " ".join(washbench if word == "washbench" else word for word in line.split(" "))
+    proc = subprocess.run(["bash", "-c", script], cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, (line, proc.stderr)
+    assert "Traceback" not in proc.stderr

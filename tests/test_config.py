@@ -8,6 +8,7 @@ one line naming file, line and key with exit status 2.
 
 from __future__ import annotations
 
+import hashlib
 import json
 import math
 import os
@@ -68,6 +69,10 @@ def test_defaults_from_washbench_toml_found_upwards_and_a_flag_wins(tmp_path: Pa
     prov = run["provenance"]
     assert prov["params"]["name"] == "MY-CW"
     assert prov["config"] == {"path": str(config), "sha256": sha256_file(config)}
+    # and in the report, as docs/how-to/configuration.md says (issue 38, item 5)
+    digest = hashlib.sha256(config.read_bytes()).hexdigest()
+    report = (project / "results" / "report.md").read_text()
+    assert f"| configuration file | `{config}` (SHA-256 `{digest}`) |" in report
     # a flag wins over the file
     proc = washbench(
         project / "logs", "cue", "small.csv", "--out", "here", "--params", str(DATA_DIR / "cw1.yaml"),

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import json
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -127,7 +128,9 @@ def test_recording_holds_the_computed_traces(run_dir: Path) -> None:
             rows += rec_t.size
     assert rows < 0.5 * 12 * t.size  # thinned: most steps lie on the lines between recorded ones
     text = "\n".join(read_text_documents(rrd).values())
-    assert "integral of |error|" in text and "| DOF | small-angle | large-angle | better by |" in text
+    assert "integral of |error|" in text and "| washout | surge | sway | heave | roll | pitch | yaw |" in text
+    ranked = [line.split(" | ")[1] for line in text.splitlines() if re.match(r"^\| \d+( \(tie\))? \| ", line)]
+    assert sorted(ranked) == ["large-angle", "small-angle", "unrestricted"]  # the ranking, first (issue 38, item 10)
     size_per_step = rrd.stat().st_size / len(t)
     print(f"\nrecording: {size_per_step:.0f} bytes per step ({len(t)} steps), {rows / 12 / t.size:.1%} of the rows")
     assert size_per_step < 250  # was 2,030, then 1,122 (takeoff) before float32 and thinning (issue 14)

@@ -18,7 +18,7 @@ import pyarrow.parquet as pq
 import pytest
 from report_helpers import check_images, check_tables, without_pdf_links
 
-from washbench.io.paths import DATA_DIR
+from washbench.io.paths import AIRCRAFT_DIR, DATA_DIR, jsbsim_root
 from washbench.io.provenance import PARQUET_KEY
 from washbench.review.figures import minmax_decimate
 from washbench.review.numbers import sig
@@ -92,10 +92,12 @@ def test_run_json_records_what_made_the_result(run_dir: Path, inputs: dict[str, 
     assert prov["platform"]["values"]["translation"]["position_limit_m"]["x"] == 0.5
     assert prov["manoeuvre"] == {"path": str(inputs["manoeuvre"]), "sha256": sha256(inputs["manoeuvre"])}
     assert prov["turbulence"] == {"severity": "light", "seed": 7}
-    model = Path(prov["aircraft"]["path"])
-    assert prov["aircraft"]["name"] == "c172p" and model.name == "c172p.xml"
-    assert prov["aircraft"]["sha256"] == sha256(model)
-    assert prov["pilot_profile"]["sha256"] == sha256(Path(prov["pilot_profile"]["path"]))
+    # bundled files are named as bundled, the same on every machine, with their hash (issue 38, item 8)
+    assert prov["aircraft"]["name"] == "c172p" and prov["aircraft"]["path"] == "jsbsim:aircraft/c172p/c172p.xml"
+    assert prov["aircraft"]["sha256"] == sha256(jsbsim_root() / "aircraft" / "c172p" / "c172p.xml")
+    assert prov["aircraft"]["bundled"] == f"jsbsim {importlib.metadata.version('jsbsim')}"
+    assert prov["pilot_profile"]["path"] == "washbench:aircraft/c172p/pilot.yaml"
+    assert prov["pilot_profile"]["sha256"] == sha256(AIRCRAFT_DIR / "c172p" / "pilot.yaml")
     sw = prov["software"]
     for key, dist in (("jsbsim", "jsbsim"), ("rerun", "rerun-sdk"), ("numpy", "numpy"), ("washbench", "washbench")):
         assert sw[key] == importlib.metadata.version(dist)
@@ -123,6 +125,9 @@ def test_report_header_names_the_inputs_and_versions(run_dir: Path, inputs: dict
     needles += [sha256(inputs["manoeuvre"]), "light, seed 7", "JSBSim 1.3.3", f"numpy {np.__version__}"]
     for needle in needles:
         assert needle in header, needle
+    # no absolute path of this machine for a bundled file (a checkout's aircraft/, site-packages' jsbsim/)
+    assert str(AIRCRAFT_DIR) not in header and str(jsbsim_root()) not in header
+    assert "`washbench:aircraft/c172p/pilot.yaml` (bundled with washbench" in header
 
 
 def test_every_linked_figure_exists_and_is_an_image(run_dir: Path) -> None:
@@ -256,7 +261,7 @@ def test_washout_colours_are_fixed_distinct_and_the_recordings() -> None:
     names = ["my-a", "large-angle", "my-b", "small-angle", "unrestricted"]
     colors = washout_colors(names)
     for name, rgb in WASHOUT_COLORS.items():
-        assert colors[name] == rgb
+        assert colors.get(name, rgb) == rgb  # (the bound's fixed grey: not among these names)
     assert len(set(colors.values())) == len(colors)
     assert [blueprint.series_color(w, names) for w in names] == [colors[w] for w in names]
     assert blueprint.series_color("aircraft") == AIRCRAFT_COLOR

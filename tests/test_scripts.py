@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import csv
 import json
+import subprocess
+import sys
 from pathlib import Path
 
 import jsbsim
@@ -148,3 +150,46 @@ def test_bad_scripts_are_one_line(tmp_path: Path) -> None:
     p.write_text("<fdm_config/>\n")
     with pytest.raises(WashbenchError, match="not a JSBSim script: the root element is <fdm_config>"):
         load_script_info(p)
+
+
+def test_a_script_that_sets_an_output_property_flies_as_plain_jsbsim(tmp_path: Path) -> None:
+    """Issue 38, item 2: JSBSim's ``c1723.xml`` sets ``simulation/output/log_rate_hz`` in an event (a property its
+    aircraft's ``<output>`` creates). washbench neutralises the directive instead of removing it: the script flies
+    to the same end, step for step, as plain JSBSim (run here in a scratch folder), and writes no CSV of JSBSim's."""
+    script = bundled_script("c1723")
+    plain = jsbsim.FGFDMExec(str(jsbsim.get_default_root_dir()), None)
+    plain.set_debug_level(0)
+    plain.set_output_path(str(tmp_path / "plain"))
+    (tmp_path / "plain").mkdir()
+    assert plain.load_script(str(script))
+    plain.run_ic()
+    steps = 0
+    while plain.run():
+        steps += 1
+    assert plain.get_property_value("simulation/output/log_rate_hz") == 10.0  # the event did set it
+
+    work = tmp_path / "work"
+    work.mkdir()
+    proc = subprocess.run([sys.executable, "-m", "washbench", "run", str(script), "--out", str(work / "out"),
+                           "--no-recording", "--no-figures", "--quiet"],
+                          capture_output=True, text=True, timeout=120, cwd=work)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert "Traceback" not in proc.stderr and "No property" not in proc.stderr
+    flight = json.loads((work / "out" / "c172x" / "c1723" / "flight.json").read_text())
+    assert flight["status"] == "ok"
+    t = pq.read_table(work / "out" / "c172x" / "c1723" / "flight.parquet").column("t_s").to_numpy()
+    # the same run to within JSBSim's last step or two (when run() says False; t = k * dt from 0 here)
+    assert t[-1] == pytest.approx(plain.get_sim_time(), abs=2.5 * flight["dt_s"])
+    assert abs(len(t) - steps) <= 2
+    assert not list(work.rglob("*.csv")) or all("out" in p.relative_to(work).parts for p in work.rglob("*.csv"))
+
+
+def test_a_script_event_jsbsim_cannot_do_is_a_failed_run_not_a_traceback(tmp_path: Path) -> None:
+    """JSBSim's ``737_cruise_steady_turn_simplex.xml`` sets ``simulation/do_simplex_trim``, which this JSBSim build
+    lacks: plain JSBSim raises from ``run()`` at 0.1 s. washbench keeps what was flown and says why, in one line."""
+    (s,) = run_script(bundled_script("737_cruise_steady_turn_simplex"), tmp_path, load_options(max_time_s=2.0))
+    assert not s.ok
+    assert "JSBSim stopped the script" in s.reason and "simulation/do_simplex_trim" in s.reason
+    assert "\n" not in s.reason
+    flight = json.loads((tmp_path / "737" / "737_cruise_steady_turn_simplex" / "flight.json").read_text())
+    assert flight["status"] == "failed"

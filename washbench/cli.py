@@ -257,7 +257,8 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--out", type=_out_path, required=True, help="output folder (tuned.yaml, tune.csv, report.md)")
     _study_options(p)
-    p = sub.add_parser("examples", help="copy the bundled manoeuvres and pilot profiles into a folder to edit")
+    p = sub.add_parser("examples", help="copy the bundled manoeuvres, pilot profiles, parameter and platform files "
+                       "into a folder to edit")
     p.add_argument("folder", type=Path, help="destination (created; existing files are never overwritten)")
 
     p = sub.add_parser("report", help="write report.md and its figures (PNG and PDF) again from existing results")

@@ -11,9 +11,11 @@ import argparse
 
 #: Where the documentation is (the top-level help names it).
 DOCS = (
-    "documentation: the docs/ folder of the washbench source (start with docs/tutorial/getting-started.md; "
-    "every command and option: docs/reference/commands.md); build it as a site with "
-    "pip install 'washbench[docs]' && python -m sphinx -b html docs docs/_build/html"
+    "documentation: each command's --help (its options, then examples) and, for the Python API, "
+    "python -m pydoc washbench (both ship with the package). The guides and reference are the docs/ folder of the "
+    "washbench source (a checkout, or the source distribution washbench-VERSION.tar.gz; the wheel holds no docs/): "
+    "start with docs/tutorial/getting-started.md; every command and option: docs/reference/commands.md; build it "
+    "as a site with pip install 'washbench[docs]' && python -m sphinx -b html docs docs/_build/html"
 )
 
 #: Command name -> example command lines (each one starts with ``washbench``).
@@ -28,7 +30,7 @@ EXAMPLES: dict[str, tuple[str, ...]] = {
         "washbench fly manoeuvres/my_turn.yaml --out out/try --aircraft-dir ~/aircraft",
     ),
     "validate": (
-        "washbench validate manoeuvres/*.yaml",
+        "washbench validate c172 columbia400/takeoff",
         "washbench validate my_turn.yaml --aircraft-dir ~/aircraft",
     ),
     "schema": (

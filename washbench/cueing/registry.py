@@ -231,6 +231,58 @@ def get(kind: str, spec: str | None = None) -> Algorithm:
     raise WashbenchError(f"unknown washout {kind!r} (valid: {', '.join(known_kinds())})")
 
 
+def _sha256(path: str | Path) -> str | None:
+    try:
+        return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+    except OSError:
+        return None
+
+
+def _distribution(ep: importlib.metadata.EntryPoint) -> dict[str, str]:
+    dist = getattr(ep, "dist", None)
+    if dist is None:
+        return {}
+    return {"distribution": str(dist.metadata["Name"]), "version": str(dist.version)}
+
+
+def identity(kind: str, params: Any = None) -> dict[str, Any] | None:
+    """Which code a plugin washout ``kind`` ran and with which values: what its provenance records; None for the
+    compiled and built-in kinds (washbench's own, named by its version).
+
+    A file plugin: ``{"from": "file", "path", "object", "sha256"}`` (the file as loaded, its bytes' SHA-256); with
+    ``"shadows"`` naming an installed entry point of the same name, which the file replaced in this run. An entry
+    point: ``{"from": "entry point", "module", "object", "distribution", "version", "sha256"}`` (of the module's
+    file). Both with ``"values"``: the plugin's parameters as its ``Params`` validated them from the
+    ``kind`` section of ``params`` (``WashoutParams``; defaults filled in; ``{}`` without ``Params``).
+    """
+    if not is_python(kind) or kind in BUILTIN_PYTHON:
+        return None
+    algo = get(kind, plugin_spec(kind))
+    rec: dict[str, Any]
+    spec = _PLUGIN_SPECS.get(kind)
+    entry = _entry_points().get(kind)
+    if spec is not None:
+        file, _, name = spec.rpartition(":")
+        rec = {"from": "file", "path": file, "object": name, "sha256": _sha256(file)}
+        if entry is not None:
+            dist = _distribution(entry)
+            owner = f" ({dist['distribution']} {dist['version']})" if dist else ""
+            rec["shadows"] = f"entry point {entry.value}{owner}"
+    elif entry is not None:
+        module, _, attr = entry.value.partition(":")
+        rec = {"from": "entry point", "module": module.strip(), "object": attr.strip(), **_distribution(entry)}
+        mod = sys.modules.get(module.strip())
+        file = getattr(mod, "__file__", None)
+        if file:  # the module's file (named by module and distribution: its place differs from machine to machine)
+            rec["sha256"] = _sha256(file)
+    else:  # registered some other way (a test's): its source as the registry knows it
+        rec = {"from": algo.source}
+    section = getattr(params, "sections", {}).get(kind) if params is not None else None
+    values = algo.make_params(section, f"washout {kind}") if algo.params_model is not None else None
+    rec["values"] = values.model_dump(mode="json") if values is not None else {}
+    return rec
+
+
 __all__ = [
     "BUILTIN_PYTHON",
     "ENTRY_POINT_GROUP",
@@ -238,6 +290,7 @@ __all__ = [
     "Algorithm",
     "check_washouts",
     "get",
+    "identity",
     "is_python",
     "known_kinds",
     "load_plugin",

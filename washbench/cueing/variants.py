@@ -268,11 +268,35 @@ def load_param_file(path: Path | None = None) -> tuple[WashoutParams, tuple[Wash
     return param_file_from_data(path, data, lines)
 
 
+_BASE_FIELDS = tuple(k for k, f in WashoutParams.model_fields.items() if f.is_required())
+"""The top-level keys a parameter set must have (``name``, ``gravity_mps2``, ``scale``, ``tilt`` ...; ``adaptive``
+has its defaults in the model)."""
+
+
+def defaulted_sections(path: Path, data: Any) -> tuple[str, ...]:
+    """The top-level keys of a parameter set that the file ``path`` (parsed: ``data``) leaves out, which are taken
+    from the bundled CW1 set (:data:`DEFAULT_PARAMS_PATH`): a file may hold only what it changes, e.g. only a
+    plugin's section. ``name`` left out is the file's stem. Empty for the bundled file itself or a non-mapping."""
+    if not isinstance(data, dict) or Path(path).resolve() == DEFAULT_PARAMS_PATH.resolve():
+        return ()
+    return tuple(k for k in _BASE_FIELDS if k not in data)
+
+
+def _with_defaults(path: Path, data: dict[str, Any]) -> dict[str, Any]:
+    missing = defaulted_sections(path, data)
+    if not missing:
+        return data
+    bundled, _ = read_yaml(DEFAULT_PARAMS_PATH)
+    filled = {k: (Path(path).stem if k == "name" else bundled[k]) for k in missing}
+    return {**filled, **data}
+
+
 def param_file_from_data(path: Path, data: Any, lines: dict[Loc, int]) -> tuple[WashoutParams, tuple[Washout, ...]]:
     """:func:`load_param_file` of a file already read (``read_yaml``: its data and line map; the top-level mapping
-    is not changed)."""
+    is not changed). Top-level sections the file leaves out are the bundled CW1 set's (:func:`defaulted_sections`):
+    a section given is taken whole, as written."""
     if isinstance(data, dict):
-        data = dict(data)
+        data = _with_defaults(path, dict(data))
     if not isinstance(data, dict):
         return validate_data(path, data, lines, WashoutParams), ()
     variants = data.pop("variants", None)
@@ -343,6 +367,7 @@ __all__ = [
     "as_washouts",
     "builtin",
     "check_key",
+    "defaulted_sections",
     "load_param_file",
     "param_file_from_data",
     "parse_value",

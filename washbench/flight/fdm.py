@@ -58,6 +58,7 @@ def make_fdm(m: Manoeuvre, profile: PilotProfile) -> tuple[Any, Setup]:
         with quiet_stdout():
             try:
                 loaded = fdm.load_model(m.aircraft)
+                fdm.disable_output()  # the model's <output> directives, neutralised, write nothing (jsbsim_xml)
             except Exception as exc:  # JSBSim raises plain exceptions on broken models
                 raise WashbenchError(m.located(("aircraft",), f"JSBSim could not load the model ({exc})")) from None
             if not loaded:

@@ -1,11 +1,14 @@
-"""What JSBSim is given to read: XML checked first, and its ``<output>`` directives taken out.
+"""What JSBSim is given to read: XML checked first, and its ``<output>`` directives neutralised.
 
 A JSBSim script (``<runscript>``) or aircraft (``<fdm_config>``) may hold ``<output>`` directives: JSBSim then
 writes CSV files wherever they say (a path climbing out of any folder, an absolute path onto an existing file)
 or opens TCP/UDP sockets, at load time. washbench records the flight itself, so these directives are switched
-off: JSBSim reads a copy without them (a script in a temporary folder; an aircraft in a temporary aircraft
-folder that links every other file of the model's folder), and washbench says so on standard error. Nothing
-is ever written by JSBSim and no socket is opened.
+off: JSBSim reads a copy (a script in a temporary folder; an aircraft in a temporary aircraft folder that links
+every other file of the model's folder) in which each directive is a CSV file of a plain name in JSBSim's output
+path (a scratch folder) logging nothing, and the output is disabled after loading; washbench says so on standard
+error. Nothing is written by JSBSim outside the scratch folder and no socket is opened. The directives are not
+removed: JSBSim creates properties for each (``simulation/output/log_rate_hz`` ...), and scripts set them in
+events (JSBSim's ``c1723.xml`` does; without the property it stops with ``No property ... is defined``).
 
 JSBSim writes one more file of its own: setting the property ``simulation/write-state-file`` (a script's
 ``<set>``, an aircraft's flight-control component, a manoeuvre's property input) writes ``initfile.T.xml`` into
@@ -134,10 +137,26 @@ def scratch_output_dir() -> str:
     return _SCRATCH[1] + os.sep
 
 
-def _strip(root: ET.Element) -> int:
+def _neutralise(root: ET.Element, stem: str) -> int:
+    """Point every top-level ``<output>`` of ``root`` at a CSV file of a plain name (``washbench-STEM-N.csv``, in
+    JSBSim's output path: a scratch folder) and drop what it would log; return how many there were.
+
+    The directives stay, so the properties JSBSim creates for each (``simulation/output/log_rate_hz``,
+    ``simulation/output[1]/enabled`` ...) exist for the script events that set them (JSBSim's ``c1723.xml``
+    does); a socket type, a path of the user's, an output-definition ``file`` and the logged properties are gone.
+    The caller also switches the output off (``FGFDMExec.disable_output``), so not even the scratch file fills.
+    """
     found = root.findall("output")
-    for elem in found:
-        root.remove(elem)
+    for i, elem in enumerate(found):
+        rate = elem.get("rate")
+        elem.attrib.clear()
+        elem.set("name", f"washbench-{stem}-{i}.csv")
+        elem.set("type", "CSV")
+        if rate is not None:
+            elem.set("rate", rate)
+        for child in list(elem):
+            elem.remove(child)
+        elem.text = None
     return len(found)
 
 
@@ -150,9 +169,9 @@ def _note(path: Path, n: int) -> None:
 
 
 def script_for_jsbsim(path: Path, tmp: Path) -> Path:
-    """``path`` if its ``<runscript>`` has no ``<output>``; else a copy without them in folder ``tmp``."""
+    """``path`` if its ``<runscript>`` has no ``<output>``; else a copy with them neutralised in folder ``tmp``."""
     root = read_xml(path)
-    n = _strip(root)
+    n = _neutralise(root, "script")
     if not n:
         return path
     copy = tmp / path.name
@@ -163,7 +182,7 @@ def script_for_jsbsim(path: Path, tmp: Path) -> Path:
 
 def aircraft_for_jsbsim(aircraft_root: Path, name: str, tmp: Path) -> Path:
     """The aircraft folder to give JSBSim for model ``name``: ``aircraft_root`` if ``<name>/<name>.xml`` holds
-    no ``<output>``; else ``tmp`` holding ``<name>/`` with the file without them and links to the rest.
+    no ``<output>``; else ``tmp`` holding ``<name>/`` with the file with them neutralised and links to the rest.
 
     The model file is checked with :func:`read_xml` either way.
     """
@@ -173,7 +192,7 @@ def aircraft_for_jsbsim(aircraft_root: Path, name: str, tmp: Path) -> Path:
         raise WashbenchError(
             located(model, f"not a JSBSim aircraft: the root element is <{root.tag}>, not <fdm_config>")
         )
-    n = _strip(root)
+    n = _neutralise(root, "aircraft")
     if not n:
         return aircraft_root
     folder = tmp / name

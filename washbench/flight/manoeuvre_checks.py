@@ -409,6 +409,7 @@ def _check_properties(m: ManoeuvreFields, files: AircraftFiles, where: Where) ->
         with quiet_stdout():
             try:
                 loaded = fdm.load_model(m.aircraft)
+                fdm.disable_output()  # the model's <output> directives, neutralised, write nothing (jsbsim_xml)
             except Exception as exc:  # JSBSim raises plain exceptions on broken models
                 raise where.error(("aircraft",), f"JSBSim could not load the model ({exc})") from None
     if not loaded:

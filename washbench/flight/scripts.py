@@ -20,7 +20,8 @@ and cause.
 
 The scripts shipped in the jsbsim package (``jsbsim.get_default_root_dir()/scripts``) are found by name
 (:func:`bundled_script`); their aircraft are JSBSim's own. The script's ``<output>`` directives are
-switched off (they would write into the current folder), and its console messages are silenced.
+neutralised (they would write into the current folder or open sockets; :mod:`washbench.flight.jsbsim_xml`), and
+its console messages are silenced.
 """
 
 from __future__ import annotations
@@ -293,8 +294,9 @@ def _structure_contacts(fdm: object) -> list[object]:
 
 def _make_fdm(info: ScriptInfo, output_dir: Path) -> object:
     """The FDM with the script loaded and initialised. The script's and the aircraft's ``<output>`` directives
-    are taken out before JSBSim reads them (:mod:`washbench.flight.jsbsim_xml`: copies in ``output_dir``, a
-    temporary folder), so JSBSim writes no file and opens no socket; output is also switched off."""
+    are neutralised before JSBSim reads them (:mod:`washbench.flight.jsbsim_xml`: copies in ``output_dir``, a
+    temporary folder, each directive a CSV file there logging nothing; the properties they create stay for the
+    script's events), and output is switched off, so JSBSim writes nothing and opens no socket."""
     import jsbsim
 
     root = aircraft_for_jsbsim(info.aircraft_root, info.aircraft, output_dir / "aircraft")
@@ -386,7 +388,12 @@ def _fly(
             if total >= limit_steps:
                 flight.stopped_by_limit = True
                 break
-            if not run():
+            try:
+                going = run()
+            except Exception as exc:  # JSBSim raises on a script event it cannot do (a property its build lacks)
+                close(rows, "failed", f"t={t:.2f} s: JSBSim stopped the script: {str(exc).strip()}")
+                return flight
+            if not going:
                 break  # the script's end: the last state has no pilot acceleration of its own
             total += 1
             if fdm.get_sim_time() < t_sim - 0.5 * dt:  # type: ignore[attr-defined]

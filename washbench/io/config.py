@@ -8,7 +8,8 @@ holds both; a ``pyproject.toml`` without the table is passed over). The keys are
     params = "params/my_cw.yaml"        # --params: a file, relative to this file's folder
     platform = "params/my_atlas.yaml"   # --platform
     aircraft-dir = ["aircraft", "/opt/jsbsim-models"]   # --aircraft-dir (a folder or a list of folders)
-    out = "results"                     # --out of run, suite, cue, fly, omct, sweep, tune
+    out = "results"                     # --out of run, suite, cue, fly, omct, sweep, tune (run and suite share a
+                                        # folder; the others each need their own: io.outfolder.folder_owner)
     jobs = 4                            # --jobs (suite, sweep, tune)
 
 A flag given on the command line wins over the file (``--aircraft-dir`` given at all replaces the file's list).

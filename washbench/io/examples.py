@@ -1,7 +1,9 @@
-"""``washbench examples DIR``: copy the bundled manoeuvres and pilot profiles into a folder the user can edit.
+"""``washbench examples DIR``: copy the bundled manoeuvres, pilot profiles, washout parameter file and platform
+file into a folder the user can edit.
 
-The copy is laid out as a washbench project: ``DIR/manoeuvres/<aircraft>/<name>.yaml`` and
-``DIR/aircraft/<aircraft>/pilot.yaml``. A manoeuvre in ``DIR/manoeuvres/`` finds ``DIR/aircraft/`` by the
+The copy is laid out as a washbench project: ``DIR/manoeuvres/<aircraft>/<name>.yaml``,
+``DIR/aircraft/<aircraft>/pilot.yaml`` and ``DIR/params/cw1.yaml``, ``DIR/params/atlas.yaml`` (for ``--params``
+and ``--platform``). A manoeuvre in ``DIR/manoeuvres/`` finds ``DIR/aircraft/`` by the
 "``aircraft/`` next to the manoeuvre or in a parent" rule, so an edited profile there is the one flown (the
 aircraft models themselves are still found bundled or in JSBSim; copy a model folder into ``DIR/aircraft/``
 to change it too).
@@ -16,7 +18,12 @@ from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
 from washbench.io.lock import output_lock
 from washbench.io.outfolder import recover, staged
-from washbench.io.paths import AIRCRAFT_DIR, MANOEUVRES_DIR, PROFILE_NAME
+from washbench.io.paths import AIRCRAFT_DIR, DATA_DIR, MANOEUVRES_DIR, PROFILE_NAME
+
+PARAM_FILES = ("cw1.yaml", "atlas.yaml")
+"""The bundled washout parameter set and platform file, copied into ``DIR/params/``."""
+TOPS = ("manoeuvres", "aircraft", "params")
+"""The folders ``washbench examples`` creates in ``DIR`` (it refuses when one exists)."""
 
 
 def example_files(dest: Path) -> list[tuple[Path, Path]]:
@@ -28,12 +35,13 @@ def example_files(dest: Path) -> list[tuple[Path, Path]]:
         (src, dest / "aircraft" / src.parent.name / PROFILE_NAME)
         for src in sorted(AIRCRAFT_DIR.glob(f"*/{PROFILE_NAME}"))
     ]
+    pairs += [(DATA_DIR / name, dest / "params" / name) for name in PARAM_FILES]
     return pairs
 
 
 def copy_examples(dest: Path) -> int:
     """Copy the examples into ``dest`` (created), all or nothing; refuse before writing anything if
-    ``dest/manoeuvres`` or ``dest/aircraft`` exists (a link there is never followed).
+    ``dest/manoeuvres``, ``dest/aircraft`` or ``dest/params`` exists (a link there is never followed).
 
     Built in a hidden stage folder inside ``dest`` and published whole (:mod:`washbench.io.outfolder`), under
     ``dest``'s lock: a full disk or a signal leaves nothing half-copied, so a rerun works.
@@ -43,7 +51,7 @@ def copy_examples(dest: Path) -> int:
         raise WashbenchError(located(dest, "exists and is not a folder"))
     with output_lock(dest):
         recover(dest, only_washbench=True)  # the user's folder: only washbench's own leftovers
-        for top in ("manoeuvres", "aircraft"):
+        for top in TOPS:
             if (dest / top).exists() or (dest / top).is_symlink():
                 raise WashbenchError(located(dest / top, "already exists; nothing copied (examples never overwrite)"))
         with staged(dest, []) as stage:
@@ -55,9 +63,12 @@ def copy_examples(dest: Path) -> int:
                 raise WashbenchError(located(dest, f"cannot write ({exc.strerror or exc})")) from None
     pairs = example_files(dest)
     n_m = sum(1 for _, d in pairs if d.suffix == ".yaml" and "manoeuvres" in d.parts)
-    print(f"{n_m} manoeuvres and {len(pairs) - n_m} pilot profiles copied to {dest}")
+    n_p = len(pairs) - n_m - len(PARAM_FILES)
+    print(f"{n_m} manoeuvres, {n_p} pilot profiles, a washout parameter file and a platform file copied to {dest}")
     print(f"  run one:   washbench run {dest / 'manoeuvres' / 'c172' / 'coordinated_turn.yaml'} --out results")
     print(f"  run all:   washbench suite {dest / 'manoeuvres'} --out results")
     print(f"  profiles:  {dest / 'aircraft'}/<aircraft>/pilot.yaml are used by the manoeuvres under {dest}")
+    print(f"  params:    --params {dest / 'params' / 'cw1.yaml'} --platform {dest / 'params' / 'atlas.yaml'} (a "
+          "parameter file may hold only the sections it changes)")  # fmt: skip
     sys.stdout.flush()
     return 0

@@ -54,7 +54,9 @@ from washbench.io.result_files import (
     MANIFEST,
     OLD_PREFIX,
     PROBE_PREFIX,
+    RUN_FILE,
     STAGE_PREFIX,
+    SUITE_FILE,
     is_legacy_leftover,
     is_own_hidden,
     publication_pid,
@@ -63,9 +65,10 @@ from washbench.io.result_files import (
 _TMP = re.compile(r"^\..+\.tmp$")
 
 __all__ = [
-    "JOURNAL_PREFIX", "MANIFEST", "OLD_PREFIX", "STAGE_PREFIX", "check_out_path", "discard_stage", "is_own_hidden",
-    "make_stage", "owned_entries", "recover", "recover_shared", "replace_entries", "result_entry", "result_set",
-    "signals_held", "staged", "swap_in", "uninterrupted", "unstaged_error",
+    "JOURNAL_PREFIX", "MANIFEST", "OLD_PREFIX", "STAGE_PREFIX", "check_out_path", "discard_stage", "folder_owner",
+    "is_own_hidden", "make_stage", "owned_entries", "recover", "recover_shared", "refuse_other_owner",
+    "replace_entries", "result_entry", "result_set", "signals_held", "staged", "swap_in", "uninterrupted",
+    "unstaged_error",
 ]  # fmt: skip
 
 
@@ -169,6 +172,55 @@ def read_manifest(out_dir: Path) -> tuple[str, list[str]] | None:
     return doc["command"], names
 
 
+def folder_owner(out_dir: Path) -> tuple[str, Path] | None:
+    """Which command's results ``out_dir`` holds, and the file that says so; None if no command's.
+
+    The one meaning of "washbench wrote this folder", for every command: a manifest ``.washbench.json`` names its
+    command (``cue``, ``fly``, ``omct``, ``sweep``, ``tune``); a suite's ``suite.json`` says ``suite``; a folder
+    ``OUT/<aircraft>/<manoeuvre>/`` holding ``run.json`` says ``run`` (a run's results gather in ``OUT`` beside
+    other runs, and a suite replaces them, so ``run`` and ``suite`` share a folder).
+    """
+    manifest = read_manifest(out_dir)
+    if manifest is not None:
+        return manifest[0], out_dir / MANIFEST
+    suite = out_dir / SUITE_FILE
+    if suite.is_file() and not suite.is_symlink():
+        with contextlib.suppress(OSError, ValueError):
+            doc = json.loads(suite.read_text(encoding="utf-8"))
+            if isinstance(doc, dict) and doc.get("washbench") == "suite":
+                return "suite", suite
+    try:
+        tops = sorted(e for e in out_dir.iterdir() if e.is_dir() and not e.is_symlink() and not is_own_hidden(e.name))
+    except OSError:
+        return None
+    for top in tops:
+        with contextlib.suppress(OSError):
+            for sub in sorted(top.iterdir()):
+                marker = sub / RUN_FILE
+                if sub.is_dir() and not sub.is_symlink() and marker.is_file() and not marker.is_symlink():
+                    return "run", marker
+    return None
+
+
+def refuse_other_owner(out_dir: Path, command: str) -> None:
+    """Raise WashbenchError (one line, naming the command and the file that says so) when ``out_dir`` holds the
+    results of a command whose results ``command``'s would not replace (:func:`folder_owner`).
+
+    A folder holds one command's results; ``run`` and ``suite`` share one (a suite is a set of runs).
+    """
+    owner = folder_owner(out_dir)
+    if owner is None:
+        return
+    sharing = {"run", "suite"}
+    if owner[0] == command or (owner[0] in sharing and command in sharing):
+        return
+    problem = (
+        f"holds the results of `washbench {owner[0]}` ({owner[1].name}), not of `washbench {command}`: a folder "
+        "holds one command's results (run and suite share one); not replaced; choose another --out"
+    )
+    raise WashbenchError(located(out_dir, problem))
+
+
 def owned_entries(out_dir: Path, command: str, adopt: Sequence[str] = ()) -> list[Path]:
     """The entries of ``out_dir`` a new result set of ``command`` replaces (those its manifest lists).
 
@@ -177,14 +229,9 @@ def owned_entries(out_dir: Path, command: str, adopt: Sequence[str] = ()) -> lis
     names the command itself is writing there for the new set (``washbench live``'s saved input), neither
     refused nor replaced.
     """
+    refuse_other_owner(out_dir, command)
     manifest = read_manifest(out_dir)
-    listed: set[str] = set()
-    if manifest is not None:
-        if manifest[0] != command:
-            raise WashbenchError(located(
-                out_dir, f"holds the results of `washbench {manifest[0]}`, not of `washbench {command}`: not "
-                "replaced; choose another --out"))  # fmt: skip
-        listed = set(manifest[1])
+    listed: set[str] = set(manifest[1]) if manifest is not None else set()
     found: list[Path] = []
     for entry in sorted(out_dir.iterdir()):
         if is_own_hidden(entry.name) and (manifest is not None or entry.name == LOCK_NAME):

@@ -11,7 +11,12 @@ One JSON-able dict (:func:`build_provenance`) records
 - ``params`` and ``platform``: the parameter set's and platform's name (the ``name`` key of the YAML file), the path
   and SHA-256 of the file actually used (the bundled ``cw1.yaml`` / ``atlas.yaml`` when none was given) and the
   values read from it (so a result can be re-examined without the file);
-- ``washouts``: the washouts that ran, name and kind, and a variant's own parameter values;
+- a file shipped with washbench or JSBSim is named as bundled, the same on every machine
+  (``washbench:data/cw1.yaml``, ``jsbsim:aircraft/c172x/c172x.xml``, :func:`bundled_name`), with ``bundled``: the
+  package and version; any other file by its path as given;
+- ``washouts``: the washouts that ran, name and kind, and a variant's own parameter values; for a plugin, which
+  code ran (``plugin``: its file or module, class, SHA-256, the installed entry point a file replaced, and its
+  parameter values);
 - ``turbulence``: severity and seed of the manoeuvre's turbulence (``None`` without turbulence);
 - ``config``: the project configuration file the command found (``washbench.toml`` or a ``pyproject.toml`` with
   ``[tool.washbench]``, see :mod:`washbench.io.config`), its path and SHA-256; left out when there was none.
@@ -36,6 +41,7 @@ from pathlib import Path
 from typing import Any
 
 from washbench.io.config import CONFIG_USED_ENV
+from washbench.io.paths import AIRCRAFT_DIR, DATA_DIR, MANOEUVRES_DIR, jsbsim_root
 
 PARQUET_KEY = b"washbench.provenance"
 """Key of the provenance JSON in a Parquet file's key-value metadata."""
@@ -97,15 +103,46 @@ def software_versions() -> dict[str, str]:
     return out
 
 
+def bundled_name(path: str | Path) -> tuple[str, str] | None:
+    """``(package, name)`` of a file shipped with washbench or JSBSim, else None.
+
+    A bundled file is named the same on every machine and in a checkout as in an installed wheel:
+    ``washbench:data/cw1.yaml``, ``washbench:aircraft/c172p/pilot.yaml``, ``washbench:manoeuvres/c172/takeoff.yaml``,
+    ``jsbsim:aircraft/c172x/c172x.xml`` (not the absolute path of the machine that made the result).
+    """
+    try:
+        resolved = Path(path).resolve()
+    except OSError:
+        return None
+    places = (("washbench", AIRCRAFT_DIR, "aircraft/"), ("washbench", MANOEUVRES_DIR, "manoeuvres/"),
+              ("washbench", DATA_DIR, "data/"), ("jsbsim", jsbsim_root(), ""))  # fmt: skip
+    for package, root, prefix in places:
+        try:
+            rel = resolved.relative_to(root.resolve())
+        except ValueError:
+            continue
+        return package, f"{package}:{prefix}{rel.as_posix()}"
+    return None
+
+
 def file_record(
     path: str | Path, name: str | None = None, values: Mapping[str, Any] | None = None, sha256: str | None = None
 ) -> dict[str, Any]:
     """``{"name", "path", "sha256", "values"}`` of one input file (name and values only when given); ``sha256``:
-    the digest of the bytes already read (:func:`washbench.io.yamlio.read_yaml_digest`), else the file is hashed."""
+    the digest of the bytes already read (:func:`washbench.io.yamlio.read_yaml_digest`), else the file is hashed.
+
+    A file shipped with washbench or JSBSim is named as bundled (:func:`bundled_name`, e.g.
+    ``washbench:data/cw1.yaml``) with ``"bundled"``: the package and its version; any other file by its path as
+    given."""
     rec: dict[str, Any] = {}
     if name is not None:
         rec["name"] = name
-    rec["path"] = str(path)
+    bundled = bundled_name(path)
+    if bundled is None:
+        rec["path"] = str(path)
+    else:
+        rec["path"] = bundled[1]
+        rec["bundled"] = f"{bundled[0]} {software_versions().get(bundled[0], '?')}"
     rec["sha256"] = sha256 or sha256_file(path)
     if values is not None:
         rec["values"] = dict(values)
@@ -127,6 +164,7 @@ def build_provenance(
     ranking: Mapping[str, Any] | None = None,
     vestibular: Mapping[str, Any] | None = None,
     digests: Mapping[str, str] | None = None,
+    plugins: Mapping[str, Mapping[str, Any]] | None = None,
 ) -> dict[str, Any]:
     """The provenance of one result (module docstring); no date in it.
 
@@ -140,6 +178,8 @@ def build_provenance(
     (:meth:`washbench.analysis.ranking.RankRule.record`); ``vestibular``: the vestibular model
     (:func:`washbench.perception.vestibular.model_record`: its name and values). ``digests``: path (as given) ->
     SHA-256 of a file already read (:func:`washbench.io.yamlio.read_yaml_digest`), so it is not read again.
+    ``plugins``: washout name -> what a plugin washout ran (:func:`washbench.cueing.registry.identity`: file or
+    module, class, SHA-256, parameter values), recorded as that washout's ``plugin``.
     """
     digests = digests or {}
     prov: dict[str, Any] = {"software": software_versions()}
@@ -157,7 +197,7 @@ def build_provenance(
         prov["params"] = file_record(params_path, params.name, params.model_dump(mode="json"),
                                      digests.get(str(params_path)))  # fmt: skip
     if washouts:
-        prov["washouts"] = [_washout_record(w, params) for w in washouts]
+        prov["washouts"] = [_washout_record(w, params, (plugins or {}).get(w.name)) for w in washouts]
     if platform is not None and platform_path is not None:
         prov["platform"] = file_record(platform_path, platform.name, platform.model_dump(mode="json"),
                                        digests.get(str(platform_path)))  # fmt: skip
@@ -189,10 +229,12 @@ def merge_provenance(*parts: Mapping[str, Any]) -> dict[str, Any]:
     return {k: merged[k] for k in [*known, *(k for k in merged if k not in _ORDER)]}
 
 
-def _washout_record(washout: Any, base: Any) -> dict[str, Any]:
+def _washout_record(washout: Any, base: Any, plugin: Mapping[str, Any] | None = None) -> dict[str, Any]:
     rec: dict[str, Any] = {"name": washout.name, "kind": washout.kind}
     if base is None or washout.params != base:
         rec["values"] = washout.params.model_dump(mode="json")
+    if plugin is not None:
+        rec["plugin"] = dict(plugin)
     return rec
 
 

@@ -1,14 +1,16 @@
 """The review layout of a recording, and the colours every view shares.
 
 Laid out for one question: which washout feels most like the aircraft? The first tab stacks the six perceived-motion
-panels (surge, sway, heave, roll, pitch, yaw, as the paper's Figures 8-16) under one lane view (flight phases, and
-per washout the platform limits it is held at), all on one linked time axis showing the whole manoeuvre; beside them
-the 3D scene (aircraft and Atlas cockpits) and the metric table. The viewer's own side panels start collapsed.
+panels (surge, sway, heave, roll, pitch, yaw, as the paper's Figures 8-16) under the phase lane, all on one linked
+time axis showing the whole manoeuvre, and gives them the height; the false cues (one lane per washout) have a tab
+of their own, the per-washout Atlas tabs sit inside one tab, so the events tab stays in sight with ten washouts.
+Beside them the 3D scene (aircraft and Atlas cockpits, labels staggered), the legend (as tall as its lines) and the
+Metrics panel (the ranking first, then washout-by-DOF tables). The viewer's own side panels start collapsed.
 
-Colours are fixed: the aircraft pilot (the reference) in a strong magenta, drawn wider, readable on the viewer's
-light and dark themes; the three washouts in blue, orange and green, in the order small-angle, large-angle,
-unrestricted; any other washout name (a user's variant) takes the next spare colour in the order the recording
-lists it.
+Colours are fixed and the figures' (:mod:`washbench.review.palette`): the aircraft pilot (the reference) in a strong
+magenta, drawn wider, readable on the viewer's light and dark themes; small-angle blue, large-angle orange,
+unrestricted green, the oracle bound grey; any other washout name takes the next spare colour in the order the
+recording lists it.
 """
 
 from __future__ import annotations
@@ -17,6 +19,10 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import rerun.blueprint as rrb
+
+from washbench.review.palette import AIRCRAFT_COLOR as AIRCRAFT_RGB
+from washbench.review.palette import EXTRA_COLORS as EXTRA_RGB
+from washbench.review.palette import WASHOUT_COLORS as FIXED_RGB
 
 __all__ = [
     "AIRCRAFT_COLOR",
@@ -30,23 +36,15 @@ __all__ = [
     "source_colors",
 ]
 
-AIRCRAFT_COLOR = (200, 0, 160)
+AIRCRAFT_COLOR = AIRCRAFT_RGB
 """The aircraft pilot's colour (magenta): visible on white and on the viewer's near-black background."""
 AIRCRAFT_WIDTH = 2.5
 WASHOUT_WIDTH = 1.5
-WASHOUT_COLORS: dict[str, tuple[int, int, int]] = {
-    "small-angle": (31, 119, 180),  # blue
-    "large-angle": (255, 127, 14),  # orange
-    "unrestricted": (44, 160, 44),  # green
-}
-EXTRA_COLORS: tuple[tuple[int, int, int], ...] = (
-    (23, 190, 207),  # cyan
-    (140, 86, 75),  # brown
-    (188, 189, 34),  # olive
-    (255, 200, 0),  # gold
-    (40, 60, 140),  # navy
-)
-"""Colours for washout names other than the three above, taken in the order the recording lists them."""
+WASHOUT_COLORS: dict[str, tuple[int, int, int]] = dict(FIXED_RGB)
+"""The fixed colours (small-angle blue, large-angle orange, unrestricted green, the bound grey): the figures'
+default palette (:mod:`washbench.review.palette`), one set of colours for the recording and the figures."""
+EXTRA_COLORS: tuple[tuple[int, int, int], ...] = EXTRA_RGB
+"""Colours for the other washout names, taken in the order the recording lists them."""
 LIMIT_COLOR = (128, 128, 128)
 THRESHOLD_COLOR = (128, 128, 128)
 AXIS_COLORS = ((220, 60, 60), (60, 170, 60), (70, 120, 230))
@@ -56,8 +54,8 @@ AXIS_COLORS = ((220, 60, 60), (60, 170, 60), (70, 120, 230))
 def series_color(source: str, washouts: Sequence[str] = ()) -> tuple[int, int, int]:
     """Fixed RGB colour of ``"aircraft"`` or a washout name.
 
-    The three named washouts have their own colours; any other name takes a spare colour by its position among the
-    other names in ``washouts`` (cycling after five).
+    The named washouts have their own colours; any other name takes a spare colour by its position among the
+    other names in ``washouts`` (cycling after :data:`EXTRA_COLORS`).
     """
     if source == "aircraft":
         return AIRCRAFT_COLOR
@@ -92,6 +90,12 @@ class Layout:
     camera: tuple[tuple[float, float, float], tuple[float, float, float]]
     envelope_quantities: tuple[tuple[str, str], ...]  # (name, unit)
     limits_text: tuple[str, ...]  # per envelope quantity, e.g. "+-1.5/1.5/1 m"
+    hidden_lanes: tuple[str, ...] = ()
+    """Lanes under ``/lanes`` no tab shows: each washout's limits joined (the envelope tab shows the limits, one lane
+    per washout and kind)."""
+    cue_lanes: tuple[str, ...] = ()
+    """The false-cue lanes (one per washout): a tab of their own, left out of the motion tabs, whose six panels get
+    the room (with seven washouts the lanes above them left each panel about 55 px)."""
 
 
 def _whole_manoeuvre(t_end_s: float) -> rrb.TimeAxis:
@@ -127,15 +131,38 @@ def _stack(layout: Layout, prefix: str, ranges: Sequence[tuple[float, float]], t
     return views
 
 
-def _lanes(layout: Layout, origin: str, name: str) -> rrb.StateTimelineView:
+def _lanes(layout: Layout, origin: str, name: str, hidden: Sequence[str] = ()) -> rrb.StateTimelineView:
+    contents = [f"+ {origin}/**", *(f"- {path}" for path in hidden)]
     return rrb.StateTimelineView(
-        origin=origin, name=name, time_view=_whole_manoeuvre(layout.t_end_s), time_ranges=_all_data()
-    )
+        origin=origin, name=name, contents=contents, time_view=_whole_manoeuvre(layout.t_end_s),
+        time_ranges=_all_data(),
+    )  # fmt: skip
+
+
+LANE_SHARE = 0.7
+"""Height of one state lane (with its name above it) against a motion panel's 2.0 (measured on screenshots: a lane
+takes about 40 px of the 1080 px window, a motion panel needs about 110 px to show its ticks)."""
+PANEL_SHARE = 2.0
+
+
+LANE_VIEW_SHARE = 1.2
+"""A lane view's title bar and time axis, against a motion panel's 2.0: with it one lane shows whole in a 720 px
+window (screenshots of the Columbia aerobatics at 1280x720: with 0.7 only the axis showed)."""
+
+
+def lane_share(n_lanes: int) -> float:
+    """The row share of a lane view of ``n_lanes`` lanes (its title bar and time axis included)."""
+    return LANE_VIEW_SHARE + LANE_SHARE * n_lanes
+
+
+
 
 
 def build_blueprint(layout: Layout) -> rrb.Blueprint:
-    """The review layout (see the module docstring); tabs: perceived, raw, envelope, one per washout, events."""
+    """The review layout (see the module docstring); tabs: perceived, raw, envelope, events, Atlas (one tab per
+    washout inside): the events tab stays in sight with ten washouts."""
     eye, target = layout.camera
+    n_legend = len(layout.washouts) + 2  # the aircraft, every washout, the threshold
     side = rrb.Vertical(
         rrb.Spatial3DView(
             origin="/world",
@@ -151,19 +178,21 @@ def build_blueprint(layout: Layout) -> rrb.Blueprint:
             plot_legend=rrb.PlotLegend(corner="LeftTop", visible=True),
             time_ranges=_all_data(),
         ),
-        rrb.TextDocumentView(origin="/metrics", name="Metrics"),
-        row_shares=[2.0, 1.3 + 0.25 * len(layout.washouts), 2.4],
+        rrb.TextDocumentView(origin="/metrics", name="Metrics: ranking and metrics"),
+        row_shares=[2.2, 0.9 + 0.26 * n_legend, 3.6],  # the legend as tall as its lines, the rest for the tables
     )
+    phase_only = [*layout.hidden_lanes, *layout.cue_lanes]  # the motion tabs: the phase lane, the panels the room
     perceived = rrb.Vertical(
-        _lanes(layout, "/lanes", "Phases; limits reached; false cues"),
+        _lanes(layout, "/lanes", "Phases", phase_only),
         *_stack(layout, "perceived", layout.perceived_ranges, "perceived "),
-        row_shares=[0.9 + 0.6 * (1 + len(layout.washouts))] + [2.0] * len(layout.dofs),
+        row_shares=[lane_share(1)] + [PANEL_SHARE] * len(layout.dofs),
         name="Perceived",
     )
+    false_cues = _lanes(layout, "/lanes", "False cues", layout.hidden_lanes)  # phases, a lane per washout
     raw = rrb.Vertical(
-        _lanes(layout, "/lanes", "Phases; limits reached; false cues"),
+        _lanes(layout, "/lanes", "Phases", phase_only),
         *_stack(layout, "raw", layout.raw_ranges, ""),
-        row_shares=[0.9 + 0.6 * (1 + len(layout.washouts))] + [2.0] * len(layout.dofs),
+        row_shares=[lane_share(1)] + [PANEL_SHARE] * len(layout.dofs),
         name="Raw motion",
     )
     usage = [
@@ -177,11 +206,10 @@ def build_blueprint(layout: Layout) -> rrb.Blueprint:
         )
         for (q, _), limit in zip(layout.envelope_quantities, layout.limits_text, strict=True)
     ]
-    lane_share = 1.0 + 0.45 * len(layout.limit_lanes) + 0.4 * len(layout.washouts)
     envelope = rrb.Vertical(
         _lanes(layout, "/limits", "Limits reached (one lane per washout and limit kind)"),
         *usage,
-        row_shares=[lane_share] + [2.0] * len(usage),
+        row_shares=[1.0 + 0.45 * len(layout.limit_lanes) + 0.4 * len(layout.washouts)] + [PANEL_SHARE] * len(usage),
         name="Platform envelope",
     )
     per_washout = [
@@ -215,7 +243,8 @@ def build_blueprint(layout: Layout) -> rrb.Blueprint:
             ],
         ),
     )
-    tabs = rrb.Tabs(perceived, raw, envelope, *per_washout, events, active_tab=0)
+    atlas = rrb.Tabs(*per_washout, active_tab=0, name="Atlas per washout")
+    tabs = rrb.Tabs(perceived, false_cues, raw, envelope, events, atlas, active_tab=0)
     return rrb.Blueprint(
         rrb.Horizontal(tabs, side, column_shares=[3, 1.4]),
         rrb.BlueprintPanel(state="collapsed"),

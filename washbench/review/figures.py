@@ -6,7 +6,8 @@ Per manoeuvre (one result folder):
   14 and 16: surge, sway, heave (m/s^2), roll, pitch, yaw (deg/s); the aircraft pilot in magenta (drawn wider), each
   washout's simulator pilot in its fixed colour (:mod:`washbench.review.palette`); the phases as a lane on top
   and shaded alternately in every panel; the perception thresholds (Zacharias, :mod:`washbench.perception.thresholds`)
-  as dashed +- lines around the resting value (0, or -g for heave), so what lies between them is not felt.
+  as a sand-coloured band +- threshold around the resting value (0, or -g for heave: the values the cue
+  classification and the recording use), so what lies inside it is not felt.
 - :func:`envelope_figure`: platform envelope usage against time, max over the axes of |value| / limit for stage
   position, velocity, acceleration, sphere angular rate and wheel speed, the limit at 1, and one lane per washout
   and limit kind showing when a limit was active.
@@ -69,9 +70,11 @@ SATURATION_LABELS = {
 
 METRIC_LABELS = {"npc": "NPC", "integral_error": "integral of |error|", "max_error": "maximum |error|"}
 
-_THRESHOLD_COLOR = (0.45, 0.45, 0.45)
-_THRESHOLD_FILL = (0.0, 0.0, 0.0, 0.07)
-_PHASE_SHADE = (0.0, 0.0, 0.0, 0.05)
+_THRESHOLD_COLOR = (0.72, 0.55, 0.18)
+"""The edges of the not-felt band: a warm sand, apart from the phases' blue-grey and every washout's colour."""
+_THRESHOLD_FILL = (0.93, 0.78, 0.40, 0.30)
+_PHASE_SHADE = (0.82, 0.86, 0.92, 0.45)
+"""Every other phase in the panels: the phase lane's own blue-grey (not the not-felt band's colour)."""
 _CHAR_IN = 7.5 * 0.56 / 72.0  # mean width of a phase-label character (DejaVu Sans at 7.5 pt) [in]
 _LAYOUT_CACHE: dict[tuple[str, int], tuple[Any, Any]] = {}
 _LAYOUT_CACHE_SIZE = 6

@@ -1,9 +1,11 @@
-"""The metric table of one run as Markdown, laid out like the paper's Table 4: one row per DOF, one column per washout.
+"""The metric tables of one run as Markdown, for the recording's Metrics panel (a narrow column beside the plots).
 
-For each metric (NPC, integral of |error|, max |error|) a table with the DOFs as rows and, per washout, its value and,
-for every washout after the first (the reference, small-angle in the bundled order), how much better it is than the
-reference: ``reference - washout``, positive means closer to the aircraft pilot (every metric is lower-is-better). The
-best value in each row is in bold. Numbers have four significant digits.
+First the ranking (rank, washout, score by the run's rule, lower is better; the oracle bound last, scored and not
+ranked: a reference, not a washout), then for each metric (NPC, integral of |error|, max |error|) a table with one
+row per washout and one column per DOF: the width does not grow with the number of washouts (with seven the
+washout-by-column layout ran off the panel). The best washout per DOF is in bold; the bound, a reference, is in
+italics and never bold. Numbers have four significant digits. How much better than small-angle each washout is
+(the paper's Table 4) is in the report.
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ import math
 from collections.abc import Sequence
 
 from washbench.analysis.metrics import DOFS
+from washbench.analysis.ranking import BOUND_WASHOUT, RankRow
 from washbench.io.metrics_csv import MetricRow
 
 __all__ = ["metrics_table_markdown"]
@@ -24,40 +27,44 @@ def _num(x: float) -> str:
     return "" if math.isnan(x) else f"{x:.4g}"
 
 
-def _diff(x: float) -> str:
-    return "" if math.isnan(x) else f"{x:+.3g}"
+def _ranking_lines(ranking: Sequence[RankRow], rule_label: str) -> list[str]:
+    lines = ["", f"**Ranking** by {rule_label}; lower is better", "", "| rank | washout | score |", "|---|---|---|"]
+    for r in ranking:
+        if r.washout == BOUND_WASHOUT:
+            lines.append(f"| - | *{r.washout} (oracle bound, not ranked)* | *{_num(r.score)}* |")
+        else:
+            lines.append(f"| {r.rank}{' (tie)' if r.tied else ''} | {r.washout} | {_num(r.score)} |")
+    return lines
 
 
-def metrics_table_markdown(title: str, rows: Sequence[MetricRow]) -> str:
-    """Markdown: a heading, one line on how to read it, and one DOF-by-washout table per metric."""
+def metrics_table_markdown(
+    title: str, rows: Sequence[MetricRow], ranking: Sequence[RankRow] = (), rule_label: str = "score"
+) -> str:
+    """Markdown: a heading, the ranking (when given), and one washout-by-DOF table per metric."""
     washouts = list(dict.fromkeys(r.washout for r in rows))
     by = {(r.washout, r.dof): r for r in rows}
-    ref = washouts[0] if washouts else ""
-    lines = [
-        f"# {title}",
-        "",
-        f"Perceived motion of each simulator pilot against the aircraft pilot's; lower is better. "
-        f"*better by* = {ref} minus that washout (positive: closer to the aircraft than {ref}). Best per row in bold.",
-    ]
+    lines = [f"# {title}"]
+    if ranking:
+        lines += _ranking_lines(ranking, rule_label)
+    lines += ["", "Perceived motion of each simulator pilot against the aircraft pilot's; lower is better. Best "
+              "washout per DOF in bold (the oracle bound, in italics, is a reference)."]  # fmt: skip
     for metric in ("npc", "integral_error", "max_error"):
         f_unit, w_unit = _UNITS[metric]
         unit = f" [{f_unit} / {w_unit}]" if f_unit else ""
-        header = ["DOF"]
-        for w in washouts:
-            header.append(w)
-            if w != ref:
-                header.append("better by")
-        lines += ["", f"**{_TITLES[metric]}**{unit}", "", "| " + " | ".join(header) + " |"]
-        lines.append("|" + "---|" * len(header))
+        lines += ["", f"**{_TITLES[metric]}**{unit}", "", "| washout | " + " | ".join(DOFS) + " |"]
+        lines.append("|" + "---|" * (1 + len(DOFS)))
+        best = {}
         for dof in DOFS:
-            values = {w: getattr(by[(w, dof)], metric) for w in washouts if (w, dof) in by}
-            finite = [v for v in values.values() if not math.isnan(v)]
-            best = min(finite) if finite else math.nan
-            cells = [dof]
-            for w in washouts:
-                v = values.get(w, math.nan)
-                cells.append(f"**{_num(v)}**" if v == best and len(finite) > 1 else _num(v))
-                if w != ref:
-                    cells.append(_diff(values.get(ref, math.nan) - v))
+            finite = [getattr(by[(w, dof)], metric) for w in washouts if (w, dof) in by and w != BOUND_WASHOUT]
+            finite = [v for v in finite if not math.isnan(v)]
+            best[dof] = min(finite) if len(finite) > 1 else math.nan
+        for w in washouts:
+            cells = [f"*{w}*" if w == BOUND_WASHOUT else w]
+            for dof in DOFS:
+                v = getattr(by[(w, dof)], metric) if (w, dof) in by else math.nan
+                if w == BOUND_WASHOUT:
+                    cells.append(f"*{_num(v)}*" if not math.isnan(v) else "")
+                else:
+                    cells.append(f"**{_num(v)}**" if v == best[dof] else _num(v))
             lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"

@@ -4,8 +4,9 @@ Two palettes, chosen by name (``washbench report --palette``, or the ``WASHBENCH
 the figures ``run``, ``cue`` and ``suite`` draw):
 
 - ``default``: the rerun recording's colours. The three bundled washouts are small-angle blue, large-angle
-  orange, unrestricted green (matplotlib's tab10); other washout names (user-named variants) take further distinct
-  colours in the order they are listed; the aircraft pilot, the reference every washout is compared with, is the
+  orange, unrestricted green (matplotlib's tab10), the oracle bound grey (a reference, not a washout); other
+  washout names (the adaptive, optimal and MPC washouts, plugins, variants) take further distinct colours in the
+  order they are listed (:data:`EXTRA_COLORS`); the aircraft pilot, the reference every washout is compared with, is the
   recording's strong magenta.
 - ``colorblind``: Okabe & Ito's eight colours (Okabe and Ito 2008, "Color Universal Design"), distinguishable
   with the common colour-vision deficiencies: small-angle blue, large-angle vermillion, unrestricted bluish green,
@@ -31,20 +32,28 @@ WASHOUT_COLORS: dict[str, RGB] = {
     "small-angle": (31, 119, 180),  # blue
     "large-angle": (255, 127, 14),  # orange
     "unrestricted": (44, 160, 44),  # green
+    "bound": (120, 120, 120),  # grey: the oracle bound is a reference, not a washout
 }
 EXTRA_COLORS: tuple[RGB, ...] = (
-    (23, 190, 207),  # cyan
-    (140, 86, 75),  # brown
+    (190, 30, 70),  # crimson
+    (100, 200, 170),  # mint
     (188, 189, 34),  # olive
-    (255, 200, 0),  # gold
-    (40, 60, 140),  # navy
+    (120, 70, 200),  # violet
+    (200, 150, 80),  # tan
+    (247, 129, 191),  # pink
+    (23, 190, 207),  # cyan
 )
+"""Colours of further washouts, in the order they are listed: each chosen (greedily) as far as could be from the
+fixed ones, the aircraft's and the ones before it (CIE76 colour difference at least 38 among the first five and the
+fixed ones, :func:`colour_difference`), and of middle lightness so it shows on white paper and on the viewer's dark
+background alike (the cyan close to small-angle's blue, and a gold close to large-angle's orange, came first before)."""
 AIRCRAFT_COLOR: RGB = (200, 0, 160)  # magenta
 
 CB_WASHOUT_COLORS: dict[str, RGB] = {
     "small-angle": (0, 114, 178),  # blue
     "large-angle": (213, 94, 0),  # vermillion
     "unrestricted": (0, 158, 115),  # bluish green
+    "bound": (120, 120, 120),  # grey
 }
 CB_EXTRA_COLORS: tuple[RGB, ...] = (
     (86, 180, 233),  # sky blue
@@ -61,12 +70,13 @@ WASHOUT_DASHES: dict[str, Dash] = {
     "small-angle": (0, None),  # solid
     "large-angle": (0, (5.0, 2.0)),  # dashed
     "unrestricted": (0, (6.0, 1.6, 1.2, 1.6)),  # dash-dot
+    "bound": (0, (2.0, 2.0)),  # short dash
 }
 EXTRA_DASHES: tuple[Dash, ...] = (
     (0, (1.2, 1.4)),  # dotted
     (0, (9.0, 2.5)),  # long dash
     (0, (3.0, 1.5, 1.0, 1.5, 1.0, 1.5)),  # dash-dot-dot
-    (0, (2.0, 2.0)),  # short dash
+    (0, (7.0, 1.5, 2.0, 1.5)),  # long dash, short dash
 )
 AIRCRAFT_DASH: Dash = (0, None)
 
@@ -115,6 +125,23 @@ def washout_dashes(washouts: Sequence[str]) -> dict[str, Dash]:
             out[w] = EXTRA_DASHES[spare % len(EXTRA_DASHES)]
             spare += 1
     return out
+
+
+def colour_difference(a: RGB, b: RGB) -> float:
+    """CIE76 colour difference (Delta E*ab: the distance in CIE L*a*b*, D65 white) of two sRGB colours; about 2 is
+    just noticeable, beyond 40 the two read as different colours at a glance."""
+
+    def lab(rgb: RGB) -> tuple[float, float, float]:
+        lin = [c / 255.0 for c in rgb]
+        lin = [c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4 for c in lin]
+        x = (0.4124 * lin[0] + 0.3576 * lin[1] + 0.1805 * lin[2]) / 0.95047
+        y = 0.2126 * lin[0] + 0.7152 * lin[1] + 0.0722 * lin[2]
+        z = (0.0193 * lin[0] + 0.1192 * lin[1] + 0.9505 * lin[2]) / 1.08883
+        fx, fy, fz = (v ** (1.0 / 3.0) if v > 0.008856 else 7.787 * v + 16.0 / 116.0 for v in (x, y, z))
+        return 116.0 * fy - 16.0, 500.0 * (fx - fy), 200.0 * (fy - fz)
+
+    la, lb = lab(a), lab(b)
+    return sum((p - q) ** 2 for p, q in zip(la, lb, strict=True)) ** 0.5
 
 
 def mpl(rgb: RGB) -> tuple[float, float, float]:

@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from washbench.analysis.cues import SCALE_BAND, parse_events
+from washbench.analysis.cues import SCALE_BAND, dof_thresholds, parse_events
 from washbench.analysis.metrics import DOFS
 from washbench.analysis.ranking import (
     DEFAULT_RULE,
@@ -38,7 +38,6 @@ from washbench.analysis.ranking import (
 from washbench.io.atomic import write_text_atomic
 from washbench.io.outfolder import discard_stage, make_stage, replace_entries
 from washbench.io.result_files import FIGURES_DIR, RECORDING_FILE, REPORT_FILE
-from washbench.perception.thresholds import ZACHARIAS
 from washbench.review.bound_section import algorithm_lines, bound_lines
 from washbench.review.cue_figures import cue_classes, cue_lane_figure
 from washbench.review.figures import SATURATION_LABELS, envelope_figure, perceived_figure
@@ -76,6 +75,21 @@ def _rel(path: Path, start: Path) -> str:
 # --------------------------------------------------------------------------------------------- pieces of a report
 
 
+def plugin_text(rec: dict[str, Any]) -> str:
+    """What a plugin washout ran, for the report's provenance table (:func:`washbench.cueing.registry.identity`)."""
+    where = rec.get("path") if rec.get("from") == "file" else rec.get("module")
+    text = f"`{rec.get('object', '?')}` from {rec.get('from', '?')} `{where or '?'}`"
+    if rec.get("distribution"):
+        text += f" ({rec['distribution']} {rec.get('version', '?')})"
+    if rec.get("sha256"):
+        text += f" (SHA-256 `{rec['sha256']}`)"
+    if rec.get("shadows"):
+        text += f"; replaces the installed {rec['shadows']}"
+    values = rec.get("values") or {}
+    text += "; values " + (", ".join(f"`{k}={v}`" for k, v in values.items()) if values else "none")
+    return text
+
+
 def provenance_lines(prov: dict[str, Any] | None, created_utc: str | None) -> list[str]:
     """The provenance as a two-column Markdown table (what produced the result)."""
     if not prov:
@@ -85,7 +99,8 @@ def provenance_lines(prov: dict[str, Any] | None, created_utc: str | None) -> li
     def file_row(label: str, rec: dict[str, Any] | None) -> None:
         if rec:
             name = f"**{rec['name']}**, " if rec.get("name") else ""
-            rows.append((label, f"{name}`{rec.get('path', '?')}` (SHA-256 `{rec.get('sha256', '?')}`)"))
+            shipped = f"bundled with {rec['bundled']}, " if rec.get("bundled") else ""
+            rows.append((label, f"{name}`{rec.get('path', '?')}` ({shipped}SHA-256 `{rec.get('sha256', '?')}`)"))
 
     file_row("manoeuvre file", prov.get("manoeuvre"))
     file_row("aircraft model", prov.get("aircraft"))
@@ -95,13 +110,21 @@ def provenance_lines(prov: dict[str, Any] | None, created_utc: str | None) -> li
     if inp and (inp.get("provenance") or {}).get("manoeuvre"):
         file_row("input's manoeuvre file", inp["provenance"]["manoeuvre"])
     file_row("washout parameters", prov.get("params"))
+    defaults = (prov.get("params") or {}).get("defaults")
+    if isinstance(defaults, dict) and defaults.get("sections"):
+        rows.append(("parameters not in that file", ", ".join(f"`{k}`" for k in defaults["sections"])
+                     + f" from `{defaults.get('path', '?')}` (SHA-256 `{defaults.get('sha256', '?')}`)"))  # fmt: skip
     if prov.get("washouts"):
         runs = [
             f"{w['name']}" + ("" if w["name"] == w["kind"] else f" ({w['kind']})") + (" with its own values" if "values"
             in w else "") for w in prov["washouts"]
         ]  # fmt: skip
         rows.append(("washouts", ", ".join(runs)))
+        for w in prov["washouts"]:
+            if isinstance(w.get("plugin"), dict):
+                rows.append((f"plugin {w['name']}", plugin_text(w["plugin"])))
     file_row("platform", prov.get("platform"))
+    file_row("configuration file", prov.get("config"))
     vest = prov.get("vestibular")
     if isinstance(vest, dict) and vest.get("model"):
         names = {"young-meiry": "Meiry-Young otolith, Young-Oman canals (the paper's)",
@@ -382,17 +405,15 @@ def check_lines(data: ResultData) -> list[str]:
 
 
 def perception_thresholds(data: ResultData) -> tuple[tuple[float, ...], tuple[float, ...]]:
-    """Zacharias thresholds and the resting values they are taken around, per DOF (m/s^2, deg/s).
+    """Zacharias thresholds and the resting values they are taken around, per DOF (m/s^2, deg/s): those of the cue
+    classification (:func:`washbench.analysis.cues.dof_thresholds`: (0, 0, -g, 0, 0, 0)), so the figure's "not felt"
+    band, the report's time beyond the threshold, the cue lanes, ``metrics.csv``'s cue columns and the recording's
+    threshold lines say the same. (The first sample, taken before, is a transient where a flight starts untrimmed,
+    as JSBSim's scripts do: the band then sat beside the curves.) ``data`` is not used (kept for the callers)."""
 
-    The resting value is what the aircraft pilot perceives at the first sample (trimmed flight, or standing on the
-    runway): a steady cue the pilot has been exposed to is not a change felt, so the band "not felt" lies around it
-    (for a level start about (0, 0, -g, 0, 0, 0); a descent or a climb starts with its own surge).
-    """
-
-    th = ZACHARIAS
-    thresholds = (th.f_x_mps2, th.f_y_mps2, th.f_z_mps2, th.omega_x_degps, th.omega_y_degps, th.omega_z_degps)
-    rest = tuple(float(v) for v in data.perceived["aircraft"][0])
-    return thresholds, rest
+    del data
+    thresholds, rest = dof_thresholds()
+    return tuple(thresholds), tuple(rest)
 
 
 def time_above_threshold(data: ResultData) -> dict[str, float]:

@@ -498,6 +498,29 @@ def _send_states(rec: rr.RecordingStream, path: str, t_s: np.ndarray, states: li
     )
 
 
+LIMIT_LANE_COLOR = (150, 150, 150)
+"""Every limit bar (position, tilt_rate ...): one neutral grey, the kind written on it; rerun's own colours by label
+looked like washout colours."""
+FALSE_CUE_COLOR = (214, 39, 40)
+"""Every false-cue bar: the red of the report's cue figure (:mod:`washbench.review.cue_figures`)."""
+PHASE_COLORS = ((105, 125, 155), (140, 158, 185))
+"""The phase lane's bars, alternating: blue-greys (as the figures' phase lane), apart from every washout colour."""
+
+
+def _rgba(rgb: tuple[int, int, int]) -> int:
+    return (rgb[0] << 24) | (rgb[1] << 16) | (rgb[2] << 8) | 0xFF
+
+
+def _lane_style(
+    rec: rr.RecordingStream, path: str, values: Sequence[str], colors: Sequence[tuple[int, int, int]]
+) -> None:
+    """The colour of each state value of a lane (static ``StateConfiguration``); "" (a gap) is left out."""
+    pairs = [(v, c) for v, c in zip(values, colors, strict=True) if v]
+    if pairs:
+        colors = np.array([_rgba(c) for _, c in pairs], dtype=np.uint32)  # 0xRRGGBBAA (a list of 3 is ambiguous)
+        rec.log(path, rr.StateConfiguration(values=[v for v, _ in pairs], colors=colors), static=True, strict=True)
+
+
 def _send_lanes(rec: rr.RecordingStream, data: RecordingData) -> None:
     """Phase lane, one lane per washout (its limits joined by "+"), one per washout and limit kind; onset events."""
     t_s = np.asarray(data.t_s, dtype=np.float64)
@@ -510,6 +533,8 @@ def _send_lanes(rec: rr.RecordingStream, data: RecordingData) -> None:
             idx = np.append(idx, np.searchsorted(t_s, data.phases[-1][2] - 0.5e-9))
             names.append("")
         _send_states(rec, phase_lane_path(), t_s, names, np.minimum(idx, n - 1))
+        unique = list(dict.fromkeys(name for name in names if name))
+        _lane_style(rec, phase_lane_path(), unique, [PHASE_COLORS[i % 2] for i in range(len(unique))])
     onsets: list[tuple[float, str]] = []
     for w in data.washouts:
         kinds = [(k, np.asarray(v, dtype=bool)) for k, v in data.platforms[w].saturated.items() if np.any(v)]
@@ -532,6 +557,7 @@ def _send_lanes(rec: rr.RecordingStream, data: RecordingData) -> None:
                 columns=states.partition([len(kinds)] * len(rows)),
                 strict=True,
             )
+            _lane_style(rec, limit_lane_path(data, w), [k for k, _ in kinds], [LIMIT_LANE_COLOR] * len(kinds))
         change = np.flatnonzero(np.diff(code, prepend=0))
         if change.size:
             states = ["+".join(k for j, (k, _) in enumerate(kinds) if code[i] >> j & 1) for i in change]
@@ -582,6 +608,8 @@ def _send_cues(rec: rr.RecordingStream, data: RecordingData) -> None:
         states = [("false: " + "+".join(d for j, d in enumerate(DOF_NAMES) if code[i] >> j & 1)) if code[i] else ""
                   for i in change]  # fmt: skip
         _send_states(rec, cue_lane_path(data, w), t_s, states, change)
+        unique = list(dict.fromkeys(states))
+        _lane_style(rec, cue_lane_path(data, w), unique, [FALSE_CUE_COLOR] * len(unique))
     if lines:
         lines.sort(key=lambda item: item[0])
         rec.send_columns(
@@ -643,6 +671,8 @@ def _layout(data: RecordingData, perceived: list[np.ndarray], raw: list[np.ndarr
         camera=scene3d.camera(offsets, data.envelope.sphere_diameter_m),
         envelope_quantities=tuple((q, unit) for q, _, unit in ENVELOPE_QUANTITIES),
         limits_text=tuple(f"+-{_limit_text(data.envelope.axes(f))} {unit}" for _, f, unit in ENVELOPE_QUANTITIES),
+        hidden_lanes=tuple(washout_lane_path(data, w) for w in data.washouts),
+        cue_lanes=tuple(cue_lane_path(data, w) for w in data.washouts),
     )
 
 

@@ -95,6 +95,17 @@ def pose_samples(t_s: np.ndarray, q_wxyz: np.ndarray, pos_m: np.ndarray | None =
     return idx[keep_changes(np.column_stack(columns), np.concatenate(tol), gap)]
 
 
+LABEL_ROW_STEP_M = 1.6
+"""Vertical step between the rows of staggered labels in the 3D view, m."""
+
+
+def label_rows(n_objects: int) -> int:
+    """Rows the objects' labels are staggered over: one up to three objects, two up to six, three beyond (in a
+    1280x720 window the labels of four objects touch; with eight, a label as long as ``adaptive-large-angle`` is
+    wider than two objects' spacing in the side view)."""
+    return 1 if n_objects <= 3 else 2 if n_objects <= 6 else 3
+
+
 def object_offsets(n_washouts: int, travel_m: np.ndarray, diameter_m: float) -> np.ndarray:
     """Centre of each object (aircraft first, then the washouts) along NED y (east), (1 + n_washouts, 3), metres."""
     spacing = 2.0 * float(travel_m[1]) + diameter_m + 1.0
@@ -169,11 +180,14 @@ def send_scene(
         strict=True,
     )
     _log_object(rec, "/world/aircraft/body", half, AIRCRAFT_COLOR)
-    # one label per object, under it (z down), where it hides no shape
+    # one label per object, under it (z down), where it hides no shape; staggered over label_rows() rows, so
+    # neighbours' labels do not run into one another when many objects share the view's width
+    rows = label_rows(len(offsets))
+    below = half + 0.5 + LABEL_ROW_STEP_M * (np.arange(len(offsets)) % rows)
     rec.log(
         "/world/labels",
         rr.Points3D(
-            offsets + np.array([0.0, 0.0, half + 0.5]),
+            offsets + np.column_stack([np.zeros(len(offsets)), np.zeros(len(offsets)), below]),
             labels=["aircraft", *washouts],
             colors=[AIRCRAFT_COLOR, *[series_color(w, washouts) for w in washouts]],
             radii=[0.05],

@@ -129,6 +129,13 @@ def _draw(pool: Executor | None, draw: Callable[..., list[Path]], *args: Any, **
     return done
 
 
+def tie_counts(n_tied: int, n_rankings: int, n_any: int) -> str:
+    """The suite report's sentence on ties: how many of ``n_rankings`` manoeuvres have first place shared (decided by
+    less than the rule's margin) and how many a tie at any rank (counts, no verb to agree with them)."""
+    return (f"First place shared (decided by less than that margin): {n_tied} of {n_rankings} manoeuvres; a tie at "
+            f"some rank: {n_any} of {n_rankings}.")
+
+
 def _write_suite_report(
     suite_dir: Path, stage: Path, entries: list[dict[str, Any]], doc: dict[str, Any], regenerate_results: bool,
     figures: bool, pool: Executor | None = None,
@@ -229,8 +236,7 @@ def _write_suite_report(
     if rankings:
         n_tied = sum(1 for r in rankings.values() if undecided(r))
         n_any = sum(1 for r in rankings.values() if any(x.tied for x in r))
-        lines += [f"Ranked by {rule.label()}. First place shared (decided by less than that margin): {n_tied} of "
-                  f"{len(rankings)} manoeuvres; a tie at some rank: {n_any} of {len(rankings)}. Shared ranks are "
+        lines += [f"Ranked by {rule.label()}. {tie_counts(n_tied, len(rankings), n_any)} Shared ranks are "
                   "marked \"(tie)\" in the reports, `tied` in `ranking.csv` and \"tie:\" in the score figure's row "
                   "labels.", ""]  # fmt: skip
     if any_above:

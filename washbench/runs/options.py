@@ -20,9 +20,9 @@ from typing import Any
 from washbench.analysis.ranking import RankRule
 from washbench.cueing import registry
 from washbench.cueing.params import DEFAULT_PARAMS_PATH, WashoutParams, check_filter_start
-from washbench.cueing.variants import Washout, param_file_from_data, select_from
+from washbench.cueing.variants import Washout, defaulted_sections, param_file_from_data, select_from
 from washbench.errors import WashbenchError
-from washbench.io.provenance import build_provenance, merge_provenance
+from washbench.io.provenance import build_provenance, file_record, merge_provenance
 from washbench.io.yamlio import read_yaml_digest, validate_data
 from washbench.perception.vestibular import VestibularParams, model_params, model_record
 from washbench.platform.limits import DEFAULT_LIMITS_PATH, PlatformLimits
@@ -122,7 +122,11 @@ def load_options(
         ranking=rule.record(),
         vestibular=model_record(vestibular),
         digests={str(source): params_sha, str(platform_source): platform_sha},  # not read again to hash them
+        plugins={w.name: rec for w in chosen if (rec := registry.identity(w.kind, w.params)) is not None},
     )
+    defaulted = defaulted_sections(Path(source), data)
+    if defaulted:  # what the file left out came from the bundled set: say which, and which file
+        provenance["params"]["defaults"] = {"sections": list(defaulted), **file_record(DEFAULT_PARAMS_PATH)}
     return RunOptions(
         params_path=params_path,
         platform_path=platform_path,

@@ -46,7 +46,7 @@ from washbench.flight.scripts import (
 from washbench.io.budget import check_samples
 from washbench.io.lock import output_lock
 from washbench.io.motion_file import read_motion
-from washbench.io.outfolder import result_entry
+from washbench.io.outfolder import refuse_other_owner, result_entry
 from washbench.io.provenance import flat_strings, utc_now
 from washbench.io.publish import check_replaceable
 from washbench.io.result_files import FLIGHT_FILE, RECORDING_FILE, REPORT_FILE, RUN_FILE
@@ -156,7 +156,8 @@ def write_cued_folder(
     if options.outputs.recording:
         title = f"{summary.aircraft} / {summary.manoeuvre}"
         props = flat_strings(provenance, str((extra or {}).get("created_utc") or "")) if provenance else None
-        write_run_recording(folder / RECORDING_FILE, title, motion, result, options.limits, aircraft_q, phases, props)
+        write_run_recording(folder / RECORDING_FILE, title, motion, result, options.limits, aircraft_q, phases, props,
+                            options.rank_rule)
     ac = result.perceived["aircraft"]
     summary = dataclasses.replace(
         summary,
@@ -253,7 +254,8 @@ def run_command(manoeuvre_path: Path, out_root: Path, options: RunOptions, *, pr
     """
 
     start = time.perf_counter()
-    with output_lock(out_root):  # held while it runs: a second writer gets one line at once
+    with output_lock(out_root) as out_dir:  # held while it runs: a second writer gets one line at once
+        refuse_other_owner(out_dir, "run")  # a folder of fly, cue ... results is not mixed with runs
         if is_script(manoeuvre_path):
             announce_script(manoeuvre_path, options)
             runs = run_script(manoeuvre_path, out_root, options)

@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from washbench.analysis.ranking import DEFAULT_RULE, DOFS, RankRow, RankRule, rank, rule_from_record
+from washbench.analysis.ranking import DEFAULT_RULE, DOFS, RankRow, RankRule, perceived_motion, rank, rule_from_record
 from washbench.io.atomic import write_text_atomic
 from washbench.io.csv_numbers import csv_number
 from washbench.io.metrics_csv import MetricRow
@@ -63,9 +63,13 @@ class RunSummary:
     saturations: dict[str, dict[str, int]] = field(default_factory=dict)
 
 
-def metrics_markdown(title: str, rows: list[MetricRow]) -> str:
-    """The metric table of one run as Markdown, DOF by washout (for the recording)."""
-    return metrics_table_markdown(title, rows)
+def metrics_markdown(
+    title: str, rows: list[MetricRow], motion: Mapping[str, float] | None = None, rule: RankRule = DEFAULT_RULE
+) -> str:
+    """The ranking (when ``motion``, the aircraft pilot's perceived motion per DOF, is given) and the metric tables of
+    one run as Markdown, washout by DOF (for the recording's Metrics panel)."""
+    ranking = rank(rows, motion, rule) if motion is not None else []
+    return metrics_table_markdown(title, rows, ranking, rule.label())
 
 
 #: The file that marks a folder as a ``washbench run`` result (only such a folder is ever replaced).
@@ -112,6 +116,7 @@ def write_run_recording(
     aircraft_q: np.ndarray,
     phases: list[tuple[str, float, float]],
     properties: dict[str, str] | None = None,
+    rule: RankRule = DEFAULT_RULE,
 ) -> None:
     """The recording of one result folder (``run`` and ``cue`` alike): the one call of the recording writer.
 
@@ -154,7 +159,8 @@ def write_run_recording(
         platforms=platforms,
         envelope=platform_envelope(limits),
         phases=[(p[0], float(p[1]), float(p[2])) for p in phases],
-        metrics_markdown=metrics_markdown(title, list(result.metrics)),
+        metrics_markdown=metrics_markdown(title, list(result.metrics),
+                                          perceived_motion(ac.f_mps2, ac.omega_radps, float(motion.dt_s)), rule),
     )
     write_recording(path, data, properties)
 

@@ -58,7 +58,7 @@ from washbench.io.cpus import usable_cpus
 from washbench.io.csv_numbers import csv_number
 from washbench.io.lock import output_lock
 from washbench.io.metrics_csv import METRICS_COLUMNS, METRICS_TEXT_COLUMNS
-from washbench.io.outfolder import recover, recover_shared, staged
+from washbench.io.outfolder import recover, recover_shared, refuse_other_owner, staged
 from washbench.io.progress import Progress
 from washbench.io.provenance import utc_now
 from washbench.io.publish import is_washbench_result, read_marker
@@ -298,6 +298,7 @@ def previous_results(out_dir: Path) -> list[Path]:
 
     Raises WashbenchError naming the first entry washbench did not write (the suite then does not start).
     """
+    refuse_other_owner(out_dir, "suite")
     marker = read_marker(out_dir, SUITE_MARKER) or {}
     listed = marker.get("entries", []) if marker.get("washbench") == "suite" else []
     listed = {n for n in listed if isinstance(n, str) and "/" not in n and n not in ("", ".", "..")}
