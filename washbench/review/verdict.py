@@ -108,8 +108,8 @@ def verdict_lines(entries: Sequence[Entry], washouts: Sequence[str], reference: 
             f"{100 * GAIN_AIM:.0f} % better than {reference} on {at_aim[best]} of {n}).")  # fmt: skip
     if has_ceiling:
         reach = _median([reached(e, best) for e in ranked])
-        text += (f" It reaches a median {_share(reach)} of the ceiling (the least error any motion of this platform "
-                 "could reach, 100 %; standing still, 0 %).")  # fmt: skip
+        text += (f" It recovers a median {_share(reach)} of what this platform could recover (the ceiling, the least "
+                 "error any motion of the platform could reach: 100 %; standing still: 0 %).")  # fmt: skip
     lines += [text, ""]
     # why: the specific-force cues against the rotational ones
     trans = {w: _median([group_errors(e, w)[0] for e in ranked]) for w in contenders}
@@ -128,7 +128,7 @@ def verdict_lines(entries: Sequence[Entry], washouts: Sequence[str], reference: 
               f"together {sum(alone.values()) + shared} of {n} manoeuvres.", ""]  # fmt: skip
     # per manoeuvre
     head = ["manoeuvre", "best washout", f"gain over {reference}"]
-    head += ["ceiling reached", "bound's replay reached"] if has_ceiling else []
+    head += ["ceiling reached", "replay reached"] if has_ceiling else []
     lines += ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for e in ranked:
         top = firsts(e.ranking)
