@@ -15,7 +15,7 @@ CEILING_FILE = "ceiling.csv"
 CEILING_NOTE = (
     "The ceiling is the least relative error that **any** motion of this platform could reach on this flight, with "
     "the whole flight known: a certified lower bound on the ranking's own measure, per degree of freedom and for the "
-    "{measure} (a convex relaxation of everything the platform model can fly, docs/metrics.md: no washout can score "
+    "{measure} (a convex relaxation of everything the platform model can fly, docs/yardstick.md: no washout can score "
     "below it). It is loose where the relaxation is generous (tilt that costs no rotational cue, each DOF with the "
     "whole of gravity), so the truly best motion lies between the ceiling and the `bound` row (an achieved motion, "
     "planned with the whole flight known and replayed through the platform model). Recovered = (still - value) / "
