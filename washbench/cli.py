@@ -587,6 +587,7 @@ def main(argv: list[str] | None = None) -> int:
     if config is not None:  # recorded in the provenance, also by worker processes
         os.environ[project_config.CONFIG_USED_ENV] = str(config.path)
     signal.signal(signal.SIGTERM, interrupts.terminate)
+    sigint_before = signal.signal(signal.SIGINT, interrupts.interrupt)  # counted (a plugin's KeyboardInterrupt is not)
     hook, sys.unraisablehook = sys.unraisablehook, interrupts.signal_in_finalizer
     try:
         try:
@@ -619,6 +620,7 @@ def main(argv: list[str] | None = None) -> int:
         return 143
     finally:
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        signal.signal(signal.SIGINT, sigint_before)
         sys.unraisablehook = hook
         os.environ.pop(project_config.CONFIG_USED_ENV, None)
         if env_before is not None:

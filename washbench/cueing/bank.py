@@ -503,9 +503,9 @@ class CueingBank:
         solves, fallbacks, brakes and solver iterations; numbers only); washouts without ``report()`` are absent."""
         out: dict[str, dict[str, float | int]] = {}
         for _, src in self._sources:
-            fn = getattr(src.algo, "report", None)
-            if callable(fn):
-                out[src.name] = {str(k): _number(v) for k, v in dict(fn()).items()}
+            reported = src.report()
+            if reported is not None:
+                out[src.name] = reported
         return out
 
     def saturation_counts(self) -> dict[str, dict[str, int]]:
@@ -568,12 +568,6 @@ def python_sources(
 ) -> list[tuple[int, SetPointSource]]:
     """(index, source) of every washout of ``specs`` that is a Python algorithm (not compiled)."""
     return [(i, SetPointSource(w, limits, dt, filter_start)) for i, w in enumerate(specs) if w.kind not in _KINDS]
-
-
-def _number(v: object) -> float | int:
-    """A reported statistic as a JSON number: a whole number as int (a count), else float."""
-    x = float(v)  # type: ignore[arg-type]
-    return int(x) if x.is_integer() and abs(x) < 2**53 else x
 
 
 def _set_start(state: np.ndarray, pos: np.ndarray, q: np.ndarray) -> None:
