@@ -384,10 +384,12 @@ class CueingBank:
         self._py = [(i, src) for i, src in self._py if i not in self._whole]
 
     def _whole_setpoints(self, future: tuple[np.ndarray, np.ndarray] | None) -> dict[int, tuple[np.ndarray, ...]]:
-        """index -> (start pos, start q, pos (N, 3), q (N, 4), flags (N, 2)) of every whole-only washout."""
+        """index -> (start pos, start q, pos (N, 3), q (N, 4), flags (N, 2)) of every whole-only washout, and, given
+        the whole recording (``future``), of every Python washout with a whole-trace form (``trace()``: used for
+        recorded files, as the interface promises, in :func:`cue_trace` and here alike)."""
         out: dict[int, tuple[np.ndarray, ...]] = {}
         for i, src in self._py:
-            if not src.whole_only:
+            if not (src.whole_only or (future is not None and src.has_trace)):
                 continue
             if future is None:
                 raise WashbenchError(f"washout {src.name}: needs the whole recording before its first step (a "
