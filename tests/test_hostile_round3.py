@@ -269,3 +269,91 @@ def test_a_suite_run_whose_plugin_exits_or_whose_worker_dies_fails_alone(how: st
     }[how]
     assert expected in proc.stderr, proc.stderr
     assert not [p for p in tree(out) if Path(p).name.startswith(".washbench-stage")], tree(out)
+
+
+# ------------------------------------------------------------------------------------------ the configuration file
+
+
+def _small_csv(path: Path) -> Path:
+    sig = generate(SignalSpec("sine", "f_x", 1.0, 0.5, 2.0, 60.0, 0.0))
+    write_motion(path, sig.t_s, sig.f_mps2, sig.omega_radps)
+    return path
+
+
+def _wb_in(cwd: Path, *args: object, env: dict[str, str] | None = None) -> subprocess.CompletedProcess[str]:
+    full = {k: v for k, v in os.environ.items() if k not in ("WASHBENCH_CONFIG_USED", "WASHBENCH_SAFE_CONFIG")}
+    full.update(env or {})
+    return subprocess.run([sys.executable, "-m", "washbench", *map(str, args)], cwd=cwd, capture_output=True,
+                          text=True, timeout=120, env=full)  # fmt: skip
+
+
+DEEP = "x = " + "[" * 100_000 + "]" * 100_000 + "\n"
+
+BAD_CONFIGS = {
+    # file text -> what the one line says (after the file's name)
+    "NUL in out": ('out = "re\\u0000sults"\n', "out: a path with a control character"),
+    "escape in out": ('out = "\\u001b[2Jr"\n', "out: a path with a control character"),
+    "arrays nested 100,000 deep": (DEEP, "nested too deeply"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD_CONFIGS))
+def test_a_hostile_configuration_file_is_one_line(case: str, tmp_path: Path) -> None:
+    text, expected = BAD_CONFIGS[case]
+    (tmp_path / "washbench.toml").write_text(text)
+    proc = _wb_in(tmp_path, "signal", "step", "--axis", "f_y", "--amplitude", "1", "--duration-s", "1", "--out",
+                  "x.csv")  # fmt: skip
+    assert_clean_error(proc, str(tmp_path / "washbench.toml"), expected)
+    assert "\x1b" not in proc.stderr and not (tmp_path / "x.csv").exists()
+    version = _wb_in(tmp_path, "--version")  # --version still answers (it was a RecursionError traceback)
+    assert version.returncode == 0 and "Traceback" not in version.stderr, version.stderr
+
+
+def test_an_8_gb_configuration_file_is_refused_unread(tmp_path: Path) -> None:
+    config = tmp_path / "washbench.toml"
+    with config.open("wb") as fh:
+        fh.truncate(8 * 1024**3)  # sparse: no disk used
+    proc = _wb_in(tmp_path, "signal", "step", "--axis", "f_y", "--amplitude", "1", "--out", "x.csv")
+    assert_clean_error(proc, str(config), "larger than 10 MB")
+
+
+def test_another_tool_s_deep_table_in_pyproject_is_passed_over(tmp_path: Path) -> None:
+    (tmp_path / "pyproject.toml").write_text('[project]\nname = "x"\n\n[tool.other]\n' + DEEP)
+    proc = _wb_in(tmp_path, "signal", "step", "--axis", "f_y", "--amplitude", "1", "--duration-s", "1", "--out",
+                  "x.csv")  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert "configuration" not in proc.stderr
+
+
+def test_a_configuration_with_a_byte_order_mark_is_used_and_named(tmp_path: Path) -> None:
+    config = tmp_path / "washbench.toml"
+    config.write_bytes(b'\xef\xbb\xbfout = "results"\n')
+    _small_csv(tmp_path / "small.csv")
+    proc = _wb_in(tmp_path, "cue", "small.csv", "--no-recording", "--no-figures")
+    assert proc.returncode == 0, proc.stderr
+    assert f"washbench: note: configuration from {config}" in proc.stderr.splitlines()
+    assert (tmp_path / "results" / "metrics.csv").is_file()
+
+
+@pytest.mark.skipif(not hasattr(os, "geteuid") or os.geteuid() != 0, reason="needs root to give a file away")
+def test_a_configuration_another_user_owns_is_not_used_but_named(tmp_path: Path) -> None:
+    """A washbench.toml in a parent folder that belongs to another user (uid 4242): not applied, a warning names
+    it and how to trust it (git's safe.directory); trusted through WASHBENCH_SAFE_CONFIG it is used."""
+    shared = tmp_path / "shared"
+    mine = shared / "mine"
+    mine.mkdir(parents=True)
+    config = shared / "washbench.toml"
+    config.write_text('out = "hijacked"\n')
+    os.chown(config, 4242, 4242)
+    os.chown(shared, 4242, 4242)
+    _small_csv(mine / "small.csv")
+    proc = _wb_in(mine, "cue", "small.csv", "--out", "r", "--no-recording", "--no-figures")
+    assert proc.returncode == 0, proc.stderr
+    assert f"{config} belongs to another user (uid 4242): not used" in proc.stderr
+    assert "WASHBENCH_SAFE_CONFIG" in proc.stderr
+    assert "configuration from" not in proc.stderr
+    trusting = _wb_in(mine, "cue", "small.csv", "--no-recording", "--no-figures",
+                      env={"WASHBENCH_SAFE_CONFIG": str(config)})  # fmt: skip
+    assert trusting.returncode == 0, trusting.stderr
+    assert (shared / "hijacked" / "metrics.csv").is_file()  # relative to the file's folder
+    assert f"configuration from {config}" in trusting.stderr
