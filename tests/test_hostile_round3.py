@@ -10,17 +10,27 @@ from __future__ import annotations
 import csv
 import os
 import signal
+import socket
 import subprocess
 import sys
 import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
+import numpy as np
 import pytest
 from hostile import assert_clean_error, short, tree, washbench
+from test_live import DT, _send_samples, free_udp_port, in_thread, live, motion, run_json, saved, wait_listening
 
 from washbench.analysis.signals import SignalSpec, generate
+from washbench.errors import WashbenchError
 from washbench.io.motion_file import write_motion
+from washbench.live import packets
+from washbench.live.link import Link
+from washbench.live.saved_input import INPUT_FILE
+from washbench.runs.cue import run_cue
+from washbench.runs.options import load_options
+from washbench.runs.outputs import Outputs
 
 # ------------------------------------------------------------------------------------------ plugins
 
@@ -357,3 +367,235 @@ def test_a_configuration_another_user_owns_is_not_used_but_named(tmp_path: Path)
     assert trusting.returncode == 0, trusting.stderr
     assert (shared / "hijacked" / "metrics.csv").is_file()  # relative to the file's folder
     assert f"configuration from {config}" in trusting.stderr
+
+
+# ------------------------------------------------------------------------------------------ live
+
+
+
+def test_a_gap_is_filled_only_as_far_as_the_arrival_clock_allows() -> None:
+    """The source's time jumps 3000 s forward while 1 ms passes: a new segment, no sample made up (before: 360,000
+    held samples here, 1.5e9 with a 2 us step); a stray t = 0 in a stream at t = 100 s and the stream going on:
+    no gap filled (before: 12,000 held samples); a real 0.5 s gap that took 0.5 s: its 59 samples held."""
+    m = motion(240, t0=100.0)
+    link = Link(dt_s=DT)
+    outs = []
+    arrival = 0.0
+    for s in m[:120]:
+        outs += link.push(s, arrival)
+        arrival += DT
+    jump = (m[119][0] + 3000.0, *m[119][1:])
+    outs += link.push(jump, arrival + 0.001)
+    assert link.counts.lost == 0 and link.counts.time_jumps == 1 and outs[-1].new_segment and len(outs) == 121
+
+    link = Link(dt_s=DT)
+    outs = []
+    arrival = 0.0
+    for k, s in enumerate(m):
+        if k == 100:
+            outs += link.push((0.0, *s[1:]), arrival)  # the stray datagram
+        outs += link.push(s, arrival)
+        arrival += DT
+    assert link.counts.lost == 0 and link.counts.restarts == 1 and link.counts.time_jumps == 1
+    assert len(outs) == 241  # every sample once, the stray too; none made up
+
+    link = Link(dt_s=DT)
+    outs = []
+    for k, s in enumerate(m):
+        if 60 <= k < 120:
+            continue  # lost in the network: 0.5 s with nothing, and the arrival clock shows it
+        outs += link.push(s, k * DT)
+    assert link.counts.lost == 60 and link.counts.time_jumps == 0 and len(outs) == 240
+
+
+def test_tiny_time_steps_stop_the_session_and_save_what_arrived(tmp_path: Path) -> None:
+    """Ten samples 2 us apart, then one at t = 3000 s: one line, exit 2, the samples received saved (before: held
+    samples without end, deaf to SIGTERM; or, with any first 8 steps under 1 us, no file)."""
+    m = [(k * 2e-6, *s[1:]) for k, s in enumerate(motion(10))] + [(3000.0, *motion(1)[0][1:])]
+    port = free_udp_port()
+    th = in_thread(_send_samples(port, "washbench", m))
+    with pytest.raises(WashbenchError, match=r"time step.*2e-06 s, outside 0.0001..10 s.*8 sample\(s\) received"):
+        live(tmp_path, "washbench", port)
+    th.join(10)
+    got = saved(tmp_path / "live")
+    assert got.shape == (8, 7) and (got[:, 0] == [k * 2e-6 for k in range(8)]).all()
+
+
+def test_rate_hz_out_of_range_is_refused_before_listening(tmp_path: Path) -> None:
+    with pytest.raises(WashbenchError, match=r"--rate-hz: expected 0.1..10000 Hz, got 1e\+300"):
+        live(tmp_path, "washbench", free_udp_port(), rate_hz=1e300)
+    assert not (tmp_path / "live").exists()
+
+
+def test_live_locks_onto_the_first_sender(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A second sender (another time base) at once: its datagrams ignored, counted and named; the result is the
+    first sender's stream alone (before: 802 datagrams became 2.78 million commands)."""
+    port = free_udp_port()
+    first, second = motion(240), motion(240, t0=500.0)
+
+    def both() -> None:
+        udp = (socket.AF_INET, socket.SOCK_DGRAM)
+        with socket.socket(*udp) as a, socket.socket(*udp) as b:
+            a.connect(("127.0.0.1", port))
+            b.connect(("127.0.0.1", port))
+            wait_listening(a)
+            enc = packets.ENCODERS["washbench"]
+            a.send(enc(0, first[0]))
+            time.sleep(0.05)
+            for k in range(1, 240):
+                a.send(enc(k, first[k]))
+                b.send(enc(k, second[k]))
+                if k % 20 == 0:
+                    time.sleep(0.002)
+
+    th = in_thread(both)
+    status, out = live(tmp_path, "washbench", port)
+    th.join(10)
+    assert status == 0
+    c = run_json(out)["live"]["counts"]
+    assert c["cued"] == 240 and c["other_senders"] == 239 and c["segments"] == 1 and c["lost_held"] == 0
+    np.testing.assert_array_equal(saved(out), np.array(first))
+    text = capsys.readouterr().out
+    assert "ignored: locked onto 127.0.0.1:" in text and "datagrams from other senders 239" in text
+
+
+def test_idle_timeout_fires_when_nothing_ever_arrives(tmp_path: Path) -> None:
+    start = time.monotonic()
+    with pytest.raises(WashbenchError, match=r"0 sample\(s\) received \(the source was quiet .*nothing arrived"):
+        live(tmp_path, "washbench", free_udp_port())
+    assert time.monotonic() - start < 60
+
+
+def test_a_session_with_too_few_samples_keeps_the_earlier_session_s_files(tmp_path: Path) -> None:
+    port = free_udp_port()
+    th = in_thread(_send_samples(port, "washbench", motion(120)))
+    status, out = live(tmp_path, "washbench", port)
+    th.join(10)
+    assert status == 0
+    before = {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()}
+    port = free_udp_port()
+    th = in_thread(_send_samples(port, "washbench", motion(1)))
+    with pytest.raises(WashbenchError, match=r"1 sample\(s\) received"):
+        live(tmp_path, "washbench", port)
+    th.join(10)
+    after = {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()}
+    assert after == before  # live_input.csv was deleted before
+
+
+def test_a_killed_session_s_part_file_is_taken_back(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "live"
+    out.mkdir()
+    part = out / (INPUT_FILE + ".part")
+    part.write_bytes(b"t_s,f_x_mps2,f_y_mps2,f_z_mps2,omega_x_degps,omega_y_degps,omega_z_degps,live_held\n0.0,1")
+    port = free_udp_port()
+    th = in_thread(_send_samples(port, "washbench", motion(120)))
+    status, _ = live(tmp_path, "washbench", port)
+    th.join(10)
+    assert status == 0 and not part.exists() and saved(out).shape == (120, 7)
+    assert "left by a session that was killed" in capsys.readouterr().out
+    part.write_text("the user's own notes\n")  # not ours: still refused
+    with pytest.raises(WashbenchError, match="washbench did not write this"):
+        live(tmp_path, "washbench", free_udp_port())
+    assert part.read_text() == "the user's own notes\n"
+
+
+def test_flightgear_native_packets_get_a_hint(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    port = free_udp_port()
+    native = b"\x00\x00\x00\x18" + bytes(404)  # FGNetFDM version 24, as JSBSim's type="FLIGHTGEAR" sends
+
+    def go() -> None:
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+            s.connect(("127.0.0.1", port))
+            wait_listening(s)
+            for _ in range(5):
+                s.send(native)
+
+    th = in_thread(go)
+    with pytest.raises(WashbenchError, match="0 sample"):
+        live(tmp_path, "flightgear", port)
+    th.join(10)
+    text = capsys.readouterr().out
+    assert text.count("FlightGear's native FDM format") == 1 and "--format flightgear" in text
+
+
+def test_arrival_time_is_the_kernel_s_so_queue_time_counts() -> None:
+    """A datagram that waited 0.2 s in the receive queue: its arrival stamp is from before the wait (before: the
+    time recvfrom returned, so the wait was not in the latency)."""
+    from washbench.runs.live import receiver
+
+    udp = (socket.AF_INET, socket.SOCK_DGRAM)
+    with socket.socket(*udp) as rx, socket.socket(*udp) as tx:
+        rx.bind(("127.0.0.1", 0))
+        recv, clock = receiver(rx)
+        tx.sendto(b"x", rx.getsockname())
+        sent = clock()
+        time.sleep(0.2)
+        data, _, arrival = recv()
+        now = clock()
+    assert data == b"x"
+    if sys.platform.startswith("linux"):
+        assert arrival <= sent + 5_000_000 and now - arrival >= 150_000_000
+
+
+def test_send_jsbsim_into_live_jsbsim_equals_cue_of_the_file(tmp_path: Path) -> None:
+    """JSBSim's one-frame lag is shifted back by live: send gives it to the samples again, so the live result is
+    cue of the file sent, every metric (before: shifted twice, 0 of 138 metrics equal)."""
+    m = motion(240)
+    src = tmp_path / "in.csv"
+    src.write_text("t_s,f_x_mps2,f_y_mps2,f_z_mps2,omega_x_degps,omega_y_degps,omega_z_degps\n"
+                   + "".join(",".join(repr(v) for v in r) + "\n" for r in m))  # fmt: skip
+    port = free_udp_port()
+
+    def go() -> None:
+        from washbench.runs.send import run_send
+
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+            s.connect(("127.0.0.1", port))
+            wait_listening(s)
+        run_send("jsbsim", ("127.0.0.1", port), src, speed=8.0)
+
+    th = in_thread(go)
+    status, out = live(tmp_path, "jsbsim", port)
+    th.join(10)
+    assert status == 0
+    np.testing.assert_allclose(saved(out), np.array(m), rtol=1e-15, atol=1e-13)
+    run_cue(src, tmp_path / "orig", run=load_options(outputs=Outputs(recording=False, figures=False)))
+    a = list(csv.DictReader((out / "metrics.csv").open()))
+    b = list(csv.DictReader((tmp_path / "orig" / "metrics.csv").open()))
+    assert len(a) == len(b) >= 6
+    for ra, rb in zip(a, b, strict=True):
+        assert ra.keys() == rb.keys()
+        for k in ra:
+            if ra[k] != rb[k]:
+                assert float(ra[k]) == pytest.approx(float(rb[k]), rel=1e-9, abs=1e-12), (k, ra, rb)
+
+
+def test_send_speed_out_of_range_is_one_line(tmp_path: Path) -> None:
+    src = tmp_path / "in.csv"
+    src.write_text("t_s,f_x_mps2,f_y_mps2,f_z_mps2,omega_x_degps,omega_y_degps,omega_z_degps\n0,0,0,-9.8,0,0,0\n"
+                   "0.01,0,0,-9.8,0,0,0\n")  # fmt: skip
+    for speed in ("1e-300", "nan", "1e300"):
+        proc = washbench("send", src, "--to", "127.0.0.1:9", "--format", "washbench", "--speed", speed, timeout=60)
+        assert_clean_error(proc, "--speed")
+
+
+def test_a_plugin_blocking_in_step_does_not_make_live_deaf(tmp_path: Path) -> None:
+    """SIGTERM while a plugin's step() blocks: live stops at once (143), the samples cued so far saved."""
+    plugin = plugin_file(tmp_path, step="time.sleep(600)", after=50)
+    port = free_udp_port()
+    out = tmp_path / "live"
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "washbench", "live", "--listen", f"127.0.0.1:{port}", "--format", "washbench",
+         "--out", str(out), "--no-viewer", "--no-recording", "--no-figures", "--washout-plugin", f"{plugin}:P",
+         "--washout", "p"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    try:
+        _send_samples(port, "washbench", motion(120))()
+        time.sleep(1.0)
+        proc.send_signal(signal.SIGTERM)
+        _, err = proc.communicate(timeout=30)
+    finally:
+        proc.kill()
+    assert proc.returncode == 143, err
+    assert "Traceback" not in err and "while the washouts were computing" in err, err
+    assert saved(out).shape[0] >= 2

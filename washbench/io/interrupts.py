@@ -48,6 +48,11 @@ def received() -> int:
     return _RECEIVED[0]
 
 
+def note_received() -> None:
+    """Count a SIGINT/SIGTERM received by a handler of a command's own (``washbench live``'s), for :func:`received`."""
+    _RECEIVED[0] += 1
+
+
 def terminate(signum: int, frame: object) -> None:
     """The SIGTERM handler: raise :class:`washbench.errors.Terminated` in the main thread."""
     _RECEIVED[0] += 1
