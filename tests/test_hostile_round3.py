@@ -8,6 +8,7 @@ naming the file or the washout, no traceback, and what was (or was not) written.
 from __future__ import annotations
 
 import csv
+import math
 import os
 import signal
 import socket
@@ -599,3 +600,90 @@ def test_a_plugin_blocking_in_step_does_not_make_live_deaf(tmp_path: Path) -> No
     assert proc.returncode == 143, err
     assert "Traceback" not in err and "while the washouts were computing" in err, err
     assert saved(out).shape[0] >= 2
+
+
+# ------------------------------------------------------------------------------------------ the rest
+
+
+def test_two_samples_give_no_npc_not_inf() -> None:
+    """Two points always correlate by exactly -1 or +1: NPC is undefined (nan, an empty CSV field), not inf."""
+    from washbench.analysis.metrics import dof_metrics
+
+    a = np.array([[1.0, 0.0, -9.8], [-1.0, 0.5, -9.0]])
+    s = -a  # anti-correlated in every axis
+    w = np.array([[0.1, 0.0, 0.2], [-0.1, 0.3, 0.0]])
+    rows = dof_metrics("x", a, w, s, -w, 0.01)
+    assert all(math.isnan(r.npc) for r in rows)
+    assert rows[0].integral_error == pytest.approx(0.01 * (2 + 2) / 2)  # the trapezoid of |a - s| = 2, 2
+    three = np.vstack([a, [[0.5, 0.1, -9.5]]])
+    w3 = np.vstack([w, [[0.0, 0.1, 0.1]]])
+    assert dof_metrics("x", three, w3, -three, -w3, 0.01)[0].npc == math.inf  # 3 samples: the documented limit
+
+
+def test_the_wrote_line_shows_escapes_not_raw(tmp_path: Path) -> None:
+    out = tmp_path / "a\x1b[2Jb.csv"
+    proc = washbench("signal", "step", "--axis", "f_y", "--amplitude", "1", "--duration-s", "1", "--out", out)
+    assert proc.returncode == 0, proc.stderr
+    assert "\x1b" not in proc.stdout and "a\\x1b[2Jb.csv" in proc.stdout
+
+
+@pytest.fixture(scope="module")
+def small_suite(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    root = tmp_path_factory.mktemp("suite")
+    out = root / "out"
+    proc = washbench("suite", short(root, "brief", 1), "--jobs", "1", "--washout", "large-angle", "--out", out,
+                     "--no-recording", timeout=240)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    return out
+
+
+def _copy(src: Path, dest: Path) -> Path:
+    subprocess.run(["cp", "-a", str(src), str(dest)], check=True)
+    return dest
+
+
+def _files(folder: Path) -> dict[str, bytes]:
+    return {str(p.relative_to(folder)): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+def test_report_refuses_a_figures_link_before_rewriting_anything(small_suite: Path, tmp_path: Path) -> None:
+    out = _copy(small_suite, tmp_path / "suite")
+    victim = tmp_path / "victim"
+    victim.mkdir()
+    (out / "figures").rename(tmp_path / "moved")
+    (out / "figures").symlink_to(victim, target_is_directory=True)
+    before = _files(out / "c172p")
+    proc = washbench("report", out, timeout=120)
+    assert_clean_error(proc, "figures", "symbolic link")
+    assert _files(out / "c172p") == before  # the run's report and figures were rewritten before the refusal
+    assert list(victim.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    ("ranking", "expected"),
+    [
+        ({"by": "bogus"}, "provenance.ranking.by"),
+        ({"by": "weighted", "dof_weights": {"surge": 0}}, "needs dof_weights"),
+        ({"by": "score", "dof_weights": {"surge": -1}}, "surge: expected a finite number"),
+        ({"by": "score", "tie_relative": "x"}, "provenance.ranking.tie_relative"),
+    ],
+)
+def test_report_checks_the_ranking_rule_recorded_in_run_json(
+    small_suite: Path, tmp_path: Path, ranking: dict, expected: str
+) -> None:
+    import json
+
+    out = _copy(small_suite / "c172p" / "brief", tmp_path / "run")
+    doc = json.loads((out / "run.json").read_text())
+    doc["provenance"]["ranking"] = ranking
+    (out / "run.json").write_text(json.dumps(doc))
+    before = _files(out)
+    assert_clean_error(washbench("report", out, timeout=120), "run.json", expected)
+    assert _files(out) == before
+
+
+def test_readback_knows_every_ranking_rule_and_dof() -> None:
+    from washbench.analysis.ranking import DOFS, RANK_BY
+    from washbench.io.readback import RANK_DOFS, RANK_RULES
+
+    assert RANK_RULES == RANK_BY and RANK_DOFS == DOFS

@@ -27,7 +27,7 @@ from washbench.analysis import omct
 from washbench.analysis.omct_boundaries import BoundaryFile
 from washbench.analysis.signals import SignalSpec, amplitude_unit, canonical_axis, generate
 from washbench.cueing.variants import Washout, select_washouts
-from washbench.errors import WashbenchError
+from washbench.errors import WashbenchError, printable
 from washbench.io.atomic import write_text_atomic
 from washbench.io.budget import check_samples
 from washbench.io.csv_numbers import csv_number
@@ -321,7 +321,8 @@ def run_entries(
     if boundary is not None:
         n_out = sum(1 for p in points if p.gain_inside is False or p.phase_inside is False)
         print(f"  boundaries {boundary.name}: {n_out} points outside")
-    print(f"wrote {out_dir / CSV_FILE}, {out_dir / REPORT_FILE}" + (f" and {len(files)} Bode plots" if files else ""))
+    wrote = f"{printable(str(out_dir / CSV_FILE))}, {printable(str(out_dir / REPORT_FILE))}"
+    print(f"wrote {wrote}" + (f" and {len(files)} Bode plots" if files else ""))
     return points
 
 
@@ -343,7 +344,7 @@ def signal_command(
     freq = "" if frequency_hz is None or kind == "step" else f" at {frequency_hz:g} Hz"
     named = axis if given == axis else f"{given} ({axis})"
     print(
-        f"wrote {out}: {kind} on {named}, amplitude {amplitude:g} {amplitude_unit(axis)}{freq}, "
+        f"wrote {printable(str(out))}: {kind} on {named}, amplitude {amplitude:g} {amplitude_unit(axis)}{freq}, "
         f"{sig.t_s.shape[0]} samples at {rate_hz:g} Hz"
     )
     return 0

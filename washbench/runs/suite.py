@@ -53,7 +53,7 @@ from washbench.analysis.ranking import (
     rule_from_record,
 )
 from washbench.cueing import registry
-from washbench.errors import WashbenchError, located
+from washbench.errors import WashbenchError, located, printable
 from washbench.flight.scripts import bundled_script, is_script
 from washbench.io.atomic import write_text_atomic
 from washbench.io.cpus import usable_cpus
@@ -424,9 +424,8 @@ def suite_command(
             figure_pool = None if pool_broken(pool) else pool  # a worker died: the figures are drawn here
             write_suite_results(outcomes, stage, dict(options.provenance), options.outputs.figures, figure_pool)
     n_ok = sum(o.run.ok for o in outcomes)
-    print(
-        f"suite: {n_ok}/{len(outcomes)} runs ok in {time.perf_counter() - start:.1f} s; report: {out_dir / REPORT_FILE}"
-    )
+    report = printable(str(out_dir / REPORT_FILE))
+    print(f"suite: {n_ok}/{len(outcomes)} runs ok in {time.perf_counter() - start:.1f} s; report: {report}")
     return 0 if n_ok == len(outcomes) else 1
 
 
