@@ -10,6 +10,7 @@ from __future__ import annotations
 import csv
 import math
 import os
+import re
 import signal
 import socket
 import subprocess
@@ -37,6 +38,7 @@ from washbench.runs.outputs import Outputs
 
 PLUGIN_HEAD = """\
 import os
+import re
 import sys
 import time
 
@@ -687,3 +689,63 @@ def test_readback_knows_every_ranking_rule_and_dof() -> None:
     from washbench.io.readback import RANK_DOFS, RANK_RULES
 
     assert RANK_RULES == RANK_BY and RANK_DOFS == DOFS
+
+
+# solvers' effort ---------------------------------------------------------------------------------
+
+
+def test_mpc_effort_is_capped_in_the_parameter_file(tmp_path: Path) -> None:
+    """max_iter 1,000,000 with tolerances of 1e-300 and a 500-step horizon: one line naming the file, the line and
+    the key (before: accepted, no end within minutes)."""
+    from washbench.io.paths import DATA_DIR
+
+    base = (DATA_DIR / "cw1.yaml").read_text()
+    cases = {
+        "solver: {max_iter: 1000000}": "mpc.solver.max_iter",
+        "solver: {eps_abs: 1.0e-300}": "mpc.solver.eps_abs",
+        "solver: {eps_rel: 1.0e-300}": "mpc.solver.eps_rel",
+        "horizon_steps: 500\n  solver: {max_iter: 50000}": "500 x solver.max_iter 50000 = 25,000,000",
+    }
+    for i, (section, expected) in enumerate(cases.items()):
+        params = tmp_path / f"p{i}.yaml"
+        params.write_text(base + f"mpc:\n  {section}\n")
+        with pytest.raises(WashbenchError, match=re.escape(expected)) as err:
+            load_options(params_path=params, washouts=["mpc"])
+        assert str(params) in str(err.value)
+
+
+def test_a_slow_mpc_says_how_long_a_minute_of_flight_takes(monkeypatch: pytest.MonkeyPatch,
+                                                          capsys: pytest.CaptureFixture[str]) -> None:  # fmt: skip
+    from washbench.cueing import mpc
+    from washbench.cueing.algorithm import WashoutContext
+
+    monkeypatch.setattr(mpc, "SLOW_FACTOR", 0.0)  # any speed counts as slow: the message is what is tested
+    limits = load_options().limits
+    algo = mpc.MpcWashout(None, WashoutContext(DT, 9.80665, limits, "steady", (0.0, 0.0, 0.0)))
+    f, w = np.array([0.1, 0.0, -9.80665]), np.zeros(3)
+    algo.start(f, w)
+    a = [algo.step(f, w) for _ in range(mpc.ESTIMATE_AFTER_STEPS + 5)]
+    err = capsys.readouterr().err
+    assert err.count("washbench: note: washout mpc:") == 1 and "a minute of flight takes about" in err
+    monkeypatch.setattr(mpc, "SLOW_FACTOR", 10.0)
+    algo2 = mpc.MpcWashout(None, WashoutContext(DT, 9.80665, limits, "steady", (0.0, 0.0, 0.0)))
+    algo2.start(f, w)
+    b = [algo2.step(f, w) for _ in range(mpc.ESTIMATE_AFTER_STEPS + 5)]
+    for (p1, q1), (p2, q2) in zip(a, b, strict=True):  # the timing changes no set point
+        assert np.array_equal(p1, p2) and np.array_equal(q1, q2)
+
+
+def test_omct_with_the_bound_estimates_its_time_and_caps_its_runs(capsys: pytest.CaptureFixture[str]) -> None:
+    from washbench.analysis import omct
+    from washbench.cueing.variants import select_washouts
+    from washbench.runs import omct as omct_run
+
+    entries = select_washouts(["bound", "small-angle"], (), None)
+    limits = load_options().limits
+    sigma = omct_run.slowest_decay(entries)
+    omct_run._bound_estimate(entries, limits, omct.TESTS[:2], omct.FREQUENCIES_RADPS[:3], 120.0, sigma, 1.0)
+    err = capsys.readouterr().err
+    assert re.search(r"omct: the oracle bound: 6 runs, [\d,]+ samples in all: about \d+ min \(timed on \d+ samples\)",
+                     err), err  # fmt: skip
+    with pytest.raises(WashbenchError, match="more than the oracle bound's limit of 500,000"):
+        omct_run._bound_estimate(entries, limits, omct.TESTS[:1], omct.FREQUENCIES_RADPS[:1], 1e5, sigma, 1.0)

@@ -39,10 +39,17 @@ from pydantic import Field
 from scipy import sparse
 
 from washbench.cueing.motion_model import discretise_foh
+from washbench.errors import WashbenchError
 from washbench.io.yamlio import StrictModel
 from washbench.numerics.rotations import quat_from_euler
 from washbench.perception.vestibular import VestibularModel, VestibularParams, canal_tf, otolith_tf
 from washbench.platform.limits import PlatformLimits
+
+MAX_BOUND_SAMPLES = 500_000
+"""The longest recording the bound replays as a washout (69 min at 120 Hz; about 20 min of solving)."""
+BOUND_S_PER_SAMPLE = 2e-3
+"""What the bound's solve costs per sample, s (measured: 1,200 samples 2.3 s, 19,200 samples 37 s on the 2-core
+development machine): the order of magnitude of the estimates printed before long work."""
 
 
 class BoundParams(StrictModel):
@@ -399,6 +406,10 @@ class BoundWashout:
 
     def trace(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         c = self.context
+        if len(f_mps2) > MAX_BOUND_SAMPLES:
+            raise WashbenchError(f"washout bound: {len(f_mps2):,} samples in one recording, more than the oracle "
+                                 f"bound's limit of {MAX_BOUND_SAMPLES:,} (one optimisation over the whole recording: "
+                                 "about 2 ms per sample); cut the recording or lower its rate")  # fmt: skip
         res = oracle_bound(f_mps2, omega_radps, c.dt_s, c.limits, c.gravity_mps2, self.params, start_at_rest=True)
         ang = res.trajectory.angles
         q = np.array([quat_from_euler(float(a), float(b), float(y)) for a, b, y in ang])

@@ -19,6 +19,8 @@ from __future__ import annotations
 import csv
 import io
 import math
+import sys
+import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -152,6 +154,7 @@ def measure(
     longest_s = max(omct.timing(w, sigma).duration_s for w in frequencies_radps)
     check_samples(longest_s * rate_hz * len(entries), f"--rate-hz {rate_hz:g}: {len(entries)} washout(s) x "
                   f"the longest OMCT run ({longest_s:.4g} s)")  # fmt: skip
+    _bound_estimate(entries, limits, tests, frequencies_radps, rate_hz, sigma, amplitude_scale)
     model = VestibularModel(dt, vestibular)
     raw: dict[tuple[str, str], list[tuple[float, float, str, complex, float, tuple[str, ...], complex, complex]]] = {}
     shown = Progress("omct", len(tests) * len(frequencies_radps), "test points") if progress else None
@@ -180,6 +183,33 @@ def measure(
         for test in tests:
             points += _points(e.name, test, raw[(e.name, test.name)], model, dt, (boundaries or {}).get(test.name))
     return points, OmctSettings(rate_hz, omct.settle_time_s(sigma), sigma, amplitude_scale)
+
+
+def _bound_estimate(
+    entries: Sequence[Washout], limits: PlatformLimits, tests: Sequence[omct.OmctTest],
+    frequencies_radps: Sequence[float], rate_hz: float, sigma: float, amplitude_scale: float,
+) -> None:  # fmt: skip
+    """With the oracle bound among ``entries``: its size and an estimated time on stderr before the runs (one
+    optimisation over each whole run: minutes), timed on a 1,200-sample piece of the first run as sweep does."""
+    from washbench.analysis.bound import MAX_BOUND_SAMPLES, BoundParams, oracle_bound  # deferred: clarabel
+
+    bounds = [e for e in entries if e.kind == "bound"]
+    if not bounds:
+        return
+    lengths = [round(omct.timing(w, sigma).duration_s * rate_hz) + 1 for _ in tests for w in frequencies_radps]
+    if max(lengths) > MAX_BOUND_SAMPLES:
+        raise WashbenchError(f"--rate-hz {rate_hz:g}: the OMCT's longest run has {max(lengths):,} samples, more than "
+                             f"the oracle bound's limit of {MAX_BOUND_SAMPLES:,}")  # fmt: skip
+    w0 = frequencies_radps[0]
+    sig = generate(omct.input_spec(tests[0], w0, rate_hz, omct.timing(w0, sigma).duration_s, amplitude_scale))
+    piece = min(1200, len(sig.t_s))
+    start = time.perf_counter()
+    oracle_bound(sig.f_mps2[:piece], sig.omega_radps[:piece], 1.0 / rate_hz, limits, _g(bounds[0]),
+                 BoundParams(), start_at_rest=True)  # fmt: skip
+    per_sample = (time.perf_counter() - start) / piece
+    total = sum(lengths) * len(bounds)
+    print(f"omct: the oracle bound: {len(lengths) * len(bounds)} runs, {total:,} samples in all: about "
+          f"{per_sample * total / 60:.0f} min (timed on {piece} samples)", file=sys.stderr, flush=True)  # fmt: skip
 
 
 def _g(entry: Washout) -> float:
