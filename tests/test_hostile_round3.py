@@ -749,3 +749,32 @@ def test_omct_with_the_bound_estimates_its_time_and_caps_its_runs(capsys: pytest
                      err), err  # fmt: skip
     with pytest.raises(WashbenchError, match="more than the oracle bound's limit of 500,000"):
         omct_run._bound_estimate(entries, limits, omct.TESTS[:1], omct.FREQUENCIES_RADPS[:1], 1e5, sigma, 1.0)
+
+
+# determinism on a cluster ------------------------------------------------------------------------
+
+MSDV_SCRIPT = """
+import numpy as np
+from washbench.perception.sickness import msdv
+print(" ".join(msdv(np.random.default_rng(seed).standard_normal(100_003) * 0.3, 1 / 120).hex() for seed in range(20)))
+"""
+
+
+def test_msdv_is_the_same_bits_whatever_blas_threads_the_process_has() -> None:
+    """A Dask worker runs BLAS on one thread (its nanny sets OPENBLAS_NUM_THREADS=1), a local run on every core:
+    np.dot's split by threads changed the MSDV's last bit (7 of these 20 differed); the sum is now in sample order.
+    Checked against math.fsum (correctly rounded) too."""
+    got = {}
+    for threads in ("1", "2"):
+        env = {**os.environ, "OPENBLAS_NUM_THREADS": threads, "OMP_NUM_THREADS": threads}
+        proc = subprocess.run([sys.executable, "-c", MSDV_SCRIPT], capture_output=True, text=True, env=env,
+                              timeout=120)  # fmt: skip
+        assert proc.returncode == 0, proc.stderr
+        got[threads] = proc.stdout.split()
+    assert got["1"] == got["2"] and len(got["1"]) == 20
+    from washbench.perception.sickness import wf_weighted
+
+    for seed, value in enumerate(got["1"][:3]):
+        aw = wf_weighted(np.random.default_rng(seed).standard_normal(100_003) * 0.3, 1 / 120)
+        exact = math.sqrt(math.fsum((aw * aw).tolist()) / 120)
+        assert float.fromhex(value) == pytest.approx(exact, rel=1e-13)
