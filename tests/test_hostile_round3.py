@@ -38,7 +38,6 @@ from washbench.runs.outputs import Outputs
 
 PLUGIN_HEAD = """\
 import os
-import re
 import sys
 import time
 
