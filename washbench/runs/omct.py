@@ -26,6 +26,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from washbench.analysis import omct
+from washbench.analysis.bound import MAX_BOUND_SAMPLES, BoundParams, oracle_bound
 from washbench.analysis.omct_boundaries import BoundaryFile
 from washbench.analysis.signals import SignalSpec, amplitude_unit, canonical_axis, generate
 from washbench.cueing.variants import Washout, select_washouts
@@ -191,7 +192,6 @@ def _bound_estimate(
 ) -> None:  # fmt: skip
     """With the oracle bound among ``entries``: its size and an estimated time on stderr before the runs (one
     optimisation over each whole run: minutes), timed on a 1,200-sample piece of the first run as sweep does."""
-    from washbench.analysis.bound import MAX_BOUND_SAMPLES, BoundParams, oracle_bound  # deferred: clarabel
 
     bounds = [e for e in entries if e.kind == "bound"]
     if not bounds:
