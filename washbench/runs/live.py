@@ -214,7 +214,8 @@ class Session:
         if sample is None:
             return
         try:
-            outs = self.link.push(sample, arrival_ns * 1e-9)
+            # the link's arrival clock is monotonic (the kernel's stamp is wall-clock time, which NTP may step)
+            outs = self.link.push(sample, time.monotonic())
         except UnusableStepError as exc:
             self._unusable(exc)
             return
