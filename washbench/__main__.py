@@ -22,6 +22,7 @@ def entry() -> int:
     """Import the CLI and run it; the console script's entry point."""
     collector.tune()  # before the imports, which allocate most of the objects the collector would scan
     signal.signal(signal.SIGTERM, interrupts.terminate)  # the CLI installs the same for the command
+    signal.signal(signal.SIGINT, interrupts.interrupt)  # Python's own, counted: a plugin's KeyboardInterrupt is not one
     sys.unraisablehook = interrupts.signal_in_finalizer
     try:
         # a Ctrl-C or SIGTERM while the CLI loads is noted and acted on once it has loaded: raised inside an

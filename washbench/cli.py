@@ -571,23 +571,30 @@ def main(argv: list[str] | None = None) -> int:
     SIGINT and SIGTERM stop the command at once: cleanup code runs (half-built results are removed, worker
     processes and viewers stopped), one line is printed and the status is 130 or 143.
     """
+    notes: list[str] = []
     try:  # the project configuration file (washbench.toml or [tool.washbench]) gives defaults; a flag wins
-        config = project_config.discover()
-    except WashbenchError as exc:
+        config = project_config.discover(notes=notes)
+    except (WashbenchError, MemoryError) as exc:
         if not {"-h", "--help", "--version"} & set(sys.argv[1:] if argv is None else argv):
-            print(f"washbench: error: {exc}", file=sys.stderr)
+            text = str(exc) if isinstance(exc, WashbenchError) else "out of memory reading the configuration file"
+            print(f"washbench: error: {printable(text)}", file=sys.stderr)
             return 2
         config = None
     parser = build_parser()
     if config is not None:
         _config_defaults(parser, config)
     args = parser.parse_args(argv)
+    for note in notes:
+        print(f"washbench: warning: {note}", file=sys.stderr)
+    if config is not None:  # which defaults apply is never silent
+        print(f"washbench: note: configuration from {printable(str(config.path))}", file=sys.stderr)
     if config is not None and getattr(args, "aircraft_dir", None) == []:
         args.aircraft_dir = list(config.aircraft_dirs)  # a --aircraft-dir given at all replaces the file's list
     env_before = os.environ.pop(project_config.CONFIG_USED_ENV, None)
     if config is not None:  # recorded in the provenance, also by worker processes
         os.environ[project_config.CONFIG_USED_ENV] = str(config.path)
     signal.signal(signal.SIGTERM, interrupts.terminate)
+    sigint_before = signal.signal(signal.SIGINT, interrupts.interrupt)  # counted (a plugin's KeyboardInterrupt is not)
     hook, sys.unraisablehook = sys.unraisablehook, interrupts.signal_in_finalizer
     try:
         try:
@@ -620,6 +627,7 @@ def main(argv: list[str] | None = None) -> int:
         return 143
     finally:
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        signal.signal(signal.SIGINT, sigint_before)
         sys.unraisablehook = hook
         os.environ.pop(project_config.CONFIG_USED_ENV, None)
         if env_before is not None:

@@ -44,6 +44,12 @@ from washbench.io.yamlio import StrictModel
 from washbench.perception.vestibular import VestibularModel, VestibularParams, canal_tf, otolith_tf
 from washbench.platform.limits import PlatformLimits
 
+MAX_BOUND_SAMPLES = 500_000
+"""The longest recording the bound replays as a washout (69 min at 120 Hz; about 20 min of solving)."""
+BOUND_S_PER_SAMPLE = 2e-3
+"""What the bound's solve costs per sample, s (measured: 1,200 samples 2.3 s, 19,200 samples 37 s on the 2-core
+development machine): the order of magnitude of the estimates printed before long work."""
+
 
 class BoundParams(StrictModel):
     """The bound's cost weights and its solver's tolerances."""

@@ -23,6 +23,9 @@ NACC = 12
 
 FLAT_RTOL = 1e-9
 """A signal whose standard deviation is at most this fraction of its peak |value| is flat."""
+MIN_PC_SAMPLES = 3
+"""Fewer samples leave PC undefined (nan): two points always correlate by +1 or -1 (a 2-sample input wrote an NPC
+of ``inf`` into metrics.csv)."""
 
 
 @njit(cache=True, inline="always")
@@ -58,10 +61,11 @@ def _flat(m2, n, peak):
 
 @njit(cache=True)
 def finish(acc, dt):
-    """(Pearson PC in [-1, 1] or nan if a signal is flat, trapezoid integral of |x - y| over dt, max |x - y|)."""
+    """(Pearson PC in [-1, 1], or nan if a signal is flat or there are fewer than 3 samples; trapezoid integral of
+    |x - y| over dt; max |x - y|)."""
     n = acc[A_N]
     integral = dt * (acc[A_SUM] - 0.5 * (acc[A_FIRST] + acc[A_LAST]))
-    if _flat(acc[A_M2X], n, acc[A_PX]) or _flat(acc[A_M2Y], n, acc[A_PY]):
+    if n < MIN_PC_SAMPLES or _flat(acc[A_M2X], n, acc[A_PX]) or _flat(acc[A_M2Y], n, acc[A_PY]):
         pc = math.nan
     else:
         pc = acc[A_CXY] / (math.sqrt(acc[A_M2X]) * math.sqrt(acc[A_M2Y]))

@@ -9,7 +9,8 @@ simulator pilot's perceived signal ``y`` sampled on the same uniform grid:
   - PC = -1 (perfectly anti-correlated, to within 1e-12): NPC is reported as ``inf`` (the limit of
     Eq. 21; written as ``inf`` in CSV, read back as ``float('inf')``).
   - a flat signal (standard deviation at most 1e-9 of its own peak magnitude, or exactly zero)
-    leaves PC undefined: NPC is ``nan`` (an empty field in CSV), never a made-up number.
+    leaves PC undefined: NPC is ``nan`` (an empty field in CSV), never a made-up number; so do fewer than 3
+    samples (two points always correlate by exactly +1 or -1: a 2-sample input gave NPC = ``inf``).
 
 * ``integral_error``: Eq. 22, ``integral |x - y| dt`` by the trapezoid rule on the uniform grid,
   from the first to the last sample.

@@ -9,7 +9,7 @@ every algorithm, built in or a user's, sits on the same bench::
 Per sample the algorithm receives
 
 - ``f_mps2``: specific force at the aircraft pilot's head, aircraft body axes (x forward, y right, z down), m/s^2;
-  [0, 0, -g] at rest (f = a - g). float64 array of shape (3,), read-only: do not keep a reference to it.
+  [0, 0, -g] at rest (f = a - g). float64 array of shape (3,), a read-only copy: do not keep a reference to it.
 - ``omega_radps``: aircraft body angular velocity, body axes, rad/s, float64 (3,), read-only.
 
 and returns a :data:`SetPoint` ``(pos_m, q)``:

@@ -384,10 +384,12 @@ class CueingBank:
         self._py = [(i, src) for i, src in self._py if i not in self._whole]
 
     def _whole_setpoints(self, future: tuple[np.ndarray, np.ndarray] | None) -> dict[int, tuple[np.ndarray, ...]]:
-        """index -> (start pos, start q, pos (N, 3), q (N, 4), flags (N, 2)) of every whole-only washout."""
+        """index -> (start pos, start q, pos (N, 3), q (N, 4), flags (N, 2)) of every whole-only washout, and, given
+        the whole recording (``future``), of every Python washout with a whole-trace form (``trace()``: used for
+        recorded files, as the interface promises, in :func:`cue_trace` and here alike)."""
         out: dict[int, tuple[np.ndarray, ...]] = {}
         for i, src in self._py:
-            if not src.whole_only:
+            if not (src.whole_only or (future is not None and src.has_trace)):
                 continue
             if future is None:
                 raise WashbenchError(f"washout {src.name}: needs the whole recording before its first step (a "
@@ -503,9 +505,9 @@ class CueingBank:
         solves, fallbacks, brakes and solver iterations; numbers only); washouts without ``report()`` are absent."""
         out: dict[str, dict[str, float | int]] = {}
         for _, src in self._sources:
-            fn = getattr(src.algo, "report", None)
-            if callable(fn):
-                out[src.name] = {str(k): _number(v) for k, v in dict(fn()).items()}
+            reported = src.report()
+            if reported is not None:
+                out[src.name] = reported
         return out
 
     def saturation_counts(self) -> dict[str, dict[str, int]]:
@@ -568,12 +570,6 @@ def python_sources(
 ) -> list[tuple[int, SetPointSource]]:
     """(index, source) of every washout of ``specs`` that is a Python algorithm (not compiled)."""
     return [(i, SetPointSource(w, limits, dt, filter_start)) for i, w in enumerate(specs) if w.kind not in _KINDS]
-
-
-def _number(v: object) -> float | int:
-    """A reported statistic as a JSON number: a whole number as int (a count), else float."""
-    x = float(v)  # type: ignore[arg-type]
-    return int(x) if x.is_integer() and abs(x) < 2**53 else x
 
 
 def _set_start(state: np.ndarray, pos: np.ndarray, q: np.ndarray) -> None:

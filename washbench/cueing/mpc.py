@@ -25,6 +25,8 @@ depend on the aircraft input) or, without one, by braking (counted: :meth:`MpcWa
 from __future__ import annotations
 
 import math
+import sys
+import time
 from dataclasses import dataclass, replace
 from typing import Annotated, Any, Literal
 
@@ -39,6 +41,13 @@ from washbench.io.yamlio import StrictModel
 from washbench.numerics.rotations import quat_from_euler
 from washbench.perception.vestibular import CanalParams, OtolithParams
 from washbench.platform.kinematics import brake_speed
+
+MAX_WORK = 10_000_000
+"""horizon_steps x solver.max_iter at most this (the defaults: 8,000; a 500-step horizon with 20,000 iterations)."""
+ESTIMATE_AFTER_STEPS = 20
+"""The MPC times its first this-many steps and says how long a minute of flight will take when it is slow."""
+SLOW_FACTOR = 10.0
+"""... when it runs more than this many times slower than real time."""
 
 Weight = Annotated[float, Field(ge=0.0, le=1e9, allow_inf_nan=False)]
 PositiveWeight = Annotated[float, Field(gt=0.0, le=1e9, allow_inf_nan=False)]
@@ -70,9 +79,11 @@ class MpcWeights(StrictModel):
 class OsqpSettings(StrictModel):
     """OSQP's settings for the per-step QP (see OSQP's documentation)."""
 
-    max_iter: Annotated[int, Field(ge=1, le=1_000_000)] = 400
-    eps_abs: Annotated[float, Field(gt=0.0, le=1.0)] = 1e-4
-    eps_rel: Annotated[float, Field(gt=0.0, le=1.0)] = 1e-4
+    max_iter: Annotated[int, Field(ge=1, le=100_000)] = 400
+    """at most 100,000 (and horizon_steps x max_iter at most :data:`MAX_WORK`)"""
+    eps_abs: Annotated[float, Field(ge=1e-9, le=1.0)] = 1e-4
+    """1e-9..1: tighter than float64's residuals reach, OSQP iterates to max_iter at every step"""
+    eps_rel: Annotated[float, Field(ge=1e-9, le=1.0)] = 1e-4
     polishing: bool = False
     adaptive_rho: bool = True
     time_limit_s: Annotated[float, Field(ge=0.0, le=10.0)] = 0.0
@@ -111,6 +122,16 @@ class MpcParams(StrictModel):
     solver: OsqpSettings = OsqpSettings()
     fallback: Literal["brake"] = "brake"
     """what a failed solve does (brake: decelerate translation and rotation at the limits)"""
+
+    @model_validator(mode="after")
+    def _bounded_work(self) -> MpcParams:
+        """The worst case of one step's solve, horizon_steps x max_iter, within :data:`MAX_WORK`."""
+        work = self.horizon_steps * self.solver.max_iter
+        if work > MAX_WORK:
+            raise ValueError(f"horizon_steps {self.horizon_steps} x solver.max_iter {self.solver.max_iter} = {work:,}: "
+                             f"more than {MAX_WORK:,} (the QP's size times its iterations, per sample: hours per "
+                             "minute of flight); lower one of them")  # fmt: skip
+        return self
 
     @model_validator(mode="before")
     @classmethod
@@ -288,6 +309,8 @@ class MpcWashout:
         self.iterations: list[int] = []
         self._sat_tilt = False
         self._sat_rot = False
+        self._timed_steps = 0
+        self._timed_s = 0.0
 
     # ---- the QP: z = [u_0, x_1, u_1, x_2, ..., u_{N-1}, x_N]
     def _iu(self, k: int) -> int:
@@ -488,6 +511,28 @@ class MpcWashout:
 
     def step(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> SetPoint:
         """Solve the QP for this sample, apply its first move for one sample, return the set point."""
+        if self._timed_steps < ESTIMATE_AFTER_STEPS:
+            t0 = time.perf_counter()
+            out = self._step(f_mps2, omega_radps)
+            self._timed_s += time.perf_counter() - t0
+            self._timed_steps += 1
+            if self._timed_steps == ESTIMATE_AFTER_STEPS:
+                self._estimate()
+            return out
+        return self._step(f_mps2, omega_radps)
+
+    def _estimate(self) -> None:
+        """Say on stderr how long a minute of flight takes, when the MPC runs far slower than real time (timed on its
+        first steps; only a message: the set points never depend on time)."""
+        per_step = self._timed_s / self._timed_steps
+        if per_step <= SLOW_FACTOR * self.dt:
+            return
+        minute = per_step * 60.0 / self.dt
+        print(f"washbench: note: washout mpc: {per_step:.3g} s per sample (timed on its first {self._timed_steps}): "
+              f"a minute of flight takes about {_duration(minute)}; fewer mpc.horizon_steps or mpc.solver.max_iter "
+              "make it faster", file=sys.stderr, flush=True)  # fmt: skip
+
+    def _step(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> SetPoint:
         r = stacked_inputs(f_mps2, omega_radps, self.g)
         if not np.all(np.isfinite(r)):
             raise ValueError("mpc: non-finite input")
@@ -522,6 +567,15 @@ class MpcWashout:
             "iterations_median": float(np.median(it)),
             "iterations_max": float(np.max(it)),
         }
+
+
+def _duration(seconds: float) -> str:
+    """``45 s``, ``12 min``, ``3.4 h``."""
+    if seconds < 120:
+        return f"{seconds:.0f} s"
+    if seconds < 7200:
+        return f"{seconds / 60:.0f} min"
+    return f"{seconds / 3600:.1f} h"
 
 
 __all__ = ["MpcParams", "MpcWashout", "MpcWeights", "OsqpSettings", "StackedModel", "stacked_model"]

@@ -30,8 +30,10 @@ from typing import Any
 
 from pydantic import BaseModel
 
+from washbench.cueing.guard import plugin_call, plugin_error
 from washbench.cueing.params import WASHOUT_KINDS
-from washbench.errors import WashbenchError, located
+from washbench.errors import Terminated, WashbenchError, located
+from washbench.io import interrupts
 from washbench.io.names import identifier_problem
 from washbench.io.yamlio import line_of
 
@@ -70,8 +72,13 @@ class Algorithm:
             return None
         import pydantic
 
-        try:
-            return self.params_model.model_validate(section or {})
+        model = self.params_model
+        try:  # the model is the plugin's code (its validators): guarded
+            return plugin_call(
+                f"{where}: {self.kind} parameters",
+                lambda: model.model_validate(section or {}),
+                passing=(pydantic.ValidationError,),
+            )
         except pydantic.ValidationError as exc:
             err = exc.errors(include_url=False)[0]
             loc = tuple(err["loc"])
@@ -121,6 +128,7 @@ def load_plugin(spec: str) -> Algorithm:
             return _LOADED[kind]
     # the same name in every process (str hashes are salted per process): a worker loads the module the parent did
     module_name = f"washbench_plugin_{hashlib.sha256(str(path.resolve()).encode()).hexdigest()[:16]}"
+    seen = interrupts.received()
     try:
         mod_spec = importlib.util.spec_from_file_location(module_name, path)
         if mod_spec is None or mod_spec.loader is None:
@@ -130,7 +138,10 @@ def load_plugin(spec: str) -> Algorithm:
         mod_spec.loader.exec_module(module)
     except WashbenchError:
         raise
-    except Exception as exc:  # a user's file: whatever it raises becomes one line
+    except BaseException as exc:  # a user's file: whatever it raises (sys.exit() too) becomes one line
+        if isinstance(exc, KeyboardInterrupt | Terminated) and interrupts.received() != seen:
+            raise  # a real Ctrl-C or SIGTERM while it loaded
+        sys.modules.pop(module_name, None)
         line = ""
         tb = exc.__traceback__
         while tb is not None:
@@ -139,11 +150,17 @@ def load_plugin(spec: str) -> Algorithm:
             tb = tb.tb_next
         if isinstance(exc, SyntaxError) and exc.lineno:
             line = f":{exc.lineno}"
-        raise WashbenchError(f"{where}: {path}{line}: {type(exc).__name__}: {exc}") from None
-    if not hasattr(module, name):
-        raise WashbenchError(f"{where}: {path} has no {name!r}")
-    obj = getattr(module, name)
-    kind = str(getattr(obj, "washout_name", name))
+        if isinstance(exc, Exception):
+            raise WashbenchError(f"{where}: {path}{line}: {type(exc).__name__}: {exc}") from None
+        raise plugin_error(f"{where}: {path}{line}", exc) from None  # sys.exit(), a KeyboardInterrupt without a signal
+
+    def named() -> tuple[Any, str]:
+        if not hasattr(module, name):
+            raise WashbenchError(f"{where}: {path} has no {name!r}")
+        obj = getattr(module, name)
+        return obj, str(getattr(obj, "washout_name", name))
+
+    obj, kind = plugin_call(where, named)
     algo = _algorithm(obj, kind, text)
     previous = _PLUGIN_SPECS.get(kind)
     if previous is not None and previous != text:
@@ -221,10 +238,7 @@ def get(kind: str, spec: str | None = None) -> Algorithm:
     eps = _entry_points()
     if kind in eps:
         source = f"entry point {eps[kind].value}"
-        try:
-            obj = eps[kind].load()
-        except Exception as exc:
-            raise WashbenchError(f"washout plugin {source}: {type(exc).__name__}: {exc}") from None
+        obj = plugin_call(f"washout plugin {source}", eps[kind].load)
         algo = _algorithm(obj, kind, source)
         _LOADED[kind] = algo
         return algo

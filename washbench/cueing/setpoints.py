@@ -16,6 +16,7 @@ import numpy as np
 
 from washbench.cueing import registry
 from washbench.cueing.algorithm import WashoutContext
+from washbench.cueing.guard import plugin_call
 from washbench.errors import WashbenchError
 
 
@@ -38,16 +39,18 @@ class SetPointSource:
         )
         self.dt_s = dt_s
         self.k = -1  # the step being computed (-1: start)
-        try:
-            self.algo = algo.factory(section, self.context)
-        except Exception as exc:
-            raise WashbenchError(self._where("making it") + f": {type(exc).__name__}: {exc}") from None
-        for method in ("start", "step"):
-            if not callable(getattr(self.algo, method, None)):
-                raise WashbenchError(self._where("making it") + f": the algorithm has no {method}() method")
-        self.has_flags = callable(getattr(self.algo, "flags", None))
-        self.has_trace = callable(getattr(self.algo, "trace", None))
-        self.whole_only = bool(getattr(algo.factory, "whole_only", False)) and self.has_trace
+        where = self._where("making it")
+        self.algo = plugin_call(where, lambda: algo.factory(section, self.context))
+
+        def methods() -> tuple[bool, bool, bool]:  # attribute look-ups run the plugin's code too (__getattr__)
+            missing = [m for m in ("start", "step") if not callable(getattr(self.algo, m, None))]
+            if missing:
+                raise WashbenchError(f"{where}: the algorithm has no {missing[0]}() method")
+            whole = bool(getattr(algo.factory, "whole_only", False))
+            return callable(getattr(self.algo, "flags", None)), callable(getattr(self.algo, "trace", None)), whole
+
+        self.has_flags, self.has_trace, whole = plugin_call(where, methods)
+        self.whole_only = whole and self.has_trace
 
     def _where(self, what: str | None = None) -> str:
         label = self.name if self.source == "built-in" else f"{self.name} ({self.source})"
@@ -55,13 +58,20 @@ class SetPointSource:
             what = "start" if self.k < 0 else f"step {self.k} (t = {self.k * self.dt_s:.6g} s)"
         return f"washout {label}: {what}"
 
-    def _call(self, fn: Any, *args: Any) -> Any:
-        try:
-            return fn(*args)
-        except WashbenchError:
-            raise
-        except Exception as exc:
-            raise WashbenchError(f"{self._where()}: raised {type(exc).__name__}: {exc}") from None
+    def report(self) -> dict[str, float | int] | None:
+        """What the algorithm reports of itself (its ``report()``: name -> number), None without one; called and
+        converted inside the guard."""
+
+        def converted() -> dict[str, float | int] | None:
+            fn = getattr(self.algo, "report", None)
+            if not callable(fn):
+                return None
+            try:
+                return {str(k): _number(v) for k, v in dict(fn()).items()}
+            except (TypeError, ValueError, OverflowError) as exc:
+                raise WashbenchError(f"{self._where('report()')}: not a mapping of names to numbers: {exc}") from None
+
+        return plugin_call(self._where("report()"), converted)
 
     def _check(self, out: Any) -> tuple[np.ndarray, np.ndarray]:
         if not isinstance(out, tuple | list) or len(out) != 2:
@@ -86,12 +96,17 @@ class SetPointSource:
     def _flags(self) -> tuple[int, int]:
         if not self.has_flags:
             return 0, 0
-        out = self._call(self.algo.flags)
-        try:
-            a, b = out
-        except (TypeError, ValueError):
-            raise WashbenchError(f"{self._where()}: flags() returned {out!r}, expected (tilt, rotational)") from None
-        return int(bool(a)), int(bool(b))
+
+        def flags() -> tuple[int, int]:  # called and converted inside the guard (an array, a raising __bool__)
+            out = self.algo.flags()
+            try:
+                a, b = out
+                return int(bool(a)), int(bool(b))
+            except (TypeError, ValueError) as exc:
+                raise WashbenchError(f"{self._where()}: flags() returned {_shown(out)}, expected two booleans "
+                                     f"(tilt, rotational): {type(exc).__name__}: {exc}") from None  # fmt: skip
+
+        return plugin_call(f"{self._where()}: flags()", flags)
 
     def start(self, f0: np.ndarray, om0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The start set point, from the first sample (or rest, with ``filter_start="rest"``)."""
@@ -99,17 +114,15 @@ class SetPointSource:
         if self.context.filter_start == "rest":
             f0 = np.array([0.0, 0.0, -self.context.gravity_mps2])
             om0 = np.zeros(3)
-        return self._check(self._call(self.algo.start, _ro(f0), _ro(om0)))
+        return plugin_call(self._where(), lambda: self._check(self.algo.start(_ro(f0), _ro(om0))))
 
     def step(self, f: np.ndarray, om: np.ndarray) -> tuple[np.ndarray, np.ndarray, int, int]:
         """The next set point and the algorithm's two limit flags."""
         self.k += 1
-        pos, q = self._check(self._call(self.algo.step, _ro(f), _ro(om)))
+        pos, q = plugin_call(self._where(), lambda: self._check(self.algo.step(_ro(f), _ro(om))))
         return pos, q, *self._flags()
 
-    def run(
-        self, f: np.ndarray, om: np.ndarray, whole: bool = False
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def run(self, f: np.ndarray, om: np.ndarray, whole: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Set points for samples f, om (M, 3) in order: pos (M, 3), q (M, 4), flags (M, 2) int64. ``whole``: these
         are all the samples there will be (the algorithm's ``trace`` form may then be used)."""
         m = f.shape[0]
@@ -124,17 +137,21 @@ class SetPointSource:
 
     def _trace(self, f: np.ndarray, om: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         self.k = 0
-        out = self._call(self.algo.trace, _ro(f), _ro(om))
         m = f.shape[0]
-        try:
-            pos = np.asarray(out[0], dtype=np.float64)
-            q = np.asarray(out[1], dtype=np.float64)
-        except (TypeError, ValueError, IndexError) as exc:
-            raise WashbenchError(f"{self._where('trace')}: returned {type(out).__name__}: {exc}") from None
+        where = self._where("trace")
+
+        def converted() -> tuple[np.ndarray, np.ndarray]:  # called and converted inside the guard
+            out = self.algo.trace(_ro(f), _ro(om))
+            if not isinstance(out, tuple | list) or len(out) != 2:
+                raise WashbenchError(f"{where}: returned {type(out).__name__}, expected a tuple (pos_m, q)")
+            try:
+                return np.array(out[0], dtype=np.float64), np.array(out[1], dtype=np.float64)
+            except (TypeError, ValueError) as exc:
+                raise WashbenchError(f"{where}: set points are not numbers: {exc}") from None
+
+        pos, q = plugin_call(where, converted)
         if pos.shape != (m, 3) or q.shape != (m, 4):
-            raise WashbenchError(
-                f"{self._where('trace')}: set point shapes {pos.shape} and {q.shape}, expected ({m}, 3) and ({m}, 4)"
-            )
+            raise WashbenchError(f"{where}: set point shapes {pos.shape} and {q.shape}, expected ({m}, 3) and ({m}, 4)")
         bad = ~(np.isfinite(pos).all(axis=1) & np.isfinite(q).all(axis=1))
         norms = np.sqrt((q * q).sum(axis=1))
         bad |= ~(norms >= 1e-6)
@@ -146,10 +163,26 @@ class SetPointSource:
 
 
 def _ro(a: np.ndarray) -> np.ndarray:
-    """A read-only float64 copy-free view for the algorithm."""
-    v = np.asarray(a, dtype=np.float64).view()
+    """A read-only float64 copy for the algorithm: a view could be made writeable again (its base is the bench's
+    array) and written into, changing what the other washouts and the metrics see; a copy cannot."""
+    v = np.array(a, dtype=np.float64, order="C")
     v.flags.writeable = False
     return v
+
+
+def _number(v: object) -> float | int:
+    """A reported statistic as a JSON number: a whole number as int (a count), else float."""
+    x = float(v)  # type: ignore[arg-type]
+    return int(x) if x.is_integer() and abs(x) < 2**53 else x
+
+
+def _shown(value: Any) -> str:
+    """``repr(value)`` shortened to 60 characters (``...`` if its ``__repr__`` raises)."""
+    try:
+        text = repr(value)
+    except Exception:
+        return "..."
+    return text if len(text) <= 60 else text[:57] + "..."
 
 
 __all__ = ["SetPointSource"]

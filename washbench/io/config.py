@@ -16,6 +16,13 @@ A flag given on the command line wins over the file (``--aircraft-dir`` given at
 Each key applies to the commands that have that option. The file used is recorded in every result's provenance
 (``config``: its path and SHA-256). A bad key or value is one line naming the file, the line and the key, exit
 status 2, before anything runs.
+
+Read safely (round three of the hardening, ``docs/hardening.md``): at most :data:`MAX_CONFIG_BYTES`; a UTF-8 byte
+order mark is accepted; tables or arrays nested too deeply for the TOML reader, a NUL or another control character
+in a path, an unreadable folder on the way up: one line naming the file. The file used is named on stderr
+(``washbench: note: configuration from FILE``). As git's ``safe.directory``: a file found upwards that another
+user owns (the file or its folder; root excepted) is not used, and a warning names it; trust it with
+``WASHBENCH_SAFE_CONFIG=FILE`` (a list separated by ``os.pathsep``, or ``*`` for any).
 """
 
 from __future__ import annotations
@@ -29,7 +36,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from washbench.errors import WashbenchError
+from washbench.errors import WashbenchError, printable
 
 #: File names, in the order they are tried in each folder.
 CONFIG_NAME = "washbench.toml"
@@ -40,6 +47,10 @@ KEYS = ("params", "platform", "aircraft-dir", "out", "jobs")
 OUT_COMMANDS = frozenset({"run", "suite", "cue", "fly", "omct", "sweep", "tune"})
 #: Environment variable through which the command tells its worker processes which file it used (provenance).
 CONFIG_USED_ENV = "WASHBENCH_CONFIG_USED"
+#: Environment variable naming configuration files owned by another user that may be used anyway (``*``: any).
+SAFE_CONFIG_ENV = "WASHBENCH_SAFE_CONFIG"
+#: Bytes of a configuration file read at most (the YAML files' bound, :data:`washbench.io.budget.MAX_YAML_BYTES`).
+MAX_CONFIG_BYTES = 10 * 1024 * 1024
 
 
 @dataclass(frozen=True)
@@ -57,30 +68,94 @@ class ProjectConfig:
 def find_config(start: Path) -> tuple[Path, str] | None:
     """The configuration file that applies in folder ``start``: ``(path, table)``, table ``""`` or ``"tool.washbench"``.
 
-    None when no folder from ``start`` up to the filesystem root holds one.
+    None when no folder from ``start`` up to the filesystem root holds one. WashbenchError (one line) when a folder
+    on the way cannot be searched.
     """
     for folder in (start, *start.parents):
         candidate = folder / CONFIG_NAME
-        if candidate.is_file():
+        if _is_file(candidate):
             return candidate, ""
         candidate = folder / PYPROJECT_NAME
-        if candidate.is_file() and _has_tool_table(candidate):
+        if _is_file(candidate) and _has_tool_table(candidate):
             return candidate, "tool.washbench"
     return None
 
 
-def _has_tool_table(path: Path) -> bool:
-    """Whether a pyproject.toml has a ``[tool.washbench]`` table (an unreadable one is reported when loaded)."""
+def _is_file(path: Path) -> bool:
     try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
-        return "[tool.washbench]" in _text_or_empty(path)
+        return path.is_file()
+    except OSError as exc:  # a folder on the way that may not be searched
+        raise WashbenchError(f"{path}: cannot look for a configuration file: {exc.strerror or exc}") from None
+
+
+def foreign_owner(path: Path) -> int | None:
+    """The uid of the other user who owns ``path`` or its folder (not this process's user, not root), else None."""
+    me = os.geteuid() if hasattr(os, "geteuid") else None
+    if me is None:  # no owners to compare (Windows)
+        return None
+    for p in (path, path.parent):
+        try:
+            uid = p.stat().st_uid
+        except OSError:
+            continue
+        if uid not in (me, 0):
+            return uid
+    return None
+
+
+def trusted(path: Path) -> bool:
+    """Whether ``path`` is listed in ``WASHBENCH_SAFE_CONFIG`` (or that holds ``*``)."""
+    listed = [p for p in os.environ.get(SAFE_CONFIG_ENV, "").split(os.pathsep) if p]
+    return "*" in listed or any(os.path.abspath(p) == os.path.abspath(path) for p in listed)
+
+
+def read_config_text(path: Path) -> str:
+    """The text of a configuration file: at most :data:`MAX_CONFIG_BYTES`, UTF-8 (a byte order mark dropped);
+    WashbenchError naming the file otherwise."""
+    try:
+        with open(path, "rb") as fh:
+            data = fh.read(MAX_CONFIG_BYTES + 1)
+    except OSError as exc:
+        raise WashbenchError(f"{path}: cannot read the configuration file: {exc.strerror or exc}") from None
+    if len(data) > MAX_CONFIG_BYTES:
+        raise WashbenchError(f"{path}: larger than {MAX_CONFIG_BYTES // (1024 * 1024)} MB: not a configuration file")
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise WashbenchError(f"{path}: cannot read the configuration file: not UTF-8 text ({exc.reason} at byte "
+                             f"{exc.start})") from None  # fmt: skip
+
+
+def parse_toml(text: str, path: Path) -> Any:
+    """``tomllib.loads(text)``; WashbenchError ``FILE:LINE: not valid TOML`` or ``nested too deeply``."""
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        line = re.search(r"line (\d+)", str(exc))
+        raise WashbenchError(f"{path}:{line.group(1) if line else 1}: not valid TOML: {exc}") from None
+    except RecursionError:
+        raise WashbenchError(f"{path}: not valid TOML for washbench: arrays or tables nested too deeply") from None
+
+
+def _has_tool_table(path: Path) -> bool:
+    """Whether a pyproject.toml has a ``[tool.washbench]`` table (an unreadable one, or one another tool's tables
+    make unreadable, is reported when loaded if it seems to hold the table)."""
+    try:
+        text = read_config_text(path)
+    except WashbenchError:
+        return "[tool.washbench]" in _head(path)
+    try:
+        data = parse_toml(text, path)
+    except WashbenchError:
+        return "[tool.washbench]" in text
     return isinstance(data.get("tool"), dict) and "washbench" in data["tool"]
 
 
-def _text_or_empty(path: Path) -> str:
+def _head(path: Path) -> str:
+    """The first :data:`MAX_CONFIG_BYTES` of ``path`` as text (errors replaced), ``""`` if it cannot be read."""
     try:
-        return path.read_text(encoding="utf-8", errors="replace")
+        with open(path, "rb") as fh:
+            return fh.read(MAX_CONFIG_BYTES).decode("utf-8", errors="replace")
     except OSError:
         return ""
 
@@ -110,15 +185,8 @@ def load_config(path: Path, table: str = "") -> ProjectConfig:
 
     Raises WashbenchError ``file:line: key: problem`` for bad TOML, an unknown key or a bad value.
     """
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise WashbenchError(f"{path}: cannot read the configuration file: {exc}") from None
-    try:
-        data: Any = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        line = re.search(r"line (\d+)", str(exc))
-        raise WashbenchError(f"{path}:{line.group(1) if line else 1}: not valid TOML: {exc}") from None
+    text = read_config_text(path)
+    data: Any = parse_toml(text, path)
     prefix = f"{table}." if table else ""
     for part in table.split(".") if table else ():
         data = data.get(part, {})
@@ -131,7 +199,9 @@ def load_config(path: Path, table: str = "") -> ProjectConfig:
 
     def a_path(key: str, value: Any, want_file: bool) -> Path:
         if not isinstance(value, str) or not value.strip():
-            raise fail(key, f"expected a path (a string), got {value!r}")
+            raise fail(key, f"expected a path (a string), got {printable(repr(value))[:80]}")
+        if any(ord(c) < 0x20 or ord(c) == 0x7F for c in value):
+            raise fail(key, f"a path with a control character (NUL, newline, escape): {printable(value)!r}")
         resolved = Path(os.path.abspath(base / os.path.expanduser(value)))
         if want_file and not resolved.is_file():
             raise fail(key, f"no such file {resolved}")
@@ -163,10 +233,22 @@ def load_config(path: Path, table: str = "") -> ProjectConfig:
     return ProjectConfig(path=path, **values)
 
 
-def discover(cwd: Path | None = None) -> ProjectConfig | None:
-    """The configuration that applies in ``cwd`` (default: the current folder), read and checked; None if none."""
+def discover(cwd: Path | None = None, notes: list[str] | None = None) -> ProjectConfig | None:
+    """The configuration that applies in ``cwd`` (default: the current folder), read and checked; None if none.
+
+    A file another user owns is not used (unless trusted, :func:`trusted`): None, and a warning appended to
+    ``notes``. WashbenchError (one line naming the file) for anything wrong with the file that applies.
+    """
     found = find_config(Path(os.path.abspath(cwd if cwd is not None else Path.cwd())))
-    return load_config(*found) if found else None
+    if not found:
+        return None
+    uid = foreign_owner(found[0])
+    if uid is not None and not trusted(found[0]):
+        if notes is not None:
+            notes.append(f"{printable(str(found[0]))} belongs to another user (uid {uid}): not used (as git's "
+                         f"safe.directory; to use it: {SAFE_CONFIG_ENV}={printable(str(found[0]))})")  # fmt: skip
+        return None
+    return load_config(*found)
 
 
 def defaults_for(config: ProjectConfig, command: str, dests: Sequence[str]) -> dict[str, Any]:

@@ -35,10 +35,34 @@ R = TypeVar("R")
 #: Signals swallowed in a finalizer and not yet sent again (see :func:`signal_in_finalizer`).
 PENDING: list[int] = []
 
+#: SIGINT and SIGTERM received by this process's handlers so far (:func:`received`).
+_RECEIVED = [0]
+
+
+def received() -> int:
+    """How many SIGINT/SIGTERM this process's handlers (:func:`terminate`, :func:`interrupt`) have received.
+
+    A KeyboardInterrupt or Terminated raised while this count did not change was raised by code (a washout
+    plugin's ``raise KeyboardInterrupt``), not by a signal (:mod:`washbench.cueing.guard`).
+    """
+    return _RECEIVED[0]
+
+
+def note_received() -> None:
+    """Count a SIGINT/SIGTERM received by a handler of a command's own (``washbench live``'s), for :func:`received`."""
+    _RECEIVED[0] += 1
+
 
 def terminate(signum: int, frame: object) -> None:
     """The SIGTERM handler: raise :class:`washbench.errors.Terminated` in the main thread."""
+    _RECEIVED[0] += 1
     raise Terminated()
+
+
+def interrupt(signum: int, frame: object) -> None:
+    """The SIGINT handler: Python's own (raise KeyboardInterrupt), counted (:func:`received`)."""
+    _RECEIVED[0] += 1
+    raise KeyboardInterrupt
 
 
 def signal_in_finalizer(unraisable: object) -> None:
@@ -86,6 +110,7 @@ def signals_held() -> Iterator[None]:
     noted: list[int] = []
 
     def note(signum: int, frame: object) -> None:
+        _RECEIVED[0] += 1
         noted.append(signum)
 
     saved = {sig: signal.signal(sig, note) for sig in (signal.SIGINT, signal.SIGTERM)}

@@ -449,20 +449,24 @@ def _unstaged(message: str, stage: Path, out_dir: Path) -> str:
     return _TMP_PART.sub(r"/\1", message.replace(str(stage), str(out_dir)))
 
 
+def refuse_links(folder: Path, names: Sequence[str]) -> None:
+    """WashbenchError (one line) if any of ``names`` in ``folder`` is a symbolic link: checked before a command
+    rewrites anything (``washbench report`` of a suite checks every result folder and the suite's own first)."""
+    for name in names:
+        entry = folder / name
+        if entry.is_symlink():
+            raise WashbenchError(located(entry, "is a symbolic link: washbench never follows or replaces a link in "
+                                         "a result folder; remove it"))  # fmt: skip
+
+
 def replace_entries(folder: Path, stage: Path, names: Sequence[str]) -> None:
     """Publish ``stage``'s entries into ``folder`` replacing the entries ``names`` (``washbench report``).
 
     Each of ``names`` present in ``folder`` must not be a symbolic link (refused, one line). A manifest in
     ``folder`` is rewritten to list the new entries too.
     """
-    previous = []
-    for name in names:
-        entry = folder / name
-        if entry.is_symlink():
-            raise WashbenchError(located(entry, "is a symbolic link: washbench never follows or replaces a link in "
-                                         "a result folder; remove it"))  # fmt: skip
-        if entry.exists():
-            previous.append(entry)
+    refuse_links(folder, names)
+    previous = [folder / name for name in names if (folder / name).exists()]
     manifest = read_manifest(folder)
     if manifest is not None:
         listed = set(manifest[1]) | {e.name for e in stage.iterdir()}

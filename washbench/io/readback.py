@@ -13,9 +13,18 @@ from __future__ import annotations
 import json
 import math
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, StrictBool, StrictFloat, StrictInt, StrictStr, ValidationError
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    StrictBool,
+    StrictFloat,
+    StrictInt,
+    StrictStr,
+    ValidationError,
+    model_validator,
+)
 
 from washbench.errors import WashbenchError, located
 
@@ -47,7 +56,35 @@ class Turbulence(_Loose):
     seed: StrictInt
 
 
+#: The ranking rules and DOFs a recorded ``ranking`` may name (:data:`washbench.analysis.ranking.RANK_BY`, ``DOFS``;
+#: written out here so that this module imports no analysis code; a test keeps them equal).
+RANK_RULES = ("score", "false-cue", "weighted")
+RANK_DOFS = ("surge", "sway", "heave", "roll", "pitch", "yaw")
+
+
+class Ranking(_Loose):
+    """The ranking rule a result was written with; ``report`` ranks by it again, so it is checked as an input."""
+
+    by: Literal["score", "false-cue", "weighted"] = "score"
+    dof_weights: dict[Literal["surge", "sway", "heave", "roll", "pitch", "yaw"], Number] | None = None
+    tie_relative: Number | None = None
+    tie_absolute: Number | None = None
+
+    @model_validator(mode="after")
+    def _sensible(self) -> Ranking:
+        for name, v in (*(self.dof_weights or {}).items(), ("tie_relative", self.tie_relative),
+                        ("tie_absolute", self.tie_absolute)):  # fmt: skip
+            if v is not None and not (math.isfinite(v) and 0.0 <= v <= 1e6):
+                raise ValueError(f"{name}: expected a finite number from 0 to 1e6, got {v!r}")
+        if self.tie_relative is not None and self.tie_relative > 1.0:
+            raise ValueError(f"tie_relative: expected 0..1, got {self.tie_relative!r}")
+        if self.by == "weighted" and not any(v > 0.0 for v in (self.dof_weights or {}).values()):
+            raise ValueError("rule 'weighted' needs dof_weights with at least one positive weight")
+        return self
+
+
 class Provenance(_Loose):
+    ranking: Ranking | None = None
     manoeuvre: FileRecord | None = None
     aircraft: FileRecord | None = None
     pilot_profile: FileRecord | None = None

@@ -10,13 +10,21 @@ on the source's grid:
   segment, as ``washbench cue`` splits a file where time jumps back;
 - a time step longer than 1.5 steps is a gap of **lost** samples: each missing step is filled by holding the last
   sample (its values, at the missing time on the grid) and flagged (``live_held`` = 1 in the saved input);
-- a jump forward by more than :data:`MAX_JUMP_S` is a malformed time (dropped, counted).
+- a jump forward by more than :data:`MAX_JUMP_S` is a malformed time (dropped, counted);
+- a jump forward that the **arrival clock** does not show (the source's time advanced by more than
+  :data:`JUMP_FACTOR` times the time between the two arrivals plus :data:`JUMP_SLACK_S`: a corrupt or foreign time
+  stamp, a source restarted at a later time) is a **time jump**: a new segment, counted, never a gap to fill. So a
+  gap is filled only with what real time allows: at most ``(JUMP_FACTOR * arrival interval + JUMP_SLACK_S) / dt``
+  held samples (eleven datagrams, ten 2 us apart and one at t = 3000 s, made 1.5e9 of them before).
 
 The source's step ``dt`` is given (``--rate-hz``) or measured: the median step of the first :data:`STARTUP_SAMPLES`
-samples, which are held back until then. Sources whose pilot accelerations lag one frame (JSBSim) are shifted
-back here, per segment, as :func:`washbench.io.readers.shift_jsbsim_lag` does for a JSBSim CSV file.
+samples, which are held back until then; a step outside :data:`DT_RANGE_S` (a stream in the wrong byte order, a
+corrupt clock) is :class:`UnusableStepError`: the session stops and saves what it received. Sources whose pilot
+accelerations lag one frame (JSBSim) are shifted back here, per segment, as
+:func:`washbench.io.readers.shift_jsbsim_lag` does for a JSBSim CSV file.
 
-:class:`LatencyStats`: the time from a datagram's arrival (``recvfrom`` returned) to its platform command's send,
+:class:`LatencyStats`: the time from a datagram's arrival (on Linux the kernel's time stamp of it, so the time it
+waited in the receive queue counts; elsewhere when ``recvfrom`` returned) to its platform command's send,
 kept in a fixed histogram of 1 us bins up to :data:`HIST_MAX_US` (memory does not grow with the session), and the
 jitter of the arrivals against the source's own clock.
 """
@@ -41,6 +49,21 @@ MAX_JUMP_S = 3600.0
 """A time jump forward by more than this is a corrupt time stamp, not a gap."""
 GAP_STEPS = 1.5
 """A step longer than this many steps is a gap: the missing samples are held."""
+JUMP_FACTOR = 4.0
+"""The source's clock may run this many times faster than the arrival clock over a gap (``washbench send
+--speed``, a burst after a stall) before a step forward is a time jump rather than a gap."""
+JUMP_SLACK_S = 0.5
+"""... plus this much (s): datagrams queued by the network or the receiving system arrive together."""
+DT_RANGE_S = (1e-4, 10.0)
+"""The source steps ``live`` accepts, s (10 kHz to 0.1 Hz; ``--rate-hz`` 0.1..10,000)."""
+
+
+class UnusableStepError(Exception):
+    """The source's step, measured from its first samples, is outside :data:`DT_RANGE_S` (``dt_s``: that step)."""
+
+    def __init__(self, dt_s: float | None) -> None:
+        super().__init__(dt_s)
+        self.dt_s = dt_s
 
 
 def reset_threshold_s(dt_s: float | None) -> float:
@@ -56,7 +79,7 @@ class LinkCounts:
     duplicate: int = 0
     reordered: int = 0
     lost: int = 0  # missing steps, filled by holding
-    time_jumps: int = 0  # jumps forward beyond MAX_JUMP_S (dropped)
+    time_jumps: int = 0  # jumps forward beyond MAX_JUMP_S (dropped), or beyond what the arrival clock allows
     restarts: int = 0
     unshifted: int = 0  # last sample of a segment dropped by the lag shift (no next frame)
 
@@ -84,9 +107,11 @@ class Link:
         self._lag_new = False
         self._pending: list[tuple[Sample, bool]] = []
         self._prev: Sample | None = None  # the last sample given out in this segment
+        self._last_arrival: float | None = None  # arrival clock of the last sample taken, s
 
-    def push(self, s: Sample) -> list[Out]:
-        """The samples to cue now that ``s`` arrived (none, or held ones and ``s``)."""
+    def push(self, s: Sample, arrival_s: float | None = None) -> list[Out]:
+        """The samples to cue now that ``s`` arrived (none, or held ones and ``s``); ``arrival_s``: when it arrived
+        (a monotonic clock, s; None: not known, the source's clock alone is trusted)."""
         c = self.counts
         c.received += 1
         t = s[0]
@@ -98,6 +123,12 @@ class Link:
             if t - last > MAX_JUMP_S:
                 c.time_jumps += 1
                 return []
+            real = None if arrival_s is None or self._last_arrival is None else arrival_s - self._last_arrival
+            if real is not None and t - last > JUMP_FACTOR * real + JUMP_SLACK_S:
+                c.time_jumps += 1  # the source's time jumped, real time did not pass: a new segment, not a gap
+                new_segment = True
+                self._recent.clear()
+                self._seen.clear()
         elif last - t > reset_threshold_s(self.dt_s):
             c.restarts += 1
             new_segment = True
@@ -110,6 +141,7 @@ class Link:
             c.reordered += 1
             return []
         self._last_t = t
+        self._last_arrival = arrival_s
         if len(self._recent) == self._recent.maxlen:
             self._seen.discard(self._recent[0])
         self._recent.append(t)
@@ -127,15 +159,23 @@ class Link:
     def flush(self) -> list[Out]:
         """At the end: the samples still held back (all of them, if the step was never measured)."""
         if self.dt_s is None and self._pending:
-            self.dt_s = _median_step(self._pending)
+            measured = _median_step(self._pending)
+            if measured is None:
+                return []  # no step to measure: nothing can be cued (the samples are in ``pending``)
+            self.dt_s = _checked(measured)
         return self._drain()
+
+    @property
+    def pending(self) -> list[Sample]:
+        """The samples held back until the step is known (still there after :class:`UnusableStepError`)."""
+        return [s for s, _ in self._pending]
 
     def _timed(self, s: Sample, new_segment: bool) -> list[Out]:
         if self.dt_s is None:
             self._pending.append((s, new_segment))
             if len(self._pending) < STARTUP_SAMPLES:
                 return []
-            self.dt_s = _median_step(self._pending)
+            self.dt_s = _checked(_median_step(self._pending))
             return self._drain()
         return self._gap_filled(s, new_segment)
 
@@ -161,6 +201,13 @@ class Link:
         out.append(Out(s, False, new_segment))
         self._prev = s
         return out
+
+
+def _checked(dt_s: float | None) -> float | None:
+    """``dt_s`` if it is within :data:`DT_RANGE_S` (or None), else :class:`UnusableStepError`."""
+    if dt_s is not None and not DT_RANGE_S[0] <= dt_s <= DT_RANGE_S[1]:
+        raise UnusableStepError(dt_s)
+    return dt_s
 
 
 def _median_step(pending: list[tuple[Sample, bool]]) -> float | None:

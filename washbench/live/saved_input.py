@@ -9,6 +9,8 @@ from pathlib import Path
 INPUT_FILE = "live_input.csv"
 INPUT_COLUMNS = ("t_s", "f_x_mps2", "f_y_mps2", "f_z_mps2", "omega_x_degps", "omega_y_degps", "omega_z_degps")
 HELD_COLUMN = "live_held"
+PART_SUFFIX = ".part"
+"""The saved input's name while the session runs (``live_input.csv.part``)."""
 FLUSH_S = 0.25
 """The saved input is flushed to the operating system at least this often (a killed session loses no more)."""
 
@@ -20,9 +22,9 @@ class InputWriter:
 
     def __init__(self, path: Path) -> None:
         self.path = path
-        self.part = path.with_name(path.name + ".part")
+        self.part = path.with_name(path.name + PART_SUFFIX)
         self._f = open(self.part, "wb")  # noqa: SIM115 (closed by close())
-        self._f.write((",".join((*INPUT_COLUMNS, HELD_COLUMN)) + "\n").encode("ascii"))
+        self._f.write(header())
         self.rows = 0
         self.segments = 0
         self.short_segments = 0
@@ -57,9 +59,32 @@ class InputWriter:
             self.segments += 1
         self._seg_rows = 0
 
-    def close(self) -> Path:
-        """End the last segment, close and rename into place; return the final path."""
+    def close(self) -> Path | None:
+        """End the last segment, close and rename into place; return the final path. With fewer than 2 rows
+        (nothing ``washbench cue`` could read) the ``.part`` file is removed and an earlier session's file left as
+        it was: None."""
         self._end_segment()
         self._f.close()
+        if self.rows < 2:
+            self.part.unlink(missing_ok=True)
+            return None
         os.replace(self.part, self.path)
         return self.path
+
+
+def header() -> bytes:
+    """The saved input's first line."""
+    return (",".join((*INPUT_COLUMNS, HELD_COLUMN)) + "\n").encode("ascii")
+
+
+def own_leftover(part: Path) -> Path | None:
+    """``part`` if it is what a killed session left (a plain file, no link, starting with the saved input's
+    header), else None (absent, or someone else's: then refused as any foreign entry)."""
+    try:
+        if part.is_symlink() or not part.is_file():
+            return None
+        with open(part, "rb") as fh:
+            first = fh.read(len(header()))
+    except OSError:
+        return None
+    return part if first == header() else None

@@ -121,9 +121,22 @@ def wf_weighted(a_mps2: np.ndarray, dt_s: float) -> np.ndarray:
 
 
 def msdv(a_mps2: np.ndarray, dt_s: float) -> float:
-    """MSDV [m/s^1.5] of a vertical acceleration (N,) sampled every ``dt_s``: sqrt(sum a_w^2 dt) (rectangle rule)."""
+    """MSDV [m/s^1.5] of a vertical acceleration (N,) sampled every ``dt_s``: sqrt(sum a_w^2 dt) (rectangle rule).
+
+    The sum is a plain loop in sample order (:func:`_sum_squares`), not ``np.dot``: BLAS splits a dot product by
+    its thread count (a Dask worker runs BLAS on one thread, this process on as many as there are cores), and the
+    last bit of the MSDV differed between a run on a cluster and a local one."""
     aw = wf_weighted(a_mps2, dt_s)
-    return float(math.sqrt(float(np.dot(aw, aw)) * dt_s))
+    return float(math.sqrt(_sum_squares(aw) * dt_s))
+
+
+@lazy_njit(cache=True)
+def _sum_squares(x: np.ndarray) -> float:
+    """sum x_i^2 in index order (no reassociation: the same bits in every process, whatever its BLAS threads)."""
+    acc = 0.0
+    for i in range(x.shape[0]):
+        acc += x[i] * x[i]
+    return acc
 
 
 def head_msdv(f_z_mps2: np.ndarray, dt_s: float) -> float:

@@ -9,7 +9,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from washbench.errors import WashbenchError, located
+from washbench.errors import WashbenchError, located, printable
 from washbench.io.lock import output_lock
 from washbench.io.outfolder import recover
 from washbench.io.result_files import SUITE_FILE
@@ -36,5 +36,5 @@ def report_command(results_dir: Path, palette: str | None = None) -> int:
             path = write_result_report(folder, pdf=True)
         else:
             path = write_suite_report(folder, regenerate_results=True)
-    print(f"report: {path}")
+    print(f"report: {printable(str(path))}")
     return 0

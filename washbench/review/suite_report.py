@@ -28,7 +28,7 @@ from washbench.analysis.ranking import (
 )
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
-from washbench.io.outfolder import discard_stage, make_stage, replace_entries
+from washbench.io.outfolder import discard_stage, make_stage, refuse_links, replace_entries
 from washbench.io.readback import SuiteDoc, read_doc, suite_member
 from washbench.io.result_files import FIGURES_DIR, METRICS_FILE, RECORDING_FILE, REPORT_FILE, SUITE_FILE
 from washbench.review.bound_section import CEILING_NOTE, read_ceiling
@@ -111,6 +111,13 @@ def write_suite_report(
 
     suite_dir = Path(suite_dir)
     entries, doc = _entries(suite_dir)
+    # a link in the place of what is rewritten is refused before anything is (the runs' reports were rewritten first)
+    refuse_links(suite_dir, [REPORT_FILE, FIGURES_DIR])
+    if regenerate_results:
+        for e in entries:
+            folder = suite_dir / e["result"] if e.get("result") else None
+            if folder is not None and is_result_folder(folder):
+                refuse_links(folder, [REPORT_FILE, FIGURES_DIR])
     stage = make_stage(suite_dir)  # report.md and figures/ replace the previous ones together (links never followed)
     try:
         _write_suite_report(suite_dir, stage, entries, doc, regenerate_results, figures, pool)

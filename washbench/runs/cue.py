@@ -300,5 +300,5 @@ def run_cue(
             print(f"  {name}: saturated samples: {sat}")
         if not summary.ok:
             print(f"  FAILED: {summary.reason}")
-        print(f"wrote {out_dir / summary.run_dir.relative_to(stage)}")
+        print(f"wrote {printable(str(out_dir / summary.run_dir.relative_to(stage)))}")
     return 0 if all(s.ok for s, _ in done) else 1

@@ -23,6 +23,7 @@ import math
 import os
 import signal
 import socket
+import struct
 import sys
 import threading
 import time
@@ -34,7 +35,8 @@ from typing import Any
 import numpy as np
 
 from washbench.cueing import CueingBank
-from washbench.errors import WashbenchError
+from washbench.errors import Terminated, WashbenchError, printable
+from washbench.io import interrupts
 from washbench.io.atomic import write_text_atomic
 from washbench.io.lock import output_lock
 from washbench.io.outfolder import owned_entries
@@ -43,14 +45,53 @@ from washbench.io.result_files import RUN_FILE
 from washbench.live import commands
 from washbench.live import viewer as live_viewer
 from washbench.live.endpoints import Sink, bind_udp
-from washbench.live.link import LatencyStats, Link, Out
+from washbench.live.link import DT_RANGE_S, LatencyStats, Link, Out, UnusableStepError
 from washbench.live.packets import RREF_DATAREFS, RREF_ID0, Decoder, PacketError, decoder, rref_request
-from washbench.live.saved_input import INPUT_FILE, InputWriter
+from washbench.live.saved_input import INPUT_FILE, PART_SUFFIX, InputWriter, own_leftover
 from washbench.runs.cue import CueOptions, run_cue
 from washbench.runs.options import RunOptions, load_options
 
 POLL_S = 0.05
 """The loop wakes up at least this often to check the stop conditions."""
+SO_TIMESTAMPNS = 35
+"""Linux's socket option for a datagram's arrival time stamped by the kernel (``SCM_TIMESTAMPNS``: a timespec)."""
+MAX_SENDER_NOTES = 8
+"""Other senders named on stdout (each once); more are only counted."""
+FLIGHTGEAR_NATIVE = b"\x00\x00\x00\x18"
+"""The first 4 bytes of FlightGear's native FDM packet (FGNetFDM, version 24, network order): what JSBSim's
+``<output type="FLIGHTGEAR">`` sends."""
+
+
+def receiver(sock: socket.socket) -> tuple[Any, Any]:
+    """``(recv, clock)``: ``recv()`` gives ``(data, address, arrival_ns)`` and ``clock()`` the time now on the same
+    clock. On Linux the arrival is the kernel's time stamp of the datagram (``SO_TIMESTAMPNS``, wall clock): the
+    time it waited in the receive queue is in the latency; elsewhere the time ``recvfrom`` returned."""
+    if sys.platform.startswith("linux"):
+        try:
+            sock.setsockopt(socket.SOL_SOCKET, SO_TIMESTAMPNS, 1)
+        except OSError:
+            pass
+        else:
+            space = socket.CMSG_SPACE(16)
+            unpack = struct.Struct("@qq").unpack_from
+            wall = time.time_ns
+
+            def recv_stamped() -> tuple[bytes, Any, int]:
+                data, ancillary, _flags, address = sock.recvmsg(65536, space)
+                for level, kind, cdata in ancillary:
+                    if level == socket.SOL_SOCKET and kind == SO_TIMESTAMPNS and len(cdata) >= 16:
+                        sec, nsec = unpack(cdata)
+                        return data, address, sec * 1_000_000_000 + nsec
+                return data, address, wall()
+
+            return recv_stamped, wall
+    clock = time.perf_counter_ns
+
+    def recv_plain() -> tuple[bytes, Any, int]:
+        data, address = sock.recvfrom(65536)
+        return data, address, clock()
+
+    return recv_plain, clock
 
 
 @dataclass(frozen=True)
@@ -74,9 +115,11 @@ class LiveOptions:
 
 
 @contextlib.contextmanager
-def stop_on_signals() -> Iterator[list[int]]:
+def stop_on_signals(busy: list[bool] | None = None) -> Iterator[list[int]]:
     """While inside, SIGINT and SIGTERM only record themselves (the loop stops at its next turn and the result is
-    written); yields the list they are recorded in. Outside the main thread (tests), nothing is installed."""
+    written); yields the list they are recorded in. While ``busy[0]`` (the washouts are computing: a plugin's
+    ``step`` may never return) the signal is raised at once, as in ``washbench cue`` (KeyboardInterrupt or
+    Terminated). Outside the main thread (tests), nothing is installed."""
     got: list[int] = []
     if threading.current_thread() is not threading.main_thread():
         yield got
@@ -84,6 +127,9 @@ def stop_on_signals() -> Iterator[list[int]]:
 
     def note(signum: int, frame: object) -> None:
         got.append(signum)
+        interrupts.note_received()  # a real signal: the plugin guard lets it through
+        if busy is not None and busy[0]:
+            raise KeyboardInterrupt if signum == signal.SIGINT else Terminated()
 
     old = {s: signal.signal(s, note) for s in (signal.SIGINT, signal.SIGTERM)}
     try:
@@ -115,51 +161,96 @@ class Session:
         self.last_done: float | None = None
         self._f = np.empty(3)
         self._w = np.empty(3)
+        self.busy = [False]  # the washouts are computing (a signal then acts at once: stop_on_signals)
+        self.recv, self.clock = receiver(sock)
+        self.sender: Any = None  # the address the session locked onto (the first that sent a datagram of the format)
+        self.other_senders = 0  # datagrams from any other address (ignored)
+        self._others: set[Any] = set()
+        self.unusable: str | None = None  # why the source's time cannot be cued (the session stops, saves, refuses)
+        self.hints: list[str] = []
 
     # ------------------------------------------------------------------ the hot path
 
     def cue(self, o: Out) -> None:
         """Save, cue and command one sample."""
         s = o.sample
-        if o.new_segment or self.bank is None:
-            self.bank = CueingBank(self.specs, None, self.limits, self.link.dt_s, self.filter_start)
-        f, w = self._f, self._w
-        f[0], f[1], f[2] = s[1], s[2], s[3]
-        w[0], w[1], w[2] = s[4], s[5], s[6]
-        rows = self.rows = self.bank.step(f, np.radians(w))
+        self.busy[0] = True  # a plugin may block in here: a signal acts at once
+        try:
+            if o.new_segment or self.bank is None:
+                self.bank = CueingBank(self.specs, None, self.limits, self.link.dt_s, self.filter_start)
+            f, w = self._f, self._w
+            f[0], f[1], f[2] = s[1], s[2], s[3]
+            w[0], w[1], w[2] = s[4], s[5], s[6]
+            rows = self.rows = self.bank.step(f, np.radians(w))
+        finally:
+            self.busy[0] = False
         flags = (commands.FLAG_HELD if o.held else 0) | (commands.FLAG_NEW_SEGMENT if o.new_segment else 0)
         self.sink.send(s[0], flags, rows)
         self.writer.row(s, o.held, o.new_segment)  # after the command: not on the latency path
         if self.viewer is not None:
             self.viewer.add(s, rows, self.link.dt_s, o.new_segment)
 
-    def receive(self, data: bytes, arrival_ns: int) -> None:
+    def receive(self, data: bytes, arrival_ns: int, address: Any = None) -> None:
+        if self.sender is not None and address != self.sender:
+            self._other_sender(address)
+            return
         try:
             sample = self.dec.decode(data)
         except PacketError as exc:
             if exc.kind == "foreign":
                 self.foreign += 1
+                if data[:4] == FLIGHTGEAR_NATIVE and len(data) >= 100 and not self.hints:
+                    self.hints.append(
+                        "datagrams in FlightGear's native FDM format (JSBSim's <output type=\"FLIGHTGEAR\">) arrive: "
+                        "washbench reads FlightGear's generic protocol (--format flightgear with washbench's protocol "
+                        "file, or JSBSim's type=\"SOCKET\" output with --format jsbsim; docs/live.md)"
+                    )
+                    print(f"live: {self.hints[-1]}", flush=True)
             else:
                 self.malformed += 1
             return
+        if self.sender is None and address is not None:
+            self.sender = address  # locked onto the first sender of this format
         if sample is None:
             return
-        outs = self.link.push(sample)
+        try:
+            # the link's arrival clock is monotonic (the kernel's stamp is wall-clock time, which NTP may step)
+            outs = self.link.push(sample, time.monotonic())
+        except UnusableStepError as exc:
+            self._unusable(exc)
+            return
         for o in outs:
             self.cue(o)
         if outs:
-            done = time.perf_counter_ns()
+            done = self.clock()
             last = outs[-1]
             if not last.held:
                 self.latency.add(done - arrival_ns, self.link.dt_s)
             self.latency.arrival(arrival_ns * 1e-9, last.new_segment)
 
+    def _other_sender(self, address: Any) -> None:
+        """A datagram from another address than the one the session locked onto: counted, ignored; named once."""
+        self.other_senders += 1
+        if address not in self._others and len(self._others) < MAX_SENDER_NOTES:
+            self._others.add(address)
+            print(f"live: datagrams from {_address(address)} ignored: locked onto {_address(self.sender)}, the first "
+                  "sender", flush=True)  # fmt: skip
+
+    def _unusable(self, exc: UnusableStepError) -> None:
+        """The source's step is outside what live accepts: save what was received as it came, and stop."""
+        for i, s in enumerate(self.link.pending):
+            self.writer.row(s, False, i == 0)
+        lo, hi = DT_RANGE_S
+        shown = "none" if exc.dt_s is None else f"{exc.dt_s:.3g} s"
+        self.unusable = (f"the source's time step, measured on its first samples, is {shown}, outside {lo:g}..{hi:g} s "
+                         "(a stream in another byte order or --format, or a corrupt clock?)")  # fmt: skip
+        self.stop = "the source's time cannot be cued"
+
     def run(self, got_signal: list[int]) -> None:
         """Receive until a stop condition; ``stop`` says which."""
         opts, sock = self.opts, self.sock
         sock.settimeout(POLL_S)
-        recv = sock.recvfrom
-        clock = time.perf_counter_ns
+        recv = self.recv
         start = time.monotonic()
         deadline = start + opts.duration_s if opts.duration_s is not None else math.inf
         idle = opts.idle_timeout_s
@@ -177,12 +268,16 @@ class Session:
             if subscribe and self.link.counts.received == 0 and now >= next_subscribe:
                 self.rref(self.opts.rref_hz)  # again every 2 s until X-Plane answers (it may start later)
                 next_subscribe = now + 2.0
+            if self.unusable:
+                return
             self.writer.tick()
             try:
-                data, _ = recv(65536)
-            except TimeoutError:  # nothing waiting: the source may have gone quiet
-                if idle is not None and self.last_arrival is not None and time.monotonic() - self.last_arrival > idle:
-                    self.stop = f"the source was quiet for --idle-timeout {idle:g} s"
+                data, address, arrival = recv()
+            except TimeoutError:  # nothing waiting: the source may have gone quiet (or never sent anything)
+                quiet_since = self.last_arrival if self.last_arrival is not None else start
+                if idle is not None and time.monotonic() - quiet_since > idle:
+                    never = " (nothing arrived)" if self.last_arrival is None else ""
+                    self.stop = f"the source was quiet for --idle-timeout {idle:g} s{never}"
                     return
                 continue
             except InterruptedError:
@@ -190,12 +285,12 @@ class Session:
             except OSError:  # an ICMP error of our own RREF requests, reported on this socket
                 self.socket_errors += 1
                 continue
-            arrival = clock()
-            self.last_arrival = time.monotonic()
-            if self.first_arrival is None:
-                self.first_arrival = self.last_arrival
-                self.cpu0 = time.process_time()
-            self.receive(data, arrival)
+            if self.sender is None or address == self.sender:
+                self.last_arrival = time.monotonic()  # another sender does not keep the session awake
+                if self.first_arrival is None:
+                    self.first_arrival = self.last_arrival
+                    self.cpu0 = time.process_time()
+            self.receive(data, arrival, address)
             self.cpu1, self.last_done = time.process_time(), time.monotonic()
             if self.viewer is not None and self.viewer.closed_now():
                 self.viewer = None
@@ -203,19 +298,24 @@ class Session:
     def drain(self) -> None:
         """Take the datagrams already waiting in the socket (received by the system before the stop)."""
         self.sock.setblocking(False)
-        while True:
+        while not self.unusable:
             try:
-                data, _ = self.sock.recvfrom(65536)
+                data, address, arrival = self.recv()
             except (BlockingIOError, InterruptedError):
                 return
             except OSError:
                 self.socket_errors += 1
                 continue
-            self.receive(data, time.perf_counter_ns())
+            self.receive(data, arrival, address)
 
     def finish(self) -> None:
         """The samples still held back, cued; the RREF subscription cancelled."""
-        for o in self.link.flush():
+        try:
+            outs = [] if self.unusable else self.link.flush()
+        except UnusableStepError as exc:
+            self._unusable(exc)
+            outs = []
+        for o in outs:
             self.cue(o)
         if self.dec.name == "xplane-rref":
             self.rref(0)
@@ -231,6 +331,8 @@ class Session:
         return {
             "format": self.dec.name,
             "listen": f"{self.opts.listen[0]}:{self.opts.listen[1]}",
+            "sender": None if self.sender is None else _address(self.sender),
+            "hints": list(self.hints),
             "stop": self.stop,
             "dt_s": self.link.dt_s,
             "counts": {
@@ -245,6 +347,7 @@ class Session:
                 "time_jumps": c.time_jumps,
                 "lag_unshifted": c.unshifted,
                 "foreign": self.foreign,
+                "other_senders": self.other_senders,
                 "malformed": self.malformed,
                 "socket_errors": self.socket_errors,
                 "commands": self.sink.seq,
@@ -292,10 +395,20 @@ def _print_figures(fig: dict[str, Any]) -> None:
     print(f"  received {c['received']}, cued {c['cued']} in {c['segments']} segment(s); lost (held) {c['lost_held']}, "
           f"duplicate {c['duplicate']}, reordered {c['reordered']}, restarts {c['restarts']}, foreign "
           f"{c['foreign']}, malformed {c['malformed']}")  # fmt: skip
+    print(f"  time jumps {c['time_jumps']}, short segments dropped {c['short_segments_dropped']}, last frame dropped "
+          f"by the lag shift {c['lag_unshifted']}, datagrams from other senders {c['other_senders']}"
+          f"{'' if fig.get('sender') is None else ' (locked onto ' + fig['sender'] + ')'}")  # fmt: skip
     print(f"  commands {c['commands']} (sink sent {c['sink_sent']}, errors {c['sink_errors']}); latency median "
           f"{ms(lat['latency_median_ms'])} ms, p99 {ms(lat['latency_p99_ms'])} ms, max "
           f"{ms(lat['latency_max_ms'])} ms, late {lat['late']}; jitter mean {ms(lat['jitter_mean_ms'])} ms, "
           f"max {ms(lat['jitter_max_ms'])} ms")  # fmt: skip
+
+
+def _address(address: Any) -> str:
+    """``HOST:PORT`` of a socket address (printable)."""
+    if isinstance(address, tuple) and len(address) >= 2:
+        return printable(f"{address[0]}:{address[1]}")
+    return printable(str(address))
 
 
 def _auto_resample(path: Path) -> float | None:
@@ -335,6 +448,9 @@ def run_live(opts: LiveOptions, run: RunOptions | None = None) -> int:
                         ("--rate-hz", opts.rate_hz), ("--resample", opts.resample_hz)):  # fmt: skip
         if value is not None and not (math.isfinite(value) and value > 0.0):
             raise WashbenchError(f"{flag}: expected a positive number, got {value:g}")
+    lo, hi = DT_RANGE_S
+    if opts.rate_hz is not None and not 1.0 / hi <= opts.rate_hz <= 1.0 / lo:
+        raise WashbenchError(f"--rate-hz: expected {1.0 / hi:g}..{1.0 / lo:g} Hz, got {opts.rate_hz:g}")
     if not 0 < opts.rref_hz <= 10000:
         raise WashbenchError(f"--rref-hz: expected 1..10000 Hz, got {opts.rref_hz}")
     if run is None:
@@ -345,9 +461,15 @@ def run_live(opts: LiveOptions, run: RunOptions | None = None) -> int:
     sink = Sink(opts.sink, opts.sink_format, names)
     t_wall = time.perf_counter()
     # a Ctrl-C or SIGTERM from the moment the port is bound only stops the loop: the result is written first
-    with stop_on_signals() as got, contextlib.closing(sink), contextlib.closing(bind_udp(opts.listen)) as sock, \
+    busy = [False]
+    with stop_on_signals(busy) as got, contextlib.closing(sink), contextlib.closing(bind_udp(opts.listen)) as sock, \
             output_lock(opts.out) as out:  # fmt: skip
-        owned_entries(out, "cue", (INPUT_FILE,))  # a folder holding someone else's files is refused before listening
+        # a folder holding someone else's files is refused before listening; a killed session's own .part is taken
+        leftover = own_leftover(out / (INPUT_FILE + PART_SUFFIX))
+        owned_entries(out, "cue", (INPUT_FILE, *([leftover.name] if leftover else [])))
+        if leftover is not None:
+            print(f"live: {leftover}: left by a session that was killed; replaced by this one's")
+        earlier = (out / INPUT_FILE).is_file()
         writer = InputWriter(out / INPUT_FILE)
         viewer = live_viewer.open_viewer(names, limits, filter_start) if opts.viewer else None
         to = f"udp://{opts.sink[0]}:{opts.sink[1]} ({opts.sink_format})" if opts.sink else "nowhere (no --sink)"
@@ -359,16 +481,23 @@ def run_live(opts: LiveOptions, run: RunOptions | None = None) -> int:
             print(f"  {note}")
         sys.stdout.flush()
         session = Session(opts, dec, specs, limits, filter_start, sock, writer, sink, viewer)
+        session.busy = busy
+        cut = False  # a signal stopped the washouts in the middle of a step (a plugin that blocks)
         gc.collect()
         gc.freeze()  # what exists now is never scanned again: shorter collector pauses in the loop
         before = realtime_priority() if opts.realtime else None
         try:
             session.run(got)
+        except (KeyboardInterrupt, Terminated) as exc:  # raised inside a step (stop_on_signals): not cued again
+            cut = True
+            session.stop = ("interrupted (Ctrl-C)" if isinstance(exc, KeyboardInterrupt) else "terminated (SIGTERM)") \
+                + " while the washouts were computing"  # fmt: skip
         finally:
             if before is not None:
                 os.sched_setscheduler(0, *before)  # the final cue runs at the ordinary priority again
             gc.unfreeze()
-            session.finish()
+            if not cut:
+                session.finish()
             saved = writer.close()
             if session.viewer is not None:
                 session.viewer.close()
@@ -376,15 +505,24 @@ def run_live(opts: LiveOptions, run: RunOptions | None = None) -> int:
     fig["wall_s"] = round(time.perf_counter() - t_wall, 3)
     _print_figures(fig)
     status = {signal.SIGINT: 130, signal.SIGTERM: 143}.get(got[0], 0) if got else 0
-    if writer.rows < 2:
-        saved.unlink(missing_ok=True)
+    if session.unusable:
+        kept = f"the {writer.rows} sample(s) received are in {saved}" if saved else "nothing was saved"
+        raise WashbenchError(f"--listen {opts.listen[0]}:{opts.listen[1]}: {session.unusable}; {kept}")
+    if cut:
+        kept = f"the {writer.rows} sample(s) cued so far are in {saved}" if saved else "fewer than 2 samples cued"
+        print(f"washbench: {session.stop}: {kept} (not cued again: a washout may not return; `washbench cue` "
+              "that file)", file=sys.stderr)  # fmt: skip
+        return status or 130
+    if saved is None:  # an earlier session's files in --out are left as they were
         with contextlib.suppress(OSError):
             out.rmdir()
         if status:
             print(f"washbench: {session.stop}: fewer than 2 samples received, nothing to cue", file=sys.stderr)
             return status
-        raise WashbenchError(f"--listen {opts.listen[0]}:{opts.listen[1]}: {writer.rows} sample(s) received "
-                             f"({session.stop}): nothing to cue")  # fmt: skip
+        raise WashbenchError(f"--listen {opts.listen[0]}:{opts.listen[1]}: {session.link.counts.received} sample(s) "
+                             f"received ({session.stop}): nothing to cue")  # fmt: skip
+    if earlier:
+        print(f"live: {out}: the earlier session's results there are replaced by this one's")
     resample = opts.resample_hz or _auto_resample(saved)
     if resample and not opts.resample_hz:
         print(f"  the source's clock is not on a uniform grid: cued with --resample {resample:g} "

@@ -19,15 +19,19 @@ from __future__ import annotations
 import csv
 import io
 import math
+import sys
+import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 from washbench.analysis import omct
+from washbench.analysis.bound import MAX_BOUND_SAMPLES, BoundParams
+from washbench.analysis.bound_replay import replay
 from washbench.analysis.omct_boundaries import BoundaryFile
 from washbench.analysis.signals import SignalSpec, amplitude_unit, canonical_axis, generate
 from washbench.cueing.variants import Washout, select_washouts
-from washbench.errors import WashbenchError
+from washbench.errors import WashbenchError, printable
 from washbench.io.atomic import write_text_atomic
 from washbench.io.budget import check_samples
 from washbench.io.csv_numbers import csv_number
@@ -152,6 +156,7 @@ def measure(
     longest_s = max(omct.timing(w, sigma).duration_s for w in frequencies_radps)
     check_samples(longest_s * rate_hz * len(entries), f"--rate-hz {rate_hz:g}: {len(entries)} washout(s) x "
                   f"the longest OMCT run ({longest_s:.4g} s)")  # fmt: skip
+    _bound_estimate(entries, limits, tests, frequencies_radps, rate_hz, sigma, amplitude_scale)
     model = VestibularModel(dt, vestibular)
     raw: dict[tuple[str, str], list[tuple[float, float, str, complex, float, tuple[str, ...], complex, complex]]] = {}
     shown = Progress("omct", len(tests) * len(frequencies_radps), "test points") if progress else None
@@ -180,6 +185,32 @@ def measure(
         for test in tests:
             points += _points(e.name, test, raw[(e.name, test.name)], model, dt, (boundaries or {}).get(test.name))
     return points, OmctSettings(rate_hz, omct.settle_time_s(sigma), sigma, amplitude_scale)
+
+
+def _bound_estimate(
+    entries: Sequence[Washout], limits: PlatformLimits, tests: Sequence[omct.OmctTest],
+    frequencies_radps: Sequence[float], rate_hz: float, sigma: float, amplitude_scale: float,
+) -> None:  # fmt: skip
+    """With the oracle bound among ``entries``: its size and an estimated time on stderr before the runs (one
+    optimisation over each whole run: minutes; the replay's, as the washout runs it), timed on a 1,200-sample piece of the first run as sweep does."""
+
+    bounds = [e for e in entries if e.kind == "bound"]
+    if not bounds:
+        return
+    lengths = [round(omct.timing(w, sigma).duration_s * rate_hz) + 1 for _ in tests for w in frequencies_radps]
+    if max(lengths) > MAX_BOUND_SAMPLES:
+        raise WashbenchError(f"--rate-hz {rate_hz:g}: the OMCT's longest run has {max(lengths):,} samples, more than "
+                             f"the oracle bound's limit of {MAX_BOUND_SAMPLES:,}")  # fmt: skip
+    w0 = frequencies_radps[0]
+    sig = generate(omct.input_spec(tests[0], w0, rate_hz, omct.timing(w0, sigma).duration_s, amplitude_scale))
+    piece = min(1200, len(sig.t_s))
+    start = time.perf_counter()
+    replay(sig.f_mps2[:piece], sig.omega_radps[:piece], 1.0 / rate_hz, limits, _g(bounds[0]),
+           BoundParams())  # fmt: skip
+    per_sample = (time.perf_counter() - start) / piece
+    total = sum(lengths) * len(bounds)
+    print(f"omct: the oracle bound: {len(lengths) * len(bounds)} runs, {total:,} samples in all: about "
+          f"{per_sample * total / 60:.0f} min (timed on {piece} samples)", file=sys.stderr, flush=True)  # fmt: skip
 
 
 def _g(entry: Washout) -> float:
@@ -321,7 +352,8 @@ def run_entries(
     if boundary is not None:
         n_out = sum(1 for p in points if p.gain_inside is False or p.phase_inside is False)
         print(f"  boundaries {boundary.name}: {n_out} points outside")
-    print(f"wrote {out_dir / CSV_FILE}, {out_dir / REPORT_FILE}" + (f" and {len(files)} Bode plots" if files else ""))
+    wrote = f"{printable(str(out_dir / CSV_FILE))}, {printable(str(out_dir / REPORT_FILE))}"
+    print(f"wrote {wrote}" + (f" and {len(files)} Bode plots" if files else ""))
     return points
 
 
@@ -343,7 +375,7 @@ def signal_command(
     freq = "" if frequency_hz is None or kind == "step" else f" at {frequency_hz:g} Hz"
     named = axis if given == axis else f"{given} ({axis})"
     print(
-        f"wrote {out}: {kind} on {named}, amplitude {amplitude:g} {amplitude_unit(axis)}{freq}, "
+        f"wrote {printable(str(out))}: {kind} on {named}, amplitude {amplitude:g} {amplitude_unit(axis)}{freq}, "
         f"{sig.t_s.shape[0]} samples at {rate_hz:g} Hz"
     )
     return 0

@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 
 from washbench.analysis.ranking import perceived_motion
-from washbench.errors import WashbenchError, located
+from washbench.errors import WashbenchError, located, printable
 from washbench.flight.fly import fly, write_flight
 from washbench.flight.manoeuvre import load_manoeuvre
 from washbench.flight.scripts import (
@@ -271,7 +271,8 @@ def run_command(manoeuvre_path: Path, out_root: Path, options: RunOptions, *, pr
         checks = f"; checks {s.checks_passed}/{s.checks_total}" if s.checks_total else ""
         print(
             f"{s.aircraft}/{s.manoeuvre}: {state}{checks}; {s.steps * s.dt_s:.1f} s flown in {wall:.1f} s; "
-            f"results in {s.run_dir}" + (f"; report: {s.run_dir / REPORT_FILE}" if s.run_dir and s.steps else "")
+            f"results in {printable(str(s.run_dir))}"
+            + (f"; report: {printable(str(s.run_dir / REPORT_FILE))}" if s.run_dir and s.steps else "")
         )
         for w, kinds in s.saturations.items():
             sat = ", ".join(

@@ -43,6 +43,8 @@ SPIN_S = 0.0015
 """The last this-many seconds before a sample is due are waited by spinning (sleep is coarser)."""
 RREF_WAIT_S = 60.0
 """How long ``--format xplane-rref`` waits for a first subscription."""
+SPEED_RANGE = (1e-3, 1e6)
+"""``--speed``: from a thousandth of real time to a million times faster."""
 
 
 class Pacer:
@@ -108,6 +110,10 @@ class Sender:
             self.sock.connect(to)
             self.to = to
         self.encode: Callable[[int, Sample], bytes] | None = ENCODERS.get(fmt)
+        # JSBSim's pilot accelerations lag one frame, and the receiver (washbench live, as washbench cue of a JSBSim
+        # CSV file) shifts them back: the samples sent (already in step) get that lag again, so they arrive as sent
+        self._lagged: Sample | None = None
+        self._step = 0.0
         if fmt == "jsbsim":
             self._send(encode_jsbsim_labels())
 
@@ -154,10 +160,34 @@ class Sender:
         time.sleep(0.05)  # the rest of the subscription burst
         self._subscriptions()
 
+    def _jsbsim_frame(self, s: Sample) -> Sample:
+        """The frame JSBSim would send for sample ``s``: its pilot accelerations those of the frame before (the first
+        of a segment: its own); a jump back in time (a restart) first closes the segment (:meth:`close_segment`)."""
+        prev = self._lagged
+        if prev is not None and s[0] < prev[0]:
+            self.close_segment()
+            prev = None
+        if prev is not None:
+            self._step = s[0] - prev[0]
+        self._lagged = s
+        if prev is None:
+            return s
+        return (s[0], prev[1], prev[2], prev[3], s[4], s[5], s[6])
+
+    def close_segment(self) -> None:
+        """JSBSim format: one more frame after a segment's last sample, carrying its accelerations (the receiver's
+        lag shift takes them from there; the frame itself is dropped as JSBSim's last one is)."""
+        last, self._lagged = self._lagged, None
+        if self.fmt != "jsbsim" or last is None or self.encode is None:
+            return
+        t = last[0] + (self._step or 1e-3)
+        self._send(self.encode(self.seq, (t, last[1], last[2], last[3], last[4], last[5], last[6])))
+        self.seq += 1
+
     def send(self, s: Sample) -> bool:
         """Send sample ``s``; False when nobody is subscribed any more (RREF)."""
         if self.encode is not None:
-            self._send(self.encode(self.seq, s))
+            self._send(self.encode(self.seq, self._jsbsim_frame(s) if self.fmt == "jsbsim" else s))
         else:
             self._subscriptions()
             if not self.subscribers:
@@ -182,8 +212,9 @@ def run_send(
     aircraft_dirs: tuple[Path, ...] = (),
 ) -> int:
     """The ``washbench send`` command."""
-    if not (speed > 0.0 and speed < 1e9):
-        raise WashbenchError(f"--speed: expected a positive number, got {speed:g}")
+    lo, hi = SPEED_RANGE
+    if not lo <= speed <= hi:  # NaN too
+        raise WashbenchError(f"--speed: expected {lo:g}..{hi:g} (times real time), got {speed:g}")
     if (path is None) == (fly_path is None):
         raise WashbenchError("give either a FILE or --fly MANOEUVRE")
     samples: Iterator[Sample] | None = None
@@ -205,6 +236,7 @@ def run_send(
                     break
         else:
             _fly_and_send(fly_path, sender, pacer, aircraft_dirs)  # type: ignore[arg-type]
+        sender.close_segment()
     finally:
         sender.close()
     print(f"send: sent {sender.sent} datagrams in {time.perf_counter() - pacer.start:.3f} s"

@@ -34,11 +34,13 @@ import contextlib
 import dataclasses
 import math
 import os
+import signal
 import sys
 import time
 import traceback
 from collections.abc import Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -51,7 +53,7 @@ from washbench.analysis.ranking import (
     rule_from_record,
 )
 from washbench.cueing import registry
-from washbench.errors import WashbenchError, located
+from washbench.errors import WashbenchError, located, printable
 from washbench.flight.scripts import bundled_script, is_script
 from washbench.io.atomic import write_text_atomic
 from washbench.io.cpus import usable_cpus
@@ -161,13 +163,61 @@ def run_suite(
             with contextlib.ExitStack() as own:
                 if pool is None:
                     pool = own.enter_context(suite_pool(opts, jobs))
-                for fut in as_completed(submit_all(pool, _run_one, args)):
-                    runs = fut.result()
+                futures = dict(zip(submit_all(pool, _run_one, args), args, strict=True))
+                lost = []  # runs whose worker process died, or that were queued when one did
+                for fut in as_completed(futures):
+                    try:
+                        runs = fut.result()
+                    except BrokenProcessPool:
+                        lost.append(futures[fut])
+                        continue
                     outcomes[runs[0].path] = _report(runs, len(outcomes) + 1, len(files), start, shown)
+                for a in sorted(lost, key=args.index):  # each alone: the one whose worker dies again is the one
+                    runs = _run_alone(a, opts)
+                    outcomes[a[0]] = _report(runs, len(outcomes) + 1, len(files), start, shown)
+                if lost:  # what the dead workers were publishing (OUT/<aircraft>/.washbench-stage-PID)
+                    for entry in sorted(out_dir.iterdir()):
+                        if entry.is_dir() and not entry.is_symlink():
+                            recover_shared(entry, only_dead=True)
     finally:
         if shown is not None:
             shown.close()
     return [o for a in args for o in outcomes[a[0]]]
+
+
+def _run_alone(a: tuple[str, str, RunOptions], opts: RunOptions) -> list[Outcome]:
+    """:func:`_run_one` in a pool of one fresh worker process: the run again after a worker process died (a plugin's
+    ``os._exit``, a SIGKILL, the OOM killer); if its worker dies again, a failed outcome saying how."""
+    with suite_pool(opts, 1) as one:
+        fut = one.submit(_run_one, *a)
+        processes = list((getattr(one, "_processes", None) or {}).values())  # the executor keeps no public list
+        try:
+            return fut.result()
+        except BrokenProcessPool:
+            for p in processes:
+                p.join(5.0)
+            code = processes[0].exitcode if processes else None
+    return [Outcome(path=a[0], wall_s=0.0, run=RunSummary(ok=False, reason=worker_died(code)))]
+
+
+def worker_died(exitcode: int | None) -> str:
+    """Why a run failed whose worker process ended in the middle of it (``exitcode``: negative for a signal)."""
+    if exitcode is not None and exitcode < 0:
+        try:
+            name = signal.Signals(-exitcode).name
+        except ValueError:
+            name = f"signal {-exitcode}"
+        how = f"was killed by {name}" + (" (the out-of-memory killer sends it too)" if name == "SIGKILL" else "")
+    elif exitcode is not None:
+        how = f"exited with status {exitcode} (a washout plugin's os._exit()?)"
+    else:
+        how = "ended"
+    return f"the worker process running it {how}; the other runs went on"
+
+
+def pool_broken(pool: ProcessPoolExecutor | None) -> bool:
+    """Whether a worker of ``pool`` died (the pool takes no more work: the suite's figures are drawn here then)."""
+    return bool(pool is not None and getattr(pool, "_broken", False))
 
 
 def _jobs(jobs: int | None, n_files: int) -> int:
@@ -372,11 +422,11 @@ def suite_command(
             for o in outcomes:  # a failure names the files where they were going, not the hidden stage
                 if not o.run.ok and str(stage) in o.run.reason:
                     o.run = dataclasses.replace(o.run, reason=o.run.reason.replace(str(stage), str(out_dir)))
-            write_suite_results(outcomes, stage, dict(options.provenance), options.outputs.figures, pool)
+            figure_pool = None if pool_broken(pool) else pool  # a worker died: the figures are drawn here
+            write_suite_results(outcomes, stage, dict(options.provenance), options.outputs.figures, figure_pool)
     n_ok = sum(o.run.ok for o in outcomes)
-    print(
-        f"suite: {n_ok}/{len(outcomes)} runs ok in {time.perf_counter() - start:.1f} s; report: {out_dir / REPORT_FILE}"
-    )
+    report = printable(str(out_dir / REPORT_FILE))
+    print(f"suite: {n_ok}/{len(outcomes)} runs ok in {time.perf_counter() - start:.1f} s; report: {report}")
     return 0 if n_ok == len(outcomes) else 1
 
 

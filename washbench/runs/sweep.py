@@ -24,7 +24,7 @@ from pathlib import Path
 from washbench.analysis.sweep import SweepRow, grid, parse_set, point_washouts, sweep_csv, sweep_metrics_csv
 from washbench.cueing.params import WASHOUT_NAMES
 from washbench.cueing.variants import Washout, load_param_file
-from washbench.errors import WashbenchError
+from washbench.errors import WashbenchError, printable
 from washbench.io.atomic import write_text_atomic
 from washbench.io.outfolder import result_set
 from washbench.io.progress import Progress
@@ -154,7 +154,7 @@ def sweep_command(
     print(
         f"sweep: {len(points)} grid point(s) x {len(kinds)} washout(s) x {len(flights)} flight(s) = {n_eval} "
         f"evaluations ({steps / max(t_eval, 1e-9) / 1e6:.2f} M steps/s) in {time.perf_counter() - start:.1f} s; "
-        f"wrote {out_dir / 'sweep.csv'}, sweep_metrics.csv, sweep.png"
+        f"wrote {printable(str(out_dir / 'sweep.csv'))}, sweep_metrics.csv, sweep.png"
     )
     failed = [f for f in flights if not f.ok]
     for f in failed:

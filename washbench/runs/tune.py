@@ -30,7 +30,7 @@ from washbench.analysis.tune import Bound, minimise, parse_tune
 from washbench.cueing import registry
 from washbench.cueing.params import WashoutParams
 from washbench.cueing.variants import Washout, apply_overrides, check_kind, load_param_file, value_of
-from washbench.errors import WashbenchError
+from washbench.errors import WashbenchError, printable
 from washbench.io.atomic import write_text_atomic
 from washbench.io.csv_numbers import csv_number
 from washbench.io.outfolder import result_set
@@ -112,7 +112,7 @@ def tune_command(
         f"tune: {kind}, {best[4]} evaluations on {len(train)} training flight(s) in "
         f"{time.perf_counter() - start:.1f} s; objective {base.name} {base_obj:.4f} -> tuned {best[3]:.4f} "
         f"({', '.join(f'{k}={v:.6g}' for k, v in zip(keys, best_x, strict=True))}); "
-        f"wrote {Path(out_dir) / 'tuned.yaml'}"
+        f"wrote {printable(str(Path(out_dir) / 'tuned.yaml'))}"
     )
     for line in score_lines(base.name, table):
         print(line)

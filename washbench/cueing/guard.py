@@ -1,0 +1,58 @@
+"""One guard around every call into a user's washout plugin: whatever it raises becomes one line.
+
+A plugin is any Python code: besides exceptions it can call ``sys.exit()``, raise ``KeyboardInterrupt`` with no
+Ctrl-C pressed, return objects whose ``__float__``, ``__bool__``, ``__len__`` or ``__iter__`` raise (so converting
+the result raises too). :func:`plugin_call` runs the call *and the conversion of its result* and turns any
+:class:`BaseException` into a :class:`washbench.errors.WashbenchError` naming the washout and the call, except a
+real SIGINT or SIGTERM (one this process's handlers received while the call ran,
+:func:`washbench.io.interrupts.received`): that one stops the command as a signal does.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import TypeVar
+
+from washbench.errors import Terminated, WashbenchError
+from washbench.io import interrupts
+
+R = TypeVar("R")
+
+
+def plugin_call(where: str, fn: Callable[[], R], passing: tuple[type[BaseException], ...] = ()) -> R:
+    """``fn()`` (a plugin's call and the conversion of what it returned) with any BaseException as one line
+    ``WHERE: raised TYPE: message`` (WashbenchError); a WashbenchError, one of ``passing`` (handled by the caller)
+    and a real signal pass unchanged."""
+    seen = interrupts.received()
+    try:
+        return fn()
+    except WashbenchError:
+        raise
+    except BaseException as exc:  # a user's code: anything it raises is one line
+        signalled = isinstance(exc, KeyboardInterrupt | Terminated) and interrupts.received() != seen
+        if signalled or isinstance(exc, passing):
+            raise  # the caller's to handle, or a real Ctrl-C or SIGTERM that arrived meanwhile
+        raise plugin_error(where, exc) from None
+
+
+def plugin_error(where: str, exc: BaseException) -> WashbenchError:
+    """The one line for ``exc`` raised by a plugin (not a signal): ``WHERE: raised TYPE: message``; ``sys.exit()``
+    and a KeyboardInterrupt said as what they are."""
+    if isinstance(exc, SystemExit):
+        code = _text(exc) if isinstance(exc.code, str | int | None) else "..."
+        return WashbenchError(f"{where}: called sys.exit({code}) (a washout may not end the command)")
+    if isinstance(exc, KeyboardInterrupt | Terminated):
+        return WashbenchError(f"{where}: raised {type(exc).__name__} (no signal was received)")
+    text = _text(exc)
+    return WashbenchError(f"{where}: raised {type(exc).__name__}" + (f": {text}" if text else ""))
+
+
+def _text(exc: BaseException) -> str:
+    """``str(exc)`` on one line; a ``__str__`` that raises too gives ``""``."""
+    try:
+        return " ".join(str(exc).split())
+    except BaseException:  # a plugin's exception whose __str__ fails
+        return ""
+
+
+__all__ = ["plugin_call", "plugin_error"]
