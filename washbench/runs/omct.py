@@ -192,7 +192,8 @@ def _bound_estimate(
     frequencies_radps: Sequence[float], rate_hz: float, sigma: float, amplitude_scale: float,
 ) -> None:  # fmt: skip
     """With the oracle bound among ``entries``: its size and an estimated time on stderr before the runs (one
-    optimisation over each whole run: minutes; the replay's, as the washout runs it), timed on a 1,200-sample piece of the first run as sweep does."""
+    optimisation over each whole run: minutes), timed with the replay as the washout runs it on a 1,200-sample piece
+    of the first run, as sweep does."""
 
     bounds = [e for e in entries if e.kind == "bound"]
     if not bounds:
