@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -30,6 +30,7 @@ from washbench.cueing.kernel import (
     C_DT,
     C_FREEFALL,
     C_G,
+    C_GEO,
     C_GK,
     C_GP,
     C_HEAD_EULER,
@@ -37,13 +38,17 @@ from washbench.cueing.kernel import (
     C_KHI,
     C_KIND,
     C_KLO,
+    C_LA,
     C_LP_BEFORE,
+    C_LV,
     C_P0,
     C_PHI,
+    C_PLAT,
     C_PLO,
     C_PMAX,
     C_R,
     C_REST,
+    C_RIG,
     C_ROT_SAT,
     C_SF,
     C_SW,
@@ -75,6 +80,7 @@ from washbench.cueing.kernel import (
     O_ACC,
     O_HEAD_F,
     O_HEAD_OMEGA,
+    O_LEG,
     O_OMEGA,
     O_POS,
     O_Q,
@@ -83,6 +89,8 @@ from washbench.cueing.kernel import (
     O_SP_Q,
     O_VEL,
     O_WHEEL,
+    PLAT_HEXAPOD,
+    PLAT_RIG,
     S_COST,
     S_GK,
     S_GP,
@@ -99,11 +107,13 @@ from washbench.cueing.kernel import (
 )
 from washbench.cueing.params import ADAPTIVE_KINDS, FILTER_STARTS, WashoutParams, check_filter_start  # noqa: F401
 from washbench.cueing.setpoints import SetPointSource
-from washbench.cueing.variants import Washout, as_washouts
+from washbench.cueing.variants import Washout, as_washouts, check_platform
 from washbench.errors import WashbenchError
 from washbench.io.motion import DT_RANGE_S
 from washbench.numerics.jitcache import announce_compile
-from washbench.platform.limits import PlatformLimits, wheel_jacobian
+from washbench.platform.hexapod import CATCH_UP_FRACTION, RATE_MARGIN
+from washbench.platform.limits import wheel_jacobian
+from washbench.platform.model import PlatformModel, platform_kind
 
 _KINDS = {
     "small-angle": KIND_SMALL,
@@ -129,13 +139,12 @@ def _off(limit: float | None) -> float:
     return math.inf if limit is None else math.radians(limit)
 
 
-def washout_arrays(washout: Washout, limits: PlatformLimits, dt: float) -> tuple[np.ndarray, np.ndarray]:
+def washout_arrays(washout: Washout, limits: PlatformModel, dt: float) -> tuple[np.ndarray, np.ndarray]:
     """One washout's row of the compiled configuration (NCFG,) and its discretised filters (NFILT, 9), all SI.
 
     ``dt`` (s) is already checked (:func:`_check_dt`).
     """
     params, kind = washout.params, _KINDS.get(washout.kind, KIND_SETPOINT)
-    lim = limits.translation
     cfg = np.zeros(NCFG)
     cfg[C_KIND] = kind
     cfg[C_DT] = dt
@@ -149,13 +158,7 @@ def washout_arrays(washout: Washout, limits: PlatformLimits, dt: float) -> tuple
     cfg[C_COSMIN] = params.small_angle.min_cos_pitch
     cfg[C_FREEFALL] = params.free_fall_threshold_mps2
     cfg[C_R : C_R + 3] = params.head.offset_m
-    cfg[C_PMAX : C_PMAX + 3] = lim.position_limit_m.xyz
-    cfg[C_VMAX : C_VMAX + 3] = lim.velocity_limit_mps.xyz
-    cfg[C_AMAX : C_AMAX + 3] = lim.acceleration_limit_mps2.xyz
-    cfg[C_WMAX] = math.radians(limits.rotation.rate_limit_degps)
-    cfg[C_ALPHA] = math.radians(limits.rotation.acceleration_limit_degps2)
-    cfg[C_CATCH] = limits.rotation.catch_up_fraction
-    cfg[C_JAC : C_JAC + 9] = wheel_jacobian(limits).ravel()
+    _platform_cfg(cfg, limits)
     # the paper's choices ("auto"): small-angle filters the tilt rate after the cross product and estimates the
     # head rate from Euler angles (Eq. 8); the quaternion washouts filter f before it and difference quaternions
     position = params.tilt.lowpass_position
@@ -182,6 +185,32 @@ def washout_arrays(washout: Washout, limits: PlatformLimits, dt: float) -> tuple
         coef[F_TILT_LP + j] = filters.discretise(filters.tilt_lowpass(tilt_wn[j]), dt)
         coef[F_ROT_HP + j] = filters.discretise(filters.rotational_highpass(rot_wn[j]), dt)
     return cfg, coef
+
+
+def _platform_cfg(cfg: np.ndarray, platform: PlatformModel) -> None:
+    """The platform's kind, limits and geometry into a configuration row (SI)."""
+    kind = platform_kind(platform)
+    if kind == "hexapod":
+        cfg[C_PLAT] = PLAT_HEXAPOD
+        geo = platform.geometry()  # type: ignore[union-attr]
+        cfg[C_GEO : C_GEO + len(geo)] = geo
+        cfg[C_LV] = platform.leg_velocity_limit_mps * (1.0 - RATE_MARGIN)  # type: ignore[union-attr]
+        cfg[C_LA] = platform.leg_acceleration_limit_mps2 * (1.0 - RATE_MARGIN)  # type: ignore[union-attr]
+        cfg[C_CATCH] = CATCH_UP_FRACTION
+        return
+    if kind == "rig":
+        cfg[C_PLAT] = PLAT_RIG
+        cfg[C_RIG : C_RIG + 12] = platform.limits_array()  # type: ignore[union-attr]
+        cfg[C_CATCH] = platform.catch_up_fraction  # type: ignore[union-attr]
+        return
+    lim = platform.translation  # type: ignore[union-attr]
+    cfg[C_PMAX : C_PMAX + 3] = lim.position_limit_m.xyz
+    cfg[C_VMAX : C_VMAX + 3] = lim.velocity_limit_mps.xyz
+    cfg[C_AMAX : C_AMAX + 3] = lim.acceleration_limit_mps2.xyz
+    cfg[C_WMAX] = math.radians(platform.rotation.rate_limit_degps)  # type: ignore[union-attr]
+    cfg[C_ALPHA] = math.radians(platform.rotation.acceleration_limit_degps2)  # type: ignore[union-attr]
+    cfg[C_CATCH] = platform.rotation.catch_up_fraction  # type: ignore[union-attr]
+    cfg[C_JAC : C_JAC + 9] = wheel_jacobian(platform).ravel()  # type: ignore[arg-type]
 
 
 def _adaptive_cfg(cfg: np.ndarray, washout: Washout) -> None:
@@ -216,11 +245,13 @@ def _adaptive_cfg(cfg: np.ndarray, washout: Washout) -> None:
 
 
 def build_arrays(
-    washouts: Sequence[Washout], limits: PlatformLimits, dt: float, filter_start: str = "steady"
+    washouts: Sequence[Washout], limits: PlatformModel, dt: float, filter_start: str = "steady"
 ) -> tuple[np.ndarray, np.ndarray]:
     """The compiled bank's configuration (n, NCFG) and filters (n, NFILT, 9) for checked washouts and dt.
 
-    ``filter_start``: the start state of every washout (:data:`FILTER_STARTS`)."""
+    ``filter_start``: the start state of every washout (:data:`FILTER_STARTS`). A washout that cannot drive the
+    platform is refused (:func:`check_platform`)."""
+    check_platform(washouts, limits)
     rows = [washout_arrays(w, limits, dt) for w in washouts]
     cfg = np.stack([r[0] for r in rows])
     cfg[:, C_REST] = 1.0 if check_filter_start(filter_start) == "rest" else 0.0
@@ -234,8 +265,9 @@ class WashoutTrace:
     pos_m, vel_mps, acc_mps2 (N, 3): platform translation, inertial NED. q (N, 4): platform attitude,
     body->inertial, scalar first. omega_radps (N, 3): platform body angular velocity. head_f_mps2,
     head_omega_radps (N, 3): simulator pilot-head specific force and angular velocity, simulator body axes.
-    wheel_radps (N, 3): omni-wheel speeds. sp_pos_m (N, 3), sp_q (N, 4): the washout's set points.
-    saturated: limit kind -> bool (N,) (kinds in ``SAT_KINDS``); saturation_counts: kind -> steps at it.
+    wheel_radps (N, 3): the Atlas's omni-wheel speeds ((N, 0) on another platform). sp_pos_m (N, 3), sp_q (N, 4):
+    the washout's set points. saturated: limit kind -> bool (N,) (kinds in ``SAT_KINDS``); saturation_counts: kind
+    -> steps at it. leg_m (N, 6): a hexapod's leg lengths, m ((N, 0) on another platform).
     """
 
     pos_m: np.ndarray
@@ -250,11 +282,13 @@ class WashoutTrace:
     sp_q: np.ndarray
     saturated: dict[str, np.ndarray]
     saturation_counts: dict[str, int]
+    leg_m: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
 
     @classmethod
-    def from_rows(cls, rows: np.ndarray, copy: bool = True) -> WashoutTrace:
+    def from_rows(cls, rows: np.ndarray, copy: bool = True, platform: str = "atlas") -> WashoutTrace:
         """Build from output rows (N, N_FIELDS) of :meth:`CueingBank.step` for one washout (columns copied, or
-        with ``copy=False`` views into ``rows``: valid only as long as ``rows`` is not overwritten)."""
+        with ``copy=False`` views into ``rows``: valid only as long as ``rows`` is not overwritten); ``platform``:
+        the platform's kind (which of its own fields the trace has)."""
         rows = np.asarray(rows, dtype=np.float64)
         if rows.ndim != 2 or rows.shape[1] != NFIELDS:
             raise ValueError(f"rows must have shape (N, {NFIELDS}), got {rows.shape}")
@@ -264,10 +298,10 @@ class WashoutTrace:
             return np.ascontiguousarray(view) if copy else view
 
         saturated = {k: rows[:, O_SAT + j] != 0.0 for j, k in enumerate(SAT_KINDS)}
-        return cls._build(cols, saturated)
+        return cls._build(cols, saturated, platform)
 
     @classmethod
-    def from_fields(cls, block: np.ndarray) -> WashoutTrace:
+    def from_fields(cls, block: np.ndarray, platform: str = "atlas") -> WashoutTrace:
         """Build from a field-major block (N_FIELDS, N) of one washout (no copy: the arrays are views, (N, k)
         in column-major order, each column contiguous)."""
         if block.ndim != 2 or block.shape[0] != NFIELDS:
@@ -277,10 +311,10 @@ class WashoutTrace:
             return block[start : start + n].T
 
         saturated = {k: block[O_SAT + j] != 0.0 for j, k in enumerate(SAT_KINDS)}
-        return cls._build(cols, saturated)
+        return cls._build(cols, saturated, platform)
 
     @classmethod
-    def _build(cls, cols, saturated: dict[str, np.ndarray]) -> WashoutTrace:
+    def _build(cls, cols, saturated: dict[str, np.ndarray], platform: str = "atlas") -> WashoutTrace:
         return cls(
             pos_m=cols(O_POS, 3),
             vel_mps=cols(O_VEL, 3),
@@ -289,11 +323,12 @@ class WashoutTrace:
             omega_radps=cols(O_OMEGA, 3),
             head_f_mps2=cols(O_HEAD_F, 3),
             head_omega_radps=cols(O_HEAD_OMEGA, 3),
-            wheel_radps=cols(O_WHEEL, 3),
+            wheel_radps=cols(O_WHEEL, 3 if platform == "atlas" else 0),
             sp_pos_m=cols(O_SP_POS, 3),
             sp_q=cols(O_SP_Q, 4),
             saturated=saturated,
             saturation_counts={k: int(v.sum()) for k, v in saturated.items()},
+            leg_m=cols(O_LEG, 6 if platform == "hexapod" else 0),
         )
 
 
@@ -363,12 +398,14 @@ class CueingBank:
         self,
         washouts: Sequence[str | Washout],
         params: WashoutParams | None,
-        limits: PlatformLimits,
+        limits: PlatformModel,
         dt_s: float,
         filter_start: str = "steady",
         future: tuple[np.ndarray, np.ndarray] | None = None,
     ) -> None:
         self.specs = as_washouts(washouts, params)
+        self.platform = platform_kind(limits)
+        """The platform's kind (``atlas``, ``hexapod``, ``rig``): :meth:`WashoutTrace.from_rows` of its rows."""
         self.washouts = tuple(w.name for w in self.specs)
         self.dt_s = _check_dt(dt_s)
         self._cfg, self._coef = build_arrays(self.specs, limits, self.dt_s, filter_start)
@@ -521,7 +558,7 @@ def cue_trace(
     dt_s: float,
     washouts: Sequence[str | Washout],
     params: WashoutParams | None,
-    limits: PlatformLimits,
+    limits: PlatformModel,
     filter_start: str = "steady",
     fields_out: np.ndarray | None = None,
 ) -> dict[str, WashoutTrace]:
@@ -560,11 +597,12 @@ def cue_trace(
             _set_start(state[i], *src.start(f[0], w[0]))
             pos, q, flags = src.run(f, w, whole=True)
             setpoint_trace(pos, q, flags, cfg[i], coef[i], state[i], counts[i], out[i])
-    return {name: WashoutTrace.from_fields(out[i]) for i, name in enumerate(names)}
+    kind = platform_kind(limits)
+    return {name: WashoutTrace.from_fields(out[i], kind) for i, name in enumerate(names)}
 
 
 def python_sources(
-    specs: Sequence[Washout], limits: PlatformLimits, dt: float, filter_start: str
+    specs: Sequence[Washout], limits: PlatformModel, dt: float, filter_start: str
 ) -> list[tuple[int, SetPointSource]]:
     """(index, source) of every washout of ``specs`` that is a Python algorithm (not compiled)."""
     return [(i, SetPointSource(w, limits, dt, filter_start)) for i, w in enumerate(specs) if w.kind not in _KINDS]
