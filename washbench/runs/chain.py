@@ -313,7 +313,7 @@ def cue_motion(
     return analyse(motion, traces, vestibular, filter_start)
 
 
-_REVIEW_FIELDS = ("pos_m", "vel_mps", "acc_mps2", "omega_radps", "wheel_radps")
+_REVIEW_FIELDS = ("pos_m", "vel_mps", "acc_mps2", "omega_radps", "wheel_radps", "leg_m")
 """Washout trace fields a streamed cue keeps whole for the report (its envelope figure and time at a limit)."""
 _RECORDING_FIELDS = ("head_f_mps2", "head_omega_radps", "q")
 """... and for the recording (the simulator pilot's raw motion, the sphere's attitude in the 3D view)."""
