@@ -546,6 +546,8 @@ def platform_head(p_sp_prev, p_sp, q_sp_prev, q_sp, first, rest, c, coef, state,
             state[S_Q + j] = q[j]
         for j in range(3):
             state[S_W + j] = w[j]
+        for j in range(6):  # no legs: the row's leg fields defined all the same (every row's bits determined)
+            row[O_LEG + j] = 0.0
 
     # ---- simulator pilot-head motion from what the platform actually does
     if c[C_HEAD_EULER] != 0.0:
