@@ -108,6 +108,11 @@ def load_platform(path: Path | None = None) -> tuple[PlatformModel, str]:
     return platform_from_data(source, data, lines), sha
 
 
+def load_platform_model(path: Path | None = None) -> PlatformModel:
+    """:func:`load_platform` without the digest."""
+    return load_platform(path)[0]
+
+
 __all__ = [
     "KINDS",
     "Platform",
@@ -115,6 +120,7 @@ __all__ = [
     "PlatformModel",
     "Pose",
     "load_platform",
+    "load_platform_model",
     "planning_limits",
     "platform_from_data",
     "platform_kind",
