@@ -187,3 +187,73 @@ def test_a_rig_stays_within_its_angles_and_rates(flights, tmp_path):
         assert np.abs(z).max() <= 0.1 and np.abs(np.diff(z)).max() / DT <= 0.3 * (1 + 1e-9)
         assert np.abs(table[f"{w}.pos_x_m"]).max() == 0.0 and np.abs(table[f"{w}.pos_y_m"]).max() == 0.0
         assert np.sum(table[f"{w}.sat_pos"]) > 0  # the violent flight reaches the stops
+
+
+PLUGIN = '''
+import numpy as np
+from pydantic import BaseModel
+
+
+class Params(BaseModel):
+    travel_m: float = 0.2
+
+
+class BoxPlatform:
+    """A toy platform: the set point's translation clipped to a box, the attitude as set."""
+
+    platform_name = "box"
+    Params = Params
+
+    def __init__(self, params, context):
+        self.travel = (params or Params()).travel_m
+        self.dt = context.dt_s
+
+    def start(self, pos, q):
+        return np.clip(pos, -self.travel, self.travel), q
+
+    def step(self, pos, q):
+        p = np.clip(pos, -self.travel, self.travel)
+        return p, q, (int(np.any(p != pos)), 0, 0, 0, 0)
+
+
+class Broken(BoxPlatform):
+    platform_name = "broken"
+
+    def step(self, pos, q):
+        return pos, q, (2, 0, 0, 0, 0)
+'''
+
+
+def test_a_platform_plugin_drives_the_washouts_and_is_recorded(flights, tmp_path):
+    plugin = tmp_path / "box.py"
+    plugin.write_text(PLUGIN)
+    file = tmp_path / "tiny.yaml"
+    file.write_text("kind: box\nname: tiny box\ntravel_m: 0.02\n")
+    out = tmp_path / "out"
+    proc = washbench("cue", flights["gentle"], "--out", out, "--platform-plugin", f"{plugin}:BoxPlatform",
+                     "--platform", file, "--washout", "large-angle", "--no-recording", "--no-figures",
+                     "--quiet")  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    (traces,) = out.rglob("traces.parquet")
+    table = pq.read_table(traces).to_pydict()
+    pos = np.column_stack([table[f"large-angle.pos_{a}_m"] for a in "xyz"])
+    sp = np.column_stack([table[f"large-angle.sp_pos_{a}_m"] for a in "xyz"])
+    np.testing.assert_array_equal(pos, np.clip(sp, -0.02, 0.02))  # the plugin's motion, the washout's set points
+    assert np.abs(sp).max() > 0.05 and np.sum(table["large-angle.sat_pos"]) > 0
+    # the head motion is the plugin's: the platform's acceleration is the second difference of its position
+    acc = np.asarray(table["large-angle.acc_x_mps2"])
+    np.testing.assert_allclose(acc[2:], np.diff(pos[:, 0], 2) / DT**2, atol=1e-6)
+    (run,) = out.rglob("run.json")
+    record = __import__("json").loads(run.read_text())["provenance"]["platform"]
+    assert record["path"] == str(file) and record["values"]["kind"] == "box" and len(record["sha256"]) == 64
+
+
+def test_a_broken_platform_plugin_is_one_line(flights, tmp_path):
+    plugin = tmp_path / "box.py"
+    plugin.write_text(PLUGIN)
+    proc = washbench("cue", flights["gentle"], "--out", tmp_path / "out", "--platform-plugin", f"{plugin}:Broken",
+                     "--washout", "large-angle", "--quiet")  # fmt: skip
+    assert proc.returncode != 0
+    assert len(proc.stderr.strip().splitlines()) == 1 and "Traceback" not in proc.stderr, proc.stderr
+    assert "platform broken" in proc.stderr and "flags" in proc.stderr
+    assert not any((tmp_path / "out").rglob("traces.parquet"))

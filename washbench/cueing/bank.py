@@ -90,6 +90,7 @@ from washbench.cueing.kernel import (
     O_VEL,
     O_WHEEL,
     PLAT_HEXAPOD,
+    PLAT_IDEAL,
     PLAT_RIG,
     S_COST,
     S_GK,
@@ -113,7 +114,8 @@ from washbench.io.motion import DT_RANGE_S
 from washbench.numerics.jitcache import announce_compile
 from washbench.platform.hexapod import CATCH_UP_FRACTION, RATE_MARGIN
 from washbench.platform.limits import wheel_jacobian
-from washbench.platform.model import PlatformModel, platform_kind
+from washbench.platform.model import PlatformContext, PlatformModel, platform_kind
+from washbench.platform.plugins import PlatformRun
 
 _KINDS = {
     "small-angle": KIND_SMALL,
@@ -197,6 +199,9 @@ def _platform_cfg(cfg: np.ndarray, platform: PlatformModel) -> None:
         cfg[C_LV] = platform.leg_velocity_limit_mps * (1.0 - RATE_MARGIN)  # type: ignore[union-attr]
         cfg[C_LA] = platform.leg_acceleration_limit_mps2 * (1.0 - RATE_MARGIN)  # type: ignore[union-attr]
         cfg[C_CATCH] = CATCH_UP_FRACTION
+        return
+    if kind not in ("atlas", "hexapod", "rig"):  # a plugin's: the washout's pass (its set points) tracked ideally
+        cfg[C_PLAT] = PLAT_IDEAL
         return
     if kind == "rig":
         cfg[C_PLAT] = PLAT_RIG
@@ -414,6 +419,7 @@ class CueingBank:
         self._counts = np.zeros((n, len(SAT_KINDS)), dtype=np.int64)
         self._out = np.zeros((n, NFIELDS))
         self._py = python_sources(self.specs, limits, self.dt_s, filter_start)
+        self._plugin = PluginPass(limits, len(self.washouts), self.dt_s, filter_start, self.specs)
         self._started = False
         self._k = 0  # samples stepped so far
         self._whole = self._whole_setpoints(future)
@@ -475,6 +481,9 @@ class CueingBank:
                 c, st = self._cfg[i], self._state[i]
                 setpoint_step(pos_a[k], q_a[k], int(fl[k, 0]), int(fl[k, 1]), c, self._coef[i], st, self._counts[i],
                               self._out[i])  # fmt: skip
+        if self._plugin:
+            for i in range(len(self.washouts)):
+                self._plugin.rows(i, self._out[i : i + 1], self._cfg[i], self._coef[i])
         self._k += 1
         return self._out
 
@@ -513,6 +522,9 @@ class CueingBank:
                 setpoint_block(np.ascontiguousarray(pos[k : k + m]), np.ascontiguousarray(q[k : k + m]),
                                np.ascontiguousarray(flags[k : k + m]), self._cfg[i], self._coef[i], self._state[i],
                                self._counts[i], out[i])  # fmt: skip
+        if self._plugin and m:
+            for i in range(len(self.washouts)):
+                self._plugin.rows(i, out[i], self._cfg[i], self._coef[i])
         if m:
             self._out[:] = out[:, -1]
         self._k += m
@@ -547,8 +559,9 @@ class CueingBank:
 
     def saturation_counts(self) -> dict[str, dict[str, int]]:
         """washout -> limit kind -> number of steps at that limit so far."""
+        counts = self._plugin.counts if self._plugin else self._counts
         return {
-            name: {k: int(self._counts[i, j]) for j, k in enumerate(SAT_KINDS)} for i, name in enumerate(self.washouts)
+            name: {k: int(counts[i, j]) for j, k in enumerate(SAT_KINDS)} for i, name in enumerate(self.washouts)
         }
 
 
@@ -597,6 +610,12 @@ def cue_trace(
             _set_start(state[i], *src.start(f[0], w[0]))
             pos, q, flags = src.run(f, w, whole=True)
             setpoint_trace(pos, q, flags, cfg[i], coef[i], state[i], counts[i], out[i])
+    plugin = PluginPass(limits, len(names), dt, filter_start, specs)
+    if plugin and len(f):
+        for i in range(len(names)):
+            rows = np.ascontiguousarray(out[i].T)
+            plugin.rows(i, rows, cfg[i], coef[i])
+            out[i][:] = rows.T
     kind = platform_kind(limits)
     return {name: WashoutTrace.from_fields(out[i], kind) for i, name in enumerate(names)}
 
@@ -606,6 +625,48 @@ def python_sources(
 ) -> list[tuple[int, SetPointSource]]:
     """(index, source) of every washout of ``specs`` that is a Python algorithm (not compiled)."""
     return [(i, SetPointSource(w, limits, dt, filter_start)) for i, w in enumerate(specs) if w.kind not in _KINDS]
+
+
+class PluginPass:
+    """A plugin platform (:mod:`washbench.platform.plugins`) behind the washouts: the kernel has tracked each
+    washout's set points ideally (``PLAT_IDEAL``); :meth:`rows` gives those set points to the plugin (one instance per
+    washout), then runs the same compiled head-motion step on the poses it reached (its own state rows), and puts the
+    washout's set points and the plugin's flags back into the rows. Empty (false) on a built-in platform."""
+
+    def __init__(
+        self, platform: PlatformModel, n: int, dt_s: float, filter_start: str, specs: Sequence[Washout]
+    ) -> None:
+        self.runs: list[PlatformRun] = []
+        if platform_kind(platform) in ("atlas", "hexapod", "rig"):
+            return
+        g = specs[0].params.gravity_mps2 if specs else 9.80665
+        context = PlatformContext(dt_s=dt_s, gravity_mps2=g, filter_start=filter_start)
+        self.runs = [PlatformRun(platform, context) for _ in range(n)]  # type: ignore[arg-type]
+        self.state = np.zeros((n, NSTATE))
+        self.counts = np.zeros((n, len(SAT_KINDS)), dtype=np.int64)
+        self.started = [False] * n
+
+    def __bool__(self) -> bool:
+        return bool(self.runs)
+
+    def rows(self, i: int, rows: np.ndarray, cfg: np.ndarray, coef: np.ndarray) -> None:
+        """Washout i's output rows (M, NFIELDS), C-contiguous, rewritten in place with the plugin's motion."""
+        if not len(rows):
+            return
+        sp = rows[:, O_SP_POS : O_SP_POS + 3].copy()
+        sq = rows[:, O_SP_Q : O_SP_Q + 4].copy()
+        own = rows[:, O_SAT + 5 : O_SAT + 7].astype(np.int64)  # the washout's tilt-rate and rotational flags
+        run = self.runs[i]
+        if not self.started[i]:
+            _set_start(self.state[i], *run.start(sp[0], sq[0]))
+            self.started[i] = True
+        pos, q, flags = run.run(sp, sq)
+        setpoint_block(np.ascontiguousarray(pos), np.ascontiguousarray(q), np.ascontiguousarray(own), cfg, coef,
+                       self.state[i], self.counts[i], rows)  # fmt: skip
+        rows[:, O_SP_POS : O_SP_POS + 3] = sp
+        rows[:, O_SP_Q : O_SP_Q + 4] = sq
+        rows[:, O_SAT : O_SAT + 5] = flags
+        self.counts[i, :5] += flags.sum(axis=0)
 
 
 def _number(v: object) -> float | int:

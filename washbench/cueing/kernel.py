@@ -87,7 +87,7 @@ C_ADAPT, C_GP, C_GK, C_WF, C_WW, C_WX, C_WV, C_WPG, C_WKG, C_P0, C_PLO, C_PHI, C
 # the platform (docs/platforms.md): its kind, a hexapod's geometry (:mod:`washbench.platform.hexapod_kinematics`)
 # and leg velocity and acceleration limits, a rig's limits (:meth:`washbench.platform.rig.RigModel.limits_array`)
 C_PLAT = 52
-PLAT_ATLAS, PLAT_HEXAPOD, PLAT_RIG = 0, 1, 2
+PLAT_ATLAS, PLAT_HEXAPOD, PLAT_RIG, PLAT_IDEAL = 0, 1, 2, 3  # IDEAL: the pose is the set point (a plugin's pass)
 C_GEO = 53
 C_LV, C_LA = C_GEO + NGEO, C_GEO + NGEO + 1
 C_RIG = C_LA + 1
@@ -434,9 +434,10 @@ def washout_classical(f, om, c, coef, state, first, rest):
 
 @njit(cache=True)
 def _other_platform(p_sp_prev, p_sp, q_sp_prev, q_sp, first, rest, c, state, row):
-    """A hexapod or a rig (``c[C_PLAT]``) following the set points from (``p_sp_prev``, ``q_sp_prev``) to (``p_sp``,
-    ``q_sp``) within its limits (:func:`washbench.platform.hexapod_kinematics.hexapod_track`,
-    :func:`washbench.platform.rig_kinematics.rig_track`). On the ``first`` sample it starts at rest at the start set
+    """A hexapod, a rig or the ideal follower of a plugin platform's pass (``c[C_PLAT]``) following the set points
+    from (``p_sp_prev``, ``q_sp_prev``) to (``p_sp``, ``q_sp``) within its limits
+    (:func:`washbench.platform.hexapod_kinematics.hexapod_track`, :func:`washbench.platform.rig_kinematics.rig_track`;
+    the ideal follower's pose is the set point). On the ``first`` sample it starts at rest at the start set
     point (as near as it can reach). The MRP's velocity and acceleration are the pose's difference quotients
     (v_k = (p_k - p_{k-1}) / dt, a_k = (v_k - v_{k-1}) / dt) and the body rate the quaternion difference's (Eqs.
     18-19): (q, q_prev, omega, acc, sat_pos, sat_vel, sat_acc, sat_rate, sat_angacc); the leg lengths into ``row``."""
@@ -450,8 +451,12 @@ def _other_platform(p_sp_prev, p_sp, q_sp_prev, q_sp, first, rest, c, state, row
     lsp = state[S_LEGSP : S_LEGSP + 6]
     work = state[S_WORK : S_WORK + NWORK]
     st = state[S_LEG : S_LEG + NRIG_STATE]
+    ideal = c[C_PLAT] == PLAT_IDEAL
     if first:
-        if hexapod:
+        if ideal:
+            p0 = p_sp_prev
+            q0 = q_sp_prev
+        elif hexapod:
             p0, q0, _, _, _ = hexapod_track(geo, c[C_LV], c[C_LA], catch, dt, p_sp_prev, q_sp_prev, p_sp_prev,
                                             q_sp_prev, legs, vels, lsp, work, True)  # fmt: skip
         else:
@@ -465,7 +470,17 @@ def _other_platform(p_sp_prev, p_sp, q_sp_prev, q_sp, first, rest, c, state, row
     p_prev = (state[S_P], state[S_P + 1], state[S_P + 2])
     v_prev = (state[S_V], state[S_V + 1], state[S_V + 2])
     q_prev = (state[S_Q], state[S_Q + 1], state[S_Q + 2], state[S_Q + 3])
-    if hexapod:
+    if ideal:
+        p = p_sp
+        q = q_sp
+        sat_pos = 0
+        sat_vel = 0
+        sat_acc = 0
+        sat_rate = 0
+        sat_angacc = 0
+        for i in range(6):
+            row[O_LEG + i] = 0.0
+    elif hexapod:
         p, q, sat_pos, sat_vel, sat_acc = hexapod_track(geo, c[C_LV], c[C_LA], catch, dt, p_prev, q_prev, p_sp, q_sp,
                                                         legs, vels, lsp, work, False)  # fmt: skip
         sat_rate = 0

@@ -23,12 +23,13 @@ Kinds (the ``kind`` key of the file given to ``--platform FILE``; without the ke
 - ``rig``: a 2- or 3-DOF rig (:mod:`washbench.platform.rig`).
 
 Every built-in kind runs in the compiled per-sample step (:mod:`washbench.cueing.kernel`). :class:`Platform` is the
-Python form of the same contract, for documentation and for a future plugin form; plugins
-(``--platform-plugin``) are not implemented yet.
+Python form of the same contract: what a user's platform (:mod:`washbench.platform.plugins`,
+``--platform-plugin FILE.py:NAME`` or the entry-point group ``washbench.platforms``) implements.
 """
 
 from __future__ import annotations
 
+import hashlib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol, Union, runtime_checkable
@@ -37,6 +38,7 @@ import numpy as np
 
 from washbench.errors import WashbenchError, located
 from washbench.io.yamlio import line_of, read_yaml_digest, validate_data
+from washbench.platform import plugins
 from washbench.platform.hexapod import HexapodModel, MotionEnvelope
 from washbench.platform.limits import DEFAULT_LIMITS_PATH, PlatformLimits
 from washbench.platform.rig import RigModel
@@ -81,31 +83,66 @@ def platform_kind(model: Any) -> str:
     return getattr(model, "kind", "atlas")
 
 
-def planning_limits(model: Any) -> PlatformLimits | MotionEnvelope:
+def planning_limits(model: Any) -> PlatformLimits | MotionEnvelope | None:
     """The Atlas-shaped limits a washout plans against (:attr:`WashoutContext.limits`): the Atlas's own, or another
-    kind's box about neutral (:meth:`HexapodModel.envelope`, :meth:`RigModel.envelope`)."""
+    kind's box about neutral (:meth:`HexapodModel.envelope`, :meth:`RigModel.envelope`, a plugin's ``envelope``:
+    None without one)."""
     return model if platform_kind(model) == "atlas" else model.envelope()
 
 
-def platform_from_data(path: Path, data: Any, lines: Any) -> PlatformModel:
-    """Validate a parsed platform file by its ``kind`` key (absent: ``atlas``); errors name file, line and field."""
+def platform_from_data(path: Path, data: Any, lines: Any) -> Any:
+    """Validate a parsed platform file by its ``kind`` key (absent: ``atlas``; a plugin's kind: its parameters, see
+    :mod:`washbench.platform.plugins`); errors name file, line and field."""
     kind = data.get("kind", "atlas") if isinstance(data, dict) else "atlas"
     if kind not in KINDS:
-        line = line_of(lines, ("kind",))
-        raise WashbenchError(located(path, f"unknown platform kind {kind!r} (valid: {', '.join(KINDS)})", line=line,
-                                     field="kind"))  # fmt: skip
+        source = plugins.source_of(str(kind))
+        if source is None:
+            line = line_of(lines, ("kind",))
+            valid = ", ".join([*KINDS, *plugins.plugin_kinds()])
+            raise WashbenchError(located(path, f"unknown platform kind {kind!r} (valid: {valid})", line=line,
+                                         field="kind"))  # fmt: skip
+        values = {k: v for k, v in data.items() if k not in ("kind", "name")}
+        platform = plugins.PluginPlatform(kind=str(kind), name=str(data.get("name", kind)), source=source,
+                                          values=values)  # fmt: skip
+        try:
+            platform.params()
+        except WashbenchError as exc:
+            raise WashbenchError(located(path, str(exc))) from None
+        return platform
     if kind == "atlas" and "kind" in data:
-        data = {
-            k: v for k, v in data.items() if k != "kind"
-        }  # the Atlas model has no kind field
+        data = {k: v for k, v in data.items() if k != "kind"}  # the Atlas model has no kind field
     return validate_data(path, data, lines, KINDS[kind])
 
 
-def load_platform(path: Path | None = None) -> tuple[PlatformModel, str]:
-    """A platform file (``None``: the bundled Atlas) as its model, and the SHA-256 of the bytes read."""
-    source = Path(path) if path is not None else DEFAULT_LIMITS_PATH
-    data, lines, sha = read_yaml_digest(source)
-    return platform_from_data(source, data, lines), sha
+_DEFAULT_PLUGIN: list[str] = []
+"""The kind of ``--platform-plugin`` when no ``--platform`` is given (this process)."""
+
+
+def set_default_plugin(kind: str | None) -> None:
+    """Make the plugin ``kind`` the platform of a run given no ``--platform`` (None: the Atlas again)."""
+    _DEFAULT_PLUGIN[:] = [kind] if kind else []
+
+
+def resolve_platform(path: Path | None) -> tuple[Any, Path, str]:
+    """(model, the file it came from, its SHA-256): ``path``; or without one the ``--platform-plugin`` loaded
+    (its Python file, no parameters), else the bundled Atlas."""
+    if path is None and _DEFAULT_PLUGIN:
+        kind = _DEFAULT_PLUGIN[0]
+        source = plugins.source_of(kind) or ""
+        file = Path(source.rpartition(":")[0])
+        platform = plugins.PluginPlatform(kind=kind, name=kind, source=source)
+        platform.params()
+        return platform, file, hashlib.sha256(file.read_bytes()).hexdigest()
+    source_path = Path(path) if path is not None else DEFAULT_LIMITS_PATH
+    data, lines, sha = read_yaml_digest(source_path)
+    return platform_from_data(source_path, data, lines), source_path, sha
+
+
+def load_platform(path: Path | None = None) -> tuple[Any, str]:
+    """A platform file (``None``: the ``--platform-plugin`` loaded, else the bundled Atlas) as its model, and the
+    SHA-256 of the bytes read."""
+    model, _, sha = resolve_platform(path)
+    return model, sha
 
 
 def load_platform_model(path: Path | None = None) -> PlatformModel:
@@ -124,4 +161,6 @@ __all__ = [
     "planning_limits",
     "platform_from_data",
     "platform_kind",
+    "resolve_platform",
+    "set_default_plugin",
 ]

@@ -26,8 +26,7 @@ from washbench.errors import WashbenchError
 from washbench.io.provenance import build_provenance, merge_provenance
 from washbench.io.yamlio import read_yaml_digest
 from washbench.perception.vestibular import VestibularParams, model_params, model_record
-from washbench.platform.limits import DEFAULT_LIMITS_PATH
-from washbench.platform.model import PlatformModel, platform_from_data, platform_kind
+from washbench.platform.model import PlatformModel, platform_kind, resolve_platform
 from washbench.runs.outputs import DEFAULT_OUTPUTS, Outputs
 from washbench.runs.rank_rule import rank_rule_from_data
 
@@ -110,9 +109,8 @@ def load_options(
     data, lines, params_sha = read_yaml_digest(Path(source))  # the parameter file, read and parsed once
     params, from_file = param_file_from_data(Path(source), data, lines)
     chosen = select_from(washouts, variants, params, from_file)
-    platform_source = platform_path or DEFAULT_LIMITS_PATH
-    platform_data, platform_lines, platform_sha = read_yaml_digest(Path(platform_source))
-    limits = platform_from_data(Path(platform_source), platform_data, platform_lines)
+    limits, resolved, platform_sha = resolve_platform(platform_path)
+    platform_source = platform_path or resolved
     if washouts is None and not variants:  # the default set: those of its washouts that can drive this platform
         chosen = tuple(w for w in chosen if platform_refusal(w, limits) is None)
     check_platform(chosen, limits)  # a washout named that cannot drive this platform: refused before anything is flown
