@@ -257,3 +257,24 @@ def test_a_broken_platform_plugin_is_one_line(flights, tmp_path):
     assert len(proc.stderr.strip().splitlines()) == 1 and "Traceback" not in proc.stderr, proc.stderr
     assert "platform broken" in proc.stderr and "flags" in proc.stderr
     assert not any((tmp_path / "out").rglob("traces.parquet"))
+
+
+def test_the_recording_draws_the_hexapods_legs_as_long_as_the_leg_columns(flights, tmp_path):
+    platform = hexapod_file(tmp_path / "h.yaml")
+    out = tmp_path / "out"
+    proc = washbench("cue", flights["violent"], "--out", out, "--platform", platform, "--washout", "large-angle",
+                     "--no-figures", "--quiet")  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    from washbench.review.rrd_read import read_component
+
+    (rrd,) = out.rglob("recording.rrd")
+    (traces,) = out.rglob("traces.parquet")
+    table = pq.read_table(traces).to_pydict()
+    t_s = np.asarray(table["t_s"])
+    legs = np.column_stack([table[f"large-angle.leg_{i}_m"] for i in range(1, 7)])
+    t, strips = read_component(rrd, "LineStrips3D:strips")["/world/hexapod/large-angle/legs"]
+    assert len(t) > 100
+    rows = np.searchsorted(t_s, t - 1e-9)
+    drawn = np.array([[np.linalg.norm(np.subtract(s[1], s[0], dtype=float)) for s in row] for row in strips])
+    np.testing.assert_allclose(drawn, legs[rows], atol=2e-5)  # float32 in the recording
+    np.testing.assert_allclose(np.asarray(strips[0][0][0], float), BASE[0], atol=1e-6)  # leg 1 starts at base joint 1

@@ -114,8 +114,8 @@ def load_options(
     if washouts is None and not variants:  # the default set: those of its washouts that can drive this platform
         chosen = tuple(w for w in chosen if platform_refusal(w, limits) is None)
     check_platform(chosen, limits)  # a washout named that cannot drive this platform: refused before anything is flown
-    if outputs.recording and platform_kind(limits) != "atlas":
-        # the recording draws the Atlas (sphere, stage, omni-wheels) only: not written for another platform yet
+    if outputs.recording and platform_kind(limits) not in ("atlas", "hexapod"):
+        # the recording draws the Atlas (sphere, stage, omni-wheels) or a hexapod only: not written for another yet
         outputs = dataclasses.replace(outputs, recording=False)
     rule = rank_rule_from_data(params_path, data, lines, rank_by)
     vestibular_params = model_params(vestibular)
