@@ -6,6 +6,7 @@ position and attitude in traces.parquet (numpy and scipy's Rotation, not washben
 within the stroke, the leg speeds and accelerations within their limits, and agree with the leg columns.
 """
 
+import json
 import subprocess
 import sys
 from pathlib import Path
@@ -244,7 +245,7 @@ def test_a_platform_plugin_drives_the_washouts_and_is_recorded(flights, tmp_path
     acc = np.asarray(table["large-angle.acc_x_mps2"])
     np.testing.assert_allclose(acc[2:], np.diff(pos[:, 0], 2) / DT**2, atol=1e-6)
     (run,) = out.rglob("run.json")
-    record = __import__("json").loads(run.read_text())["provenance"]["platform"]
+    record = json.loads(run.read_text())["provenance"]["platform"]
     assert record["path"] == str(file) and record["values"]["kind"] == "box" and len(record["sha256"]) == 64
 
 
@@ -278,3 +279,50 @@ def test_the_recording_draws_the_hexapods_legs_as_long_as_the_leg_columns(flight
     drawn = np.array([[np.linalg.norm(np.subtract(s[1], s[0], dtype=float)) for s in row] for row in strips])
     np.testing.assert_allclose(drawn, legs[rows], atol=2e-5)  # float32 in the recording
     np.testing.assert_allclose(np.asarray(strips[0][0][0], float), BASE[0], atol=1e-6)  # leg 1 starts at base joint 1
+
+
+def _geometry():
+    from washbench.platform.hexapod import HexapodModel
+
+    model = HexapodModel.model_validate_json(json.dumps({
+        "kind": "hexapod", "name": "t", "base_joints_m": BASE, "platform_joints_m": PLATFORM,
+        "neutral_m": [0.0, 0.0, -1.83], "leg_length_m": {"min": LMIN, "max": LMAX},
+        "leg_velocity_limit_mps": VMAX, "leg_acceleration_limit_mps2": AMAX,
+    }))  # fmt: skip
+    return model, model.geometry()
+
+
+def test_forward_kinematics_recovers_the_pose_of_the_legs():
+    from washbench.platform.hexapod_kinematics import forward_kinematics, leg
+
+    _, geo = _geometry()
+    rng = np.random.default_rng(4)
+    work = np.zeros(48)
+    for _ in range(20):
+        p = tuple(rng.uniform(-0.1, 0.1, 3))
+        rot = Rotation.from_rotvec(rng.uniform(-0.1, 0.1, 3))
+        x, y, z, w = rot.as_quat()
+        legs = legs_from_pose(np.array([p]), np.array([[w, x, y, z]]))[0]
+        assert np.allclose([leg(geo, i, p, (w, x, y, z)) for i in range(6)], legs, atol=1e-12, rtol=0)
+        p_fk, q_fk, ok = forward_kinematics(geo, legs, (0.0, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0), work)
+        assert ok
+        np.testing.assert_allclose(p_fk, p, atol=1e-10)
+        angle = (Rotation.from_quat([q_fk[1], q_fk[2], q_fk[3], q_fk[0]]).inv() * rot).magnitude()
+        assert angle < 1e-10
+
+
+def test_a_set_point_beyond_the_workspace_is_scaled_to_its_edge():
+    from washbench.platform.hexapod_kinematics import reachable
+
+    _, geo = _geometry()
+    rot = Rotation.from_rotvec([0.3, -0.2, 0.1])
+    x, y, z, w = rot.as_quat()
+    p, q, scaled = reachable(geo, (0.8, -0.5, 0.4), (w, x, y, z))
+    assert scaled == 1
+    legs = legs_from_pose(np.array([p]), np.array([q]))[0]
+    assert legs.min() >= LMIN and legs.max() <= LMAX
+    assert min(legs.min() - LMIN, LMAX - legs.max()) < 1e-6  # the largest scale: a leg at its stroke's end
+    s = p[0] / 0.8  # the same scale on translation and rotation, towards neutral
+    np.testing.assert_allclose(p, [0.8 * s, -0.5 * s, 0.4 * s], rtol=1e-12)
+    np.testing.assert_allclose(Rotation.from_quat([q[1], q[2], q[3], q[0]]).as_rotvec(), s * rot.as_rotvec(),
+                               atol=1e-12)  # fmt: skip
