@@ -573,7 +573,7 @@ def _load_plugins(args: argparse.Namespace) -> None:
             registry.load_plugin(spec)
     platform_spec = getattr(args, "platform_plugin", None)
     if platform_spec:
-        from washbench.platform import model, plugins
+        from washbench.platform import model, plugins  # deferred: numpy
 
         kind = plugins.load_plugin(platform_spec)
         model.set_default_plugin(kind if getattr(args, "platform", None) is None else None)
