@@ -699,12 +699,16 @@ def bank_trace(f, om, cfg, coef, state, counts, out):
     for i in prange(cfg.shape[0]):
         if cfg[i, C_KIND] < 0.0:
             continue
+        # the Atlas has no legs: its leg fields (zero in every row) are set at once, not copied sample by sample
+        nf = O_LEG if cfg[i, C_PLAT] == PLAT_ATLAS else NFIELDS
+        if nf < NFIELDS:
+            out[i, nf:, :] = 0.0
         for k0 in range(0, n, TRACE_CHUNK):
             k1 = min(n, k0 + TRACE_CHUNK)
             rows = np.empty((1, k1 - k0, NFIELDS))
             bank_block(f[k0:k1], om[k0:k1], cfg[i : i + 1], coef[i : i + 1], state[i : i + 1], counts[i : i + 1], rows)
             for k in range(k0, k1):
-                for j in range(NFIELDS):
+                for j in range(nf):
                     out[i, j, k] = rows[0, k - k0, j]
 
 
