@@ -65,11 +65,20 @@ def _rank_option(p: argparse.ArgumentParser) -> None:
                    help="vestibular models (default young-meiry: Meiry-Young otolith, Young-Oman canals)")
 
 
+def _platform_options(p: argparse.ArgumentParser) -> None:
+    """--platform and --platform-plugin (docs/platforms.md)."""
+    p.add_argument("--platform", type=Path,
+                   help="platform file, its kind: key picks the model: atlas, hexapod, rig or a plugin's (default: "
+                   "bundled Atlas)")  # fmt: skip
+    p.add_argument("--platform-plugin", metavar="FILE.py:NAME",
+                   help="load a platform from a Python file (docs/platforms.md); without --platform it is the platform")
+
+
 def _study_options(p: argparse.ArgumentParser) -> None:
     """What sweep and tune share."""
     _plugin_option(p)
     p.add_argument("--params", type=Path, help="base washout parameter YAML (default: bundled CW1)")
-    p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
+    _platform_options(p)
     p.add_argument(
         "--from",
         dest="from_dir",
@@ -142,7 +151,7 @@ def build_parser() -> argparse.ArgumentParser:
     _washout_options(p)
     _rank_option(p)
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
-    p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
+    _platform_options(p)
 
     p = sub.add_parser("fly", help="fly a manoeuvre file with JSBSim and the scripted pilot")
     p.add_argument("manoeuvre", type=Path, help="manoeuvre YAML file, or a bundled one by name (c172/takeoff)")
@@ -168,7 +177,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--max-time-s", type=float, metavar="S", help="JSBSim script: stop after S s (default 1200)")
     p.add_argument("--filter-start", choices=("steady", "rest"), default="steady", help="filters' start state")
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
-    p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
+    _platform_options(p)
     p.add_argument("--quiet", action="store_true", help="no progress display")
     _output_options(p)
 
@@ -188,7 +197,7 @@ def build_parser() -> argparse.ArgumentParser:
     _washout_options(p)
     _rank_option(p)
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
-    p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
+    _platform_options(p)
     p.add_argument("--dask", metavar="ADDRESS", help="run on this Dask scheduler instead of local processes")
     p.add_argument("--quiet", action="store_true", help="no progress display")
     _output_options(p)
@@ -197,7 +206,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", type=_out_path, required=True, help="output folder (omct.csv, bode_<test>.png, report.md)")
     _washout_options(p)
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
-    p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
+    _platform_options(p)
     p.add_argument("--boundaries", type=Path, help="gain/phase boundaries YAML, drawn and checked (docs: OMCT)")
     p.add_argument("--rate-hz", type=float, default=120.0, help="washout sample rate (default 120)")
     p.add_argument("--amplitude-scale", type=float, default=1.0, help="multiply every input amplitude (default 1)")
@@ -297,7 +306,7 @@ def _live_parsers(sub: Any) -> None:
     p.add_argument("--print-flightgear-protocol", action="store_true", help="print FlightGear's protocol file, exit")
     _washout_options(p)
     p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
-    p.add_argument("--platform", type=Path, help="platform limits YAML (default: bundled Atlas)")
+    _platform_options(p)
     _rank_option(p)
     _output_options(p)
 
@@ -563,6 +572,12 @@ def _load_plugins(args: argparse.Namespace) -> None:
     if specs:
         for spec in specs:
             registry.load_plugin(spec)
+    platform_spec = getattr(args, "platform_plugin", None)
+    if platform_spec:
+        from washbench.platform import model, plugins  # deferred: numpy
+
+        kind = plugins.load_plugin(platform_spec)
+        model.set_default_plugin(kind if getattr(args, "platform", None) is None else None)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -42,10 +42,11 @@ section of the parameter file named after the plugin (an instance of the class's
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Protocol, runtime_checkable
+from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
+from washbench.platform.hexapod import MotionEnvelope
 from washbench.platform.limits import PlatformLimits
 
 SetPoint = tuple[np.ndarray, np.ndarray]
@@ -56,18 +57,21 @@ SetPoint = tuple[np.ndarray, np.ndarray]
 class WashoutContext:
     """What an algorithm is told when it is made: the run's fixed facts, SI.
 
-    dt_s: sample interval, s. gravity_mps2: g, m/s^2 (g_I = [0, 0, +g]). limits: the platform's limits (position,
-    velocity, acceleration per inertial axis; sphere rate and acceleration), as in the platform file; the Atlas
-    model enforces them whatever the set points, an algorithm may use them to plan. filter_start: ``"steady"``
-    (the first sample is a steady state) or ``"rest"`` (the simulator was level and still before it).
-    head_offset_m: the pilot's head from the cockpit centre, simulator body axes, m.
+    dt_s: sample interval, s. gravity_mps2: g, m/s^2 (g_I = [0, 0, +g]). limits: the platform's limits in the
+    Atlas's shape (position, velocity, acceleration per inertial axis; rotation rate and acceleration): the Atlas
+    file's own, or for another platform a box about neutral (:func:`washbench.platform.model.planning_limits`); the
+    platform enforces its own limits whatever the set points, an algorithm may use these to plan. filter_start:
+    ``"steady"`` (the first sample is a steady state) or ``"rest"`` (the simulator was level and still before it).
+    head_offset_m: the pilot's head from the cockpit centre (the motion reference point), simulator body axes, m.
+    platform: the loaded platform file of any kind (:data:`washbench.platform.model.PlatformModel`), or None.
     """
 
     dt_s: float
     gravity_mps2: float
-    limits: PlatformLimits
+    limits: PlatformLimits | MotionEnvelope
     filter_start: str
     head_offset_m: tuple[float, float, float]
+    platform: Any = None
 
 
 @runtime_checkable

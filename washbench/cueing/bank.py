@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -30,6 +30,7 @@ from washbench.cueing.kernel import (
     C_DT,
     C_FREEFALL,
     C_G,
+    C_GEO,
     C_GK,
     C_GP,
     C_HEAD_EULER,
@@ -37,13 +38,17 @@ from washbench.cueing.kernel import (
     C_KHI,
     C_KIND,
     C_KLO,
+    C_LA,
     C_LP_BEFORE,
+    C_LV,
     C_P0,
     C_PHI,
+    C_PLAT,
     C_PLO,
     C_PMAX,
     C_R,
     C_REST,
+    C_RIG,
     C_ROT_SAT,
     C_SF,
     C_SW,
@@ -75,6 +80,7 @@ from washbench.cueing.kernel import (
     O_ACC,
     O_HEAD_F,
     O_HEAD_OMEGA,
+    O_LEG,
     O_OMEGA,
     O_POS,
     O_Q,
@@ -83,6 +89,9 @@ from washbench.cueing.kernel import (
     O_SP_Q,
     O_VEL,
     O_WHEEL,
+    PLAT_HEXAPOD,
+    PLAT_IDEAL,
+    PLAT_RIG,
     S_COST,
     S_GK,
     S_GP,
@@ -99,11 +108,14 @@ from washbench.cueing.kernel import (
 )
 from washbench.cueing.params import ADAPTIVE_KINDS, FILTER_STARTS, WashoutParams, check_filter_start  # noqa: F401
 from washbench.cueing.setpoints import SetPointSource
-from washbench.cueing.variants import Washout, as_washouts
+from washbench.cueing.variants import Washout, as_washouts, check_platform
 from washbench.errors import WashbenchError
 from washbench.io.motion import DT_RANGE_S
 from washbench.numerics.jitcache import announce_compile
-from washbench.platform.limits import PlatformLimits, wheel_jacobian
+from washbench.platform.hexapod import CATCH_UP_FRACTION, RATE_MARGIN
+from washbench.platform.limits import wheel_jacobian
+from washbench.platform.model import PlatformContext, PlatformModel, platform_kind
+from washbench.platform.plugins import PlatformRun
 
 _KINDS = {
     "small-angle": KIND_SMALL,
@@ -129,13 +141,12 @@ def _off(limit: float | None) -> float:
     return math.inf if limit is None else math.radians(limit)
 
 
-def washout_arrays(washout: Washout, limits: PlatformLimits, dt: float) -> tuple[np.ndarray, np.ndarray]:
+def washout_arrays(washout: Washout, limits: PlatformModel, dt: float) -> tuple[np.ndarray, np.ndarray]:
     """One washout's row of the compiled configuration (NCFG,) and its discretised filters (NFILT, 9), all SI.
 
     ``dt`` (s) is already checked (:func:`_check_dt`).
     """
     params, kind = washout.params, _KINDS.get(washout.kind, KIND_SETPOINT)
-    lim = limits.translation
     cfg = np.zeros(NCFG)
     cfg[C_KIND] = kind
     cfg[C_DT] = dt
@@ -149,13 +160,7 @@ def washout_arrays(washout: Washout, limits: PlatformLimits, dt: float) -> tuple
     cfg[C_COSMIN] = params.small_angle.min_cos_pitch
     cfg[C_FREEFALL] = params.free_fall_threshold_mps2
     cfg[C_R : C_R + 3] = params.head.offset_m
-    cfg[C_PMAX : C_PMAX + 3] = lim.position_limit_m.xyz
-    cfg[C_VMAX : C_VMAX + 3] = lim.velocity_limit_mps.xyz
-    cfg[C_AMAX : C_AMAX + 3] = lim.acceleration_limit_mps2.xyz
-    cfg[C_WMAX] = math.radians(limits.rotation.rate_limit_degps)
-    cfg[C_ALPHA] = math.radians(limits.rotation.acceleration_limit_degps2)
-    cfg[C_CATCH] = limits.rotation.catch_up_fraction
-    cfg[C_JAC : C_JAC + 9] = wheel_jacobian(limits).ravel()
+    _platform_cfg(cfg, limits)
     # the paper's choices ("auto"): small-angle filters the tilt rate after the cross product and estimates the
     # head rate from Euler angles (Eq. 8); the quaternion washouts filter f before it and difference quaternions
     position = params.tilt.lowpass_position
@@ -182,6 +187,35 @@ def washout_arrays(washout: Washout, limits: PlatformLimits, dt: float) -> tuple
         coef[F_TILT_LP + j] = filters.discretise(filters.tilt_lowpass(tilt_wn[j]), dt)
         coef[F_ROT_HP + j] = filters.discretise(filters.rotational_highpass(rot_wn[j]), dt)
     return cfg, coef
+
+
+def _platform_cfg(cfg: np.ndarray, platform: PlatformModel) -> None:
+    """The platform's kind, limits and geometry into a configuration row (SI)."""
+    kind = platform_kind(platform)
+    if kind == "hexapod":
+        cfg[C_PLAT] = PLAT_HEXAPOD
+        geo = platform.geometry()  # type: ignore[union-attr]
+        cfg[C_GEO : C_GEO + len(geo)] = geo
+        cfg[C_LV] = platform.leg_velocity_limit_mps * (1.0 - RATE_MARGIN)  # type: ignore[union-attr]
+        cfg[C_LA] = platform.leg_acceleration_limit_mps2 * (1.0 - RATE_MARGIN)  # type: ignore[union-attr]
+        cfg[C_CATCH] = CATCH_UP_FRACTION
+        return
+    if kind not in ("atlas", "hexapod", "rig"):  # a plugin's: the washout's pass (its set points) tracked ideally
+        cfg[C_PLAT] = PLAT_IDEAL
+        return
+    if kind == "rig":
+        cfg[C_PLAT] = PLAT_RIG
+        cfg[C_RIG : C_RIG + 12] = platform.limits_array()  # type: ignore[union-attr]
+        cfg[C_CATCH] = platform.catch_up_fraction  # type: ignore[union-attr]
+        return
+    lim = platform.translation  # type: ignore[union-attr]
+    cfg[C_PMAX : C_PMAX + 3] = lim.position_limit_m.xyz
+    cfg[C_VMAX : C_VMAX + 3] = lim.velocity_limit_mps.xyz
+    cfg[C_AMAX : C_AMAX + 3] = lim.acceleration_limit_mps2.xyz
+    cfg[C_WMAX] = math.radians(platform.rotation.rate_limit_degps)  # type: ignore[union-attr]
+    cfg[C_ALPHA] = math.radians(platform.rotation.acceleration_limit_degps2)  # type: ignore[union-attr]
+    cfg[C_CATCH] = platform.rotation.catch_up_fraction  # type: ignore[union-attr]
+    cfg[C_JAC : C_JAC + 9] = wheel_jacobian(platform).ravel()  # type: ignore[arg-type]
 
 
 def _adaptive_cfg(cfg: np.ndarray, washout: Washout) -> None:
@@ -216,11 +250,13 @@ def _adaptive_cfg(cfg: np.ndarray, washout: Washout) -> None:
 
 
 def build_arrays(
-    washouts: Sequence[Washout], limits: PlatformLimits, dt: float, filter_start: str = "steady"
+    washouts: Sequence[Washout], limits: PlatformModel, dt: float, filter_start: str = "steady"
 ) -> tuple[np.ndarray, np.ndarray]:
     """The compiled bank's configuration (n, NCFG) and filters (n, NFILT, 9) for checked washouts and dt.
 
-    ``filter_start``: the start state of every washout (:data:`FILTER_STARTS`)."""
+    ``filter_start``: the start state of every washout (:data:`FILTER_STARTS`). A washout that cannot drive the
+    platform is refused (:func:`check_platform`)."""
+    check_platform(washouts, limits)
     rows = [washout_arrays(w, limits, dt) for w in washouts]
     cfg = np.stack([r[0] for r in rows])
     cfg[:, C_REST] = 1.0 if check_filter_start(filter_start) == "rest" else 0.0
@@ -234,8 +270,9 @@ class WashoutTrace:
     pos_m, vel_mps, acc_mps2 (N, 3): platform translation, inertial NED. q (N, 4): platform attitude,
     body->inertial, scalar first. omega_radps (N, 3): platform body angular velocity. head_f_mps2,
     head_omega_radps (N, 3): simulator pilot-head specific force and angular velocity, simulator body axes.
-    wheel_radps (N, 3): omni-wheel speeds. sp_pos_m (N, 3), sp_q (N, 4): the washout's set points.
-    saturated: limit kind -> bool (N,) (kinds in ``SAT_KINDS``); saturation_counts: kind -> steps at it.
+    wheel_radps (N, 3): the Atlas's omni-wheel speeds ((N, 0) on another platform). sp_pos_m (N, 3), sp_q (N, 4):
+    the washout's set points. saturated: limit kind -> bool (N,) (kinds in ``SAT_KINDS``); saturation_counts: kind
+    -> steps at it. leg_m (N, 6): a hexapod's leg lengths, m ((N, 0) on another platform).
     """
 
     pos_m: np.ndarray
@@ -250,11 +287,13 @@ class WashoutTrace:
     sp_q: np.ndarray
     saturated: dict[str, np.ndarray]
     saturation_counts: dict[str, int]
+    leg_m: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
 
     @classmethod
-    def from_rows(cls, rows: np.ndarray, copy: bool = True) -> WashoutTrace:
+    def from_rows(cls, rows: np.ndarray, copy: bool = True, platform: str = "atlas") -> WashoutTrace:
         """Build from output rows (N, N_FIELDS) of :meth:`CueingBank.step` for one washout (columns copied, or
-        with ``copy=False`` views into ``rows``: valid only as long as ``rows`` is not overwritten)."""
+        with ``copy=False`` views into ``rows``: valid only as long as ``rows`` is not overwritten); ``platform``:
+        the platform's kind (which of its own fields the trace has)."""
         rows = np.asarray(rows, dtype=np.float64)
         if rows.ndim != 2 or rows.shape[1] != NFIELDS:
             raise ValueError(f"rows must have shape (N, {NFIELDS}), got {rows.shape}")
@@ -264,10 +303,10 @@ class WashoutTrace:
             return np.ascontiguousarray(view) if copy else view
 
         saturated = {k: rows[:, O_SAT + j] != 0.0 for j, k in enumerate(SAT_KINDS)}
-        return cls._build(cols, saturated)
+        return cls._build(cols, saturated, platform)
 
     @classmethod
-    def from_fields(cls, block: np.ndarray) -> WashoutTrace:
+    def from_fields(cls, block: np.ndarray, platform: str = "atlas") -> WashoutTrace:
         """Build from a field-major block (N_FIELDS, N) of one washout (no copy: the arrays are views, (N, k)
         in column-major order, each column contiguous)."""
         if block.ndim != 2 or block.shape[0] != NFIELDS:
@@ -277,10 +316,10 @@ class WashoutTrace:
             return block[start : start + n].T
 
         saturated = {k: block[O_SAT + j] != 0.0 for j, k in enumerate(SAT_KINDS)}
-        return cls._build(cols, saturated)
+        return cls._build(cols, saturated, platform)
 
     @classmethod
-    def _build(cls, cols, saturated: dict[str, np.ndarray]) -> WashoutTrace:
+    def _build(cls, cols, saturated: dict[str, np.ndarray], platform: str = "atlas") -> WashoutTrace:
         return cls(
             pos_m=cols(O_POS, 3),
             vel_mps=cols(O_VEL, 3),
@@ -289,11 +328,12 @@ class WashoutTrace:
             omega_radps=cols(O_OMEGA, 3),
             head_f_mps2=cols(O_HEAD_F, 3),
             head_omega_radps=cols(O_HEAD_OMEGA, 3),
-            wheel_radps=cols(O_WHEEL, 3),
+            wheel_radps=cols(O_WHEEL, 3 if platform == "atlas" else 0),
             sp_pos_m=cols(O_SP_POS, 3),
             sp_q=cols(O_SP_Q, 4),
             saturated=saturated,
             saturation_counts={k: int(v.sum()) for k, v in saturated.items()},
+            leg_m=cols(O_LEG, 6 if platform == "hexapod" else 0),
         )
 
 
@@ -363,12 +403,14 @@ class CueingBank:
         self,
         washouts: Sequence[str | Washout],
         params: WashoutParams | None,
-        limits: PlatformLimits,
+        limits: PlatformModel,
         dt_s: float,
         filter_start: str = "steady",
         future: tuple[np.ndarray, np.ndarray] | None = None,
     ) -> None:
         self.specs = as_washouts(washouts, params)
+        self.platform = platform_kind(limits)
+        """The platform's kind (``atlas``, ``hexapod``, ``rig``): :meth:`WashoutTrace.from_rows` of its rows."""
         self.washouts = tuple(w.name for w in self.specs)
         self.dt_s = _check_dt(dt_s)
         self._cfg, self._coef = build_arrays(self.specs, limits, self.dt_s, filter_start)
@@ -377,6 +419,7 @@ class CueingBank:
         self._counts = np.zeros((n, len(SAT_KINDS)), dtype=np.int64)
         self._out = np.zeros((n, NFIELDS))
         self._py = python_sources(self.specs, limits, self.dt_s, filter_start)
+        self._plugin = PluginPass(limits, len(self.washouts), self.dt_s, filter_start, self.specs)
         self._started = False
         self._k = 0  # samples stepped so far
         self._whole = self._whole_setpoints(future)
@@ -440,6 +483,9 @@ class CueingBank:
                 c, st = self._cfg[i], self._state[i]
                 setpoint_step(pos_a[k], q_a[k], int(fl[k, 0]), int(fl[k, 1]), c, self._coef[i], st, self._counts[i],
                               self._out[i])  # fmt: skip
+        if self._plugin:
+            for i in range(len(self.washouts)):
+                self._plugin.rows(i, self._out[i : i + 1], self._cfg[i], self._coef[i])
         self._k += 1
         return self._out
 
@@ -478,6 +524,9 @@ class CueingBank:
                 setpoint_block(np.ascontiguousarray(pos[k : k + m]), np.ascontiguousarray(q[k : k + m]),
                                np.ascontiguousarray(flags[k : k + m]), self._cfg[i], self._coef[i], self._state[i],
                                self._counts[i], out[i])  # fmt: skip
+        if self._plugin and m:
+            for i in range(len(self.washouts)):
+                self._plugin.rows(i, out[i], self._cfg[i], self._coef[i])
         if m:
             self._out[:] = out[:, -1]
         self._k += m
@@ -512,8 +561,9 @@ class CueingBank:
 
     def saturation_counts(self) -> dict[str, dict[str, int]]:
         """washout -> limit kind -> number of steps at that limit so far."""
+        counts = self._plugin.counts if self._plugin else self._counts
         return {
-            name: {k: int(self._counts[i, j]) for j, k in enumerate(SAT_KINDS)} for i, name in enumerate(self.washouts)
+            name: {k: int(counts[i, j]) for j, k in enumerate(SAT_KINDS)} for i, name in enumerate(self.washouts)
         }
 
 
@@ -523,7 +573,7 @@ def cue_trace(
     dt_s: float,
     washouts: Sequence[str | Washout],
     params: WashoutParams | None,
-    limits: PlatformLimits,
+    limits: PlatformModel,
     filter_start: str = "steady",
     fields_out: np.ndarray | None = None,
 ) -> dict[str, WashoutTrace]:
@@ -562,14 +612,69 @@ def cue_trace(
             _set_start(state[i], *src.start(f[0], w[0]))
             pos, q, flags = src.run(f, w, whole=True)
             setpoint_trace(pos, q, flags, cfg[i], coef[i], state[i], counts[i], out[i])
-    return {name: WashoutTrace.from_fields(out[i]) for i, name in enumerate(names)}
+    plugin = PluginPass(limits, len(names), dt, filter_start, specs)
+    if plugin and len(f):
+        for i in range(len(names)):
+            rows = np.ascontiguousarray(out[i].T)
+            plugin.rows(i, rows, cfg[i], coef[i])
+            out[i][:] = rows.T
+    kind = platform_kind(limits)
+    return {name: WashoutTrace.from_fields(out[i], kind) for i, name in enumerate(names)}
 
 
 def python_sources(
-    specs: Sequence[Washout], limits: PlatformLimits, dt: float, filter_start: str
+    specs: Sequence[Washout], limits: PlatformModel, dt: float, filter_start: str
 ) -> list[tuple[int, SetPointSource]]:
     """(index, source) of every washout of ``specs`` that is a Python algorithm (not compiled)."""
     return [(i, SetPointSource(w, limits, dt, filter_start)) for i, w in enumerate(specs) if w.kind not in _KINDS]
+
+
+class PluginPass:
+    """A plugin platform (:mod:`washbench.platform.plugins`) behind the washouts: the kernel has tracked each
+    washout's set points ideally (``PLAT_IDEAL``); :meth:`rows` gives those set points to the plugin (one instance per
+    washout), then runs the same compiled head-motion step on the poses it reached (its own state rows), and puts the
+    washout's set points and the plugin's flags back into the rows. Empty (false) on a built-in platform."""
+
+    def __init__(
+        self, platform: PlatformModel, n: int, dt_s: float, filter_start: str, specs: Sequence[Washout]
+    ) -> None:
+        self.runs: list[PlatformRun] = []
+        if platform_kind(platform) in ("atlas", "hexapod", "rig"):
+            return
+        g = specs[0].params.gravity_mps2 if specs else 9.80665
+        context = PlatformContext(dt_s=dt_s, gravity_mps2=g, filter_start=filter_start)
+        self.runs = [PlatformRun(platform, context) for _ in range(n)]  # type: ignore[arg-type]
+        self.state = np.zeros((n, NSTATE))
+        self.counts = np.zeros((n, len(SAT_KINDS)), dtype=np.int64)
+        self.started = [False] * n
+
+    def __bool__(self) -> bool:
+        return bool(self.runs)
+
+    def rows(self, i: int, rows: np.ndarray, cfg: np.ndarray, coef: np.ndarray) -> None:
+        """Washout i's output rows (M, NFIELDS), C-contiguous, rewritten in place with the plugin's motion."""
+        if not len(rows):
+            return
+        sp = rows[:, O_SP_POS : O_SP_POS + 3].copy()
+        sq = rows[:, O_SP_Q : O_SP_Q + 4].copy()
+        own = rows[:, O_SAT + 5 : O_SAT + 7].astype(np.int64)  # the washout's tilt-rate and rotational flags
+        run = self.runs[i]
+        if not self.started[i]:
+            _set_start(self.state[i], *run.start(sp[0], sq[0]))
+            self.started[i] = True
+        pos, q, flags = run.run(sp, sq)
+        setpoint_block(np.ascontiguousarray(pos), np.ascontiguousarray(q), np.ascontiguousarray(own), cfg, coef,
+                       self.state[i], self.counts[i], rows)  # fmt: skip
+        rows[:, O_SP_POS : O_SP_POS + 3] = sp
+        rows[:, O_SP_Q : O_SP_Q + 4] = sq
+        rows[:, O_SAT : O_SAT + 5] = flags
+        self.counts[i, :5] += flags.sum(axis=0)
+
+
+def _number(v: object) -> float | int:
+    """A reported statistic as a JSON number: a whole number as int (a count), else float."""
+    x = float(v)  # type: ignore[arg-type]
+    return int(x) if x.is_integer() and abs(x) < 2**53 else x
 
 
 def _set_start(state: np.ndarray, pos: np.ndarray, q: np.ndarray) -> None:

@@ -43,7 +43,9 @@ from washbench.numerics.rotations import (
     rot_euler_inv,
     wrap_near,
 )
+from washbench.platform.hexapod_kinematics import NGEO, NWORK, hexapod_track
 from washbench.platform.kinematics import track_axis, track_rotation, wheel_speeds
+from washbench.platform.rig_kinematics import NRIG_STATE, rig_track
 
 KIND_SMALL, KIND_LARGE, KIND_UNRESTRICTED = 0, 1, 2
 KIND_SETPOINT = -1  # an algorithm outside the kernel gives the set points (:func:`setpoint_step`)
@@ -62,10 +64,12 @@ FIELDS: tuple[str, ...] = (
     "sp_pos_x_m", "sp_pos_y_m", "sp_pos_z_m",
     "sp_q_w", "sp_q_x", "sp_q_y", "sp_q_z",
     *(f"sat_{k}" for k in SAT_KINDS),
+    *(f"leg_{i}_m" for i in range(1, 7)),
 )  # fmt: skip
 NFIELDS = len(FIELDS)
 O_POS, O_VEL, O_ACC, O_Q, O_OMEGA = 0, 3, 6, 9, 13
 O_HEAD_F, O_HEAD_OMEGA, O_WHEEL, O_SP_POS, O_SP_Q, O_SAT = 16, 19, 22, 25, 28, 32
+O_LEG = 39  # hexapod leg lengths (6), m; zero for other platforms
 
 # cfg offsets
 C_KIND, C_DT, C_G, C_SF, C_SW, C_TILT_K, C_TILT_RATE, C_ROT_SAT, C_COSMIN, C_FREEFALL = range(10)
@@ -80,7 +84,14 @@ C_REST = 37  # 1: start from rest (level, f = [0, 0, -g], no rotation) instead o
 # the coordinated adaptive washout (:func:`_adapt`, docs/washouts.md): 1 to adapt, adaptation rates, cost weights,
 # the translational gain's start and bounds, the tilt gain's bounds (its start is C_TILT_K)
 C_ADAPT, C_GP, C_GK, C_WF, C_WW, C_WX, C_WV, C_WPG, C_WKG, C_P0, C_PLO, C_PHI, C_KLO, C_KHI = range(38, 52)
-NCFG = 52
+# the platform (docs/platforms.md): its kind, a hexapod's geometry (:mod:`washbench.platform.hexapod_kinematics`)
+# and leg velocity and acceleration limits, a rig's limits (:meth:`washbench.platform.rig.RigModel.limits_array`)
+C_PLAT = 52
+PLAT_ATLAS, PLAT_HEXAPOD, PLAT_RIG, PLAT_IDEAL = 0, 1, 2, 3  # IDEAL: the pose is the set point (a plugin's pass)
+C_GEO = 53
+C_LV, C_LA = C_GEO + NGEO, C_GEO + NGEO + 1
+C_RIG = C_LA + 1
+NCFG = C_RIG + 12
 
 # filter indices (each 3 consecutive axes)
 F_TRANS_HP, F_TILT_LP, F_ROT_HP, F_EULER_D, F_OMEGA_D = 0, 3, 6, 9, 12
@@ -104,7 +115,11 @@ S_SFX = S_AD + 24  # the sensitivity high-pass filters' states (3 filters x 2)
 S_GRAD = S_AD + 30  # the last step's gradient dJ/dp (3), dJ/dk (3)
 S_COST = S_AD + 36  # the last step's cost J
 S_DW = S_AD + 37  # the last step's tilt-rate sensitivities d(w_t)/dk, 3x3 row-major [i, j] = component i of column j
-NSTATE = S_AD + 46
+# another platform than the Atlas: a hexapod's legs (6), leg velocities (6), leg set points (6), Newton scratch
+# (NWORK); a rig's axes (NRIG_STATE, from S_LEG)
+S_LEG = S_AD + 46
+S_LEGV, S_LEGSP, S_WORK = S_LEG + 6, S_LEG + 12, S_LEG + 18
+NSTATE = S_WORK + max(NWORK, NRIG_STATE)
 
 
 _INLINE_INTO = ("bank_block",)
@@ -417,6 +432,78 @@ def washout_classical(f, om, c, coef, state, first, rest):
     return q_sp_prev, p_sp_prev, sat_tilt, sat_rot
 
 
+@njit(cache=True)
+def _other_platform(p_sp_prev, p_sp, q_sp_prev, q_sp, first, rest, c, state, row):
+    """A hexapod, a rig or the ideal follower of a plugin platform's pass (``c[C_PLAT]``) following the set points
+    from (``p_sp_prev``, ``q_sp_prev``) to (``p_sp``, ``q_sp``) within its limits
+    (:func:`washbench.platform.hexapod_kinematics.hexapod_track`, :func:`washbench.platform.rig_kinematics.rig_track`;
+    the ideal follower's pose is the set point). On the ``first`` sample it starts at rest at the start set
+    point (as near as it can reach). The MRP's velocity and acceleration are the pose's difference quotients
+    (v_k = (p_k - p_{k-1}) / dt, a_k = (v_k - v_{k-1}) / dt) and the body rate the quaternion difference's (Eqs.
+    18-19): (q, q_prev, omega, acc, sat_pos, sat_vel, sat_acc, sat_rate, sat_angacc); the leg lengths into ``row``."""
+    dt = c[C_DT]
+    catch = c[C_CATCH]
+    hexapod = c[C_PLAT] == PLAT_HEXAPOD
+    geo = c[C_GEO : C_GEO + NGEO]
+    rig = c[C_RIG : C_RIG + 12]
+    legs = state[S_LEG : S_LEG + 6]
+    vels = state[S_LEGV : S_LEGV + 6]
+    lsp = state[S_LEGSP : S_LEGSP + 6]
+    work = state[S_WORK : S_WORK + NWORK]
+    st = state[S_LEG : S_LEG + NRIG_STATE]
+    ideal = c[C_PLAT] == PLAT_IDEAL
+    if first:
+        if ideal:
+            p0 = p_sp_prev
+            q0 = q_sp_prev
+        elif hexapod:
+            p0, q0, _, _, _ = hexapod_track(geo, c[C_LV], c[C_LA], catch, dt, p_sp_prev, q_sp_prev, p_sp_prev,
+                                            q_sp_prev, legs, vels, lsp, work, True)  # fmt: skip
+        else:
+            p0, q0, _, _, _, _, _ = rig_track(rig, catch, dt, p_sp_prev, q_sp_prev, st, True)
+        for j in range(3):
+            state[S_P + j] = p0[j]
+            state[S_V + j] = 0.0
+            state[S_W + j] = 0.0
+        for j in range(4):
+            state[S_Q + j] = q0[j]
+    p_prev = (state[S_P], state[S_P + 1], state[S_P + 2])
+    v_prev = (state[S_V], state[S_V + 1], state[S_V + 2])
+    q_prev = (state[S_Q], state[S_Q + 1], state[S_Q + 2], state[S_Q + 3])
+    if ideal:
+        p = p_sp
+        q = q_sp
+        sat_pos = 0
+        sat_vel = 0
+        sat_acc = 0
+        sat_rate = 0
+        sat_angacc = 0
+        for i in range(6):
+            row[O_LEG + i] = 0.0
+    elif hexapod:
+        p, q, sat_pos, sat_vel, sat_acc = hexapod_track(geo, c[C_LV], c[C_LA], catch, dt, p_prev, q_prev, p_sp, q_sp,
+                                                        legs, vels, lsp, work, False)  # fmt: skip
+        sat_rate = 0
+        sat_angacc = 0
+        for i in range(6):
+            row[O_LEG + i] = legs[i]
+    else:
+        p, q, sat_pos, sat_vel, sat_acc, sat_rate, sat_angacc = rig_track(rig, catch, dt, p_sp, q_sp, st, False)
+        for i in range(6):
+            row[O_LEG + i] = 0.0
+    v = ((p[0] - p_prev[0]) / dt, (p[1] - p_prev[1]) / dt, (p[2] - p_prev[2]) / dt)
+    acc = ((v[0] - v_prev[0]) / dt, (v[1] - v_prev[1]) / dt, (v[2] - v_prev[2]) / dt)
+    w = qrate_body(q, q_prev, dt)
+    for j in range(3):
+        state[S_P + j] = p[j]
+        state[S_V + j] = v[j]
+        state[S_W + j] = w[j]
+        row[O_ACC + j] = acc[j]
+    for j in range(4):
+        state[S_Q + j] = q[j]
+    return q, q_prev, w, acc, sat_pos, sat_vel, sat_acc, sat_rate, sat_angacc
+
+
 @njit(cache=True, inline=_inline_per_sample)
 def platform_head(p_sp_prev, p_sp, q_sp_prev, q_sp, first, rest, c, coef, state, counts, row, sat_tilt, sat_rot):
     """The Atlas platform tracking the set points (from ``p_sp_prev``, ``q_sp_prev`` to ``p_sp``, ``q_sp``) within
@@ -427,46 +514,55 @@ def platform_head(p_sp_prev, p_sp, q_sp_prev, q_sp, first, rest, c, coef, state,
     at the set point's rate."""
     dt = c[C_DT]
     g_i = (0.0, 0.0, c[C_G])
-    if first:
-        for j in range(3):
-            state[S_P + j] = 0.0
-            state[S_V + j] = 0.0
-        for j in range(4):
-            state[S_Q + j] = q_sp_prev[j]
-        w0 = qrate_body(q_sp, q_sp_prev, dt)  # already moving at the set point's rate: no start jolt
-        for j in range(3):
-            state[S_W + j] = 0.0 if rest else w0[j]
-    sat_pos = 0
-    sat_vel = 0
-    sat_acc = 0
-    for j in range(3):
-        v_prev = state[S_V + j]
-        p, v, s_p, s_v, s_a = track_axis(
-            state[S_P + j],
-            v_prev,
-            p_sp_prev[j],
-            p_sp[j],
-            c[C_PMAX + j],
-            c[C_VMAX + j],
-            c[C_AMAX + j],
-            c[C_CATCH],
-            dt,
+    if c[C_PLAT] != PLAT_ATLAS:
+        q, q_prev, w, acc, sat_pos, sat_vel, sat_acc, sat_rate, sat_angacc = _other_platform(
+            p_sp_prev, p_sp, q_sp_prev, q_sp, first, rest, c, state, row
         )
-        state[S_P + j] = p
-        state[S_V + j] = v
-        # the acceleration the stage made, within its limit exactly (the difference quotient rounds)
-        row[O_ACC + j] = min(max((v - v_prev) / dt, -c[C_AMAX + j]), c[C_AMAX + j])
-        sat_pos |= s_p
-        sat_vel |= s_v
-        sat_acc |= s_a
-    acc = (row[O_ACC], row[O_ACC + 1], row[O_ACC + 2])
-    q_prev = (state[S_Q], state[S_Q + 1], state[S_Q + 2], state[S_Q + 3])
-    w_prev = (state[S_W], state[S_W + 1], state[S_W + 2])
-    q, w, sat_rate, sat_angacc = track_rotation(q_prev, w_prev, q_sp_prev, q_sp, c[C_WMAX], c[C_ALPHA], c[C_CATCH], dt)
-    for j in range(4):
-        state[S_Q + j] = q[j]
-    for j in range(3):
-        state[S_W + j] = w[j]
+    else:
+        if first:
+            for j in range(3):
+                state[S_P + j] = 0.0
+                state[S_V + j] = 0.0
+            for j in range(4):
+                state[S_Q + j] = q_sp_prev[j]
+            w0 = qrate_body(q_sp, q_sp_prev, dt)  # already moving at the set point's rate: no start jolt
+            for j in range(3):
+                state[S_W + j] = 0.0 if rest else w0[j]
+        sat_pos = 0
+        sat_vel = 0
+        sat_acc = 0
+        for j in range(3):
+            v_prev = state[S_V + j]
+            p, v, s_p, s_v, s_a = track_axis(
+                state[S_P + j],
+                v_prev,
+                p_sp_prev[j],
+                p_sp[j],
+                c[C_PMAX + j],
+                c[C_VMAX + j],
+                c[C_AMAX + j],
+                c[C_CATCH],
+                dt,
+            )
+            state[S_P + j] = p
+            state[S_V + j] = v
+            # the acceleration the stage made, within its limit exactly (the difference quotient rounds)
+            row[O_ACC + j] = min(max((v - v_prev) / dt, -c[C_AMAX + j]), c[C_AMAX + j])
+            sat_pos |= s_p
+            sat_vel |= s_v
+            sat_acc |= s_a
+        acc = (row[O_ACC], row[O_ACC + 1], row[O_ACC + 2])
+        q_prev = (state[S_Q], state[S_Q + 1], state[S_Q + 2], state[S_Q + 3])
+        w_prev = (state[S_W], state[S_W + 1], state[S_W + 2])
+        q, w, sat_rate, sat_angacc = track_rotation(
+            q_prev, w_prev, q_sp_prev, q_sp, c[C_WMAX], c[C_ALPHA], c[C_CATCH], dt
+        )
+        for j in range(4):
+            state[S_Q + j] = q[j]
+        for j in range(3):
+            state[S_W + j] = w[j]
+        for j in range(6):  # no legs: the row's leg fields defined all the same (every row's bits determined)
+            row[O_LEG + j] = 0.0
 
     # ---- simulator pilot-head motion from what the platform actually does
     if c[C_HEAD_EULER] != 0.0:
@@ -603,12 +699,16 @@ def bank_trace(f, om, cfg, coef, state, counts, out):
     for i in prange(cfg.shape[0]):
         if cfg[i, C_KIND] < 0.0:
             continue
+        # the Atlas has no legs: its leg fields (zero in every row) are set at once, not copied sample by sample
+        nf = O_LEG if cfg[i, C_PLAT] == PLAT_ATLAS else NFIELDS
+        if nf < NFIELDS:
+            out[i, nf:, :] = 0.0
         for k0 in range(0, n, TRACE_CHUNK):
             k1 = min(n, k0 + TRACE_CHUNK)
             rows = np.empty((1, k1 - k0, NFIELDS))
             bank_block(f[k0:k1], om[k0:k1], cfg[i : i + 1], coef[i : i + 1], state[i : i + 1], counts[i : i + 1], rows)
             for k in range(k0, k1):
-                for j in range(NFIELDS):
+                for j in range(nf):
                     out[i, j, k] = rows[0, k - k0, j]
 
 
@@ -639,6 +739,8 @@ drop_stale_cache(
         _HERE / "filters.py",
         _HERE.parent / "numerics" / "jitcache.py",
         _HERE.parent / "platform" / "kinematics.py",
+        _HERE.parent / "platform" / "hexapod_kinematics.py",
+        _HERE.parent / "platform" / "rig_kinematics.py",
     ],
 )
 

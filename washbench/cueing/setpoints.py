@@ -18,6 +18,7 @@ from washbench.cueing import registry
 from washbench.cueing.algorithm import WashoutContext
 from washbench.cueing.guard import plugin_call
 from washbench.errors import WashbenchError
+from washbench.platform.model import planning_limits
 
 
 class SetPointSource:
@@ -33,9 +34,10 @@ class SetPointSource:
         self.context = WashoutContext(
             dt_s=dt_s,
             gravity_mps2=params.gravity_mps2,
-            limits=limits,
+            limits=planning_limits(limits),
             filter_start=filter_start,
             head_offset_m=tuple(params.head.offset_m),
+            platform=limits,
         )
         self.dt_s = dt_s
         self.k = -1  # the step being computed (-1: start)

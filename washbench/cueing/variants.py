@@ -360,6 +360,31 @@ def select_from(
     return as_washouts([*builtin(named, base), *extra] if named else list(extra), None)
 
 
+
+def platform_refusal(washout: Washout, platform: Any) -> str | None:
+    """Why ``washout`` cannot drive ``platform`` (one line), or None when it can: on a platform of limited rotation
+    (hexapod, rig) the unrestricted family (its attitude set point is never washed back to level) and the oracle
+    bound (its ceiling is over the Atlas's workspace only) cannot."""
+    kind = getattr(platform, "kind", "atlas")
+    if kind == "atlas":
+        return None
+    if washout.kind in ("unrestricted", "adaptive-unrestricted") and not getattr(platform, "unlimited_rotation", False):
+        return (f"washout {washout.name} ({washout.kind}): cannot drive a {kind} (limited rotation; its attitude set "
+                "point is never washed back to level); use large-angle or adaptive-large-angle")
+    if washout.kind == "bound":
+        return f"washout {washout.name} (bound): the oracle bound is computed for the Atlas only, not over a {kind}"
+    return None
+
+
+def check_platform(specs: Sequence[Washout], platform: Any) -> None:
+    """Raise a one-line WashbenchError for the first washout of ``specs`` that cannot drive ``platform``
+    (:func:`platform_refusal`)."""
+    for w in specs:
+        why = platform_refusal(w, platform)
+        if why is not None:
+            raise WashbenchError(why)
+
+
 __all__ = [
     "VariantText",
     "Washout",
@@ -367,11 +392,13 @@ __all__ = [
     "as_washouts",
     "builtin",
     "check_key",
+    "check_platform",
     "defaulted_sections",
     "load_param_file",
     "param_file_from_data",
     "parse_value",
     "parse_variant",
+    "platform_refusal",
     "resolve",
     "select_from",
     "select_washouts",

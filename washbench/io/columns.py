@@ -18,7 +18,8 @@ unchanged to ``traces.parquet`` (e.g. the flight pipeline's state columns).
     W.pos_{x,y,z}_m, W.vel_{x,y,z}_mps, W.acc_{x,y,z}_mps2   platform centre, NED inertial
     W.q_{w,x,y,z}                                            platform attitude, body -> inertial
     W.omega_platform_{x,y,z}_degps                           platform angular velocity, body axes
-    W.wheel_{1,2,3}_radps                                    Atlas omni-wheel speeds
+    W.wheel_{1,2,3}_radps                                    Atlas omni-wheel speeds (the Atlas only)
+    W.leg_{1..6}_m                                           hexapod leg lengths, joint to joint (a hexapod only)
     W.sp_pos_{x,y,z}_m, W.sp_q_{w,x,y,z}                     the washout's set points for the platform
     W.sat_<kind>                                             saturation flags, 0/1 (int8)
     <extra input columns, unchanged>
@@ -99,6 +100,11 @@ def omega_platform_columns(washout: str) -> tuple[str, str, str]:
 def wheel_columns(washout: str) -> tuple[str, str, str]:
     """Atlas omni-wheel speeds [rad/s]."""
     return tuple(f"{washout}.wheel_{i}_radps" for i in (1, 2, 3))  # type: ignore[return-value]
+
+
+def leg_columns(washout: str) -> tuple[str, ...]:
+    """Hexapod leg lengths, joint to joint [m], in the order of the platform file's joints."""
+    return tuple(f"{washout}.leg_{i}_m" for i in range(1, 7))
 
 
 def sp_pos_columns(washout: str) -> tuple[str, str, str]:

@@ -66,7 +66,23 @@ SATURATION_LABELS = {
     "tilt_rate": "tilt-rate limit",
     "rot_rate": "rotational saturation",
 }
-"""Readable names of the saturation kinds (``W.sat_<kind>`` columns)."""
+"""Readable names of the saturation kinds (``W.sat_<kind>`` columns) on the Atlas."""
+
+PLATFORM_SATURATION_LABELS = {
+    "hexapod": {"pos": "workspace / leg stroke", "vel": "leg velocity", "acc": "leg acceleration"},
+    "rig": {"pos": "axis stop (angle, heave)", "vel": "heave velocity", "acc": "heave acceleration",
+            "rate": "axis rate", "angacc": "axis ang. acceleration"},
+}  # fmt: skip
+"""What the platform's own saturation kinds mean on another platform than the Atlas (docs/platforms.md)."""
+
+
+def saturation_labels(platform: str = "atlas") -> dict[str, str]:
+    """:data:`SATURATION_LABELS` for a platform of kind ``platform`` (a plugin's: the kinds' own names)."""
+    if platform == "atlas":
+        return dict(SATURATION_LABELS)
+    plugin = {k: f"platform {k}" for k in ("pos", "vel", "acc", "rate", "angacc")}
+    own = PLATFORM_SATURATION_LABELS.get(platform, plugin)
+    return {**SATURATION_LABELS, **own}
 
 METRIC_LABELS = {"npc": "NPC", "integral_error": "integral of |error|", "max_error": "maximum |error|"}
 
@@ -506,11 +522,13 @@ def envelope_figure(
     phases: Sequence[tuple[str, float, float]] = (),
     formats: Sequence[str] = ("png",),
     palette: str | None = None,
+    labels: Mapping[str, str] | None = None,
 ) -> list[Path]:
     """Platform envelope usage and saturation lanes (module docstring); returns the paths (PNG first).
 
     ``usage``: panel label (e.g. "position") -> washout -> (N,) |value| / limit (dimensionless, 1 = at the limit);
-    ``saturated``: washout -> limit kind -> bool (N,) (kinds without any True are left out of the lanes).
+    ``saturated``: washout -> limit kind -> bool (N,) (kinds without any True are left out of the lanes);
+    ``labels``: the lanes' names per kind (default :data:`SATURATION_LABELS`, the Atlas's: :func:`saturation_labels`).
     """
     from matplotlib.lines import Line2D
 
@@ -520,7 +538,8 @@ def envelope_figure(
     lanes = [(w, k, flags) for w in washouts for k, flags in saturated.get(w, {}).items() if np.any(flags)]
     n_lanes = max(len(lanes), 1)
     # the lane labels (7.5 pt, about 0.06 in a character) and the "limit active" label set the left margin
-    label_in = max([len(SATURATION_LABELS.get(k, k)) for _, k, _ in lanes] + [8]) * 0.062
+    names = labels if labels is not None else SATURATION_LABELS
+    label_in = max([len(names.get(k, k)) for _, k, _ in lanes] + [8]) * 0.062
     size_in = (8.6, 1.55 * len(usage) + 0.9 + 0.2 * n_lanes)
     margins_in = (max(0.85, label_in + 0.45), 0.12, 0.62, 0.45)
     ratios = (*[1.0] * len(usage), 0.12 * n_lanes + 0.25)
@@ -550,7 +569,7 @@ def envelope_figure(
             a, b = run_edges(flags)
             bars(lane_ax, t_s[a], np.maximum((b - a) * dt, min_width), y - 0.35, 0.7, color=mpl(colors[w]), lw=0)
         lane_ax.set_yticks(range(len(lanes)))
-        lane_ax.set_yticklabels([SATURATION_LABELS.get(k, k) for _, k, _ in reversed(lanes)], fontsize=7.5)
+        lane_ax.set_yticklabels([names.get(k, k) for _, k, _ in reversed(lanes)], fontsize=7.5)
         for tick, (w, _, _) in zip(lane_ax.get_yticklabels(), reversed(lanes), strict=True):
             tick.set_color(mpl(colors[w]))
         lane_ax.set_ylim(-0.6, len(lanes) - 0.4)

@@ -40,7 +40,7 @@ from washbench.io.outfolder import discard_stage, make_stage, replace_entries
 from washbench.io.result_files import FIGURES_DIR, RECORDING_FILE, REPORT_FILE
 from washbench.review.bound_section import algorithm_lines, bound_lines
 from washbench.review.cue_figures import cue_classes, cue_lane_figure
-from washbench.review.figures import SATURATION_LABELS, envelope_figure, perceived_figure
+from washbench.review.figures import envelope_figure, perceived_figure, saturation_labels
 from washbench.review.input_figure import input_section
 from washbench.review.numbers import SCORE_FLAG, pct, sig
 from washbench.review.result_data import ResultData, load_result
@@ -199,7 +199,9 @@ def end_stop_note(data: ResultData, washout: str) -> str:
     steps = int(np.count_nonzero(flags)) if flags is not None else 0
     if not steps or steps < END_STOP_SHARE * data.n:
         return ""
-    return (f"end stop: stage at its position limit for {sig(steps * data.dt_s)} s "
+    kind = platform_of(data)
+    what = "stage at its position limit" if kind == "atlas" else f"at its {saturation_labels(kind)['pos']} limit"
+    return (f"end stop: {what} for {sig(steps * data.dt_s)} s "
             f"({pct(100.0 * steps / data.n, False)}), the score reflects its hard stops")  # fmt: skip
 
 
@@ -379,6 +381,7 @@ def saturation_lines(data: ResultData) -> list[str]:
     kinds = list(dict.fromkeys(k for w in data.washouts for k, f in data.saturated.get(w, {}).items() if f.any()))
     if not kinds:
         return ["No platform or washout limit was reached.", ""]
+    labels = saturation_labels(platform_of(data))
     head = "| limit | " + " | ".join(f"{w} (s, % of manoeuvre)" for w in data.washouts) + " |"
     lines = [head, "|---|" + "---|" * len(data.washouts)]
     for k in kinds:
@@ -387,7 +390,7 @@ def saturation_lines(data: ResultData) -> list[str]:
             flags = data.saturated.get(w, {}).get(k)
             steps = int(np.count_nonzero(flags)) if flags is not None else 0
             cells.append("-" if not steps else f"{sig(steps * data.dt_s)} s ({pct(100.0 * steps / data.n, False)})")
-        lines.append(f"| {SATURATION_LABELS.get(k, k)} (`{k}`) | " + " | ".join(cells) + " |")
+        lines.append(f"| {labels.get(k, k)} (`{k}`) | " + " | ".join(cells) + " |")
     return [*lines, ""]
 
 
@@ -461,9 +464,17 @@ def result_figures(
     if data.usage:
         out["envelope"] = envelope_figure(
             fig_dir / "envelope", data.title, data.t_s, data.usage, data.saturated, phases=data.phases, formats=formats,
-            palette=palette,
+            palette=palette, labels=saturation_labels(platform_of(data)),
         )[0]
     return out
+
+
+def platform_of(data: ResultData) -> str:
+    """The platform's kind a result was made on (its provenance; ``atlas`` when it does not say)."""
+    record = (data.provenance or {}).get("platform") or {}
+    values = record.get("values") if isinstance(record, dict) else None
+    kind = values.get("kind", "atlas") if isinstance(values, dict) else "atlas"
+    return kind if isinstance(kind, str) else "atlas"
 
 
 NO_FIGURES = "_No figures were drawn (`--no-figures`): `washbench report` on this folder draws them from its files._"

@@ -72,6 +72,7 @@ __all__ = [
     "DOFS",
     "ENVELOPE_QUANTITIES",
     "TIMELINE",
+    "HexapodDrawing",
     "MotionSeries",
     "PlatformEnvelope",
     "PlatformSeries",
@@ -181,8 +182,8 @@ class PlatformEnvelope:
     pos_m: float | tuple[float, float, float]
     vel_mps: float | tuple[float, float, float]
     acc_mps2: float | tuple[float, float, float]
-    wheel_radps: float | tuple[float, float, float]
-    sphere_diameter_m: float = 2.9  # drawn in the 3D view
+    wheel_radps: float | tuple[float, float, float] | None  # None: a platform without wheels (no wheels panel)
+    sphere_diameter_m: float = 2.9  # drawn in the 3D view (a hexapod: its base's diameter, for the spacing)
 
     def axes(self, fname: str) -> np.ndarray:
         """The limit ``fname`` (e.g. "pos_m") as a per-axis array (3,)."""
@@ -207,6 +208,23 @@ class RecordingData:
     phases: list[tuple[str, float, float]]  # (name, t_start_s, t_end_s)
     metrics_markdown: str
     thresholds: Thresholds = ZACHARIAS
+    hexapod: HexapodDrawing | None = None  # a hexapod's joints: drawn with its legs instead of the Atlas
+
+
+@dataclass(frozen=True)
+class HexapodDrawing:
+    """What the 3D view needs to draw a hexapod (docs/platforms.md), m: base joints (6, 3) in the base frame (NED,
+    origin at the base centre), platform joints (6, 3) in the cockpit's body axes (origin at the motion reference
+    point), the motion reference point at neutral (3,) in the base frame."""
+
+    base_joints_m: np.ndarray
+    platform_joints_m: np.ndarray
+    neutral_m: np.ndarray
+
+
+def envelope_quantities(data: RecordingData) -> tuple[tuple[str, str, str], ...]:
+    """The :data:`ENVELOPE_QUANTITIES` this recording's platform has (no wheels on a hexapod)."""
+    return tuple(q for q in ENVELOPE_QUANTITIES if getattr(data.envelope, q[1]) is not None)
 
 
 # ---------------------------------------------------------------------------------------------------------------------
@@ -306,11 +324,11 @@ def _check(data: RecordingData) -> int:
             _check_array(f"{src}.{fname}", getattr(m, fname), (n, 3))
         _check_array(f"{src}.q", m.q, (n, 4))
     for w, p in data.platforms.items():
-        for _, fname, _ in ENVELOPE_QUANTITIES:
+        for _, fname, _ in envelope_quantities(data):
             _check_array(f"platforms[{w}].{fname}", getattr(p, fname), (n, 3))
         for kind, flags in p.saturated.items():
             _check_array(f"platforms[{w}].saturated[{kind}]", flags, (n,), "b")
-    for fname in [f for _, f, _ in ENVELOPE_QUANTITIES] + ["sphere_diameter_m"]:
+    for fname in [f for _, f, _ in envelope_quantities(data)] + ["sphere_diameter_m"]:
         limit = np.asarray(getattr(data.envelope, fname))
         if (
             limit.shape not in ((), (3,))
@@ -442,7 +460,7 @@ def _send_motion(
 def _usage(data: RecordingData) -> dict[str, np.ndarray]:
     """Envelope usage per quantity: (N, washouts) max over the axes of |value| / limit."""
     out = {}
-    for q, fname, _unit in ENVELOPE_QUANTITIES:
+    for q, fname, _unit in envelope_quantities(data):
         limit = data.envelope.axes(fname)
         cols = []
         for w in data.washouts:
@@ -457,7 +475,7 @@ def _send_platforms(rec: rr.RecordingStream, data: RecordingData, usage: dict[st
     t_s = np.asarray(data.t_s, dtype=np.float64)
     washouts = list(data.washouts)
     colors = [series_color(w, washouts) for w in washouts]
-    for q, fname, unit in ENVELOPE_QUANTITIES:
+    for q, fname, unit in envelope_quantities(data):
         limit = data.envelope.axes(fname)
         axes = _axis_names(q)
         uniform = bool(np.all(limit == limit[0]))
@@ -669,8 +687,8 @@ def _layout(data: RecordingData, perceived: list[np.ndarray], raw: list[np.ndarr
         raw_ranges=tuple(_span([r]) for r in raw),
         limit_lanes=tuple(_limit_lanes(data)),
         camera=scene3d.camera(offsets, data.envelope.sphere_diameter_m),
-        envelope_quantities=tuple((q, unit) for q, _, unit in ENVELOPE_QUANTITIES),
-        limits_text=tuple(f"+-{_limit_text(data.envelope.axes(f))} {unit}" for _, f, unit in ENVELOPE_QUANTITIES),
+        envelope_quantities=tuple((q, unit) for q, _, unit in envelope_quantities(data)),
+        limits_text=tuple(f"+-{_limit_text(data.envelope.axes(f))} {unit}" for _, f, unit in envelope_quantities(data)),
         hidden_lanes=tuple(washout_lane_path(data, w) for w in data.washouts),
         cue_lanes=tuple(cue_lane_path(data, w) for w in data.washouts),
     )
@@ -773,6 +791,7 @@ def write_recording(path: Path, data: RecordingData, properties: Mapping[str, st
                 {w: p.pos_m for w, p in data.platforms.items()},
                 data.envelope.axes("pos_m"),
                 float(data.envelope.sphere_diameter_m),
+                data.hexapod,
             )
             _send_text(rec, data)
             _send_legend(rec, data)

@@ -24,6 +24,7 @@ from washbench.io.columns import (
     AIRCRAFT,
     TIME_COLUMN,
     acc_columns,
+    leg_columns,
     omega_platform_columns,
     perceived_f_columns,
     perceived_omega_columns,
@@ -35,6 +36,7 @@ from washbench.io.metrics_csv import MetricRow, read_metrics_csv
 from washbench.io.provenance import read_parquet_provenance
 from washbench.io.readback import FlightDoc, RunDoc, check_provenance, read_doc
 from washbench.io.result_files import FLIGHT_JSON, METRICS_FILE, RUN_FILE, TRACES_FILE
+from washbench.platform.hexapod import HexapodModel
 from washbench.platform.limits import PlatformLimits, wheel_jacobian
 
 
@@ -106,10 +108,35 @@ def _limits_from(prov: dict[str, Any] | None) -> Any:
         return None
     from pydantic import ValidationError
 
+    kind = values.get("kind", "atlas") if isinstance(values, dict) else "atlas"
+    model = {"hexapod": HexapodModel}.get(kind, PlatformLimits)
     try:
-        return PlatformLimits.model_validate_json(json.dumps(values))  # JSON mode: arrays are tuples
+        return model.model_validate_json(json.dumps(values))  # JSON mode: arrays are tuples
     except ValidationError:
         return None
+
+
+def leg_usage(table: dict[str, np.ndarray], washouts: list[str], hexapod: Any) -> dict[str, dict[str, np.ndarray]]:
+    """A hexapod's leg usage per panel and washout: each leg's |l_i - mid-stroke| / half-stroke (panels ``leg 1``
+    ... ``leg 6``: 1 = at an end of its stroke), and the fastest leg's |dl/dt| / leg velocity limit (``leg speed``,
+    0 at the first sample)."""
+    lo, hi = hexapod.leg_length_m.min, hexapod.leg_length_m.max
+    mid, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
+    time = np.asarray(table[TIME_COLUMN], dtype=np.float64) if TIME_COLUMN in table else None
+    out: dict[str, dict[str, np.ndarray]] = {f"leg {i}": {} for i in range(1, 7)}
+    out["leg speed"] = {}
+    for w in washouts:
+        cols = leg_columns(w)
+        if not all(c in table for c in cols):
+            continue
+        legs = np.column_stack([np.asarray(table[c], dtype=np.float64) for c in cols])
+        for i in range(6):
+            out[f"leg {i + 1}"][w] = np.abs(legs[:, i] - mid) / half
+        if time is not None and time.shape[0] > 1:
+            speed = np.zeros(time.shape[0])
+            speed[1:] = np.max(np.abs(np.diff(legs, axis=0)), axis=1) / np.diff(time)
+            out["leg speed"][w] = speed / hexapod.leg_velocity_limit_mps
+    return {k: v for k, v in out.items() if v}
 
 
 def envelope_usage(table: dict[str, np.ndarray], washouts: list[str], limits: Any) -> dict[str, dict[str, np.ndarray]]:
@@ -187,7 +214,7 @@ def load_result(folder: Path, table: Mapping[str, np.ndarray] | None = None, *, 
     for w in washouts:
         if series:
             want += [c for c in (*pos_columns(w), *vel_columns(w), *acc_columns(w), *omega_platform_columns(w),
-                                 *wheel_columns(w)) if c in names]  # fmt: skip
+                                 *wheel_columns(w), *leg_columns(w)) if c in names]  # fmt: skip
         want += sorted(c for c in names if c.startswith(f"{w}.sat_"))
     if table is None:
         try:
@@ -223,7 +250,12 @@ def load_result(folder: Path, table: Mapping[str, np.ndarray] | None = None, *, 
     else:
         prov = check_provenance(read_parquet_provenance(traces_path), traces_path)
     limits = _limits_from(prov)
-    usage = envelope_usage(table, washouts, limits) if limits is not None and series else {}
+    if limits is None or not series:
+        usage = {}
+    elif isinstance(limits, HexapodModel):
+        usage = leg_usage(table, washouts, limits)
+    else:
+        usage = envelope_usage(table, washouts, limits)
     motion_doc = run.get("perceived_motion")
     if isinstance(motion_doc, dict) and set(motion_doc) >= set(DOFS):
         motion = {d: float(motion_doc[d]["value"]) for d in DOFS}  # as the suite ranked it

@@ -162,8 +162,11 @@ def send_scene(
     stage_pos_m: dict[str, np.ndarray],
     travel_m: np.ndarray,
     diameter_m: float,
+    hexapod: object | None = None,
 ) -> None:
-    """Log the scene; ``time_of(t_s)`` makes the time column. Quaternions scalar first, body->NED."""
+    """Log the scene; ``time_of(t_s)`` makes the time column. Quaternions scalar first, body->NED. ``hexapod``
+    (:class:`washbench.review.rerun_log.HexapodDrawing`): each washout's platform is that hexapod, drawn with its
+    legs (:func:`_send_hexapod`), instead of the Atlas."""
     washouts = list(washout_q)
     offsets = object_offsets(len(washouts), travel_m, diameter_m)
     half = diameter_m / 2.0
@@ -196,6 +199,11 @@ def send_scene(
         static=True,
         strict=True,
     )
+    if hexapod is not None:
+        for i, w in enumerate(washouts):
+            _send_hexapod(rec, time_of, t_s, w, series_color(w, washouts), offsets[i + 1], washout_q[w], stage_pos_m[w],
+                          hexapod, half)  # fmt: skip
+        return
     for i, w in enumerate(washouts):
         color = series_color(w, washouts)
         base = f"/world/atlas/{w}"
@@ -221,3 +229,54 @@ def send_scene(
             strict=True,
         )
         _log_object(rec, f"{base}/cockpit", 0.8 * half, color)
+
+
+def _send_hexapod(
+    rec: rr.RecordingStream,
+    time_of: object,
+    t_s: np.ndarray,
+    washout: str,
+    color: tuple[int, int, int],
+    offset: np.ndarray,
+    q_wxyz: np.ndarray,
+    pos_m: np.ndarray,
+    hexapod: object,
+    half: float,
+) -> None:
+    """One washout's hexapod: the base joints (static, a hexagon on the floor), the cockpit (its platform joints'
+    hexagon and the attitude shape) at the motion reference point n + p with attitude q, and the six legs from each
+    base joint b_i to its platform joint n + p + R(q) a_i, at the poses sent (:func:`pose_samples`). The base frame's
+    origin sits at ``offset`` less the neutral point, so the cockpit at neutral is at ``offset``."""
+    b = np.asarray(hexapod.base_joints_m, dtype=np.float64)  # type: ignore[attr-defined]
+    a = np.asarray(hexapod.platform_joints_m, dtype=np.float64)  # type: ignore[attr-defined]
+    n = np.asarray(hexapod.neutral_m, dtype=np.float64)  # type: ignore[attr-defined]
+    root = f"/world/hexapod/{washout}"
+    rec.log(root, rr.Transform3D(translation=np.asarray(offset) - n), static=True, strict=True)
+    rec.log(f"{root}/base", rr.LineStrips3D([np.vstack([b, b[:1]])], colors=[LIMIT_COLOR], radii=[0.03]), static=True,
+            strict=True)  # fmt: skip
+    idx = pose_samples(t_s, q_wxyz, pos_m)
+    q = np.asarray(q_wxyz, dtype=np.float64)[idx]
+    p = np.asarray(pos_m, dtype=np.float64)[idx] + n
+    rec.send_columns(
+        f"{root}/cockpit",
+        indexes=[time_of(t_s[idx])],
+        columns=rr.Transform3D.columns(translation=p, quaternion=quat_wxyz_to_xyzw(q)),
+        strict=True,
+    )
+    rec.log(f"{root}/cockpit/joints", rr.LineStrips3D([np.vstack([a, a[:1]])], colors=[color], radii=[0.03]),
+            static=True, strict=True)  # fmt: skip
+    _log_object(rec, f"{root}/cockpit", 0.8 * half, color)
+    # legs: platform joints in the base frame, v + 2 w (u x v) + 2 u x (u x v) for each pose and joint
+    w, u = q[:, None, :1], np.broadcast_to(q[:, None, 1:], (len(q), 6, 3))
+    av = np.broadcast_to(a, (len(q), 6, 3))
+    t = 2.0 * np.cross(u, av)
+    top = p[:, None, :] + av + w * t + np.cross(u, t)
+    strips = np.stack([np.broadcast_to(b, top.shape), top], axis=2).reshape(-1, 2, 3)  # (poses * 6, 2, 3)
+    rec.send_columns(
+        f"{root}/legs",
+        indexes=[time_of(t_s[idx])],
+        columns=rr.LineStrips3D.columns(strips=list(strips)).partition([6] * len(idx)),
+        strict=True,
+    )
+    rec.log(f"{root}/legs", rr.LineStrips3D.from_fields(colors=[(200, 200, 200)], radii=[0.04]), static=True,
+            strict=True)  # fmt: skip

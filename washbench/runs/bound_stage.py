@@ -32,6 +32,7 @@ from washbench.analysis.ranking import BOUND_WASHOUT, DEFAULT_RULE, MOTION_FLOOR
 from washbench.cueing.registry import whole_only
 from washbench.io.atomic import write_text_atomic
 from washbench.io.csv_numbers import csv_number
+from washbench.platform.model import platform_kind
 from washbench.runs.chain import analyse, from_lockstep, stacked_rows
 
 CEILING_FILE = "ceiling.csv"
@@ -72,9 +73,11 @@ def lockstep_result(motion: Any, rows: list[Any], options: Any) -> Any:
 
     stepped, whole = split_whole(options.washouts)
     if not whole:
-        return from_lockstep(motion, rows, options.washout_order, options.vestibular_params, options.filter_start)
+        return from_lockstep(motion, rows, options.washout_order, options.vestibular_params, options.filter_start,
+                             platform_kind(options.limits))  # fmt: skip
     block = stacked_rows(rows)  # (washouts, N, fields)
-    traces = {w.name: WashoutTrace.from_rows(block[i]) for i, w in enumerate(stepped)}
+    kind = platform_kind(options.limits)
+    traces = {w.name: WashoutTrace.from_rows(block[i], platform=kind) for i, w in enumerate(stepped)}
     del block
     traces = with_whole(traces, motion, whole, options.washout_order, options.limits, options.filter_start)
     return analyse(motion, traces, options.vestibular_params, options.filter_start)

@@ -36,6 +36,7 @@ from washbench.io.columns import (
     TIME_COLUMN,
     acc_columns,
     f_columns,
+    leg_columns,
     omega_columns,
     omega_platform_columns,
     perceived_f_columns,
@@ -133,6 +134,7 @@ class CueResult:
                 _put(table, acc_columns(name), tr.acc_mps2)
                 _put(table, omega_platform_columns(name), tr.omega_radps * _DEG)
                 _put(table, wheel_columns(name), tr.wheel_radps)
+                _put(table, leg_columns(name), getattr(tr, "leg_m", _NONE))
             for kind, flags in tr.saturated.items():
                 table[sat_column(name, kind)] = np.asarray(flags)
         return table
@@ -142,6 +144,8 @@ class CueResult:
         for a in range(0, max(self.n, 1), rows):
             yield self.columns(a, min(self.n, a + rows))
 
+
+_NONE = np.zeros((0, 0))
 
 _TRACE_FIELDS = {
     "pos_m": 3,
@@ -154,7 +158,16 @@ _TRACE_FIELDS = {
     "wheel_radps": 3,
     "sp_pos_m": 3,
     "sp_q": 4,
+    "leg_m": 6,
 }
+_PLATFORM_FIELDS = {"wheel_radps": "atlas", "leg_m": "hexapod"}
+"""Trace fields only one kind of platform has: (N, 0) on the others."""
+
+
+def _width(attr: str, platform: str) -> int:
+    """Columns of trace field ``attr`` on a platform of kind ``platform``."""
+    own = _PLATFORM_FIELDS.get(attr)
+    return _TRACE_FIELDS[attr] if own is None or own == platform else 0
 
 
 def _checked_trace(name: str, trace: TraceLike, n: int, first: int = 0) -> dict[str, np.ndarray]:
@@ -162,8 +175,10 @@ def _checked_trace(name: str, trace: TraceLike, n: int, first: int = 0) -> dict[
     the sample number of the trace's first row, for the message)."""
     out = {}
     for attr, width in _TRACE_FIELDS.items():
-        a = np.asarray(getattr(trace, attr), dtype=np.float64)
-        if a.shape != (n, width):
+        a = np.asarray(getattr(trace, attr, _NONE[:n]) if attr == "leg_m" else getattr(trace, attr), dtype=np.float64)
+        if a.shape == (0, 0):
+            a = a.reshape(n, 0)
+        if a.shape != (n, width) and not (attr in _PLATFORM_FIELDS and a.shape == (n, 0)):
             raise ValueError(f"washout {name!r}: {attr} has shape {a.shape}, expected ({n}, {width})")
         bad = ~np.isfinite(a)
         if bad.any():
@@ -232,7 +247,9 @@ def _metric_rows(
 
 
 def _put(table: dict[str, np.ndarray], names: Sequence[str], values: np.ndarray) -> None:
-    for i, name in enumerate(names):
+    """The columns of ``values`` under ``names`` (as many as ``values`` has: none for a platform's field of another
+    kind of platform)."""
+    for i, name in enumerate(names[: values.shape[1]]):
         table[name] = values[:, i]
 
 
@@ -265,6 +282,7 @@ def _table_rows(
         _put(table, q_columns(name), f["q"])
         _put(table, omega_platform_columns(name), f["omega_radps"] * _DEG)
         _put(table, wheel_columns(name), f["wheel_radps"])
+        _put(table, leg_columns(name), f["leg_m"])
         _put(table, sp_pos_columns(name), f["sp_pos_m"])
         _put(table, sp_q_columns(name), f["sp_q"])
         for kind, flags in saturated[name].items():
@@ -295,7 +313,7 @@ def cue_motion(
     return analyse(motion, traces, vestibular, filter_start)
 
 
-_REVIEW_FIELDS = ("pos_m", "vel_mps", "acc_mps2", "omega_radps", "wheel_radps")
+_REVIEW_FIELDS = ("pos_m", "vel_mps", "acc_mps2", "omega_radps", "wheel_radps", "leg_m")
 """Washout trace fields a streamed cue keeps whole for the report (its envelope figure and time at a limit)."""
 _RECORDING_FIELDS = ("head_f_mps2", "head_omega_radps", "q")
 """... and for the recording (the simulator pilot's raw motion, the sphere's attitude in the 3D view)."""
@@ -340,7 +358,7 @@ def stream_cue(
     vertical = {p: np.empty(n) for p in streams}  # body-z specific force at each pilot's head (MSDV)
     sick = {p: SvcStream(motion.dt_s, start=filter_start) for p in streams}  # predicted incidence (MSI)
     keep = (_REVIEW_FIELDS if figures or recording else ()) + (_RECORDING_FIELDS if recording else ())
-    kept = {w: {f: np.empty((n, _TRACE_FIELDS[f])) for f in keep} for w in names}
+    kept = {w: {f: np.empty((n, _width(f, bank.platform))) for f in keep} for w in names}
     flags: dict[str, dict[str, np.ndarray]] = {w: {} for w in names}
     buf = np.empty((len(names), min(chunk_rows, n), len(CueingBank.FIELDS)))
 
@@ -355,7 +373,7 @@ def stream_cue(
             fields, saturated = {}, {}
             finite = bool(np.isfinite(block).all())  # one check of the chunk; the failing field named if not
             for i, w in enumerate(names):
-                tr = WashoutTrace.from_rows(block[i], copy=False)  # views into the reused buffer, used in the chunk
+                tr = WashoutTrace.from_rows(block[i], copy=False, platform=bank.platform)  # views, used in the chunk
                 fields[w] = {f: getattr(tr, f) for f in _TRACE_FIELDS} if finite else _checked_trace(w, tr, b - a, a)
                 saturated[w] = tr.saturated
                 perceived[w] = streams[w].perceive(fields[w]["head_f_mps2"], fields[w]["head_omega_radps"])
@@ -491,13 +509,15 @@ def from_lockstep(
     washouts: Sequence[str],
     vestibular: VestibularParams | None = None,
     filter_start: str = "steady",
+    platform: str = "atlas",
 ) -> CueResult:
     """The chain entered with a flight flown in lockstep: the washout traces the lockstep filled (``rows`` of
     :func:`lockstep_blocks` or :func:`lockstep_washouts`, emptied here; ``washouts`` their names in order) on
-    ``motion`` (the flight as read back from ``flight.parquet``), through :func:`analyse`."""
+    ``motion`` (the flight as read back from ``flight.parquet``), through :func:`analyse`. ``platform``: the
+    platform's kind (:func:`washbench.platform.model.platform_kind`)."""
     from washbench.cueing import WashoutTrace  # deferred: numba
 
     block = stacked_rows(rows)  # (washouts, N, fields); the lockstep's blocks are freed
-    traces = {w: WashoutTrace.from_rows(block[i]) for i, w in enumerate(washouts)}  # contiguous columns
+    traces = {w: WashoutTrace.from_rows(block[i], platform=platform) for i, w in enumerate(washouts)}  # contiguous
     del block
     return analyse(motion, traces, vestibular, filter_start)

@@ -30,7 +30,7 @@ from washbench.analysis.bound import MAX_BOUND_SAMPLES, BoundParams
 from washbench.analysis.bound_replay import replay
 from washbench.analysis.omct_boundaries import BoundaryFile
 from washbench.analysis.signals import SignalSpec, amplitude_unit, canonical_axis, generate
-from washbench.cueing.variants import Washout, select_washouts
+from washbench.cueing.variants import Washout, check_platform, platform_refusal, select_washouts
 from washbench.errors import WashbenchError, printable
 from washbench.io.atomic import write_text_atomic
 from washbench.io.budget import check_samples
@@ -41,8 +41,7 @@ from washbench.io.progress import Progress
 from washbench.io.result_files import REPORT_FILE
 from washbench.io.yamlio import load_yaml_model
 from washbench.perception.vestibular import VestibularModel, VestibularParams
-from washbench.platform import load_platform_limits
-from washbench.platform.limits import PlatformLimits
+from washbench.platform.model import PlatformModel, load_platform_model
 from washbench.review.bode import write_bode_plots
 from washbench.review.omct_report import report_text
 
@@ -124,7 +123,7 @@ def slowest_decay(entries: Sequence[Washout]) -> float:
 
 def measure(
     entries: Sequence[Washout],
-    limits: PlatformLimits,
+    limits: PlatformModel,
     rate_hz: float = 120.0,
     tests: Sequence[omct.OmctTest] = omct.TESTS,
     frequencies_radps: Sequence[float] = omct.FREQUENCIES_RADPS,
@@ -188,7 +187,7 @@ def measure(
 
 
 def _bound_estimate(
-    entries: Sequence[Washout], limits: PlatformLimits, tests: Sequence[omct.OmctTest],
+    entries: Sequence[Washout], limits: PlatformModel, tests: Sequence[omct.OmctTest],
     frequencies_radps: Sequence[float], rate_hz: float, sigma: float, amplitude_scale: float,
 ) -> None:  # fmt: skip
     """With the oracle bound among ``entries``: its size and an estimated time on stderr before the runs (one
@@ -314,7 +313,10 @@ def run_omct(
     WashbenchError before anything is written.
     """
     entries = select_washouts(washouts, variants, params_path)
-    limits = load_platform_limits(platform_path)
+    limits = load_platform_model(platform_path)
+    if washouts is None and not variants:  # the default set: those that can drive this platform
+        entries = [w for w in entries if platform_refusal(w, limits) is None]
+    check_platform(entries, limits)
     boundary = load_boundaries(boundaries_path) if boundaries_path is not None else None
     return run_entries(
         out_dir, entries, limits, boundary, rate_hz=rate_hz, amplitude_scale=amplitude_scale, plots=plots,
@@ -325,7 +327,7 @@ def run_omct(
 def run_entries(
     out_dir: Path,
     entries: Sequence[Washout],
-    limits: PlatformLimits,
+    limits: PlatformModel,
     boundary: BoundaryFile | None,
     rate_hz: float = 120.0,
     amplitude_scale: float = 1.0,

@@ -11,6 +11,7 @@ files again.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -20,12 +21,19 @@ from typing import Any
 from washbench.analysis.ranking import RankRule
 from washbench.cueing import registry
 from washbench.cueing.params import DEFAULT_PARAMS_PATH, WashoutParams, check_filter_start
-from washbench.cueing.variants import Washout, defaulted_sections, param_file_from_data, select_from
+from washbench.cueing.variants import (
+    Washout,
+    check_platform,
+    defaulted_sections,
+    param_file_from_data,
+    platform_refusal,
+    select_from,
+)
 from washbench.errors import WashbenchError
 from washbench.io.provenance import build_provenance, file_record, merge_provenance
-from washbench.io.yamlio import read_yaml_digest, validate_data
+from washbench.io.yamlio import read_yaml_digest
 from washbench.perception.vestibular import VestibularParams, model_params, model_record
-from washbench.platform.limits import DEFAULT_LIMITS_PATH, PlatformLimits
+from washbench.platform.model import PlatformModel, platform_kind, resolve_platform
 from washbench.runs.outputs import DEFAULT_OUTPUTS, Outputs
 from washbench.runs.rank_rule import rank_rule_from_data
 
@@ -55,7 +63,7 @@ class RunOptions:
     vestibular: str | None = None
     params: WashoutParams
     washouts: tuple[Washout, ...]
-    limits: PlatformLimits
+    limits: PlatformModel
     rank_rule: RankRule
     vestibular_params: VestibularParams
     plugins: tuple[str, ...] = ()
@@ -108,9 +116,14 @@ def load_options(
     data, lines, params_sha = read_yaml_digest(Path(source))  # the parameter file, read and parsed once
     params, from_file = param_file_from_data(Path(source), data, lines)
     chosen = select_from(washouts, variants, params, from_file)
-    platform_source = platform_path or DEFAULT_LIMITS_PATH
-    platform_data, platform_lines, platform_sha = read_yaml_digest(Path(platform_source))
-    limits = validate_data(Path(platform_source), platform_data, platform_lines, PlatformLimits)
+    limits, resolved, platform_sha = resolve_platform(platform_path)
+    platform_source = platform_path or resolved
+    if washouts is None and not variants:  # the default set: those of its washouts that can drive this platform
+        chosen = tuple(w for w in chosen if platform_refusal(w, limits) is None)
+    check_platform(chosen, limits)  # a washout named that cannot drive this platform: refused before anything is flown
+    if outputs.recording and platform_kind(limits) not in ("atlas", "hexapod"):
+        # the recording draws the Atlas (sphere, stage, omni-wheels) or a hexapod only: not written for another yet
+        outputs = dataclasses.replace(outputs, recording=False)
     rule = rank_rule_from_data(params_path, data, lines, rank_by)
     vestibular_params = model_params(vestibular)
     provenance = build_provenance(

@@ -124,6 +124,7 @@ def write_run_recording(
     ``properties``: the provenance as flat strings (:func:`washbench.io.provenance.flat_strings`).
     """
     from washbench.review.rerun_log import (  # deferred: rerun
+        HexapodDrawing,
         MotionSeries,
         PlatformSeries,
         RecordingData,
@@ -142,9 +143,14 @@ def write_run_recording(
             perceived_omega_radps=p.omega_radps,
             q=tr.q,
         )
+        wheels = tr.wheel_radps if np.shape(tr.wheel_radps)[1:] == (3,) else np.zeros((len(tr.pos_m), 3))  # (unused)
         platforms[name] = PlatformSeries(
-            pos_m=tr.pos_m, vel_mps=tr.vel_mps, acc_mps2=tr.acc_mps2, wheel_radps=tr.wheel_radps, saturated=tr.saturated
+            pos_m=tr.pos_m, vel_mps=tr.vel_mps, acc_mps2=tr.acc_mps2, wheel_radps=wheels, saturated=tr.saturated
         )
+    hexapod = None
+    if getattr(limits, "kind", "atlas") == "hexapod":
+        hexapod = HexapodDrawing(np.asarray(limits.base_joints_m), np.asarray(limits.platform_joints_m),
+                                 np.asarray(limits.neutral_m))  # fmt: skip
     data = RecordingData(
         title=title,
         t_s=motion.t_s,
@@ -161,13 +167,22 @@ def write_run_recording(
         phases=[(p[0], float(p[1]), float(p[2])) for p in phases],
         metrics_markdown=metrics_markdown(title, list(result.metrics),
                                           perceived_motion(ac.f_mps2, ac.omega_radps, float(motion.dt_s)), rule),
+        hexapod=hexapod,
     )
     write_recording(path, data, properties)
 
 
-def platform_envelope(limits: PlatformLimits) -> PlatformEnvelope:
-    """The recording's envelope lines from the platform limits (wheel limit from the rate limit)."""
+def platform_envelope(limits: Any) -> PlatformEnvelope:
+    """The recording's envelope lines from the platform limits (wheel limit from the rate limit); a hexapod's: its
+    box about neutral (:meth:`washbench.platform.hexapod.HexapodModel.envelope`), no wheels, the base's diameter."""
     from washbench.review.rerun_log import PlatformEnvelope  # deferred: rerun
+
+    if getattr(limits, "kind", "atlas") == "hexapod":
+        box = limits.envelope().translation
+        radius = float(np.max(np.linalg.norm(np.asarray(limits.base_joints_m)[:, :2], axis=1)))
+        return PlatformEnvelope(pos_m=box.position_limit_m.xyz, vel_mps=box.velocity_limit_mps.xyz,
+                                acc_mps2=box.acceleration_limit_mps2.xyz, wheel_radps=None,
+                                sphere_diameter_m=2.0 * radius)  # fmt: skip
 
     t = limits.translation
     jac = wheel_jacobian(limits)

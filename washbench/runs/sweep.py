@@ -23,12 +23,12 @@ from pathlib import Path
 
 from washbench.analysis.sweep import SweepRow, grid, parse_set, point_washouts, sweep_csv, sweep_metrics_csv
 from washbench.cueing.params import WASHOUT_NAMES
-from washbench.cueing.variants import Washout, load_param_file
+from washbench.cueing.variants import Washout, check_platform, load_param_file
 from washbench.errors import WashbenchError, printable
 from washbench.io.atomic import write_text_atomic
 from washbench.io.outfolder import result_set
 from washbench.io.progress import Progress
-from washbench.platform import load_platform_limits
+from washbench.platform.model import load_platform_model
 from washbench.review.study_figures import sweep_figure
 from washbench.runs.inputs import find_manoeuvres
 from washbench.runs.study import StudyFlight, evaluate, load_flights
@@ -122,7 +122,8 @@ def sweep_command(
     keys = [a.key for a in axes]
     base, _ = load_param_file(params_path)
     candidates = [w for k in kinds for w in point_washouts(k, base, points)]
-    limits = load_platform_limits(platform_path)
+    limits = load_platform_model(platform_path)
+    check_platform(candidates, limits)
     with result_set(out_dir, "sweep") as stage:  # the whole set replaces the previous one at once
         flights = load_flights(files, stage, limits, from_dir=from_dir, jobs=jobs, dask=dask, progress=progress,
             aircraft_dirs=aircraft_dirs,

@@ -29,14 +29,21 @@ from washbench.analysis.sweep import format_value
 from washbench.analysis.tune import Bound, minimise, parse_tune
 from washbench.cueing import registry
 from washbench.cueing.params import WashoutParams
-from washbench.cueing.variants import Washout, apply_overrides, check_kind, load_param_file, value_of
+from washbench.cueing.variants import (
+    Washout,
+    apply_overrides,
+    check_kind,
+    check_platform,
+    load_param_file,
+    value_of,
+)
 from washbench.errors import WashbenchError, printable
 from washbench.io.atomic import write_text_atomic
 from washbench.io.csv_numbers import csv_number
 from washbench.io.outfolder import result_set
 from washbench.io.progress import Progress
 from washbench.io.result_files import REPORT_FILE
-from washbench.platform import load_platform_limits
+from washbench.platform.model import load_platform_model
 from washbench.review.study_figures import convergence_figure
 from washbench.runs.inputs import find_manoeuvres
 from washbench.runs.study import evaluate, load_flights
@@ -100,7 +107,8 @@ def tune_command(
     for b in bounds:  # both ends must be valid values of the key
         for v in (b.low, b.high):
             apply_overrides(base, {b.key: v}, f"--tune {b.key}={b.low}:{b.high}")
-    limits = load_platform_limits(platform_path)
+    limits = load_platform_model(platform_path)
+    check_platform([Washout(kind, kind, base, registry.plugin_spec(kind))], limits)
     train_files = find_manoeuvres(manoeuvres)
     test_files = [p for p in (find_manoeuvres(test) if test else []) if p not in train_files]
     with result_set(out_dir, "tune") as stage:  # the whole set replaces the previous one at once
