@@ -100,6 +100,7 @@ def translation_plan(
     vestibular: VestibularParams | None = None,
     filter_start: str = "steady",
     position_weight: float = 0.0,
+    tolerance: float = REPLAY_TOL,
 ) -> tuple[np.ndarray, str]:
     """Stage 2 (module docstring): the stage's positions (N, 3) m, NED, for the attitudes ``q`` (N, 4), and the
     solver's status. ``f_air`` (N, 3) m/s^2 the aircraft pilot's specific force; ``jerk_weight`` per (m/s^3)^2,
@@ -192,7 +193,7 @@ def translation_plan(
     settings = clarabel.DefaultSettings()
     settings.verbose = False
     settings.max_iter = 200
-    settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = REPLAY_TOL
+    settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = tolerance
     cones = [clarabel.ZeroConeT(n_eq), clarabel.NonnegativeConeT(n_le)]
     sol = clarabel.DefaultSolver(sparse.triu(pmat, format="csc"), cost, a_mat, b_vec, cones, settings).solve()
     z = np.asarray(sol.x, dtype=np.float64)
@@ -220,7 +221,7 @@ def replay(
     traj = res.trajectory
     q_sp, q = attitudes(traj.angles, traj.omega[:, 2], dt_s, limits)
     pos, status = translation_plan(f, q, dt_s, limits, gravity_mps2, params.jerk_weight, filter_start=filter_start,
-                                   position_weight=params.position_weight)  # fmt: skip
+                                   position_weight=params.position_weight, tolerance=params.eps)  # fmt: skip
     solved = {f"{k}_solved": float(v == "Solved") for k, v in res.statuses.items()}
     solved["translation_solved"] = float(status == "Solved")
     return pos, q_sp, solved
