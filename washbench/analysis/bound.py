@@ -1,4 +1,8 @@
-"""The oracle bound: the least perceived error that any washout could reach on a recorded flight on this platform.
+"""The linearised bound: the quadratic perceived-error cost J over a small-angle, fixed-heading platform model, and its
+minimum with the whole flight known. It plans the attitude of the bound's replay
+(:mod:`washbench.analysis.bound_replay`). It is **not** a bound on the ranking (it minimises J, not the score, over a
+linearisation that does not contain what the Atlas does with unlimited rotation): the certified lower bound on the
+ranking's own measure is the ceiling, :mod:`washbench.analysis.ceiling` (docs/yardstick.md).
 
 The cost (:func:`perceived_cost`) compares what the simulator pilot and the aircraft pilot perceive, through the
 bench's vestibular models (:class:`washbench.perception.vestibular.VestibularModel`, both started in the steady
