@@ -603,10 +603,13 @@ def score_heatmap(
     scores: np.ndarray,
     title: str = "ranking score",
     formats: Sequence[str] = ("png",),
+    firsts: Sequence[Sequence[str]] | None = None,
 ) -> list[Path]:
-    """Score per manoeuvre (row) and washout (column), lower is better; best per row framed, above 1 in red.
+    """Score per manoeuvre (row) and washout (column), lower is better; the first place per row framed (each of a
+    tie), above 1 in red; the bound's replay (``bound``: knows the future, not ranked) in italics, never framed.
 
-    ``scores`` (R, W), NaN where a washout did not run. Returns the paths (PNG first).
+    ``scores`` (R, W), NaN where a washout did not run; ``firsts``: per row the washouts ranked first (None: the
+    lowest score of the ranked washouts). Returns the paths (PNG first).
     """
     from matplotlib.colors import LinearSegmentedColormap, TwoSlopeNorm
     from matplotlib.font_manager import FontProperties
@@ -624,27 +627,37 @@ def score_heatmap(
     ax = fig.subplots()
     image = ax.imshow(np.ma.masked_invalid(scores), cmap=cmap, norm=norm, aspect="auto")
     normal, bold = FontProperties(size=8), FontProperties(size=8, weight="bold")
+    italic = FontProperties(size=8, style="italic")
+    ranked = [c for c, w in enumerate(washouts) if w != "bound"]
     cells, texts, fonts = [], [], []
     for r in range(len(rows)):
         row = scores[r]
-        best = np.nanmin(row) if np.isfinite(row).any() else math.nan
+        if firsts is not None:
+            top = set(firsts[r])
+        else:
+            vals = [row[c] for c in ranked if math.isfinite(row[c])]
+            top = {washouts[c] for c in ranked if vals and row[c] == min(vals)}
         for c in range(len(washouts)):
             v = row[c]
-            is_best = math.isfinite(v) and v == best
+            is_best = math.isfinite(v) and washouts[c] in top and washouts[c] != "bound"
             cells.append((c, r))
             texts.append("-" if not math.isfinite(v) else _sig(v) + (f" {SCORE_FLAG}" if v > 1.0 else ""))
-            fonts.append(bold if is_best else normal)
+            fonts.append(bold if is_best else italic if washouts[c] == "bound" else normal)
             if is_best:
                 ax.add_patch(Rectangle((c - 0.5, r - 0.5), 1, 1, fill=False, lw=1.6, ec="black"))
     ax.add_artist(CellTexts(cells, texts, fonts))
-    ax.set_xticks(range(len(washouts)), washouts, fontsize=8.5)
+    labels = [f"{w} (replay)" if w == "bound" else w for w in washouts]
+    # many columns: the names slanted, so that long ones (adaptive-large-angle) do not run into each other
+    slant = {"rotation": 20, "ha": "left", "rotation_mode": "anchor"} if len(washouts) > 6 else {}
+    ax.set_xticks(range(len(washouts)), labels, fontsize=8.5, **slant)
     ax.xaxis.tick_top()
     ax.set_yticks(range(len(rows)), rows, fontsize=8)
     bar = fig.colorbar(image, ax=ax, shrink=0.8, pad=0.02)
     bar.set_label("score (lower is better)", fontsize=7.5)
     bar.ax.tick_params(labelsize=7)
-    ax.set_title(f"{title}: best per manoeuvre framed;\n{SCORE_FLAG} above 1 = worse than a simulator standing still",
-                 fontsize=9)  # fmt: skip
+    replay = "; bound (replay, knows the future): italics, not ranked" if "bound" in washouts else ""
+    ax.set_title(f"{title}: first place per manoeuvre framed (each of a tie){replay};\n{SCORE_FLAG} above 1 = worse "
+                 "than a simulator standing still", fontsize=9)  # fmt: skip
     return save_figure(fig, stem, formats)
 
 

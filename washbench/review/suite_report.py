@@ -175,7 +175,9 @@ def _write_suite_report(
         for r, d in enumerate(loaded):
             for row in rankings[id(d)]:
                 scores[r, washouts.index(row.washout)] = row.score
-        drawing["scores"] = _draw(pool, score_heatmap, fig_dir / "scores", labels, washouts, scores, formats=formats)
+        firsts = [[r.washout for r in rankings[id(d)] if r.rank == 1] for d in loaded]
+        drawing["scores"] = _draw(pool, score_heatmap, fig_dir / "scores", labels, washouts, scores, formats=formats,
+                                  firsts=firsts)  # fmt: skip
         others = [w for w in washouts if w != reference]
         if others:
             better = {w: np.full((len(loaded), len(METRICS) * len(DOFS)), math.nan) for w in others}
