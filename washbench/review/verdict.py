@@ -110,16 +110,22 @@ def verdict_lines(entries: Sequence[Entry], washouts: Sequence[str], reference: 
         reach = _median([reached(e, best) for e in ranked])
         text += (f" It recovers a median {_share(reach)} of what this platform could recover (the ceiling, the least "
                  "error any motion of the platform could reach: 100 %; standing still: 0 %).")  # fmt: skip
+    if not has_ceiling:
+        text += (" How much better any washout could be on each manoeuvre (the ceiling) needs `--washout bound` "
+                 "(docs/yardstick.md).")
     lines += [text, ""]
     # why: the specific-force cues against the rotational ones
     trans = {w: _median([group_errors(e, w)[0] for e in ranked]) for w in contenders}
     rot = {w: _median([group_errors(e, w)[1] for e in ranked]) for w in contenders}
     best_t = min(contenders, key=lambda w: trans[w] if math.isfinite(trans[w]) else math.inf)
     best_r = min(contenders, key=lambda w: rot[w] if math.isfinite(rot[w]) else math.inf)
-    why = (f"Why: the specific-force cues (surge, sway, heave) are best given by **{best_t}** (median relative error "
-           f"{sig(trans[best_t])}, {reference} {sig(trans.get(reference, math.nan))}), the rotational cues (roll, "
-           f"pitch, yaw) by **{best_r}** ({sig(rot[best_r])}, {reference} {sig(rot.get(reference, math.nan))}); "
-           "relative error: the integral error over what the aircraft pilot felt, 1 = a platform standing still.")
+    def versus(w: str, values: Mapping[str, float]) -> str:
+        ref = "" if w == reference else f", {reference} {sig(values.get(reference, math.nan))}"
+        return f"median relative error {sig(values[w])}{ref}"
+
+    why = (f"Why: the specific-force cues (surge, sway, heave) are best given by **{best_t}** "
+           f"({versus(best_t, trans)}), the rotational cues (roll, pitch, yaw) by **{best_r}** ({versus(best_r, rot)}); relative error: the "
+           "integral error over what the aircraft pilot felt, 1 = a platform standing still.")
     if best_t != best_r:
         why += " No washout has both halves: the score trades one against the other."
     lines += [why, ""]
