@@ -119,13 +119,15 @@ def verdict_lines(entries: Sequence[Entry], washouts: Sequence[str], reference: 
     rot = {w: _median([group_errors(e, w)[1] for e in ranked]) for w in contenders}
     best_t = min(contenders, key=lambda w: trans[w] if math.isfinite(trans[w]) else math.inf)
     best_r = min(contenders, key=lambda w: rot[w] if math.isfinite(rot[w]) else math.inf)
+
     def versus(w: str, values: Mapping[str, float]) -> str:
         ref = "" if w == reference else f", {reference} {sig(values.get(reference, math.nan))}"
         return f"median relative error {sig(values[w])}{ref}"
 
     why = (f"Why: the specific-force cues (surge, sway, heave) are best given by **{best_t}** "
-           f"({versus(best_t, trans)}), the rotational cues (roll, pitch, yaw) by **{best_r}** ({versus(best_r, rot)}); relative error: the "
-           "integral error over what the aircraft pilot felt, 1 = a platform standing still.")
+           f"({versus(best_t, trans)}), the rotational cues (roll, pitch, yaw) by **{best_r}** "
+           f"({versus(best_r, rot)}); relative error: the integral error over what the aircraft pilot felt, 1 = a "
+           "platform standing still.")
     if best_t != best_r:
         why += " No washout has both halves: the score trades one against the other."
     lines += [why, ""]
