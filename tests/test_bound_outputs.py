@@ -245,7 +245,7 @@ def test_mpc_omct_measures_its_unconstrained_law_at_the_omct_amplitudes() -> Non
 
 @pytest.mark.skipif(not (os.environ.get("WASHBENCH_BOUND_SUITE") or os.environ.get("WASHBENCH_SLOW")),
                     reason="every bundled manoeuvre: WASHBENCH_BOUND_SUITE=<suite folder> or WASHBENCH_SLOW=1 "
-                    "(3.5 min on two cores; .ci/run runs it)")  # fmt: skip
+                    "(5-6 min on two cores; .ci/run runs it)")  # fmt: skip
 def test_ceiling_below_every_washout_on_every_bundled_manoeuvre(tmp_path: Path) -> None:
     given = os.environ.get("WASHBENCH_BOUND_SUITE")
     out = Path(given) if given else None
