@@ -17,9 +17,9 @@ CEILING_NOTE = (
     "the whole flight known: a certified lower bound on the ranking's own measure, per degree of freedom and for the "
     "{measure} (a convex relaxation of everything the platform model can fly, docs/yardstick.md: no washout can score "
     "below it). It is loose where the relaxation is generous (tilt that costs no rotational cue, each DOF with the "
-    "whole of gravity), so the truly best motion lies between the ceiling and the `bound` row (an achieved motion, "
-    "planned with the whole flight known and replayed through the platform model). Recovered = (still - value) / "
-    "(still - ceiling): the share of what a platform standing still leaves that a washout recovers (100 %: the "
+    "whole of gravity), so the best any motion can do lies between the ceiling and the best score achieved: usually "
+    "the `bound` row (an achieved motion, planned with the whole flight known and replayed through the platform "
+    "model). Recovered = (still - value) / (still - ceiling): the share of what a platform standing still leaves that a washout recovers (100 %: the "
     "ceiling; below 0: worse than standing still)."
 )
 
