@@ -19,8 +19,8 @@ CEILING_NOTE = (
     "below it). It is loose where the relaxation is generous (tilt that costs no rotational cue, each DOF with the "
     "whole of gravity), so the best any motion can do lies between the ceiling and the best score achieved: usually "
     "the `bound` row (an achieved motion, planned with the whole flight known and replayed through the platform "
-    "model). Recovered = (still - value) / (still - ceiling): the share of what a platform standing still leaves that a washout recovers (100 %: the "
-    "ceiling; below 0: worse than standing still)."
+    "model). Recovered = (still - value) / (still - ceiling): the share of what a platform standing still leaves "
+    "that a washout recovers (100 %: the ceiling; below 0: worse than standing still)."
 )
 
 _ORDER = ("score", "surge", "sway", "heave", "roll", "pitch", "yaw")
