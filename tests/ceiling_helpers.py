@@ -1,13 +1,22 @@
-"""The check that no washout scores below the ceiling, on a result folder's files (ceiling.csv, ranking.csv,
-metrics.csv, run.json): shared by the tests of the bound's outputs and of the ceiling."""
+"""The ``washbench`` command in a fresh process, and the check that no washout scores below the ceiling on a result
+folder's files (ceiling.csv, ranking.csv, metrics.csv, run.json): shared by the tests of the bound's outputs and of
+the ceiling."""
 
 from __future__ import annotations
 
 import csv
 import json
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
+
+
+def washbench(*args: str | Path) -> subprocess.CompletedProcess[str]:
+    """The ``washbench`` command in a fresh process (the outputs as a user gets them)."""
+    return subprocess.run([sys.executable, "-m", "washbench", *map(str, args)], capture_output=True, text=True,
+                          timeout=1800)  # fmt: skip
 
 
 def read_csv(path: Path) -> list[dict[str, str]]:

@@ -13,14 +13,12 @@ import csv
 import json
 import math
 import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pyarrow.parquet as pq
 import pytest
-from ceiling_helpers import DOFS, check_ceiling_below_every_washout, read_csv
+from ceiling_helpers import DOFS, check_ceiling_below_every_washout, read_csv, washbench
 
 from washbench.cueing.params import DEFAULT_PARAMS_PATH
 from washbench.io.paths import MANOEUVRES_DIR
@@ -52,10 +50,6 @@ phases:
     until: {duration_s: 2.5}
 """
 
-
-def washbench(*args: str | Path) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "washbench", *map(str, args)], capture_output=True, text=True,
-                          timeout=1800)  # fmt: skip
 
 
 @pytest.fixture(scope="module")

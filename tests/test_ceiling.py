@@ -10,13 +10,11 @@ from __future__ import annotations
 
 import json
 import math
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
-from ceiling_helpers import check_ceiling_below_every_washout
+from ceiling_helpers import check_ceiling_below_every_washout, washbench
 from scipy import signal
 from scipy.optimize import linprog
 
@@ -188,10 +186,6 @@ def test_thresholds_are_refused(limits) -> None:
     with pytest.raises(ValueError, match="thresholds"):
         ceiling(p.f_mps2, p.omega_radps, DT, limits, G, VestibularParams(thresholds=ZACHARIAS))
 
-
-def washbench(*args: str | Path) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "washbench", *map(str, args)], capture_output=True, text=True,
-                          timeout=900)  # fmt: skip
 
 
 @pytest.mark.parametrize(

@@ -115,8 +115,9 @@ def verdict_lines(entries: Sequence[Entry], washouts: Sequence[str], reference: 
                  "(docs/yardstick.md).")
     lines += [text, ""]
     # why: the specific-force cues against the rotational ones
-    trans = {w: _median([group_errors(e, w)[0] for e in ranked]) for w in contenders}
-    rot = {w: _median([group_errors(e, w)[1] for e in ranked]) for w in contenders}
+    errors = {w: [group_errors(e, w) for e in ranked] for w in contenders}  # (specific force, rotation) per manoeuvre
+    trans = {w: _median([t for t, _ in errors[w]]) for w in contenders}
+    rot = {w: _median([r for _, r in errors[w]]) for w in contenders}
     best_t = min(contenders, key=lambda w: trans[w] if math.isfinite(trans[w]) else math.inf)
     best_r = min(contenders, key=lambda w: rot[w] if math.isfinite(rot[w]) else math.inf)
 
