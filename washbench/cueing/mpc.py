@@ -37,6 +37,7 @@ from scipy import linalg, sparse
 from washbench.cueing.algorithm import SetPoint, WashoutContext
 from washbench.cueing.motion_model import CHANNELS, ChannelModel, channel_inputs, channel_model, discretise_zoh
 from washbench.cueing.optimal import merge_channel_defaults
+from washbench.io.progress import duration_text
 from washbench.io.yamlio import StrictModel
 from washbench.numerics.rotations import quat_from_euler
 from washbench.perception.vestibular import CanalParams, OtolithParams
@@ -529,7 +530,7 @@ class MpcWashout:
             return
         minute = per_step * 60.0 / self.dt
         print(f"washbench: note: washout mpc: {per_step:.3g} s per sample (timed on its first {self._timed_steps}): "
-              f"a minute of flight takes about {_duration(minute)}; fewer mpc.horizon_steps or mpc.solver.max_iter "
+              f"a minute of flight takes about {duration_text(minute)}; fewer mpc.horizon_steps or mpc.solver.max_iter "
               "make it faster", file=sys.stderr, flush=True)  # fmt: skip
 
     def _step(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> SetPoint:
@@ -567,15 +568,6 @@ class MpcWashout:
             "iterations_median": float(np.median(it)),
             "iterations_max": float(np.max(it)),
         }
-
-
-def _duration(seconds: float) -> str:
-    """``45 s``, ``12 min``, ``3.4 h``."""
-    if seconds < 120:
-        return f"{seconds:.0f} s"
-    if seconds < 7200:
-        return f"{seconds / 60:.0f} min"
-    return f"{seconds / 3600:.1f} h"
 
 
 __all__ = ["MpcParams", "MpcWashout", "MpcWeights", "OsqpSettings", "StackedModel", "stacked_model"]
