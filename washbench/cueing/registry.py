@@ -35,6 +35,7 @@ from washbench.cueing.params import WASHOUT_KINDS
 from washbench.errors import Terminated, WashbenchError, located
 from washbench.io import interrupts
 from washbench.io.names import identifier_problem
+from washbench.io.paths import plugin_file
 from washbench.io.yamlio import line_of
 
 ENTRY_POINT_GROUP = "washbench.washouts"
@@ -114,15 +115,8 @@ def _algorithm(obj: Any, kind: str, source: str) -> Algorithm:
 
 def load_plugin(spec: str) -> Algorithm:
     """Load ``FILE.py:NAME`` and register it; WashbenchError (one line) if it cannot be loaded."""
-    text = str(spec)
-    file, sep, name = text.rpartition(":")
-    where = f"--washout-plugin {text}"
-    if not sep or not file or not name:
-        raise WashbenchError(f"{where}: expected FILE.py:NAME")
-    path = Path(file).expanduser()
-    if not path.is_file():
-        raise WashbenchError(f"{where}: {path}: no such file")
-    text = f"{path.resolve()}:{name}"  # absolute: worker processes load the same file
+    where, path, name = plugin_file(spec, "--washout-plugin")
+    text = f"{path}:{name}"  # absolute: worker processes load the same file
     for kind, loaded in _PLUGIN_SPECS.items():
         if loaded == text:
             return _LOADED[kind]

@@ -198,3 +198,18 @@ def resolve_manoeuvre(item: Path) -> Path:
         if candidate.exists():
             return candidate
     return item
+
+
+def plugin_file(spec: str, option: str) -> tuple[str, Path, str]:
+    """A plugin given as ``FILE.py:NAME`` to ``option`` (``--washout-plugin``, ``--platform-plugin``): the text that
+    names it in errors (``OPTION SPEC``), the file resolved to an absolute path (worker processes load the same file)
+    and NAME. WashbenchError (one line) when the text has no ``:``, or the file does not exist."""
+    text = str(spec)
+    file, sep, name = text.rpartition(":")
+    where = f"{option} {text}"
+    if not sep or not file or not name:
+        raise WashbenchError(f"{where}: expected FILE.py:NAME")
+    path = Path(file).expanduser()
+    if not path.is_file():
+        raise WashbenchError(f"{where}: {path}: no such file")
+    return where, path.resolve(), name

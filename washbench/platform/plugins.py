@@ -28,6 +28,7 @@ from typing import Any
 
 from washbench.errors import WashbenchError
 from washbench.io.names import identifier_problem
+from washbench.io.paths import plugin_file
 
 ENTRY_POINT_GROUP = "washbench.platforms"
 BUILTIN_KINDS = frozenset({"atlas", "hexapod", "rig"})
@@ -159,15 +160,8 @@ class PlatformRun:
 
 def load_plugin(spec: str) -> str:
     """Load ``FILE.py:NAME`` and register it; return its kind. WashbenchError (one line) if it cannot be loaded."""
-    text = str(spec)
-    file, sep, name = text.rpartition(":")
-    where = f"--platform-plugin {text}"
-    if not sep or not file or not name:
-        raise WashbenchError(f"{where}: expected FILE.py:NAME")
-    path = Path(file).expanduser()
-    if not path.is_file():
-        raise WashbenchError(f"{where}: {path}: no such file")
-    source = f"{path.resolve()}:{name}"
+    where, path, name = plugin_file(spec, "--platform-plugin")
+    source = f"{path}:{name}"
     factory, _ = load_source(source, where)
     kind = str(getattr(factory, "platform_name", name))
     problem = identifier_problem(kind)
