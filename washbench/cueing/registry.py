@@ -46,6 +46,7 @@ RESERVED_NAMES = frozenset({"aircraft", "limit", "t_s"})
 BUILTIN_PYTHON: dict[str, str] = {
     "optimal": "washbench.cueing.optimal:OptimalWashout",
     "mpc": "washbench.cueing.mpc:MpcWashout",
+    "mpc-unrestricted": "washbench.cueing.mpc_unrestricted:MpcUnrestrictedWashout",
     # the oracle bound replayed as a washout (whole recordings only); by name, so cueing imports no analysis module
     "bound": "washbench.analysis.bound_replay:BoundWashout",
 }

@@ -368,7 +368,7 @@ def platform_refusal(washout: Washout, platform: Any) -> str | None:
     kind = getattr(platform, "kind", "atlas")
     if kind == "atlas":
         return None
-    if washout.kind in ("unrestricted", "adaptive-unrestricted") and not getattr(platform, "unlimited_rotation", False):
+    if washout.kind in ("unrestricted", "adaptive-unrestricted", "mpc-unrestricted") and not getattr(platform, "unlimited_rotation", False):
         return (f"washout {washout.name} ({washout.kind}): cannot drive a {kind} (limited rotation; its attitude set "
                 "point is never washed back to level); use large-angle or adaptive-large-angle")
     if washout.kind == "bound":

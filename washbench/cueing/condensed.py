@@ -1,0 +1,152 @@
+"""Condensed (dense) prediction matrices for the MPC washouts, and the dense QP solver they share (DAQP).
+
+A prediction over ``N`` intervals of ``tp`` seconds, inputs held over each interval (zero-order hold), of a
+single-input single-output model ``dx/dt = A x + B u``, ``y = C x`` (strictly proper) is
+
+    y_{k+1} = C Phi^{k+1} x_0 + sum_{j<=k} C Phi^{k-j} Gamma u_j,         k = 0 .. N-1,
+
+i.e. ``y = O x_0 + T u`` with ``T`` lower-triangular Toeplitz (:func:`siso_prediction`). The washouts' axes share one
+vestibular model per organ (the paper's Eqs. 11-12 have the same constants on every axis), so a three-axis
+prediction is a Kronecker product ``T (x) I_3`` and the per-step cost matrices of the MPC washouts are sums of
+Kronecker products of these ``N x N`` matrices with 3 x 3 matrices that depend on the cockpit's attitude
+(docs/optimal-mpc.md, "mpc-unrestricted"). Move blocking (one decision held over several intervals,
+:func:`blocking_matrix`) multiplies every prediction matrix on the right.
+
+:class:`DenseQp` wraps DAQP (Arnström, Bemporad and Axehill, "A dual active-set solver for embedded quadratic
+programming using recursive LDL^T updates", IEEE TAC 67(8), 2022): a dual active-set method for small dense QPs,
+warm-started from the previous step's active set, exact (no iteration tolerance on optimality beyond rounding).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import signal
+
+from washbench.cueing.motion_model import discretise_zoh
+
+
+@dataclass(frozen=True)
+class SisoPrediction:
+    """``y_{1..N} = O x_0 + T u_{0..N-1}`` of one SISO model (see the module docstring); ``Phi``, ``Gamma``, ``C``:
+    its exact discretisation at ``tp`` (for propagating the state)."""
+
+    O: np.ndarray  # (N, n)
+    T: np.ndarray  # (N, N)
+    A: np.ndarray  # continuous (n, n)
+    B: np.ndarray  # continuous (n,)
+    C: np.ndarray  # (n,)
+
+
+def siso_state_space(num: np.ndarray, den: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(A (n, n), B (n,), C (n,)) of a strictly proper transfer function ``num/den`` (coefficients in s)."""
+    a, b, c, d = signal.tf2ss(num, den)
+    if np.any(np.abs(d) > 0.0):
+        raise ValueError("the model must be strictly proper")
+    return a, b[:, 0], c[0]
+
+
+def siso_prediction(num: np.ndarray, den: np.ndarray, tp_s: float, n_steps: int) -> SisoPrediction:
+    """The prediction matrices of ``num/den`` over ``n_steps`` intervals of ``tp_s`` seconds (ZOH)."""
+    a, b, c = siso_state_space(num, den)
+    phi, gam = discretise_zoh(a, b[:, None], tp_s)
+    n = a.shape[0]
+    o = np.empty((n_steps, n))
+    h = np.empty(n_steps)  # Markov parameters C Phi^i Gamma
+    p = np.eye(n)
+    for i in range(n_steps):
+        h[i] = c @ p @ gam[:, 0]
+        p = phi @ p
+        o[i] = c @ p
+    t = np.zeros((n_steps, n_steps))
+    for i in range(n_steps):
+        t[i:, i] = h[: n_steps - i]
+    return SisoPrediction(O=o, T=t, A=a, B=b, C=c)
+
+
+def default_blocks(n_steps: int) -> tuple[int, ...]:
+    """Move-blocking lengths (intervals per decision) covering ``n_steps``: 1, 1, 1, 2, 2, 2, 3, 3, 4, 4, 5, 5, ...
+
+    Fine moves first (the first is the one applied), coarser ones later; a remainder of at most half a move joins
+    the last one. 20 intervals take 9 moves (1, 1, 1, 2, 2, 2, 3, 3, 5).
+    """
+    out: list[int] = []
+    total = 0
+    while total < n_steps:
+        i = len(out)
+        length = 1 + i // 3 if i < 6 else 3 + (i - 6) // 2
+        take = min(length, n_steps - total)
+        if take <= length // 2:  # a short remainder joins the last move
+            out[-1] += take
+        else:
+            out.append(take)
+        total += take
+    return tuple(out)
+
+
+def blocking_matrix(blocks: tuple[int, ...]) -> np.ndarray:
+    """(N, M) 0/1 matrix mapping M held moves to N = sum(blocks) intervals."""
+    n = int(sum(blocks))
+    out = np.zeros((n, len(blocks)))
+    row = 0
+    for j, b in enumerate(blocks):
+        out[row : row + b, j] = 1.0
+        row += b
+    return out
+
+
+def rows_kron3(m: np.ndarray) -> np.ndarray:
+    """``m (x) I_3``: the three-axis form of a per-axis matrix, for node-major vectors (index 3 k + axis)."""
+    return np.kron(m, np.eye(3))
+
+
+class DenseQp:
+    """``minimise 1/2 z' H z + f' z`` s.t. ``lo <= z <= hi`` (simple bounds), ``lo_A <= A z <= hi_A`` (rows with
+    ``eq`` True: equalities) by DAQP, the workspace kept between solves (warm start from the last active set).
+
+    ``solve`` returns (ok, z, iterations); ``ok`` is False unless DAQP reports an optimal solution (exit flag 1 or
+    2, "optimal" and "soft optimal") with a finite result.
+    """
+
+    def __init__(self, n: int, A: np.ndarray, eq: np.ndarray, iter_limit: int) -> None:
+        import daqp  # imported when an MPC washout is made
+
+        self.n = n
+        self.A = np.ascontiguousarray(A, dtype=np.float64)
+        m = n + self.A.shape[0]
+        self.sense = np.zeros(m, dtype=np.int32)
+        self.sense[n:][np.asarray(eq, dtype=bool)] = 5
+        self._model = daqp.Model()
+        self._ready = False
+        self.iter_limit = int(iter_limit)
+
+    def solve(
+        self, H: np.ndarray, f: np.ndarray, lo: np.ndarray, hi: np.ndarray, h_changed: bool = True
+    ) -> tuple[bool, np.ndarray, int]:
+        """Solve with this step's data (``lo``/``hi``: simple bounds then the rows of ``A``)."""
+        if not self._ready:
+            flag, _ = self._model.setup(H, f, self.A, hi, lo, self.sense)
+            self._model.settings = {"iter_limit": self.iter_limit}
+            self._ready = flag >= 0
+            if not self._ready:
+                return False, np.zeros(self.n), 0
+        elif h_changed:
+            self._model.update(H=H, f=f, bupper=hi, blower=lo)
+        else:
+            self._model.update(f=f, bupper=hi, blower=lo)
+        x, _, flag, info = self._model.solve()
+        z = np.asarray(x, dtype=np.float64)
+        ok = flag in (1, 2) and z.shape == (self.n,) and bool(np.all(np.isfinite(z)))
+        return ok, z, int(info.get("iterations", 0))
+
+
+__all__ = [
+    "DenseQp",
+    "SisoPrediction",
+    "blocking_matrix",
+    "default_blocks",
+    "rows_kron3",
+    "siso_prediction",
+    "siso_state_space",
+]

@@ -1,0 +1,438 @@
+"""The model-predictive washout over the whole Atlas (``mpc-unrestricted``): the stage and the sphere's unlimited
+rotation in one prediction, re-linearised about the cockpit's attitude at every sample.
+
+At every sample, with the cockpit at attitude ``R0`` (body to inertial) and ``g_B0 = R0' [0, 0, g]`` gravity in its
+body axes, the simulator pilot's specific force for a stage acceleration ``a`` (inertial, m/s^2) and a small further
+rotation ``dtheta`` (body axes, rad) is, to first order,
+
+    f_B  =  R0' a  -  g_B0  +  G dtheta,        G = -[g_B0]x                  (f = R' (a - g_I), R = R0 (I + [dtheta]x))
+
+and ``d(dtheta)/dt = omega`` (the sphere's body rate, rad/s). The washout solves, by DAQP (a dual active-set solver
+for small dense QPs, warm-started: :class:`washbench.cueing.condensed.DenseQp`), over N intervals of ``tp``
+
+    minimise  sum_k  |e_oto,k|^2_Wo + |e_f,k|^2_Wd + |e_can,k|^2_Wc + |p_k|^2_Wp + |v_k|^2_Wv
+                     + r_a |a_k|^2 + r_w |omega_k|^2                            (times tp)
+    subject to  |a| <= margin a_max per inertial axis, |p|, |v| likewise (nodes 1..N), v_N = 0 (optional),
+                |omega|_1 <= margin rate limit (inside the Atlas's 2-norm ball), and its change per move
+                (from the current rate over one sample for the first move) within margin alpha_max,
+
+where ``e_oto`` and ``e_can`` are the perceived errors (the paper's otolith and canal models, Eqs. 11-12, driven by
+simulator minus aircraft head signals in body axes), ``e_f`` the specific-force error at the head itself, and the
+aircraft input over the horizon is held (decaying towards level flight as ``e^{-gamma t}``), or, with ``preview_s``
+> 0 and the recording known (``run``, ``suite``, ``cue``: :meth:`MpcUnrestrictedWashout.trace`), the aircraft's own
+future. Decisions are held over blocks of intervals (move blocking). There is no attitude cost and no tilt-rate
+limit: the sphere may turn without limit, and tilt is paid for only by what the canals perceive of it. The first
+move is applied for one sample, exactly: the stage integrates ``a``, the attitude ``q <- q exp(omega dt / 2)``, and
+the error models are driven by the head signals of that exact motion. See docs/optimal-mpc.md ("mpc-unrestricted")
+for the derivation, the references and the choices.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated
+
+import numpy as np
+from pydantic import Field
+
+from washbench.cueing.algorithm import SetPoint, WashoutContext
+from washbench.cueing.condensed import DenseQp, blocking_matrix, default_blocks, siso_prediction, siso_state_space
+from washbench.cueing.motion_model import discretise_zoh
+from washbench.cueing.mpc import VestibularChoice
+from washbench.errors import WashbenchError
+from washbench.io.yamlio import StrictModel
+from washbench.perception.vestibular import canal_tf, otolith_tf
+from washbench.platform.kinematics import brake_speed
+
+Weight = Annotated[float, Field(ge=0.0, le=1e9, allow_inf_nan=False)]
+PositiveWeight = Annotated[float, Field(gt=0.0, le=1e9, allow_inf_nan=False)]
+Axes = tuple[Weight, Weight, Weight]
+
+# sign patterns of the 1-norm ball's facets |p| + |q| + |r| <= w, as |s . omega| <= w
+_FACETS = np.array([[1.0, 1.0, 1.0], [1.0, 1.0, -1.0], [1.0, -1.0, 1.0], [1.0, -1.0, -1.0]])
+
+
+class DaqpSettings(StrictModel):
+    """DAQP's settings for the per-step QP."""
+
+    iter_limit: Annotated[int, Field(ge=1, le=100_000)] = 1000
+    """active-set iterations per solve at most (a solve that reaches it falls back, counted)"""
+
+
+class MpcUnrestrictedParams(StrictModel):
+    """The ``mpc-unrestricted:`` section of the parameter file (SI; axis triples are x, y, z)."""
+
+    horizon_steps: Annotated[int, Field(ge=1, le=200)] = 20
+    """N, prediction intervals (extended to cover ``preview_s``)"""
+    prediction_step_s: Annotated[float, Field(gt=0.0, le=5.0, allow_inf_nan=False)] = 0.1
+    """the prediction interval tp (s); at least the sample step"""
+    preview_s: Annotated[float, Field(ge=0.0, le=20.0, allow_inf_nan=False)] = 0.0
+    """how far ahead the aircraft's motion is known (s): 0 none; > 0 needs the recording in advance"""
+    reference_decay_per_s: Annotated[float, Field(ge=0.0, le=100.0, allow_inf_nan=False)] = 0.5
+    """gamma: beyond what is previewed, the aircraft's deviation from level 1-g flight and its rate are predicted
+    as decaying as e^{-gamma t} from the last known value"""
+    limit_margin: Annotated[float, Field(gt=0.0, le=1.0)] = 0.95
+    """the QP's limits are this fraction of the platform's"""
+    terminal_rest: bool = True
+    """the plan ends with the stage at rest (velocity 0 at node N)"""
+    vestibular: VestibularChoice = VestibularChoice()
+    force: Axes = (1.0, 1.0, 1.0)
+    """weights of the perceived specific-force error (otolith), body x, y, z, per (m/s^2)^2"""
+    direct_force: Axes = (1.0, 1.0, 1.0)
+    """weights of the specific-force error at the head (before the otolith), per (m/s^2)^2"""
+    rate: Axes = (10.0, 10.0, 10.0)
+    """weights of the perceived angular-velocity error (canals), body roll, pitch, yaw, per (rad/s)^2"""
+    position: Axes = (0.4, 0.4, 4.0)
+    """stage position, inertial north, east, down, per m^2"""
+    velocity: Axes = (0.4, 0.4, 1.0)
+    """stage velocity, per (m/s)^2"""
+    acceleration: PositiveWeight = 0.05
+    """stage acceleration (control), per (m/s^2)^2"""
+    angular_rate: PositiveWeight = 0.05
+    """sphere body rate (control), per (rad/s)^2"""
+    solver: DaqpSettings = DaqpSettings()
+
+
+def _skew(v: np.ndarray) -> np.ndarray:
+    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+
+
+def quat_matrix(q: np.ndarray) -> np.ndarray:
+    """Rotation matrix (body to inertial) of a unit quaternion, scalar first."""
+    w, x, y, z = q
+    return np.array([
+        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+    ])  # fmt: skip
+
+
+def quat_step(q: np.ndarray, omega_radps: np.ndarray, dt_s: float) -> np.ndarray:
+    """``q exp(omega dt / 2)``: the attitude after turning at body rate ``omega`` for ``dt`` (exact), normalised."""
+    th = float(np.linalg.norm(omega_radps)) * dt_s
+    if th < 1e-12:
+        d = np.array([1.0, *(0.5 * dt_s * omega_radps)])
+    else:
+        ax = omega_radps / np.linalg.norm(omega_radps)
+        d = np.array([math.cos(0.5 * th), *(math.sin(0.5 * th) * ax)])
+    w0, x0, y0, z0 = q
+    w1, x1, y1, z1 = d
+    out = np.array([
+        w0 * w1 - x0 * x1 - y0 * y1 - z0 * z1,
+        w0 * x1 + x0 * w1 + y0 * z1 - z0 * y1,
+        w0 * y1 - x0 * z1 + y0 * w1 + z0 * x1,
+        w0 * z1 + x0 * y1 - y0 * x1 + z0 * w1,
+    ])  # fmt: skip
+    return out / np.linalg.norm(out)
+
+
+def tilt_matched(f_mps2: np.ndarray) -> np.ndarray:
+    """The level-heading attitude (yaw 0) whose gravity gives the direction of ``f`` (body axes): roll
+    ``atan2(-f_y, -f_z)``, pitch ``asin(f_x / |f|)``; level when ``|f|`` is below 1 m/s^2."""
+    n = float(np.linalg.norm(f_mps2))
+    if n < 1.0:
+        return np.array([1.0, 0.0, 0.0, 0.0])
+    phi = math.atan2(-f_mps2[1], -f_mps2[2])
+    theta = math.asin(max(-1.0, min(1.0, f_mps2[0] / n)))
+    cp, sp = math.cos(0.5 * phi), math.sin(0.5 * phi)
+    ct, st = math.cos(0.5 * theta), math.sin(0.5 * theta)
+    return np.array([cp * ct, sp * ct, cp * st, -sp * st])
+
+
+class MpcUnrestrictedWashout:
+    """``mpc-unrestricted`` per step (:class:`washbench.cueing.algorithm.WashoutAlgorithm`), see the module docstring.
+
+    State: attitude ``q`` (body to inertial, scalar first), stage position ``p`` and velocity ``v`` (inertial, from
+    the centre), the applied rate ``w``, the otolith (2, 3) and canal (3, 3) error-model states per body axis.
+    Counters (:meth:`report`): solves, fallbacks (failed or unsafe solves: braking), iterations.
+    """
+
+    Params = MpcUnrestrictedParams
+    name = "mpc-unrestricted"
+
+    def __init__(self, params: MpcUnrestrictedParams | None, context: WashoutContext) -> None:
+        self.params = p = params if params is not None else MpcUnrestrictedParams()
+        self.context = context
+        self.dt = float(context.dt_s)
+        self.g = float(context.gravity_mps2)
+        if p.prediction_step_s < self.dt * (1.0 - 1e-9):
+            raise ValueError(f"mpc-unrestricted: prediction_step_s {p.prediction_step_s} s is shorter than the "
+                             f"sample {self.dt} s")  # fmt: skip
+        lim = context.limits
+        if not hasattr(lim, "rotation") or not hasattr(lim, "translation"):
+            raise WashbenchError("mpc-unrestricted: needs a platform of unlimited rotation (the Atlas)")
+        mg = p.limit_margin
+        self.p_max = np.array(lim.translation.position_limit_m.xyz)
+        self.v_max = np.array(lim.translation.velocity_limit_mps.xyz)
+        self.a_max = np.array(lim.translation.acceleration_limit_mps2.xyz)
+        self.w_max = math.radians(lim.rotation.rate_limit_degps)
+        self.alpha_max = math.radians(lim.rotation.acceleration_limit_degps2)
+        self.tp = tp = p.prediction_step_s
+        self.N = N = max(p.horizon_steps, math.ceil(p.preview_s / tp - 1e-9))
+        self.blocks = default_blocks(N)
+        Bk = blocking_matrix(self.blocks)
+        self.M = M = len(self.blocks)
+        v = p.vestibular
+        oto = siso_prediction(*otolith_tf(v.otolith), tp, N)
+        can = siso_prediction(*canal_tf(v.canals), tp, N)
+        # per-sample (dt) discretisations of the error models, for applying a move exactly
+        ao, bo, self._co = siso_state_space(*otolith_tf(v.otolith))
+        ac, bc, self._cc = siso_state_space(*canal_tf(v.canals))
+        self._phi_o, g = discretise_zoh(ao, bo[:, None], self.dt)
+        self._gam_o = g[:, 0]
+        self._phi_c, g = discretise_zoh(ac, bc[:, None], self.dt)
+        self._gam_c = g[:, 0]
+        self._Oo, self._Oc = oto.O, can.O
+        self._To, self._Tc = oto.T, can.T
+        lower = np.tril(np.ones((N, N)), -1)
+        Lm = tp * (lower + 0.5 * np.eye(N))  # dtheta at the intervals' midpoints from the moves' rates
+        self._Pp = tp * tp * (np.tril(np.subtract.outer(np.arange(N), np.arange(N)), 0) + 0.5 * np.tril(np.ones((N, N))))
+        self._Pv = tp * np.tril(np.ones((N, N)))
+        self._t_nodes = tp * np.arange(1, N + 1)
+        # blocked prediction matrices (N, M)
+        self._ToB = oto.T @ Bk
+        self._ToLmB = oto.T @ Lm @ Bk
+        self._LmB = Lm @ Bk
+        self._TcB = can.T @ Bk
+        self._PpB = self._Pp @ Bk
+        self._PvB = self._Pv @ Bk
+        self._B = Bk
+        # the constant N x N (M x M) Gram blocks of the Hessian
+        BtB = Bk.T @ (Bk * 1.0)
+        self._G_aa_o = self._ToB.T @ self._ToB
+        self._G_aa_d = BtB
+        self._H_aa_const = np.kron(self._PpB.T @ self._PpB, np.diag(p.position)) + np.kron(
+            self._PvB.T @ self._PvB, np.diag(p.velocity)
+        ) + np.kron(BtB, p.acceleration * np.eye(3))  # fmt: skip
+        self._G_aw_o = self._ToB.T @ self._ToLmB
+        self._G_aw_d = Bk.T @ self._LmB
+        self._G_ww_o = self._ToLmB.T @ self._ToLmB
+        self._G_ww_d = self._LmB.T @ self._LmB
+        self._H_ww_const = np.kron(self._TcB.T @ self._TcB, np.diag(p.rate)) + np.kron(BtB, p.angular_rate * np.eye(3))
+        self._Wo = np.diag(p.force)
+        self._Wd = np.diag(p.direct_force)
+        self._Wc = np.diag(p.rate)
+        self._Wp = np.diag(p.position)
+        self._Wv = np.diag(p.velocity)
+        # constraints: rows [position (3N), velocity (3N), rate facets (4M), rate change facets (4M)] over
+        # z = [a_0..a_{M-1} (3 each), omega_0..omega_{M-1} (3 each)]
+        nz = 6 * M
+        A_pos = np.hstack([np.kron(self._PpB, np.eye(3)), np.zeros((3 * N, 3 * M))])
+        A_vel = np.hstack([np.kron(self._PvB, np.eye(3)), np.zeros((3 * N, 3 * M))])
+        facets = np.kron(np.eye(M), _FACETS)  # (4M, 3M)
+        diff = np.eye(M) - np.eye(M, k=-1)
+        A_rate = np.hstack([np.zeros((4 * M, 3 * M)), facets])
+        A_dacc = np.hstack([np.zeros((4 * M, 3 * M)), np.kron(diff, _FACETS)])
+        A = np.vstack([A_pos, A_vel, A_rate, A_dacc])
+        eq = np.zeros(A.shape[0], dtype=bool)
+        if p.terminal_rest:
+            eq[3 * N + 3 * (N - 1) : 3 * N + 3 * N] = True
+        self.qp = DenseQp(nz, A, eq, p.solver.iter_limit)
+        w = mg * self.w_max
+        self._hi = np.concatenate([
+            np.tile(mg * self.a_max, M), np.full(3 * M, w),  # simple bounds
+            np.tile(mg * self.p_max, N), np.tile(mg * self.v_max, N),
+            np.full(4 * M, w), np.full(4 * M, mg * self.alpha_max * tp),
+        ])  # fmt: skip
+        self._lo = -self._hi
+        self._n_pos = slice(nz, nz + 3 * N)
+        self._n_vel = slice(nz + 3 * N, nz + 6 * N)
+        self._n_dacc0 = slice(nz + 6 * N + 4 * M, nz + 6 * N + 4 * M + 4)
+        self._dw0 = mg * self.alpha_max * self.dt
+        self._decay = np.exp(-p.reference_decay_per_s * tp * np.arange(N))  # interval j, from its start
+        # state
+        self.q = np.array([1.0, 0.0, 0.0, 0.0])
+        self.p = np.zeros(3)
+        self.v = np.zeros(3)
+        self.w = np.zeros(3)
+        self.xo = np.zeros((ao.shape[0], 3))
+        self.xc = np.zeros((ac.shape[0], 3))
+        self.solves = 0
+        self.fallbacks = 0
+        self.iterations: list[int] = []
+        self._sat_rot = False
+        self._H = np.zeros((nz, nz))
+        self._future: tuple[np.ndarray, np.ndarray] | None = None
+        self._k = 0
+
+    # ---- perception error models
+    def _steady_states(self, e_f: np.ndarray, e_w: np.ndarray) -> None:
+        """The error models' steady state for constant head-signal errors ``e_f`` (m/s^2), ``e_w`` (rad/s)."""
+        ao, bo, _ = siso_state_space(*otolith_tf(self.params.vestibular.otolith))
+        ac, bc, _ = siso_state_space(*canal_tf(self.params.vestibular.canals))
+        self.xo = -np.linalg.solve(ao, bo[:, None]) @ e_f[None, :]
+        self.xc = -np.linalg.solve(ac, bc[:, None]) @ e_w[None, :]
+
+    def _head_force(self, q: np.ndarray, a: np.ndarray) -> np.ndarray:
+        return quat_matrix(q).T @ (a - np.array([0.0, 0.0, self.g]))
+
+    # ---- the washout
+    def start(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> SetPoint:
+        """Start at the steady state of the first sample: centred and still, the cockpit tilted so that gravity
+        gives the direction of the first specific force (level with ``filter_start="rest"``), the error models
+        at the steady state of what is left (the magnitude's difference)."""
+        f = np.asarray(f_mps2, float)
+        w = np.asarray(omega_radps, float)
+        if self.context.filter_start == "rest":
+            f, w = np.array([0.0, 0.0, -self.g]), np.zeros(3)
+        self.q = tilt_matched(f)
+        self.p = np.zeros(3)
+        self.v = np.zeros(3)
+        self.w = np.zeros(3)
+        self._steady_states(self._head_force(self.q, np.zeros(3)) - f, -w)
+        self._k = 0
+        return self.p.copy(), self.q.copy()
+
+    def _reference(self, f: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The aircraft's specific force and rate over the horizon's intervals (N, 3) each: the previewed samples
+        (at the intervals' midpoints) as far as ``preview_s`` reaches, then the last known one decaying towards level
+        flight."""
+        level = np.array([0.0, 0.0, -self.g])
+        F = level + np.outer(self._decay, f - level)
+        W = np.outer(self._decay, w)
+        fut = self._future
+        if fut is None or self.params.preview_s <= 0.0:
+            return F, W
+        ff, ww = fut
+        n = len(ff)
+        mid = self.tp * (np.arange(self.N) + 0.5)
+        seen = mid <= self.params.preview_s + 1e-9
+        idx = np.minimum(self._k + np.rint(mid / self.dt).astype(np.int64), n - 1)
+        F[seen] = ff[idx[seen]]
+        W[seen] = ww[idx[seen]]
+        j = int(np.count_nonzero(seen))
+        if j < self.N:
+            last_f, last_w = F[j - 1] if j else f, W[j - 1] if j else w
+            F[j:] = level + np.outer(self._decay[: self.N - j], last_f - level)
+            W[j:] = np.outer(self._decay[: self.N - j], last_w)
+        return F, W
+
+    def _plan(self, f: np.ndarray, w: np.ndarray) -> tuple[bool, np.ndarray, np.ndarray]:
+        """Solve this sample's QP; (solved, a moves (M, 3) inertial, omega moves (M, 3) body)."""
+        M = self.M
+        R0 = quat_matrix(self.q)
+        gB = R0.T @ np.array([0.0, 0.0, self.g])
+        G = -_skew(gB)
+        Wo, Wd = self._Wo, self._Wd
+        RWoR = R0 @ Wo @ R0.T
+        RWdR = R0 @ Wd @ R0.T
+        H = self._H
+        H[: 3 * M, : 3 * M] = np.kron(self._G_aa_o, RWoR) + np.kron(self._G_aa_d, RWdR) + self._H_aa_const
+        haw = np.kron(self._G_aw_o, R0 @ Wo @ G) + np.kron(self._G_aw_d, R0 @ Wd @ G)
+        H[: 3 * M, 3 * M :] = haw
+        H[3 * M :, : 3 * M] = haw.T
+        H[3 * M :, 3 * M :] = (np.kron(self._G_ww_o, G.T @ Wo @ G) + np.kron(self._G_ww_d, G.T @ Wd @ G)
+                               + self._H_ww_const)  # fmt: skip
+        F, Wr = self._reference(f, w)
+        Fref = F + gB  # the otolith input is R0' a + G dtheta - (f_air + g_B0)
+        c_o = self._Oo @ self.xo - self._To @ Fref  # (N, 3)
+        c_d = -Fref
+        c_c = self._Oc @ self.xc - self._Tc @ Wr
+        c_p = self.p + np.outer(self._t_nodes, self.v)
+        c_v = np.broadcast_to(self.v, (self.N, 3))
+        fa = (self._ToB.T @ (c_o @ Wo) + self._B.T @ (c_d @ Wd)) @ R0.T + self._PpB.T @ (c_p @ self._Wp) + (
+            self._PvB.T @ (c_v @ self._Wv)
+        )  # fmt: skip
+        fw = (self._ToLmB.T @ (c_o @ Wo) + self._LmB.T @ (c_d @ Wd)) @ G + self._TcB.T @ (c_c @ self._Wc)
+        fz = np.concatenate([fa.ravel(), fw.ravel()])
+        lo, hi = self._lo.copy(), self._hi.copy()
+        lo[self._n_pos] -= c_p.ravel()
+        hi[self._n_pos] -= c_p.ravel()
+        lo[self._n_vel] -= c_v.ravel()
+        hi[self._n_vel] -= c_v.ravel()
+        if self.params.terminal_rest:  # v_N = 0: (PvB (x) I) z_a = -v_0
+            lo[self._n_vel.stop - 3 : self._n_vel.stop] = -c_v[-1]
+            hi[self._n_vel.stop - 3 : self._n_vel.stop] = -c_v[-1]
+        s = _FACETS @ self.w
+        lo[self._n_dacc0] = s - self._dw0
+        hi[self._n_dacc0] = s + self._dw0
+        # the whole cost doubled and times tp is 1/2 z' H z + f' z with H = 2 tp (J' W J), f = 2 tp J' W c
+        ok, z, it = self.qp.solve(2.0 * self.tp * H, 2.0 * self.tp * fz, lo, hi)
+        self.solves += 1
+        self.iterations.append(it)
+        return ok, z[: 3 * M].reshape(M, 3), z[3 * M :].reshape(M, 3)
+
+    def _safe(self, a: np.ndarray, w: np.ndarray) -> bool:
+        """Whether the move keeps the stage within its limits after one sample and able to stop, and the rate
+        within the sphere's limits."""
+        if not (np.all(np.isfinite(a)) and np.all(np.isfinite(w))):
+            return False
+        dt = self.dt
+        v1 = self.v + a * dt
+        p1 = self.p + self.v * dt + 0.5 * a * dt * dt
+        if np.any(np.abs(p1) > self.p_max) or np.any(np.abs(v1) > self.v_max) or np.any(np.abs(a) > self.a_max):
+            return False
+        for j in range(3):
+            room = self.p_max[j] - p1[j] if v1[j] > 0 else self.p_max[j] + p1[j]
+            if abs(v1[j]) > brake_speed(room, self.a_max[j], dt) + 1e-9:
+                return False
+        return bool(np.linalg.norm(w) <= self.w_max and np.linalg.norm(w - self.w) <= self.alpha_max * dt * (1 + 1e-9))
+
+    def _brake(self) -> tuple[np.ndarray, np.ndarray]:
+        """Braking: each stage axis decelerates towards rest at its limit, the rate towards 0 at the sphere's."""
+        a = -np.clip(self.v / self.dt, -self.a_max, self.a_max)
+        nw = float(np.linalg.norm(self.w))
+        step = self.alpha_max * self.dt
+        w = np.zeros(3) if nw <= step else self.w * (1.0 - step / nw)
+        return a, w
+
+    def _advance(self, f: np.ndarray, w_air: np.ndarray) -> SetPoint:
+        if not (np.all(np.isfinite(f)) and np.all(np.isfinite(w_air))):
+            raise ValueError("mpc-unrestricted: non-finite input")
+        ok, a_plan, w_plan = self._plan(f, w_air)
+        a, w = (a_plan[0], w_plan[0]) if ok else (np.zeros(3), np.zeros(3))
+        if not (ok and self._safe(a, w)):
+            self.fallbacks += 1
+            a, w = self._brake()
+        dt = self.dt
+        q_mid = quat_step(self.q, w, 0.5 * dt)
+        e_f = self._head_force(q_mid, a) - f
+        self.xo = self._phi_o @ self.xo + np.outer(self._gam_o, e_f)
+        self.xc = self._phi_c @ self.xc + np.outer(self._gam_c, w - w_air)
+        self.p = self.p + self.v * dt + 0.5 * a * dt * dt
+        self.v = self.v + a * dt
+        self.q = quat_step(self.q, w, dt)
+        self._sat_rot = bool(np.sum(np.abs(w)) >= 0.999 * self.params.limit_margin * self.w_max)
+        self.w = w
+        self._k += 1
+        return self.p.copy(), self.q.copy()
+
+    def step(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> SetPoint:
+        """Solve this sample's QP, apply its first move for one sample, return the set point."""
+        if self.params.preview_s > 0.0 and self._future is None:
+            raise WashbenchError("washout mpc-unrestricted: preview_s > 0 needs the recording in advance (run, "
+                                 "suite, cue), not a live stream; set mpc-unrestricted.preview_s: 0")  # fmt: skip
+        return self._advance(np.asarray(f_mps2, float), np.asarray(omega_radps, float))
+
+    def trace(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The set points of the whole recording (after :meth:`start`); with ``preview_s`` > 0 each sample's plan
+        sees the recording ``preview_s`` ahead. Without preview the same numbers as stepping."""
+        f = np.asarray(f_mps2, float)
+        w = np.asarray(omega_radps, float)
+        n = len(f)
+        pos = np.empty((n, 3))
+        q = np.empty((n, 4))
+        self._future = (f, w)
+        try:
+            for i in range(n):
+                pos[i], q[i] = self._advance(f[i], w[i])
+        finally:
+            self._future = None
+        return pos, q
+
+    def flags(self) -> tuple[bool, bool]:
+        """(tilt-rate limit reached: never, it has none; the sphere's rate limit reached) on the last step."""
+        return False, self._sat_rot
+
+    def report(self) -> dict[str, float]:
+        """Solver statistics: solves, fallbacks (failed or unsafe solves: braking), iterations (median, max)."""
+        it = np.array(self.iterations) if self.iterations else np.zeros(1)
+        return {
+            "solves": float(self.solves),
+            "fallbacks": float(self.fallbacks),
+            "iterations_median": float(np.median(it)),
+            "iterations_max": float(np.max(it)),
+        }
+
+
+__all__ = ["MpcUnrestrictedParams", "MpcUnrestrictedWashout", "quat_matrix", "quat_step", "tilt_matched"]
