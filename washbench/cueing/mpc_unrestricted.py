@@ -46,7 +46,24 @@ from washbench.platform.kinematics import brake_speed
 
 Weight = Annotated[float, Field(ge=0.0, le=1e9, allow_inf_nan=False)]
 PositiveWeight = Annotated[float, Field(gt=0.0, le=1e9, allow_inf_nan=False)]
-Axes = tuple[Weight, Weight, Weight]
+
+
+class AxisWeights(StrictModel):
+    """One weight per axis (x, y, z: body axes for perceived errors and rates, inertial for the stage)."""
+
+    x: Weight
+    y: Weight
+    z: Weight
+
+    @property
+    def xyz(self) -> tuple[float, float, float]:
+        """The three values in axis order."""
+        return (self.x, self.y, self.z)
+
+
+def _axes(x: float, y: float, z: float) -> AxisWeights:
+    return AxisWeights(x=x, y=y, z=z)
+
 
 # sign patterns of the 1-norm ball's facets |p| + |q| + |r| <= w, as |s . omega| <= w
 _FACETS = np.array([[1.0, 1.0, 1.0], [1.0, 1.0, -1.0], [1.0, -1.0, 1.0], [1.0, -1.0, -1.0]])
@@ -76,15 +93,15 @@ class MpcUnrestrictedParams(StrictModel):
     terminal_rest: bool = True
     """the plan ends with the stage at rest (velocity 0 at node N)"""
     vestibular: VestibularChoice = VestibularChoice()
-    force: Axes = (1.0, 1.0, 1.0)
+    force: AxisWeights = _axes(1.0, 1.0, 1.0)
     """weights of the perceived specific-force error (otolith), body x, y, z, per (m/s^2)^2"""
-    direct_force: Axes = (1.0, 1.0, 1.0)
+    direct_force: AxisWeights = _axes(1.0, 1.0, 1.0)
     """weights of the specific-force error at the head (before the otolith), per (m/s^2)^2"""
-    rate: Axes = (10.0, 10.0, 10.0)
+    rate: AxisWeights = _axes(10.0, 10.0, 10.0)
     """weights of the perceived angular-velocity error (canals), body roll, pitch, yaw, per (rad/s)^2"""
-    position: Axes = (0.4, 0.4, 4.0)
+    position: AxisWeights = _axes(0.4, 0.4, 4.0)
     """stage position, inertial north, east, down, per m^2"""
-    velocity: Axes = (0.4, 0.4, 1.0)
+    velocity: AxisWeights = _axes(0.4, 0.4, 1.0)
     """stage velocity, per (m/s)^2"""
     acceleration: PositiveWeight = 0.05
     """stage acceleration (control), per (m/s^2)^2"""
@@ -201,19 +218,19 @@ class MpcUnrestrictedWashout:
         BtB = Bk.T @ (Bk * 1.0)
         self._G_aa_o = self._ToB.T @ self._ToB
         self._G_aa_d = BtB
-        self._H_aa_const = np.kron(self._PpB.T @ self._PpB, np.diag(p.position)) + np.kron(
-            self._PvB.T @ self._PvB, np.diag(p.velocity)
+        self._H_aa_const = np.kron(self._PpB.T @ self._PpB, np.diag(p.position.xyz)) + np.kron(
+            self._PvB.T @ self._PvB, np.diag(p.velocity.xyz)
         ) + np.kron(BtB, p.acceleration * np.eye(3))  # fmt: skip
         self._G_aw_o = self._ToB.T @ self._ToLmB
         self._G_aw_d = Bk.T @ self._LmB
         self._G_ww_o = self._ToLmB.T @ self._ToLmB
         self._G_ww_d = self._LmB.T @ self._LmB
-        self._H_ww_const = np.kron(self._TcB.T @ self._TcB, np.diag(p.rate)) + np.kron(BtB, p.angular_rate * np.eye(3))
-        self._Wo = np.diag(p.force)
-        self._Wd = np.diag(p.direct_force)
-        self._Wc = np.diag(p.rate)
-        self._Wp = np.diag(p.position)
-        self._Wv = np.diag(p.velocity)
+        self._H_ww_const = np.kron(self._TcB.T @ self._TcB, np.diag(p.rate.xyz)) + np.kron(BtB, p.angular_rate * np.eye(3))
+        self._Wo = np.diag(p.force.xyz)
+        self._Wd = np.diag(p.direct_force.xyz)
+        self._Wc = np.diag(p.rate.xyz)
+        self._Wp = np.diag(p.position.xyz)
+        self._Wv = np.diag(p.velocity.xyz)
         # constraints: rows [position (3N), velocity (3N), rate facets (4M), rate change facets (4M)] over
         # z = [a_0..a_{M-1} (3 each), omega_0..omega_{M-1} (3 each)]
         nz = 6 * M
