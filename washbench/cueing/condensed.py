@@ -5,7 +5,7 @@ single-input single-output model ``dx/dt = A x + B u``, ``y = C x`` (strictly pr
 
     y_{k+1} = C Phi^{k+1} x_0 + sum_{j<=k} C Phi^{k-j} Gamma u_j,         k = 0 .. N-1,
 
-i.e. ``y = O x_0 + T u`` with ``T`` lower-triangular Toeplitz (:func:`siso_prediction`). The washouts' axes share one
+i.e. ``y = F x_0 + T u`` with ``T`` lower-triangular Toeplitz (:func:`siso_prediction`). The washouts' axes share one
 vestibular model per organ (the paper's Eqs. 11-12 have the same constants on every axis), so a three-axis
 prediction is a Kronecker product ``T (x) I_3`` and the per-step cost matrices of the MPC washouts are sums of
 Kronecker products of these ``N x N`` matrices with 3 x 3 matrices that depend on the cockpit's attitude
@@ -29,10 +29,10 @@ from washbench.cueing.motion_model import discretise_zoh
 
 @dataclass(frozen=True)
 class SisoPrediction:
-    """``y_{1..N} = O x_0 + T u_{0..N-1}`` of one SISO model (see the module docstring); ``Phi``, ``Gamma``, ``C``:
+    """``y_{1..N} = F x_0 + T u_{0..N-1}`` of one SISO model (see the module docstring); ``Phi``, ``Gamma``, ``C``:
     its exact discretisation at ``tp`` (for propagating the state)."""
 
-    O: np.ndarray  # (N, n)
+    free: np.ndarray  # F (N, n)
     T: np.ndarray  # (N, N)
     A: np.ndarray  # continuous (n, n)
     B: np.ndarray  # continuous (n,)
@@ -62,7 +62,7 @@ def siso_prediction(num: np.ndarray, den: np.ndarray, tp_s: float, n_steps: int)
     t = np.zeros((n_steps, n_steps))
     for i in range(n_steps):
         t[i:, i] = h[: n_steps - i]
-    return SisoPrediction(O=o, T=t, A=a, B=b, C=c)
+    return SisoPrediction(free=o, T=t, A=a, B=b, C=c)
 
 
 def default_blocks(n_steps: int) -> tuple[int, ...]:

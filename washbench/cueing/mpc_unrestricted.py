@@ -107,7 +107,16 @@ class MpcUnrestrictedParams(StrictModel):
     """stage acceleration (control), per (m/s^2)^2"""
     angular_rate: PositiveWeight = 0.05
     """sphere body rate (control), per (rad/s)^2"""
+    relinearise_deg: Annotated[float, Field(ge=0.0, le=10.0, allow_inf_nan=False)] = 2.0
+    """the model is linearised again when the cockpit has turned more than this since the last linearisation (deg;
+    0: every sample); in between the turn so far enters the prediction as an offset (first order: an error of at
+    most g (1 - cos x) ~ 0.006 m/s^2 at 2 deg)"""
     solver: DaqpSettings = DaqpSettings()
+
+
+def _norm(v: np.ndarray) -> float:
+    """Euclidean norm of a short vector (without numpy.linalg's overhead)."""
+    return math.sqrt(float(v @ v))
 
 
 def _skew(v: np.ndarray) -> np.ndarray:
@@ -126,27 +135,48 @@ def quat_matrix(q: np.ndarray) -> np.ndarray:
 
 def quat_step(q: np.ndarray, omega_radps: np.ndarray, dt_s: float) -> np.ndarray:
     """``q exp(omega dt / 2)``: the attitude after turning at body rate ``omega`` for ``dt`` (exact), normalised."""
-    th = float(np.linalg.norm(omega_radps)) * dt_s
+    th = float(_norm(omega_radps)) * dt_s
     if th < 1e-12:
         d = np.array([1.0, *(0.5 * dt_s * omega_radps)])
     else:
-        ax = omega_radps / np.linalg.norm(omega_radps)
+        ax = omega_radps / _norm(omega_radps)
         d = np.array([math.cos(0.5 * th), *(math.sin(0.5 * th) * ax)])
-    w0, x0, y0, z0 = q
-    w1, x1, y1, z1 = d
-    out = np.array([
+    out = quat_mul(q, d)
+    return out / _norm(out)
+
+
+def quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Hamilton product ``a b`` (scalar first)."""
+    w0, x0, y0, z0 = a
+    w1, x1, y1, z1 = b
+    return np.array([
         w0 * w1 - x0 * x1 - y0 * y1 - z0 * z1,
         w0 * x1 + x0 * w1 + y0 * z1 - z0 * y1,
         w0 * y1 - x0 * z1 + y0 * w1 + z0 * x1,
         w0 * z1 + x0 * y1 - y0 * x1 + z0 * w1,
     ])  # fmt: skip
-    return out / np.linalg.norm(out)
+
+
+def quat_conj(q: np.ndarray) -> np.ndarray:
+    """The conjugate (inverse of a unit quaternion)."""
+    return np.array([q[0], -q[1], -q[2], -q[3]])
+
+
+def rotation_vector(q: np.ndarray) -> np.ndarray:
+    """The rotation vector (rad) of a unit quaternion, the shorter way round."""
+    w, v = q[0], q[1:]
+    if w < 0.0:
+        w, v = -w, -v
+    n = float(_norm(v))
+    if n < 1e-12:
+        return 2.0 * v
+    return (2.0 * math.atan2(n, w) / n) * v
 
 
 def tilt_matched(f_mps2: np.ndarray) -> np.ndarray:
     """The level-heading attitude (yaw 0) whose gravity gives the direction of ``f`` (body axes): roll
     ``atan2(-f_y, -f_z)``, pitch ``asin(f_x / |f|)``; level when ``|f|`` is below 1 m/s^2."""
-    n = float(np.linalg.norm(f_mps2))
+    n = float(_norm(f_mps2))
     if n < 1.0:
         return np.array([1.0, 0.0, 0.0, 0.0])
     phi = math.atan2(-f_mps2[1], -f_mps2[2])
@@ -199,11 +229,13 @@ class MpcUnrestrictedWashout:
         self._gam_o = g[:, 0]
         self._phi_c, g = discretise_zoh(ac, bc[:, None], self.dt)
         self._gam_c = g[:, 0]
-        self._Oo, self._Oc = oto.O, can.O
+        self._Oo, self._Oc = oto.free, can.free
         self._To, self._Tc = oto.T, can.T
         lower = np.tril(np.ones((N, N)), -1)
         Lm = tp * (lower + 0.5 * np.eye(N))  # dtheta at the intervals' midpoints from the moves' rates
-        self._Pp = tp * tp * (np.tril(np.subtract.outer(np.arange(N), np.arange(N)), 0) + 0.5 * np.tril(np.ones((N, N))))
+        self._Pp = (
+            tp * tp * (np.tril(np.subtract.outer(np.arange(N), np.arange(N)), 0) + 0.5 * np.tril(np.ones((N, N))))
+        )
         self._Pv = tp * np.tril(np.ones((N, N)))
         self._t_nodes = tp * np.arange(1, N + 1)
         # blocked prediction matrices (N, M)
@@ -214,18 +246,32 @@ class MpcUnrestrictedWashout:
         self._PpB = self._Pp @ Bk
         self._PvB = self._Pv @ Bk
         self._B = Bk
-        # the constant N x N (M x M) Gram blocks of the Hessian
-        BtB = Bk.T @ (Bk * 1.0)
-        self._G_aa_o = self._ToB.T @ self._ToB
-        self._G_aa_d = BtB
-        self._H_aa_const = np.kron(self._PpB.T @ self._PpB, np.diag(p.position.xyz)) + np.kron(
-            self._PvB.T @ self._PvB, np.diag(p.velocity.xyz)
-        ) + np.kron(BtB, p.acceleration * np.eye(3))  # fmt: skip
-        self._G_aw_o = self._ToB.T @ self._ToLmB
-        self._G_aw_d = Bk.T @ self._LmB
-        self._G_ww_o = self._ToLmB.T @ self._ToLmB
-        self._G_ww_d = self._LmB.T @ self._LmB
-        self._H_ww_const = np.kron(self._TcB.T @ self._TcB, np.diag(p.rate.xyz)) + np.kron(BtB, p.angular_rate * np.eye(3))
+        # The Hessian, z = [a moves (M x 3), omega moves (M x 3)]: sum_k Gram_k (x) S_k with the (2M, 2M) Gram
+        # matrices fixed and the 3 x 3 factors S_k set by the attitude each sample (see _plan), plus a fixed part.
+        BtB = Bk.T @ Bk
+        gram = np.zeros((8, 2 * M, 2 * M))
+        a_, w_ = slice(0, M), slice(M, 2 * M)
+        gram[0][a_, a_] = self._ToB.T @ self._ToB  # (R Wo R')
+        gram[1][a_, a_] = BtB  # (R Wd R')
+        gram[2][a_, w_] = self._ToB.T @ self._ToLmB  # (R Wo G)
+        gram[3][w_, a_] = gram[2][a_, w_].T  # (G' Wo R')
+        gram[4][a_, w_] = Bk.T @ self._LmB  # (R Wd G)
+        gram[5][w_, a_] = gram[4][a_, w_].T  # (G' Wd R')
+        gram[6][w_, w_] = self._ToLmB.T @ self._ToLmB  # (G' Wo G)
+        gram[7][w_, w_] = self._LmB.T @ self._LmB  # (G' Wd G)
+        self._gram = gram.reshape(8, -1).T.copy()  # (4 M^2, 8): H's varying part is one product with S (8, 9)
+        h_fixed = np.zeros((6 * M, 6 * M))
+        h_fixed[: 3 * M, : 3 * M] = (np.kron(self._PpB.T @ self._PpB, np.diag(p.position.xyz))
+                                     + np.kron(self._PvB.T @ self._PvB, np.diag(p.velocity.xyz))
+                                     + np.kron(BtB, p.acceleration * np.eye(3)))  # fmt: skip
+        h_fixed[3 * M :, 3 * M :] = np.kron(self._TcB.T @ self._TcB, np.diag(p.rate.xyz)) + np.kron(
+            BtB, p.angular_rate * np.eye(3)
+        )
+        self._h_fixed = h_fixed
+        self._S = np.empty((8, 3, 3))
+        self._relin_rad = math.radians(p.relinearise_deg)
+        self._H: np.ndarray | None = None
+        self._q_lin = np.array([1.0, 0.0, 0.0, 0.0])
         self._Wo = np.diag(p.force.xyz)
         self._Wd = np.diag(p.direct_force.xyz)
         self._Wc = np.diag(p.rate.xyz)
@@ -234,8 +280,11 @@ class MpcUnrestrictedWashout:
         # constraints: rows [position (3N), velocity (3N), rate facets (4M), rate change facets (4M)] over
         # z = [a_0..a_{M-1} (3 each), omega_0..omega_{M-1} (3 each)]
         nz = 6 * M
-        A_pos = np.hstack([np.kron(self._PpB, np.eye(3)), np.zeros((3 * N, 3 * M))])
-        A_vel = np.hstack([np.kron(self._PvB, np.eye(3)), np.zeros((3 * N, 3 * M))])
+        # the stage's limits at the end of each move (velocity is linear within a move, so its box holds between;
+        # position may bulge within a move by at most a_max tb^2 / 8, inside the margin for these moves)
+        self._ends = ends = np.cumsum(self.blocks) - 1
+        A_pos = np.hstack([np.kron(self._PpB[ends], np.eye(3)), np.zeros((3 * M, 3 * M))])
+        A_vel = np.hstack([np.kron(self._PvB[ends], np.eye(3)), np.zeros((3 * M, 3 * M))])
         facets = np.kron(np.eye(M), _FACETS)  # (4M, 3M)
         diff = np.eye(M) - np.eye(M, k=-1)
         A_rate = np.hstack([np.zeros((4 * M, 3 * M)), facets])
@@ -243,18 +292,18 @@ class MpcUnrestrictedWashout:
         A = np.vstack([A_pos, A_vel, A_rate, A_dacc])
         eq = np.zeros(A.shape[0], dtype=bool)
         if p.terminal_rest:
-            eq[3 * N + 3 * (N - 1) : 3 * N + 3 * N] = True
+            eq[6 * M - 3 : 6 * M] = True
         self.qp = DenseQp(nz, A, eq, p.solver.iter_limit)
         w = mg * self.w_max
         self._hi = np.concatenate([
             np.tile(mg * self.a_max, M), np.full(3 * M, w),  # simple bounds
-            np.tile(mg * self.p_max, N), np.tile(mg * self.v_max, N),
+            np.tile(mg * self.p_max, M), np.tile(mg * self.v_max, M),
             np.full(4 * M, w), np.full(4 * M, mg * self.alpha_max * tp),
         ])  # fmt: skip
         self._lo = -self._hi
-        self._n_pos = slice(nz, nz + 3 * N)
-        self._n_vel = slice(nz + 3 * N, nz + 6 * N)
-        self._n_dacc0 = slice(nz + 6 * N + 4 * M, nz + 6 * N + 4 * M + 4)
+        self._n_pos = slice(nz, nz + 3 * M)
+        self._n_vel = slice(nz + 3 * M, nz + 6 * M)
+        self._n_dacc0 = slice(nz + 6 * M + 4 * M, nz + 6 * M + 4 * M + 4)
         self._dw0 = mg * self.alpha_max * self.dt
         self._decay = np.exp(-p.reference_decay_per_s * tp * np.arange(N))  # interval j, from its start
         # state
@@ -268,7 +317,6 @@ class MpcUnrestrictedWashout:
         self.fallbacks = 0
         self.iterations: list[int] = []
         self._sat_rot = False
-        self._H = np.zeros((nz, nz))
         self._future: tuple[np.ndarray, np.ndarray] | None = None
         self._k = 0
 
@@ -298,6 +346,7 @@ class MpcUnrestrictedWashout:
         self.w = np.zeros(3)
         self._steady_states(self._head_force(self.q, np.zeros(3)) - f, -w)
         self._k = 0
+        self._H = None
         return self.p.copy(), self.q.copy()
 
     def _reference(self, f: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -327,21 +376,33 @@ class MpcUnrestrictedWashout:
     def _plan(self, f: np.ndarray, w: np.ndarray) -> tuple[bool, np.ndarray, np.ndarray]:
         """Solve this sample's QP; (solved, a moves (M, 3) inertial, omega moves (M, 3) body)."""
         M = self.M
-        R0 = quat_matrix(self.q)
-        gB = R0.T @ np.array([0.0, 0.0, self.g])
-        G = -_skew(gB)
+        d0 = rotation_vector(quat_mul(quat_conj(self._q_lin), self.q)) if self._H is not None else None
+        relinearise = d0 is None or float(_norm(d0)) > self._relin_rad
+        if relinearise:  # a new linearisation point: the Hessian and its 3 x 3 factors are rebuilt
+            self._q_lin = self.q.copy()
+            d0 = np.zeros(3)
+            R0 = quat_matrix(self.q)
+            gB = R0.T @ np.array([0.0, 0.0, self.g])
+            G = -_skew(gB)
+            Wo, Wd = self._Wo, self._Wd
+            S = self._S
+            RWo, RWd = R0 @ Wo, R0 @ Wd
+            S[0] = RWo @ R0.T
+            S[1] = RWd @ R0.T
+            S[2] = RWo @ G
+            S[3] = S[2].T
+            S[4] = RWd @ G
+            S[5] = S[4].T
+            S[6] = G.T @ Wo @ G
+            S[7] = G.T @ Wd @ G
+            H = (self._gram @ S.reshape(8, 9)).reshape(2 * M, 2 * M, 3, 3).transpose(0, 2, 1, 3)
+            self._H = 2.0 * self.tp * (H.reshape(6 * M, 6 * M) + self._h_fixed)
+            self._lin = (R0, gB, G)
+        R0, gB, G = self._lin
         Wo, Wd = self._Wo, self._Wd
-        RWoR = R0 @ Wo @ R0.T
-        RWdR = R0 @ Wd @ R0.T
-        H = self._H
-        H[: 3 * M, : 3 * M] = np.kron(self._G_aa_o, RWoR) + np.kron(self._G_aa_d, RWdR) + self._H_aa_const
-        haw = np.kron(self._G_aw_o, R0 @ Wo @ G) + np.kron(self._G_aw_d, R0 @ Wd @ G)
-        H[: 3 * M, 3 * M :] = haw
-        H[3 * M :, : 3 * M] = haw.T
-        H[3 * M :, 3 * M :] = (np.kron(self._G_ww_o, G.T @ Wo @ G) + np.kron(self._G_ww_d, G.T @ Wd @ G)
-                               + self._H_ww_const)  # fmt: skip
         F, Wr = self._reference(f, w)
-        Fref = F + gB  # the otolith input is R0' a + G dtheta - (f_air + g_B0)
+        # the otolith input is R0' a + G (d0 + dtheta) - (f_air + g_B0), d0 the rotation since the linearisation
+        Fref = F + (gB - G @ d0)
         c_o = self._Oo @ self.xo - self._To @ Fref  # (N, 3)
         c_d = -Fref
         c_c = self._Oc @ self.xc - self._Tc @ Wr
@@ -353,10 +414,12 @@ class MpcUnrestrictedWashout:
         fw = (self._ToLmB.T @ (c_o @ Wo) + self._LmB.T @ (c_d @ Wd)) @ G + self._TcB.T @ (c_c @ self._Wc)
         fz = np.concatenate([fa.ravel(), fw.ravel()])
         lo, hi = self._lo.copy(), self._hi.copy()
-        lo[self._n_pos] -= c_p.ravel()
-        hi[self._n_pos] -= c_p.ravel()
-        lo[self._n_vel] -= c_v.ravel()
-        hi[self._n_vel] -= c_v.ravel()
+        cp_end = c_p[self._ends].ravel()
+        lo[self._n_pos] -= cp_end
+        hi[self._n_pos] -= cp_end
+        v_all = np.broadcast_to(self.v, (self.M, 3)).ravel()
+        lo[self._n_vel] -= v_all
+        hi[self._n_vel] -= v_all
         if self.params.terminal_rest:  # v_N = 0: (PvB (x) I) z_a = -v_0
             lo[self._n_vel.stop - 3 : self._n_vel.stop] = -c_v[-1]
             hi[self._n_vel.stop - 3 : self._n_vel.stop] = -c_v[-1]
@@ -364,7 +427,7 @@ class MpcUnrestrictedWashout:
         lo[self._n_dacc0] = s - self._dw0
         hi[self._n_dacc0] = s + self._dw0
         # the whole cost doubled and times tp is 1/2 z' H z + f' z with H = 2 tp (J' W J), f = 2 tp J' W c
-        ok, z, it = self.qp.solve(2.0 * self.tp * H, 2.0 * self.tp * fz, lo, hi)
+        ok, z, it = self.qp.solve(self._H, 2.0 * self.tp * fz, lo, hi, h_changed=relinearise)
         self.solves += 1
         self.iterations.append(it)
         return ok, z[: 3 * M].reshape(M, 3), z[3 * M :].reshape(M, 3)
@@ -383,12 +446,12 @@ class MpcUnrestrictedWashout:
             room = self.p_max[j] - p1[j] if v1[j] > 0 else self.p_max[j] + p1[j]
             if abs(v1[j]) > brake_speed(room, self.a_max[j], dt) + 1e-9:
                 return False
-        return bool(np.linalg.norm(w) <= self.w_max and np.linalg.norm(w - self.w) <= self.alpha_max * dt * (1 + 1e-9))
+        return bool(_norm(w) <= self.w_max and _norm(w - self.w) <= self.alpha_max * dt * (1 + 1e-9))
 
     def _brake(self) -> tuple[np.ndarray, np.ndarray]:
         """Braking: each stage axis decelerates towards rest at its limit, the rate towards 0 at the sphere's."""
         a = -np.clip(self.v / self.dt, -self.a_max, self.a_max)
-        nw = float(np.linalg.norm(self.w))
+        nw = float(_norm(self.w))
         step = self.alpha_max * self.dt
         w = np.zeros(3) if nw <= step else self.w * (1.0 - step / nw)
         return a, w

@@ -183,7 +183,6 @@ def apply_overrides(
     try:
         return WashoutParams.model_validate_json(json.dumps(data, allow_nan=True))
     except pydantic.ValidationError as exc:
-
         err = exc.errors(include_url=False)[0]
         loc = tuple(str(p) for p in err["loc"] if isinstance(p, str))
         key = next((k for k, _ in items if tuple(k.split(".")) == loc[: len(k.split("."))]), ".".join(loc))
@@ -360,7 +359,6 @@ def select_from(
     return as_washouts([*builtin(named, base), *extra] if named else list(extra), None)
 
 
-
 def platform_refusal(washout: Washout, platform: Any) -> str | None:
     """Why ``washout`` cannot drive ``platform`` (one line), or None when it can: on a platform of limited rotation
     (hexapod, rig) the unrestricted family (its attitude set point is never washed back to level) and the oracle
@@ -368,9 +366,12 @@ def platform_refusal(washout: Washout, platform: Any) -> str | None:
     kind = getattr(platform, "kind", "atlas")
     if kind == "atlas":
         return None
-    if washout.kind in ("unrestricted", "adaptive-unrestricted", "mpc-unrestricted") and not getattr(platform, "unlimited_rotation", False):
-        return (f"washout {washout.name} ({washout.kind}): cannot drive a {kind} (limited rotation; its attitude set "
-                "point is never washed back to level); use large-angle or adaptive-large-angle")
+    unlimited = getattr(platform, "unlimited_rotation", False)
+    if washout.kind in ("unrestricted", "adaptive-unrestricted", "mpc-unrestricted") and not unlimited:
+        return (
+            f"washout {washout.name} ({washout.kind}): cannot drive a {kind} (limited rotation; its attitude set "
+            "point is never washed back to level); use large-angle or adaptive-large-angle"
+        )
     if washout.kind == "bound":
         return f"washout {washout.name} (bound): the oracle bound is computed for the Atlas only, not over a {kind}"
     return None
