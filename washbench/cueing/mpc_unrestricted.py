@@ -18,7 +18,7 @@ for small dense QPs, warm-started: :class:`washbench.cueing.condensed.DenseQp`),
 
 where ``e_oto`` and ``e_can`` are the perceived errors (the paper's otolith and canal models, Eqs. 11-12, driven by
 simulator minus aircraft head signals in body axes), ``e_f`` the specific-force error at the head itself, and the
-aircraft input over the horizon is held (decaying towards level flight as ``e^{-gamma t}``), or, with ``preview_s``
+aircraft input over the horizon returns from its last value to its recent mean as ``e^{-gamma t}``, or, with ``preview_s``
 > 0 and the recording known (``run``, ``suite``, ``cue``: :meth:`MpcUnrestrictedWashout.trace`), the aircraft's own
 future. Decisions are held over blocks of intervals (move blocking). There is no attitude cost and no tilt-rate
 limit: the sphere may turn without limit, and tilt is paid for only by what the canals perceive of it. The first
@@ -86,8 +86,11 @@ class MpcUnrestrictedParams(StrictModel):
     preview_s: Annotated[float, Field(ge=0.0, le=20.0, allow_inf_nan=False)] = 0.0
     """how far ahead the aircraft's motion is known (s): 0 none; > 0 needs the recording in advance"""
     reference_decay_per_s: Annotated[float, Field(ge=0.0, le=100.0, allow_inf_nan=False)] = 0.5
-    """gamma: beyond what is previewed, the aircraft's deviation from level 1-g flight and its rate are predicted
-    as decaying as e^{-gamma t} from the last known value"""
+    """gamma: beyond what is previewed, the aircraft's specific force and rate are predicted to return from the last
+    known value to their recent mean as e^{-gamma t} (0: held)"""
+    reference_mean_s: Annotated[float, Field(gt=0.0, le=600.0, allow_inf_nan=False)] = 5.0
+    """the time constant of that recent mean (s): a first-order low-pass of the aircraft's input, started at the
+    first sample, so a steady flight is predicted to stay as it is"""
     limit_margin: Annotated[float, Field(gt=0.0, le=1.0)] = 0.95
     """the QP's limits are this fraction of the platform's"""
     terminal_rest: bool = True
@@ -306,6 +309,9 @@ class MpcUnrestrictedWashout:
         self._n_dacc0 = slice(nz + 6 * M + 4 * M, nz + 6 * M + 4 * M + 4)
         self._dw0 = mg * self.alpha_max * self.dt
         self._decay = np.exp(-p.reference_decay_per_s * tp * np.arange(N))  # interval j, from its start
+        self._mean_gain = -math.expm1(-self.dt / p.reference_mean_s)  # the recent mean's low-pass, per sample
+        self._f_mean = np.array([0.0, 0.0, -self.g])
+        self._w_mean = np.zeros(3)
         # state
         self.q = np.array([1.0, 0.0, 0.0, 0.0])
         self.p = np.zeros(3)
@@ -345,17 +351,18 @@ class MpcUnrestrictedWashout:
         self.v = np.zeros(3)
         self.w = np.zeros(3)
         self._steady_states(self._head_force(self.q, np.zeros(3)) - f, -w)
+        self._f_mean, self._w_mean = f.copy(), w.copy()
         self._k = 0
         self._H = None
         return self.p.copy(), self.q.copy()
 
     def _reference(self, f: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The aircraft's specific force and rate over the horizon's intervals (N, 3) each: the previewed samples
-        (at the intervals' midpoints) as far as ``preview_s`` reaches, then the last known one decaying towards level
-        flight."""
-        level = np.array([0.0, 0.0, -self.g])
-        F = level + np.outer(self._decay, f - level)
-        W = np.outer(self._decay, w)
+        (at the intervals' midpoints) as far as ``preview_s`` reaches, then the last known one returning to the recent
+        mean as e^{-gamma t}."""
+        fm, wm = self._f_mean, self._w_mean
+        F = fm + np.outer(self._decay, f - fm)
+        W = wm + np.outer(self._decay, w - wm)
         fut = self._future
         if fut is None or self.params.preview_s <= 0.0:
             return F, W
@@ -369,8 +376,8 @@ class MpcUnrestrictedWashout:
         j = int(np.count_nonzero(seen))
         if j < self.N:
             last_f, last_w = F[j - 1] if j else f, W[j - 1] if j else w
-            F[j:] = level + np.outer(self._decay[: self.N - j], last_f - level)
-            W[j:] = np.outer(self._decay[: self.N - j], last_w)
+            F[j:] = fm + np.outer(self._decay[: self.N - j], last_f - fm)
+            W[j:] = wm + np.outer(self._decay[: self.N - j], last_w - wm)
         return F, W
 
     def _plan(self, f: np.ndarray, w: np.ndarray) -> tuple[bool, np.ndarray, np.ndarray]:
@@ -459,6 +466,8 @@ class MpcUnrestrictedWashout:
     def _advance(self, f: np.ndarray, w_air: np.ndarray) -> SetPoint:
         if not (np.all(np.isfinite(f)) and np.all(np.isfinite(w_air))):
             raise ValueError("mpc-unrestricted: non-finite input")
+        self._f_mean += self._mean_gain * (f - self._f_mean)
+        self._w_mean += self._mean_gain * (w_air - self._w_mean)
         ok, a_plan, w_plan = self._plan(f, w_air)
         a, w = (a_plan[0], w_plan[0]) if ok else (np.zeros(3), np.zeros(3))
         if not (ok and self._safe(a, w)):

@@ -1,0 +1,249 @@
+"""The unrestricted MPC washout (``mpc-unrestricted``): its condensed QP against an independent step-by-step
+simulation of the same linearised model (scipy's ZOH discretisation, scipy Rotation for the gravity Jacobian), its
+set points against the Atlas's limits on stress signals, its start, and its preview."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy import signal
+from scipy.spatial.transform import Rotation
+from test_mpc import STRESS, _check_limits, _far_limits
+
+from washbench.analysis.signals import SignalSpec, generate
+from washbench.cueing.algorithm import WashoutAlgorithm, WashoutContext
+from washbench.cueing.condensed import blocking_matrix, default_blocks, siso_prediction
+from washbench.cueing.mpc_unrestricted import MpcUnrestrictedParams, MpcUnrestrictedWashout, tilt_matched
+from washbench.errors import WashbenchError
+from washbench.perception.vestibular import CanalParams, OtolithParams, canal_tf, otolith_tf
+from washbench.platform.limits import PlatformLimits, load_platform_limits
+
+G = 9.80665
+DT = 1.0 / 120.0
+
+
+@pytest.fixture(scope="module")
+def limits() -> PlatformLimits:
+    return load_platform_limits()
+
+
+def _context(limits: PlatformLimits, start: str = "steady") -> WashoutContext:
+    return WashoutContext(DT, G, limits, start, (0.0, 0.0, 0.0))
+
+
+def test_is_a_washout_algorithm(limits):
+    assert isinstance(MpcUnrestrictedWashout(None, _context(limits)), WashoutAlgorithm)
+
+
+def test_prediction_matrices_match_scipy_dlsim():
+    """``y = F x0 + T u`` of the otolith and canal models over 0.1 s intervals equals scipy's own ZOH
+    discretisation (cont2discrete) simulated by dlsim, for a random input and start state."""
+    rng = np.random.default_rng(3)
+    for num, den in (otolith_tf(OtolithParams()), canal_tf(CanalParams())):
+        pred = siso_prediction(num, den, 0.1, 15)
+        a, b, c, d = signal.tf2ss(num, den)
+        ad, bd, cd, dd, _ = signal.cont2discrete((a, b, c, d), 0.1, method="zoh")
+        u = rng.standard_normal(15)
+        x0 = rng.standard_normal(a.shape[0])
+        _, y, _ = signal.dlsim((ad, bd, cd, dd, 0.1), np.append(u, 0.0), x0=x0)
+        np.testing.assert_allclose(pred.free @ x0 + pred.T @ u, y[1:, 0], rtol=1e-9, atol=1e-12)
+
+
+def test_blocks_cover_the_horizon():
+    for n in (1, 5, 20, 50):
+        b = default_blocks(n)
+        assert sum(b) == n and b[0] == 1
+        m = blocking_matrix(b)
+        assert m.shape == (n, len(b)) and np.all(m.sum(axis=1) == 1.0)
+    assert default_blocks(20) == (1, 1, 1, 2, 2, 2, 3, 3, 5)
+
+
+def _gravity_jacobian(q: np.ndarray) -> np.ndarray:
+    """d f_B / d dtheta at dtheta = 0 for f_B = (R(q) Exp(dtheta))' (-g_I), by central differences of scipy
+    Rotations (independent of the module's -[g_B]x)."""
+    r0 = Rotation.from_quat(q[[1, 2, 3, 0]])
+    out = np.empty((3, 3))
+    h = 1e-6
+    for i in range(3):
+        e = np.zeros(3)
+        e[i] = h
+        fp = (r0 * Rotation.from_rotvec(e)).inv().apply([0.0, 0.0, -G])
+        fm = (r0 * Rotation.from_rotvec(-e)).inv().apply([0.0, 0.0, -G])
+        out[:, i] = (fp - fm) / (2 * h)
+    return out
+
+
+def _simulated_cost(w: MpcUnrestrictedWashout, z: np.ndarray, f_air: np.ndarray, w_air: np.ndarray) -> float:
+    """The plan's cost by stepping the linearised model interval by interval: otolith and canal error models
+    discretised by scipy (cont2discrete, ZOH at tp) per body axis, the stage integrated exactly, the head force
+    linearised with the scipy-Rotation Jacobian, the attitude change at each interval's midpoint."""
+    p = w.params
+    tp, n_int, blocks = w.tp, w.N, w.blocks
+    m = len(blocks)
+    a_mv, w_mv = z[: 3 * m].reshape(m, 3), z[3 * m :].reshape(m, 3)
+    idx = np.repeat(np.arange(m), blocks)
+    a_int, w_int = a_mv[idx], w_mv[idx]
+    r0 = Rotation.from_quat(w.q[[1, 2, 3, 0]])
+    jac = _gravity_jacobian(w.q)
+    f0 = r0.inv().apply([0.0, 0.0, -G])
+    models = []
+    for num, den in (otolith_tf(p.vestibular.otolith), canal_tf(p.vestibular.canals)):
+        a, b, c, d = signal.tf2ss(num, den)
+        models.append(signal.cont2discrete((a, b, c, d), tp, method="zoh")[:3])
+    (ao, bo, co), (ac, bc, cc) = models
+    xo, xc = w.xo.copy(), w.xc.copy()
+    pos, vel = w.p.copy(), w.v.copy()
+    dth = np.zeros(3)
+    wo, wd, wc = (np.array(x.xyz) for x in (p.force, p.direct_force, p.rate))
+    wp, wv = np.array(p.position.xyz), np.array(p.velocity.xyz)
+    cost = 0.0
+    for j in range(n_int):
+        mid = dth + 0.5 * tp * w_int[j]
+        f_sim = r0.inv().apply(a_int[j]) + f0 + jac @ mid
+        e_in = f_sim - f_air
+        cost += tp * (np.sum(wd * e_in**2) + p.acceleration * a_int[j] @ a_int[j] + p.angular_rate * w_int[j] @ w_int[j])
+        xo = ao @ xo + bo @ e_in[None, :]
+        xc = ac @ xc + bc @ (w_int[j] - w_air)[None, :]
+        pos = pos + vel * tp + 0.5 * a_int[j] * tp * tp
+        vel = vel + a_int[j] * tp
+        dth = dth + tp * w_int[j]
+        e_o, e_c = (co @ xo)[0], (cc @ xc)[0]
+        cost += tp * (np.sum(wo * e_o**2) + np.sum(wc * e_c**2) + np.sum(wp * pos**2) + np.sum(wv * vel**2))
+    return float(cost)
+
+
+def test_the_plan_minimises_the_independently_simulated_cost(limits):
+    """From a banked, pitched and yawed cockpit with the error models, the stage and the rate away from rest and the
+    limits out of reach (no constraint active but the plan's end at rest, dropped here), the QP's plan is the
+    minimiser of the cost simulated step by step: its gradient there, by central differences, vanishes against the
+    cost's scale, and random moves away from it cost more."""
+    params = MpcUnrestrictedParams(reference_decay_per_s=0.0, terminal_rest=False, relinearise_deg=0.0)
+    w = MpcUnrestrictedWashout(params, _context(_far_limits(limits)))
+    rng = np.random.default_rng(7)
+    w.start(np.array([0.0, 0.0, -G]), np.zeros(3))
+    w.q = Rotation.from_euler("ZYX", [40.0, 12.0, -25.0], degrees=True).as_quat()[[3, 0, 1, 2]]
+    w.xo = 0.3 * rng.standard_normal(w.xo.shape)
+    w.xc = 0.02 * rng.standard_normal(w.xc.shape)
+    w.p = np.array([0.1, -0.05, 0.02])
+    w.v = np.array([0.05, 0.1, -0.02])
+    f_air = np.array([1.5, -0.8, -10.5])
+    w_air = np.array([0.05, -0.1, 0.2])
+    ok, a_mv, w_mv = w._plan(f_air, w_air)
+    assert ok
+    z = np.concatenate([a_mv.ravel(), w_mv.ravel()])
+    j0 = _simulated_cost(w, z, f_air, w_air)
+    h = 1e-4
+    grad = np.empty_like(z)
+    for i in range(z.size):
+        e = np.zeros_like(z)
+        e[i] = h
+        grad[i] = (_simulated_cost(w, z + e, f_air, w_air) - _simulated_cost(w, z - e, f_air, w_air)) / (2 * h)
+    # the scale: the gradient at the zero plan
+    g_zero = np.empty_like(z)
+    for i in range(z.size):
+        e = np.zeros_like(z)
+        e[i] = h
+        g_zero[i] = (_simulated_cost(w, e, f_air, w_air) - _simulated_cost(w, -e, f_air, w_air)) / (2 * h)
+    assert np.linalg.norm(grad) < 1e-6 * np.linalg.norm(g_zero), (np.linalg.norm(grad), np.linalg.norm(g_zero))
+    for _ in range(5):
+        d = 0.01 * rng.standard_normal(z.size)
+        assert _simulated_cost(w, z + d, f_air, w_air) > j0
+
+
+def _run(w, f: np.ndarray, om: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    w.start(f[0], om[0])
+    pos = np.empty((len(f), 3))
+    q = np.empty((len(f), 4))
+    for k in range(len(f)):
+        pos[k], q[k] = w.step(f[k], om[k])
+    return pos, q
+
+
+@pytest.mark.parametrize("spec", STRESS, ids=lambda s: f"{s.kind}-{s.axis}")
+def test_set_points_stay_within_the_platform_limits_on_stress_signals(limits, spec):
+    sig = generate(spec)
+    w = MpcUnrestrictedWashout(None, _context(limits))
+    pos, q = _run(w, sig.f_mps2, sig.omega_radps)
+    _check_limits(pos, q, limits)
+    rep = w.report()
+    assert rep["solves"] == len(sig.f_mps2)
+    assert rep["fallbacks"] <= 0.01 * rep["solves"], rep
+
+
+def test_it_follows_a_sustained_yaw_rate_without_limit(limits):
+    """A 90 deg/s yaw step held 6 s: the sphere yaws on through more than 120 deg (a hexapod's yaw travel is about
+    +-30 deg), level, while the canals still feel the turn (they adapt within seconds: so does the plan)."""
+    sig = generate(SignalSpec("step", "yaw", 90.0, duration_s=6.0, start_s=0.5))
+    w = MpcUnrestrictedWashout(None, _context(limits))
+    _, q = _run(w, sig.f_mps2, sig.omega_radps)
+    rot = Rotation.from_quat(q[:, [1, 2, 3, 0]])
+    rates = (rot[:-1].inv() * rot[1:]).as_rotvec() / DT
+    turned = np.degrees(np.sum(rates[:, 2]) * DT)
+    assert turned > 120.0, turned
+    tilt = np.degrees(np.arccos(np.clip(rot.apply([0.0, 0.0, 1.0])[:, 2], -1.0, 1.0)))
+    assert tilt.max() < 2.0  # about the vertical: no false tilt
+
+
+def test_a_steady_tilted_start_holds_still(limits):
+    """A steady climb (specific force tilted 6 deg nose up, |f| = g): the washout starts tilted to match and stays
+    there: under a millimetre and 0.01 deg/s over 5 s (the linear MPC used to make a start-up move)."""
+    th = math.radians(6.0)
+    f = np.tile([G * math.sin(th), 0.0, -G * math.cos(th)], (600, 1))
+    om = np.zeros((600, 3))
+    w = MpcUnrestrictedWashout(None, _context(limits))
+    p0, q0 = w.start(f[0], om[0])
+    assert np.allclose(Rotation.from_quat(q0[[1, 2, 3, 0]]).inv().apply([0, 0, -G]), f[0], atol=1e-9)
+    pos, q = _run(w, f, om)
+    assert np.abs(pos).max() < 1e-3
+    rot = Rotation.from_quat(q[:, [1, 2, 3, 0]])
+    rates = np.degrees(np.linalg.norm((rot[:-1].inv() * rot[1:]).as_rotvec(), axis=1) / DT)
+    assert rates.max() < 0.01
+
+
+def test_tilt_matched_gives_gravity_the_direction_of_the_force():
+    rng = np.random.default_rng(1)
+    for _ in range(20):
+        f = rng.standard_normal(3) * 4.0 + np.array([0.0, 0.0, -G])
+        q = tilt_matched(f)
+        g_b = Rotation.from_quat(q[[1, 2, 3, 0]]).inv().apply([0.0, 0.0, -G])
+        np.testing.assert_allclose(g_b / G, f / np.linalg.norm(f), atol=1e-12)
+
+
+def test_preview_anticipates_and_no_preview_is_causal(limits):
+    """A surge step at t = 2 s: without preview nothing moves before it (and ``trace`` gives the steps' numbers bit
+    for bit); with 1 s of preview the stage is already moving forward before the step."""
+    sig = generate(SignalSpec("step", "f_x", 2.0, duration_s=4.0, start_s=2.0))
+    f, om = sig.f_mps2, sig.omega_radps
+    before = int(round(1.95 / DT))
+    plain = MpcUnrestrictedWashout(None, _context(limits))
+    pos_s, q_s = _run(plain, f, om)
+    again = MpcUnrestrictedWashout(None, _context(limits))
+    again.start(f[0], om[0])
+    pos_t, q_t = again.trace(f, om)
+    assert np.array_equal(pos_s, pos_t) and np.array_equal(q_s, q_t)
+    assert np.abs(pos_s[:before]).max() < 1e-9
+    seeing = MpcUnrestrictedWashout(MpcUnrestrictedParams(preview_s=1.0), _context(limits))
+    seeing.start(f[0], om[0])
+    pos_p, _ = seeing.trace(f, om)
+    assert np.abs(pos_p[:before]).max() > 1e-3
+    _check_limits(pos_p, q_s, limits)
+
+
+def test_preview_in_a_live_stream_is_refused(limits):
+    w = MpcUnrestrictedWashout(MpcUnrestrictedParams(preview_s=0.5), _context(limits))
+    w.start(np.array([0.0, 0.0, -G]), np.zeros(3))
+    with pytest.raises(WashbenchError, match="preview_s"):
+        w.step(np.array([0.0, 0.0, -G]), np.zeros(3))
+
+
+def test_it_cannot_drive_a_hexapod():
+    from washbench.cueing.variants import builtin, load_param_file, platform_refusal
+    from washbench.io.paths import DATA_DIR
+    from washbench.platform.model import load_platform_model
+
+    platform = load_platform_model(DATA_DIR / "hexapod.yaml")
+    spec = builtin(["mpc-unrestricted"], load_param_file(None)[0])[0]
+    why = platform_refusal(spec, platform)
+    assert why is not None and "mpc-unrestricted" in why and "\n" not in why
