@@ -100,8 +100,22 @@ class MpcUnrestrictedParams(StrictModel):
     """weights of the perceived specific-force error (otolith), body x, y, z, per (m/s^2)^2"""
     direct_force: AxisWeights = _axes(1.0, 1.0, 1.0)
     """weights of the specific-force error at the head (before the otolith), per (m/s^2)^2"""
-    rate: AxisWeights = _axes(10.0, 10.0, 10.0)
-    """weights of the perceived angular-velocity error (canals), body roll, pitch, yaw, per (rad/s)^2"""
+    rate: AxisWeights = _axes(1.0, 1.0, 1.0)
+    """weights of the perceived angular-velocity error (canals), body roll, pitch, yaw, per (rad/s)^2; with
+    ``yardstick_weights`` multiplied by (mean felt force / mean felt rate)^2 (see there)"""
+    yardstick_weights: bool = True
+    """weigh force against rate as the ranking's score does: the score divides each group's integral error by the
+    pilot's own felt motion in that group, so a quadratic proxy weighs errors normalised by each group's mean felt
+    magnitude; the rate weights are multiplied by (m_f / m_w)^2, m_f and m_w the aircraft pilot's mean perceived
+    force and rate so far (|perceived - perceived at the start|, summed over the axes, averaged over the time flown;
+    at least ``felt_floor``); false: the weights as given"""
+    yardstick_power: Annotated[float, Field(ge=0.0, le=1.0, allow_inf_nan=False)] = 0.75
+    """beta: the rate weights' factor is 10^(1 - beta) ((m_f / m_w)^2)^beta ((m/s^2)^2 per (rad/s)^2): 1 the score's
+    ratio, 0 a fixed 10 (the mpc washout's rate weight against its force weight 1)"""
+    felt_floor_mps2: Annotated[float, Field(gt=0.0, le=10.0, allow_inf_nan=False)] = 0.05
+    """the least mean felt force m_f (m/s^2)"""
+    felt_floor_degps: Annotated[float, Field(gt=0.0, le=100.0, allow_inf_nan=False)] = 0.3
+    """the least mean felt rate m_w (deg/s)"""
     position: AxisWeights = _axes(0.4, 0.4, 4.0)
     """stage position, inertial north, east, down, per m^2"""
     velocity: AxisWeights = _axes(0.4, 0.4, 1.0)
@@ -267,9 +281,9 @@ class MpcUnrestrictedWashout:
         h_fixed[: 3 * M, : 3 * M] = (np.kron(self._PpB.T @ self._PpB, np.diag(p.position.xyz))
                                      + np.kron(self._PvB.T @ self._PvB, np.diag(p.velocity.xyz))
                                      + np.kron(BtB, p.acceleration * np.eye(3)))  # fmt: skip
-        h_fixed[3 * M :, 3 * M :] = np.kron(self._TcB.T @ self._TcB, np.diag(p.rate.xyz)) + np.kron(
-            BtB, p.angular_rate * np.eye(3)
-        )
+        h_fixed[3 * M :, 3 * M :] = np.kron(BtB, p.angular_rate * np.eye(3))
+        self._h_can = np.zeros((6 * M, 6 * M))  # the canal error's part, scaled by the rate weights' factor
+        self._h_can[3 * M :, 3 * M :] = np.kron(self._TcB.T @ self._TcB, np.diag(p.rate.xyz))
         self._h_fixed = h_fixed
         self._S = np.empty((8, 3, 3))
         self._relin_rad = math.radians(p.relinearise_deg)
@@ -312,6 +326,12 @@ class MpcUnrestrictedWashout:
         self._mean_gain = -math.expm1(-self.dt / p.reference_mean_s)  # the recent mean's low-pass, per sample
         self._f_mean = np.array([0.0, 0.0, -self.g])
         self._w_mean = np.zeros(3)
+        # the aircraft pilot's own perception (for the yardstick weights): its models' states, start and integrals
+        self._air_o = np.zeros((ao.shape[0], 3))
+        self._air_c = np.zeros((ac.shape[0], 3))
+        self._air_0 = (np.zeros(3), np.zeros(3))
+        self._felt = np.zeros(2)  # integral of |perceived - perceived at the start|: force (m/s), rate (rad)
+        self._scale_used = 1.0
         # state
         self.q = np.array([1.0, 0.0, 0.0, 0.0])
         self.p = np.zeros(3)
@@ -334,6 +354,27 @@ class MpcUnrestrictedWashout:
         self.xo = -np.linalg.solve(ao, bo[:, None]) @ e_f[None, :]
         self.xc = -np.linalg.solve(ac, bc[:, None]) @ e_w[None, :]
 
+    def _feel(self, f: np.ndarray, w: np.ndarray) -> None:
+        """Advance the aircraft pilot's perception by one sample and add |perceived - perceived at the start| to the
+        felt integrals (the ranking's M_d, summed per group)."""
+        self._air_o = self._phi_o @ self._air_o + np.outer(self._gam_o, f)
+        self._air_c = self._phi_c @ self._air_c + np.outer(self._gam_c, w)
+        po = self._co @ self._air_o - self._air_0[0]
+        pc = self._cc @ self._air_c - self._air_0[1]
+        self._felt[0] += self.dt * float(np.abs(po).sum())
+        self._felt[1] += self.dt * float(np.abs(pc).sum())
+
+    def _rate_scale(self) -> float:
+        """The rate weights' factor (m_f / m_w)^2 (1 without ``yardstick_weights``)."""
+        p = self.params
+        if not p.yardstick_weights:
+            return 1.0
+        t = max(self._k, 1) * self.dt
+        m_f = max(self._felt[0] / t, p.felt_floor_mps2)
+        m_w = max(self._felt[1] / t, math.radians(p.felt_floor_degps))
+        beta = p.yardstick_power
+        return 10.0 ** (1.0 - beta) * ((m_f / m_w) ** 2) ** beta
+
     def _head_force(self, q: np.ndarray, a: np.ndarray) -> np.ndarray:
         return quat_matrix(q).T @ (a - np.array([0.0, 0.0, self.g]))
 
@@ -352,6 +393,13 @@ class MpcUnrestrictedWashout:
         self.w = np.zeros(3)
         self._steady_states(self._head_force(self.q, np.zeros(3)) - f, -w)
         self._f_mean, self._w_mean = f.copy(), w.copy()
+        ao, bo, _ = siso_state_space(*otolith_tf(self.params.vestibular.otolith))
+        ac, bc, _ = siso_state_space(*canal_tf(self.params.vestibular.canals))
+        self._air_o = -np.linalg.solve(ao, bo[:, None]) @ f[None, :]
+        self._air_c = -np.linalg.solve(ac, bc[:, None]) @ w[None, :]
+        self._air_0 = (self._co @ self._air_o, self._cc @ self._air_c)
+        self._felt = np.zeros(2)
+        self._scale_used = 1.0
         self._k = 0
         self._H = None
         return self.p.copy(), self.q.copy()
@@ -384,7 +432,8 @@ class MpcUnrestrictedWashout:
         """Solve this sample's QP; (solved, a moves (M, 3) inertial, omega moves (M, 3) body)."""
         M = self.M
         d0 = rotation_vector(quat_mul(quat_conj(self._q_lin), self.q)) if self._H is not None else None
-        relinearise = d0 is None or float(_norm(d0)) > self._relin_rad
+        scale = self._rate_scale()
+        relinearise = d0 is None or float(_norm(d0)) > self._relin_rad or abs(scale / self._scale_used - 1.0) > 0.05
         if relinearise:  # a new linearisation point: the Hessian and its 3 x 3 factors are rebuilt
             self._q_lin = self.q.copy()
             d0 = np.zeros(3)
@@ -403,7 +452,8 @@ class MpcUnrestrictedWashout:
             S[6] = G.T @ Wo @ G
             S[7] = G.T @ Wd @ G
             H = (self._gram @ S.reshape(8, 9)).reshape(2 * M, 2 * M, 3, 3).transpose(0, 2, 1, 3)
-            self._H = 2.0 * self.tp * (H.reshape(6 * M, 6 * M) + self._h_fixed)
+            self._H = 2.0 * self.tp * (H.reshape(6 * M, 6 * M) + self._h_fixed + scale * self._h_can)
+            self._scale_used = scale
             self._lin = (R0, gB, G)
         R0, gB, G = self._lin
         Wo, Wd = self._Wo, self._Wd
@@ -418,7 +468,7 @@ class MpcUnrestrictedWashout:
         fa = (self._ToB.T @ (c_o @ Wo) + self._B.T @ (c_d @ Wd)) @ R0.T + self._PpB.T @ (c_p @ self._Wp) + (
             self._PvB.T @ (c_v @ self._Wv)
         )  # fmt: skip
-        fw = (self._ToLmB.T @ (c_o @ Wo) + self._LmB.T @ (c_d @ Wd)) @ G + self._TcB.T @ (c_c @ self._Wc)
+        fw = (self._ToLmB.T @ (c_o @ Wo) + self._LmB.T @ (c_d @ Wd)) @ G + self._TcB.T @ (c_c @ self._Wc) * self._scale_used
         fz = np.concatenate([fa.ravel(), fw.ravel()])
         lo, hi = self._lo.copy(), self._hi.copy()
         cp_end = c_p[self._ends].ravel()
@@ -466,6 +516,7 @@ class MpcUnrestrictedWashout:
     def _advance(self, f: np.ndarray, w_air: np.ndarray) -> SetPoint:
         if not (np.all(np.isfinite(f)) and np.all(np.isfinite(w_air))):
             raise ValueError("mpc-unrestricted: non-finite input")
+        self._feel(f, w_air)
         self._f_mean += self._mean_gain * (f - self._f_mean)
         self._w_mean += self._mean_gain * (w_air - self._w_mean)
         ok, a_plan, w_plan = self._plan(f, w_air)
