@@ -1,5 +1,6 @@
 """The MPC washout: against the unconstrained discrete LQ solution of the same cost (scipy's DARE), its set points
-against the platform's limits on stress signals (rates from scipy Rotation), and a provoked solver failure."""
+against the platform's limits on stress signals (rates from scipy Rotation), a provoked solver failure, its steady
+start, and its preview."""
 
 from __future__ import annotations
 
@@ -66,15 +67,13 @@ def test_unconstrained_mpc_approaches_the_lq_solution_as_the_horizon_grows(limit
         "limit_margin": 1.0,
         # the LQ comparison uses the standard stage cost x' Q x + u' R u (no direct force term)
         **{ch: {"direct_force": 0.0} for ch in ("pitch", "roll", "heave")},
-        "solver": {"eps_abs": 1e-9, "eps_rel": 1e-9, "max_iter": 100000, "polishing": True},
     }
     # a state reached on a real signal: a surge doublet and a roll-rate doublet through the long-horizon MPC
     sig_f = generate(SignalSpec("doublet", "f_x", 3.0, frequency_hz=0.5, duration_s=3.0))
     sig_r = generate(SignalSpec("doublet", "roll", 15.0, frequency_hz=0.5, duration_s=3.0))
     f = sig_f.f_mps2 + sig_r.f_mps2 - np.array([0.0, 0.0, -G])
     om = sig_r.omega_radps
-    prep = {k: v for k, v in base.items() if k != "solver"}
-    ref = MpcWashout(MpcParams.model_validate({**prep, "horizon_steps": 20}), _context(far))
+    ref = MpcWashout(MpcParams.model_validate({**base, "horizon_steps": 20}), _context(far))
     _run(ref, f[::2], om[::2])  # every other sample: a state is all it needs
     x0, r0 = ref.x.copy(), stacked_inputs(f[-1], om[-1], G)
 
@@ -92,6 +91,7 @@ def test_unconstrained_mpc_approaches_the_lq_solution_as_the_horizon_grows(limit
     for n in (5, 10, 20, 40, 80):
         w = MpcWashout(MpcParams.model_validate({**base, "horizon_steps": n}), _context(far))
         w.x = x0.copy()
+        w.r_mean = np.zeros(6)  # the input predicted as r0 rho^k: the reference model of the DARE above
         ok, plan = w.plan(r0)
         assert ok
         gaps.append(np.linalg.norm(plan[0] - u_lq) / np.linalg.norm(u_lq))
@@ -144,19 +144,24 @@ def test_set_points_stay_within_the_platform_limits_on_stress_signals(limits, sp
     assert rep["fallbacks"] <= 0.02 * rep["solves"], rep
 
 
+def _failing(w: MpcWashout) -> None:
+    """Make every later solve report failure (DAQP solves these QPs exactly in a few iterations, so a failure has to
+    be provoked; what is tested is what the washout does with one)."""
+    w.qp.solve = lambda *args, **kwargs: (False, np.zeros(w.nz), 0)
+
+
 def test_solver_failure_falls_back_to_braking_without_nan(limits):
-    """One OSQP iteration: no solve succeeds once the input moves (at rest the trivial QP converges at once); every
-    step falls back (counted), nothing is NaN, no limit is broken, and the platform stays at rest."""
+    """No solve succeeds: every step falls back (counted), nothing is NaN, no limit is broken, and the platform
+    stays at rest."""
     sig = generate(SignalSpec("doublet", "f_x", 8.0, frequency_hz=0.5, duration_s=2.5, start_s=0.2))
     good = MpcWashout(None, _context(limits))
     pos_g, _ = _run(good, sig.f_mps2, sig.omega_radps)
     assert np.max(np.abs(pos_g[:, 0])) > 0.05
-    w = MpcWashout(MpcParams.model_validate({"solver": {"max_iter": 1}}), _context(limits))
+    w = MpcWashout(None, _context(limits))
+    _failing(w)
     pos, q = _run(w, sig.f_mps2, sig.omega_radps)
     rep = w.report()
-    onset = int(0.2 / DT)
-    assert rep["solves"] == len(sig.f_mps2)
-    assert rep["fallbacks"] >= len(sig.f_mps2) - onset - 1, rep
+    assert rep["fallbacks"] == len(sig.f_mps2), rep
     _check_limits(pos, q, limits)
     assert np.max(np.abs(pos)) < 1e-12  # it started at rest and braking keeps it there
 
@@ -170,8 +175,8 @@ def test_failure_mid_motion_brakes_to_rest_within_the_limits(limits):
     pos = []
     q = []
     for k in range(len(f)):
-        if k == 60:  # 0.5 s in: the platform is moving; from now on the solver gets one iteration
-            w.solver.update_settings(max_iter=1)
+        if k == 60:  # 0.5 s in: the platform is moving; from now on every solve fails
+            _failing(w)
         p_k, q_k = w.step(f[k], om[k])
         pos.append(p_k)
         q.append(q_k)
@@ -190,6 +195,8 @@ def test_params_reject_a_prediction_step_shorter_than_the_sample(limits):
         MpcWashout(MpcParams.model_validate({"prediction_step_s": 0.001}), _context(limits))
     with pytest.raises(Exception, match="bogus"):
         MpcParams.model_validate({"solver": {"bogus": 1}})
+    with pytest.raises(Exception, match="iter_limit"):
+        MpcParams.model_validate({"horizon_steps": 500, "solver": {"iter_limit": 50_000}})
     p = MpcParams.model_validate({"heave": {"force": 2.0}})
     assert p.heave.force == 2.0 and p.heave.position == MpcParams().heave.position  # the channel's default kept
 
@@ -205,3 +212,43 @@ def test_translational_cue_starts_in_the_direction_of_the_force(limits, axis, am
     p = pos[:, axis] * np.sign(amp)
     assert p.min() > -1e-4, p.min()
     assert p[int(1.0 / DT)] > 0.02
+
+
+def test_a_steady_tilted_start_holds_still(limits):
+    """A steady climb (specific force 4 deg nose up, |f| = g) from the first sample: the MPC starts tilted at its
+    steady state and stays: under a millimetre and 0.01 deg/s over 5 s (it used to make a 45 mm, 2 deg/s start-up
+    move on a level cruise), its tilt towards the force (the same sign as the classical tilt coordination)."""
+    th = math.radians(4.0)
+    f = np.tile([G * math.sin(th), 0.0, -G * math.cos(th)], (600, 1))
+    om = np.zeros((600, 3))
+    w = MpcWashout(None, _context(limits))
+    _, q0 = w.start(f[0], om[0])
+    pitch0 = Rotation.from_quat(q0[[1, 2, 3, 0]]).as_euler("ZYX")[1]
+    assert 0.5 * th < pitch0 <= th * 1.001
+    pos, q = _run(w, f, om)
+    assert np.abs(pos).max() < 1e-3
+    rot = Rotation.from_quat(q[:, [1, 2, 3, 0]])
+    rates = np.degrees(np.linalg.norm((rot[:-1].inv() * rot[1:]).as_rotvec(), axis=1) / DT)
+    assert rates.max() < 0.01
+
+
+def test_preview_anticipates_and_no_preview_is_causal(limits):
+    """A surge step at t = 2 s: without preview nothing moves before it, and ``trace`` gives the steps' numbers bit
+    for bit; with 1 s of preview the platform already moves before the step (it backs up to gain travel), within its
+    limits."""
+    sig = generate(SignalSpec("step", "f_x", 2.0, duration_s=4.0, start_s=2.0))
+    f, om = sig.f_mps2, sig.omega_radps
+    before = round(1.95 / DT)
+    pos_s, q_s = _run(MpcWashout(None, _context(limits)), f, om)
+    again = MpcWashout(None, _context(limits))
+    again.start(f[0], om[0])
+    pos_t, q_t = again.trace(f, om)
+    assert np.array_equal(pos_s, pos_t) and np.array_equal(q_s, q_t)
+    assert np.abs(pos_s[:before]).max() < 1e-9
+    seeing = MpcWashout(MpcParams(preview_s=1.0), _context(limits))
+    seeing.start(f[0], om[0])
+    pos_p, q_p = seeing.trace(f, om)
+    assert np.abs(pos_p[:before]).max() > 1e-3
+    _check_limits(pos_p, q_p, limits)
+    with pytest.raises(Exception, match="preview_s"):
+        MpcWashout(MpcParams(preview_s=1.0), _context(limits)).step(f[0], om[0])

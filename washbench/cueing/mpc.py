@@ -1,6 +1,7 @@
 """The model-predictive washout (``mpc``): a quadratic program per step, the platform's limits as hard constraints.
 
-At every sample the washout solves, by OSQP (a sparse ADMM QP solver, warm-started from the previous step),
+At every sample the washout solves, by DAQP (a dual active-set solver for small dense QPs, warm-started from the
+previous step's active set; the states eliminated, :mod:`washbench.cueing.condensed`),
 
     minimise    sum_{k=1..N} x_k' Q x_k dt_p  +  sum_{k=0..N-1} u_k' R u_k dt_p
     subject to  x_{k+1} = Phi x_k + Gamma u_k + Gamma_r r_k           (the linear model, held controls)
@@ -13,8 +14,9 @@ At every sample the washout solves, by OSQP (a sparse ADMM QP solver, warm-start
 
 with the state x of :mod:`washbench.cueing.motion_model` (perceived-error states of the otolith and canal models,
 cockpit angles, platform position and velocity; the pitch and roll angles split into a tilt part, whose rate is
-limited, and a rotational part), x_0 the washout's current state and r_k the aircraft input of this sample held
-over the horizon (``reference_decay_per_s`` > 0: decaying as e^{-gamma t}): no knowledge of the future. The
+limited, and a rotational part), x_0 the washout's current state and r_k the aircraft input of this sample
+returning over the horizon to its recent mean as e^{-gamma t} (``reference_decay_per_s``, ``reference_mean_s``), or,
+with ``preview_s`` > 0 and the recording known, the aircraft's own future (:meth:`MpcWashout.trace`). The
 horizon's intervals are ``prediction_step_s`` (coarser than the sample: see docs/optimal-mpc.md). The first move
 u_0 is applied for one sample (exact discretisation at dt) and the set points are the resulting position and
 attitude. Every solve's status is checked: a failed solve, or a first move that would leave the platform unable to stop
@@ -32,11 +34,13 @@ from typing import Annotated, Any, Literal
 
 import numpy as np
 from pydantic import Field, model_validator
-from scipy import linalg, sparse
+from scipy import linalg
 
 from washbench.cueing.algorithm import SetPoint, WashoutContext
+from washbench.cueing.condensed import DenseQp
 from washbench.cueing.motion_model import CHANNELS, ChannelModel, channel_inputs, channel_model, discretise_zoh
 from washbench.cueing.optimal import merge_channel_defaults
+from washbench.errors import WashbenchError
 from washbench.io.progress import duration_text
 from washbench.io.yamlio import StrictModel
 from washbench.numerics.rotations import quat_from_euler
@@ -44,7 +48,7 @@ from washbench.perception.vestibular import CanalParams, OtolithParams
 from washbench.platform.kinematics import brake_speed
 
 MAX_WORK = 10_000_000
-"""horizon_steps x solver.max_iter at most this (the defaults: 8,000; a 500-step horizon with 20,000 iterations)."""
+"""horizon_steps x solver.iter_limit at most this (the defaults: 20,000; a 500-step horizon with 20,000 iterations)."""
 ESTIMATE_AFTER_STEPS = 20
 """The MPC times its first this-many steps and says how long a minute of flight will take when it is slow."""
 SLOW_FACTOR = 10.0
@@ -77,18 +81,12 @@ class MpcWeights(StrictModel):
     """cockpit angular rates (controls), per (rad/s)^2"""
 
 
-class OsqpSettings(StrictModel):
-    """OSQP's settings for the per-step QP (see OSQP's documentation)."""
+class DaqpSettings(StrictModel):
+    """DAQP's settings for the per-step QP (see DAQP's documentation)."""
 
-    max_iter: Annotated[int, Field(ge=1, le=100_000)] = 400
-    """at most 100,000 (and horizon_steps x max_iter at most :data:`MAX_WORK`)"""
-    eps_abs: Annotated[float, Field(ge=1e-9, le=1.0)] = 1e-4
-    """1e-9..1: tighter than float64's residuals reach, OSQP iterates to max_iter at every step"""
-    eps_rel: Annotated[float, Field(ge=1e-9, le=1.0)] = 1e-4
-    polishing: bool = False
-    adaptive_rho: bool = True
-    time_limit_s: Annotated[float, Field(ge=0.0, le=10.0)] = 0.0
-    """0: none"""
+    iter_limit: Annotated[int, Field(ge=1, le=100_000)] = 1000
+    """active-set iterations per solve, at most 100,000 (and horizon_steps x iter_limit at most :data:`MAX_WORK`);
+    a solve that reaches it falls back (counted)"""
 
 
 class VestibularChoice(StrictModel):
@@ -106,9 +104,15 @@ class MpcParams(StrictModel):
     prediction_step_s: Annotated[float, Field(gt=0.0, le=5.0, allow_inf_nan=False)] = 0.1
     """the prediction interval (s); at least the sample step"""
     reference_decay_per_s: Annotated[float, Field(ge=0.0, le=100.0, allow_inf_nan=False)] = 0.5
-    """gamma: the aircraft input predicted as r e^{-gamma t} over the horizon (0: held; the default 0.5 1/s: with the
-    input held the plan must undo within the horizon any cue it gives, and heave cues came out with the wrong sign,
-    see docs/optimal-mpc.md)"""
+    """gamma: the aircraft input predicted to return from its last value to its recent mean as e^{-gamma t} over the
+    horizon (0: held; the default 0.5 1/s: with the input held the plan must undo within the horizon any cue it
+    gives, and heave cues came out with the wrong sign, see docs/optimal-mpc.md)"""
+    reference_mean_s: Annotated[float, Field(gt=0.0, le=600.0, allow_inf_nan=False)] = 5.0
+    """the time constant of that recent mean (s): a first-order low-pass of the aircraft's input, started at the first
+    sample (a steady flight is predicted to stay as it is)"""
+    preview_s: Annotated[float, Field(ge=0.0, le=20.0, allow_inf_nan=False)] = 0.0
+    """how far ahead the aircraft's motion is known (s; the horizon is extended to cover it): 0 none; > 0 needs the
+    recording in advance (run, suite, cue), not a live stream"""
     limit_margin: Annotated[float, Field(gt=0.0, le=1.0)] = 0.95
     """the QP's limits are this fraction of the platform's"""
     tilt_rate_limit_degps: Annotated[float, Field(gt=0.0, le=1000.0)] | None = 3.0
@@ -120,16 +124,17 @@ class MpcParams(StrictModel):
     roll: MpcWeights = MpcWeights()
     heave: MpcWeights = MpcWeights(position=4.0, velocity=1.0)
     yaw: MpcWeights = MpcWeights(tilt_angle=0.5)
-    solver: OsqpSettings = OsqpSettings()
+    solver: DaqpSettings = DaqpSettings()
     fallback: Literal["brake"] = "brake"
     """what a failed solve does (brake: decelerate translation and rotation at the limits)"""
 
     @model_validator(mode="after")
     def _bounded_work(self) -> MpcParams:
-        """The worst case of one step's solve, horizon_steps x max_iter, within :data:`MAX_WORK`."""
-        work = self.horizon_steps * self.solver.max_iter
+        """The worst case of one step's solve, horizon_steps x iter_limit, within :data:`MAX_WORK`."""
+        work = self.horizon_steps * self.solver.iter_limit
         if work > MAX_WORK:
-            raise ValueError(f"horizon_steps {self.horizon_steps} x solver.max_iter {self.solver.max_iter} = {work:,}: "
+            raise ValueError(f"horizon_steps {self.horizon_steps} x solver.iter_limit {self.solver.iter_limit} = "
+                             f"{work:,}: "
                              f"more than {MAX_WORK:,} (the QP's size times its iterations, per sample: hours per "
                              "minute of flight); lower one of them")  # fmt: skip
         return self
@@ -248,8 +253,6 @@ def stacked_inputs(f_mps2: np.ndarray, omega_radps: np.ndarray, gravity_mps2: fl
     return np.concatenate([channel_inputs(c, f_mps2, omega_radps, gravity_mps2) for c in CHANNELS], axis=-1)
 
 
-_ACCEPTED = ("solved", "solved inaccurate")
-
 # sign patterns of the 1-norm ball's facets |p| + |q| + |r| <= w, as |s . omega| <= w (roll, pitch, yaw)
 _FACETS = np.array([[1.0, 1.0, 1.0], [1.0, 1.0, -1.0], [1.0, -1.0, 1.0], [1.0, -1.0, -1.0]])
 
@@ -258,16 +261,14 @@ class MpcWashout:
     """The MPC washout per step (:class:`washbench.cueing.algorithm.WashoutAlgorithm`).
 
     State: the stacked model state ``x`` (perceived-error states, angles, position, velocity), the last applied
-    controls ``u`` and OSQP's workspace (warm start). Counters: :attr:`solves`, :attr:`fallbacks` (failed or
-    rejected solves replaced by braking), :attr:`iterations` (OSQP iterations per step).
+    controls ``u``, the input's recent mean ``r_mean`` and DAQP's workspace (warm start). Counters: :attr:`solves`,
+    :attr:`fallbacks` (failed or rejected solves replaced by braking), :attr:`iterations` (DAQP iterations per step).
     """
 
     Params = MpcParams
     name = "mpc"
 
     def __init__(self, params: MpcParams | None, context: WashoutContext) -> None:
-        import osqp  # imported when an MPC washout is made (loading it costs ~0.1 s)
-
         self.params = p = params if params is not None else MpcParams()
         self.context = context
         self.dt = float(context.dt_s)
@@ -282,28 +283,23 @@ class MpcWashout:
         self.w_max = math.radians(lim.rotation.rate_limit_degps)
         self.alpha_max = math.radians(lim.rotation.acceleration_limit_degps2)
         self.n, self.m = sm.B.shape
-        self.N = p.horizon_steps
         self.tp = p.prediction_step_s
+        self.N = max(p.horizon_steps, math.ceil(p.preview_s / self.tp - 1e-9))
         ab = np.hstack([sm.B, sm.E])
         self.phi_p, gam = discretise_zoh(sm.A, ab, self.tp)
         self.gam_p, self.gam_rp = gam[:, : self.m], gam[:, self.m :]
         self.phi_f, gam = discretise_zoh(sm.A, ab, self.dt)
         self.gam_f, self.gam_rf = gam[:, : self.m], gam[:, self.m :]
         self.rho = math.exp(-p.reference_decay_per_s * self.tp)
+        self._decay = self.rho ** np.arange(self.N)
+        self._mean_gain = -math.expm1(-self.dt / p.reference_mean_s)
         self._build_qp()
-        s = p.solver
-        self.solver = osqp.OSQP()
-        extra = {"time_limit": s.time_limit_s} if s.time_limit_s > 0.0 else {}
-        settings = {"max_iter": s.max_iter, "eps_abs": s.eps_abs, "eps_rel": s.eps_rel, "polishing": s.polishing}
-        settings.update(adaptive_rho=s.adaptive_rho, check_termination=5, verbose=False, warm_starting=True, **extra)
-        self.solver.setup(self.P_qp, np.zeros(self.nz), self.A_qp, self.l0, self.u0, **settings)
-        self._lo = self.l0.copy()
-        self._hi = self.u0.copy()
+        self.qp = DenseQp(self.nz, self.A_qp, self._eq, p.solver.iter_limit)
         self.x = np.zeros(self.n)
         self.u = np.zeros(self.m)
+        self.r_mean = np.zeros(6)
         self.solves = 0
         self.fallbacks = 0
-        self.inaccurate = 0
         self.brakes = 0
         self._plan: np.ndarray | None = None
         self._plan_age = 0
@@ -312,84 +308,83 @@ class MpcWashout:
         self._sat_rot = False
         self._timed_steps = 0
         self._timed_s = 0.0
+        self._future: tuple[np.ndarray, np.ndarray] | None = None
+        self._k = 0
 
-    # ---- the QP: z = [u_0, x_1, u_1, x_2, ..., u_{N-1}, x_N]
-    def _iu(self, k: int) -> int:
-        return k * (self.m + self.n)
-
-    def _ix(self, k: int) -> int:  # x_k, k >= 1
-        return (k - 1) * (self.m + self.n) + self.m
-
+    # ---- the QP, condensed: z = [u_0, ..., u_{N-1}], the states eliminated (x_{k+1} = Phi x_k + Gamma u_k +
+    # Gamma_r R_k); the parameters of a solve are w = [x_0 (n), R_0 .. R_{N-1} (6 each)]
     def _build_qp(self) -> None:
         sm, n, m, N, tp = self.model, self.n, self.m, self.N, self.tp
         p = self.params
-        self.nz = nz = N * (n + m)
-        # stage k: [u_k, x_{k+1}] with u' R u + x' Q x + w_d |C_dir x + D_dir u - r_f|^2 (r_f: the aircraft force
-        # deviation held), all times dt_p; OSQP minimises 1/2 z' P z + q' z (the whole cost halved: same minimiser)
-        mdir = np.hstack([sm.D_dir, sm.C_dir])  # (3, m + n)
+        self.nz = nz = N * m
+        nw = n + 6 * N
+        # forward recursion of the states' dependence on z and w
+        xu = np.zeros((n, nz))
+        xw = np.zeros((n, nw))
+        xw[:, :n] = np.eye(n)
+        mdir = np.hstack([sm.D_dir, sm.C_dir])  # (3, m + n): head force deviation of stage k from [u_k, x_{k+1}]
         wdir = np.diag(sm.W_dir)
         block = linalg.block_diag(sm.R, sm.Q) + mdir.T @ wdir @ mdir
-        self.P_qp = sparse.csc_matrix(sparse.triu(sparse.block_diag([block * tp] * N)))
         sel = np.zeros((3, 6))
         sel[0, 0] = sel[1, 2] = sel[2, 4] = 1.0  # r = [f_x, omega_y | f_y, omega_x | f_z + g | omega_z]
-        qblk = -(mdir.T @ wdir @ sel) * tp  # (m + n, 6)
-        self._q_map = np.vstack([qblk * self.rho**k for k in range(N)])  # q = _q_map @ r
-        rows: list[sparse.spmatrix] = []
-        # dynamics: x_{k+1} - Phi x_k - Gamma u_k = (Phi x_0 if k == 0) + Gamma_r r_k
-        dyn = sparse.lil_matrix((N * n, nz))
+        H = np.zeros((nz, nz))
+        F = np.zeros((nz, nw))
+        Xu, Xw = [], []
         for k in range(N):
-            r0 = k * n
-            dyn[r0 : r0 + n, self._ix(k + 1) : self._ix(k + 1) + n] = np.eye(n)
-            dyn[r0 : r0 + n, self._iu(k) : self._iu(k) + m] = -self.gam_p
-            if k > 0:
-                dyn[r0 : r0 + n, self._ix(k) : self._ix(k) + n] = -self.phi_p
-        rows.append(dyn.tocsc())
-        lo_b = np.full(nz, -np.inf)
-        hi_b = np.full(nz, np.inf)
+            eu = np.zeros((m, nz))
+            eu[:, k * m : (k + 1) * m] = np.eye(m)
+            rk = np.zeros((6, nw))
+            rk[:, n + 6 * k : n + 6 * (k + 1)] = np.eye(6)
+            xu = self.phi_p @ xu + self.gam_p @ eu
+            xw = self.phi_p @ xw + self.gam_rp @ rk
+            Xu.append(xu)
+            Xw.append(xw)
+            gu = np.vstack([eu, xu])  # y_k = [u_k; x_{k+1}] = gu z + gw w
+            gw = np.vstack([np.zeros((m, nw)), xw])
+            H += gu.T @ block @ gu
+            F += gu.T @ (block @ gw - mdir.T @ wdir @ sel @ rk)
+        # the whole cost times 2 dt_p: 1/2 z' H z + (F w)' z
+        self.H_qp = 2.0 * tp * 0.5 * (H + H.T)
+        self.F_qp = 2.0 * tp * F
+        # constraints: simple bounds on z, then rows [position, velocity (nodes 1..N), rate facets, rate changes]
         mg = p.limit_margin
         tilt = math.radians(p.tilt_rate_limit_degps) if p.tilt_rate_limit_degps is not None else np.inf
+        hi_z = np.full(nz, np.inf)
         for k in range(N):
-            iu, ix = self._iu(k), self._ix(k + 1)
-            hi_b[iu + sm.j_acc] = mg * self.a_max
-            hi_b[iu + sm.j_tilt] = tilt
-            hi_b[iu + sm.j_rot] = mg * self.w_max
-            hi_b[ix + sm.i_pos] = mg * self.p_max
-            hi_b[ix + sm.i_vel] = mg * self.v_max
-        lo_b = -hi_b
-        if p.terminal_rest:
-            ixn = self._ix(N)
-            lo_b[ixn + sm.i_vel] = 0.0
-            hi_b[ixn + sm.i_vel] = 0.0
-        finite = np.isfinite(hi_b)
-        self._bound_idx = np.flatnonzero(finite)
-        rows.append(sparse.eye(nz, format="csc")[self._bound_idx])
-        # total angular rates omega = tilt + rotational (roll, pitch), yaw: 1-norm ball and its change
-        rate = sparse.lil_matrix((N * 4, nz))
-        dacc = sparse.lil_matrix((N * 4, nz))
+            hi_z[k * m + sm.j_acc] = mg * self.a_max
+            hi_z[k * m + sm.j_tilt] = tilt
+            hi_z[k * m + sm.j_rot] = mg * self.w_max
+        pv = np.concatenate([sm.i_pos, sm.i_vel])
+        A_state = np.vstack([Xu[k][pv] for k in range(N)])  # (6N, nz)
+        self._state_w = np.vstack([Xw[k][pv] for k in range(N)])  # their dependence on w
+        hi_state = np.tile(np.concatenate([mg * self.p_max, mg * self.v_max]), N)
+        rate = np.zeros((4 * N, nz))
+        dacc = np.zeros((4 * N, nz))
         for k in range(N):
-            iu = self._iu(k)
-            for f, s in enumerate(_FACETS):
+            for f, sgn in enumerate(_FACETS):
                 row = 4 * k + f
                 for ax in range(3):
-                    cols = [iu + sm.j_rot[ax]] + ([iu + sm.j_tilt[ax]] if ax < 2 else [])
+                    cols = [k * m + sm.j_rot[ax]] + ([k * m + sm.j_tilt[ax]] if ax < 2 else [])
                     for c in cols:
-                        rate[row, c] = s[ax]
-                        dacc[row, c] = s[ax]
+                        rate[row, c] = sgn[ax]
+                        dacc[row, c] = sgn[ax]
                         if k > 0:
-                            dacc[row, c - (n + m)] = -s[ax]
-        rows += [rate.tocsc(), dacc.tocsc()]
-        self.A_qp = sparse.vstack(rows, format="csc")
-        n_dyn = N * n
-        n_b = self._bound_idx.size
-        self._rows_dyn = slice(0, n_dyn)
-        self._rows_dacc0 = slice(n_dyn + n_b + 4 * N, n_dyn + n_b + 4 * N + 4)
+                            dacc[row, c - m] = -sgn[ax]
+        self.A_qp = np.vstack([A_state, rate, dacc])
         w = mg * self.w_max
         dw = mg * self.alpha_max * tp
-        self.l0 = np.concatenate([np.zeros(n_dyn), lo_b[self._bound_idx], np.full(4 * N, -w), np.full(4 * N, -dw)])
-        self.u0 = np.concatenate([np.zeros(n_dyn), hi_b[self._bound_idx], np.full(4 * N, w), np.full(4 * N, dw)])
+        self._hi = np.concatenate([hi_z, hi_state, np.full(4 * N, w), np.full(4 * N, dw)])
+        self._lo = -self._hi
+        self._eq = np.zeros(self.A_qp.shape[0], dtype=bool)
+        n_s = 6 * N
+        self._rows_state = slice(nz, nz + n_s)
+        if p.terminal_rest:  # v_N = 0
+            self._eq[n_s - 3 : n_s] = True
+            self._lo[nz + n_s - 3 : nz + n_s] = 0.0
+            self._hi[nz + n_s - 3 : nz + n_s] = 0.0
+        self._rows_dacc0 = slice(nz + n_s + 4 * N, nz + n_s + 4 * N + 4)
         self._dw0 = mg * self.alpha_max * self.dt
         self._tilt_max = tilt
-        self._gam_r_stack = np.vstack([self.gam_rp * self.rho**k for k in range(N)])
 
     def _total_rates(self, u: np.ndarray) -> np.ndarray:
         sm = self.model
@@ -405,41 +400,52 @@ class MpcWashout:
         return x[sm.i_pos].copy(), np.array(quat_from_euler(float(ang[0]), float(ang[1]), float(ang[2])))
 
     def start(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> SetPoint:
-        """Start level and centred at rest, with the perceived-error states of a pilot who has sat level and still
-        (the error models start at the steady error of the first sample, or of rest)."""
+        """Start at the steady state of the first sample (of rest with ``filter_start="rest"``): centred and still,
+        tilted by the roll and pitch that minimise the stage cost for that input held (:meth:`_steady_state`), the
+        error models at their steady state; the recent mean of the input starts at it."""
         if self.context.filter_start == "rest":
             r0 = stacked_inputs(np.array([0.0, 0.0, -self.g]), np.zeros(3), self.g)
         else:
             r0 = stacked_inputs(np.asarray(f_mps2, float), np.asarray(omega_radps, float), self.g)
-        self.x = self._steady_error(r0)
+        self.x = self._steady_state(r0)
         self.u = np.zeros(self.m)
+        self.r_mean = r0.copy()
         self._plan, self._plan_age = None, 0
+        self._k = 0
         return self._set_point()
 
-    def _steady_error(self, r0: np.ndarray) -> np.ndarray:
-        """State with the platform level, centred and still and the error models in their steady state."""
+    def _steady_state(self, r0: np.ndarray) -> np.ndarray:
+        """The still equilibrium for the input ``r0`` held with the least stage cost: the tilt angles tau (roll,
+        pitch) minimise (x' Q x + |C_dir x - r_f|^2_Wd) over x(tau) = the error models' steady state with the
+        platform centred, still and tilted by tau (a 2 x 2 least-squares problem)."""
+        sm = self.model
+        xa = self._steady_error(r0)
+        cols = []
+        for i in sm.i_tilt[:2]:
+            unit = np.zeros(self.n)
+            unit[i] = 1.0
+            cols.append(self._steady_error(np.zeros(6), unit) + unit)
+        xt = np.column_stack(cols)
+        sel = np.zeros((3, 6))
+        sel[0, 0] = sel[1, 2] = sel[2, 4] = 1.0
+        wd = np.diag(sm.W_dir)
+        m = sm.Q + sm.C_dir.T @ wd @ sm.C_dir
+        lhs = xt.T @ m @ xt
+        rhs = xt.T @ (sm.Q @ xa + sm.C_dir.T @ wd @ (sm.C_dir @ xa - sel @ r0))
+        return xa + xt @ np.linalg.solve(lhs, -rhs)
+
+    def _steady_error(self, r0: np.ndarray, platform: np.ndarray | None = None) -> np.ndarray:
+        """The error models' steady state for the input ``r0`` held with the platform still at ``platform`` (its
+        angle and position entries of a state; None: level and centred); the platform's entries are left 0."""
         sm = self.model
         x = np.zeros(self.n)
         plat = np.zeros(self.n, dtype=bool)
         plat[np.concatenate([sm.i_pos, sm.i_vel, sm.i_tilt, sm.i_rot])] = True
         vest = ~plat
         a = sm.A[np.ix_(vest, vest)]
-        x[vest] = -np.linalg.solve(a, (sm.E @ r0)[vest])
+        drive = sm.E @ r0 + (sm.A @ platform if platform is not None else 0.0)
+        x[vest] = -np.linalg.solve(a, drive[vest])
         return x
-
-    def _update_bounds(self, r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The constraint bounds for this step (reused arrays: only the dynamics rows and the first angular
-        acceleration rows change from step to step; the others keep :attr:`l0`, :attr:`u0`)."""
-        n = self.n
-        lo, hi = self._lo, self._hi
-        aff = self._gam_r_stack @ r
-        aff[:n] += self.phi_p @ self.x
-        lo[self._rows_dyn] = aff
-        hi[self._rows_dyn] = aff
-        s = _FACETS @ self._total_rates(self.u)
-        lo[self._rows_dacc0] = s - self._dw0
-        hi[self._rows_dacc0] = s + self._dw0
-        return lo, hi
 
     def _safe(self, u0: np.ndarray) -> bool:
         """Whether the first move keeps the platform within its limits at the sample step and able to stop."""
@@ -488,30 +494,50 @@ class MpcWashout:
             u[idx] = 0.0 if nw <= step else w * (1.0 - step / nw)
         return u
 
+    def _references(self, r: np.ndarray) -> np.ndarray:
+        """The aircraft input over the horizon's intervals (N, 6): the previewed samples (at the intervals'
+        midpoints) as far as ``preview_s`` reaches, then the last known returning to the recent mean as rho^k."""
+        rm = self.r_mean
+        R = rm + np.outer(self._decay, r - rm)
+        fut = self._future
+        if fut is None or self.params.preview_s <= 0.0:
+            return R
+        rr = fut
+        mid = self.tp * (np.arange(self.N) + 0.5)
+        seen = mid <= self.params.preview_s + 1e-9
+        idx = np.minimum(self._k + np.rint(mid / self.dt).astype(np.int64), len(rr) - 1)
+        R[seen] = rr[idx[seen]]
+        j = int(np.count_nonzero(seen))
+        if 0 < j < self.N:
+            R[j:] = rm + np.outer(self._decay[: self.N - j], R[j - 1] - rm)
+        return R
+
     def plan(self, r: np.ndarray) -> tuple[bool, np.ndarray]:
         """Solve the QP from the current state for the stacked aircraft input ``r`` (6,).
 
-        Returns (solved, controls (N, m)); ``solved`` is False unless OSQP reports ``solved`` or ``solved inaccurate``
-        (the iteration limit reached with residuals within ten times the tolerances: counted in
-        :attr:`inaccurate`; its first move is still checked by :meth:`_safe`) with a finite result.
+        Returns (solved, controls (N, m)); ``solved`` is False unless DAQP reports an optimal solution with a finite
+        result (its first move is still checked by :meth:`_safe`).
         """
-        lo, hi = self._update_bounds(r)
-        self.solver.update(q=self._q_map @ r, l=lo, u=hi)
-        res = self.solver.solve(raise_error=False)
-        info, z = res.info, res.x
+        w = np.concatenate([self.x, self._references(r).ravel()])
+        lo, hi = self._lo.copy(), self._hi.copy()
+        off = self._state_w @ w
+        lo[self._rows_state] -= off
+        hi[self._rows_state] -= off
+        s = _FACETS @ self._total_rates(self.u)
+        lo[self._rows_dacc0] = s - self._dw0
+        hi[self._rows_dacc0] = s + self._dw0
+        ok, z, it = self.qp.solve(self.H_qp, self.F_qp @ w, lo, hi, h_changed=False)
         self.solves += 1
-        self.iterations.append(int(info.iter))
-        status = info.status
-        ok = status in _ACCEPTED and z is not None and bool(np.all(np.isfinite(z)))
-        if ok and status != "solved":
-            self.inaccurate += 1
+        self.iterations.append(it)
         if not ok:
             return False, np.zeros((self.N, self.m))
-        # z = [u_0, x_1, u_1, x_2, ...]: the controls are the first m of each stage (copied: z is the solver's)
-        return True, z.reshape(self.N, self.m + self.n)[:, : self.m].copy()
+        return True, z.reshape(self.N, self.m)
 
     def step(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> SetPoint:
         """Solve the QP for this sample, apply its first move for one sample, return the set point."""
+        if self.params.preview_s > 0.0 and self._future is None:
+            raise WashbenchError("washout mpc: preview_s > 0 needs the recording in advance (run, suite, cue), not a "
+                                 "live stream; set mpc.preview_s: 0")  # fmt: skip
         if self._timed_steps < ESTIMATE_AFTER_STEPS:
             t0 = time.perf_counter()
             out = self._step(f_mps2, omega_radps)
@@ -530,13 +556,14 @@ class MpcWashout:
             return
         minute = per_step * 60.0 / self.dt
         print(f"washbench: note: washout mpc: {per_step:.3g} s per sample (timed on its first {self._timed_steps}): "
-              f"a minute of flight takes about {duration_text(minute)}; fewer mpc.horizon_steps or mpc.solver.max_iter "
-              "make it faster", file=sys.stderr, flush=True)  # fmt: skip
+              f"a minute of flight takes about {duration_text(minute)}; fewer mpc.horizon_steps or "
+              "mpc.solver.iter_limit make it faster", file=sys.stderr, flush=True)  # fmt: skip
 
     def _step(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> SetPoint:
         r = stacked_inputs(f_mps2, omega_radps, self.g)
         if not np.all(np.isfinite(r)):
             raise ValueError("mpc: non-finite input")
+        self.r_mean += self._mean_gain * (r - self.r_mean)
         ok, plan = self.plan(r)
         self._r_term = self.gam_rf @ r
         if ok and self._safe(plan[0]):
@@ -550,7 +577,23 @@ class MpcWashout:
         self._sat_rot = bool(np.sum(np.abs(self._total_rates(move))) >= 0.999 * self.params.limit_margin * self.w_max)
         self.u = move
         self.x = self.phi_f @ self.x + self.gam_f @ move + self._r_term
+        self._k += 1
         return self._set_point()
+
+    def trace(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The set points of the whole recording (after :meth:`start`); with ``preview_s`` > 0 each sample's plan
+        sees the recording ``preview_s`` ahead. Without preview the same numbers as stepping."""
+        f = np.asarray(f_mps2, float)
+        w = np.asarray(omega_radps, float)
+        pos = np.empty((len(f), 3))
+        q = np.empty((len(f), 4))
+        self._future = stacked_inputs(f, w, self.g)
+        try:
+            for i in range(len(f)):
+                pos[i], q[i] = self._step(f[i], w[i])
+        finally:
+            self._future = None
+        return pos, q
 
     def flags(self) -> tuple[bool, bool]:
         """(tilt-rate limit reached, rotational-rate limit reached) on the last step."""
@@ -558,16 +601,15 @@ class MpcWashout:
 
     def report(self) -> dict[str, float]:
         """Solver statistics so far: solves, fallbacks (failed or unsafe solves), of which brakes (no usable previous
-        plan: braking), inaccurate (accepted at the iteration limit), iterations (median, max)."""
+        plan: braking), iterations (DAQP's active-set iterations: median, max)."""
         it = np.array(self.iterations) if self.iterations else np.zeros(1)
         return {
             "solves": float(self.solves),
             "fallbacks": float(self.fallbacks),
-            "inaccurate": float(self.inaccurate),
             "brakes": float(self.brakes),
             "iterations_median": float(np.median(it)),
             "iterations_max": float(np.max(it)),
         }
 
 
-__all__ = ["MpcParams", "MpcWashout", "MpcWeights", "OsqpSettings", "StackedModel", "stacked_model"]
+__all__ = ["DaqpSettings", "MpcParams", "MpcWashout", "MpcWeights", "StackedModel", "stacked_model"]
