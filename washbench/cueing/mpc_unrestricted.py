@@ -18,10 +18,12 @@ for small dense QPs, warm-started: :class:`washbench.cueing.condensed.DenseQp`),
 
 where ``e_oto`` and ``e_can`` are the perceived errors (the paper's otolith and canal models, Eqs. 11-12, driven by
 simulator minus aircraft head signals in body axes), ``e_f`` the specific-force error at the head itself, and the
-aircraft input over the horizon returns from its last value to its recent mean as ``e^{-gamma t}``, or, with ``preview_s``
-> 0 and the recording known (``run``, ``suite``, ``cue``: :meth:`MpcUnrestrictedWashout.trace`), the aircraft's own
+aircraft input over the horizon returns from its last value to its recent mean as ``e^{-gamma t}``, or, with
+``preview_s`` > 0 and the recording known (``run``, ``suite``, ``cue``: :meth:`MpcUnrestrictedWashout.trace`), the aircraft's own
 future. Decisions are held over blocks of intervals (move blocking). There is no attitude cost and no tilt-rate
-limit: the sphere may turn without limit, and tilt is paid for only by what the canals perceive of it. The first
+limit: the sphere may turn without limit, and tilt is paid for only by what the canals perceive of it. The canal
+weights follow the ranking's score (``yardstick_weights``): multiplied by the squared ratio of the aircraft pilot's
+mean felt force to mean felt rate so far (to the power ``yardstick_power``). The first
 move is applied for one sample, exactly: the stage integrates ``a``, the attitude ``q <- q exp(omega dt / 2)``, and
 the error models are driven by the head signals of that exact motion. See docs/optimal-mpc.md ("mpc-unrestricted")
 for the derivation, the references and the choices.
@@ -468,7 +470,8 @@ class MpcUnrestrictedWashout:
         fa = (self._ToB.T @ (c_o @ Wo) + self._B.T @ (c_d @ Wd)) @ R0.T + self._PpB.T @ (c_p @ self._Wp) + (
             self._PvB.T @ (c_v @ self._Wv)
         )  # fmt: skip
-        fw = (self._ToLmB.T @ (c_o @ Wo) + self._LmB.T @ (c_d @ Wd)) @ G + self._TcB.T @ (c_c @ self._Wc) * self._scale_used
+        fw = (self._ToLmB.T @ (c_o @ Wo) + self._LmB.T @ (c_d @ Wd)) @ G
+        fw += self._TcB.T @ (c_c @ self._Wc) * self._scale_used
         fz = np.concatenate([fa.ravel(), fw.ravel()])
         lo, hi = self._lo.copy(), self._hi.copy()
         cp_end = c_p[self._ends].ravel()
