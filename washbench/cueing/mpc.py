@@ -268,6 +268,12 @@ class MpcWashout:
     Params = MpcParams
     name = "mpc"
 
+    @staticmethod
+    def whole_only(section: dict) -> bool:
+        """With ``preview_s`` > 0 it needs the recording in advance (cued after the flight, by :meth:`trace`)."""
+        value = section.get("preview_s", 0.0)
+        return isinstance(value, int | float) and value > 0.0
+
     def __init__(self, params: MpcParams | None, context: WashoutContext) -> None:
         self.params = p = params if params is not None else MpcParams()
         self.context = context

@@ -19,8 +19,8 @@ for small dense QPs, warm-started: :class:`washbench.cueing.condensed.DenseQp`),
 where ``e_oto`` and ``e_can`` are the perceived errors (the paper's otolith and canal models, Eqs. 11-12, driven by
 simulator minus aircraft head signals in body axes), ``e_f`` the specific-force error at the head itself, and the
 aircraft input over the horizon returns from its last value to its recent mean as ``e^{-gamma t}``, or, with
-``preview_s`` > 0 and the recording known (``run``, ``suite``, ``cue``: :meth:`MpcUnrestrictedWashout.trace`), the aircraft's own
-future. Decisions are held over blocks of intervals (move blocking). There is no attitude cost and no tilt-rate
+``preview_s`` > 0 and the recording known (``run``, ``suite``, ``cue``: :meth:`MpcUnrestrictedWashout.trace`), the
+aircraft's own future. Decisions are held over blocks of intervals (move blocking). There is no attitude cost and no tilt-rate
 limit: the sphere may turn without limit, and tilt is paid for only by what the canals perceive of it. The canal
 weights follow the ranking's score (``yardstick_weights``): multiplied by the squared ratio of the aircraft pilot's
 mean felt force to mean felt rate so far (to the power ``yardstick_power``). The first
@@ -215,6 +215,12 @@ class MpcUnrestrictedWashout:
 
     Params = MpcUnrestrictedParams
     name = "mpc-unrestricted"
+
+    @staticmethod
+    def whole_only(section: dict) -> bool:
+        """With ``preview_s`` > 0 it needs the recording in advance (cued after the flight, by :meth:`trace`)."""
+        value = section.get("preview_s", 0.0)
+        return isinstance(value, int | float) and value > 0.0
 
     def __init__(self, params: MpcUnrestrictedParams | None, context: WashoutContext) -> None:
         self.params = p = params if params is not None else MpcUnrestrictedParams()

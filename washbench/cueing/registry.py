@@ -186,10 +186,21 @@ def is_python(kind: str) -> bool:
     return kind not in WASHOUT_KINDS
 
 
-def whole_only(kind: str, spec: str | None = None) -> bool:
-    """Whether the Python algorithm ``kind`` needs the whole recording (its factory's ``whole_only`` attribute: it
-    has a ``trace`` form and no ``step``, e.g. the oracle bound); compiled kinds never do."""
-    return is_python(kind) and bool(getattr(get(kind, spec).factory, "whole_only", False))
+def needs_whole(factory: Any, section: Any = None) -> bool:
+    """Whether an algorithm made by ``factory`` with the raw parameter section ``section`` (a mapping or None) needs
+    the whole recording: the factory's ``whole_only`` attribute, a bool (the oracle bound) or a function of the section
+    (the MPC washouts with ``preview_s`` > 0)."""
+    attr = getattr(factory, "whole_only", False)
+    if callable(attr):
+        return bool(attr(dict(section) if isinstance(section, dict) else {}))
+    return bool(attr)
+
+
+def whole_only(kind: str, spec: str | None = None, section: Any = None) -> bool:
+    """Whether the Python algorithm ``kind`` (with the raw parameter section ``section``) needs the whole recording
+    (:func:`needs_whole`: it has a ``trace`` form and is cued after the flight, e.g. the oracle bound, or an MPC
+    washout with preview); compiled kinds never do."""
+    return is_python(kind) and needs_whole(get(kind, spec).factory, section)
 
 
 def plugin_spec(kind: str) -> str | None:
@@ -303,6 +314,7 @@ __all__ = [
     "is_python",
     "known_kinds",
     "load_plugin",
+    "needs_whole",
     "plugin_spec",
     "plugin_specs",
     "python_kinds",

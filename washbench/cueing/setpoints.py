@@ -48,7 +48,7 @@ class SetPointSource:
             missing = [m for m in ("start", "step") if not callable(getattr(self.algo, m, None))]
             if missing:
                 raise WashbenchError(f"{where}: the algorithm has no {missing[0]}() method")
-            whole = bool(getattr(algo.factory, "whole_only", False))
+            whole = registry.needs_whole(algo.factory, params.sections.get(washout.kind))
             return callable(getattr(self.algo, "flags", None)), callable(getattr(self.algo, "trace", None)), whole
 
         self.has_flags, self.has_trace, whole = plugin_call(where, methods)

@@ -47,7 +47,7 @@ no ceiling (``false-cue``)."""
 def split_whole(specs: Sequence[Any]) -> tuple[list[Any], list[Any]]:
     """The washouts (``Washout`` variants) that run sample by sample, and those that need the whole recording."""
 
-    whole = [s for s in specs if whole_only(s.kind, s.source)]
+    whole = [s for s in specs if whole_only(s.kind, s.source, s.params.sections.get(s.kind))]
     return [s for s in specs if s not in whole], whole
 
 
