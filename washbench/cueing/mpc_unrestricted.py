@@ -21,12 +21,11 @@ simulator minus aircraft head signals in body axes), ``e_f`` the specific-force 
 aircraft input over the horizon returns from its last value to its recent mean as ``e^{-gamma t}``, or, with
 ``preview_s`` > 0 and the recording known (``run``, ``suite``, ``cue``: :meth:`MpcUnrestrictedWashout.trace`), the
 aircraft's own future. Decisions are held over blocks of intervals (move blocking). There is no attitude cost and no
-tilt-rate limit: the sphere may turn without limit, and tilt is paid for only by what the canals perceive of it. The canal
-weights follow the ranking's score (``yardstick_weights``): multiplied by the squared ratio of the aircraft pilot's
-mean felt force to mean felt rate so far (to the power ``yardstick_power``). The first
-move is applied for one sample, exactly: the stage integrates ``a``, the attitude ``q <- q exp(omega dt / 2)``, and
-the error models are driven by the head signals of that exact motion. See docs/optimal-mpc.md ("mpc-unrestricted")
-for the derivation, the references and the choices.
+tilt-rate limit: the sphere may turn without limit, and tilt is paid for only by what the canals perceive of it.
+The canal weights follow the ranking's score (``yardstick_weights``): multiplied by the squared ratio of the
+aircraft pilot's mean felt force to mean felt rate so far (to the power ``yardstick_power``). The first move is
+applied for one sample, exactly: the stage integrates ``a``, the attitude ``q <- q exp(omega dt / 2)``, and the error
+models are driven by the head signals of that exact motion. See docs/optimal-mpc.md ("mpc-unrestricted") for the derivation, the references and the choices.
 """
 
 from __future__ import annotations
