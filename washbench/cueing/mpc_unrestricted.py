@@ -25,7 +25,8 @@ tilt-rate limit: the sphere may turn without limit, and tilt is paid for only by
 The canal weights follow the ranking's score (``yardstick_weights``): multiplied by the squared ratio of the
 aircraft pilot's mean felt force to mean felt rate so far (to the power ``yardstick_power``). The first move is
 applied for one sample, exactly: the stage integrates ``a``, the attitude ``q <- q exp(omega dt / 2)``, and the error
-models are driven by the head signals of that exact motion. See docs/optimal-mpc.md ("mpc-unrestricted") for the derivation, the references and the choices.
+models are driven by the head signals of that exact motion. See docs/optimal-mpc.md ("mpc-unrestricted") for the
+derivation, the references and the choices.
 """
 
 from __future__ import annotations
