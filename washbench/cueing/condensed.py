@@ -121,6 +121,12 @@ class DenseQp:
         self._ready = False
         self.iter_limit = int(iter_limit)
 
+    def set_iter_limit(self, iter_limit: int) -> None:
+        """Change the iteration limit of later solves."""
+        self.iter_limit = int(iter_limit)
+        if self._ready:
+            self._model.settings = {"iter_limit": self.iter_limit}
+
     def solve(
         self, H: np.ndarray, f: np.ndarray, lo: np.ndarray, hi: np.ndarray, h_changed: bool = True
     ) -> tuple[bool, np.ndarray, int]:
