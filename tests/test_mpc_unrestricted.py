@@ -251,3 +251,27 @@ def test_it_cannot_drive_a_hexapod():
     spec = builtin(["mpc-unrestricted"], load_param_file(None)[0])[0]
     why = platform_refusal(spec, platform)
     assert why is not None and "mpc-unrestricted" in why and "\n" not in why
+
+
+def test_run_with_only_preview_washouts_cues_them_after_the_flight(tmp_path):
+    """``washbench run`` whose every washout needs the recording in advance (the MPC washouts with preview): the
+    flight is flown alone and they are cued on it (before: "no washout selected"); both rank, and both start still
+    on a steady level cruise (real JSBSim)."""
+    import pyarrow.parquet as pq
+    from ceiling_helpers import washbench
+    from test_ceiling import CRUISE
+
+    (tmp_path / "level_cruise.yaml").write_text(CRUISE)
+    params = tmp_path / "p.yaml"
+    params.write_text("mpc:\n  preview_s: 1.0\nmpc-unrestricted:\n  preview_s: 1.0\n")
+    out = tmp_path / "o"
+    proc = washbench("run", tmp_path / "level_cruise.yaml", "--out", out, "--washout", "mpc", "--washout",
+                     "mpc-unrestricted", "--params", params, "--no-recording", "--no-figures", "--quiet")  # fmt: skip
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    run = out / "c172p" / "level_cruise"
+    ranked = (run / "ranking.csv").read_text()
+    assert ",mpc," in ranked and ",mpc-unrestricted," in ranked
+    table = pq.read_table(run / "traces.parquet")
+    for w in ("mpc", "mpc-unrestricted"):
+        pos = np.column_stack([table.column(f"{w}.pos_{a}_m").to_numpy() for a in "xyz"])
+        assert np.abs(pos).max() < 0.005, (w, np.abs(pos).max(0))  # no start-up move (it was 45 mm)

@@ -443,8 +443,15 @@ def lockstep_washouts(
     (the rows it fills, the flight's step hook)."""
     from washbench.cueing import CueingBank  # deferred: numba
 
-    bank = CueingBank(specs, None, limits, dt_s, filter_start)
     rows: list[np.ndarray] = []
+    if not specs:  # every washout is cued after the flight (the bound, an MPC with preview): count the samples
+
+        def count(k: int, f_mps2: np.ndarray, omega_radps: np.ndarray) -> None:
+            rows.append(np.empty((0, len(CueingBank.FIELDS))))
+
+        count.reports = dict  # type: ignore[attr-defined]
+        return rows, count
+    bank = CueingBank(specs, None, limits, dt_s, filter_start)
     step = bank.step
     omega_deg = np.empty(3)
 
@@ -471,9 +478,17 @@ def lockstep_blocks(
     call (:func:`sample_count`, :func:`stacked_rows`)."""
     from washbench.cueing import CueingBank  # deferred: numba
 
-    bank = CueingBank(specs, None, limits, dt_s, filter_start)
     rows: list[np.ndarray] = []
     done = [0]
+    if not specs:  # every washout is cued after the flight (the bound, an MPC with preview): count the samples
+
+        def count(k0: int, f_mps2: np.ndarray, omega_radps: np.ndarray) -> None:
+            rows.append(np.empty((0, f_mps2.shape[0], len(CueingBank.FIELDS))))
+            done[0] += f_mps2.shape[0]
+
+        count.reports = dict  # type: ignore[attr-defined]
+        return rows, count
+    bank = CueingBank(specs, None, limits, dt_s, filter_start)
 
     def lockstep(k0: int, f_mps2: np.ndarray, omega_radps: np.ndarray) -> None:
         if k0 != done[0]:
