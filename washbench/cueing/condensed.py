@@ -110,7 +110,7 @@ class DenseQp:
     """
 
     def __init__(self, n: int, A: np.ndarray, eq: np.ndarray, iter_limit: int) -> None:
-        import daqp  # imported when an MPC washout is made
+        import daqp  # deferred: daqp (imported when an MPC washout is made)
 
         self.n = n
         self.A = np.ascontiguousarray(A, dtype=np.float64)
