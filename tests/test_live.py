@@ -317,6 +317,28 @@ def test_washbench_format_result_equals_cue_of_the_original_file(tmp_path: Path)
     assert (out / "metrics.csv").read_text() == (tmp_path / "orig" / "metrics.csv").read_text()
 
 
+def test_the_mpc_washouts_run_live_and_equal_cue(tmp_path: Path) -> None:
+    """``mpc`` and ``mpc-unrestricted`` stepped live, sample by sample as packets arrive, give what ``washbench cue``
+    of the same file gives with their whole-recording form (``trace``), bit for bit."""
+    m = motion()
+    src = tmp_path / "flight.csv"
+    src.write_text("t_s,f_x_mps2,f_y_mps2,f_z_mps2,omega_x_degps,omega_y_degps,omega_z_degps\n"
+                   + "".join(",".join(repr(v) for v in r) + "\n" for r in m))  # fmt: skip
+    port = free_udp_port()
+    th = in_thread(_send_samples(port, "washbench", m))
+    both = load_options(outputs=Outputs(recording=False, figures=False), washouts=["mpc", "mpc-unrestricted"])
+    opts = LiveOptions(listen=("127.0.0.1", port), fmt="washbench", out=tmp_path / "live", idle_timeout_s=0.6,
+                       viewer=False)  # fmt: skip
+    status = run_live(opts, both)
+    th.join(10)
+    assert status == 0
+    run_cue(src, tmp_path / "orig", run=both)
+    a = pq.read_table(tmp_path / "live" / "traces.parquet")
+    b = pq.read_table(tmp_path / "orig" / "traces.parquet")
+    assert any(c.startswith("mpc-unrestricted.") for c in b.column_names)
+    assert a.drop_columns(["live_held"]).equals(b)
+
+
 def test_faults_are_counted_and_the_result_still_equals_cue(tmp_path: Path) -> None:
     m = motion(300)
     m2 = motion(200)  # the sender restarts: time from 0 again

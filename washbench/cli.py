@@ -48,7 +48,7 @@ def _washout_options(p: argparse.ArgumentParser, variants: bool = True) -> None:
         "--washout",
         action="append",
         metavar="NAME",
-        help=f"washout to run, repeatable: {', '.join(WASHOUT_KINDS)}, optimal, mpc, bound (whole recordings), or "
+        help=f"washout to run, repeatable: {', '.join(WASHOUT_KINDS)}, optimal, mpc, mpc-unrestricted, bound (whole recordings), or "
         "a plugin's name (default: the first three, or none with a variant)",
     )
     if variants:
@@ -245,7 +245,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("manoeuvres", type=Path, nargs="+", help="training manoeuvre files or folders")
     p.add_argument(
         "--washout", required=True, metavar="KIND",
-        help=f"washout kind: {', '.join(WASHOUT_KINDS)}, optimal, mpc or a plugin's name",
+        help=f"washout kind: {', '.join(WASHOUT_KINDS)}, optimal, mpc, mpc-unrestricted or a plugin's name",
     )  # fmt: skip
     p.add_argument(
         "--tune",
