@@ -275,3 +275,12 @@ def test_run_with_only_preview_washouts_cues_them_after_the_flight(tmp_path):
     for w in ("mpc", "mpc-unrestricted"):
         pos = np.column_stack([table.column(f"{w}.pos_{a}_m").to_numpy() for a in "xyz"])
         assert np.abs(pos).max() < 0.005, (w, np.abs(pos).max(0))  # no start-up move (it was 45 mm)
+
+
+def test_an_axis_given_in_part_keeps_the_other_defaults():
+    p = MpcUnrestrictedParams.model_validate({"rate": {"z": 2.0}, "position": {"x": 1.0}})
+    d = MpcUnrestrictedParams()
+    assert p.rate.xyz == (d.rate.x, d.rate.y, 2.0)
+    assert p.position.xyz == (1.0, d.position.y, d.position.z)
+    with pytest.raises(Exception, match="w"):
+        MpcUnrestrictedParams.model_validate({"rate": {"w": 2.0}})

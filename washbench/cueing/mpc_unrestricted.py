@@ -32,10 +32,10 @@ derivation, the references and the choices.
 from __future__ import annotations
 
 import math
-from typing import Annotated
+from typing import Annotated, Any
 
 import numpy as np
-from pydantic import Field
+from pydantic import Field, model_validator
 
 from washbench.cueing.algorithm import SetPoint, WashoutContext
 from washbench.cueing.condensed import DenseQp, blocking_matrix, default_blocks, siso_prediction, siso_state_space
@@ -131,6 +131,19 @@ class MpcUnrestrictedParams(StrictModel):
     0: every sample); in between the turn so far enters the prediction as an offset (first order: an error of at
     most g (1 - cos x) ~ 0.006 m/s^2 at 2 deg)"""
     solver: DaqpSettings = DaqpSettings()
+
+    @model_validator(mode="before")
+    @classmethod
+    def _axis_defaults(cls, data: Any) -> Any:
+        """An axis triple given in part (``rate: {z: 2}``, ``--set mpc-unrestricted.rate.z=2``) keeps the default
+        of the axes it does not give."""
+        if not isinstance(data, dict):
+            return data
+        out = dict(data)
+        for name, field in cls.model_fields.items():
+            if isinstance(field.default, AxisWeights) and isinstance(out.get(name), dict):
+                out[name] = {**field.default.model_dump(), **out[name]}
+        return out
 
 
 def _norm(v: np.ndarray) -> float:
