@@ -163,10 +163,13 @@ def send_scene(
     travel_m: np.ndarray,
     diameter_m: float,
     hexapod: object | None = None,
+    platform: str = "atlas",
 ) -> None:
     """Log the scene; ``time_of(t_s)`` makes the time column. Quaternions scalar first, body->NED. ``hexapod``
     (:class:`washbench.review.rerun_log.HexapodDrawing`): each washout's platform is that hexapod, drawn with its
-    legs (:func:`_send_hexapod`), instead of the Atlas."""
+    legs (:func:`_send_hexapod`), instead of the Atlas. ``platform``: ``atlas`` (the sphere in its stage's range box),
+    anything else without a hexapod drawing (a rig, a plugin's platform): a base and the cockpit at its pose
+    (:func:`_send_base_and_cockpit`)."""
     washouts = list(washout_q)
     offsets = object_offsets(len(washouts), travel_m, diameter_m)
     half = diameter_m / 2.0
@@ -203,6 +206,11 @@ def send_scene(
         for i, w in enumerate(washouts):
             _send_hexapod(rec, time_of, t_s, w, series_color(w, washouts), offsets[i + 1], washout_q[w], stage_pos_m[w],
                           hexapod, half)  # fmt: skip
+        return
+    if platform != "atlas":
+        for i, w in enumerate(washouts):
+            _send_base_and_cockpit(rec, time_of, t_s, w, series_color(w, washouts), offsets[i + 1], washout_q[w],
+                                   stage_pos_m[w], travel_m, half)  # fmt: skip
         return
     for i, w in enumerate(washouts):
         color = series_color(w, washouts)
@@ -280,3 +288,40 @@ def _send_hexapod(
     )
     rec.log(f"{root}/legs", rr.LineStrips3D.from_fields(colors=[(200, 200, 200)], radii=[0.04]), static=True,
             strict=True)  # fmt: skip
+
+
+def _send_base_and_cockpit(
+    rec: rr.RecordingStream,
+    time_of: object,
+    t_s: np.ndarray,
+    washout: str,
+    color: tuple[int, int, int],
+    offset: np.ndarray,
+    q_wxyz: np.ndarray,
+    pos_m: np.ndarray,
+    travel_m: np.ndarray,
+    half: float,
+) -> None:
+    """A platform drawn simply (a rig, a plugin's platform): a grey base plate under the motion reference point
+    (static), a post from it to the cockpit, the travel box when the platform has one, and the cockpit (attitude
+    shape and floor plate) at the pose reached: translated by ``pos_m`` (NED, from neutral) and turned by ``q``."""
+    root = f"/world/platform/{washout}"
+    rec.log(root, rr.Transform3D(translation=offset), static=True, strict=True)
+    below = 0.9 * half  # the base's depth under the motion reference point, m (down is +z)
+    plate = rr.Boxes3D(centers=[[0.0, 0.0, below]], half_sizes=[[0.7 * half, 0.7 * half, 0.04 * half]],
+                       colors=[(*LIMIT_COLOR, 200)], fill_mode="Solid")  # fmt: skip
+    rec.log(f"{root}/base", plate, static=True, strict=True)
+    rec.log(f"{root}/post", rr.LineStrips3D([[[0.0, 0.0, below], [0.0, 0.0, 0.0]]], colors=[LIMIT_COLOR],
+                                            radii=[0.03]), static=True, strict=True)  # fmt: skip
+    if np.any(np.asarray(travel_m) > 1e-2):  # a travel box worth drawing (a rig's heave, a plugin's envelope)
+        rec.log(f"{root}/range", rr.Boxes3D(half_sizes=[np.maximum(travel_m, 1e-2)], colors=[(*LIMIT_COLOR, 160)],
+                                            fill_mode="MajorWireframe"), static=True, strict=True)  # fmt: skip
+    idx = pose_samples(t_s, q_wxyz, pos_m)
+    rec.send_columns(
+        f"{root}/cockpit",
+        indexes=[time_of(t_s[idx])],
+        columns=rr.Transform3D.columns(translation=np.asarray(pos_m, dtype=np.float64)[idx],
+                                       quaternion=quat_wxyz_to_xyzw(np.asarray(q_wxyz, dtype=np.float64)[idx])),
+        strict=True,
+    )  # fmt: skip
+    _log_object(rec, f"{root}/cockpit", 0.8 * half, color)
