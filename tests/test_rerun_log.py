@@ -29,8 +29,8 @@ from washbench.review.rerun_log import (
     PlatformEnvelope,
     PlatformSeries,
     RecordingData,
-    envelope_usage_path,
     cue_lane_path,
+    envelope_usage_path,
     perceived_path,
     phase_lane_path,
     platform_path,
@@ -514,6 +514,10 @@ def test_blueprint_stacks_the_perceived_panels_on_the_whole_manoeuvre(written):
         lo, hi = v["ScalarAxis:range"][0]
         m = series[perceived_path(dof)][1]
         assert lo < m.min() and hi > m.max()  # every trace inside the fixed range
+        # two labelled gridlines at least: the viewer labels multiples of a power of ten (a panel from -8.4 to 7.4
+        # showed a lone "0"), so the range holds two multiples of the power of ten below its height
+        step = 10.0 ** np.floor(np.log10(hi - lo))
+        assert np.floor(hi / step) - np.ceil(lo / step) >= 1, (dof, lo, hi)
     # a tab named "Perceived" of two columns (surge, sway, heave | roll, pitch, yaw), each the phase lane then its
     # three panels
     containers = _containers(path)

@@ -97,16 +97,26 @@ def test_false_cues_have_a_tab_and_the_motion_panels_the_room(recording: tuple[P
             assert len(shares) == 4 and shares[0] < min(shares[1:]) and min(shares[1:]) / sum(shares) >= 0.25
 
 
-def test_labels_in_the_3d_view_are_staggered_apart(recording: tuple[Path, object]) -> None:
+def test_labels_in_the_3d_view_stay_apart(recording: tuple[Path, object]) -> None:
+    """At most four objects a row (eight in one row ran their labels into one word): each label a whole spacing from
+    its row's neighbours, the rows behind one another, every object's label under it."""
     path, data = recording
     positions = np.asarray(read_static(path, "Points3D:positions")["/world/labels"], dtype=float)
     assert len(positions) == 1 + len(data.washouts)
-    spacing = float(np.min(np.diff(positions[:, 1])))
-    for i in range(len(positions)):
-        same_row = [j for j in range(len(positions)) if j != i and math.isclose(positions[j, 2], positions[i, 2])]
-        nearest = min((abs(positions[j, 1] - positions[i, 1]) for j in same_row), default=math.inf)
-        # a label as long as "adaptive-large-angle" needs more than two objects' spacing (screenshots)
-        assert nearest >= (3.0 if len(positions) > 6 else 1.0) * spacing - 1e-9
+    rows = sorted(set(np.round(positions[:, 0], 6)))
+    assert len(rows) == math.ceil(len(positions) / 4)
+    spacing = None
+    for x in rows:
+        row = np.sort(positions[np.isclose(positions[:, 0], x), 1])
+        assert 1 <= len(row) <= 4
+        if len(row) > 1:
+            spacing = spacing or float(np.min(np.diff(row)))
+            assert np.min(np.diff(row)) >= spacing - 1e-9
+    if len(rows) > 1:
+        assert np.min(np.diff(rows)) >= spacing  # the rows as far apart as the objects in a row
+    statics = read_static(path, "Transform3D:translation")
+    centres = [statics["/world/aircraft"][0]] + [statics[f"/world/atlas/{w}"][0] for w in data.washouts]
+    np.testing.assert_allclose(positions[:, :2], np.asarray(centres, dtype=float)[:, :2], atol=1e-6)
 
 
 def test_the_metrics_panel_ranks_and_keeps_the_bound_a_reference() -> None:

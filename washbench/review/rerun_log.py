@@ -40,6 +40,7 @@ sample; the sources of one panel share one row (one time and one row id for all 
 from __future__ import annotations
 
 import contextlib
+import math
 import os
 import uuid
 from collections.abc import Mapping, Sequence
@@ -425,6 +426,17 @@ def _span(values: list[np.ndarray], extra: tuple[float, ...] = ()) -> tuple[floa
     return (lo - pad, hi + pad)
 
 
+def labelled_span(span: tuple[float, float]) -> tuple[float, float]:
+    """``span`` widened, if need be, to hold two multiples of the power of ten below its height: the viewer labels
+    only gridlines at powers of ten that are far enough apart, and a panel from -8.4 to 7.4 deg/s (gridlines 10
+    apart; 1 apart too dense) showed a single "0" tick. Widened to the next multiples outward (-10 to 10)."""
+    lo, hi = span
+    step = 10.0 ** math.floor(math.log10(hi - lo))
+    if math.floor(hi / step) - math.ceil(lo / step) >= 1:  # two multiples inside already
+        return span
+    return (min(lo, math.floor(lo / step) * step), max(hi, math.ceil(hi / step) * step))
+
+
 def _dof_columns(data: RecordingData) -> tuple[list[np.ndarray], list[np.ndarray]]:
     """Per DOF, (N, sources) arrays of perceived and raw motion in the recording's units."""
     every = [*data.washouts.values(), data.aircraft]  # in sources() order
@@ -760,10 +772,10 @@ def _layout(data: RecordingData, perceived: list[np.ndarray], raw: list[np.ndarr
         dofs=tuple((dof, unit) for dof, _, _, unit in DOFS),
         t_end_s=float(data.t_s[-1]),
         perceived_ranges=tuple(
-            _span([p], (c - th, c + th))
+            labelled_span(_span([p], (c - th, c + th)))
             for p, (c, th) in zip(perceived, _threshold_lines(data.thresholds), strict=True)
         ),
-        raw_ranges=tuple(_span([r]) for r in raw),
+        raw_ranges=tuple(labelled_span(_span([r])) for r in raw),
         camera=scene3d.camera(offsets, data.envelope.sphere_diameter_m),
         usage=tuple(
             UsageView(envelope_usage_path(p.key), p.title if p.limit is None else f"{p.title} ({p.limit})",

@@ -1,10 +1,12 @@
-"""The recording's 3D scene: the aircraft and each washout's Atlas cockpit side by side, in one NED frame.
+"""The recording's 3D scene: the aircraft and each washout's platform cockpit side by side (rows of at most
+:data:`MAX_PER_ROW`), in one NED frame.
 
 Every object is the same line shape (fuselage with a nose chevron, wings, tailplane, fin) over a translucent floor
 plate, so roll, pitch and yaw read at a glance and the aircraft and the cockpits point the same way when their
 attitudes agree. The aircraft is shown relative to its initial heading (the cockpits start at yaw 0). Each Atlas
 cockpit sits in its sphere (``envelope.sphere_diameter_m``) and is translated by the stage position inside the stage's
-range box. One label per object. Poses are sent at most at :data:`SCENE_RATE_HZ`: the 3D view shows one instant, and
+range box (a hexapod drawn with its legs, a rig or a plugin's platform as a base and the cockpit at its pose). One
+label per object. Poses are sent at most at :data:`SCENE_RATE_HZ`: the 3D view shows one instant, and
 scrubbing or playing needs no more; of those, only the ones that differ from the last one sent by more than
 :data:`POSE_ANGLE_TOLERANCE_DEG` or :data:`POSE_TRANSLATION_TOLERANCE_M` (the view holds the latest pose), and one at
 least every :data:`POSE_MAX_GAP_S`.
@@ -26,6 +28,7 @@ __all__ = [
     "POSE_TRANSLATION_TOLERANCE_M",
     "SCENE_RATE_HZ",
     "camera",
+    "grid_shape",
     "object_offsets",
     "pose_samples",
     "relative_to_initial_heading",
@@ -95,31 +98,42 @@ def pose_samples(t_s: np.ndarray, q_wxyz: np.ndarray, pos_m: np.ndarray | None =
     return idx[keep_changes(np.column_stack(columns), np.concatenate(tol), gap)]
 
 
-LABEL_ROW_STEP_M = 1.6
-"""Vertical step between the rows of staggered labels in the 3D view, m."""
+MAX_PER_ROW = 4
+"""Objects side by side in one row of the 3D view; more go into rows behind (north of) it. In the 3D tab of a
+1280x720 window four objects a row leave each label about 210 px, more than ``adaptive-large-angle`` needs; eight in
+one row ran their labels into one another."""
 
 
-def label_rows(n_objects: int) -> int:
-    """Rows the objects' labels are staggered over: one up to three objects, two up to six, three beyond (in a
-    1280x720 window the labels of four objects touch; with eight, a label as long as ``adaptive-large-angle`` is
-    wider than two objects' spacing in the side view)."""
-    return 1 if n_objects <= 3 else 2 if n_objects <= 6 else 3
+def grid_shape(n_objects: int) -> tuple[int, int]:
+    """(rows, objects a row): one row up to :data:`MAX_PER_ROW` objects, else as few rows as hold them, filled
+    evenly (eight objects: two rows of four)."""
+    rows = max(1, math.ceil(n_objects / MAX_PER_ROW))
+    return rows, math.ceil(n_objects / rows)
 
 
 def object_offsets(n_washouts: int, travel_m: np.ndarray, diameter_m: float) -> np.ndarray:
-    """Centre of each object (aircraft first, then the washouts) along NED y (east), (1 + n_washouts, 3), metres."""
+    """Centre of each object (aircraft first, then the washouts) (1 + n_washouts, 3), NED, metres: in rows along y
+    (east), at most :data:`MAX_PER_ROW` a row, further rows behind the first (north, away from the camera)."""
     spacing = 2.0 * float(travel_m[1]) + diameter_m + 1.0
-    offsets = np.zeros((1 + n_washouts, 3))
-    offsets[:, 1] = np.arange(1 + n_washouts) * spacing
+    n = 1 + n_washouts
+    _, per_row = grid_shape(n)
+    i = np.arange(n)
+    offsets = np.zeros((n, 3))
+    offsets[:, 0] = (i // per_row) * 1.3 * spacing
+    offsets[:, 1] = (i % per_row) * spacing
     return offsets
 
 
 def camera(offsets: np.ndarray, diameter_m: float) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
-    """Eye and target (NED, m): behind (south of) the row of objects and above it, looking north at its middle."""
-    width = float(offsets[-1, 1] - offsets[0, 1]) + 2.0 * diameter_m
-    centre = 0.5 * float(offsets[0, 1] + offsets[-1, 1])
-    eye = (-0.52 * width, centre, -0.27 * width)
-    return eye, (0.0, centre, 0.0)
+    """Eye and target (NED, m): behind (south of) the rows of objects and above them, looking north at their middle;
+    far enough back that the widest row fits a view about as wide as tall."""
+    width = float(offsets[:, 1].max() - offsets[:, 1].min()) + 2.0 * diameter_m
+    depth = float(offsets[:, 0].max() - offsets[:, 0].min())
+    centre_y = 0.5 * float(offsets[:, 1].min() + offsets[:, 1].max())
+    centre_x = 0.5 * float(offsets[:, 0].min() + offsets[:, 0].max())
+    back = 0.85 * width + 0.5 * depth
+    eye = (centre_x - back, centre_y, -0.5 * back)
+    return eye, (centre_x, centre_y, 0.0)
 
 
 def _shape(size: float) -> list[list[list[float]]]:
@@ -186,10 +200,9 @@ def send_scene(
         strict=True,
     )
     _log_object(rec, "/world/aircraft/body", half, AIRCRAFT_COLOR)
-    # one label per object, under it (z down), where it hides no shape; staggered over label_rows() rows, so
-    # neighbours' labels do not run into one another when many objects share the view's width
-    rows = label_rows(len(offsets))
-    below = half + 0.5 + LABEL_ROW_STEP_M * (np.arange(len(offsets)) % rows)
+    # one label per object, under it (z down), where it hides no shape; at most MAX_PER_ROW objects a row, so
+    # neighbours' labels do not run into one another (eight in one row did)
+    below = np.full(len(offsets), half + 0.5)
     rec.log(
         "/world/labels",
         rr.Points3D(
