@@ -179,10 +179,16 @@ def _motion_tab(layout: Layout, prefix: str, ranges: Sequence[tuple[float, float
 
 
 def legend_share(n_washouts: int) -> float:
-    """The legend's share of the side column (the Metrics panel has 1 - it): its title bar and axis (about 60 px) and
-    23 px a line (aircraft, every washout, the threshold), for a side column of 800 px (a 900 px window), at most
-    half: the legend is as tall as its lines, the rest is the ranking's."""
-    return min(0.5, (60.0 + 23.0 * (n_washouts + 2)) / 800.0)
+    """The legend's share of the side column (the Metrics panel has 1 - it): its title bar, axes and margins (about
+    90 px) and 23 px a line (aircraft, every washout, the threshold), for the 620 px side column of a 720 px window
+    (measured on screenshots: sized for a 900 px window the last two of nine lines were cut off at 720 px, with 60 px
+    for the frame the last one), at most 0.6: the legend is as tall as its lines, the rest is the ranking's."""
+    return min(0.6, (90.0 + 23.0 * (n_washouts + 2)) / 620.0)
+
+
+SIDE_SHARE = 1.3
+"""The side column's width against the tabs' 3: about 390 px in a 1280 px window, as wide as the ranking table with
+its recovered column (at 1.1 that column was cut off)."""
 
 
 def build_blueprint(layout: Layout) -> rrb.Blueprint:
@@ -256,7 +262,7 @@ def build_blueprint(layout: Layout) -> rrb.Blueprint:
     scene_tab = rrb.Vertical(scene, name="3-D view")  # the view's own title is too long for a tab
     tabs = rrb.Tabs(perceived, false_cues, raw, envelope, scene_tab, events, platforms, active_tab=0)
     return rrb.Blueprint(
-        rrb.Horizontal(tabs, side, column_shares=[3, 1.1]),
+        rrb.Horizontal(tabs, side, column_shares=[3, SIDE_SHARE]),
         rrb.BlueprintPanel(state="collapsed"),
         rrb.SelectionPanel(state="collapsed"),
         rrb.TimePanel(state="collapsed", timeline="time", play_state="paused"),

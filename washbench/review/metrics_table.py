@@ -48,13 +48,17 @@ def _ranking_lines(ranking: Sequence[RankRow], rule_label: str, ceiling: Mapping
         extra = f" {got} |" if with_ceiling else ""
         if r.washout == BOUND_WASHOUT:
             shown = f" *{got}* |" if with_ceiling and got else extra
-            lines.append(f"| - | *{r.washout} (oracle bound, not ranked)* | *{_num(r.score)}* |{shown}")
+            lines.append(f"| - | *{r.washout}* (not ranked) | *{_num(r.score)}* |{shown}")
         else:
             lines.append(f"| {r.rank}{' (tie)' if r.tied else ''} | {r.washout} | {_num(r.score)} |{extra}")
     if with_ceiling:
-        lines.append(f"| - | **ceiling** (no motion scores lower) | **{_num(float(score))}** | 100 % |")
-        lines += ["", "Recovered: the share of what a platform standing still leaves that the washout recovers (0 %: "
-                  "no better than standing still, 100 %: the ceiling; report.md explains the ceiling)."]  # fmt: skip
+        lines.append(f"| - | **ceiling** | **{_num(float(score))}** | 100 % |")
+        lines += ["", "Ceiling: the least score any motion of the platform can reach on this flight (no washout scores "
+                  "lower; report.md explains it). Recovered: the share of what a platform standing still leaves that "
+                  "the washout recovers (0 %: no better than standing still, 100 %: the ceiling)."]  # fmt: skip
+    if any(r.washout == BOUND_WASHOUT for r in ranking):
+        lines += ["", "*bound*: the oracle bound's replay, planned with the whole flight known: a reference, not "
+                  "ranked."]  # fmt: skip
     return lines
 
 

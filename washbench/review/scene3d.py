@@ -119,20 +119,21 @@ def object_offsets(n_washouts: int, travel_m: np.ndarray, diameter_m: float) -> 
     _, per_row = grid_shape(n)
     i = np.arange(n)
     offsets = np.zeros((n, 3))
-    offsets[:, 0] = (i // per_row) * 1.3 * spacing
+    offsets[:, 0] = (i // per_row) * 2.0 * spacing
     offsets[:, 1] = (i % per_row) * spacing
     return offsets
 
 
 def camera(offsets: np.ndarray, diameter_m: float) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
     """Eye and target (NED, m): behind (south of) the rows of objects and above them, looking north at their middle;
-    far enough back that the widest row fits a view about as wide as tall."""
+    far enough back that the widest row fits a view about as wide as tall, high enough that a row's labels fall
+    between it and the row in front (screenshots at 1280x720 and 1920x1080)."""
     width = float(offsets[:, 1].max() - offsets[:, 1].min()) + 2.0 * diameter_m
     depth = float(offsets[:, 0].max() - offsets[:, 0].min())
     centre_y = 0.5 * float(offsets[:, 1].min() + offsets[:, 1].max())
     centre_x = 0.5 * float(offsets[:, 0].min() + offsets[:, 0].max())
-    back = 0.85 * width + 0.5 * depth
-    eye = (centre_x - back, centre_y, -0.5 * back)
+    back = 0.6 * width + 0.4 * depth
+    eye = (centre_x - back, centre_y, -0.6 * back)
     return eye, (centre_x, centre_y, 0.0)
 
 
