@@ -284,6 +284,8 @@ def test_the_recording_draws_the_hexapods_legs_as_long_as_the_leg_columns(flight
     drawn = np.array([[np.linalg.norm(np.subtract(s[1], s[0], dtype=float)) for s in row] for row in strips])
     np.testing.assert_allclose(drawn, legs[rows], atol=2e-5)  # float32 in the recording
     np.testing.assert_allclose(np.asarray(strips[0][0][0], float), BASE[0], atol=1e-6)  # leg 1 starts at base joint 1
+    titles = _titles(rrd)  # the titles name the hexapod (they said "Atlas")
+    assert {"Hexapod per washout", "Hexapod envelope"} <= titles and not any("Atlas" in t for t in titles)
 
 
 def _geometry():
