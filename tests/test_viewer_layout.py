@@ -196,3 +196,20 @@ def test_the_legend_shows_every_line_in_a_720_px_window(recording: tuple[Path, o
     shares = side["ContainerBlueprint:row_shares"]
     lines = len(data.washouts) + 2  # the aircraft, every washout, the threshold
     assert shares[0] / sum(shares) * 620 >= 90 + 23 * lines
+
+
+def test_the_envelope_tab_holds_every_lane_and_its_panels_in_a_720_px_window(recording: tuple[Path, object]) -> None:
+    """At 1280x720 the tab has about 610 px; a lane view needs about 45 px for its title bar and axis and 40 px a
+    lane (screenshots), a usage panel about 100 px to show its 0 and 1. One lane per washout, the panels in a grid."""
+    path, data = recording
+    views, containers = _views(path), _containers(path)
+    (tab,) = [c for c in containers.values() if c.get("ContainerBlueprint:display_name") == ["Atlas envelope"]]
+    lanes_id, grid_id = (c.split("/")[1] for c in tab["ContainerBlueprint:contents"])
+    shares = tab["ContainerBlueprint:row_shares"]
+    lanes_px = shares[0] / sum(shares) * 610
+    assert views[lanes_id]["ViewContents:query"] == [f"+ {washout_lane_path(data, w)}" for w in data.washouts]
+    assert lanes_px >= 45 + 40 * len(data.washouts)
+    grid = containers[grid_id]
+    panels = len(grid["ContainerBlueprint:contents"])
+    rows = math.ceil(panels / grid["ContainerBlueprint:grid_columns"][0])
+    assert (610 - lanes_px) / rows >= 100, (panels, rows)

@@ -186,6 +186,12 @@ def legend_share(n_washouts: int) -> float:
     return min(0.6, (90.0 + 23.0 * (n_washouts + 2)) / 620.0)
 
 
+def usage_columns(n_washouts: int, n_panels: int) -> int:
+    """Columns of the envelope tab's usage grid: two, three with more than six washouts and more than four panels
+    (their lanes need the height: at 1280x720 ten lanes need about 445 px of the tab's 610)."""
+    return 3 if n_washouts > 6 and n_panels > 4 else 2
+
+
 SIDE_SHARE = 1.3
 """The side column's width against the tabs' 3: about 390 px in a 1280 px window, as wide as the ranking table with
 its recovered column (at 1.1 that column was cut off)."""
@@ -226,10 +232,11 @@ def build_blueprint(layout: Layout) -> rrb.Blueprint:
         name="False cues",
     )
     usage = [_panel(layout, u.origin, u.title, u.y_range) for u in layout.usage]
-    rows = (len(usage) + 1) // 2
+    columns = usage_columns(len(layout.washouts), len(usage))
+    rows = -(-len(usage) // columns)
     envelope = rrb.Vertical(
         _lanes(layout, "Limits held (one lane per washout)", layout.limit_lanes),
-        *([rrb.Grid(*usage, grid_columns=2)] if usage else []),
+        *([rrb.Grid(*usage, grid_columns=columns)] if usage else []),
         row_shares=[lane_share(len(layout.limit_lanes))] + ([PANEL_SHARE * rows] if usage else []),
         name=f"{platform} envelope",
     )

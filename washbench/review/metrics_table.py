@@ -54,8 +54,9 @@ def _ranking_lines(ranking: Sequence[RankRow], rule_label: str, ceiling: Mapping
     if with_ceiling:
         lines.append(f"| - | **ceiling** | **{_num(float(score))}** | 100 % |")
         lines += ["", "Ceiling: the least score any motion of the platform can reach on this flight (no washout scores "
-                  "lower; report.md explains it). Recovered: the share of what a platform standing still leaves that "
-                  "the washout recovers (0 %: no better than standing still, 100 %: the ceiling)."]  # fmt: skip
+                  "lower; report.md explains it). Recovered: the share of what a platform standing still leaves "
+                  "that the washout recovers (100 %: the ceiling, 0 %: no better than standing still, below 0: "
+                  "worse)."]  # fmt: skip
     if any(r.washout == BOUND_WASHOUT for r in ranking):
         lines += ["", "*bound*: the oracle bound's replay, planned with the whole flight known: a reference, not "
                   "ranked."]  # fmt: skip

@@ -9,14 +9,17 @@ the nanosecond):
   so the reference lies on top of a washout that follows it); ``/perceived/<dof>/threshold`` the
   perception threshold as two lines (+-threshold around 0, around -g for heave);
 - ``/raw/<dof>``: the same layout for the unperceived specific force and angular velocity;
-- ``/envelope/<quantity>``: platform envelope usage, max over the three axes of |value| / limit, one scalar per
-  washout (``quantity`` in position, velocity, acceleration, wheels), drawn with Max aggregation, and the limit line
-  ``/envelope/<quantity>/limit`` at 1;
+- ``/envelope/<quantity>``: platform envelope usage, one scalar per washout, drawn with Max aggregation, and the
+  limit line ``/envelope/<quantity>/limit`` at 1 (:func:`usage_panels`): max over the three axes of |value| / limit
+  for position, velocity, acceleration and wheels, the cockpit's |omega| / rate limit (``rate``, the Atlas), a rig's
+  angles / its stops (``angle``); ``/envelope/tilt_rate_held``: the seconds each washout has been held at its
+  tilt-rate limit so far (no limit line);
 - ``/platform/<washout>/<quantity>/axes``: the platform's stage position, velocity, acceleration (NED, SI) and
-  omni-wheel speeds (rad/s), three scalars per row, with ``limit_max`` and ``limit_min`` lines;
-- ``/lanes/0_phase`` (flight phases) and ``/lanes/<i>_<washout>`` (the limits a washout is held at, joined by "+";
-  i = 1, 2, ... in washout order, as the viewer sorts lanes by name): state lanes; ``/limits/<i>_<washout>/<kind>``:
-  one entity per washout with one lane (instance) per limit kind it ever reaches;
+  omni-wheel speeds (rad/s), three scalars per row, with ``limit_max`` and ``limit_min`` lines where the platform has
+  that limit;
+- state lanes, each labelled by the viewer with its path: ``/phase`` (flight phases), ``/limits/<i>_<washout>`` (the
+  limits a washout is held at, joined by "+") and ``/false_cues/<i>_<washout>`` (the DOFs felt falsely); i = 1, 2, ...
+  in washout order, as the viewer sorts lanes by name;
 - ``/world/...``: the 3D scene (:mod:`washbench.review.scene3d`);
 - ``/events/phases`` and ``/events/saturation``: text log entries at phase starts and limit onsets, each text
   starting with its time (the viewer's time column is narrow);
