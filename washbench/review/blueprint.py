@@ -180,10 +180,11 @@ def _motion_tab(layout: Layout, prefix: str, ranges: Sequence[tuple[float, float
 
 def legend_share(n_washouts: int) -> float:
     """The legend's share of the side column (the Metrics panel has 1 - it): its title bar, axes and margins (about
-    90 px) and 23 px a line (aircraft, every washout, the threshold), for the 620 px side column of a 720 px window
-    (measured on screenshots: sized for a 900 px window the last two of nine lines were cut off at 720 px, with 60 px
-    for the frame the last one), at most 0.6: the legend is as tall as its lines, the rest is the ranking's."""
-    return min(0.6, (90.0 + 23.0 * (n_washouts + 2)) / 620.0)
+    120 px: the legend's box ends some 80 px above the panel's bottom) and 23 px a line (aircraft, every washout, the
+    threshold), for the 620 px side column of a 720 px window (measured on screenshots at 1280x720: sized for a
+    900 px window the last two of nine lines were cut off, with 90 px for the frame the last of eleven), at most 0.65:
+    the legend is as tall as its lines, the rest is the ranking's."""
+    return min(0.65, (120.0 + 23.0 * (n_washouts + 2)) / 620.0)
 
 
 def usage_columns(n_washouts: int, n_panels: int) -> int:

@@ -517,8 +517,9 @@ def _zyx_angles(q: np.ndarray) -> np.ndarray:
 
 
 def usage_panels(data: RecordingData) -> list[UsagePanel]:
-    """The envelope tab's panels, each one line per washout: the stage's position, velocity and acceleration and the
-    wheel speeds against their limits (max over the axes of |value| / limit); the cockpit's rate against its limit
+    """The envelope tab's panels (short titles: with nine washouts a panel is a third of the tab wide), each one line
+    per washout: the stage's position, velocity and acceleration and the wheel speeds against their limits (max over
+    the axes of |value| / limit); the cockpit's rate against its limit
     (the Atlas sphere: |omega| / rate limit); a rig's angles against its stops; and the time each washout has been
     held at its tilt-rate limit so far (the limit washouts reach most: a rate inside the washout, not a platform
     quantity, so its time held, from the ``tilt_rate`` flags)."""
@@ -528,22 +529,22 @@ def usage_panels(data: RecordingData) -> list[UsagePanel]:
     for q, fname, unit in envelope_quantities(data):
         limit = env.axes(fname)
         values = np.column_stack([_max_ratio(getattr(data.platforms[w], fname), limit) for w in washouts])
-        panels.append(UsagePanel(q, f"{q}: max |axis| / limit", values, f"+-{_limit_text(limit)} {unit}"))
+        panels.append(UsagePanel(q, f"{q} / limit", values, f"+-{_limit_text(limit)} {unit}"))
     if env.rate_radps is not None:
         rate = float(env.rate_radps)
         values = np.column_stack([np.linalg.norm(np.asarray(data.washouts[w].omega_radps, dtype=np.float64), axis=1)
                                   / rate for w in washouts])  # fmt: skip
-        panels.append(UsagePanel("rate", "cockpit rate: |omega| / limit", values, f"{np.degrees(rate):.3g} deg/s"))
+        panels.append(UsagePanel("rate", "cockpit rate / limit", values, f"{np.degrees(rate):.3g} deg/s"))
     if env.angle_rad is not None:
         limit = np.asarray(env.angle_rad, dtype=np.float64)
         values = np.column_stack([_max_ratio(_zyx_angles(data.washouts[w].q), limit) for w in washouts])
         shown = "/".join("-" if not np.isfinite(v) else f"{np.degrees(v):.3g}" for v in limit)
-        panels.append(UsagePanel("angle", "rig angles: max |roll, pitch, yaw| / stop", values, f"{shown} deg"))
+        panels.append(UsagePanel("angle", "rig angles / stops", values, f"{shown} deg"))
     if any("tilt_rate" in data.platforms[w].saturated for w in washouts):
         dt = float(t_s[1] - t_s[0]) if t_s.size > 1 else 0.0
         held = [np.cumsum(np.asarray(data.platforms[w].saturated.get("tilt_rate", np.zeros(t_s.size, bool)),
                                      dtype=np.float64)) * dt for w in washouts]  # fmt: skip
-        panels.append(UsagePanel("tilt_rate_held", "time held at the tilt-rate limit so far [s]",
+        panels.append(UsagePanel("tilt_rate_held", "time at tilt-rate limit [s]",
                                  np.column_stack(held), None))  # fmt: skip
     return panels
 
