@@ -71,6 +71,7 @@ from washbench.review.blueprint import (
     series_color,
     source_colors,
 )
+from washbench.review.figures import saturation_labels
 from washbench.review.rrd_read import read_component, read_properties, read_scalar_series, read_text_documents
 from washbench.review.thinning import keep_samples
 
@@ -644,8 +645,6 @@ def limit_text(kinds: str, labels: Mapping[str, str]) -> str:
 def _send_lanes(rec: rr.RecordingStream, data: RecordingData) -> None:
     """Phase lane; one lane per washout, the limits it is held at joined by "+" (one lane per washout: with seven
     washouts one lane per washout and kind ran off a 720 px window); limit onset events."""
-    from washbench.review.figures import saturation_labels  # light: matplotlib is imported inside its functions
-
     labels = saturation_labels(data.platform)
     t_s = np.asarray(data.t_s, dtype=np.float64)
     n = t_s.size
