@@ -33,16 +33,17 @@ def test_both_recordings_in_one_panel_per_dof(pair):
     a, b, out = pair
     sa, sb, sc = read_scalar_series(a), read_scalar_series(b), read_scalar_series(out)
     names = read_static(out, "SeriesLines:names")[perceived_path("roll")]
-    assert names == ["aircraft", *(f"CW1: {w}" for w in WASHOUTS), *(f"CW1-soft: {w}" for w in WASHOUTS)]
+    assert names == [*(f"CW1: {w}" for w in WASHOUTS), *(f"CW1-soft: {w}" for w in WASHOUTS), "aircraft"]  # on top
     for dof in ("surge", "heave", "yaw"):
         t, v = sc[perceived_path(dof)]
         (t_a, v_a), (t_b, v_b) = sa[perceived_path(dof)], sb[perceived_path(dof)]
         np.testing.assert_array_equal(t, np.union1d(t_a, t_b))  # both's recorded times
         k_a, k_b = np.searchsorted(t, t_a), np.searchsorted(t, t_b)
-        np.testing.assert_array_equal(v[k_a, :4], v_a)  # aircraft once, then A's washouts, exact at A's samples
-        np.testing.assert_array_equal(v[k_b, 4:], v_b[:, 1:])  # then B's
-        for j in range(4):  # between its samples each line is its own recording's line
-            np.testing.assert_allclose(v[:, j], np.interp(t, t_a, v_a[:, j]), rtol=1e-12, atol=1e-12)
+        np.testing.assert_array_equal(v[k_a, :3], v_a[:, :3])  # A's washouts, exact at A's samples
+        np.testing.assert_array_equal(v[k_b, 3:6], v_b[:, :3])  # then B's
+        np.testing.assert_array_equal(v[k_a, 6], v_a[:, 3])  # the aircraft once, last
+        for j, i in zip((0, 1, 2, 6), range(4), strict=True):  # between its samples each line is its recording's
+            np.testing.assert_allclose(v[:, j], np.interp(t, t_a, v_a[:, i]), rtol=1e-12, atol=1e-12)
     colours = read_static(out, "SeriesLines:colors")[perceived_path("roll")]
     assert len(set(colours)) == 7  # B's washouts in their own (washed) shades
     _, usage = sc["/envelope/position"]
@@ -73,8 +74,8 @@ def test_thinned_recordings_share_the_aircraft_only_when_it_agrees(tmp_path):
     assert t_a.size < 240 and not np.array_equal(t_a, t_b)  # thinned, each at its own times
     write_comparison(a, b, tmp_path / "ab.rrd")
     write_comparison(a, c, tmp_path / "ac.rrd")
-    assert read_static(tmp_path / "ab.rrd", "SeriesLines:names")[perceived_path("surge")][0] == "aircraft"
-    assert read_static(tmp_path / "ac.rrd", "SeriesLines:names")[perceived_path("surge")][:2] == [
+    assert read_static(tmp_path / "ab.rrd", "SeriesLines:names")[perceived_path("surge")][-1] == "aircraft"
+    assert read_static(tmp_path / "ac.rrd", "SeriesLines:names")[perceived_path("surge")][-2:] == [
         "one: aircraft",
         "three: aircraft",
     ]  # 10 % more motion: two lines

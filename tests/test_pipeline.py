@@ -112,7 +112,7 @@ def test_recording_holds_the_computed_traces(run_dir: Path) -> None:
     t = traces.column("t_s").to_numpy()
     rrd = run_dir / "recording.rrd"
     series = read_scalar_series(rrd)
-    sources = ("aircraft", "small-angle", "large-angle", "unrestricted")
+    sources = ("small-angle", "large-angle", "unrestricted", "aircraft")  # the aircraft last, drawn on top
     assert read_static(rrd, "SeriesLines:names")["/perceived/surge"] == list(sources)
     rows = 0
     for dof, col in DOF_COLUMNS.items():

@@ -284,6 +284,8 @@ def test_the_recording_draws_the_hexapods_legs_as_long_as_the_leg_columns(flight
     drawn = np.array([[np.linalg.norm(np.subtract(s[1], s[0], dtype=float)) for s in row] for row in strips])
     np.testing.assert_allclose(drawn, legs[rows], atol=2e-5)  # float32 in the recording
     np.testing.assert_allclose(np.asarray(strips[0][0][0], float), BASE[0], atol=1e-6)  # leg 1 starts at base joint 1
+    titles = _titles(rrd)  # the titles name the hexapod (they said "Atlas")
+    assert {"Hexapod per washout", "Hexapod envelope"} <= titles and not any("Atlas" in t for t in titles)
 
 
 def _geometry():
@@ -331,3 +333,69 @@ def test_a_set_point_beyond_the_workspace_is_scaled_to_its_edge():
     np.testing.assert_allclose(p, [0.8 * s, -0.5 * s, 0.4 * s], rtol=1e-12)
     np.testing.assert_allclose(Rotation.from_quat([q[1], q[2], q[3], q[0]]).as_rotvec(), s * rot.as_rotvec(),
                                atol=1e-12)  # fmt: skip
+
+
+def _recorded_pose(rrd: Path, entity: str, table: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The cockpit's recorded pose (rows of traces.parquet it stands for, quaternion scalar last, translation)."""
+    from washbench.review.rrd_read import read_component
+
+    t_q, q = read_component(rrd, "Transform3D:quaternion")[entity]
+    t_p, p = read_component(rrd, "Transform3D:translation")[entity]
+    np.testing.assert_array_equal(t_q, t_p)
+    rows = np.searchsorted(np.asarray(table["t_s"]), t_q - 1e-9)
+    return rows, np.asarray(q, dtype=np.float64), np.asarray(p, dtype=np.float64)
+
+
+def _titles(rrd: Path) -> set[str]:
+    from washbench.review.rrd_read import read_blueprint_components
+
+    names = set()
+    for comps in read_blueprint_components(rrd).values():
+        for key in ("ViewBlueprint:display_name", "ContainerBlueprint:display_name"):
+            names.update(str(n) for n in comps.get(key) or [])
+    return names
+
+
+def test_a_rig_and_a_plugins_platform_are_recorded_with_titles_naming_them(flights, tmp_path):
+    """docs/platforms.md said: on a rig or a plugin's platform the recording is not written. Now it is: the rig drawn
+    as a base and the cockpit at the pose in traces.parquet (scipy checks the attitude), its angles against its stops
+    in the envelope tab; the plugin's platform (no envelope) with its time series and its pose; every title names
+    the platform, none says Atlas."""
+    from washbench.review.rrd_read import read_scalar_series
+
+    plugin = tmp_path / "box.py"
+    plugin.write_text(PLUGIN)
+    runs = {"rig": ("--platform", DATA_DIR / "rig2dof.yaml"), "box": ("--platform-plugin", f"{plugin}:BoxPlatform")}
+    for label, option in runs.items():
+        out = tmp_path / label
+        proc = washbench("cue", flights["gentle"], "--out", out, *option, "--washout", "large-angle", "--no-figures",
+                         "--quiet")  # fmt: skip
+        assert proc.returncode == 0, proc.stderr
+        (rrd,) = out.rglob("recording.rrd")
+        (traces,) = out.rglob("traces.parquet")
+        table = pq.read_table(traces).to_pydict()
+        titles = _titles(rrd)
+        word = {"rig": "Rig", "box": "box"}[label]
+        assert f"{word} per washout" in titles and f"{word} large-angle" in titles and f"{word} envelope" in titles
+        assert f"Aircraft (from its initial heading) and {word} cockpits" in titles
+        assert not any("Atlas" in t for t in titles), titles
+        rows, q, p = _recorded_pose(rrd, "/world/platform/large-angle/cockpit", table)
+        assert len(rows) > 100
+        q_traces = np.column_stack([table[f"large-angle.q_{a}"] for a in "wxyz"])[rows]
+        pos = np.column_stack([table[f"large-angle.pos_{a}_m"] for a in "xyz"])[rows]
+        angle = (Rotation.from_quat(q) * Rotation.from_quat(q_traces, scalar_first=True).inv()).magnitude()
+        assert np.degrees(angle).max() < 1e-3  # float32 in the recording
+        np.testing.assert_allclose(p, pos, atol=1e-6)
+        series = read_scalar_series(rrd)
+        assert "/platform/large-angle/position/axes" in series  # the time series, whatever the platform
+        if label == "rig":  # its angles against its 20 deg stops (rig2dof.yaml), scipy's ZYX angles
+            t_a, usage = series["/envelope/angle"]
+            q_all = np.column_stack([table[f"large-angle.q_{a}"] for a in "wxyz"])
+            yaw_pitch_roll = Rotation.from_quat(q_all, scalar_first=True).as_euler("ZYX")
+            expected = np.max(np.abs(yaw_pitch_roll[:, 1:]), axis=1) / np.radians(20.0)
+            k = np.searchsorted(np.asarray(table["t_s"]), t_a - 1e-9)
+            usage = usage.reshape(len(t_a), -1)[:, 0]
+            np.testing.assert_allclose(usage, expected[k], atol=1e-5)
+            assert 0.2 < usage.max() <= 1.0 + 1e-6
+        else:  # no envelope: no usage panel of the stage, no limit line
+            assert "/envelope/position" not in series and "/platform/large-angle/position/limit_max" not in series

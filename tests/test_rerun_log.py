@@ -29,8 +29,8 @@ from washbench.review.rerun_log import (
     PlatformEnvelope,
     PlatformSeries,
     RecordingData,
+    cue_lane_path,
     envelope_usage_path,
-    limit_lane_path,
     perceived_path,
     phase_lane_path,
     platform_path,
@@ -74,7 +74,8 @@ def make_data(n: int = 600, washouts: tuple[str, ...] = WASHOUTS, seed: int = 7)
             vel_mps=rng.normal(0, 0.5, (n, 3)),
             acc_mps2=rng.normal(0, 2.0, (n, 3)),
             wheel_radps=rng.normal(0, 10.0, (n, 3)),
-            saturated={"pos": burst, "rate": (k % 300) == 5, "vel": np.zeros(n, dtype=bool)},
+            saturated={"pos": burst, "rate": (k % 300) == 5, "vel": np.zeros(n, dtype=bool),
+                       "tilt_rate": (k % 150 >= 100) & (k % 150 < 100 + 10 * min(3, 1 + washouts.index(w)))},
         )
     return RecordingData(
         title="c172p / coordinated_turn",
@@ -82,7 +83,8 @@ def make_data(n: int = 600, washouts: tuple[str, ...] = WASHOUTS, seed: int = 7)
         aircraft=motion(),
         washouts={w: motion() for w in washouts},
         platforms=platforms,
-        envelope=PlatformEnvelope(pos_m=(1.5, 1.5, 1.0), vel_mps=2.0, acc_mps2=5.0, wheel_radps=40.0),
+        envelope=PlatformEnvelope(pos_m=(1.5, 1.5, 1.0), vel_mps=2.0, acc_mps2=5.0, wheel_radps=40.0,
+                                  rate_radps=np.radians(30.0)),
         phases=[("entry", 0.0, t[n // 5]), ("hold", t[n // 5], t[n // 2]), ("exit", t[n // 2], t[-1])],
         metrics_markdown=METRICS,
     )
@@ -172,7 +174,7 @@ def test_motion_traces_equal_the_inputs_one_line_per_source(written):
     each entity."""
     path, data = written
     series = read_scalar_series(path)
-    sources = [data.aircraft, *data.washouts.values()]
+    sources = [*data.washouts.values(), data.aircraft]  # the aircraft's line last: drawn on top
     for dof, sig, axis, _unit in DOFS:
         for entity, fields in ((perceived_path(dof), ("perceived_f_mps2", "perceived_omega_radps")),
                                (raw_path(dof), ("f_mps2", "omega_radps"))):  # fmt: skip
@@ -183,7 +185,7 @@ def test_motion_traces_equal_the_inputs_one_line_per_source(written):
                 expected = expected * 180 / np.pi
             assert_recorded(t_rec, v_rec, data.t_s, expected, motion_tolerances(path, entity, 1 + len(WASHOUTS)))
     names = read_static(path, "SeriesLines:names")
-    assert names[perceived_path("surge")] == [AIRCRAFT, *WASHOUTS]
+    assert names[perceived_path("surge")] == [*WASHOUTS, AIRCRAFT]
 
 
 def test_smooth_motion_is_thinned_and_fast_motion_kept(tmp_path):
@@ -204,7 +206,7 @@ def test_smooth_motion_is_thinned_and_fast_motion_kept(tmp_path):
     write_recording(tmp_path / "r.rrd", data)
     series = read_scalar_series(tmp_path / "r.rrd")
     t_rec, v_rec = series[perceived_path("surge")]
-    expected = np.column_stack([fast[:, 0]] + [slow[:, 0]] * 3)
+    expected = np.column_stack([slow[:, 0]] * 3 + [fast[:, 0]])  # the aircraft last
     assert_recorded(t_rec, v_rec, t, expected, motion_tolerances(tmp_path / "r.rrd", perceived_path("surge"), 4))
     in_burst = (t_rec > 10.0) & (t_rec < 12.0)
     assert in_burst.sum() > 0.5 * burst.sum()  # the fast part at (almost) full rate
@@ -252,6 +254,28 @@ def test_platform_traces_and_envelope_usage(written):
     assert {aggregation[envelope_usage_path(q)][0] for q, _, _ in ENVELOPE_QUANTITIES} == {3}  # 3 = Max
 
 
+def test_cockpit_rate_and_the_time_held_at_the_tilt_rate_limit_have_panels(written):
+    """No view showed the tilt-rate or the sphere-rate usage (the tilt rate is the limit washouts reach most): the
+    envelope tab has the cockpit's |omega| against the sphere's rate limit, and each washout's time held at its
+    tilt-rate limit so far (the flags' count times dt: at the end, the report's "time at a limit")."""
+    path, data = written
+    series = read_scalar_series(path)
+    t_r, rate = series[envelope_usage_path("rate")]
+    expected = np.column_stack([np.sqrt(np.sum(data.washouts[w].omega_radps ** 2, axis=1)) / np.radians(30.0)
+                                for w in WASHOUTS])  # fmt: skip
+    assert_recorded(t_r, rate, data.t_s, expected, 0.002)
+    np.testing.assert_array_equal(series["/envelope/rate/limit"][1], [1.0, 1.0])
+    t_h, held = series[envelope_usage_path("tilt_rate_held")]
+    dt = 1.0 / 120.0
+    for i, w in enumerate(WASHOUTS):
+        flags = data.platforms[w].saturated["tilt_rate"]
+        assert held[-1, i] == pytest.approx(flags.sum() * dt, rel=1e-6)
+        np.testing.assert_allclose(np.interp(data.t_s, t_h, held[:, i]), np.cumsum(flags) * dt, atol=0.1 * dt + 1e-6)
+    names = {v["ViewBlueprint:display_name"][0]: v for v in _views(path).values()}
+    assert names["cockpit rate / limit (30 deg/s)"]["ViewBlueprint:space_origin"] == ["/envelope/rate"]
+    assert names["time at tilt-rate limit [s]"]["ViewBlueprint:space_origin"] == ["/envelope/tilt_rate_held"]
+
+
 def test_smooth_platform_traces_are_thinned_within_the_stated_tolerance(tmp_path):
     """Smooth position and velocity keep a few per cent of the steps; random acceleration keeps (nearly) all."""
     base = make_data(n=1200)
@@ -283,21 +307,20 @@ def test_limit_lanes_reproduce_the_saturation_flags(written):
     lanes = read_component(path, "StateChange:state")
     for w in WASHOUTS:
         sat = data.platforms[w].saturated
-        # one lane per kind reached, in data order ("vel" is never reached: no lane)
-        t_ch, states = lanes[limit_lane_path(data, w)]
-        assert states.shape[1] == 2
-        for j, kind in enumerate(("pos", "rate")):
-            np.testing.assert_array_equal(_state_at(t_ch, states[:, j], data.t_s) == kind, sat[kind])
-        # the washout's own lane: the kinds held at, joined by "+"
+        # the washout's one lane: the kinds held at, joined by "+" in data order ("vel" is never reached)
         t_ch, joined = lanes[washout_lane_path(data, w)]
         at = _state_at(t_ch, joined, data.t_s)
-        expected = np.where(
-            sat["pos"] & sat["rate"], "pos+rate", np.where(sat["pos"], "pos", np.where(sat["rate"], "rate", ""))
-        )
+        expected = np.array(["+".join(k for k in ("pos", "rate", "tilt_rate") if sat[k][i])
+                             for i in range(data.t_s.size)])  # fmt: skip
         np.testing.assert_array_equal(at, expected)
-    assert [p.rsplit("/", 1)[1] for p in sorted(k for k in lanes if k.startswith("/lanes/"))] == [
-        "0_phase", "1_small-angle", "2_large-angle", "3_unrestricted",
-        "cues_1_small-angle", "cues_2_large-angle", "cues_3_unrestricted"]  # fmt: skip
+    # every lane's path reads as a group and a name (the viewer labels each lane with it): one lane per washout
+    assert sorted(k for k in lanes if not k.startswith("/false_cues/")) == [
+        "/limits/1_small-angle", "/limits/2_large-angle", "/limits/3_unrestricted", "/phase"]  # fmt: skip
+    labels = read_static(path, "StateConfiguration:labels")
+    values = read_static(path, "StateConfiguration:values")
+    shown = dict(zip(values[washout_lane_path(data, "small-angle")], labels[washout_lane_path(data, "small-angle")],
+                     strict=True))  # fmt: skip
+    assert shown["pos"] == "stage position" and shown["tilt_rate"] == "tilt-rate limit"  # the figures' names
 
 
 def test_false_cue_lanes_and_events(written):
@@ -317,7 +340,8 @@ def test_false_cue_lanes_and_events(written):
         cls = [classify(ac[:, j], sim[:, j], thresholds[j], rest[j]) for j in range(6)]
         expected = np.array(["false: " + "+".join(d for j, d in enumerate(names) if cls[j][k] == FALSE)
                              if any(c[k] == FALSE for c in cls) else "" for k in range(len(data.t_s))])  # fmt: skip
-        t_ch, states = lanes[f"/lanes/cues_{i + 1}_{w}"]
+        assert cue_lane_path(data, w) == f"/false_cues/{i + 1}_{w}"
+        t_ch, states = lanes[cue_lane_path(data, w)]
         np.testing.assert_array_equal(_state_at(t_ch, states, data.t_s), expected)
         dt = float(data.t_s[1] - data.t_s[0])
         n_events += sum(len(false_events(cls[j], sim[:, j] - rest[j], dt, names[j])) for j in range(6))
@@ -331,7 +355,7 @@ def test_saturation_onset_events(written):
     path, data = written
     expected_onsets = []
     for w in WASHOUTS:
-        for kind in ("pos", "rate"):
+        for kind in ("pos", "rate", "tilt_rate"):
             flags = data.platforms[w].saturated[kind]
             rising = np.flatnonzero(np.diff(flags.astype(int), prepend=0) == 1)
             expected_onsets += [(data.t_s[i], f"{w}: {kind} limit") for i in rising]
@@ -490,18 +514,28 @@ def test_blueprint_stacks_the_perceived_panels_on_the_whole_manoeuvre(written):
         lo, hi = v["ScalarAxis:range"][0]
         m = series[perceived_path(dof)][1]
         assert lo < m.min() and hi > m.max()  # every trace inside the fixed range
-    # the lanes above, then the six panels, stacked in one container (a tab named "Perceived")
-    stacks = [c for c in _containers(path).values() if c.get("ContainerBlueprint:display_name") == ["Perceived"]]
-    (stack,) = stacks
-    contents = [c.split("/")[1] for c in stack["ContainerBlueprint:contents"]]
-    assert contents[1:] == perceived
-    assert views[contents[0]]["ViewBlueprint:class_identifier"] == ["StateTimeline"]
-    assert views[contents[0]]["ViewBlueprint:space_origin"] == ["/lanes"]
+        # two labelled gridlines at least: the viewer labels multiples of a power of ten (a panel from -8.4 to 7.4
+        # showed a lone "0"), so the range holds two multiples of the power of ten below its height
+        step = 10.0 ** np.floor(np.log10(hi - lo))
+        assert np.floor(hi / step) - np.ceil(lo / step) >= 1, (dof, lo, hi)
+    # a tab named "Perceived" of two columns (surge, sway, heave | roll, pitch, yaw), each the phase lane then its
+    # three panels
+    containers = _containers(path)
+    (tab,) = [c for c in containers.values() if c.get("ContainerBlueprint:display_name") == ["Perceived"]]
+    columns = [containers[c.split("/")[1]] for c in tab["ContainerBlueprint:contents"]]
+    assert len(columns) == 2
+    shown = []
+    for column in columns:
+        contents = [c.split("/")[1] for c in column["ContainerBlueprint:contents"]]
+        assert views[contents[0]]["ViewBlueprint:class_identifier"] == ["StateTimeline"]
+        assert views[contents[0]]["ViewContents:query"] == [f"+ {phase_lane_path()}"]
+        shown += contents[1:]
+    assert shown == perceived
     legend = [v for v in views.values() if v["ViewBlueprint:space_origin"] == ["/legend"]]
     assert len(legend) == 1 and legend[0]["PlotLegend:visible"] == [True]
-    for name in ("Raw motion", "Platform envelope", "Atlas small-angle", "Atlas unrestricted"):
-        assert any(c.get("ContainerBlueprint:display_name") == [name] for c in _containers(path).values())
-    assert {f"{q}: max |axis| / limit" for q, _, _ in ENVELOPE_QUANTITIES} <= {n.split(" (")[0] for n in by_name}
+    for name in ("Raw motion", "Atlas envelope", "Atlas small-angle", "Atlas unrestricted"):
+        assert any(c.get("ContainerBlueprint:display_name") == [name] for c in containers.values())
+    assert {f"{q} / limit" for q, _, _ in ENVELOPE_QUANTITIES} <= {n.split(" (")[0] for n in by_name}
     # panels collapsed so the plots get the screen (2 = Collapsed)
     comps = read_blueprint_components(path)
     assert comps["/blueprint_panel"]["PanelBlueprint:state"] == [2]
@@ -552,14 +586,14 @@ def test_colours_fixed_and_the_aircraft_readable_on_both_themes(written):
     blue, orange, green = (31, 119, 180), (255, 127, 14), (44, 160, 44)
     aircraft = rerun_log.series_color(AIRCRAFT)
     for dof, _, _, _ in DOFS:
-        assert colours[perceived_path(dof)] == [_rgba(c) for c in (aircraft, blue, orange, green)]
+        assert colours[perceived_path(dof)] == [_rgba(c) for c in (blue, orange, green, aircraft)]
         assert colours[raw_path(dof)] == colours[perceived_path(dof)]
     for q, _, _ in ENVELOPE_QUANTITIES:
         assert colours[envelope_usage_path(q)] == [_rgba(c) for c in (blue, orange, green)]
     # the reference trace reads on the viewer's light (247,246,246) and dark (24,24,23) backgrounds (WCAG >= 3:1)
     assert _contrast(aircraft, (247, 246, 246)) >= 3.0 and _contrast(aircraft, (24, 24, 23)) >= 3.0
     widths = read_static(path, "SeriesLines:widths")[perceived_path("surge")]
-    assert widths[0] > max(widths[1:])  # the aircraft drawn wider
+    assert widths[-1] > max(widths[:-1])  # the aircraft drawn wider (and last, on top)
 
 
 def test_washout_names_come_from_the_data(tmp_path):
@@ -569,12 +603,12 @@ def test_washout_names_come_from_the_data(tmp_path):
     data = make_data(n=60, washouts=names)
     write_recording(path, data)
     lines = read_static(path, "SeriesLines:names")
-    assert lines[perceived_path("yaw")] == [AIRCRAFT, *names]
+    assert lines[perceived_path("yaw")] == [*names, AIRCRAFT]
     colours = _series_colours(path)[perceived_path("yaw")]
-    assert colours[1] == _rgba((255, 127, 14)) and colours[3] == _rgba((31, 119, 180))
+    assert colours[0] == _rgba((255, 127, 14)) and colours[2] == _rgba((31, 119, 180))
     assert len(set(colours)) == 5
     lanes = read_component(path, "StateChange:state")
-    assert washout_lane_path(data, "my_variant") == "/lanes/4_my_variant" and "/lanes/4_my_variant" in lanes
+    assert washout_lane_path(data, "my_variant") == "/limits/4_my_variant" and "/limits/4_my_variant" in lanes
     views = {v["ViewBlueprint:display_name"][0] for v in _views(path).values()}
     assert {
         "cw1-soft: position [m] (x red, y green, z blue)",
@@ -648,7 +682,7 @@ def test_write_time_15000_samples_three_washouts(tmp_path):
     size_mb = (tmp_path / "big.rrd").stat().st_size / 1e6
     print(f"\nwrite_recording: 15,000 samples x 3 washouts in {elapsed:.3f} s, {size_mb:.1f} MB")
     t_rec, v_rec = read_scalar_series(tmp_path / "big.rrd")[perceived_path("yaw")]
-    sources = [data.aircraft, *data.washouts.values()]
+    sources = [*data.washouts.values(), data.aircraft]
     expected = np.column_stack([np.rad2deg(m.perceived_omega_radps[:, 2]) for m in sources])
     tol = motion_tolerances(tmp_path / "big.rrd", perceived_path("yaw"), 4)
     assert_recorded(t_rec, v_rec, data.t_s, expected, tol)

@@ -173,7 +173,7 @@ def test_variant_names_in_every_output(variant_run: Path) -> None:
     assert "fast_tilt.perceived_f_x_mps2" in columns and "cw1.sat_pos" in columns
     assert set(json.loads((variant_run / "run.json").read_text())["saturations"]) == names
     lines = read_static(variant_run / "recording.rrd", "SeriesLines:names")["/perceived/surge"]
-    assert lines[0] == "aircraft" and set(lines[1:]) == names  # one line per source, names from the data
+    assert lines[-1] == "aircraft" and set(lines[:-1]) == names  # one line per source (the aircraft last, on top)
     # the suite's tables: better_by against the first washout listed when small-angle does not run
     summary = json.loads((variant_run / "run.json").read_text())
     out = variant_run.parent.parent / "suite_tables"

@@ -53,54 +53,70 @@ def _queries(path: Path) -> dict[str, list[str]]:
     return out
 
 
-def test_the_tabs_stay_few_and_the_events_tab_in_sight(recording: tuple[Path, object]) -> None:
-    path, data = recording
+def _tab_names(path: Path) -> tuple[list[str], dict]:
     containers, views = _containers(path), _views(path)
     tab_sets = [c for c in containers.values() if c.get("ContainerBlueprint:container_kind") == [1]]  # 1 = Tabs
     (top,) = [c for c in tab_sets if c.get("ContainerBlueprint:display_name") is None]
     children = [c.split("/")[1] for c in top["ContainerBlueprint:contents"]]
-    assert len(children) <= 6  # whatever the number of washouts
-    names = [(containers.get(c) or views.get(c) or {}).get("ContainerBlueprint:display_name")
-             or (views.get(c) or {}).get("ViewBlueprint:display_name") for c in children]  # fmt: skip
-    assert any("events" in n[0] for n in names if n)
-    (atlas,) = [c for c in tab_sets if c.get("ContainerBlueprint:display_name") == ["Atlas per washout"]]
+    names = [((containers.get(c) or {}).get("ContainerBlueprint:display_name")
+              or (views.get(c) or {}).get("ViewBlueprint:display_name"))[0] for c in children]  # fmt: skip
+    return names, {"tab_sets": tab_sets}
+
+
+def test_the_tabs_stay_few_and_the_events_tab_in_sight(recording: tuple[Path, object]) -> None:
+    """Seven tabs whatever the number of washouts, their names short enough to fit the 870 px the tab bar has in a
+    1280 px window (screenshots: about 7.5 px a character and 40 px a tab for its icon and gaps)."""
+    path, data = recording
+    names, found = _tab_names(path)
+    assert len(names) == 7 and "Events" in names and "3-D view" in names[4]
+    assert sum(7.5 * len(n) + 40 for n in names) <= 870, names
+    (atlas,) = [c for c in found["tab_sets"] if c.get("ContainerBlueprint:display_name") == ["Atlas per washout"]]
     assert len(atlas["ContainerBlueprint:contents"]) == len(data.washouts)  # one tab per washout, inside
 
 
 def test_false_cues_have_a_tab_and_the_motion_panels_the_room(recording: tuple[Path, object]) -> None:
     path, data = recording
     views, queries = _views(path), _queries(path)
-    lanes = {
-        vid: v["ViewBlueprint:display_name"][0]
-        for vid, v in views.items()
-        if v["ViewBlueprint:class_identifier"] == ["StateTimeline"] and v["ViewBlueprint:space_origin"] == ["/lanes"]
-    }
+    lanes = {vid: v["ViewBlueprint:display_name"][0] for vid, v in views.items()
+             if v["ViewBlueprint:class_identifier"] == ["StateTimeline"]}  # fmt: skip
     cues = [cue_lane_path(data, w) for w in data.washouts]
     limits = [washout_lane_path(data, w) for w in data.washouts]
-    (false_cues,) = [vid for vid, name in lanes.items() if name == "False cues"]
-    shown = queries[false_cues]
-    assert "+ /lanes/**" in shown and not any(f"- {p}" in shown for p in cues)  # every false-cue lane
-    assert all(f"- {p}" in shown for p in limits)
+    (false_cues,) = [vid for vid, name in lanes.items() if name.startswith("False cues")]
+    assert queries[false_cues] == [f"+ {p}" for p in cues]  # every false-cue lane, nothing else
+    (held,) = [vid for vid, name in lanes.items() if name.startswith("Limits held")]
+    assert queries[held] == [f"+ {p}" for p in limits]  # one lane per washout (per kind ran off a 720 px window)
     phases = [vid for vid, name in lanes.items() if name == "Phases"]
-    assert len(phases) == 2  # above the perceived and the raw panels: the phases only
-    for vid in phases:
-        assert all(f"- {p}" in queries[vid] for p in [*cues, *limits])
+    assert len(phases) == 5  # two columns of the perceived and raw tabs, the false-cue tab: the phases only
+    assert all(queries[vid] == [f"+ {phase_lane_path()}"] for vid in phases)
+    containers = _containers(path)
     for name in ("Perceived", "Raw motion"):
-        (stack,) = [c for c in _containers(path).values() if c.get("ContainerBlueprint:display_name") == [name]]
-        shares = stack["ContainerBlueprint:row_shares"]
-        assert len(shares) == 7 and shares[0] < min(shares[1:])  # each of the six panels taller than the lane
+        (tab,) = [c for c in containers.values() if c.get("ContainerBlueprint:display_name") == [name]]
+        for column in tab["ContainerBlueprint:contents"]:
+            shares = containers[column.split("/")[1]]["ContainerBlueprint:row_shares"]
+            # three panels a column: each at least a quarter of the tab's height, the phase lane less than a panel
+            assert len(shares) == 4 and shares[0] < min(shares[1:]) and min(shares[1:]) / sum(shares) >= 0.25
 
 
-def test_labels_in_the_3d_view_are_staggered_apart(recording: tuple[Path, object]) -> None:
+def test_labels_in_the_3d_view_stay_apart(recording: tuple[Path, object]) -> None:
+    """At most four objects a row (eight in one row ran their labels into one word): each label a whole spacing from
+    its row's neighbours, the rows behind one another, every object's label under it."""
     path, data = recording
     positions = np.asarray(read_static(path, "Points3D:positions")["/world/labels"], dtype=float)
     assert len(positions) == 1 + len(data.washouts)
-    spacing = float(np.min(np.diff(positions[:, 1])))
-    for i in range(len(positions)):
-        same_row = [j for j in range(len(positions)) if j != i and math.isclose(positions[j, 2], positions[i, 2])]
-        nearest = min((abs(positions[j, 1] - positions[i, 1]) for j in same_row), default=math.inf)
-        # a label as long as "adaptive-large-angle" needs more than two objects' spacing (screenshots)
-        assert nearest >= (3.0 if len(positions) > 6 else 1.0) * spacing - 1e-9
+    rows = sorted(set(np.round(positions[:, 0], 6)))
+    assert len(rows) == math.ceil(len(positions) / 4)
+    spacing = None
+    for x in rows:
+        row = np.sort(positions[np.isclose(positions[:, 0], x), 1])
+        assert 1 <= len(row) <= 4
+        if len(row) > 1:
+            spacing = spacing or float(np.min(np.diff(row)))
+            assert np.min(np.diff(row)) >= spacing - 1e-9
+    if len(rows) > 1:
+        assert np.min(np.diff(rows)) >= spacing  # the rows as far apart as the objects in a row
+    statics = read_static(path, "Transform3D:translation")
+    centres = [statics["/world/aircraft"][0]] + [statics[f"/world/atlas/{w}"][0] for w in data.washouts]
+    np.testing.assert_allclose(positions[:, :2], np.asarray(centres, dtype=float)[:, :2], atol=1e-6)
 
 
 def test_the_metrics_panel_ranks_and_keeps_the_bound_a_reference() -> None:
@@ -110,7 +126,7 @@ def test_the_metrics_panel_ranks_and_keeps_the_bound_a_reference() -> None:
     ranking = [RankRow(w, 0.9 + 0.1 * i, i + 1, {}) for i, w in enumerate(washouts)] + [RankRow("bound", 0.4, 0, {})]
     text = metrics_table_markdown("c172p / steep_turn", rows, ranking, "score")
     assert "**Ranking**" in text and "| 1 | small-angle | 0.9 |" in text
-    assert "| - | *bound (oracle bound, not ranked)* | *0.4* |" in text
+    assert "| - | *bound* (not ranked) | *0.4* |" in text
     tables = re.findall(r"^\| washout \|[^\n]*\n(?:\|[^\n]*\n)+", text, flags=re.M)
     assert len(tables) == 3  # NPC, integral and max error
     for table in tables:
@@ -120,6 +136,26 @@ def test_the_metrics_panel_ranks_and_keeps_the_bound_a_reference() -> None:
         assert "**" not in bound  # the bound is never "best"
         (best,) = [line for line in lines if line.startswith("| small-angle")]
         assert best.count("**") == 2 * len(DOFS)  # the best washout in every DOF
+
+
+def test_the_metrics_panel_gives_the_ceiling_and_each_washouts_share_recovered() -> None:
+    """With the bound's record (run.json ``bound``), the ranking ends with the ceiling, and each washout's recovered
+    share is the record's: (still - score) / (still - ceiling), here with still = 1 (one DOF weighted 1)."""
+    washouts = SEVEN[:-1]
+    rows = [MetricRow(w, d, 1.0, 2.0, 3.0) for w in SEVEN for d in DOFS]
+    scores = {w: 0.9 - 0.1 * i for i, w in enumerate(washouts)} | {"bound": 0.25}
+    ranking = [RankRow(w, scores[w], i + 1, {}) for i, w in enumerate(washouts)] + [RankRow("bound", 0.25, 0, {})]
+    ceiling = 0.2
+    record = {"ceiling": {"score": ceiling}, "recovered": {w: {"score": (1.0 - v) / (1.0 - ceiling)}
+                                                           for w, v in scores.items()}}  # fmt: skip
+    text = metrics_table_markdown("c172p / steep_turn", rows, ranking, "score", record)
+    assert "| rank | washout | score | recovered |" in text
+    assert "| 1 | small-angle | 0.9 | 12 % |" in text  # (1 - 0.9) / 0.8
+    assert "| 6 | mpc | 0.4 | 75 % |" in text
+    assert "| - | *bound* (not ranked) | *0.25* | *94 %* |" in text
+    assert "| - | **ceiling** | **0.2** | 100 % |" in text
+    without = metrics_table_markdown("c172p / steep_turn", rows, ranking, "score")
+    assert "ceiling" not in without and "| rank | washout | score |" in without
 
 
 def test_lane_bars_take_fixed_colours_apart_from_the_washouts(recording: tuple[Path, object]) -> None:
@@ -132,7 +168,9 @@ def test_lane_bars_take_fixed_colours_apart_from_the_washouts(recording: tuple[P
     limit_lanes = [p for p in colours if p.startswith("/limits/")]
     assert len(limit_lanes) == len(data.washouts)  # make_data: every washout reaches its "pos" and "rate" limits
     for p in limit_lanes:
-        assert set(colours[p]) == {_rgba(LIMIT_LANE_COLOR)} and set(values[p]) == {"pos", "rate"}
+        assert set(colours[p]) == {_rgba(LIMIT_LANE_COLOR)}
+        assert {"pos", "rate"} <= set(values[p]) and all(set(v.split("+")) <= {"pos", "rate", "tilt_rate"}
+                                                         for v in values[p])  # fmt: skip
     for w in data.washouts:
         p = cue_lane_path(data, w)
         if p in colours:
@@ -145,3 +183,33 @@ def test_lane_bars_take_fixed_colours_apart_from_the_washouts(recording: tuple[P
 def _rgba(rgb: tuple[int, int, int]) -> int:
     r, g, b = rgb
     return (r << 24) | (g << 16) | (b << 8) | 0xFF
+
+
+def test_the_legend_shows_every_line_in_a_720_px_window(recording: tuple[Path, object]) -> None:
+    """The side column holds the legend over the Metrics panel; at 1280x720 (a side column of about 620 px) the legend
+    needs about 120 px for its title bar, axes and margins and 23 px a line (screenshots: sized for a taller window,
+    the last two of nine lines were cut off)."""
+    path, data = recording
+    views, containers = _views(path), _containers(path)
+    (legend,) = [vid for vid, v in views.items() if v["ViewBlueprint:space_origin"] == ["/legend"]]
+    (side,) = [c for c in containers.values() if f"view/{legend}" in c.get("ContainerBlueprint:contents", [])]
+    shares = side["ContainerBlueprint:row_shares"]
+    lines = len(data.washouts) + 2  # the aircraft, every washout, the threshold
+    assert shares[0] / sum(shares) * 620 >= 120 + 23 * lines - 0.5  # (the shares are stored as float32)
+
+
+def test_the_envelope_tab_holds_every_lane_and_its_panels_in_a_720_px_window(recording: tuple[Path, object]) -> None:
+    """At 1280x720 the tab has about 610 px; a lane view needs about 45 px for its title bar and axis and 40 px a
+    lane (screenshots), a usage panel about 100 px to show its 0 and 1. One lane per washout, the panels in a grid."""
+    path, data = recording
+    views, containers = _views(path), _containers(path)
+    (tab,) = [c for c in containers.values() if c.get("ContainerBlueprint:display_name") == ["Atlas envelope"]]
+    lanes_id, grid_id = (c.split("/")[1] for c in tab["ContainerBlueprint:contents"])
+    shares = tab["ContainerBlueprint:row_shares"]
+    lanes_px = shares[0] / sum(shares) * 610
+    assert views[lanes_id]["ViewContents:query"] == [f"+ {washout_lane_path(data, w)}" for w in data.washouts]
+    assert lanes_px >= 45 + 40 * len(data.washouts)
+    grid = containers[grid_id]
+    panels = len(grid["ContainerBlueprint:contents"])
+    rows = math.ceil(panels / grid["ContainerBlueprint:grid_columns"][0])
+    assert (610 - lanes_px) / rows >= 100, (panels, rows)

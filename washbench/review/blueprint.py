@@ -1,11 +1,14 @@
 """The review layout of a recording, and the colours every view shares.
 
-Laid out for one question: which washout feels most like the aircraft? The first tab stacks the six perceived-motion
-panels (surge, sway, heave, roll, pitch, yaw, as the paper's Figures 8-16) under the phase lane, all on one linked
-time axis showing the whole manoeuvre, and gives them the height; the false cues (one lane per washout) have a tab
-of their own, the per-washout Atlas tabs sit inside one tab, so the events tab stays in sight with ten washouts.
-Beside them the 3D scene (aircraft and Atlas cockpits, labels staggered), the legend (as tall as its lines) and the
-Metrics panel (the ranking first, then washout-by-DOF tables). The viewer's own side panels start collapsed.
+Laid out for one question: which washout feels most like the aircraft? The first tab holds the six perceived-motion
+panels (surge, sway, heave | roll, pitch, yaw, as the paper's Figures 8-16) in two columns, each under the phase lane,
+all on one linked time axis showing the whole manoeuvre: each panel as tall as a third of the tab, whatever the number
+of washouts; in every panel the aircraft pilot's line is drawn last, on top. The false cues (one lane per washout)
+have a tab of their own; the envelope tab one lane per washout (the limits it is held at) over the usage panels; the
+3D view (aircraft and platform cockpits, labels staggered) a tab of its own, as wide as the plots; the per-washout
+platform tabs sit inside one tab: seven tabs, the events tab in sight with ten washouts. Beside the tabs: the legend
+(as tall as its lines) and the Metrics panel (the ranking with the ceiling first, then washout-by-DOF tables). Titles
+name the platform (Atlas, Hexapod, Rig or a plugin's kind). The viewer's own side panels start collapsed.
 
 Colours are fixed and the figures' (:mod:`washbench.review.palette`): the aircraft pilot (the reference) in a strong
 magenta, drawn wider, readable on the viewer's light and dark themes; small-angle blue, large-angle orange,
@@ -31,6 +34,7 @@ __all__ = [
     "THRESHOLD_COLOR",
     "WASHOUT_WIDTH",
     "Layout",
+    "UsageView",
     "build_blueprint",
     "series_color",
     "source_colors",
@@ -46,7 +50,8 @@ default palette (:mod:`washbench.review.palette`), one set of colours for the re
 EXTRA_COLORS: tuple[tuple[int, int, int], ...] = EXTRA_RGB
 """Colours for the other washout names, taken in the order the recording lists them."""
 LIMIT_COLOR = (128, 128, 128)
-THRESHOLD_COLOR = (128, 128, 128)
+THRESHOLD_COLOR = (128, 128, 128, 100)
+"""The perception thresholds' lines: a faint (translucent) grey, thin, apart from the oracle bound's solid grey."""
 AXIS_COLORS = ((220, 60, 60), (60, 170, 60), (70, 120, 230))
 """x, y, z (or wheel 1, 2, 3) inside one washout's Atlas panels."""
 
@@ -72,13 +77,23 @@ def source_colors(washouts: Sequence[str]) -> list[tuple[int, int, int]]:
 
 
 @dataclass(frozen=True)
+class UsageView:
+    """One panel of the envelope tab: its entity, title and y range."""
+
+    origin: str
+    title: str
+    y_range: tuple[float, float]
+
+
+@dataclass(frozen=True)
 class Layout:
     """What the blueprint needs to know about the data (the blueprint is built with the recording).
 
     ``perceived_ranges`` and ``raw_ranges``: per DOF (in the order of ``dofs``) the y range to show, thresholds and
-    all traces inside.
-    ``limit_lanes``: (washout, kind) pairs that reach a limit at least once. ``camera``: (eye, target) in the scene's
-    NED frame, metres.
+    all traces inside. ``camera``: (eye, target) in the scene's NED frame, metres. ``usage``: the envelope tab's
+    panels. ``platform_quantities``: (name, unit) of each washout's platform panels. ``platform_name``: the word the
+    titles use for the platform. Lanes: the phases' (None without phases), one limit lane and one false-cue lane per
+    washout.
     """
 
     washouts: tuple[str, ...]
@@ -86,16 +101,13 @@ class Layout:
     t_end_s: float
     perceived_ranges: tuple[tuple[float, float], ...]
     raw_ranges: tuple[tuple[float, float], ...]
-    limit_lanes: tuple[tuple[str, str], ...]
     camera: tuple[tuple[float, float, float], tuple[float, float, float]]
-    envelope_quantities: tuple[tuple[str, str], ...]  # (name, unit)
-    limits_text: tuple[str, ...]  # per envelope quantity, e.g. "+-1.5/1.5/1 m"
-    hidden_lanes: tuple[str, ...] = ()
-    """Lanes under ``/lanes`` no tab shows: each washout's limits joined (the envelope tab shows the limits, one lane
-    per washout and kind)."""
-    cue_lanes: tuple[str, ...] = ()
-    """The false-cue lanes (one per washout): a tab of their own, left out of the motion tabs, whose six panels get
-    the room (with seven washouts the lanes above them left each panel about 55 px)."""
+    usage: tuple[UsageView, ...]
+    platform_quantities: tuple[tuple[str, str], ...]
+    platform_name: str
+    phase_lane: str | None
+    limit_lanes: tuple[str, ...]
+    cue_lanes: tuple[str, ...]
 
 
 def _whole_manoeuvre(t_end_s: float) -> rrb.TimeAxis:
@@ -113,41 +125,35 @@ def _all_data() -> rrb.VisibleTimeRange:
     return rrb.VisibleTimeRange("time", start=rrb.TimeRangeBoundary.infinite(), end=rrb.TimeRangeBoundary.infinite())
 
 
-def _stack(layout: Layout, prefix: str, ranges: Sequence[tuple[float, float]], title: str) -> list[rrb.TimeSeriesView]:
-    """Six stacked panels (one per DOF) without legends, y ranges fixed to hold all the data and the thresholds."""
-    views = []
-    for (dof, unit), (lo, hi) in zip(layout.dofs, ranges, strict=True):
-        legend = rrb.PlotLegend(visible=False)  # the one legend has a panel of its own
-        views.append(
-            rrb.TimeSeriesView(
-                origin=f"/{prefix}/{dof}",
-                name=f"{title}{dof} [{unit}]",
-                axis_x=_whole_manoeuvre(layout.t_end_s),
-                axis_y=rrb.ScalarAxis(range=(lo, hi)),
-                plot_legend=legend,
-                time_ranges=_all_data(),
-            )
-        )
-    return views
+def _panel(layout: Layout, origin: str, name: str, y_range: tuple[float, float] | None) -> rrb.TimeSeriesView:
+    """A time-series panel on the whole manoeuvre, without legend (the one legend has a panel of its own)."""
+    return rrb.TimeSeriesView(
+        origin=origin,
+        name=name,
+        axis_x=_whole_manoeuvre(layout.t_end_s),
+        axis_y=rrb.ScalarAxis(range=y_range) if y_range is not None else None,
+        plot_legend=rrb.PlotLegend(visible=False),
+        time_ranges=_all_data(),
+    )
 
 
-def _lanes(layout: Layout, origin: str, name: str, hidden: Sequence[str] = ()) -> rrb.StateTimelineView:
-    contents = [f"+ {origin}/**", *(f"- {path}" for path in hidden)]
+def _lanes(layout: Layout, name: str, paths: Sequence[str]) -> rrb.StateTimelineView:
+    """A lane view of exactly ``paths`` (one lane each), on the whole manoeuvre."""
     return rrb.StateTimelineView(
-        origin=origin, name=name, contents=contents, time_view=_whole_manoeuvre(layout.t_end_s),
+        origin="/", name=name, contents=[f"+ {p}" for p in paths], time_view=_whole_manoeuvre(layout.t_end_s),
         time_ranges=_all_data(),
     )  # fmt: skip
 
 
-LANE_SHARE = 0.7
-"""Height of one state lane (with its name above it) against a motion panel's 2.0 (measured on screenshots: a lane
-takes about 40 px of the 1080 px window, a motion panel needs about 110 px to show its ticks)."""
 PANEL_SHARE = 2.0
-
-
+LANE_SHARE = 0.8
+"""Height of one state lane (its label above it) against a motion panel's 2.0 (measured on screenshots: a lane
+with its label takes about 40 px of the window; a motion panel needs about 110 px to show its ticks)."""
 LANE_VIEW_SHARE = 1.2
-"""A lane view's title bar and time axis, against a motion panel's 2.0: with it one lane shows whole in a 720 px
-window (screenshots of the Columbia aerobatics at 1280x720: with 0.7 only the axis showed)."""
+"""A lane view's title bar and time axis, against a motion panel's 2.0."""
+PHASE_VIEW_SHARE = 1.0
+"""The phase lane's view above three motion panels (2.0 each): about 85 px in a 720 px window, the lane whole
+(screenshots at 1280x720 and 1920x1080)."""
 
 
 def lane_share(n_lanes: int) -> float:
@@ -155,21 +161,57 @@ def lane_share(n_lanes: int) -> float:
     return LANE_VIEW_SHARE + LANE_SHARE * n_lanes
 
 
+def _motion_tab(layout: Layout, prefix: str, ranges: Sequence[tuple[float, float]], title: str, name: str
+                ) -> rrb.Horizontal:  # fmt: skip
+    """Two columns, the translational DOFs (surge, sway, heave) and the rotational ones (roll, pitch, yaw), each under
+    the phase lane: each of the six panels gets half the tab's width and twice the height it had in one column of
+    six (with seven washouts those panels got about 75 px and showed a single tick)."""
+    columns = []
+    for part in (slice(0, 3), slice(3, 6)):
+        panels = [_panel(layout, f"/{prefix}/{dof}", f"{title}{dof} [{unit}]", rng)
+                  for (dof, unit), rng in zip(layout.dofs[part], ranges[part], strict=True)]  # fmt: skip
+        if layout.phase_lane is not None:
+            columns.append(rrb.Vertical(_lanes(layout, "Phases", [layout.phase_lane]), *panels,
+                                        row_shares=[PHASE_VIEW_SHARE] + [PANEL_SHARE] * len(panels)))  # fmt: skip
+        else:
+            columns.append(rrb.Vertical(*panels))
+    return rrb.Horizontal(*columns, name=name)
 
+
+def legend_share(n_washouts: int) -> float:
+    """The legend's share of the side column (the Metrics panel has 1 - it): its title bar, axes and margins (about
+    120 px: the legend's box ends some 80 px above the panel's bottom) and 23 px a line (aircraft, every washout, the
+    threshold), for the 620 px side column of a 720 px window (measured on screenshots at 1280x720: sized for a
+    900 px window the last two of nine lines were cut off, with 90 px for the frame the last of eleven), at most 0.65:
+    the legend is as tall as its lines, the rest is the ranking's."""
+    return min(0.65, (120.0 + 23.0 * (n_washouts + 2)) / 620.0)
+
+
+def usage_columns(n_washouts: int, n_panels: int) -> int:
+    """Columns of the envelope tab's usage grid: two, three with more than six washouts and more than four panels
+    (their lanes need the height: at 1280x720 ten lanes need about 445 px of the tab's 610)."""
+    return 3 if n_washouts > 6 and n_panels > 4 else 2
+
+
+SIDE_SHARE = 1.3
+"""The side column's width against the tabs' 3: about 390 px in a 1280 px window, as wide as the ranking table with
+its recovered column (at 1.1 that column was cut off)."""
 
 
 def build_blueprint(layout: Layout) -> rrb.Blueprint:
-    """The review layout (see the module docstring); tabs: perceived, raw, envelope, events, Atlas (one tab per
-    washout inside): the events tab stays in sight with ten washouts."""
+    """The review layout (module docstring). Tabs: perceived, false cues, raw motion, envelope, the 3D view, events,
+    the platform per washout (one tab per washout inside): seven tabs whatever the number of washouts, the events tab
+    in sight in a 1280 px window. Beside them: the legend and the Metrics panel (the ranking and the ceiling)."""
     eye, target = layout.camera
-    n_legend = len(layout.washouts) + 2  # the aircraft, every washout, the threshold
+    platform = layout.platform_name
+    scene = rrb.Spatial3DView(
+        origin="/world",
+        name=f"Aircraft (from its initial heading) and {platform} cockpits",
+        eye_controls=rrb.EyeControls3D(kind="Orbital", position=eye, look_target=target, eye_up=(0.0, 0.0, -1.0)),
+        line_grid=rrb.LineGrid3D(visible=False),
+    )
+    legend_part = legend_share(len(layout.washouts))
     side = rrb.Vertical(
-        rrb.Spatial3DView(
-            origin="/world",
-            name="Aircraft (from its initial heading) and Atlas cockpits",
-            eye_controls=rrb.EyeControls3D(kind="Orbital", position=eye, look_target=target, eye_up=(0.0, 0.0, -1.0)),
-            line_grid=rrb.LineGrid3D(visible=False),
-        ),
         rrb.TimeSeriesView(
             origin="/legend",
             name="Legend",
@@ -178,62 +220,43 @@ def build_blueprint(layout: Layout) -> rrb.Blueprint:
             plot_legend=rrb.PlotLegend(corner="LeftTop", visible=True),
             time_ranges=_all_data(),
         ),
-        rrb.TextDocumentView(origin="/metrics", name="Metrics: ranking and metrics"),
-        row_shares=[2.2, 0.9 + 0.26 * n_legend, 3.6],  # the legend as tall as its lines, the rest for the tables
+        rrb.TextDocumentView(origin="/metrics", name="Metrics: ranking, ceiling and metrics"),
+        row_shares=[legend_part, 1.0 - legend_part],
     )
-    phase_only = [*layout.hidden_lanes, *layout.cue_lanes]  # the motion tabs: the phase lane, the panels the room
-    perceived = rrb.Vertical(
-        _lanes(layout, "/lanes", "Phases", phase_only),
-        *_stack(layout, "perceived", layout.perceived_ranges, "perceived "),
-        row_shares=[lane_share(1)] + [PANEL_SHARE] * len(layout.dofs),
-        name="Perceived",
+    perceived = _motion_tab(layout, "perceived", layout.perceived_ranges, "perceived ", "Perceived")
+    raw = _motion_tab(layout, "raw", layout.raw_ranges, "", "Raw motion")
+    phase = [layout.phase_lane] if layout.phase_lane is not None else []
+    false_cues = rrb.Vertical(
+        *([_lanes(layout, "Phases", phase)] if phase else []),
+        _lanes(layout, "False cues (one lane per washout: the DOFs felt falsely)", layout.cue_lanes),
+        row_shares=([PHASE_VIEW_SHARE] if phase else []) + [lane_share(len(layout.cue_lanes))],
+        name="False cues",
     )
-    false_cues = _lanes(layout, "/lanes", "False cues", layout.hidden_lanes)  # phases, a lane per washout
-    raw = rrb.Vertical(
-        _lanes(layout, "/lanes", "Phases", phase_only),
-        *_stack(layout, "raw", layout.raw_ranges, ""),
-        row_shares=[lane_share(1)] + [PANEL_SHARE] * len(layout.dofs),
-        name="Raw motion",
-    )
-    usage = [
-        rrb.TimeSeriesView(
-            origin=f"/envelope/{q}",
-            name=f"{q}: max |axis| / limit ({limit})",
-            axis_x=_whole_manoeuvre(layout.t_end_s),
-            axis_y=rrb.ScalarAxis(range=(0.0, 1.15)),
-            plot_legend=rrb.PlotLegend(visible=False),  # the colours are those of the one legend
-            time_ranges=_all_data(),
-        )
-        for (q, _), limit in zip(layout.envelope_quantities, layout.limits_text, strict=True)
-    ]
+    usage = [_panel(layout, u.origin, u.title, u.y_range) for u in layout.usage]
+    columns = usage_columns(len(layout.washouts), len(usage))
+    rows = -(-len(usage) // columns)
     envelope = rrb.Vertical(
-        _lanes(layout, "/limits", "Limits reached (one lane per washout and limit kind)"),
-        *usage,
-        row_shares=[1.0 + 0.45 * len(layout.limit_lanes) + 0.4 * len(layout.washouts)] + [PANEL_SHARE] * len(usage),
-        name="Platform envelope",
+        _lanes(layout, "Limits held (one lane per washout)", layout.limit_lanes),
+        *([rrb.Grid(*usage, grid_columns=columns)] if usage else []),
+        row_shares=[lane_share(len(layout.limit_lanes))] + ([PANEL_SHARE * rows] if usage else []),
+        name=f"{platform} envelope",
     )
     per_washout = [
         rrb.Grid(
             *[
-                rrb.TimeSeriesView(
-                    origin=f"/platform/{w}/{q}",
-                    name=f"{w}: {q} [{unit}] ({axes})",
-                    axis_x=_whole_manoeuvre(layout.t_end_s),
-                    plot_legend=rrb.PlotLegend(visible=False),
-                    time_ranges=_all_data(),
-                )
-                for q, unit in layout.envelope_quantities
+                _panel(layout, f"/platform/{w}/{q}", f"{w}: {q} [{unit}] ({axes})", None)
+                for q, unit in layout.platform_quantities
                 for axes in ["w1 red, w2 green, w3 blue" if q == "wheels" else "x red, y green, z blue"]
             ],
             grid_columns=2,
-            name=f"Atlas {w}",
+            name=f"{platform} {w}",
         )
         for w in layout.washouts
     ]
     enc = rrb.encodings
     events = rrb.TextLogView(
         origin="/events",
-        name="Phases, limit and false-cue events",
+        name="Events",
         columns=rrb.archetypes.TextLogColumns(
             timeline_columns=[enc.TimelineColumn("time")],
             text_log_columns=[
@@ -243,10 +266,11 @@ def build_blueprint(layout: Layout) -> rrb.Blueprint:
             ],
         ),
     )
-    atlas = rrb.Tabs(*per_washout, active_tab=0, name="Atlas per washout")
-    tabs = rrb.Tabs(perceived, false_cues, raw, envelope, events, atlas, active_tab=0)
+    platforms = rrb.Tabs(*per_washout, active_tab=0, name=f"{platform} per washout")
+    scene_tab = rrb.Vertical(scene, name="3-D view")  # the view's own title is too long for a tab
+    tabs = rrb.Tabs(perceived, false_cues, raw, envelope, scene_tab, events, platforms, active_tab=0)
     return rrb.Blueprint(
-        rrb.Horizontal(tabs, side, column_shares=[3, 1.4]),
+        rrb.Horizontal(tabs, side, column_shares=[3, SIDE_SHARE]),
         rrb.BlueprintPanel(state="collapsed"),
         rrb.SelectionPanel(state="collapsed"),
         rrb.TimePanel(state="collapsed", timeline="time", play_state="paused"),

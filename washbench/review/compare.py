@@ -192,19 +192,6 @@ def _send_pair(
     washouts_a = [n for n in names_a if n != AIRCRAFT]
     washouts_b = [n for n in names_b if n != AIRCRAFT]
     names, colors, widths, cols, tols = [], [], [], [], []
-    if aircraft and AIRCRAFT in names_a:
-        i_a = names_a.index(AIRCRAFT)
-        ac_a = line_a(i_a)
-        same = AIRCRAFT not in names_b
-        if not same:
-            i_b = names_b.index(AIRCRAFT)
-            ac_b = line_b(i_b)
-            same = bool(np.all(np.abs(ac_a - ac_b) <= tol_a[i_a] + tol_b[i_b] + 1e-12 * np.abs(ac_a)))
-        names += ["aircraft"] if same else [f"{la}: aircraft", f"{lb}: aircraft"]
-        colors += [series_color(AIRCRAFT)] if same else [series_color(AIRCRAFT), _washed(series_color(AIRCRAFT))]
-        widths += [AIRCRAFT_WIDTH] if same else [AIRCRAFT_WIDTH, AIRCRAFT_WIDTH]
-        cols += [ac_a] if same else [ac_a, ac_b]
-        tols += [tol_a[i_a]] if same else [tol_a[i_a], tol_b[i_b]]
     for w in washouts_a:
         names.append(f"{la}: {w}")
         colors.append(series_color(w, washouts_a))
@@ -217,8 +204,23 @@ def _send_pair(
         widths.append(WASHOUT_WIDTH)
         cols.append(line_b(names_b.index(w)))
         tols.append(tol_b[names_b.index(w)])
+    n_washouts = len(names)
+    if aircraft and AIRCRAFT in names_a:  # last: the viewer draws it on top of the washouts (as in a recording)
+        i_a = names_a.index(AIRCRAFT)
+        ac_a = line_a(i_a)
+        same = AIRCRAFT not in names_b
+        if not same:
+            i_b = names_b.index(AIRCRAFT)
+            ac_b = line_b(i_b)
+            same = bool(np.all(np.abs(ac_a - ac_b) <= tol_a[i_a] + tol_b[i_b] + 1e-12 * np.abs(ac_a)))
+        names += ["aircraft"] if same else [f"{la}: aircraft", f"{lb}: aircraft"]
+        colors += [series_color(AIRCRAFT)] if same else [series_color(AIRCRAFT), _washed(series_color(AIRCRAFT))]
+        widths += [AIRCRAFT_WIDTH] if same else [AIRCRAFT_WIDTH, AIRCRAFT_WIDTH]
+        cols += [ac_a] if same else [ac_a, ac_b]
+        tols += [tol_a[i_a]] if same else [tol_a[i_a], tol_b[i_b]]
     style = rr.SeriesLines(colors=colors, names=names, widths=widths, aggregation_policy=aggregation)
     rec.log(entity, style, rr.AnyValues(interpolation_tolerance=np.array(tols)), static=True)
     time = rr.TimeColumn(TIMELINE, duration=t_ns.astype("timedelta64[ns]"))
     rec.send_columns(entity, indexes=[time], columns=rr.Scalars.columns(scalars=np.column_stack(cols)))
-    return names, colors, widths
+    legend = list(range(n_washouts, len(names))) + list(range(n_washouts))  # the legend: the aircraft first
+    return [names[i] for i in legend], [colors[i] for i in legend], [widths[i] for i in legend]

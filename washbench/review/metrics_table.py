@@ -1,7 +1,9 @@
 """The metric tables of one run as Markdown, for the recording's Metrics panel (a narrow column beside the plots).
 
 First the ranking (rank, washout, score by the run's rule, lower is better; the oracle bound last, scored and not
-ranked: a reference, not a washout), then for each metric (NPC, integral of |error|, max |error|) a table with one
+ranked: a reference, not a washout) and, when the bound ran, the ceiling (the least score any motion of the platform
+can reach on this flight, ``ceiling.csv``) as the table's last row with each washout's share recovered between a
+still platform and the ceiling; then for each metric (NPC, integral of |error|, max |error|) a table with one
 row per washout and one column per DOF: the width does not grow with the number of washouts (with seven the
 washout-by-column layout ran off the panel). The best washout per DOF is in bold; the bound, a reference, is in
 italics and never bold. Numbers have four significant digits. How much better than small-angle each washout is
@@ -11,7 +13,8 @@ italics and never bold. Numbers have four significant digits. How much better th
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from typing import Any
 
 from washbench.analysis.metrics import DOFS
 from washbench.analysis.ranking import BOUND_WASHOUT, RankRow
@@ -27,25 +30,53 @@ def _num(x: float) -> str:
     return "" if math.isnan(x) else f"{x:.4g}"
 
 
-def _ranking_lines(ranking: Sequence[RankRow], rule_label: str) -> list[str]:
-    lines = ["", f"**Ranking** by {rule_label}; lower is better", "", "| rank | washout | score |", "|---|---|---|"]
+def _recovered(x: float | None) -> str:
+    return "" if x is None or not math.isfinite(x) else f"{100.0 * x:.0f} %"
+
+
+def _ranking_lines(ranking: Sequence[RankRow], rule_label: str, ceiling: Mapping[str, Any] | None = None
+                   ) -> list[str]:  # fmt: skip
+    """The ranking table; with ``ceiling`` (run.json's ``bound`` record) a column of the share recovered and the
+    ceiling as the last row."""
+    score = ((ceiling or {}).get("ceiling") or {}).get("score")
+    recovered = (ceiling or {}).get("recovered") or {}
+    with_ceiling = isinstance(score, int | float) and math.isfinite(score)
+    head = "| rank | washout | score | recovered |" if with_ceiling else "| rank | washout | score |"
+    lines = ["", f"**Ranking** by {rule_label}; lower is better", "", head, "|---" * (head.count("|") - 1) + "|"]
     for r in ranking:
+        got = _recovered((recovered.get(r.washout) or {}).get("score")) if with_ceiling else None
+        extra = f" {got} |" if with_ceiling else ""
         if r.washout == BOUND_WASHOUT:
-            lines.append(f"| - | *{r.washout} (oracle bound, not ranked)* | *{_num(r.score)}* |")
+            shown = f" *{got}* |" if with_ceiling and got else extra
+            lines.append(f"| - | *{r.washout}* (not ranked) | *{_num(r.score)}* |{shown}")
         else:
-            lines.append(f"| {r.rank}{' (tie)' if r.tied else ''} | {r.washout} | {_num(r.score)} |")
+            lines.append(f"| {r.rank}{' (tie)' if r.tied else ''} | {r.washout} | {_num(r.score)} |{extra}")
+    if with_ceiling:
+        lines.append(f"| - | **ceiling** | **{_num(float(score))}** | 100 % |")
+        lines += ["", "Ceiling: the least score any motion of the platform can reach on this flight (no washout scores "
+                  "lower; report.md explains it). Recovered: the share of what a platform standing still leaves "
+                  "that the washout recovers (100 %: the ceiling, 0 %: no better than standing still, below 0: "
+                  "worse)."]  # fmt: skip
+    if any(r.washout == BOUND_WASHOUT for r in ranking):
+        lines += ["", "*bound*: the oracle bound's replay, planned with the whole flight known: a reference, not "
+                  "ranked."]  # fmt: skip
     return lines
 
 
 def metrics_table_markdown(
-    title: str, rows: Sequence[MetricRow], ranking: Sequence[RankRow] = (), rule_label: str = "score"
+    title: str,
+    rows: Sequence[MetricRow],
+    ranking: Sequence[RankRow] = (),
+    rule_label: str = "score",
+    ceiling: Mapping[str, Any] | None = None,
 ) -> str:
-    """Markdown: a heading, the ranking (when given), and one washout-by-DOF table per metric."""
+    """Markdown: a heading, the ranking (when given; with the ceiling when ``ceiling``, run.json's ``bound``
+    record, is given), and one washout-by-DOF table per metric."""
     washouts = list(dict.fromkeys(r.washout for r in rows))
     by = {(r.washout, r.dof): r for r in rows}
     lines = [f"# {title}"]
     if ranking:
-        lines += _ranking_lines(ranking, rule_label)
+        lines += _ranking_lines(ranking, rule_label, ceiling)
     lines += ["", "Perceived motion of each simulator pilot against the aircraft pilot's; lower is better. Best "
               "washout per DOF in bold (the oracle bound, in italics, is a reference)."]  # fmt: skip
     for metric in ("npc", "integral_error", "max_error"):

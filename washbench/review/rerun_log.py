@@ -4,18 +4,22 @@ A recording holds, on one timeline named ``time`` (a duration, seconds since the
 the nanosecond):
 
 - ``/perceived/<dof>``: perceived motion in one degree of freedom (surge, sway, heave in m/s^2; roll, pitch, yaw in
-  deg/s), one row per recorded step with one scalar per source: the aircraft pilot first, then each washout's
-  simulator pilot in the order of ``RecordingData.washouts`` (:func:`sources`); ``/perceived/<dof>/threshold`` the
+  deg/s), one row per recorded step with one scalar per source: each washout's simulator pilot in the order of
+  ``RecordingData.washouts``, then the aircraft pilot (:func:`sources`: the viewer draws a panel's lines in that order,
+  so the reference lies on top of a washout that follows it); ``/perceived/<dof>/threshold`` the
   perception threshold as two lines (+-threshold around 0, around -g for heave);
 - ``/raw/<dof>``: the same layout for the unperceived specific force and angular velocity;
-- ``/envelope/<quantity>``: platform envelope usage, max over the three axes of |value| / limit, one scalar per
-  washout (``quantity`` in position, velocity, acceleration, wheels), drawn with Max aggregation, and the limit line
-  ``/envelope/<quantity>/limit`` at 1;
+- ``/envelope/<quantity>``: platform envelope usage, one scalar per washout, drawn with Max aggregation, and the
+  limit line ``/envelope/<quantity>/limit`` at 1 (:func:`usage_panels`): max over the three axes of |value| / limit
+  for position, velocity, acceleration and wheels, the cockpit's |omega| / rate limit (``rate``, the Atlas), a rig's
+  angles / its stops (``angle``); ``/envelope/tilt_rate_held``: the seconds each washout has been held at its
+  tilt-rate limit so far (no limit line);
 - ``/platform/<washout>/<quantity>/axes``: the platform's stage position, velocity, acceleration (NED, SI) and
-  omni-wheel speeds (rad/s), three scalars per row, with ``limit_max`` and ``limit_min`` lines;
-- ``/lanes/0_phase`` (flight phases) and ``/lanes/<i>_<washout>`` (the limits a washout is held at, joined by "+";
-  i = 1, 2, ... in washout order, as the viewer sorts lanes by name): state lanes; ``/limits/<i>_<washout>/<kind>``:
-  one entity per washout with one lane (instance) per limit kind it ever reaches;
+  omni-wheel speeds (rad/s), three scalars per row, with ``limit_max`` and ``limit_min`` lines where the platform has
+  that limit;
+- state lanes, each labelled by the viewer with its path: ``/phase`` (flight phases), ``/limits/<i>_<washout>`` (the
+  limits a washout is held at, joined by "+") and ``/false_cues/<i>_<washout>`` (the DOFs felt falsely); i = 1, 2, ...
+  in washout order, as the viewer sorts lanes by name;
 - ``/world/...``: the 3D scene (:mod:`washbench.review.scene3d`);
 - ``/events/phases`` and ``/events/saturation``: text log entries at phase starts and limit onsets, each text
   starting with its time (the viewer's time column is narrow);
@@ -39,6 +43,7 @@ sample; the sources of one panel share one row (one time and one row id for all 
 from __future__ import annotations
 
 import contextlib
+import math
 import os
 import uuid
 from collections.abc import Mapping, Sequence
@@ -54,16 +59,19 @@ from washbench.io.atomic import atomic_path
 from washbench.perception.thresholds import STANDARD_GRAVITY_MPS2, ZACHARIAS, Thresholds
 from washbench.review import scene3d
 from washbench.review.blueprint import (
+    AIRCRAFT_COLOR,
     AIRCRAFT_WIDTH,
     AXIS_COLORS,
     LIMIT_COLOR,
     THRESHOLD_COLOR,
     WASHOUT_WIDTH,
     Layout,
+    UsageView,
     build_blueprint,
     series_color,
     source_colors,
 )
+from washbench.review.figures import saturation_labels
 from washbench.review.rrd_read import read_component, read_properties, read_scalar_series, read_text_documents
 from washbench.review.thinning import keep_samples
 
@@ -78,7 +86,6 @@ __all__ = [
     "PlatformSeries",
     "RecordingData",
     "envelope_usage_path",
-    "limit_lane_path",
     "motion_tolerance",
     "perceived_path",
     "phase_lane_path",
@@ -173,21 +180,29 @@ class PlatformSeries:
 
 @dataclass(frozen=True)
 class PlatformEnvelope:
-    """Symmetric platform limits (+- value), for envelope-usage plots.
+    """Symmetric platform limits (+- value), for envelope-usage plots; None: the platform has no such limit (no panel
+    and no limit line).
 
-    Each limit is one value for all three axes (wheels) or a per-axis triple (x, y, z NED or w1, w2, w3), e.g. the
-    Atlas stage's ``position_limit_m`` (1.5, 1.5, 1.0).
+    Each translational limit is one value for all three axes (wheels) or a per-axis triple (x, y, z NED or w1, w2,
+    w3), e.g. the Atlas stage's ``position_limit_m`` (1.5, 1.5, 1.0). ``rate_radps``: the limit on the cockpit's
+    |angular velocity| (the Atlas sphere's rate limit), rad/s. ``angle_rad``: a rig's angle limits (roll, pitch,
+    yaw about level; ``math.inf`` for an axis it lacks), rad.
     """
 
-    pos_m: float | tuple[float, float, float]
-    vel_mps: float | tuple[float, float, float]
-    acc_mps2: float | tuple[float, float, float]
+    pos_m: float | tuple[float, float, float] | None
+    vel_mps: float | tuple[float, float, float] | None
+    acc_mps2: float | tuple[float, float, float] | None
     wheel_radps: float | tuple[float, float, float] | None  # None: a platform without wheels (no wheels panel)
     sphere_diameter_m: float = 2.9  # drawn in the 3D view (a hexapod: its base's diameter, for the spacing)
+    rate_radps: float | None = None
+    angle_rad: tuple[float, float, float] | None = None
 
     def axes(self, fname: str) -> np.ndarray:
-        """The limit ``fname`` (e.g. "pos_m") as a per-axis array (3,)."""
-        return np.broadcast_to(np.asarray(getattr(self, fname), dtype=np.float64), (3,)).copy()
+        """The limit ``fname`` (e.g. "pos_m") as a per-axis array (3,); zeros where the platform has none."""
+        value = getattr(self, fname)
+        if value is None:
+            return np.zeros(3)
+        return np.broadcast_to(np.asarray(value, dtype=np.float64), (3,)).copy()
 
 
 @dataclass(frozen=True)
@@ -209,6 +224,8 @@ class RecordingData:
     metrics_markdown: str
     thresholds: Thresholds = ZACHARIAS
     hexapod: HexapodDrawing | None = None  # a hexapod's joints: drawn with its legs instead of the Atlas
+    platform: str = "atlas"  # the platform's kind: atlas, hexapod, rig or a plugin's (the 3D drawing, limit names)
+    platform_name: str = "Atlas"  # the word the tab and view titles use ("Atlas", "Hexapod", "Rig", a plugin's kind)
 
 
 @dataclass(frozen=True)
@@ -223,8 +240,15 @@ class HexapodDrawing:
 
 
 def envelope_quantities(data: RecordingData) -> tuple[tuple[str, str, str], ...]:
-    """The :data:`ENVELOPE_QUANTITIES` this recording's platform has (no wheels on a hexapod)."""
+    """The :data:`ENVELOPE_QUANTITIES` this recording's platform has a limit on (no wheels on a hexapod, no stage on a
+    rig without heave or a plugin without an envelope)."""
     return tuple(q for q in ENVELOPE_QUANTITIES if getattr(data.envelope, q[1]) is not None)
+
+
+def platform_quantities(data: RecordingData) -> tuple[tuple[str, str, str], ...]:
+    """The quantities of each washout's platform tab: position, velocity and acceleration whatever the platform (a
+    limit line where it has one), the wheels on the Atlas."""
+    return tuple(q for q in ENVELOPE_QUANTITIES if q[1] != "wheel_radps" or data.envelope.wheel_radps is not None)
 
 
 # ---------------------------------------------------------------------------------------------------------------------
@@ -252,30 +276,28 @@ def platform_path(washout: str, quantity: str) -> str:
 
 
 def _lane_name(data: RecordingData, washout: str) -> str:
-    """``<i>_<washout>``, i = 1, 2, ... in data order, zero-padded: the viewer sorts lanes by name."""
+    """``<i>_<washout>``, i = 1, 2, ... in data order, zero-padded: the viewer sorts lanes by name and labels each with
+    its entity path, so a lane's path is a group word and this name (``/false_cues/1_small-angle``)."""
     names = list(data.washouts)
     width = len(str(len(names)))
     return f"{names.index(washout) + 1:0{width}d}_{washout}"
 
 
 def phase_lane_path() -> str:
-    """State lane of the flight phases (sorted first among the lanes)."""
-    return "/lanes/0_phase"
+    """State lane of the flight phases (its own view above the others: the viewer labels it ``/phase``)."""
+    return "/phase"
 
 
 def washout_lane_path(data: RecordingData, washout: str) -> str:
-    """State lane of the limits ``washout`` is held at (joined by "+"), ordered as the washouts."""
-    return f"/lanes/{_lane_name(data, washout)}"
-
-
-def limit_lane_path(data: RecordingData, washout: str) -> str:
-    """State lanes of one washout's limits: one lane (instance) per limit kind it reaches, in data order."""
+    """State lane of the limits ``washout`` is held at (the kinds joined by "+"), ordered as the washouts."""
     return f"/limits/{_lane_name(data, washout)}"
 
 
 def sources(data: RecordingData) -> list[str]:
-    """The instance order of the perceived and raw entities: ``["aircraft", *washouts]``."""
-    return [AIRCRAFT, *data.washouts]
+    """The instance order of the perceived and raw entities: ``[*washouts, "aircraft"]``. The viewer draws the lines
+    of a panel in instance order: the aircraft pilot's, the reference every washout is compared with, last, on top
+    (drawn first, a washout that followed it hid it)."""
+    return [*data.washouts, AIRCRAFT]
 
 
 def _axis_names(quantity: str) -> tuple[str, str, str]:
@@ -324,16 +346,17 @@ def _check(data: RecordingData) -> int:
             _check_array(f"{src}.{fname}", getattr(m, fname), (n, 3))
         _check_array(f"{src}.q", m.q, (n, 4))
     for w, p in data.platforms.items():
-        for _, fname, _ in envelope_quantities(data):
+        for _, fname, _ in platform_quantities(data):
             _check_array(f"platforms[{w}].{fname}", getattr(p, fname), (n, 3))
         for kind, flags in p.saturated.items():
             _check_array(f"platforms[{w}].saturated[{kind}]", flags, (n,), "b")
-    for fname in [f for _, f, _ in envelope_quantities(data)] + ["sphere_diameter_m"]:
+    extra = [f for f in ("rate_radps", "angle_rad") if getattr(data.envelope, f) is not None]
+    for fname in [f for _, f, _ in envelope_quantities(data)] + ["sphere_diameter_m", *extra]:
         limit = np.asarray(getattr(data.envelope, fname))
         if (
             limit.shape not in ((), (3,))
             or limit.dtype.kind not in "fiu"
-            or not np.all(np.isfinite(limit) & (limit > 0))
+            or not np.all((np.isfinite(limit) | (fname == "angle_rad")) & (limit > 0))
         ):
             raise ValueError(f"envelope.{fname}: expected a positive number or three, got {limit.tolist()!r}")
     for name, t0, t1 in data.phases:
@@ -407,9 +430,20 @@ def _span(values: list[np.ndarray], extra: tuple[float, ...] = ()) -> tuple[floa
     return (lo - pad, hi + pad)
 
 
+def labelled_span(span: tuple[float, float]) -> tuple[float, float]:
+    """``span`` widened, if need be, to hold two multiples of the power of ten below its height: the viewer labels
+    only gridlines at powers of ten that are far enough apart, and a panel from -8.4 to 7.4 deg/s (gridlines 10
+    apart; 1 apart too dense) showed a single "0" tick. Widened to the next multiples outward (-10 to 10)."""
+    lo, hi = span
+    step = 10.0 ** math.floor(math.log10(hi - lo))
+    if math.floor(hi / step) - math.ceil(lo / step) >= 1:  # two multiples inside already
+        return span
+    return (min(lo, math.floor(lo / step) * step), max(hi, math.ceil(hi / step) * step))
+
+
 def _dof_columns(data: RecordingData) -> tuple[list[np.ndarray], list[np.ndarray]]:
     """Per DOF, (N, sources) arrays of perceived and raw motion in the recording's units."""
-    every = [data.aircraft, *data.washouts.values()]
+    every = [*data.washouts.values(), data.aircraft]  # in sources() order
     perceived, raw = [], []
     for _dof, sig, axis, _unit in DOFS:
         if sig == "f":
@@ -438,8 +472,8 @@ def _send_motion(
     layout: Layout,
 ) -> None:
     names = sources(data)
-    colors = source_colors(list(data.washouts))
-    widths = [AIRCRAFT_WIDTH] + [WASHOUT_WIDTH] * len(data.washouts)
+    colors = [*source_colors(list(data.washouts))[1:], AIRCRAFT_COLOR]
+    widths = [WASHOUT_WIDTH] * len(data.washouts) + [AIRCRAFT_WIDTH]
     t_s = np.asarray(data.t_s, dtype=np.float64)
     lines = _threshold_lines(data.thresholds)
     tol_p = motion_tolerance(data.thresholds, layout.perceived_ranges)
@@ -457,35 +491,91 @@ def _send_motion(
         )
 
 
-def _usage(data: RecordingData) -> dict[str, np.ndarray]:
-    """Envelope usage per quantity: (N, washouts) max over the axes of |value| / limit."""
-    out = {}
-    for q, fname, _unit in envelope_quantities(data):
-        limit = data.envelope.axes(fname)
-        cols = []
-        for w in data.washouts:
-            ratio = np.abs(np.asarray(getattr(data.platforms[w], fname), dtype=np.float64)) / limit
-            # max over the three axes column by column: np.max(ratio, axis=1) is several times slower on (N, 3)
-            cols.append(np.maximum(np.maximum(ratio[:, 0], ratio[:, 1]), ratio[:, 2]))
-        out[q] = np.column_stack(cols)
-    return out
+@dataclass(frozen=True)
+class UsagePanel:
+    """One panel of the envelope tab: ``values`` (N, washouts) at ``/envelope/<key>``; ``limit``: the line at 1 (a
+    usage against a limit) or None (a time held, s)."""
+
+    key: str
+    title: str
+    values: np.ndarray
+    limit: str | None
 
 
-def _send_platforms(rec: rr.RecordingStream, data: RecordingData, usage: dict[str, np.ndarray]) -> None:
+def _max_ratio(values: np.ndarray, limit: np.ndarray) -> np.ndarray:
+    """max over the three axes of |value| / limit, column by column (np.max(axis=1) is several times slower)."""
+    ratio = np.abs(np.asarray(values, dtype=np.float64)) / limit
+    return np.maximum(np.maximum(ratio[:, 0], ratio[:, 1]), ratio[:, 2])
+
+
+def _zyx_angles(q: np.ndarray) -> np.ndarray:
+    """Roll, pitch, yaw (ZYX Euler angles, rad) of body -> NED quaternions (N, 4), scalar first: a rig's gimbals."""
+    w, x, y, z = (np.asarray(q, dtype=np.float64)[:, i] for i in range(4))
+    roll = np.arctan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
+    pitch = np.arcsin(np.clip(2.0 * (w * y - z * x), -1.0, 1.0))
+    yaw = np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+    return np.column_stack([roll, pitch, yaw])
+
+
+def usage_panels(data: RecordingData) -> list[UsagePanel]:
+    """The envelope tab's panels (short titles: with nine washouts a panel is a third of the tab wide), each one line
+    per washout: the stage's position, velocity and acceleration and the wheel speeds against their limits (max over
+    the axes of |value| / limit); the cockpit's rate against its limit
+    (the Atlas sphere: |omega| / rate limit); a rig's angles against its stops; and the time each washout has been
+    held at its tilt-rate limit so far (the limit washouts reach most: a rate inside the washout, not a platform
+    quantity, so its time held, from the ``tilt_rate`` flags)."""
+    env, washouts = data.envelope, list(data.washouts)
+    t_s = np.asarray(data.t_s, dtype=np.float64)
+    panels = []
+    for q, fname, unit in envelope_quantities(data):
+        limit = env.axes(fname)
+        values = np.column_stack([_max_ratio(getattr(data.platforms[w], fname), limit) for w in washouts])
+        panels.append(UsagePanel(q, f"{q} / limit", values, f"+-{_limit_text(limit)} {unit}"))
+    if env.rate_radps is not None:
+        rate = float(env.rate_radps)
+        values = np.column_stack([np.linalg.norm(np.asarray(data.washouts[w].omega_radps, dtype=np.float64), axis=1)
+                                  / rate for w in washouts])  # fmt: skip
+        panels.append(UsagePanel("rate", "cockpit rate / limit", values, f"{np.degrees(rate):.3g} deg/s"))
+    if env.angle_rad is not None:
+        limit = np.asarray(env.angle_rad, dtype=np.float64)
+        values = np.column_stack([_max_ratio(_zyx_angles(data.washouts[w].q), limit) for w in washouts])
+        shown = "/".join("-" if not np.isfinite(v) else f"{np.degrees(v):.3g}" for v in limit)
+        panels.append(UsagePanel("angle", "rig angles / stops", values, f"{shown} deg"))
+    if any("tilt_rate" in data.platforms[w].saturated for w in washouts):
+        dt = float(t_s[1] - t_s[0]) if t_s.size > 1 else 0.0
+        held = [np.cumsum(np.asarray(data.platforms[w].saturated.get("tilt_rate", np.zeros(t_s.size, bool)),
+                                     dtype=np.float64)) * dt for w in washouts]  # fmt: skip
+        panels.append(UsagePanel("tilt_rate_held", "time at tilt-rate limit [s]",
+                                 np.column_stack(held), None))  # fmt: skip
+    return panels
+
+
+def _send_platforms(rec: rr.RecordingStream, data: RecordingData, panels: list[UsagePanel]) -> None:
     t_s = np.asarray(data.t_s, dtype=np.float64)
     washouts = list(data.washouts)
     colors = [series_color(w, washouts) for w in washouts]
-    for q, fname, unit in envelope_quantities(data):
+    widths = [WASHOUT_WIDTH] * len(washouts)
+    for panel in panels:
+        path = envelope_usage_path(panel.key)
+        if panel.limit is not None:
+            _limit_line(rec, f"{path}/limit", t_s, [1.0], [f"limit ({panel.limit})"])
+            _series(rec, path, t_s, panel.values, washouts, colors, widths, ENVELOPE_TOLERANCE, "Max")
+        else:  # a time held: tolerance a tenth of a step
+            dt = float(t_s[1] - t_s[0]) if t_s.size > 1 else 1.0
+            _series(rec, path, t_s, panel.values, washouts, colors, widths, 0.1 * dt, "Max")
+    for q, fname, _unit in platform_quantities(data):
+        has_limit = getattr(data.envelope, fname) is not None
         limit = data.envelope.axes(fname)
         axes = _axis_names(q)
         uniform = bool(np.all(limit == limit[0]))
-        _limit_line(rec, f"/envelope/{q}/limit", t_s, [1.0], [f"limit (+-{_limit_text(limit)} {unit})"])
-        widths = [WASHOUT_WIDTH] * len(washouts)
-        _series(rec, envelope_usage_path(q), t_s, usage[q], washouts, colors, widths, ENVELOPE_TOLERANCE, "Max")
         for w in washouts:
             values = getattr(data.platforms[w], fname)  # (N, 3): N rows of three scalars
-            tol = PLATFORM_DETAIL_TOLERANCE * limit
+            scale = limit if has_limit else np.maximum(np.max(np.abs(np.asarray(values, dtype=np.float64)), axis=0),
+                                                       1e-3)  # fmt: skip
+            tol = PLATFORM_DETAIL_TOLERANCE * scale
             _series(rec, platform_path(w, q), t_s, values, list(axes), list(AXIS_COLORS), [1.5] * 3, tol)
+            if not has_limit:
+                continue
             for sign, end, bound in (("+", "max", limit), ("-", "min", -limit)):
                 line_path = f"/platform/{w}/{q}/limit_{end}"
                 if uniform:  # one line for all axes
@@ -530,17 +620,32 @@ def _rgba(rgb: tuple[int, int, int]) -> int:
 
 
 def _lane_style(
-    rec: rr.RecordingStream, path: str, values: Sequence[str], colors: Sequence[tuple[int, int, int]]
+    rec: rr.RecordingStream,
+    path: str,
+    values: Sequence[str],
+    colors: Sequence[tuple[int, int, int]],
+    labels: Sequence[str] | None = None,
 ) -> None:
-    """The colour of each state value of a lane (static ``StateConfiguration``); "" (a gap) is left out."""
-    pairs = [(v, c) for v, c in zip(values, colors, strict=True) if v]
-    if pairs:
-        colors = np.array([_rgba(c) for _, c in pairs], dtype=np.uint32)  # 0xRRGGBBAA (a list of 3 is ambiguous)
-        rec.log(path, rr.StateConfiguration(values=[v for v, _ in pairs], colors=colors), static=True, strict=True)
+    """The colour (and the text shown, ``labels``) of each state value of a lane (static ``StateConfiguration``);
+    "" (a gap) is left out."""
+    shown = list(labels) if labels is not None else list(values)
+    triples = [(v, c, t) for v, c, t in zip(values, colors, shown, strict=True) if v]
+    if triples:
+        colors = np.array([_rgba(c) for _, c, _ in triples], dtype=np.uint32)  # 0xRRGGBBAA (a list of 3: ambiguous)
+        rec.log(path, rr.StateConfiguration(values=[v for v, _, _ in triples], colors=colors,
+                                            labels=[t for _, _, t in triples]), static=True, strict=True)  # fmt: skip
+
+
+def limit_text(kinds: str, labels: Mapping[str, str]) -> str:
+    """The text a limit lane shows for a state (kinds joined by "+"): the kinds' readable names (``labels``, the
+    figures' :func:`washbench.review.figures.saturation_labels`), joined by " + "."""
+    return " + ".join(labels.get(k, k) for k in kinds.split("+"))
 
 
 def _send_lanes(rec: rr.RecordingStream, data: RecordingData) -> None:
-    """Phase lane, one lane per washout (its limits joined by "+"), one per washout and limit kind; onset events."""
+    """Phase lane; one lane per washout, the limits it is held at joined by "+" (one lane per washout: with seven
+    washouts one lane per washout and kind ran off a 720 px window); limit onset events."""
+    labels = saturation_labels(data.platform)
     t_s = np.asarray(data.t_s, dtype=np.float64)
     n = t_s.size
     if data.phases:
@@ -566,20 +671,12 @@ def _send_lanes(rec: rr.RecordingStream, data: RecordingData) -> None:
                 for s, e in zip(starts, ends, strict=True)
             )
         change = np.flatnonzero(np.diff(code, prepend=0))
-        if kinds:  # one entity per washout, one lane (instance) per kind reached, in a fixed order
-            rows = [[k if code[i] >> j & 1 else "" for j, (k, _) in enumerate(kinds)] for i in change]
-            states = rr.StateChange.columns(state=[x for row in rows for x in row])
-            rec.send_columns(
-                limit_lane_path(data, w),
-                indexes=[_time_column(t_s[change])],
-                columns=states.partition([len(kinds)] * len(rows)),
-                strict=True,
-            )
-            _lane_style(rec, limit_lane_path(data, w), [k for k, _ in kinds], [LIMIT_LANE_COLOR] * len(kinds))
-        change = np.flatnonzero(np.diff(code, prepend=0))
         if change.size:
             states = ["+".join(k for j, (k, _) in enumerate(kinds) if code[i] >> j & 1) for i in change]
             _send_states(rec, washout_lane_path(data, w), t_s, states, change)
+            unique = list(dict.fromkeys(states))
+            _lane_style(rec, washout_lane_path(data, w), unique, [LIMIT_LANE_COLOR] * len(unique),
+                        [limit_text(u, labels) for u in unique])  # fmt: skip
         else:  # an empty lane: never held at a limit
             _send_states(rec, washout_lane_path(data, w), t_s, [""], np.array([0]))
     if onsets:
@@ -594,7 +691,7 @@ def _send_lanes(rec: rr.RecordingStream, data: RecordingData) -> None:
 
 def cue_lane_path(data: RecordingData, washout: str) -> str:
     """State lane of the DOFs in which ``washout``'s simulator pilot feels a false cue (joined by "+")."""
-    return f"/lanes/cues_{_lane_name(data, washout)}"
+    return f"/false_cues/{_lane_name(data, washout)}"
 
 
 def _send_cues(rec: rr.RecordingStream, data: RecordingData) -> None:
@@ -627,7 +724,8 @@ def _send_cues(rec: rr.RecordingStream, data: RecordingData) -> None:
                   for i in change]  # fmt: skip
         _send_states(rec, cue_lane_path(data, w), t_s, states, change)
         unique = list(dict.fromkeys(states))
-        _lane_style(rec, cue_lane_path(data, w), unique, [FALSE_CUE_COLOR] * len(unique))
+        _lane_style(rec, cue_lane_path(data, w), unique, [FALSE_CUE_COLOR] * len(unique),
+                    [u.removeprefix("false: ") for u in unique])  # the lane says "false cues": the DOFs only
     if lines:
         lines.sort(key=lambda item: item[0])
         rec.send_columns(
@@ -656,7 +754,7 @@ def _send_text(rec: rr.RecordingStream, data: RecordingData) -> None:
 
 def _send_legend(rec: rr.RecordingStream, data: RecordingData) -> None:
     """The one legend: a panel of its own (lines outside its y range, so it covers no data)."""
-    names = [*sources(data), "perception threshold"]
+    names = [AIRCRAFT, *data.washouts, "perception threshold"]  # the reference first
     colors = [*source_colors(list(data.washouts)), THRESHOLD_COLOR]
     widths = [AIRCRAFT_WIDTH] + [WASHOUT_WIDTH] * len(data.washouts) + [1.0]
     rec.log("/legend", rr.SeriesLines(colors=colors, names=names, widths=widths), static=True, strict=True)
@@ -669,27 +767,28 @@ def _send_legend(rec: rr.RecordingStream, data: RecordingData) -> None:
     )
 
 
-def _limit_lanes(data: RecordingData) -> list[tuple[str, str]]:
-    """(washout, kind) for every limit kind a washout reaches at least once, in data order."""
-    return [(w, k) for w, p in data.platforms.items() for k, v in p.saturated.items() if np.any(v)]
-
-
-def _layout(data: RecordingData, perceived: list[np.ndarray], raw: list[np.ndarray]) -> Layout:
+def _layout(data: RecordingData, perceived: list[np.ndarray], raw: list[np.ndarray], panels: list[UsagePanel]
+            ) -> Layout:  # fmt: skip
     offsets = scene3d.object_offsets(len(data.washouts), data.envelope.axes("pos_m"), data.envelope.sphere_diameter_m)
     return Layout(
         washouts=tuple(data.washouts),
         dofs=tuple((dof, unit) for dof, _, _, unit in DOFS),
         t_end_s=float(data.t_s[-1]),
         perceived_ranges=tuple(
-            _span([p], (c - th, c + th))
+            labelled_span(_span([p], (c - th, c + th)))
             for p, (c, th) in zip(perceived, _threshold_lines(data.thresholds), strict=True)
         ),
-        raw_ranges=tuple(_span([r]) for r in raw),
-        limit_lanes=tuple(_limit_lanes(data)),
+        raw_ranges=tuple(labelled_span(_span([r])) for r in raw),
         camera=scene3d.camera(offsets, data.envelope.sphere_diameter_m),
-        envelope_quantities=tuple((q, unit) for q, _, unit in envelope_quantities(data)),
-        limits_text=tuple(f"+-{_limit_text(data.envelope.axes(f))} {unit}" for _, f, unit in envelope_quantities(data)),
-        hidden_lanes=tuple(washout_lane_path(data, w) for w in data.washouts),
+        usage=tuple(
+            UsageView(envelope_usage_path(p.key), p.title if p.limit is None else f"{p.title} ({p.limit})",
+                      (0.0, 1.15) if p.limit is not None else _span([p.values], (0.0,)))
+            for p in panels
+        ),
+        platform_quantities=tuple((q, unit) for q, _, unit in platform_quantities(data)),
+        platform_name=data.platform_name,
+        phase_lane=phase_lane_path() if data.phases else None,
+        limit_lanes=tuple(washout_lane_path(data, w) for w in data.washouts),
         cue_lanes=tuple(cue_lane_path(data, w) for w in data.washouts),
     )
 
@@ -770,7 +869,8 @@ def write_recording(path: Path, data: RecordingData, properties: Mapping[str, st
             )
         )
     perceived, raw = _dof_columns(data)
-    layout = _layout(data, perceived, raw)
+    panels = usage_panels(data)
+    layout = _layout(data, perceived, raw, panels)
     blueprint = build_blueprint(layout)
     with atomic_path(path) as tmp:
         rrd = RrdFile(rec, tmp, blueprint)
@@ -779,7 +879,7 @@ def write_recording(path: Path, data: RecordingData, properties: Mapping[str, st
             if props:
                 rec.send_property(PROPERTIES, rr.AnyValues(**props))
             _send_motion(rec, data, perceived, raw, layout)
-            _send_platforms(rec, data, _usage(data))
+            _send_platforms(rec, data, panels)
             _send_lanes(rec, data)
             _send_cues(rec, data)
             scene3d.send_scene(
@@ -792,6 +892,7 @@ def write_recording(path: Path, data: RecordingData, properties: Mapping[str, st
                 data.envelope.axes("pos_m"),
                 float(data.envelope.sphere_diameter_m),
                 data.hexapod,
+                data.platform,
             )
             _send_text(rec, data)
             _send_legend(rec, data)

@@ -1,10 +1,12 @@
-"""The recording's 3D scene: the aircraft and each washout's Atlas cockpit side by side, in one NED frame.
+"""The recording's 3D scene: the aircraft and each washout's platform cockpit side by side (rows of at most
+:data:`MAX_PER_ROW`), in one NED frame.
 
 Every object is the same line shape (fuselage with a nose chevron, wings, tailplane, fin) over a translucent floor
 plate, so roll, pitch and yaw read at a glance and the aircraft and the cockpits point the same way when their
 attitudes agree. The aircraft is shown relative to its initial heading (the cockpits start at yaw 0). Each Atlas
 cockpit sits in its sphere (``envelope.sphere_diameter_m``) and is translated by the stage position inside the stage's
-range box. One label per object. Poses are sent at most at :data:`SCENE_RATE_HZ`: the 3D view shows one instant, and
+range box (a hexapod drawn with its legs, a rig or a plugin's platform as a base and the cockpit at its pose). One
+label per object. Poses are sent at most at :data:`SCENE_RATE_HZ`: the 3D view shows one instant, and
 scrubbing or playing needs no more; of those, only the ones that differ from the last one sent by more than
 :data:`POSE_ANGLE_TOLERANCE_DEG` or :data:`POSE_TRANSLATION_TOLERANCE_M` (the view holds the latest pose), and one at
 least every :data:`POSE_MAX_GAP_S`.
@@ -26,6 +28,7 @@ __all__ = [
     "POSE_TRANSLATION_TOLERANCE_M",
     "SCENE_RATE_HZ",
     "camera",
+    "grid_shape",
     "object_offsets",
     "pose_samples",
     "relative_to_initial_heading",
@@ -95,31 +98,43 @@ def pose_samples(t_s: np.ndarray, q_wxyz: np.ndarray, pos_m: np.ndarray | None =
     return idx[keep_changes(np.column_stack(columns), np.concatenate(tol), gap)]
 
 
-LABEL_ROW_STEP_M = 1.6
-"""Vertical step between the rows of staggered labels in the 3D view, m."""
+MAX_PER_ROW = 4
+"""Objects side by side in one row of the 3D view; more go into rows behind (north of) it. In the 3D tab of a
+1280x720 window four objects a row leave each label about 210 px, more than ``adaptive-large-angle`` needs; eight in
+one row ran their labels into one another."""
 
 
-def label_rows(n_objects: int) -> int:
-    """Rows the objects' labels are staggered over: one up to three objects, two up to six, three beyond (in a
-    1280x720 window the labels of four objects touch; with eight, a label as long as ``adaptive-large-angle`` is
-    wider than two objects' spacing in the side view)."""
-    return 1 if n_objects <= 3 else 2 if n_objects <= 6 else 3
+def grid_shape(n_objects: int) -> tuple[int, int]:
+    """(rows, objects a row): one row up to :data:`MAX_PER_ROW` objects, else as few rows as hold them, filled
+    evenly (eight objects: two rows of four)."""
+    rows = max(1, math.ceil(n_objects / MAX_PER_ROW))
+    return rows, math.ceil(n_objects / rows)
 
 
 def object_offsets(n_washouts: int, travel_m: np.ndarray, diameter_m: float) -> np.ndarray:
-    """Centre of each object (aircraft first, then the washouts) along NED y (east), (1 + n_washouts, 3), metres."""
+    """Centre of each object (aircraft first, then the washouts) (1 + n_washouts, 3), NED, metres: in rows along y
+    (east), at most :data:`MAX_PER_ROW` a row, further rows behind the first (north, away from the camera)."""
     spacing = 2.0 * float(travel_m[1]) + diameter_m + 1.0
-    offsets = np.zeros((1 + n_washouts, 3))
-    offsets[:, 1] = np.arange(1 + n_washouts) * spacing
+    n = 1 + n_washouts
+    _, per_row = grid_shape(n)
+    i = np.arange(n)
+    offsets = np.zeros((n, 3))
+    offsets[:, 0] = (i // per_row) * 2.0 * spacing
+    offsets[:, 1] = (i % per_row) * spacing
     return offsets
 
 
 def camera(offsets: np.ndarray, diameter_m: float) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
-    """Eye and target (NED, m): behind (south of) the row of objects and above it, looking north at its middle."""
-    width = float(offsets[-1, 1] - offsets[0, 1]) + 2.0 * diameter_m
-    centre = 0.5 * float(offsets[0, 1] + offsets[-1, 1])
-    eye = (-0.52 * width, centre, -0.27 * width)
-    return eye, (0.0, centre, 0.0)
+    """Eye and target (NED, m): behind (south of) the rows of objects and above them, looking north at their middle;
+    far enough back that the widest row fits a view about as wide as tall, high enough that a row's labels fall
+    between it and the row in front (screenshots at 1280x720 and 1920x1080)."""
+    width = float(offsets[:, 1].max() - offsets[:, 1].min()) + 2.0 * diameter_m
+    depth = float(offsets[:, 0].max() - offsets[:, 0].min())
+    centre_y = 0.5 * float(offsets[:, 1].min() + offsets[:, 1].max())
+    centre_x = 0.5 * float(offsets[:, 0].min() + offsets[:, 0].max())
+    back = 0.6 * width + 0.4 * depth
+    eye = (centre_x - back, centre_y, -0.6 * back)
+    return eye, (centre_x, centre_y, 0.0)
 
 
 def _shape(size: float) -> list[list[list[float]]]:
@@ -163,10 +178,13 @@ def send_scene(
     travel_m: np.ndarray,
     diameter_m: float,
     hexapod: object | None = None,
+    platform: str = "atlas",
 ) -> None:
     """Log the scene; ``time_of(t_s)`` makes the time column. Quaternions scalar first, body->NED. ``hexapod``
     (:class:`washbench.review.rerun_log.HexapodDrawing`): each washout's platform is that hexapod, drawn with its
-    legs (:func:`_send_hexapod`), instead of the Atlas."""
+    legs (:func:`_send_hexapod`), instead of the Atlas. ``platform``: ``atlas`` (the sphere in its stage's range box),
+    anything else without a hexapod drawing (a rig, a plugin's platform): a base and the cockpit at its pose
+    (:func:`_send_base_and_cockpit`)."""
     washouts = list(washout_q)
     offsets = object_offsets(len(washouts), travel_m, diameter_m)
     half = diameter_m / 2.0
@@ -183,10 +201,9 @@ def send_scene(
         strict=True,
     )
     _log_object(rec, "/world/aircraft/body", half, AIRCRAFT_COLOR)
-    # one label per object, under it (z down), where it hides no shape; staggered over label_rows() rows, so
-    # neighbours' labels do not run into one another when many objects share the view's width
-    rows = label_rows(len(offsets))
-    below = half + 0.5 + LABEL_ROW_STEP_M * (np.arange(len(offsets)) % rows)
+    # one label per object, under it (z down), where it hides no shape; at most MAX_PER_ROW objects a row, so
+    # neighbours' labels do not run into one another (eight in one row did)
+    below = np.full(len(offsets), half + 0.5)
     rec.log(
         "/world/labels",
         rr.Points3D(
@@ -203,6 +220,11 @@ def send_scene(
         for i, w in enumerate(washouts):
             _send_hexapod(rec, time_of, t_s, w, series_color(w, washouts), offsets[i + 1], washout_q[w], stage_pos_m[w],
                           hexapod, half)  # fmt: skip
+        return
+    if platform != "atlas":
+        for i, w in enumerate(washouts):
+            _send_base_and_cockpit(rec, time_of, t_s, w, series_color(w, washouts), offsets[i + 1], washout_q[w],
+                                   stage_pos_m[w], travel_m, half)  # fmt: skip
         return
     for i, w in enumerate(washouts):
         color = series_color(w, washouts)
@@ -280,3 +302,40 @@ def _send_hexapod(
     )
     rec.log(f"{root}/legs", rr.LineStrips3D.from_fields(colors=[(200, 200, 200)], radii=[0.04]), static=True,
             strict=True)  # fmt: skip
+
+
+def _send_base_and_cockpit(
+    rec: rr.RecordingStream,
+    time_of: object,
+    t_s: np.ndarray,
+    washout: str,
+    color: tuple[int, int, int],
+    offset: np.ndarray,
+    q_wxyz: np.ndarray,
+    pos_m: np.ndarray,
+    travel_m: np.ndarray,
+    half: float,
+) -> None:
+    """A platform drawn simply (a rig, a plugin's platform): a grey base plate under the motion reference point
+    (static), a post from it to the cockpit, the travel box when the platform has one, and the cockpit (attitude
+    shape and floor plate) at the pose reached: translated by ``pos_m`` (NED, from neutral) and turned by ``q``."""
+    root = f"/world/platform/{washout}"
+    rec.log(root, rr.Transform3D(translation=offset), static=True, strict=True)
+    below = 0.9 * half  # the base's depth under the motion reference point, m (down is +z)
+    plate = rr.Boxes3D(centers=[[0.0, 0.0, below]], half_sizes=[[0.7 * half, 0.7 * half, 0.04 * half]],
+                       colors=[(*LIMIT_COLOR, 200)], fill_mode="Solid")  # fmt: skip
+    rec.log(f"{root}/base", plate, static=True, strict=True)
+    rec.log(f"{root}/post", rr.LineStrips3D([[[0.0, 0.0, below], [0.0, 0.0, 0.0]]], colors=[LIMIT_COLOR],
+                                            radii=[0.03]), static=True, strict=True)  # fmt: skip
+    if np.any(np.asarray(travel_m) > 1e-2):  # a travel box worth drawing (a rig's heave, a plugin's envelope)
+        rec.log(f"{root}/range", rr.Boxes3D(half_sizes=[np.maximum(travel_m, 1e-2)], colors=[(*LIMIT_COLOR, 160)],
+                                            fill_mode="MajorWireframe"), static=True, strict=True)  # fmt: skip
+    idx = pose_samples(t_s, q_wxyz, pos_m)
+    rec.send_columns(
+        f"{root}/cockpit",
+        indexes=[time_of(t_s[idx])],
+        columns=rr.Transform3D.columns(translation=np.asarray(pos_m, dtype=np.float64)[idx],
+                                       quaternion=quat_wxyz_to_xyzw(np.asarray(q_wxyz, dtype=np.float64)[idx])),
+        strict=True,
+    )  # fmt: skip
+    _log_object(rec, f"{root}/cockpit", 0.8 * half, color)

@@ -236,7 +236,7 @@ def write_outputs(
                     q = recorded_attitude(seg.motion)
                     props = flat_strings(provenance, created) if provenance else None
                     write_run_recording(tmp[RECORDING_FILE], title, seg.motion, result, run.limits, q, [], props,
-                                        run.rank_rule)
+                                        run.rank_rule, bound)
                 done.append((summary, result))
         for seg, (summary, result) in zip(segments, done, strict=True):  # last, as a suite's report: each written
             if not recording:  # atomically once the rest is in place; an earlier recording would mislead

@@ -11,7 +11,6 @@ files again.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -33,7 +32,7 @@ from washbench.errors import WashbenchError
 from washbench.io.provenance import build_provenance, file_record, merge_provenance
 from washbench.io.yamlio import read_yaml_digest
 from washbench.perception.vestibular import VestibularParams, model_params, model_record
-from washbench.platform.model import PlatformModel, platform_kind, resolve_platform
+from washbench.platform.model import PlatformModel, resolve_platform
 from washbench.runs.outputs import DEFAULT_OUTPUTS, Outputs
 from washbench.runs.rank_rule import rank_rule_from_data
 
@@ -121,9 +120,6 @@ def load_options(
     if washouts is None and not variants:  # the default set: those of its washouts that can drive this platform
         chosen = tuple(w for w in chosen if platform_refusal(w, limits) is None)
     check_platform(chosen, limits)  # a washout named that cannot drive this platform: refused before anything is flown
-    if outputs.recording and platform_kind(limits) not in ("atlas", "hexapod"):
-        # the recording draws the Atlas (sphere, stage, omni-wheels) or a hexapod only: not written for another yet
-        outputs = dataclasses.replace(outputs, recording=False)
     rule = rank_rule_from_data(params_path, data, lines, rank_by)
     vestibular_params = model_params(vestibular)
     provenance = build_provenance(

@@ -157,7 +157,7 @@ def write_cued_folder(
         title = f"{summary.aircraft} / {summary.manoeuvre}"
         props = flat_strings(provenance, str((extra or {}).get("created_utc") or "")) if provenance else None
         write_run_recording(folder / RECORDING_FILE, title, motion, result, options.limits, aircraft_q, phases, props,
-                            options.rank_rule)
+                            options.rank_rule, bound)
     ac = result.perceived["aircraft"]
     summary = dataclasses.replace(
         summary,

@@ -64,12 +64,17 @@ class RunSummary:
 
 
 def metrics_markdown(
-    title: str, rows: list[MetricRow], motion: Mapping[str, float] | None = None, rule: RankRule = DEFAULT_RULE
+    title: str,
+    rows: list[MetricRow],
+    motion: Mapping[str, float] | None = None,
+    rule: RankRule = DEFAULT_RULE,
+    ceiling: Mapping[str, Any] | None = None,
 ) -> str:
-    """The ranking (when ``motion``, the aircraft pilot's perceived motion per DOF, is given) and the metric tables of
-    one run as Markdown, washout by DOF (for the recording's Metrics panel)."""
+    """The ranking (when ``motion``, the aircraft pilot's perceived motion per DOF, is given; with the ceiling when
+    ``ceiling``, run.json's ``bound`` record, is) and the metric tables of one run as Markdown, washout by DOF (for
+    the recording's Metrics panel)."""
     ranking = rank(rows, motion, rule) if motion is not None else []
-    return metrics_table_markdown(title, rows, ranking, rule.label())
+    return metrics_table_markdown(title, rows, ranking, rule.label(), ceiling)
 
 
 #: The file that marks a folder as a ``washbench run`` result (only such a folder is ever replaced).
@@ -117,11 +122,13 @@ def write_run_recording(
     phases: list[tuple[str, float, float]],
     properties: dict[str, str] | None = None,
     rule: RankRule = DEFAULT_RULE,
+    ceiling: Mapping[str, Any] | None = None,
 ) -> None:
     """The recording of one result folder (``run`` and ``cue`` alike): the one call of the recording writer.
 
     ``aircraft_q`` (N, 4) the aircraft's attitude, body -> NED, scalar first; ``phases`` (name, start, end) [s];
-    ``properties``: the provenance as flat strings (:func:`washbench.io.provenance.flat_strings`).
+    ``properties``: the provenance as flat strings (:func:`washbench.io.provenance.flat_strings`); ``ceiling``:
+    run.json's ``bound`` record (:func:`washbench.runs.bound_stage.bound_outputs`), when the bound ran.
     """
     from washbench.review.rerun_log import (  # deferred: rerun
         HexapodDrawing,
@@ -148,7 +155,8 @@ def write_run_recording(
             pos_m=tr.pos_m, vel_mps=tr.vel_mps, acc_mps2=tr.acc_mps2, wheel_radps=wheels, saturated=tr.saturated
         )
     hexapod = None
-    if getattr(limits, "kind", "atlas") == "hexapod":
+    kind = getattr(limits, "kind", "atlas")
+    if kind == "hexapod":
         hexapod = HexapodDrawing(np.asarray(limits.base_joints_m), np.asarray(limits.platform_joints_m),
                                  np.asarray(limits.neutral_m))  # fmt: skip
     data = RecordingData(
@@ -166,23 +174,57 @@ def write_run_recording(
         envelope=platform_envelope(limits),
         phases=[(p[0], float(p[1]), float(p[2])) for p in phases],
         metrics_markdown=metrics_markdown(title, list(result.metrics),
-                                          perceived_motion(ac.f_mps2, ac.omega_radps, float(motion.dt_s)), rule),
+                                          perceived_motion(ac.f_mps2, ac.omega_radps, float(motion.dt_s)), rule,
+                                          ceiling),
         hexapod=hexapod,
+        platform=kind,
+        platform_name=platform_title(limits),
     )
     write_recording(path, data, properties)
 
 
+def platform_title(limits: Any) -> str:
+    """The word the recording's tab and view titles use for the platform: Atlas, Hexapod, Rig, or a plugin's kind."""
+    kind = str(getattr(limits, "kind", "atlas"))
+    return {"atlas": "Atlas", "hexapod": "Hexapod", "rig": "Rig"}.get(kind, kind)
+
+
 def platform_envelope(limits: Any) -> PlatformEnvelope:
-    """The recording's envelope lines from the platform limits (wheel limit from the rate limit); a hexapod's: its
-    box about neutral (:meth:`washbench.platform.hexapod.HexapodModel.envelope`), no wheels, the base's diameter."""
+    """The recording's envelope lines from the platform limits: the Atlas's stage, wheels (the wheel limit from the
+    rate limit) and sphere rate; a hexapod's box about neutral
+    (:meth:`washbench.platform.hexapod.HexapodModel.envelope`), no wheels, the base's diameter; a rig's angle stops
+    and its heave's limits (none without heave); a plugin's platform its ``envelope`` box when it has one (nothing
+    otherwise: its motion is drawn without limit lines)."""
     from washbench.review.rerun_log import PlatformEnvelope  # deferred: rerun
 
-    if getattr(limits, "kind", "atlas") == "hexapod":
+    kind = getattr(limits, "kind", "atlas")
+    if kind == "hexapod":
         box = limits.envelope().translation
         radius = float(np.max(np.linalg.norm(np.asarray(limits.base_joints_m)[:, :2], axis=1)))
         return PlatformEnvelope(pos_m=box.position_limit_m.xyz, vel_mps=box.velocity_limit_mps.xyz,
                                 acc_mps2=box.acceleration_limit_mps2.xyz, wheel_radps=None,
                                 sphere_diameter_m=2.0 * radius)  # fmt: skip
+    if kind == "rig":
+        h = limits.heave
+        angles = tuple(math.radians(a.angle_limit_deg) if a is not None else math.inf
+                       for a in (limits.roll, limits.pitch, limits.yaw))  # fmt: skip
+        tiny = 1e-3  # the rig's horizontal axes do not move (as its envelope() for planning)
+        return PlatformEnvelope(
+            pos_m=(tiny, tiny, h.position_limit_m) if h else None,
+            vel_mps=(tiny, tiny, h.velocity_limit_mps) if h else None,
+            acc_mps2=(tiny, tiny, h.acceleration_limit_mps2) if h else None,
+            wheel_radps=None,
+            sphere_diameter_m=2.0,
+            angle_rad=angles,  # type: ignore[arg-type]
+        )
+    if kind != "atlas":  # a plugin's platform
+        env = limits.envelope()
+        if env is None:
+            return PlatformEnvelope(pos_m=None, vel_mps=None, acc_mps2=None, wheel_radps=None, sphere_diameter_m=2.0)
+        t = env.translation
+        return PlatformEnvelope(pos_m=t.position_limit_m.xyz, vel_mps=t.velocity_limit_mps.xyz,
+                                acc_mps2=t.acceleration_limit_mps2.xyz, wheel_radps=None,
+                                sphere_diameter_m=2.0)  # fmt: skip
 
     t = limits.translation
     jac = wheel_jacobian(limits)
@@ -194,6 +236,7 @@ def platform_envelope(limits: Any) -> PlatformEnvelope:
         acc_mps2=t.acceleration_limit_mps2.xyz,
         wheel_radps=wheel_max,
         sphere_diameter_m=limits.sphere_diameter_m,
+        rate_radps=math.radians(limits.rotation.rate_limit_degps),
     )
 
 
