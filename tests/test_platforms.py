@@ -20,6 +20,7 @@ from ceiling_helpers import check_ceiling_below_every_washout
 from scipy.spatial.transform import Rotation
 
 from washbench.io.paths import DATA_DIR
+from washbench.review.result_data import load_result
 
 # a geometry of its own: smaller than the bundled one, joints off the platform plane, asymmetric pairs
 BASE = [[1.30, -0.25, 0.05], [1.30, 0.25, 0.0], [-0.43, 1.25, 0.0], [-0.87, 1.0, 0.02], [-0.87, -1.0, 0.0],
@@ -193,6 +194,30 @@ def rig_run(flights: dict[str, Path], tmp_path_factory: pytest.TempPathFactory) 
     return root / "out"
 
 
+def test_the_rig_s_envelope_figure_shows_each_angle_against_its_stop(rig_run):
+    """The report's envelope panels on a rig: each gimbal's angle over its stop (scipy's ZYX angles, not
+    washbench's), the heave over its travel, the rates and accelerations over their limits (at most 1, reached on
+    the violent flight), and the figure drawn by ``washbench report``."""
+    (traces,) = rig_run.rglob("traces.parquet")
+    table = pq.read_table(traces).to_pydict()
+    data = load_result(traces.parent)
+    assert list(data.usage) == ["roll", "pitch", "heave", "rate", "acceleration"]
+    for w in ("large-angle", "optimal"):
+        q = np.column_stack([table[f"{w}.q_{c}"] for c in "wxyz"])
+        _, pitch, roll = Rotation.from_quat(q[:, [1, 2, 3, 0]]).as_euler("ZYX", degrees=True).T
+        np.testing.assert_allclose(data.usage["roll"][w], np.abs(roll) / 15.0, atol=1e-9)
+        np.testing.assert_allclose(data.usage["pitch"][w], np.abs(pitch) / 12.0, atol=1e-9)
+        rate = np.maximum(np.abs(np.diff(roll)) / 30.0, np.abs(np.diff(pitch)) / 25.0) / DT
+        np.testing.assert_allclose(data.usage["rate"][w][1:], np.maximum(rate, np.abs(np.diff(table[f"{w}.pos_z_m"]))
+                                   / DT / 0.3), rtol=1e-6, atol=1e-9)  # fmt: skip
+        for panel in ("rate", "acceleration"):
+            assert data.usage[panel][w].max() <= 1.0 + 1e-6
+    assert max(data.usage["roll"][w].max() for w in ("large-angle", "optimal")) == pytest.approx(1.0, abs=1e-6)
+    proc = washbench("report", traces.parent)
+    assert proc.returncode == 0, proc.stderr
+    assert (traces.parent / "figures" / "envelope.png").stat().st_size > 10000
+
+
 def test_a_rig_stays_within_its_angles_and_rates(rig_run):
     (traces,) = rig_run.rglob("traces.parquet")
     table = pq.read_table(traces).to_pydict()
@@ -227,6 +252,16 @@ class BoxPlatform:
     def __init__(self, params, context):
         self.travel = (params or Params()).travel_m
         self.dt = context.dt_s
+
+    @staticmethod
+    def envelope(params):
+        from washbench.platform.hexapod import MotionEnvelope
+
+        t = (params or Params()).travel_m
+        return MotionEnvelope.model_validate({"name": "box", "translation": {
+            "position_limit_m": {"x": t, "y": t, "z": t}, "velocity_limit_mps": {"x": 1, "y": 1, "z": 1},
+            "acceleration_limit_mps2": {"x": 5, "y": 5, "z": 5}},
+            "rotation": {"rate_limit_degps": 30, "acceleration_limit_degps2": 100, "catch_up_fraction": 0.5}})
 
     def start(self, pos, q):
         return np.clip(pos, -self.travel, self.travel), q
@@ -266,6 +301,13 @@ def test_a_platform_plugin_drives_the_washouts_and_is_recorded(flights, tmp_path
     (run,) = out.rglob("run.json")
     record = json.loads(run.read_text())["provenance"]["platform"]
     assert record["path"] == str(file) and record["values"]["kind"] == "box" and len(record["sha256"]) == 64
+    # the plugin exposes its limits (envelope): the report's envelope figure draws the motion against them
+    assert record["values"]["envelope"]["translation"]["position_limit_m"] == {"x": 0.02, "y": 0.02, "z": 0.02}
+    data = load_result(traces.parent)
+    assert set(data.usage) == {"position", "velocity", "acceleration", "rate", "ang. acc."}
+    np.testing.assert_allclose(data.usage["position"]["large-angle"], np.abs(pos).max(axis=1) / 0.02, rtol=1e-12)
+    omega = np.column_stack([table[f"large-angle.omega_platform_{a}_degps"] for a in "xyz"])
+    np.testing.assert_allclose(data.usage["rate"]["large-angle"], np.linalg.norm(omega, axis=1) / 30.0, rtol=1e-12)
 
 
 def test_a_broken_platform_plugin_is_one_line(flights, tmp_path):

@@ -135,6 +135,7 @@ class CueResult:
                 _put(table, omega_platform_columns(name), tr.omega_radps * _DEG)
                 _put(table, wheel_columns(name), getattr(tr, "wheel_radps", _NONE))
                 _put(table, leg_columns(name), getattr(tr, "leg_m", _NONE))
+                _put(table, q_columns(name), getattr(tr, "q", _NONE))  # (a rig's angles in its envelope figure)
             for kind, flags in tr.saturated.items():
                 table[sat_column(name, kind)] = np.asarray(flags)
         return table
