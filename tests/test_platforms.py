@@ -389,7 +389,7 @@ def test_a_set_point_beyond_the_workspace_is_scaled_to_its_edge():
                                atol=1e-12)  # fmt: skip
 
 
-# --- the ceiling over a hexapod's and a rig's workspace (docs/yardstick.md, "Other platforms") ---
+# --- the ceiling over a hexapod's and a rig's workspace (docs/yardstick.md, "Over a hexapod's or a rig's workspace")
 
 
 def _trace_namespace(table: dict, washout: str) -> SimpleNamespace:
