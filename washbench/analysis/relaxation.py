@@ -365,7 +365,12 @@ def observed(traces: dict[str, Any], dt_s: float, gravity_mps2: float) -> dict[s
         q = np.asarray(tr.q)
         w, x, y, z = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
         gam = np.column_stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)])  # R^T e_z
-        dots = np.abs(np.sum(q[1:] * q[:-1], axis=1)).clip(0.0, 1.0)
+        # the turn over each sample, 2 atan2(|vec(r)|, |w(r)|) of r = q_prev* q (accurate for small turns, where
+        # 2 acos(q_prev . q) loses half its digits)
+        a, b = q[:-1], q[1:]
+        rw = np.sum(a * b, axis=1)
+        rv = a[:, :1] * b[:, 1:] - b[:, :1] * a[:, 1:] - np.cross(a[:, 1:], b[:, 1:])
+        turns = 2.0 * np.arctan2(np.linalg.norm(rv, axis=1), np.abs(rw))
         om = np.asarray(tr.omega_radps)
         out["gx"] = max(out["gx"], float(np.abs(gam[:, 0]).max()))
         out["gy"] = max(out["gy"], float(np.abs(gam[:, 1]).max()))
@@ -376,7 +381,7 @@ def observed(traces: dict[str, Any], dt_s: float, gravity_mps2: float) -> dict[s
         out["rate"] = max(out["rate"], float(np.abs(om).max()))
         if len(om) > 1:
             out["rate_step"] = max(out["rate_step"], float(np.linalg.norm(np.diff(om, axis=0), axis=1).max()))
-            out["turn"] = max(out["turn"], float((2.0 * np.arccos(dots)).max()))
+            out["turn"] = max(out["turn"], float(turns.max()))
     out["g"] = g
     out["dt"] = float(dt_s)
     return out
