@@ -443,6 +443,7 @@ def test_the_hexapod_s_ceiling_is_below_every_washout_through_the_bound_outputs(
     assert set(scores) == {*HEXAPOD_WASHOUTS, "bound"}
     doc = json.loads((run_dir / "run.json").read_text())["bound"]["relaxation"]
     assert doc["kind"] == "hexapod" and doc["widened"] == []
+    assert "found numerically, not proved" in (run_dir / "report.md").read_text()  # the report says so
     table = pq.read_table(hexapod_runs["gentle"]).to_pydict()
     legs = legs_from_pose(np.column_stack([table[f"bound.pos_{a}_m"] for a in "xyz"]),
                           np.column_stack([table[f"bound.q_{c}"] for c in "wxyz"]))  # fmt: skip
