@@ -1,4 +1,6 @@
-"""The ceiling: a certified lower bound on the ranking's own measure, over every motion the Atlas model can make.
+"""The ceiling: a certified lower bound on the ranking's own measure, over every motion the Atlas model can make
+(on a hexapod or a rig: over that platform's relaxation, :mod:`washbench.analysis.relaxation`, whose bounds a rig
+gives in closed form and a hexapod's are found numerically; docs/yardstick.md).
 
 The ranking scores a washout by ``score = sum_d w_d E_d / M_d`` (:mod:`washbench.analysis.ranking`): ``E_d`` the
 integral of |perceived error| in DOF d (trapezoid rule), ``M_d`` the aircraft pilot's own perceived motion there,
@@ -12,7 +14,8 @@ in that DOF. A relaxation contains every head-motion trace the platform model ca
 at most every washout's ``E_d``, whatever the washout (classical, optimal, MPC, a plugin, the bound's own replay).
 The ceiling of a DOF is ``r_d = min E_d / M_d``; the ceiling of the score is ``sum_d w_d r_d``.
 
-The relaxation of one DOF (docs/metrics.md, "The ceiling", derives each line). Body axes (x forward, y right,
+The relaxation of one DOF on the Atlas (docs/yardstick.md, "The ceiling", derives each line; the same rows with
+another platform's bounds: :class:`washbench.analysis.relaxation.Relaxation`). Body axes (x forward, y right,
 z down), inertial NED, the Atlas stage's limits per inertial axis ``p_max, v_max, a_max`` (m, m/s, m/s^2), the
 sphere's rate and angular-acceleration limits ``w_max`` (rad/s), ``alpha_max`` (rad/s^2), step ``dt``:
 
