@@ -29,6 +29,7 @@ from typing import Any
 
 from washbench.analysis.metrics import DOFS
 from washbench.analysis.ranking import BOUND_WASHOUT, DEFAULT_RULE, MOTION_FLOOR, perceived_motion, rule_values
+from washbench.analysis.relaxation import observed, relaxation_of, widened
 from washbench.cueing.registry import whole_only
 from washbench.io.atomic import write_text_atomic
 from washbench.io.csv_numbers import csv_number
@@ -107,7 +108,6 @@ def bound_outputs(
         (folder / CEILING_FILE).unlink(missing_ok=True)  # an earlier run's ceiling would not be this run's
         return None
     from washbench.analysis.ceiling import ceiling  # deferred: scipy.sparse
-    from washbench.analysis.relaxation import observed, relaxation_of, widened
 
     rule = DEFAULT_RULE if rule is None else rule
     dt_s = result.motion.dt_s
