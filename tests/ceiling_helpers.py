@@ -1,6 +1,7 @@
-"""The ``washbench`` command in a fresh process, and the check that no washout scores below the ceiling on a result
-folder's files (ceiling.csv, ranking.csv, metrics.csv, run.json): shared by the tests of the bound's outputs and of
-the ceiling."""
+"""The ``washbench`` command in a fresh process, the check that no washout scores below the ceiling on a result
+folder's files (ceiling.csv, ranking.csv, metrics.csv, run.json), and the independent formulation's pieces (lsim's
+response matrix, the trapezoid rule): shared by the tests of the bound's outputs, of the ceiling and of the
+platforms."""
 
 from __future__ import annotations
 
@@ -10,7 +11,9 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
+from scipy import signal
 
 
 def washbench(*args: str | Path) -> subprocess.CompletedProcess[str]:
@@ -56,3 +59,24 @@ def check_ceiling_below_every_washout(run_dir: Path) -> dict[str, float]:
     assert set(doc["solver_status"].values()) <= {"Solved", "Exact"}, doc["solver_status"]
     assert doc["below_ceiling"] == []
     return scores
+
+
+def response_matrix(num: np.ndarray, den: np.ndarray, n: int, dt: float) -> np.ndarray:
+    """H (n, n): y = H u for the continuous model num/den, input linear between samples, started in the steady
+    state of u[0] (scipy.signal.lsim, one column per unit input)."""
+    sys_ = signal.StateSpace(*signal.tf2ss(num, den))
+    x_unit = -np.linalg.solve(sys_.A, sys_.B).ravel()  # the steady state per unit constant input
+    t = np.arange(n) * dt
+    h = np.empty((n, n))
+    for j in range(n):
+        u = np.zeros(n)
+        u[j] = 1.0
+        _, y, _ = signal.lsim(sys_, u, t, X0=x_unit if j == 0 else np.zeros_like(x_unit))
+        h[:, j] = y
+    return h
+
+
+def trapezoid(n: int, dt: float) -> np.ndarray:
+    w = np.full(n, dt)
+    w[0] = w[-1] = 0.5 * dt
+    return w

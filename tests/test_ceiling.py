@@ -14,8 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from ceiling_helpers import check_ceiling_below_every_washout, washbench
-from scipy import signal
+from ceiling_helpers import check_ceiling_below_every_washout, response_matrix, trapezoid, washbench
 from scipy.optimize import linprog
 
 from washbench.analysis.ceiling import EXACT, ceiling, rotational_floor, translational_floor
@@ -36,27 +35,6 @@ G = 9.80665
 @pytest.fixture(scope="module")
 def limits():
     return load_platform_limits()
-
-
-def response_matrix(num: np.ndarray, den: np.ndarray, n: int, dt: float) -> np.ndarray:
-    """H (n, n): y = H u for the continuous model num/den, input linear between samples, started in the steady
-    state of u[0] (scipy.signal.lsim, one column per unit input)."""
-    sys_ = signal.StateSpace(*signal.tf2ss(num, den))
-    x_unit = -np.linalg.solve(sys_.A, sys_.B).ravel()  # the steady state per unit constant input
-    t = np.arange(n) * dt
-    h = np.empty((n, n))
-    for j in range(n):
-        u = np.zeros(n)
-        u[j] = 1.0
-        _, y, _ = signal.lsim(sys_, u, t, X0=x_unit if j == 0 else np.zeros_like(x_unit))
-        h[:, j] = y
-    return h
-
-
-def trapezoid(n: int, dt: float) -> np.ndarray:
-    w = np.full(n, dt)
-    w[0] = w[-1] = 0.5 * dt
-    return w
 
 
 def rotation_lp(h: np.ndarray, ref: np.ndarray, w_max: float, dw: float, dt: float) -> float:

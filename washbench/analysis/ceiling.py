@@ -1,4 +1,6 @@
-"""The ceiling: a certified lower bound on the ranking's own measure, over every motion the Atlas model can make.
+"""The ceiling: a certified lower bound on the ranking's own measure, over every motion the Atlas model can make
+(on a hexapod or a rig: over that platform's relaxation, :mod:`washbench.analysis.relaxation`, whose bounds a rig
+gives in closed form and a hexapod's are found numerically; docs/yardstick.md).
 
 The ranking scores a washout by ``score = sum_d w_d E_d / M_d`` (:mod:`washbench.analysis.ranking`): ``E_d`` the
 integral of |perceived error| in DOF d (trapezoid rule), ``M_d`` the aircraft pilot's own perceived motion there,
@@ -12,7 +14,8 @@ in that DOF. A relaxation contains every head-motion trace the platform model ca
 at most every washout's ``E_d``, whatever the washout (classical, optimal, MPC, a plugin, the bound's own replay).
 The ceiling of a DOF is ``r_d = min E_d / M_d``; the ceiling of the score is ``sum_d w_d r_d``.
 
-The relaxation of one DOF (docs/metrics.md, "The ceiling", derives each line). Body axes (x forward, y right,
+The relaxation of one DOF on the Atlas (docs/yardstick.md, "The ceiling", derives each line; the same rows with
+another platform's bounds: :class:`washbench.analysis.relaxation.Relaxation`). Body axes (x forward, y right,
 z down), inertial NED, the Atlas stage's limits per inertial axis ``p_max, v_max, a_max`` (m, m/s, m/s^2), the
 sphere's rate and angular-acceleration limits ``w_max`` (rad/s), ``alpha_max`` (rad/s^2), step ``dt``:
 
@@ -46,6 +49,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from scipy import sparse
@@ -53,6 +57,7 @@ from scipy import sparse
 from washbench.analysis.lp_rows import Rows as _Rows
 from washbench.analysis.lp_rows import trapezoid as _trapezoid
 from washbench.analysis.metrics import DOFS
+from washbench.analysis.relaxation import Relaxation, relaxation_of
 from washbench.io.units import G0_MPS2
 from washbench.perception.vestibular import (
     DiscreteModel,
@@ -138,29 +143,23 @@ def _solve(c: np.ndarray, rows: _Rows, nvar: int) -> tuple[float, str]:
     return max(0.0, dual - CEILING_TOL * max(1.0, abs(dual))), status
 
 
-def _follows_exactly_rotation(w_air: np.ndarray, dt: float, limits: PlatformLimits) -> bool:
+def _follows_exactly_rotation(w_air: np.ndarray, dt: float, relax: Relaxation, axis: int) -> bool:
     """True when the aircraft's own rate on this axis (N,) rad/s is within the relaxation's rows: the platform's head
     rate can equal it, so the least error is 0 exactly (the same model, the same start)."""
-    rot = limits.rotation
-    w_max = math.radians(rot.rate_limit_degps)
-    dw = math.radians(rot.acceleration_limit_degps2) * dt
-    return bool(np.all(np.abs(w_air) <= w_max) and np.all(np.abs(np.diff(w_air)) <= dw))
+    return bool(np.all(np.abs(w_air) <= relax.rate[axis]) and np.all(np.abs(np.diff(w_air)) <= relax.rate_step))
 
 
-def _follows_exactly_force(f_air: np.ndarray, dt: float, limits: PlatformLimits, gravity_mps2: float) -> bool:
+def _follows_exactly_force(f_air: np.ndarray, dt: float, relax: Relaxation, axis: int) -> bool:
     """True when the relaxation holds a motion whose specific force on this axis equals the aircraft's (N,) m/s^2:
     gravity's component turned towards ``-f`` as fast as the rows allow, the stage making up the rest, its velocity
     and position in the turning frame pulled towards zero by as much as the turning terms allow (``e_k``, ``d_k``),
     and every row then checked. The least error is then 0 exactly."""
-    g = float(gravity_mps2)
-    t = limits.translation
-    chord = 2.0 * math.sin(min(math.radians(limits.rotation.rate_limit_degps) * dt, math.pi) / 2.0)
-    a_bar = math.hypot(*t.acceleration_limit_mps2.xyz)
-    v_bar = math.hypot(*t.velocity_limit_mps.xyz)
-    p_bar = math.hypot(*t.position_limit_m.xyz)
-    ev, ep = chord * v_bar, chord * p_bar
-    step = g * chord
-    target = np.clip(-np.asarray(f_air, dtype=np.float64), -g, g)
+    lo, hi = relax.gravity_lo[axis], relax.gravity_hi[axis]
+    chord = relax.chord
+    a_bar, v_bar, p_bar = relax.acc[axis], relax.vel[axis], relax.pos[axis]
+    ev, ep = chord * relax.vel_norm, chord * relax.pos_norm
+    step = _gravity_step(relax)
+    target = np.clip(-np.asarray(f_air, dtype=np.float64), lo, hi)
     gk, vk, pk = float(target[0]), 0.0, 0.0
     for k in range(len(target)):
         gk = gk + min(max(float(target[k]) - gk, -step), step)
@@ -178,30 +177,33 @@ def _follows_exactly_force(f_air: np.ndarray, dt: float, limits: PlatformLimits,
     return True
 
 
+def _gravity_step(relax: Relaxation) -> float:
+    """The bound on |gamma_k - gamma_{k-1}| (m/s^2, each component): gravity's norm g (the largest |gamma_z|) times
+    the chord of the largest turn per sample."""
+    return max(abs(relax.gravity_hi[2]), abs(relax.gravity_lo[2])) * relax.chord
+
+
 def translational_floor(
     reference: np.ndarray,
     axis: int,
     dt_s: float,
-    limits: PlatformLimits,
+    limits: PlatformLimits | Relaxation | Any,
     gravity_mps2: float,
     model: DiscreteModel,
     rest_start: bool,
     head_offset_m: float = 0.0,
 ) -> tuple[float, str]:
     """The least integral of |perceived specific-force error| (m/s^2*s) on body axis ``axis`` over the relaxation
-    (module docstring); ``reference`` (N,) the aircraft pilot's perceived specific force on that axis, m/s^2."""
+    (module docstring); ``reference`` (N,) the aircraft pilot's perceived specific force on that axis, m/s^2;
+    ``limits``: the platform (Atlas limits, a hexapod, a rig) or its :class:`Relaxation`."""
     n = len(reference)
     dt = float(dt_s)
-    g = float(gravity_mps2)
-    t = limits.translation
-    rot = limits.rotation
-    w_max = math.radians(rot.rate_limit_degps)
-    alpha = math.radians(rot.acceleration_limit_degps2)
-    chord = 2.0 * math.sin(min(w_max * dt, math.pi) / 2.0)
-    a_bar = math.hypot(*t.acceleration_limit_mps2.xyz)
-    v_bar = math.hypot(*t.velocity_limit_mps.xyz)
-    p_bar = math.hypot(*t.position_limit_m.xyz)
-    o_bar = abs(head_offset_m) * (alpha + w_max * w_max)
+    relax = relaxation_of(limits, dt, gravity_mps2)
+    chord = relax.chord
+    a_bar = relax.acc[axis]
+    v_bar, p_bar = relax.vel[axis], relax.pos[axis]
+    w_max = max(relax.rate)
+    o_bar = abs(head_offset_m) * (relax.ang_acc + w_max * w_max)
     ns = len(model.phi)
     names = ["f", "gam", "V", "P", "o", "t"]
     off = {nm: i * n for i, nm in enumerate(names)}
@@ -212,23 +214,29 @@ def translational_floor(
     k = np.arange(1, n)
     # b = f + gamma - o (the stage's acceleration in body axes)
     f, gam, vv, pp, o = idx["f"], idx["gam"], idx["V"], idx["P"], idx["o"]
-    rows.box(gam, -g, g)
+    rows.box(gam, relax.gravity_lo[axis], relax.gravity_hi[axis])
     rows.box(o, -o_bar, o_bar)
-    rows.add([(gam[k], 1.0), (gam[k - 1], -1.0)], np.full(n - 1, g * chord), equal=False)
-    rows.add([(gam[k], -1.0), (gam[k - 1], 1.0)], np.full(n - 1, g * chord), equal=False)
+    step = _gravity_step(relax)
+    rows.add([(gam[k], 1.0), (gam[k - 1], -1.0)], np.full(n - 1, step), equal=False)
+    rows.add([(gam[k], -1.0), (gam[k - 1], 1.0)], np.full(n - 1, step), equal=False)
     rows.add([(f, 1.0), (gam, 1.0), (o, -1.0)], np.full(n, a_bar), equal=False)
     rows.add([(f, -1.0), (gam, -1.0), (o, 1.0)], np.full(n, a_bar), equal=False)
     rows.box(vv, -v_bar, v_bar)
     rows.box(pp, -p_bar, p_bar)
-    ev = chord * v_bar
-    ep = chord * p_bar
+    ev = chord * relax.vel_norm
+    ep = chord * relax.pos_norm
     # V_k - V_{k-1} - dt b_k in [-ev, ev], V_{-1} = 0 (and its first step: the frame has not turned a moving stage)
     for sign in (1.0, -1.0):
         rows.add([(vv[k], sign), (vv[k - 1], -sign), (f[k], -sign * dt), (gam[k], -sign * dt), (o[k], sign * dt)],
                  np.full(n - 1, ev), equal=False)  # fmt: skip
         rows.add([(pp[k], sign), (pp[k - 1], -sign), (vv[k], -sign * dt)], np.full(n - 1, ep), equal=False)
     rows.add([(vv[:1], 1.0), (f[:1], -dt), (gam[:1], -dt), (o[:1], dt)], np.zeros(1), equal=True)
-    rows.add([(pp[:1], 1.0), (vv[:1], -dt)], np.zeros(1), equal=True)
+    start = relax.start_pos[axis]
+    if start > 0.0:  # P_0 - dt V_0 = P_{-1}: the platform starts at rest where its first set point put it
+        rows.add([(pp[:1], 1.0), (vv[:1], -dt)], np.full(1, start), equal=False)
+        rows.add([(pp[:1], -1.0), (vv[:1], dt)], np.full(1, start), equal=False)
+    else:  # from rest at neutral
+        rows.add([(pp[:1], 1.0), (vv[:1], -dt)], np.zeros(1), equal=True)
     rest_input = float(np.array((0.0, 0.0, -G0_MPS2))[axis]) if rest_start else None
     _perception_rows(rows, f, x0, off["t"], n, model, np.asarray(reference, dtype=np.float64), 1.0, rest_input)
     c = np.zeros(nvar)
@@ -239,18 +247,19 @@ def translational_floor(
 def rotational_floor(
     reference_radps: np.ndarray,
     dt_s: float,
-    limits: PlatformLimits,
+    limits: PlatformLimits | Relaxation | Any,
     model: DiscreteModel,
     rest_start: bool,
+    axis: int = 0,
 ) -> tuple[float, str]:
-    """The least integral of |perceived angular-velocity error| (deg) on one body axis over the relaxation;
+    """The least integral of |perceived angular-velocity error| (deg) on body axis ``axis`` over the relaxation;
     ``reference_radps`` (N,) the aircraft pilot's perceived angular velocity on that axis, rad/s."""
     n = len(reference_radps)
     dt = float(dt_s)
-    rot = limits.rotation
+    relax = relaxation_of(limits, dt, G0_MPS2)
     slack = 1.0 + 1e-9  # the platform's rounding
-    w_max = math.radians(rot.rate_limit_degps) * slack
-    dw = math.radians(rot.acceleration_limit_degps2) * dt * slack
+    w_max = relax.rate[axis] * slack
+    dw = relax.rate_step * slack
     ns = len(model.phi)
     w = np.arange(n)
     t0 = n
@@ -259,8 +268,9 @@ def rotational_floor(
     rows = _Rows()
     k = np.arange(1, n)
     rows.box(w, -w_max, w_max)
-    rows.add([(w[k], 1.0), (w[k - 1], -1.0)], np.full(n - 1, dw), equal=False)
-    rows.add([(w[k], -1.0), (w[k - 1], 1.0)], np.full(n - 1, dw), equal=False)
+    if math.isfinite(dw):
+        rows.add([(w[k], 1.0), (w[k - 1], -1.0)], np.full(n - 1, dw), equal=False)
+        rows.add([(w[k], -1.0), (w[k - 1], 1.0)], np.full(n - 1, dw), equal=False)
     # solved in rad (70 interior-point iterations on the aerobatics' roll, against 95 with the error in deg), given
     # in deg as metrics.csv gives it
     _perception_rows(rows, w, x0, t0, n, model, np.asarray(reference_radps, dtype=np.float64), 1.0,
@@ -275,7 +285,7 @@ def ceiling(
     perceived_f_mps2: np.ndarray,
     perceived_omega_radps: np.ndarray,
     dt_s: float,
-    limits: PlatformLimits,
+    limits: PlatformLimits | Relaxation | Any,
     gravity_mps2: float,
     vestibular: VestibularParams | None = None,
     filter_start: str = "steady",
@@ -285,8 +295,9 @@ def ceiling(
 ) -> Ceiling:
     """The ceiling of a flight from the aircraft pilot's perceived motion (N, 3) each (module docstring).
 
-    ``f_mps2``, ``omega_radps`` (N, 3): the aircraft pilot's head motion itself, when known: a DOF where the
-    relaxation holds a motion equal to it has the ceiling 0 without a programme (status ``Exact``).
+    ``limits``: the platform (Atlas limits, a hexapod, a rig: :func:`washbench.analysis.relaxation.relaxation_of`)
+    or its relaxation. ``f_mps2``, ``omega_radps`` (N, 3): the aircraft pilot's head motion itself, when known: a
+    DOF where the relaxation holds a motion equal to it has the ceiling 0 without a programme (status ``Exact``).
 
     Raises ValueError for perception thresholds (a dead band makes the error non-convex in the head motion: the
     ceiling is not defined for them)."""
@@ -297,20 +308,21 @@ def ceiling(
     can = canal_model(vest.canals, dt_s)
     rest = filter_start == "rest"
     r = math.hypot(*head_offset_m)
+    relax = relaxation_of(limits, dt_s, gravity_mps2)
     floor: dict[str, float] = {}
     status: dict[str, str] = {}
     for axis, dof in enumerate(DOFS[:3]):
-        if f_mps2 is not None and _follows_exactly_force(f_mps2[:, axis], dt_s, limits, gravity_mps2):
+        if f_mps2 is not None and _follows_exactly_force(f_mps2[:, axis], dt_s, relax, axis):
             floor[dof], status[dof] = 0.0, EXACT
             continue
         floor[dof], status[dof] = translational_floor(
-            perceived_f_mps2[:, axis], axis, dt_s, limits, gravity_mps2, oto, rest, r
+            perceived_f_mps2[:, axis], axis, dt_s, relax, gravity_mps2, oto, rest, r
         )
     for axis, dof in enumerate(DOFS[3:]):
-        if omega_radps is not None and _follows_exactly_rotation(omega_radps[:, axis], dt_s, limits):
+        if omega_radps is not None and _follows_exactly_rotation(omega_radps[:, axis], dt_s, relax, axis):
             floor[dof], status[dof] = 0.0, EXACT
             continue
-        floor[dof], status[dof] = rotational_floor(perceived_omega_radps[:, axis], dt_s, limits, can, rest)
+        floor[dof], status[dof] = rotational_floor(perceived_omega_radps[:, axis], dt_s, relax, can, rest, axis)
     return Ceiling(floor=floor, status=status)
 
 

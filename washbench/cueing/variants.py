@@ -361,8 +361,9 @@ def select_from(
 
 def platform_refusal(washout: Washout, platform: Any) -> str | None:
     """Why ``washout`` cannot drive ``platform`` (one line), or None when it can: on a platform of limited rotation
-    (hexapod, rig) the unrestricted family (its attitude set point is never washed back to level) and the oracle
-    bound (its ceiling is over the Atlas's workspace only) cannot."""
+    (hexapod, rig) the unrestricted family (its attitude set point is never washed back to level) cannot; on a
+    plugin's platform the oracle bound cannot either (its ceiling needs the platform's workspace, which a plugin
+    does not give)."""
     kind = getattr(platform, "kind", "atlas")
     if kind == "atlas":
         return None
@@ -372,8 +373,9 @@ def platform_refusal(washout: Washout, platform: Any) -> str | None:
             f"washout {washout.name} ({washout.kind}): cannot drive a {kind} (limited rotation; its attitude set "
             "point is never washed back to level); use large-angle or adaptive-large-angle"
         )
-    if washout.kind == "bound":
-        return f"washout {washout.name} (bound): the oracle bound is computed for the Atlas only, not over a {kind}"
+    if washout.kind == "bound" and kind not in ("hexapod", "rig"):
+        return (f"washout {washout.name} (bound): its ceiling needs the platform's workspace, which the {kind} "
+                "platform plugin does not give (the Atlas, a hexapod and a rig have one)")
     return None
 
 

@@ -76,8 +76,13 @@ class PluginPlatform:
         return fn(self.params()) if callable(fn) else None
 
     def model_dump(self, mode: str = "python") -> dict[str, Any]:
-        """The provenance's values: kind, name, source and parameters."""
-        return {"kind": self.kind, "name": self.name, "source": self.source, **self.values}
+        """The provenance's values: kind, name, source and parameters, and the plugin's ``envelope`` when it gives
+        one (what the report's envelope figure draws the motion against)."""
+        out = {"kind": self.kind, "name": self.name, "source": self.source, **self.values}
+        envelope = self.envelope()
+        if envelope is not None and "envelope" not in self.values:
+            out["envelope"] = envelope.model_dump(mode=mode)
+        return out
 
 
 class PlatformRun:

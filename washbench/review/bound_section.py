@@ -114,6 +114,14 @@ def bound_lines(folder: Path, order: list[str] | None = None, explain: bool = Tr
     if below:
         lines += [f"**{', '.join(below)} below the ceiling**: a defect (the ceiling is a lower bound on every "
                   "motion of this platform); please report it.", ""]  # fmt: skip
+    relax = rec.get("relaxation") if isinstance(rec.get("relaxation"), dict) else {}
+    if explain and relax.get("kind") == "hexapod":
+        widened = [str(w) for w in relax.get("widened") or []]
+        seen = (f"widened to what the washouts did where they went beyond ({', '.join(widened)}: the search missed "
+                "them)" if widened else "every washout's motion was within them")  # fmt: skip
+        lines += ["On a hexapod the relaxation's workspace and rate bounds (its largest tilt, travel, speeds and "
+                  "rates) are found numerically, not proved (docs/yardstick.md), and " + seen + "; its rate bounds are "
+                  "the leg Jacobian's worst pose, which makes this ceiling looser than the Atlas's.", ""]  # fmt: skip
     return [*lines, CEILING_NOTE.format(measure=measure), ""] if explain else lines
 
 

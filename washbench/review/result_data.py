@@ -29,6 +29,7 @@ from washbench.io.columns import (
     perceived_f_columns,
     perceived_omega_columns,
     pos_columns,
+    q_columns,
     vel_columns,
     wheel_columns,
 )
@@ -36,8 +37,9 @@ from washbench.io.metrics_csv import MetricRow, read_metrics_csv
 from washbench.io.provenance import read_parquet_provenance
 from washbench.io.readback import FlightDoc, RunDoc, check_provenance, read_doc
 from washbench.io.result_files import FLIGHT_JSON, METRICS_FILE, RUN_FILE, TRACES_FILE
-from washbench.platform.hexapod import HexapodModel
+from washbench.platform.hexapod import HexapodModel, MotionEnvelope
 from washbench.platform.limits import PlatformLimits, wheel_jacobian
+from washbench.platform.rig import RigModel
 
 
 @dataclass(eq=False)
@@ -109,7 +111,11 @@ def _limits_from(prov: dict[str, Any] | None) -> Any:
     from pydantic import ValidationError
 
     kind = values.get("kind", "atlas") if isinstance(values, dict) else "atlas"
-    model = {"hexapod": HexapodModel}.get(kind, PlatformLimits)
+    model = {"hexapod": HexapodModel, "rig": RigModel}.get(kind, PlatformLimits)
+    if kind not in ("atlas", "hexapod", "rig"):  # a plugin's platform: the envelope it exposes, if any
+        model, values = MotionEnvelope, values.get("envelope")
+        if not isinstance(values, dict):
+            return None
     try:
         return model.model_validate_json(json.dumps(values))  # JSON mode: arrays are tuples
     except ValidationError:
@@ -139,6 +145,55 @@ def leg_usage(table: dict[str, np.ndarray], washouts: list[str], hexapod: Any) -
     return {k: v for k, v in out.items() if v}
 
 
+def _angles_zyx(q: np.ndarray) -> np.ndarray:
+    """Roll, pitch, yaw (N, 3), rad, of attitudes (N, 4) [w, x, y, z] (ZYX Euler angles, the rig's gimbals; yaw
+    unwrapped)."""
+    w, x, y, z = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
+    roll = np.arctan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
+    pitch = np.arcsin(np.clip(2.0 * (w * y - z * x), -1.0, 1.0))
+    yaw = np.unwrap(np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z)))
+    return np.column_stack([roll, pitch, yaw])
+
+
+def rig_usage(table: dict[str, np.ndarray], washouts: list[str], rig: Any) -> dict[str, dict[str, np.ndarray]]:
+    """A rig's usage per panel and washout: each present gimbal's |angle| / its angle limit (``roll``, ``pitch``,
+    ``yaw``; ZYX Euler angles of the attitude columns) and the heave's |down position| / its travel (``heave``), then
+    the largest over those axes of |rate| / rate limit (``rate``: the angles' and the heave's first differences) and
+    of |acceleration| / acceleration limit (``acceleration``: their second differences), 0 where undefined (the first
+    one or two samples)."""
+    time = np.asarray(table[TIME_COLUMN], dtype=np.float64) if TIME_COLUMN in table else None
+    axes = [(name, j, ax) for j, (name, ax) in enumerate((("roll", rig.roll), ("pitch", rig.pitch),
+                                                         ("yaw", rig.yaw))) if ax is not None]  # fmt: skip
+    out: dict[str, dict[str, np.ndarray]] = {name: {} for name, _, _ in axes}
+    if rig.heave is not None:
+        out["heave"] = {}
+    out["rate"], out["acceleration"] = {}, {}
+    for w in washouts:
+        cols = q_columns(w)
+        if not all(c in table for c in cols):
+            continue
+        angles = _angles_zyx(np.column_stack([np.asarray(table[c], dtype=np.float64) for c in cols]))
+        series = [(angles[:, j], math.radians(ax.angle_limit_deg), math.radians(ax.rate_limit_degps),
+                   math.radians(ax.acceleration_limit_degps2), name) for name, j, ax in axes]  # fmt: skip
+        z = pos_columns(w)[2]
+        if rig.heave is not None and z in table:
+            h = rig.heave
+            series.append((np.asarray(table[z], dtype=np.float64), h.position_limit_m, h.velocity_limit_mps,
+                           h.acceleration_limit_mps2, "heave"))  # fmt: skip
+        n = series[0][0].shape[0] if series else 0
+        rate, acc = np.zeros(n), np.zeros(n)
+        for x, lim, rate_lim, acc_lim, name in series:
+            out[name][w] = np.abs(x) / lim
+            if time is not None and n > 2:
+                dt = np.diff(time)
+                v = np.diff(x) / dt
+                rate[1:] = np.maximum(rate[1:], np.abs(v) / rate_lim)
+                acc[2:] = np.maximum(acc[2:], np.abs(np.diff(v) / dt[1:]) / acc_lim)
+        if time is not None and n > 2:
+            out["rate"][w], out["acceleration"][w] = rate, acc
+    return {k: v for k, v in out.items() if v}
+
+
 def envelope_usage(table: dict[str, np.ndarray], washouts: list[str], limits: Any) -> dict[str, dict[str, np.ndarray]]:
     """Envelope usage per panel and washout: max over axes |value| / limit (stage), |omega| / rate limit (sphere).
 
@@ -151,10 +206,12 @@ def envelope_usage(table: dict[str, np.ndarray], washouts: list[str], limits: An
     rate_limit_degps = limits.rotation.rate_limit_degps
     acc_limit_degps2 = limits.rotation.acceleration_limit_degps2
     time = np.asarray(table[TIME_COLUMN], dtype=np.float64) if TIME_COLUMN in table else None
-    wheel_max = float(np.max(np.linalg.norm(wheel_jacobian(limits), axis=1)) * math.radians(rate_limit_degps))
+    atlas = isinstance(limits, PlatformLimits)  # else a plugin's envelope: no sphere, no wheels
+    wheel_max = (float(np.max(np.linalg.norm(wheel_jacobian(limits), axis=1)) * math.radians(rate_limit_degps))
+                 if atlas else math.nan)  # fmt: skip
+    rate_name, angacc_name = ("sphere rate", "sphere ang. acc.") if atlas else ("rate", "ang. acc.")
     out: dict[str, dict[str, np.ndarray]] = {
-        "position": {}, "velocity": {}, "acceleration": {}, "sphere rate": {}, "sphere ang. acc.": {},
-        "wheel speed": {},
+        "position": {}, "velocity": {}, "acceleration": {}, rate_name: {}, angacc_name: {}, "wheel speed": {},
     }  # fmt: skip
     for w in washouts:
         stage = (
@@ -169,13 +226,13 @@ def envelope_usage(table: dict[str, np.ndarray], washouts: list[str], limits: An
         cols = omega_platform_columns(w)
         if all(c in table for c in cols):
             omega = np.column_stack([table[c] for c in cols])
-            out["sphere rate"][w] = np.linalg.norm(omega, axis=1) / rate_limit_degps
+            out[rate_name][w] = np.linalg.norm(omega, axis=1) / rate_limit_degps
             if time is not None and time.shape[0] > 1:
                 alpha = np.zeros(time.shape[0])
                 alpha[1:] = np.linalg.norm(np.diff(omega, axis=0), axis=1) / np.diff(time)
-                out["sphere ang. acc."][w] = alpha / acc_limit_degps2
+                out[angacc_name][w] = alpha / acc_limit_degps2
         cols = wheel_columns(w)
-        if all(c in table for c in cols):
+        if atlas and all(c in table for c in cols):
             out["wheel speed"][w] = np.max(np.abs(np.column_stack([table[c] for c in cols])), axis=1) / wheel_max
     return {k: v for k, v in out.items() if v}
 
@@ -214,7 +271,7 @@ def load_result(folder: Path, table: Mapping[str, np.ndarray] | None = None, *, 
     for w in washouts:
         if series:
             want += [c for c in (*pos_columns(w), *vel_columns(w), *acc_columns(w), *omega_platform_columns(w),
-                                 *wheel_columns(w), *leg_columns(w)) if c in names]  # fmt: skip
+                                 *wheel_columns(w), *leg_columns(w), *q_columns(w)) if c in names]  # fmt: skip
         want += sorted(c for c in names if c.startswith(f"{w}.sat_"))
     if table is None:
         try:
@@ -254,6 +311,8 @@ def load_result(folder: Path, table: Mapping[str, np.ndarray] | None = None, *, 
         usage = {}
     elif isinstance(limits, HexapodModel):
         usage = leg_usage(table, washouts, limits)
+    elif isinstance(limits, RigModel):
+        usage = rig_usage(table, washouts, limits)
     else:
         usage = envelope_usage(table, washouts, limits)
     motion_doc = run.get("perceived_motion")

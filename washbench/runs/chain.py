@@ -133,8 +133,9 @@ class CueResult:
                 _put(table, vel_columns(name), tr.vel_mps)
                 _put(table, acc_columns(name), tr.acc_mps2)
                 _put(table, omega_platform_columns(name), tr.omega_radps * _DEG)
-                _put(table, wheel_columns(name), tr.wheel_radps)
+                _put(table, wheel_columns(name), getattr(tr, "wheel_radps", _NONE))
                 _put(table, leg_columns(name), getattr(tr, "leg_m", _NONE))
+                _put(table, q_columns(name), getattr(tr, "q", _NONE))  # (a rig's angles in its envelope figure)
             for kind, flags in tr.saturated.items():
                 table[sat_column(name, kind)] = np.asarray(flags)
         return table
@@ -317,6 +318,8 @@ _REVIEW_FIELDS = ("pos_m", "vel_mps", "acc_mps2", "omega_radps", "wheel_radps", 
 """Washout trace fields a streamed cue keeps whole for the report (its envelope figure and time at a limit)."""
 _RECORDING_FIELDS = ("head_f_mps2", "head_omega_radps", "q")
 """... and for the recording (the simulator pilot's raw motion, the sphere's attitude in the 3D view)."""
+_RELAXATION_FIELDS = ("pos_m", "vel_mps", "acc_mps2", "omega_radps", "q")
+"""... and on a platform other than the Atlas, for the ceiling (:func:`washbench.analysis.relaxation.observed`)."""
 
 
 def stream_cue(
@@ -358,6 +361,8 @@ def stream_cue(
     vertical = {p: np.empty(n) for p in streams}  # body-z specific force at each pilot's head (MSDV)
     sick = {p: SvcStream(motion.dt_s, start=filter_start) for p in streams}  # predicted incidence (MSI)
     keep = (_REVIEW_FIELDS if figures or recording else ()) + (_RECORDING_FIELDS if recording else ())
+    if bank.platform != "atlas":  # the ceiling's relaxation is widened to what each washout did (bound_stage)
+        keep = tuple(dict.fromkeys(keep + _RELAXATION_FIELDS))
     kept = {w: {f: np.empty((n, _width(f, bank.platform))) for f in keep} for w in names}
     flags: dict[str, dict[str, np.ndarray]] = {w: {} for w in names}
     buf = np.empty((len(names), min(chunk_rows, n), len(CueingBank.FIELDS)))
