@@ -415,7 +415,7 @@ def _titles(rrd: Path) -> set[str]:
 def test_a_rig_and_a_plugins_platform_are_recorded_with_titles_naming_them(flights, tmp_path):
     """docs/platforms.md said: on a rig or a plugin's platform the recording is not written. Now it is: the rig drawn
     as a base and the cockpit at the pose in traces.parquet (scipy checks the attitude), its angles against its stops
-    in the envelope tab; the plugin's platform (no envelope) with its time series and its pose; every title names
+    in the envelope tab; the plugin's platform with its time series, its pose and its envelope box; every title names
     the platform, none says Atlas."""
     from washbench.review.rrd_read import read_scalar_series
 
@@ -453,8 +453,8 @@ def test_a_rig_and_a_plugins_platform_are_recorded_with_titles_naming_them(fligh
             usage = usage.reshape(len(t_a), -1)[:, 0]
             np.testing.assert_allclose(usage, expected[k], atol=1e-5)
             assert 0.2 < usage.max() <= 1.0 + 1e-6
-        else:  # no envelope: no usage panel of the stage, no limit line
-            assert "/envelope/position" not in series and "/platform/large-angle/position/limit_max" not in series
+        else:  # BoxPlatform exposes envelope(params): the stage's usage panel against its box
+            assert "/envelope/position" in series
 
 
 # --- the ceiling over a hexapod's and a rig's workspace (docs/yardstick.md, "Over a hexapod's or a rig's workspace")
