@@ -5,7 +5,11 @@
 The expected end is a straight line through the work done so far: with ``done`` of ``total`` units
 finished ``elapsed`` seconds after the start, the rest takes ``elapsed * (total - done) / done``. The
 units are what the command knows in advance: rows for ``cue``, steps (samples x candidates) for
-``sweep``, evaluations for ``tune``, manoeuvres for ``suite``.
+``sweep``, evaluations for ``tune``, manoeuvres for ``suite``. Where the units time themselves (the suite's
+runs, each timed in its worker: :meth:`Progress.timed`), the elapsed time counts from when the first of them
+started, not from the command's start: what the command paid once before its first unit (starting its worker
+processes and, after an install, compiling the kernels: a minute on a loaded machine) does not stretch every
+estimate (a suite at 5 % once printed an end 28 minutes away, and ended 2 minutes later).
 
 Nothing is shown for work finished within :data:`QUIET_FOR_S` seconds (a short command stays silent).
 After that, on a terminal the bar overwrites itself (at most five times a second) and :meth:`Progress.close`
@@ -64,16 +68,24 @@ class Progress:
         self.tty = self.stream.isatty() if tty is None else tty
         self.clock, self.wall = clock, wall
         self.start = clock()
+        self.work_start: float | None = None
         self._last = -1e9
         self._tenth = 0
         self._shown = False
 
+    def timed(self, seconds: float) -> None:
+        """A unit just finished that took ``seconds`` where it ran (a suite run's wall time in its worker): the work
+        started at the latest ``seconds`` ago (:attr:`work_start`, the earliest such start)."""
+        began = self.clock() - max(float(seconds), 0.0)
+        self.work_start = began if self.work_start is None else min(self.work_start, began)
+
     def expected_end(self, done: int) -> tuple[float, float] | None:
-        """(seconds still to go, expected end as epoch seconds) after ``done`` units, None before the first."""
+        """(seconds still to go, expected end as epoch seconds) after ``done`` units, None before the first: the
+        straight line through the time elapsed since the work started (:meth:`timed`; else since the start)."""
         if done <= 0:
             return None
-        elapsed = self.clock() - self.start
-        left = elapsed * max(self.total - done, 0) / done
+        since = self.start if self.work_start is None else max(self.work_start, self.start)
+        left = (self.clock() - since) * max(self.total - done, 0) / done
         return left, self.wall() + left
 
     def line(self, done: int, note: str = "") -> str:
