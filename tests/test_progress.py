@@ -48,3 +48,22 @@ def test_without_timed_units_the_straight_line_through_the_elapsed_time() -> Non
     shown = Progress("cue", 100, stream=io.StringIO(), tty=False, clock=lambda: now[0], wall=lambda: 1000.0)
     shown.start = 0.0
     assert shown.expected_end(25) == (120.0, 1120.0)
+
+
+def test_a_cue_s_first_print_leaves_out_what_its_first_chunk_paid_once() -> None:
+    """A cue of 10 chunks, 1 s each, the first one 20 s longer (a first compile): each printed estimate within 1.5x
+    of the true time left (the first chunk alone is not printed: the update after it comes within the quiet time
+    of a fast start, or is the first point of the line)."""
+    now = [0.0]
+    stream = io.StringIO()
+    shown = Progress("cue", 10_000, stream=stream, tty=False, clock=lambda: now[0], wall=lambda: 0.0)
+    t = 20.0
+    for chunk in range(1, 11):
+        t += 1.0
+        now[0] = t
+        if chunk >= 2:
+            left, _ = shown.expected_end(chunk * 1000)
+            truth = 10 - chunk
+            assert truth / 1.5 <= left <= 1.5 * truth or truth == 0 == left, (chunk, left, truth)
+        shown.update(chunk * 1000)
+    assert "expected end" in stream.getvalue()
