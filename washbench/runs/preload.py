@@ -22,12 +22,16 @@ collector.tune()  # the server is a new interpreter: its own settings, before it
 
 import jsbsim  # noqa: E402, F401
 import pyarrow.parquet  # noqa: E402, F401
+from numba import types  # noqa: E402
 
 import washbench.perception.vestibular  # noqa: E402, F401
 from washbench.analysis.metric_sums import signal_metrics  # noqa: E402
 from washbench.cueing.bank import _warm_up, warm_up_block  # noqa: E402
 from washbench.cueing.kernel import bank_block, bank_step  # noqa: E402
+from washbench.flight.stepper import compiled_flight_step  # noqa: E402
 from washbench.numerics.jitcache import announce_compile  # noqa: E402
+from washbench.numerics.lazyjit import LazyJit  # noqa: E402
+from washbench.perception import svc  # noqa: E402
 from washbench.perception.sections import sections_apply  # noqa: E402
 from washbench.review.thinning import _changes, _keep  # noqa: E402
 
@@ -49,13 +53,6 @@ def _compile_run_kernels() -> None:
     the flight step, the metric sums, the sickness models and the recording's thinning. After an install or upgrade
     each worker would otherwise compile them again in its first run (several seconds each, on every core at once),
     which also made the suite's first runs, and the expected end printed from them, seem slower than the rest."""
-    from numba import types
-
-    from washbench.analysis.metric_sums import signal_metrics
-    from washbench.flight.stepper import compiled_flight_step
-    from washbench.numerics.lazyjit import LazyJit
-    from washbench.perception import svc
-
     a1, a2, f8, i8 = types.float64[::1], types.float64[:, ::1], types.float64, types.int64
     svc_run = svc._run.compiled() if isinstance(svc._run, LazyJit) else svc._run
     for kernel, signature in (
