@@ -2,20 +2,25 @@
 
     python tests/warm_kernels.py FOLDER
 
-After a fresh clone or an upgrade the numba cache is empty, and each pytest-xdist worker would compile the same
-kernels at the same time (about 20 s of CPU each). This script runs real commands side by side into ``FOLDER``
-(numba compiles one kernel at a time in a process, so separate processes share the work): ``washbench fly`` of a
-1 s flight (the flight step), the washout bank's lockstep and streaming steps, and a ``washbench cue`` of a 1 s
-input with every compiled washout (streamed: the adaptive washouts, perception, metrics, the sickness models); once
-the first two are done, a ``washbench run`` of the flight (what is left: the recording's thinning). Then it writes
-``FOLDER/done`` with their exit statuses; the workers wait for that file before their first test.
+After a fresh clone or an upgrade the numba cache is empty, and each pytest-xdist worker (and each ``washbench``
+process a test starts) would compile the kernels it needs itself, several at the same time: numba has no lock
+between processes, so a kernel two processes need at once is compiled twice. This script compiles each kernel the
+tests need once, in two lanes side by side (two cores), each lane one process after another into ``FOLDER``:
 
-What is left for the tests to compile (about 15 s of CPU: the whole-trace kernel ``bank_trace`` and the set-point
-path through ``cue_trace``, a study's ``evaluate_batch``) is left to them: compiling it here as well (a ``cue_trace``
-beside the first three, a ``sweep`` beside the ``run``) made a cold test run slower, 220 s against 202 s, since
-the workers wait for the warm-up.
-With the cache already filled, the commands load it (about 3 s in all). A failure here fails nothing: the tests
-that need a kernel compile it themselves and report what is wrong.
+- lane 1: the washout kernel's block step and streaming step (``bank_block``, ``bank_step``: the largest, about
+  15 s of CPU), then the whole-trace step (``bank_trace``, through ``cue_trace``) and a study's evaluation
+  (``evaluate_batch``, through ``FlightEvaluator``), which both call the block step compiled just before;
+- lane 2: ``washbench fly`` of a 1 s flight (the flight step); then, once lane 1's block step is in the cache (a
+  ``cue`` or ``run`` needs it: started earlier, it would compile it a second time), a ``washbench cue`` of a 1 s
+  input with every compiled washout (the adaptive washouts, perception, metrics, the sickness models), a
+  ``washbench run`` of the flight (the recording's thinning) and the set-point path of the Python washouts and
+  the other platforms (``setpoint_block``, ``setpoint_trace``: the MPC, the bound, plugins).
+
+Then it writes ``FOLDER/done`` with their exit statuses; the workers wait for that file before their first test.
+The previous warm-up ran the block step and a ``cue`` side by side (both compiled ``bank_block``) and left the
+whole-trace step, the study's evaluation and the set-point path to the workers (each worker that needed one first
+compiled it). With the cache already filled, the commands load it (a few seconds in all). A failure here fails
+nothing: the tests that need a kernel compile it themselves and report what is wrong.
 
 First, where Python is told not to write bytecode (``PYTHONDONTWRITEBYTECODE``, set on these machines), it writes
 washbench's ``.pyc`` files once (0.2 s): otherwise each of the test run's 300-odd ``washbench`` processes compiles
@@ -28,12 +33,43 @@ import compileall
 import importlib.util
 import subprocess
 import sys
+import threading
 from pathlib import Path
 
 from hostile import short  # this script's folder, tests/, is first on sys.path
 
 COMPILED_WASHOUTS = ("small-angle", "large-angle", "unrestricted", "adaptive", "adaptive-large-angle",
                      "adaptive-unrestricted")  # fmt: skip
+
+#: Lane 1 after the block step: the whole-trace step and a study's evaluation, with the argument types ``cue``,
+#: ``omct``, the bound and ``sweep``/``tune`` pass (C-contiguous float64 arrays from the public functions).
+TRACE_AND_EVALUATION = """\
+import numpy as np
+from washbench.analysis.evaluate import FlightEvaluator
+from washbench.cueing import WASHOUT_NAMES, cue_trace, load_washout_params
+from washbench.cueing.variants import as_washouts
+from washbench.platform.model import load_platform_model
+limits, params = load_platform_model(), load_washout_params()
+k = np.arange(240)
+f = np.column_stack([0.5 * (k > 30), 0.0 * k, -9.80665 + 0.0 * k])
+om = np.column_stack([np.radians(2.0) * (k > 60), 0.0 * k, 0.0 * k])
+cue_trace(f, om, 1 / 120, list(WASHOUT_NAMES), params, limits)
+FlightEvaluator(f, om, 1 / 120, limits).evaluate(as_washouts(list(WASHOUT_NAMES), params))
+"""
+
+#: Lane 2 last: the set-point path (a washout computed outside the kernel, or another platform), block and trace
+#: forms, with the argument types :meth:`CueingBank.steps` and ``cue_trace`` pass (one washout's rows of the bank's
+#: C-contiguous arrays), on no samples.
+SETPOINT = """\
+import numpy as np
+from washbench.cueing import filters
+from washbench.cueing.kernel import NCFG, NFIELDS, NFILT, NSTATE, SAT_KINDS, setpoint_block, setpoint_trace
+cfg, coef = np.zeros((1, NCFG)), np.zeros((1, NFILT, filters.NCOEF))
+state, counts = np.zeros((1, NSTATE)), np.zeros((1, len(SAT_KINDS)), dtype=np.int64)
+pos, q, flags = np.zeros((0, 3)), np.zeros((0, 4)), np.zeros((0, 2), dtype=np.int64)
+setpoint_block(pos, q, flags, cfg[0], coef[0], state[0], counts[0], np.zeros((1, 0, NFIELDS))[0])
+setpoint_trace(pos, q, flags, cfg[0], coef[0], state[0], counts[0], np.zeros((1, NFIELDS, 0))[0])
+"""
 
 
 def main(folder: Path) -> int:
@@ -49,21 +85,44 @@ def main(folder: Path) -> int:
     washbench = [sys.executable, "-m", "washbench"]
     washouts = [a for w in COMPILED_WASHOUTS for a in ("--washout", w)]
     block = "from washbench.cueing.bank import _warm_up, warm_up_block; warm_up_block(); _warm_up()"
-    first = [  # side by side: the kernels compile in separate processes (numba compiles one at a time per process)
-        [*washbench, "fly", str(folder / "warm.yaml"), "--out", str(folder / "fly"), "--quiet"],  # the flight step
-        [sys.executable, "-c", block],  # the lockstep and streaming washout steps
+    lane1 = [
+        [sys.executable, "-c", block],  # the block and streaming washout steps
+        [sys.executable, "-c", TRACE_AND_EVALUATION],
+    ]
+    lane2_first = [*washbench, "fly", str(folder / "warm.yaml"), "--out", str(folder / "fly"), "--quiet"]
+    lane2_then = [
         [*washbench, "cue", str(folder / "warm.csv"), "--out", str(folder / "cue"), "--no-figures", "--no-recording",
          *washouts],  # the streamed washouts, perception, metrics, sickness
+        [*washbench, "run", str(folder / "warm.yaml"), "--out", str(folder / "run"), "--no-figures", "--quiet"],
+        [sys.executable, "-c", SETPOINT],
     ]  # fmt: skip
-    then = [*washbench, "run", str(folder / "warm.yaml"), "--out", str(folder / "run"), "--no-figures", "--quiet"]
-    statuses: list[int | None] = []
+    statuses: dict[int, int] = {}
+    block_done = threading.Event()
+
+    def run(index: int, command: list[str]) -> None:
+        statuses[index] = subprocess.run(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL).returncode
+
+    def first_lane() -> None:
+        try:
+            run(0, lane1[0])
+        finally:
+            block_done.set()
+        run(1, lane1[1])
+
+    def second_lane() -> None:
+        run(2, lane2_first)
+        block_done.wait()
+        for i, command in enumerate(lane2_then):
+            run(3 + i, command)
+
     try:
-        procs = [subprocess.Popen(c, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL) for c in first]
-        statuses = [p.wait() for p in procs[:2]]  # what is left for a run (the recording's thinning): from the cache
-        statuses.append(subprocess.run(then, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL).returncode)
-        statuses.append(procs[2].wait())
+        lanes = [threading.Thread(target=first_lane), threading.Thread(target=second_lane)]
+        for lane in lanes:
+            lane.start()
+        for lane in lanes:
+            lane.join()
     finally:
-        (folder / "done").write_text(" ".join(map(str, statuses)) + "\n")
+        (folder / "done").write_text(" ".join(str(statuses.get(i)) for i in range(6)) + "\n")
     return 0
 
 

@@ -128,7 +128,8 @@ _INLINE_INTO = ("bank_block",)
 def _inline_per_sample(expr: object, caller: Any, callee: Any) -> bool:
     """numba's inlining decision for the per-sample step (:func:`step_one`, :func:`washout_classical`,
     :func:`platform_head`): inlined into :func:`bank_block` (which the streaming and whole-trace steps call),
-    called elsewhere (the study's :func:`washbench.analysis.evaluate.evaluate_batch`, set-point washouts).
+    called elsewhere (set-point washouts; the study's :func:`washbench.analysis.evaluate.evaluate_batch` calls
+    :func:`bank_block`).
 
     As calls, each passes its arrays by reference count: numba increments every array argument's count on entry
     and decrements it on exit, an atomic operation each, about 40 per washout and sample, which took half the

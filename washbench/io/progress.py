@@ -5,7 +5,13 @@
 The expected end is a straight line through the work done so far: with ``done`` of ``total`` units
 finished ``elapsed`` seconds after the start, the rest takes ``elapsed * (total - done) / done``. The
 units are what the command knows in advance: rows for ``cue``, steps (samples x candidates) for
-``sweep``, evaluations for ``tune``, manoeuvres for ``suite``.
+``sweep``, evaluations for ``tune``, manoeuvres for ``suite``. What a command pays once before or with its
+first units (starting its worker processes and, after an install, compiling the kernels: a minute on a loaded
+machine) must not stretch every estimate (a suite at 5 % once printed an end 28 minutes away, and ended 2
+minutes later; a ``cue`` of 216,000 rows at 4 % an end 3 minutes away, and ended 26 s later). So the line goes
+through the first update instead of the start once there is a later one: the rows or steps done since then, in
+the time since then. Where the units time themselves (the suite's runs, each timed in its worker:
+:meth:`Progress.timed`), the time counts from when the first of them started.
 
 Nothing is shown for work finished within :data:`QUIET_FOR_S` seconds (a short command stays silent).
 After that, on a terminal the bar overwrites itself (at most five times a second) and :meth:`Progress.close`
@@ -64,16 +70,32 @@ class Progress:
         self.tty = self.stream.isatty() if tty is None else tty
         self.clock, self.wall = clock, wall
         self.start = clock()
+        self.work_start: float | None = None
+        self._first: tuple[float, int] | None = None  # (clock, units) at the first update, shown or not
         self._last = -1e9
         self._tenth = 0
         self._shown = False
 
+    def timed(self, seconds: float) -> None:
+        """A unit just finished that took ``seconds`` where it ran (a suite run's wall time in its worker): the work
+        started at the latest ``seconds`` ago (:attr:`work_start`, the earliest such start)."""
+        began = self.clock() - max(float(seconds), 0.0)
+        self.work_start = began if self.work_start is None else min(self.work_start, began)
+
     def expected_end(self, done: int) -> tuple[float, float] | None:
-        """(seconds still to go, expected end as epoch seconds) after ``done`` units, None before the first."""
+        """(seconds still to go, expected end as epoch seconds) after ``done`` units, None before the first: the
+        straight line through the time elapsed since the work started (:meth:`timed`), else through the units
+        done since the first update (when more are), else since the start."""
         if done <= 0:
             return None
-        elapsed = self.clock() - self.start
-        left = elapsed * max(self.total - done, 0) / done
+        now = self.clock()
+        if self.work_start is not None:
+            rate = (now - max(self.work_start, self.start)) / done
+        elif self._first is not None and done > self._first[1] and now > self._first[0]:
+            rate = (now - self._first[0]) / (done - self._first[1])
+        else:
+            rate = (now - self.start) / done
+        left = rate * max(self.total - done, 0)
         return left, self.wall() + left
 
     def line(self, done: int, note: str = "") -> str:
@@ -95,6 +117,8 @@ class Progress:
         """Show the progress after ``done`` units (plus :attr:`offset`) when it is due."""
         done += self.offset
         now = self.clock()
+        if self._first is None:
+            self._first = (now, done)
         if now - self.start < QUIET_FOR_S and not self._shown:
             return
         tenth = int(10 * done / max(self.total, 1))

@@ -8,7 +8,9 @@
   helpers from another file and that file changes, the stale machine code would still be loaded. Each module
   that compiles in helpers from elsewhere calls :func:`drop_stale_cache` at import, before anything is compiled.
 - Saying so: the first command after an install or upgrade that needs a compiled function compiles it (the
-  washout kernel 10-20 s; the perception and metric sums, the recording's thinning a few seconds each).
+  washout kernel 13-20 s of CPU; the flight step, perception and metric sums, the recording's thinning a few
+  seconds each: a first ``washbench run`` took 22-23 s of CPU, 25-29 s on two idle cores and 60-80 s on a busy
+  machine, measured on the two-core development machine).
   :func:`announce_compile` is called before every compiled call a command makes from Python (it costs a flag test
   once it has looked) and prints one line to stderr, once per command, when the cache holds nothing for a function
   about to run: the suite's process server looks at every kernel its workers will run before it forks them
@@ -125,7 +127,8 @@ def announce_compile(*dispatchers: object) -> None:
             _announced = True
             print(
                 "washbench: compiling the numerical kernels for this machine (first use after an install or upgrade, "
-                f"10-30 s; kept in {_cache_place(folder)} for later commands)",
+                f"about 25 s on two idle cores, a minute or more on a busy machine; kept in {_cache_place(folder)} for "
+                "later commands)",
                 file=sys.stderr,
                 flush=True,
             )

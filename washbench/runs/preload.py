@@ -22,12 +22,16 @@ collector.tune()  # the server is a new interpreter: its own settings, before it
 
 import jsbsim  # noqa: E402, F401
 import pyarrow.parquet  # noqa: E402, F401
+from numba import types  # noqa: E402
 
 import washbench.perception.vestibular  # noqa: E402, F401
 from washbench.analysis.metric_sums import signal_metrics  # noqa: E402
 from washbench.cueing.bank import _warm_up, warm_up_block  # noqa: E402
 from washbench.cueing.kernel import bank_block, bank_step  # noqa: E402
+from washbench.flight.stepper import compiled_flight_step  # noqa: E402
 from washbench.numerics.jitcache import announce_compile  # noqa: E402
+from washbench.numerics.lazyjit import LazyJit  # noqa: E402
+from washbench.perception import svc  # noqa: E402
 from washbench.perception.sections import sections_apply  # noqa: E402
 from washbench.review.thinning import _changes, _keep  # noqa: E402
 
@@ -41,3 +45,24 @@ announce_compile(bank_block, bank_step, sections_apply, signal_metrics, _keep, _
 # using GNU OpenMP must not fork. The block step is the lockstep's; the per-sample step, JSBSim scripts'.
 warm_up_block()
 _warm_up()
+
+
+def _compile_run_kernels() -> None:
+    """Compile (or load from numba's cache) the serial kernels every run calls besides the cueing step, for the
+    argument types a run passes (C-contiguous float64 arrays, as each wrapper makes them), without running them:
+    the flight step, the metric sums, the sickness models and the recording's thinning. After an install or upgrade
+    each worker would otherwise compile them again in its first run (several seconds each, on every core at once),
+    which also made the suite's first runs, and the expected end printed from them, seem slower than the rest."""
+    a1, a2, f8, i8 = types.float64[::1], types.float64[:, ::1], types.float64, types.int64
+    svc_run = svc._run.compiled() if isinstance(svc._run, LazyJit) else svc._run
+    for kernel, signature in (
+        (compiled_flight_step(), (a1, a2)),
+        (signal_metrics, (a1, a1, f8)),
+        (svc_run, (a1, a1, a2, f8, a1, f8, a1, a1)),
+        (_keep, (a1, a2, a1, f8)),
+        (_changes, (a2, a1, i8)),
+    ):
+        kernel.compile(signature)  # type: ignore[attr-defined]
+
+
+_compile_run_kernels()

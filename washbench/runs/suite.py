@@ -155,7 +155,7 @@ def run_suite(
     try:
         if dask:
             for runs in dask_map(dask, _run_one, args):
-                outcomes[runs[0].path] = _report(runs, len(outcomes) + 1, len(files), start, shown)
+                outcomes[runs[0].path] = _report(runs, len(outcomes) + 1, len(files), start, shown, timed=False)
         elif jobs == 1:
             for a in args:
                 outcomes[a[0]] = _report(_run_one(*a), len(outcomes) + 1, len(files), start, shown)
@@ -173,8 +173,8 @@ def run_suite(
                         continue
                     outcomes[runs[0].path] = _report(runs, len(outcomes) + 1, len(files), start, shown)
                 for a in sorted(lost, key=args.index):  # each alone: the one whose worker dies again is the one
-                    runs = _run_alone(a, opts)
-                    outcomes[a[0]] = _report(runs, len(outcomes) + 1, len(files), start, shown)
+                    runs = _run_alone(a, opts)  # a fresh worker's start in its time: not a run's
+                    outcomes[a[0]] = _report(runs, len(outcomes) + 1, len(files), start, shown, timed=False)
                 if lost:  # what the dead workers were publishing (OUT/<aircraft>/.washbench-stage-PID)
                     for entry in sorted(out_dir.iterdir()):
                         if entry.is_dir() and not entry.is_symlink():
@@ -235,10 +235,17 @@ def _destination(out_dir: Path) -> Path:
     return out_dir.parent if out_dir.name.startswith(STAGE_PREFIX) else out_dir
 
 
-def _report(runs: list[Outcome], done: int, total: int, start: float, progress: Progress | None) -> list[Outcome]:
+def _report(
+    runs: list[Outcome], done: int, total: int, start: float, progress: Progress | None, timed: bool = True
+) -> list[Outcome]:
+    """Say that a file's runs are done; ``timed``: their wall time, measured in the worker, dates the start of the
+    work for the expected end, which then leaves out the pool's start (and a first compile) (not on a Dask
+    cluster, whose queue the workers' times do not date, nor for a run again after its worker died)."""
     for outcome in runs:
         _report_one(outcome, done, total, start, progress)
     if progress is not None:
+        if timed:
+            progress.timed(sum(o.wall_s for o in runs))
         progress.update(done)
     return runs
 
