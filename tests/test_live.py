@@ -699,7 +699,8 @@ def test_a_viewer_closed_while_running(tmp_path: Path, monkeypatch: pytest.Monke
     assert capsys.readouterr().err.count("the viewer was closed") == 1
     doc = run_json(tmp_path / "o")
     assert doc["live"]["viewer"] == "closed" and doc["live"]["counts"]["cued"] == 360
-    # what the viewer got before it closed: the recording's entity paths, the aircraft first, the sample's values
+    # what the viewer got before it closed: the recording's entity paths, the aircraft last (drawn on top, as in a
+    # recording), the sample's values
     from washbench.review.rerun_log import read_scalar_series
 
     series = read_scalar_series(rrd)
@@ -709,7 +710,7 @@ def test_a_viewer_closed_while_running(tmp_path: Path, monkeypatch: pytest.Monke
     # the values at each logged time are those of the result (the same step, the same filters chunk by chunk)
     table = pq.read_table(tmp_path / "o" / "traces.parquet").to_pydict()
     row_of = {round(v, 9): i for i, v in enumerate(table["t_s"])}
-    names = ("aircraft", "small-angle", "large-angle", "unrestricted")
+    names = ("small-angle", "large-angle", "unrestricted", "aircraft")
     tp, perceived = series["/perceived/surge"]
     np.testing.assert_array_equal(tp, t)
     for ti, raw, felt in zip(t, surge, perceived, strict=True):

@@ -67,8 +67,9 @@ def send_styles(rec: Any, names: Sequence[str]) -> None:
     from washbench.review.blueprint import AIRCRAFT_WIDTH, AXIS_COLORS, WASHOUT_WIDTH, source_colors  # deferred: rerun
     from washbench.review.rerun_log import AIRCRAFT, DOFS, perceived_path, platform_path, raw_path  # deferred: rerun
 
-    style = rr.SeriesLines(colors=source_colors(list(names)), names=[AIRCRAFT, *names],
-                           widths=[AIRCRAFT_WIDTH] + [WASHOUT_WIDTH] * len(names))  # fmt: skip
+    colors = source_colors(list(names))  # the aircraft's first: its line is drawn last, on top, as in a recording
+    style = rr.SeriesLines(colors=[*colors[1:], colors[0]], names=[*names, AIRCRAFT],
+                           widths=[WASHOUT_WIDTH] * len(names) + [AIRCRAFT_WIDTH])  # fmt: skip
     for dof, *_ in DOFS:
         rec.log(raw_path(dof), style, static=True)
         rec.log(perceived_path(dof), style, static=True)
@@ -144,8 +145,9 @@ class LiveViewer:
                 else:
                     raw = [np.degrees(wi[-1, axis]) for wi in w]
                     seen = [np.degrees(p.omega_radps[-1, axis]) for p in felt]
-                self.rec.log(raw_path(dof), rr.Scalars(np.asarray(raw, dtype=np.float64)))
-                self.rec.log(perceived_path(dof), rr.Scalars(np.asarray(seen, dtype=np.float64)))
+                # the washouts first, the aircraft last (drawn on top), the order of send_styles
+                self.rec.log(raw_path(dof), rr.Scalars(np.asarray([*raw[1:], raw[0]], dtype=np.float64)))
+                self.rec.log(perceived_path(dof), rr.Scalars(np.asarray([*seen[1:], seen[0]], dtype=np.float64)))
             for i, name in enumerate(self.names):
                 self.rec.log(platform_path(name, "position"), rr.Scalars(rows[i, O_POS : O_POS + 3]))
         except Exception:  # a viewer problem must never stop the session
