@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from scipy import signal
 from scipy.spatial.transform import Rotation
-from test_mpc import STRESS, _check_limits, _far_limits
+from test_mpc import STRESS, _check_limits, _far_limits, _run
 
 from washbench.analysis.signals import SignalSpec, generate
 from washbench.cueing.algorithm import WashoutAlgorithm, WashoutContext
@@ -153,15 +153,6 @@ def test_the_plan_minimises_the_independently_simulated_cost(limits):
     for _ in range(5):
         d = 0.01 * rng.standard_normal(z.size)
         assert _simulated_cost(w, z + d, f_air, w_air) > j0
-
-
-def _run(w, f: np.ndarray, om: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    w.start(f[0], om[0])
-    pos = np.empty((len(f), 3))
-    q = np.empty((len(f), 4))
-    for k in range(len(f)):
-        pos[k], q[k] = w.step(f[k], om[k])
-    return pos, q
 
 
 @pytest.mark.parametrize("spec", STRESS, ids=lambda s: f"{s.kind}-{s.axis}")

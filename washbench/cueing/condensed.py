@@ -101,6 +101,42 @@ def rows_kron3(m: np.ndarray) -> np.ndarray:
     return np.kron(m, np.eye(3))
 
 
+def horizon_reference(
+    current: np.ndarray,
+    mean: np.ndarray,
+    decay: np.ndarray,
+    future: np.ndarray | None,
+    index: int,
+    preview_s: float,
+    tp_s: float,
+    dt_s: float,
+) -> np.ndarray:
+    """The aircraft input over a horizon's intervals (N, k), for the MPC washouts: the ``current`` input (k,)
+    returning to its recent ``mean`` as ``decay`` (N,: e^{-gamma tp j}); with a recording ``future`` (n, k) of which
+    ``index`` is the current sample and ``preview_s`` > 0, the samples at the intervals' midpoints (at ``tp_s``,
+    samples ``dt_s`` apart, the last one held past the end) as far as the preview reaches, and beyond it the last
+    previewed value returning to the mean the same way."""
+    n_int = decay.shape[0]
+    out = mean + np.outer(decay, current - mean)
+    if future is None or preview_s <= 0.0:
+        return out
+    mid = tp_s * (np.arange(n_int) + 0.5)
+    seen = mid <= preview_s + 1e-9
+    idx = np.minimum(index + np.rint(mid / dt_s).astype(np.int64), len(future) - 1)
+    out[seen] = future[idx[seen]]
+    j = int(np.count_nonzero(seen))
+    if 0 < j < n_int:
+        out[j:] = mean + np.outer(decay[: n_int - j], out[j - 1] - mean)
+    return out
+
+
+def preview_needs_recording(section: dict) -> bool:
+    """An MPC washout's ``whole_only`` (:func:`washbench.cueing.registry.needs_whole`): with ``preview_s`` > 0 in
+    its parameter section it needs the recording in advance (cued after the flight, by its ``trace``)."""
+    value = section.get("preview_s", 0.0)
+    return isinstance(value, int | float) and value > 0.0
+
+
 class DenseQp:
     """``minimise 1/2 z' H z + f' z`` s.t. ``lo <= z <= hi`` (simple bounds), ``lo_A <= A z <= hi_A`` (rows with
     ``eq`` True: equalities) by DAQP, the workspace kept between solves (warm start from the last active set).
@@ -152,6 +188,8 @@ __all__ = [
     "SisoPrediction",
     "blocking_matrix",
     "default_blocks",
+    "horizon_reference",
+    "preview_needs_recording",
     "rows_kron3",
     "siso_prediction",
     "siso_state_space",

@@ -37,7 +37,7 @@ from pydantic import Field, model_validator
 from scipy import linalg
 
 from washbench.cueing.algorithm import SetPoint, WashoutContext
-from washbench.cueing.condensed import DenseQp
+from washbench.cueing.condensed import DenseQp, horizon_reference, preview_needs_recording
 from washbench.cueing.motion_model import CHANNELS, ChannelModel, channel_inputs, channel_model, discretise_zoh
 from washbench.cueing.optimal import merge_channel_defaults
 from washbench.errors import WashbenchError
@@ -268,11 +268,7 @@ class MpcWashout:
     Params = MpcParams
     name = "mpc"
 
-    @staticmethod
-    def whole_only(section: dict) -> bool:
-        """With ``preview_s`` > 0 it needs the recording in advance (cued after the flight, by :meth:`trace`)."""
-        value = section.get("preview_s", 0.0)
-        return isinstance(value, int | float) and value > 0.0
+    whole_only = staticmethod(preview_needs_recording)  # with preview_s > 0: cued after the flight, by trace()
 
     def __init__(self, params: MpcParams | None, context: WashoutContext) -> None:
         self.params = p = params if params is not None else MpcParams()
@@ -501,22 +497,10 @@ class MpcWashout:
         return u
 
     def _references(self, r: np.ndarray) -> np.ndarray:
-        """The aircraft input over the horizon's intervals (N, 6): the previewed samples (at the intervals'
-        midpoints) as far as ``preview_s`` reaches, then the last known returning to the recent mean as rho^k."""
-        rm = self.r_mean
-        R = rm + np.outer(self._decay, r - rm)
-        fut = self._future
-        if fut is None or self.params.preview_s <= 0.0:
-            return R
-        rr = fut
-        mid = self.tp * (np.arange(self.N) + 0.5)
-        seen = mid <= self.params.preview_s + 1e-9
-        idx = np.minimum(self._k + np.rint(mid / self.dt).astype(np.int64), len(rr) - 1)
-        R[seen] = rr[idx[seen]]
-        j = int(np.count_nonzero(seen))
-        if 0 < j < self.N:
-            R[j:] = rm + np.outer(self._decay[: self.N - j], R[j - 1] - rm)
-        return R
+        """The aircraft input over the horizon's intervals (N, 6) (:func:`washbench.cueing.condensed.horizon_reference`:
+        previewed as far as ``preview_s`` reaches, then returning to the recent mean as rho^k)."""
+        p = self.params
+        return horizon_reference(r, self.r_mean, self._decay, self._future, self._k, p.preview_s, self.tp, self.dt)
 
     def plan(self, r: np.ndarray) -> tuple[bool, np.ndarray]:
         """Solve the QP from the current state for the stacked aircraft input ``r`` (6,).

@@ -38,11 +38,20 @@ import numpy as np
 from pydantic import Field, model_validator
 
 from washbench.cueing.algorithm import SetPoint, WashoutContext
-from washbench.cueing.condensed import DenseQp, blocking_matrix, default_blocks, siso_prediction, siso_state_space
+from washbench.cueing.condensed import (
+    DenseQp,
+    blocking_matrix,
+    default_blocks,
+    horizon_reference,
+    preview_needs_recording,
+    siso_prediction,
+    siso_state_space,
+)
 from washbench.cueing.motion_model import discretise_zoh
 from washbench.cueing.mpc import VestibularChoice
 from washbench.errors import WashbenchError
 from washbench.io.yamlio import StrictModel
+from washbench.numerics.rotations import quat_from_euler
 from washbench.perception.vestibular import canal_tf, otolith_tf
 from washbench.platform.kinematics import brake_speed
 
@@ -213,9 +222,7 @@ def tilt_matched(f_mps2: np.ndarray) -> np.ndarray:
         return np.array([1.0, 0.0, 0.0, 0.0])
     phi = math.atan2(-f_mps2[1], -f_mps2[2])
     theta = math.asin(max(-1.0, min(1.0, f_mps2[0] / n)))
-    cp, sp = math.cos(0.5 * phi), math.sin(0.5 * phi)
-    ct, st = math.cos(0.5 * theta), math.sin(0.5 * theta)
-    return np.array([cp * ct, sp * ct, cp * st, -sp * st])
+    return np.array(quat_from_euler(phi, theta, 0.0))
 
 
 class MpcUnrestrictedWashout:
@@ -229,11 +236,7 @@ class MpcUnrestrictedWashout:
     Params = MpcUnrestrictedParams
     name = "mpc-unrestricted"
 
-    @staticmethod
-    def whole_only(section: dict) -> bool:
-        """With ``preview_s`` > 0 it needs the recording in advance (cued after the flight, by :meth:`trace`)."""
-        value = section.get("preview_s", 0.0)
-        return isinstance(value, int | float) and value > 0.0
+    whole_only = staticmethod(preview_needs_recording)  # with preview_s > 0: cued after the flight, by trace()
 
     def __init__(self, params: MpcUnrestrictedParams | None, context: WashoutContext) -> None:
         self.params = p = params if params is not None else MpcUnrestrictedParams()
@@ -263,6 +266,9 @@ class MpcUnrestrictedWashout:
         # per-sample (dt) discretisations of the error models, for applying a move exactly
         ao, bo, self._co = siso_state_space(*otolith_tf(v.otolith))
         ac, bc, self._cc = siso_state_space(*canal_tf(v.canals))
+        # per unit constant input, the models' steady states (2,) and (3,): -A^-1 B
+        self._oto_gain = -np.linalg.solve(ao, bo)
+        self._can_gain = -np.linalg.solve(ac, bc)
         self._phi_o, g = discretise_zoh(ao, bo[:, None], self.dt)
         self._gam_o = g[:, 0]
         self._phi_c, g = discretise_zoh(ac, bc[:, None], self.dt)
@@ -364,16 +370,14 @@ class MpcUnrestrictedWashout:
         self.fallbacks = 0
         self.iterations: list[int] = []
         self._sat_rot = False
-        self._future: tuple[np.ndarray, np.ndarray] | None = None
+        self._future: np.ndarray | None = None  # the recording (n, 6): f, omega, while trace() runs
         self._k = 0
 
     # ---- perception error models
     def _steady_states(self, e_f: np.ndarray, e_w: np.ndarray) -> None:
         """The error models' steady state for constant head-signal errors ``e_f`` (m/s^2), ``e_w`` (rad/s)."""
-        ao, bo, _ = siso_state_space(*otolith_tf(self.params.vestibular.otolith))
-        ac, bc, _ = siso_state_space(*canal_tf(self.params.vestibular.canals))
-        self.xo = -np.linalg.solve(ao, bo[:, None]) @ e_f[None, :]
-        self.xc = -np.linalg.solve(ac, bc[:, None]) @ e_w[None, :]
+        self.xo = np.outer(self._oto_gain, e_f)
+        self.xc = np.outer(self._can_gain, e_w)
 
     def _feel(self, f: np.ndarray, w: np.ndarray) -> None:
         """Advance the aircraft pilot's perception by one sample and add |perceived - perceived at the start| to the
@@ -414,10 +418,8 @@ class MpcUnrestrictedWashout:
         self.w = np.zeros(3)
         self._steady_states(self._head_force(self.q, np.zeros(3)) - f, -w)
         self._f_mean, self._w_mean = f.copy(), w.copy()
-        ao, bo, _ = siso_state_space(*otolith_tf(self.params.vestibular.otolith))
-        ac, bc, _ = siso_state_space(*canal_tf(self.params.vestibular.canals))
-        self._air_o = -np.linalg.solve(ao, bo[:, None]) @ f[None, :]
-        self._air_c = -np.linalg.solve(ac, bc[:, None]) @ w[None, :]
+        self._air_o = np.outer(self._oto_gain, f)
+        self._air_c = np.outer(self._can_gain, w)
         self._air_0 = (self._co @ self._air_o, self._cc @ self._air_c)
         self._felt = np.zeros(2)
         self._scale_used = 1.0
@@ -426,28 +428,12 @@ class MpcUnrestrictedWashout:
         return self.p.copy(), self.q.copy()
 
     def _reference(self, f: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The aircraft's specific force and rate over the horizon's intervals (N, 3) each: the previewed samples
-        (at the intervals' midpoints) as far as ``preview_s`` reaches, then the last known one returning to the recent
-        mean as e^{-gamma t}."""
-        fm, wm = self._f_mean, self._w_mean
-        F = fm + np.outer(self._decay, f - fm)
-        W = wm + np.outer(self._decay, w - wm)
-        fut = self._future
-        if fut is None or self.params.preview_s <= 0.0:
-            return F, W
-        ff, ww = fut
-        n = len(ff)
-        mid = self.tp * (np.arange(self.N) + 0.5)
-        seen = mid <= self.params.preview_s + 1e-9
-        idx = np.minimum(self._k + np.rint(mid / self.dt).astype(np.int64), n - 1)
-        F[seen] = ff[idx[seen]]
-        W[seen] = ww[idx[seen]]
-        j = int(np.count_nonzero(seen))
-        if j < self.N:
-            last_f, last_w = F[j - 1] if j else f, W[j - 1] if j else w
-            F[j:] = fm + np.outer(self._decay[: self.N - j], last_f - fm)
-            W[j:] = wm + np.outer(self._decay[: self.N - j], last_w - wm)
-        return F, W
+        """The aircraft's specific force and rate over the horizon's intervals, (N, 3) each
+        (:func:`washbench.cueing.condensed.horizon_reference`)."""
+        p = self.params
+        r = horizon_reference(np.concatenate([f, w]), np.concatenate([self._f_mean, self._w_mean]), self._decay,
+                              self._future, self._k, p.preview_s, self.tp, self.dt)  # fmt: skip
+        return r[:, :3], r[:, 3:]
 
     def _plan(self, f: np.ndarray, w: np.ndarray) -> tuple[bool, np.ndarray, np.ndarray]:
         """Solve this sample's QP; (solved, a moves (M, 3) inertial, omega moves (M, 3) body)."""
@@ -574,7 +560,7 @@ class MpcUnrestrictedWashout:
         n = len(f)
         pos = np.empty((n, 3))
         q = np.empty((n, 4))
-        self._future = (f, w)
+        self._future = np.hstack([f, w])
         try:
             for i in range(n):
                 pos[i], q[i] = self._advance(f[i], w[i])
