@@ -78,11 +78,12 @@ def in_thread(fn: Callable[[], None]) -> threading.Thread:
     return th
 
 
-def live(tmp_path: Path, fmt: str, port: int, name: str = "live", **kw: object) -> tuple[int, Path]:
+def live(tmp_path: Path, fmt: str, port: int, name: str = "live", washouts: list[str] | None = None,
+         **kw: object) -> tuple[int, Path]:  # fmt: skip
     outputs = Outputs(recording=bool(kw.pop("recording", False)), figures=False)
     opts = LiveOptions(listen=("127.0.0.1", port), fmt=fmt, out=tmp_path / name, idle_timeout_s=0.6, viewer=False,
                        **kw)  # type: ignore[arg-type]  # fmt: skip
-    return run_live(opts, load_options(outputs=outputs)), tmp_path / name
+    return run_live(opts, load_options(outputs=outputs, washouts=washouts)), tmp_path / name
 
 
 def assert_equals_cue(out: Path, tmp_path: Path, folders: tuple[str, ...] = ("",)) -> None:
@@ -299,44 +300,28 @@ def test_each_source_format_gives_the_cue_result(tmp_path: Path, fmt: str) -> No
         assert seen["cancelled"] == {packets.RREF_ID0 + i for i in range(len(packets.RREF_DATAREFS))}
 
 
-def test_washbench_format_result_equals_cue_of_the_original_file(tmp_path: Path) -> None:
-    """float64 end to end: the live result is also ``washbench cue`` of the file that was sent."""
+@pytest.mark.parametrize("washouts", [None, ["mpc", "mpc-unrestricted"]], ids=["default", "mpc"])
+def test_washbench_format_result_equals_cue_of_the_original_file(tmp_path: Path, washouts: list[str] | None) -> None:
+    """float64 end to end: the live result is also ``washbench cue`` of the file that was sent. With the MPC
+    washouts: stepped live, sample by sample as packets arrive, they give what ``cue`` gives with their
+    whole-recording form (``trace``), bit for bit."""
     m = motion()
     src = tmp_path / "flight.csv"
     src.write_text("t_s,f_x_mps2,f_y_mps2,f_z_mps2,omega_x_degps,omega_y_degps,omega_z_degps\n"
                    + "".join(",".join(repr(v) for v in r) + "\n" for r in m))  # fmt: skip
     port = free_udp_port()
     th = in_thread(_send_samples(port, "washbench", m))
-    status, out = live(tmp_path, "washbench", port)
+    status, out = live(tmp_path, "washbench", port, washouts=washouts)
     th.join(10)
     assert status == 0
-    run_cue(src, tmp_path / "orig", run=load_options(outputs=Outputs(recording=False, figures=False)))
+    run = load_options(outputs=Outputs(recording=False, figures=False), washouts=washouts)
+    run_cue(src, tmp_path / "orig", run=run)
     a = pq.read_table(out / "traces.parquet")
     b = pq.read_table(tmp_path / "orig" / "traces.parquet")
+    if washouts:
+        assert any(c.startswith("mpc-unrestricted.") for c in b.column_names)
     assert a.drop_columns(["live_held"]).equals(b)
     assert (out / "metrics.csv").read_text() == (tmp_path / "orig" / "metrics.csv").read_text()
-
-
-def test_the_mpc_washouts_run_live_and_equal_cue(tmp_path: Path) -> None:
-    """``mpc`` and ``mpc-unrestricted`` stepped live, sample by sample as packets arrive, give what ``washbench cue``
-    of the same file gives with their whole-recording form (``trace``), bit for bit."""
-    m = motion()
-    src = tmp_path / "flight.csv"
-    src.write_text("t_s,f_x_mps2,f_y_mps2,f_z_mps2,omega_x_degps,omega_y_degps,omega_z_degps\n"
-                   + "".join(",".join(repr(v) for v in r) + "\n" for r in m))  # fmt: skip
-    port = free_udp_port()
-    th = in_thread(_send_samples(port, "washbench", m))
-    both = load_options(outputs=Outputs(recording=False, figures=False), washouts=["mpc", "mpc-unrestricted"])
-    opts = LiveOptions(listen=("127.0.0.1", port), fmt="washbench", out=tmp_path / "live", idle_timeout_s=0.6,
-                       viewer=False)  # fmt: skip
-    status = run_live(opts, both)
-    th.join(10)
-    assert status == 0
-    run_cue(src, tmp_path / "orig", run=both)
-    a = pq.read_table(tmp_path / "live" / "traces.parquet")
-    b = pq.read_table(tmp_path / "orig" / "traces.parquet")
-    assert any(c.startswith("mpc-unrestricted.") for c in b.column_names)
-    assert a.drop_columns(["live_held"]).equals(b)
 
 
 def test_faults_are_counted_and_the_result_still_equals_cue(tmp_path: Path) -> None:
