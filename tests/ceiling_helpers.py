@@ -8,18 +8,18 @@ from __future__ import annotations
 import csv
 import json
 import subprocess
-import sys
 from pathlib import Path
 
+import inprocess
 import numpy as np
 import pytest
 from scipy import signal
 
 
 def washbench(*args: str | Path) -> subprocess.CompletedProcess[str]:
-    """The ``washbench`` command in a fresh process (the outputs as a user gets them)."""
-    return subprocess.run([sys.executable, "-m", "washbench", *map(str, args)], capture_output=True, text=True,
-                          timeout=1800)  # fmt: skip
+    """The ``washbench`` command (the outputs as a user gets them; in the test process where it can be:
+    :func:`inprocess.washbench`)."""
+    return inprocess.washbench(*args, timeout=1800)
 
 
 def read_csv(path: Path) -> list[dict[str, str]]:

@@ -11,6 +11,8 @@ import sys
 import tempfile
 from pathlib import Path
 
+import inprocess
+
 #: A short level flight (one phase of ``{seconds}`` s); ``{name}`` and ``{extra}`` (top-level lines) vary.
 SHORT = """\
 name: {name}
@@ -34,14 +36,9 @@ def short(folder: Path, name: str = "short", seconds: float = 1, extra: str = ""
 
 
 def washbench(*args: object, timeout: float = 60, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
-    """Run ``python -m washbench ARGS`` to its end, failing the test if it takes longer than ``timeout`` s."""
-    return subprocess.run(
-        [sys.executable, "-m", "washbench", *map(str, args)],
-        capture_output=True,
-        text=True,
-        timeout=timeout,
-        cwd=cwd,
-    )
+    """Run ``python -m washbench ARGS`` to its end, failing the test if it takes longer than ``timeout`` s: in the
+    test process where the command allows (:func:`inprocess.washbench`), else as a subprocess."""
+    return inprocess.washbench(*args, timeout=timeout, cwd=cwd)
 
 
 #: A progress line (washbench.io.progress.Progress.line, in a log): printed once a command has run for 2 s, so its

@@ -14,9 +14,9 @@ import math
 import os
 import shutil
 import subprocess
-import sys
 from pathlib import Path
 
+import inprocess
 import pytest
 
 from washbench.cli import _config_defaults, build_parser
@@ -31,9 +31,7 @@ def washbench(cwd: Path, *args: str) -> subprocess.CompletedProcess[str]:
     env = dict(os.environ, PYTHONPATH=str(REPO) + os.pathsep + os.environ.get("PYTHONPATH", ""))
     env.pop("WASHBENCH_AIRCRAFT_PATH", None)
     env.pop("WASHBENCH_CONFIG_USED", None)
-    return subprocess.run(
-        [sys.executable, "-m", "washbench", *args], cwd=cwd, capture_output=True, text=True, env=env, timeout=300
-    )
+    return inprocess.washbench(*args, cwd=cwd, env=env, timeout=300)
 
 
 def small_csv(path: Path) -> Path:

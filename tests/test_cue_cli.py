@@ -5,6 +5,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import inprocess
 import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
@@ -47,9 +48,7 @@ def write_csv(path: Path, cols: dict[str, np.ndarray]) -> Path:
 
 
 def cue(*args: str | Path) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [sys.executable, "-m", "washbench", "cue", *map(str, args)], capture_output=True, text=True, timeout=300
-    )
+    return inprocess.washbench("cue", *args, timeout=300)
 
 
 @pytest.fixture(scope="module")

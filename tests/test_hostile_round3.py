@@ -19,6 +19,7 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
+import inprocess
 import numpy as np
 import pytest
 from hostile import assert_clean_error, short, tree, washbench
@@ -295,8 +296,7 @@ def _small_csv(path: Path) -> Path:
 def _wb_in(cwd: Path, *args: object, env: dict[str, str] | None = None) -> subprocess.CompletedProcess[str]:
     full = {k: v for k, v in os.environ.items() if k not in ("WASHBENCH_CONFIG_USED", "WASHBENCH_SAFE_CONFIG")}
     full.update(env or {})
-    return subprocess.run([sys.executable, "-m", "washbench", *map(str, args)], cwd=cwd, capture_output=True,
-                          text=True, timeout=120, env=full)  # fmt: skip
+    return inprocess.washbench(*args, cwd=cwd, timeout=120, env=full)
 
 
 DEEP = "x = " + "[" * 100_000 + "]" * 100_000 + "\n"

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import json
 import subprocess
-import sys
 from pathlib import Path
 
+import inprocess
 import pytest
 from flight_helpers import BUNDLED, manoeuvre_id
 
@@ -56,7 +56,7 @@ EXPECTED = {
 
 
 def cli(*args: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "washbench", *args], capture_output=True, text=True)
+    return inprocess.washbench(*args, timeout=120)
 
 
 def test_every_corpus_file_has_an_expected_message() -> None:

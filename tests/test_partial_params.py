@@ -6,9 +6,9 @@ from __future__ import annotations
 
 import json
 import subprocess
-import sys
 from pathlib import Path
 
+import inprocess
 import pytest
 
 from washbench.analysis.signals import SignalSpec, generate
@@ -24,8 +24,7 @@ EXAMPLE = ROOT / "docs" / "examples" / "first_order_washout.py"
 
 
 def _wb(*args: object) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "washbench", *map(str, args)], capture_output=True, text=True,
-                          timeout=240)  # fmt: skip
+    return inprocess.washbench(*args, timeout=240)
 
 
 def test_only_a_plugins_section_runs_with_the_bundled_sections(tmp_path: Path) -> None:

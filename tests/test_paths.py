@@ -13,9 +13,9 @@ import os
 import re
 import shutil
 import subprocess
-import sys
 from pathlib import Path
 
+import inprocess
 import pytest
 
 from washbench.errors import WashbenchError
@@ -144,14 +144,7 @@ def test_bundled_manoeuvres_by_name(tmp_path: Path) -> None:
 
 
 def _cli(*args: str, cwd: Path, env: dict[str, str] | None = None) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [sys.executable, "-m", "washbench", *args],
-        cwd=cwd,
-        capture_output=True,
-        text=True,
-        timeout=300,
-        env={**os.environ, **(env or {})},
-    )
+    return inprocess.washbench(*args, cwd=cwd, timeout=300, env={**os.environ, **(env or {})})
 
 
 def test_a_renamed_copy_in_the_users_folder_flies_from_the_cli(tmp_path: Path, no_env: None) -> None:

@@ -6,9 +6,9 @@ import csv
 import json
 import re
 import subprocess
-import sys
 from pathlib import Path
 
+import inprocess
 import numpy as np
 import pyarrow.parquet as pq
 import pytest
@@ -30,9 +30,7 @@ DOF_COLUMNS = {
 
 
 def washbench(*args: str | Path) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [sys.executable, "-m", "washbench", *map(str, args)], capture_output=True, text=True, timeout=600
-    )
+    return inprocess.washbench(*args, timeout=600)
 
 
 @pytest.fixture(scope="module", params=MANOEUVRES, ids=lambda p: p.stem)

@@ -14,6 +14,7 @@ import urllib.error
 import urllib.request
 from pathlib import Path
 
+import inprocess
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
@@ -53,9 +54,7 @@ def recording(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 def run_cli(*args: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [sys.executable, "-m", "washbench", *args], capture_output=True, text=True, timeout=60, check=False
-    )
+    return inprocess.washbench(*args, timeout=60)
 
 
 def assert_one_line_error(out: subprocess.CompletedProcess[str], *needles: str) -> None:

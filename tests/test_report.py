@@ -10,9 +10,9 @@ import json
 import re
 import shutil
 import subprocess
-import sys
 from pathlib import Path
 
+import inprocess
 import numpy as np
 import pyarrow.parquet as pq
 import pytest
@@ -45,9 +45,7 @@ checks:
 
 
 def washbench(*args: str | Path) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [sys.executable, "-m", "washbench", *map(str, args)], capture_output=True, text=True, timeout=600
-    )
+    return inprocess.washbench(*args, timeout=600)
 
 
 def sha256(path: Path) -> str:
