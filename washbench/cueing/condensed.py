@@ -187,7 +187,8 @@ class WhitenedQp:
     """``minimise 1/2 z' H z + f' z`` s.t. ``lo <= z <= hi``, ``lo_A <= A z <= hi_A`` (fixed rows; ``eq`` True:
     equalities) and ``lo_V <= V z <= hi_V`` (rows that change at every solve), H fixed, by DAQP in the whitened
     variables y = R z (H = R' R, R upper triangular): 1/2 y' y + (R^-T f)' y, every row times R^-1, the simple
-    bounds on z rows R^-1 of their own.
+    bounds on z rows R^-1 of their own. Rows (and simple bounds) that ``bounded`` marks False (both bounds
+    infinite, for every solve) are left out.
 
     DAQP keeps M = A R^-1 and rebuilds it (O(rows n^2)) whenever A changes; with H = I here its update is a copy,
     and the changing rows come already whitened (:meth:`whiten` of their fixed factors, once), so a solve with new
@@ -195,18 +196,21 @@ class WhitenedQp:
     set). ``solve`` returns (ok, z, iterations) as :meth:`DenseQp.solve`.
     """
 
-    def __init__(self, H: np.ndarray, A: np.ndarray, eq: np.ndarray, n_var: int, iter_limit: int) -> None:
+    def __init__(self, H: np.ndarray, A: np.ndarray, eq: np.ndarray, n_var: int, iter_limit: int,
+                 bounded: np.ndarray) -> None:  # fmt: skip
         import daqp  # deferred: daqp (imported when an MPC washout is made)
 
         self.n = n = H.shape[0]
         r = linalg.cholesky(0.5 * (H + H.T), lower=False)
         self.r_inv = linalg.solve_triangular(r, np.eye(n), lower=False)
-        fixed = np.vstack([self.r_inv, np.asarray(A, dtype=np.float64) @ self.r_inv])
+        self._keep = np.flatnonzero(bounded)
+        fixed = np.vstack([self.r_inv, np.asarray(A, dtype=np.float64) @ self.r_inv])[self._keep]
         self.n_fixed = fixed.shape[0]
         self.A = np.zeros((self.n_fixed + n_var, n))
         self.A[: self.n_fixed] = fixed
         self.sense = np.zeros(self.A.shape[0], dtype=np.int32)
-        self.sense[n : self.n_fixed][np.asarray(eq, dtype=bool)] = 5
+        equality = np.concatenate([np.zeros(n, dtype=bool), np.asarray(eq, dtype=bool)])
+        self.sense[: self.n_fixed][equality[self._keep]] = 5
         self._eye = np.eye(n)
         self._model = daqp.Model()
         self._ready = False
@@ -224,10 +228,10 @@ class WhitenedQp:
     def solve(self, f: np.ndarray, lo: np.ndarray, hi: np.ndarray, var_lo: np.ndarray,
               var_hi: np.ndarray) -> tuple[bool, np.ndarray, int]:  # fmt: skip
         """Solve with this step's data: ``lo``/``hi`` for the simple bounds then the fixed rows, the bounds of the
-        changing rows (written into :attr:`var_rows` before)."""
+        changing rows (written into :attr:`var_rows` before); ``lo``/``hi`` cover every row, those left out too."""
         fy = self.r_inv.T @ f
-        up = np.concatenate([hi, var_hi])
-        low = np.concatenate([lo, var_lo])
+        up = np.concatenate([hi[self._keep], var_hi])
+        low = np.concatenate([lo[self._keep], var_lo])
         if not self._ready:
             flag, _ = self._model.setup(self._eye, fy, self.A, up, low, self.sense)
             self._model.settings = {"iter_limit": self.iter_limit}

@@ -425,7 +425,9 @@ class MpcWashout:
             rate_z[k, 1, :3] = vel @ self._Xu[k]
             rate_w[k, 1, :3] = vel @ self._Xw[k]
         margin = self.params.limit_margin
-        self.qp = qp = WhitenedQp(self.H_qp, self.A_qp, self._eq, 6 * N + 12 * k_rate, self.params.solver.iter_limit)
+        bounded = np.isfinite(self._lo) | np.isfinite(self._hi)  # (the box's positions are not: the legs instead)
+        self.qp = qp = WhitenedQp(self.H_qp, self.A_qp, self._eq, 6 * N + 12 * k_rate, self.params.solver.iter_limit,
+                                  bounded)  # fmt: skip
         self.legs = LegRows(hexapod, margin, qp.whiten(pose_z), pose_w, qp.whiten(rate_z), rate_w)
 
     def _total_rates(self, u: np.ndarray) -> np.ndarray:
