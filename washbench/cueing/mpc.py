@@ -12,6 +12,11 @@ previous step's active set; the states eliminated, :mod:`washbench.cueing.conden
                 |Delta omega|_1 <= margin * alpha_max * interval       (the first: over dt, from the current rate)
                 velocity_N = 0                                         (optional: the plan ends at rest)
 
+On a hexapod (``WashoutContext.platform`` a :class:`washbench.platform.hexapod.HexapodModel`) the position rows give
+way to the legs: their lengths at nodes 1..N and their speeds on the first moves, linearised about the current pose
+at every sample (:mod:`washbench.cueing.mpc_legs`), the QP then solved in whitened variables
+(:class:`washbench.cueing.condensed.WhitenedQp`) so that its changing rows stay cheap.
+
 with the state x of :mod:`washbench.cueing.motion_model` (perceived-error states of the otolith and canal models,
 cockpit angles, platform position and velocity; the pitch and roll angles split into a tilt part, whose rate is
 limited, and a rotational part), x_0 the washout's current state and r_k the aircraft input of this sample
