@@ -504,24 +504,25 @@ class MpcWashout:
         x1 = self.phi_f @ self.x + self.gam_f @ u0 + self._r_term
         p1 = x1[sm.i_pos]
         v1 = x1[sm.i_vel]
-        if self.hexapod is not None:
-            if not self._legs_safe(x1, u0) or np.any(np.abs(v1) > self.v_max):
-                return False
-        elif np.any(np.abs(p1) > self.p_max) or np.any(np.abs(v1) > self.v_max):
+        if np.any(np.abs(v1) > self.v_max) or np.any(np.abs(u0[sm.j_acc]) > self.a_max * (1 + 1e-9)):
             return False
-        if np.any(np.abs(u0[sm.j_acc]) > self.a_max * (1 + 1e-9)):
-            return False
-        for j in range(3 if self.hexapod is None else 0):
-            room = self.p_max[j] - p1[j] if v1[j] > 0 else self.p_max[j] + p1[j]
-            if abs(v1[j]) > brake_speed(room, self.a_max[j], self.dt) + 1e-9:
+        if self.hexapod is not None:  # its legs (the hexapod's own tracker brakes each leg at its stroke)
+            if not self._legs_safe(x1, u0):
                 return False
+        else:
+            if np.any(np.abs(p1) > self.p_max):
+                return False
+            for j in range(3):
+                room = self.p_max[j] - p1[j] if v1[j] > 0 else self.p_max[j] + p1[j]
+                if abs(v1[j]) > brake_speed(room, self.a_max[j], self.dt) + 1e-9:
+                    return False
         w = self._total_rates(u0)
         dw = np.linalg.norm(w - self._total_rates(self.u))
         return bool(np.linalg.norm(w) <= self.w_max and dw <= self.alpha_max * self.dt)
 
     def _legs_safe(self, x1: np.ndarray, u0: np.ndarray) -> bool:
-        """On a hexapod: whether every leg of the pose after the first move is within its stroke (exactly,
-        :func:`washbench.platform.hexapod.leg_lengths`) and its speed (to first order) within its limit."""
+        """On a hexapod: whether every leg of the pose after the first move is within its stroke (its length, not
+        linearised) and its speed (to first order: G [v; eta_dot]) within its limit."""
         hx = self.hexapod
         legs, g = self.legs.at(self._pose_sel @ x1)
         speed = g @ np.concatenate([x1[self.model.i_vel], self._rate_sel @ u0])
