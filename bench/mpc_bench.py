@@ -7,7 +7,10 @@ what a real-time loop sees on this shared machine, with preemption by other proc
 (``thread_time``, without it). Baseline in the same run: bare JSBSim ``fdm.run()`` (bench/baseline.py). The optimal
 washout's step is timed too.
 
-    python bench/mpc_bench.py [--seconds 30] [--horizons 10 20 40] [--manoeuvre PATH]
+    python bench/mpc_bench.py [--seconds 30] [--horizons 10 20 40] [--manoeuvre PATH] [--platform FILE]
+
+``--platform FILE``: the washouts are made for that platform file (as ``washbench run --platform``: the limits they
+plan against and the loaded file in their context); mpc-unrestricted is skipped on a platform it cannot drive.
 
 The real-time factor is (sample interval) / (time per step): above 1 the washout keeps up; at 120 Hz a step must
 take under 8.33 ms (issue 35's aim: at most 1 ms at the 99th percentile of CPU).
@@ -29,7 +32,7 @@ from washbench.cueing.optimal import OptimalWashout
 from washbench.flight.fly import fly
 from washbench.flight.manoeuvre import load_manoeuvre
 from washbench.io.paths import MANOEUVRES_DIR
-from washbench.platform.limits import load_platform_limits
+from washbench.platform.model import load_platform_model, planning_limits, platform_kind
 
 
 def head_motion(path: Path, seconds: float) -> tuple[np.ndarray, np.ndarray, float]:
@@ -60,12 +63,15 @@ def main() -> None:
     ap.add_argument("--seconds", type=float, default=30.0)
     ap.add_argument("--horizons", type=int, nargs="*", default=[10, 20, 40])
     ap.add_argument("--manoeuvre", type=Path, default=MANOEUVRES_DIR / "c172" / "steep_turn.yaml")
+    ap.add_argument("--platform", type=Path, default=None, help="platform file (default: the bundled Atlas)")
     args = ap.parse_args()
     f, w, dt = head_motion(args.manoeuvre, args.seconds)
-    ctx = WashoutContext(dt, 9.80665, load_platform_limits(), "steady", (0.0, 0.0, 0.0))
+    platform = load_platform_model(args.platform)
+    ctx = WashoutContext(dt, 9.80665, planning_limits(platform), "steady", (0.0, 0.0, 0.0), platform=platform)
     fdm = c172p_in_air(dt_s=dt)
     jsb_us = run_cpu_s(fdm, len(f)) / len(f) * 1e6
-    print(f"input: {args.manoeuvre.name}, {len(f)} samples at {1 / dt:.0f} Hz")
+    print(f"input: {args.manoeuvre.name}, {len(f)} samples at {1 / dt:.0f} Hz; platform: {platform.name} "
+          f"({platform_kind(platform)})")  # fmt: skip
     print(f"bare JSBSim fdm.run(): {jsb_us:.1f} us CPU per step")
     wall, cpu = time_steps(OptimalWashout(None, ctx), f, w)
     print(f"optimal: median {np.median(wall) * 1e6:.1f} us wall, {np.median(cpu) * 1e6:.1f} us CPU "
@@ -74,6 +80,9 @@ def main() -> None:
               "fallbacks  x_fdm.run")  # fmt: skip
     for name, cls, params in (("mpc", MpcWashout, MpcParams), ("mpc-unrestricted", MpcUnrestrictedWashout,
                                                                MpcUnrestrictedParams)):  # fmt: skip
+        if name == "mpc-unrestricted" and platform_kind(platform) != "atlas":
+            print(f"{name}: skipped (it cannot drive a {platform_kind(platform)})")
+            continue
         default_n = params().horizon_steps
         tp = params().prediction_step_s
         print(f"{name} (prediction step {tp} s; default horizon {default_n} steps = {default_n * tp:.1f} s):")

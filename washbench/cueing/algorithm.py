@@ -42,12 +42,14 @@ section of the parameter file named after the plugin (an instance of the class's
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Protocol, runtime_checkable
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 
 from washbench.platform.hexapod import MotionEnvelope
 from washbench.platform.limits import PlatformLimits
+from washbench.platform.model import PlatformModel
+from washbench.platform.plugins import PluginPlatform
 
 SetPoint = tuple[np.ndarray, np.ndarray]
 """(pos_m (3,) inertial NED, m; q (4,) body->inertial, scalar first)."""
@@ -63,7 +65,10 @@ class WashoutContext:
     platform enforces its own limits whatever the set points, an algorithm may use these to plan. filter_start:
     ``"steady"`` (the first sample is a steady state) or ``"rest"`` (the simulator was level and still before it).
     head_offset_m: the pilot's head from the cockpit centre (the motion reference point), simulator body axes, m.
-    platform: the loaded platform file of any kind (:data:`washbench.platform.model.PlatformModel`), or None.
+    platform: the loaded platform file of any kind (:data:`washbench.platform.model.PlatformModel`, a plugin's
+    :class:`washbench.platform.plugins.PluginPlatform`), or None (unknown: plan against ``limits`` alone). A washout
+    that knows a kind's own geometry plans against it from here: the ``mpc`` washout, on a hexapod
+    (:class:`washbench.platform.hexapod.HexapodModel`), against its legs (docs/optimal-mpc.md).
     """
 
     dt_s: float
@@ -71,7 +76,7 @@ class WashoutContext:
     limits: PlatformLimits | MotionEnvelope
     filter_start: str
     head_offset_m: tuple[float, float, float]
-    platform: Any = None
+    platform: PlatformModel | PluginPlatform | None = None
 
 
 @runtime_checkable

@@ -22,7 +22,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import signal
+from scipy import linalg, signal
 
 from washbench.cueing.motion_model import discretise_zoh
 
@@ -183,9 +183,73 @@ class DenseQp:
         return ok, z, int(info.get("iterations", 0))
 
 
+class WhitenedQp:
+    """``minimise 1/2 z' H z + f' z`` s.t. ``lo <= z <= hi``, ``lo_A <= A z <= hi_A`` (fixed rows; ``eq`` True:
+    equalities) and ``lo_V <= V z <= hi_V`` (rows that change at every solve), H fixed, by DAQP in the whitened
+    variables y = R z (H = R' R, R upper triangular): 1/2 y' y + (R^-T f)' y, every row times R^-1, the simple
+    bounds on z rows R^-1 of their own. Rows (and simple bounds) that ``bounded`` marks False (both bounds
+    infinite, for every solve) are left out.
+
+    DAQP keeps M = A R^-1 and rebuilds it (O(rows n^2)) whenever A changes; with H = I here its update is a copy,
+    and the changing rows come already whitened (:meth:`whiten` of their fixed factors, once), so a solve with new
+    rows costs O(rows n), not O(rows n^2). The workspace is kept between solves (warm start from the last active
+    set). ``solve`` returns (ok, z, iterations) as :meth:`DenseQp.solve`.
+    """
+
+    def __init__(self, H: np.ndarray, A: np.ndarray, eq: np.ndarray, n_var: int, iter_limit: int,
+                 bounded: np.ndarray) -> None:  # fmt: skip
+        import daqp  # deferred: daqp (imported when an MPC washout is made)
+
+        self.n = n = H.shape[0]
+        r = linalg.cholesky(0.5 * (H + H.T), lower=False)
+        self.r_inv = linalg.solve_triangular(r, np.eye(n), lower=False)
+        self._keep = np.flatnonzero(bounded)
+        fixed = np.vstack([self.r_inv, np.asarray(A, dtype=np.float64) @ self.r_inv])[self._keep]
+        self.n_fixed = fixed.shape[0]
+        self.A = np.zeros((self.n_fixed + n_var, n))
+        self.A[: self.n_fixed] = fixed
+        self.sense = np.zeros(self.A.shape[0], dtype=np.int32)
+        equality = np.concatenate([np.zeros(n, dtype=bool), np.asarray(eq, dtype=bool)])
+        self.sense[: self.n_fixed][equality[self._keep]] = 5
+        self._eye = np.eye(n)
+        self._model = daqp.Model()
+        self._ready = False
+        self.iter_limit = int(iter_limit)
+
+    def whiten(self, rows: np.ndarray) -> np.ndarray:
+        """Rows acting on z (..., n) as rows acting on y: ``rows R^-1``."""
+        return rows @ self.r_inv
+
+    @property
+    def var_rows(self) -> np.ndarray:
+        """The changing rows, whitened (n_var, n): a view to write this solve's rows into."""
+        return self.A[self.n_fixed :]
+
+    def solve(self, f: np.ndarray, lo: np.ndarray, hi: np.ndarray, var_lo: np.ndarray,
+              var_hi: np.ndarray) -> tuple[bool, np.ndarray, int]:  # fmt: skip
+        """Solve with this step's data: ``lo``/``hi`` for the simple bounds then the fixed rows, the bounds of the
+        changing rows (written into :attr:`var_rows` before); ``lo``/``hi`` cover every row, those left out too."""
+        fy = self.r_inv.T @ f
+        up = np.concatenate([hi[self._keep], var_hi])
+        low = np.concatenate([lo[self._keep], var_lo])
+        if not self._ready:
+            flag, _ = self._model.setup(self._eye, fy, self.A, up, low, self.sense)
+            self._model.settings = {"iter_limit": self.iter_limit}
+            self._ready = flag >= 0
+            if not self._ready:
+                return False, np.zeros(self.n), 0
+        else:
+            self._model.update(f=fy, A=self.A, bupper=up, blower=low)
+        y, _, flag, info = self._model.solve()
+        y = np.asarray(y, dtype=np.float64)
+        ok = flag in (1, 2) and y.shape == (self.n,) and bool(np.all(np.isfinite(y)))
+        return ok, (self.r_inv @ y if ok else np.zeros(self.n)), int(info.get("iterations", 0))
+
+
 __all__ = [
     "DenseQp",
     "SisoPrediction",
+    "WhitenedQp",
     "blocking_matrix",
     "default_blocks",
     "horizon_reference",

@@ -12,6 +12,11 @@ previous step's active set; the states eliminated, :mod:`washbench.cueing.conden
                 |Delta omega|_1 <= margin * alpha_max * interval       (the first: over dt, from the current rate)
                 velocity_N = 0                                         (optional: the plan ends at rest)
 
+On a hexapod (``WashoutContext.platform`` a :class:`washbench.platform.hexapod.HexapodModel`) the position rows give
+way to the legs: their lengths at nodes 1..N and their speeds on the first moves, linearised about the current pose
+at every sample (:mod:`washbench.cueing.mpc_legs`), the QP then solved in whitened variables
+(:class:`washbench.cueing.condensed.WhitenedQp`) so that its changing rows stay cheap.
+
 with the state x of :mod:`washbench.cueing.motion_model` (perceived-error states of the otolith and canal models,
 cockpit angles, platform position and velocity; the pitch and roll angles split into a tilt part, whose rate is
 limited, and a rotational part), x_0 the washout's current state and r_k the aircraft input of this sample
@@ -37,14 +42,16 @@ from pydantic import Field, model_validator
 from scipy import linalg
 
 from washbench.cueing.algorithm import SetPoint, WashoutContext
-from washbench.cueing.condensed import DenseQp, horizon_reference, preview_needs_recording
+from washbench.cueing.condensed import DenseQp, WhitenedQp, horizon_reference, preview_needs_recording
 from washbench.cueing.motion_model import CHANNELS, ChannelModel, channel_inputs, channel_model, discretise_zoh
+from washbench.cueing.mpc_legs import LEG_RATE_MOVES, LegRows
 from washbench.cueing.optimal import merge_channel_defaults
 from washbench.errors import WashbenchError
 from washbench.io.progress import duration_text
 from washbench.io.yamlio import StrictModel
 from washbench.numerics.rotations import quat_from_euler
 from washbench.perception.vestibular import CanalParams, OtolithParams
+from washbench.platform.hexapod import HexapodModel
 from washbench.platform.kinematics import brake_speed
 
 MAX_WORK = 10_000_000
@@ -278,6 +285,7 @@ class MpcWashout:
         if p.prediction_step_s < self.dt * (1.0 - 1e-9):
             raise ValueError(f"mpc: prediction_step_s {p.prediction_step_s} s is shorter than the sample {self.dt} s")
         self.model = sm = stacked_model(p, self.g)
+        self.hexapod = context.platform if isinstance(context.platform, HexapodModel) else None
         lim = context.limits
         self.p_max = np.array(lim.translation.position_limit_m.xyz)
         self.v_max = np.array(lim.translation.velocity_limit_mps.xyz)
@@ -296,7 +304,10 @@ class MpcWashout:
         self._decay = self.rho ** np.arange(self.N)
         self._mean_gain = -math.expm1(-self.dt / p.reference_mean_s)
         self._build_qp()
-        self.qp = DenseQp(self.nz, self.A_qp, self._eq, p.solver.iter_limit)
+        if self.hexapod is None:
+            self.qp: DenseQp | WhitenedQp = DenseQp(self.nz, self.A_qp, self._eq, p.solver.iter_limit)
+        else:
+            self._build_legs(self.hexapod)
         self.x = np.zeros(self.n)
         self.u = np.zeros(self.m)
         self.r_mean = np.zeros(6)
@@ -359,7 +370,8 @@ class MpcWashout:
         pv = np.concatenate([sm.i_pos, sm.i_vel])
         A_state = np.vstack([Xu[k][pv] for k in range(N)])  # (6N, nz)
         self._state_w = np.vstack([Xw[k][pv] for k in range(N)])  # their dependence on w
-        hi_state = np.tile(np.concatenate([mg * self.p_max, mg * self.v_max]), N)
+        p_box = mg * self.p_max if self.hexapod is None else np.full(3, np.inf)  # a hexapod: its legs instead
+        hi_state = np.tile(np.concatenate([p_box, mg * self.v_max]), N)
         rate = np.zeros((4 * N, nz))
         dacc = np.zeros((4 * N, nz))
         for k in range(N):
@@ -387,6 +399,41 @@ class MpcWashout:
         self._rows_dacc0 = slice(nz + n_s + 4 * N, nz + n_s + 4 * N + 4)
         self._dw0 = mg * self.alpha_max * self.dt
         self._tilt_max = tilt
+        self._Xu, self._Xw = Xu, Xw  # (for the hexapod's rows)
+
+    def _build_legs(self, hexapod: HexapodModel) -> None:
+        """On a hexapod: the QP in whitened variables (:class:`WhitenedQp`) with the legs' rows (:class:`LegRows`:
+        their lengths at nodes 1..N, their speeds on the first moves), rebuilt about the current pose at every
+        sample."""
+        sm, n, m, N, nz = self.model, self.n, self.m, self.N, self.nz
+        nw = n + 6 * N
+        sel = np.zeros((6, n))  # the pose [p; eta] of a state: position, and roll and pitch tilt + rotational
+        sel[[0, 1, 2], sm.i_pos] = 1.0
+        sel[[3, 4, 5], sm.i_tilt] = 1.0
+        sel[[3, 4], sm.i_rot] = 1.0
+        vel = np.zeros((3, n))
+        vel[[0, 1, 2], sm.i_vel] = 1.0
+        rates = np.zeros((3, m))  # the angle rates eta_dot of a move: tilt + rotational (roll, pitch), yaw
+        rates[[0, 1, 2], sm.j_rot] = 1.0
+        rates[[0, 1], sm.j_tilt] = 1.0
+        self._pose_sel, self._rate_sel = sel, rates
+        x0_w = np.hstack([np.eye(n), np.zeros((n, nw - n))])
+        pose_z = np.stack([sel @ self._Xu[k] for k in range(N)])
+        pose_w = np.stack([sel @ self._Xw[k] for k in range(N)])
+        k_rate = min(LEG_RATE_MOVES, N)
+        rate_z = np.zeros((k_rate, 2, 6, nz))
+        rate_w = np.zeros((k_rate, 2, 6, nw))
+        for k in range(k_rate):
+            rate_z[k, :, 3:, k * m : (k + 1) * m] = rates
+            rate_z[k, 0, :3] = vel @ self._Xu[k - 1] if k > 0 else 0.0
+            rate_w[k, 0, :3] = vel @ (self._Xw[k - 1] if k > 0 else x0_w)
+            rate_z[k, 1, :3] = vel @ self._Xu[k]
+            rate_w[k, 1, :3] = vel @ self._Xw[k]
+        margin = self.params.limit_margin
+        bounded = np.isfinite(self._lo) | np.isfinite(self._hi)  # (the box's positions are not: the legs instead)
+        self.qp = qp = WhitenedQp(self.H_qp, self.A_qp, self._eq, 6 * N + 12 * k_rate, self.params.solver.iter_limit,
+                                  bounded)  # fmt: skip
+        self.legs = LegRows(hexapod, margin, qp.whiten(pose_z), pose_w, qp.whiten(rate_z), rate_w)
 
     def _total_rates(self, u: np.ndarray) -> np.ndarray:
         sm = self.model
@@ -457,17 +504,30 @@ class MpcWashout:
         x1 = self.phi_f @ self.x + self.gam_f @ u0 + self._r_term
         p1 = x1[sm.i_pos]
         v1 = x1[sm.i_vel]
-        if np.any(np.abs(p1) > self.p_max) or np.any(np.abs(v1) > self.v_max):
+        if np.any(np.abs(v1) > self.v_max) or np.any(np.abs(u0[sm.j_acc]) > self.a_max * (1 + 1e-9)):
             return False
-        if np.any(np.abs(u0[sm.j_acc]) > self.a_max * (1 + 1e-9)):
-            return False
-        for j in range(3):
-            room = self.p_max[j] - p1[j] if v1[j] > 0 else self.p_max[j] + p1[j]
-            if abs(v1[j]) > brake_speed(room, self.a_max[j], self.dt) + 1e-9:
+        if self.hexapod is not None:  # its legs (the hexapod's own tracker brakes each leg at its stroke)
+            if not self._legs_safe(x1, u0):
                 return False
+        else:
+            if np.any(np.abs(p1) > self.p_max):
+                return False
+            for j in range(3):
+                room = self.p_max[j] - p1[j] if v1[j] > 0 else self.p_max[j] + p1[j]
+                if abs(v1[j]) > brake_speed(room, self.a_max[j], self.dt) + 1e-9:
+                    return False
         w = self._total_rates(u0)
         dw = np.linalg.norm(w - self._total_rates(self.u))
         return bool(np.linalg.norm(w) <= self.w_max and dw <= self.alpha_max * self.dt)
+
+    def _legs_safe(self, x1: np.ndarray, u0: np.ndarray) -> bool:
+        """On a hexapod: whether every leg of the pose after the first move is within its stroke (its length, not
+        linearised) and its speed (to first order: G [v; eta_dot]) within its limit."""
+        hx = self.hexapod
+        legs, g = self.legs.at(self._pose_sel @ x1)
+        speed = g @ np.concatenate([x1[self.model.i_vel], self._rate_sel @ u0])
+        lo, hi = hx.leg_length_m.min, hx.leg_length_m.max
+        return bool(np.all((legs >= lo) & (legs <= hi)) and np.all(np.abs(speed) <= hx.leg_velocity_limit_mps))
 
     def _fallback_move(self) -> np.ndarray:
         """The move of a failed step: the last accepted plan, continued (feasible for the platform: its limits do not
@@ -516,7 +576,11 @@ class MpcWashout:
         s = _FACETS @ self._total_rates(self.u)
         lo[self._rows_dacc0] = s - self._dw0
         hi[self._rows_dacc0] = s + self._dw0
-        ok, z, it = self.qp.solve(self.H_qp, self.F_qp @ w, lo, hi, h_changed=False)
+        if isinstance(self.qp, WhitenedQp):  # a hexapod: its legs, linearised about the current pose
+            leg_lo, leg_hi = self.legs.rows(self._pose_sel @ self.x, w, self.qp.var_rows)
+            ok, z, it = self.qp.solve(self.F_qp @ w, lo, hi, leg_lo, leg_hi)
+        else:
+            ok, z, it = self.qp.solve(self.H_qp, self.F_qp @ w, lo, hi, h_changed=False)
         self.solves += 1
         self.iterations.append(it)
         if not ok:
