@@ -53,10 +53,12 @@ def in_process(args: list[str]) -> bool:
 def washbench(
     *args: object, timeout: float = 60, cwd: Path | None = None, env: dict[str, str] | None = None
 ) -> subprocess.CompletedProcess[str]:
-    """Run ``python -m washbench ARGS`` to its end and return its status and output (text): in this process when
-    called from its main thread, :func:`in_process` allows and ``env`` (the whole environment, None: this process's) differs from this process's
-    only in washbench's own variables (``WASHBENCH_*``: read when a command runs, not when a module is imported),
-    else as a subprocess (``timeout`` s at most)."""
+    """Run ``python -m washbench ARGS`` to its end and return its status and output (text).
+
+    In this process when called from its main thread, :func:`in_process` allows, and ``env`` (the whole
+    environment; None: this process's) differs from this process's only in washbench's own variables
+    (``WASHBENCH_*``: read when a command runs, not when a module is imported); else as a subprocess (``timeout``
+    s at most)."""
     argv = [str(a) for a in args]
     # a command in another thread (tests that run several at once) is a process: the file descriptors and the
     # signal handlers are the process's

@@ -8,10 +8,10 @@ within the stroke, the leg speeds and accelerations within their limits, and agr
 
 import json
 import subprocess
-import sys
 from pathlib import Path
 from types import SimpleNamespace
 
+import inprocess
 import numpy as np
 import pyarrow.parquet as pq
 import pytest
@@ -34,8 +34,7 @@ HEXAPOD_WASHOUTS = ("small-angle", "large-angle", "adaptive", "adaptive-large-an
 
 
 def washbench(*args: object, timeout: float = 300) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "washbench", *map(str, args)], capture_output=True, text=True,
-                          timeout=timeout)  # fmt: skip
+    return inprocess.washbench(*args, timeout=timeout)
 
 
 def hexapod_file(path: Path) -> Path:
