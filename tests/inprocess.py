@@ -35,17 +35,20 @@ import threading
 import traceback
 from pathlib import Path
 
-#: The commands run in the test process: they start no process of their own (``suite``, ``sweep``, ``tune``,
-#: ``omct`` and ``live`` do) and read no plugin (a washout or platform plugin is registered for the process).
-IN_PROCESS = frozenset({"cue", "fly", "run", "report", "validate", "schema", "signal", "examples"})
+#: The commands run in the test process: they start no process of their own (``suite`` does, ``live`` serves and
+#: starts viewers) and read no plugin (a washout or platform plugin is registered for the process).
+IN_PROCESS = frozenset({"cue", "fly", "run", "report", "validate", "schema", "signal", "examples", "omct"})
+#: ... and these with ``--from`` (the flights already flown: without it they fly them in a pool of processes).
+IN_PROCESS_FROM = frozenset({"sweep", "tune"})
 #: Options that load code into the process or make it serve: such a command runs as a subprocess.
 SUBPROCESS_OPTIONS = ("--washout-plugin", "--platform-plugin", "--jobs", "--dask")
 
 
 def in_process(args: list[str]) -> bool:
-    """Whether ``washbench ARGS`` can run in the test process (:data:`IN_PROCESS`, no :data:`SUBPROCESS_OPTIONS`)."""
+    """Whether ``washbench ARGS`` can run in the test process (:data:`IN_PROCESS`, :data:`IN_PROCESS_FROM`, no
+    :data:`SUBPROCESS_OPTIONS`)."""
     command = next((a for a in args if not a.startswith("-")), None)
-    if command not in IN_PROCESS:
+    if command not in IN_PROCESS and not (command in IN_PROCESS_FROM and "--from" in args):
         return False
     return not any(a == o or a.startswith(o + "=") for a in args for o in SUBPROCESS_OPTIONS)
 
