@@ -8,19 +8,20 @@ between processes, so a kernel two processes need at once is compiled twice. Thi
 tests need once, in two lanes side by side (two cores), each lane one process after another into ``FOLDER``:
 
 - lane 1: the washout kernel's block step and streaming step (``bank_block``, ``bank_step``: the largest, about
-  15 s of CPU), then the whole-trace step (``bank_trace``, through ``cue_trace``) and a study's evaluation
-  (``evaluate_batch``, through ``FlightEvaluator``), which both call the block step compiled just before;
-- lane 2: ``washbench fly`` of a 1 s flight (the flight step); then, once lane 1's block step is in the cache (a
-  ``cue`` or ``run`` needs it: started earlier, it would compile it a second time), a ``washbench cue`` of a 1 s
-  input with every compiled washout (the adaptive washouts, perception, metrics, the sickness models), a
-  ``washbench run`` of the flight (the recording's thinning) and the set-point path of the Python washouts and
-  the other platforms (``setpoint_block``, ``setpoint_trace``: the MPC, the bound, plugins).
+  19 s of CPU, on which the whole-trace step and a study's evaluation build), then the whole-trace step
+  (``bank_trace``, through ``cue_trace``) and a ``washbench run`` of a 1 s flight (the recording's thinning);
+- lane 2, while lane 1 compiles the block step: ``washbench fly`` of the flight (the flight step), then the
+  set-point path (a washout computed outside the kernel, or another platform: ``setpoint_block``,
+  ``setpoint_trace``); once lane 1's block step is in the cache (started earlier, these would compile it a second
+  time), a study's evaluation (``evaluate_batch``, through ``FlightEvaluator``) and a ``washbench cue`` of a 1 s
+  input with every compiled washout (the adaptive washouts, perception, metrics, the sickness models).
 
 Then it writes ``FOLDER/done`` with their exit statuses; the workers wait for that file before their first test.
-The previous warm-up ran the block step and a ``cue`` side by side (both compiled ``bank_block``) and left the
-whole-trace step, the study's evaluation and the set-point path to the workers (each worker that needed one first
-compiled it). With the cache already filled, the commands load it (a few seconds in all). A failure here fails
-nothing: the tests that need a kernel compile it themselves and report what is wrong.
+The previous warm-up ran the whole-trace step and the evaluation one after the other behind the block step, and
+the set-point path last, while the other lane waited for the block step with nothing to do (34 s on two idle
+cores).
+With the cache already filled, the commands load it (a few seconds in all). A failure here fails nothing: the
+tests that need a kernel compile it themselves and report what is wrong.
 
 First, where Python is told not to write bytecode (``PYTHONDONTWRITEBYTECODE``, set on these machines), it writes
 washbench's ``.pyc`` files once (0.2 s): otherwise each of the test run's 300-odd ``washbench`` processes compiles
@@ -41,11 +42,10 @@ from hostile import short  # this script's folder, tests/, is first on sys.path
 COMPILED_WASHOUTS = ("small-angle", "large-angle", "unrestricted", "adaptive", "adaptive-large-angle",
                      "adaptive-unrestricted")  # fmt: skip
 
-#: Lane 1 after the block step: the whole-trace step and a study's evaluation, with the argument types ``cue``,
-#: ``omct``, the bound and ``sweep``/``tune`` pass (C-contiguous float64 arrays from the public functions).
-TRACE_AND_EVALUATION = """\
+#: After the block step: the whole-trace step (lane 1) and a study's evaluation (lane 2), with the argument types
+#: ``cue``, ``omct``, the bound and ``sweep``/``tune`` pass (C-contiguous float64 arrays from the public functions).
+_INPUT = """\
 import numpy as np
-from washbench.analysis.evaluate import FlightEvaluator
 from washbench.cueing import WASHOUT_NAMES, cue_trace, load_washout_params
 from washbench.cueing.variants import as_washouts
 from washbench.platform.model import load_platform_model
@@ -53,7 +53,10 @@ limits, params = load_platform_model(), load_washout_params()
 k = np.arange(240)
 f = np.column_stack([0.5 * (k > 30), 0.0 * k, -9.80665 + 0.0 * k])
 om = np.column_stack([np.radians(2.0) * (k > 60), 0.0 * k, 0.0 * k])
-cue_trace(f, om, 1 / 120, list(WASHOUT_NAMES), params, limits)
+"""
+TRACE = _INPUT + "cue_trace(f, om, 1 / 120, list(WASHOUT_NAMES), params, limits)\n"
+EVALUATION = _INPUT + """\
+from washbench.analysis.evaluate import FlightEvaluator
 FlightEvaluator(f, om, 1 / 120, limits).evaluate(as_washouts(list(WASHOUT_NAMES), params))
 """
 
@@ -87,14 +90,17 @@ def main(folder: Path) -> int:
     block = "from washbench.cueing.bank import _warm_up, warm_up_block; warm_up_block(); _warm_up()"
     lane1 = [
         [sys.executable, "-c", block],  # the block and streaming washout steps
-        [sys.executable, "-c", TRACE_AND_EVALUATION],
+        [sys.executable, "-c", TRACE],
+        [*washbench, "run", str(folder / "warm.yaml"), "--out", str(folder / "run"), "--no-figures", "--quiet"],
     ]
-    lane2_first = [*washbench, "fly", str(folder / "warm.yaml"), "--out", str(folder / "fly"), "--quiet"]
+    lane2_first = [
+        [*washbench, "fly", str(folder / "warm.yaml"), "--out", str(folder / "fly"), "--quiet"],
+        [sys.executable, "-c", SETPOINT],
+    ]
     lane2_then = [
+        [sys.executable, "-c", EVALUATION],
         [*washbench, "cue", str(folder / "warm.csv"), "--out", str(folder / "cue"), "--no-figures", "--no-recording",
          *washouts],  # the streamed washouts, perception, metrics, sickness
-        [*washbench, "run", str(folder / "warm.yaml"), "--out", str(folder / "run"), "--no-figures", "--quiet"],
-        [sys.executable, "-c", SETPOINT],
     ]  # fmt: skip
     statuses: dict[int, int] = {}
     block_done = threading.Event()
@@ -107,13 +113,15 @@ def main(folder: Path) -> int:
             run(0, lane1[0])
         finally:
             block_done.set()
-        run(1, lane1[1])
+        for i, command in enumerate(lane1[1:]):
+            run(1 + i, command)
 
     def second_lane() -> None:
-        run(2, lane2_first)
+        for i, command in enumerate(lane2_first):
+            run(3 + i, command)
         block_done.wait()
         for i, command in enumerate(lane2_then):
-            run(3 + i, command)
+            run(5 + i, command)
 
     try:
         lanes = [threading.Thread(target=first_lane), threading.Thread(target=second_lane)]
@@ -122,7 +130,7 @@ def main(folder: Path) -> int:
         for lane in lanes:
             lane.join()
     finally:
-        (folder / "done").write_text(" ".join(str(statuses.get(i)) for i in range(6)) + "\n")
+        (folder / "done").write_text(" ".join(str(statuses.get(i)) for i in range(7)) + "\n")
     return 0
 
 
