@@ -38,19 +38,37 @@ from pathlib import Path
 #: The commands run in the test process: they start no process of their own (``suite`` does, ``live`` serves and
 #: starts viewers) and read no plugin (a washout or platform plugin is registered for the process).
 IN_PROCESS = frozenset({"cue", "fly", "run", "report", "validate", "schema", "signal", "examples", "omct"})
-#: ... and these with ``--from`` (the flights already flown: without it they fly them in a pool of processes).
-IN_PROCESS_FROM = frozenset({"sweep", "tune"})
+#: ... and these with ``--from`` (the flights already flown) or one manoeuvre file to fly (more are flown in a pool
+#: of processes).
+STUDIES = frozenset({"sweep", "tune"})
 #: Options that load code into the process or make it serve: such a command runs as a subprocess.
 SUBPROCESS_OPTIONS = ("--washout-plugin", "--platform-plugin", "--jobs", "--dask")
 
 
 def in_process(args: list[str]) -> bool:
-    """Whether ``washbench ARGS`` can run in the test process (:data:`IN_PROCESS`, :data:`IN_PROCESS_FROM`, no
+    """Whether ``washbench ARGS`` can run in the test process (:data:`IN_PROCESS`, :data:`STUDIES`, no
     :data:`SUBPROCESS_OPTIONS`)."""
     command = next((a for a in args if not a.startswith("-")), None)
-    if command not in IN_PROCESS and not (command in IN_PROCESS_FROM and "--from" in args):
+    if command not in IN_PROCESS | STUDIES:
         return False
-    return not any(a == o or a.startswith(o + "=") for a in args for o in SUBPROCESS_OPTIONS)
+    if any(a == o or a.startswith(o + "=") for a in args for o in SUBPROCESS_OPTIONS):
+        return False
+    return command not in STUDIES or _one_flight_or_none(args)
+
+
+def _one_flight_or_none(args: list[str]) -> bool:
+    """Whether a study (``sweep``, ``tune``) flies at most one manoeuvre here: ``--from`` (none) or one file (its
+    training and ``--test`` manoeuvres, as washbench's own parser reads them); an argument error: yes (it stops
+    before flying anything)."""
+    from washbench.cli import build_parser
+
+    try:
+        with contextlib.redirect_stderr(io.StringIO()), contextlib.redirect_stdout(io.StringIO()):
+            ns = build_parser().parse_args(args)
+    except SystemExit:
+        return True
+    flights = [*ns.manoeuvres, *(getattr(ns, "test", None) or [])]
+    return ns.from_dir is not None or (len(flights) == 1 and Path(flights[0]).is_file())
 
 
 def washbench(

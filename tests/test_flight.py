@@ -4,10 +4,9 @@ from __future__ import annotations
 
 import json
 import math
-import subprocess
-import sys
 from pathlib import Path
 
+import inprocess
 import numpy as np
 import pyarrow.parquet as pq
 import pytest
@@ -227,9 +226,7 @@ phases:
 def test_monitor_stops_the_flight_keeps_the_record_and_fails(text: str, cause: str, tmp_path: Path) -> None:
     path = write(tmp_path, "bad_flight.yaml", text)
     out_dir = tmp_path / "out"
-    proc = subprocess.run(
-        [sys.executable, "-m", "washbench", "fly", str(path), "--out", str(out_dir)], capture_output=True, text=True
-    )
+    proc = inprocess.washbench("fly", path, "--out", out_dir, timeout=120)
     assert proc.returncode == 1
     assert "Traceback" not in proc.stderr
     summary = json.loads((out_dir / "flight.json").read_text())
@@ -245,11 +242,7 @@ def test_monitor_stops_the_flight_keeps_the_record_and_fails(text: str, cause: s
 
 def test_fly_cli_writes_files_and_prints_one_summary_line(tmp_path: Path) -> None:
     out_dir = tmp_path / "turn"
-    proc = subprocess.run(
-        [sys.executable, "-m", "washbench", "fly", str(C172 / "coordinated_turn.yaml"), "--out", str(out_dir)],
-        capture_output=True,
-        text=True,
-    )
+    proc = inprocess.washbench("fly", C172 / "coordinated_turn.yaml", "--out", out_dir, timeout=120)
     assert proc.returncode == 0, proc.stderr
     lines = proc.stdout.strip().splitlines()
     n_checks = len(load_manoeuvre(C172 / "coordinated_turn.yaml").checks)

@@ -5,10 +5,9 @@ from __future__ import annotations
 import itertools
 import json
 import math
-import subprocess
-import sys
 from pathlib import Path
 
+import inprocess
 import numpy as np
 import pytest
 import scipy.signal
@@ -184,8 +183,7 @@ def test_bad_inputs_are_one_line_with_file_line_and_field(
 def test_unknown_jsbsim_property_is_refused_at_start_up_by_the_cli(tmp_path: Path) -> None:
     typo = "properties: [{property: fcs/speedbrak-cmd-norm, shape: step, amplitude: 1}]"
     path = write(tmp_path, "bad.yaml", BASE.replace("INPUT", typo).replace("HOLD", "{}").replace("LIMIT", "10"))
-    out = subprocess.run([sys.executable, "-m", "washbench", "fly", str(path), "--out", str(tmp_path / "o")],
-                         capture_output=True, text=True)  # fmt: skip
+    out = inprocess.washbench("fly", path, "--out", tmp_path / "o", timeout=120)
     assert out.returncode == 2 and "Traceback" not in out.stderr
     assert out.stderr.strip() == (
         f"washbench: error: {path}:9: phases[0].inputs.properties[0].property: unknown JSBSim property "

@@ -8,10 +8,9 @@ from __future__ import annotations
 
 import csv
 import json
-import subprocess
-import sys
 from pathlib import Path
 
+import inprocess
 import jsbsim
 import numpy as np
 import pyarrow.parquet as pq
@@ -170,9 +169,8 @@ def test_a_script_that_sets_an_output_property_flies_as_plain_jsbsim(tmp_path: P
 
     work = tmp_path / "work"
     work.mkdir()
-    proc = subprocess.run([sys.executable, "-m", "washbench", "run", str(script), "--out", str(work / "out"),
-                           "--no-recording", "--no-figures", "--quiet"],
-                          capture_output=True, text=True, timeout=120, cwd=work)  # fmt: skip
+    proc = inprocess.washbench("run", script, "--out", work / "out", "--no-recording", "--no-figures", "--quiet",
+                               timeout=120, cwd=work)  # fmt: skip
     assert proc.returncode == 0, proc.stderr
     assert "Traceback" not in proc.stderr and "No property" not in proc.stderr
     flight = json.loads((work / "out" / "c172x" / "c1723" / "flight.json").read_text())
