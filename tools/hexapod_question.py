@@ -46,7 +46,10 @@ def main() -> None:
     atlas, atlas_best = scores(atlas_dir)
     hexa, hex_best = scores(hex_dir)
     keys = [k for k in hexa if k in atlas]
-    names = {w for k in keys for w in hexa[k]}
+    names = {w for k in keys for w in hexa[k] if all(w in atlas[j] and w in hexa[j] for j in keys)}
+    # "won" among the washouts both suites ran (a hexapod suite with --washout bound ranks its replay too)
+    atlas_best = {k: {w for w in names if atlas[k][w] == min(atlas[k][v] for v in names)} for k in keys}
+    hex_best = {k: {w for w in names if hexa[k][w] == min(hexa[k][v] for v in names)} for k in keys}
     order = ("small-angle", "large-angle", "adaptive", "adaptive-large-angle", "optimal", "mpc")
     washouts = [w for w in order if w in names] + sorted(names - set(order))
     print("| washout | mean score, Atlas | mean score, hexapod | won, Atlas | won, hexapod "
