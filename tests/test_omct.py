@@ -401,3 +401,26 @@ def test_small_angle_yaw_to_yaw_is_the_rotational_high_pass(omct_run: tuple[Path
         assert abs(gain_db) <= 0.5 and abs(dphase) <= 5.0, (w, gain_db, dphase)
         checked += 1
     assert checked == 10  # 0.1 .. 6.31 rad/s
+
+
+def test_a_bode_plot_drawn_after_others_has_the_pixels_of_one_drawn_alone(tmp_path: Path) -> None:
+    """``write_bode_plots`` draws each test into the previous test's emptied figure (a new figure's tick marks are
+    most of the drawing time): every PNG must have the bytes of the same plot drawn alone in a new figure, whatever
+    came before it (boundaries and their shading, a log or a linear gain axis, legends of other lengths)."""
+    from washbench.review.bode import write_bode_plots
+    from washbench.runs.omct import load_boundaries
+
+    bounds = load_boundaries(EXAMPLE_BOUNDARIES).bounds()
+    entries = [Washout("small-angle", "small-angle", PARAMS), Washout("unrestricted", "unrestricted", PARAMS)]
+    tests = [TESTS_BY_NAME[n] for n in ("pitch_to_pitch", "f_x_to_pitch", "yaw_to_yaw", "f_x_to_f_x")]
+    points, _ = measure(entries, LIMITS, rate_hz=30.0, tests=tests, frequencies_radps=[0.1, 1.0, 6.31],
+                        boundaries=bounds)  # fmt: skip
+    names = [e.name for e in entries]
+    (tmp_path / "together").mkdir()
+    together = write_bode_plots(tmp_path / "together", points, bounds, names)
+    assert sorted(together) == sorted(t.name for t in tests)
+    for test in tests:
+        alone = tmp_path / f"alone_{test.name}"
+        alone.mkdir()
+        (name,) = write_bode_plots(alone, [p for p in points if p.test == test.name], bounds, names).values()
+        assert (alone / name).read_bytes() == (tmp_path / "together" / together[test.name]).read_bytes(), test.name

