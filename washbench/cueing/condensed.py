@@ -19,6 +19,7 @@ warm-started from the previous step's active set, exact (no iteration tolerance 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -128,6 +129,17 @@ def horizon_reference(
     if 0 < j < n_int:
         out[j:] = mean + np.outer(decay[: n_int - j], out[j - 1] - mean)
     return out
+
+
+def stage_limits(limits: object) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, float]:
+    """The limits an MPC plans against, in SI: the stage's position, velocity and acceleration limits per inertial
+    axis (3,) each (m, m/s, m/s^2) and the rotation's rate and angular-acceleration limits (rad/s, rad/s^2), from
+    Atlas-shaped ``limits`` (:class:`washbench.platform.limits.PlatformLimits`, or the box about neutral that stands
+    for another platform)."""
+    t, r = limits.translation, limits.rotation
+    return (np.array(t.position_limit_m.xyz), np.array(t.velocity_limit_mps.xyz),
+            np.array(t.acceleration_limit_mps2.xyz), math.radians(r.rate_limit_degps),
+            math.radians(r.acceleration_limit_degps2))  # fmt: skip
 
 
 def preview_needs_recording(section: dict) -> bool:
@@ -257,4 +269,5 @@ __all__ = [
     "rows_kron3",
     "siso_prediction",
     "siso_state_space",
+    "stage_limits",
 ]

@@ -42,7 +42,13 @@ from pydantic import Field, model_validator
 from scipy import linalg
 
 from washbench.cueing.algorithm import SetPoint, WashoutContext
-from washbench.cueing.condensed import DenseQp, WhitenedQp, horizon_reference, preview_needs_recording
+from washbench.cueing.condensed import (
+    DenseQp,
+    WhitenedQp,
+    horizon_reference,
+    preview_needs_recording,
+    stage_limits,
+)
 from washbench.cueing.motion_model import CHANNELS, ChannelModel, channel_inputs, channel_model, discretise_zoh
 from washbench.cueing.mpc_legs import LEG_RATE_MOVES, LegRows
 from washbench.cueing.optimal import merge_channel_defaults
@@ -287,11 +293,7 @@ class MpcWashout:
         self.model = sm = stacked_model(p, self.g)
         self.hexapod = context.platform if isinstance(context.platform, HexapodModel) else None
         lim = context.limits
-        self.p_max = np.array(lim.translation.position_limit_m.xyz)
-        self.v_max = np.array(lim.translation.velocity_limit_mps.xyz)
-        self.a_max = np.array(lim.translation.acceleration_limit_mps2.xyz)
-        self.w_max = math.radians(lim.rotation.rate_limit_degps)
-        self.alpha_max = math.radians(lim.rotation.acceleration_limit_degps2)
+        self.p_max, self.v_max, self.a_max, self.w_max, self.alpha_max = stage_limits(lim)
         self.n, self.m = sm.B.shape
         self.tp = p.prediction_step_s
         self.N = max(p.horizon_steps, math.ceil(p.preview_s / self.tp - 1e-9))

@@ -46,6 +46,7 @@ from washbench.cueing.condensed import (
     preview_needs_recording,
     siso_prediction,
     siso_state_space,
+    stage_limits,
 )
 from washbench.cueing.motion_model import discretise_zoh
 from washbench.cueing.mpc import VestibularChoice
@@ -250,11 +251,7 @@ class MpcUnrestrictedWashout:
         if not hasattr(lim, "rotation") or not hasattr(lim, "translation"):
             raise WashbenchError("mpc-unrestricted: needs a platform of unlimited rotation (the Atlas)")
         mg = p.limit_margin
-        self.p_max = np.array(lim.translation.position_limit_m.xyz)
-        self.v_max = np.array(lim.translation.velocity_limit_mps.xyz)
-        self.a_max = np.array(lim.translation.acceleration_limit_mps2.xyz)
-        self.w_max = math.radians(lim.rotation.rate_limit_degps)
-        self.alpha_max = math.radians(lim.rotation.acceleration_limit_degps2)
+        self.p_max, self.v_max, self.a_max, self.w_max, self.alpha_max = stage_limits(lim)
         self.tp = tp = p.prediction_step_s
         self.N = N = max(p.horizon_steps, math.ceil(p.preview_s / tp - 1e-9))
         self.blocks = default_blocks(N)
