@@ -65,28 +65,28 @@ def write_bode_plots(
     out_dir: Path, points: Sequence[Any], bounds: dict[str, Bounds], washouts: Sequence[str]
 ) -> dict[str, str]:
     """Write ``bode_<test>.png`` for every test in ``points`` (OmctPoint); return test -> file name."""
+    by_test = {t.name: [p for p in points if p.test == t.name] for t in TESTS}
+    tests = [t for t in TESTS if by_test[t.name]]
+    if not tests:
+        return {}
     plt = _pyplot()
+    fig_axes = plt.subplots(2, 2, figsize=(11, 7), sharex=True)  # one figure, emptied for each next test
     files: dict[str, str] = {}
-    fig_axes = None
     try:
-        for test in TESTS:
-            pts = [p for p in points if p.test == test.name]
-            if pts:
-                fig_axes = _emptied(fig_axes) if fig_axes is not None else plt.subplots(2, 2, figsize=(11, 7),
-                                                                                          sharex=True)
-                files[test.name] = _bode_plot(fig_axes, Path(out_dir), test, pts, bounds, washouts)
+        for k, test in enumerate(tests):
+            if k:
+                _empty(fig_axes[1])
+            files[test.name] = _bode_plot(fig_axes, Path(out_dir), test, by_test[test.name], bounds, washouts)
     finally:
-        if fig_axes is not None:
-            plt.close(fig_axes[0])
+        plt.close(fig_axes[0])
     return files
 
 
-def _emptied(fig_axes: tuple[Any, Any]) -> tuple[Any, Any]:
-    """The figure of the previous test emptied of its data (lines, shading, texts, legends, titles, labels, scales,
+def _empty(axes: Any) -> None:
+    """Empty the figure of the previous test of its data (lines, shading, texts, legends, titles, labels, scales,
     data limits), to draw the next test in: the same bytes as a new figure (tested), without a new figure's axes
     creating their tick marks again, the larger part of a Bode plot's drawing (``washbench omct`` of four washouts and
     ten tests with boundaries: 11.5 s of CPU before, 7.9 s after)."""
-    fig, axes = fig_axes
     for ax in axes.flat:
         for artist in [*ax.lines, *ax.patches, *ax.texts, *ax.collections]:
             artist.remove()
@@ -100,7 +100,6 @@ def _emptied(fig_axes: tuple[Any, Any]) -> tuple[Any, Any]:
         ax.relim()
         ax.ignore_existing_data_limits = True
         ax.autoscale(True)
-    return fig, axes
 
 
 def _differs(gain: np.ndarray, phase_deg: np.ndarray, ref_gain: np.ndarray, ref_phase_deg: np.ndarray) -> bool:
