@@ -105,8 +105,9 @@ def _run_here(
     for stream in (sys.stdout, sys.stderr):
         stream.flush()
     saved_fds = (os.dup(1), os.dup(2))
-    saved = (sys.stdout, sys.stderr, sys.argv, sys.unraisablehook, os.getcwd(), dict(os.environ),
-             signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM))  # fmt: skip
+    streams = (sys.stdout, sys.stderr, sys.argv, sys.unraisablehook)
+    folder, environ = os.getcwd(), dict(os.environ)
+    handlers = {sig: signal.getsignal(sig) for sig in (signal.SIGINT, signal.SIGTERM)}
     with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
         os.dup2(out.fileno(), 1)
         os.dup2(err.fileno(), 2)
@@ -127,16 +128,15 @@ def _run_here(
             for stream in (sys.stdout, sys.stderr):
                 with contextlib.suppress(OSError, ValueError):  # a command that closed its stdout (a broken pipe)
                     stream.flush()
-            os.dup2(saved_fds[0], 1)
-            os.dup2(saved_fds[1], 2)
-            for fd in saved_fds:
-                os.close(fd)
-            sys.stdout, sys.stderr, sys.argv, sys.unraisablehook = saved[:4]
-            os.chdir(saved[4])
+            for fd, saved_fd in ((1, saved_fds[0]), (2, saved_fds[1])):
+                os.dup2(saved_fd, fd)
+                os.close(saved_fd)
+            sys.stdout, sys.stderr, sys.argv, sys.unraisablehook = streams
+            os.chdir(folder)
             os.environ.clear()
-            os.environ.update(saved[5])
-            signal.signal(signal.SIGINT, saved[6])
-            signal.signal(signal.SIGTERM, saved[7])
+            os.environ.update(environ)
+            for sig, handler in handlers.items():
+                signal.signal(sig, handler)
         texts = []
         for f in (out, err):
             f.seek(0)
