@@ -102,26 +102,28 @@ def main(folder: Path) -> int:
         [*washbench, "cue", str(folder / "warm.csv"), "--out", str(folder / "cue"), "--no-figures", "--no-recording",
          *washouts],  # the streamed washouts, perception, metrics, sickness
     ]  # fmt: skip
+    order = [*lane1, *lane2_first, *lane2_then]  # each command's number in FOLDER/done
     statuses: dict[int, int] = {}
     block_done = threading.Event()
 
-    def run(index: int, command: list[str]) -> None:
-        statuses[index] = subprocess.run(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL).returncode
+    def run(command: list[str]) -> None:
+        statuses[order.index(command)] = subprocess.run(command, stdout=subprocess.DEVNULL,
+                                                        stderr=subprocess.DEVNULL).returncode  # fmt: skip
 
     def first_lane() -> None:
         try:
-            run(0, lane1[0])
+            run(lane1[0])
         finally:
             block_done.set()
-        for i, command in enumerate(lane1[1:]):
-            run(1 + i, command)
+        for command in lane1[1:]:
+            run(command)
 
     def second_lane() -> None:
-        for i, command in enumerate(lane2_first):
-            run(3 + i, command)
+        for command in lane2_first:
+            run(command)
         block_done.wait()
-        for i, command in enumerate(lane2_then):
-            run(5 + i, command)
+        for command in lane2_then:
+            run(command)
 
     try:
         lanes = [threading.Thread(target=first_lane), threading.Thread(target=second_lane)]
@@ -130,7 +132,7 @@ def main(folder: Path) -> int:
         for lane in lanes:
             lane.join()
     finally:
-        (folder / "done").write_text(" ".join(str(statuses.get(i)) for i in range(7)) + "\n")
+        (folder / "done").write_text(" ".join(str(statuses.get(i)) for i in range(len(order))) + "\n")
     return 0
 
 
