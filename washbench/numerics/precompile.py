@@ -29,6 +29,9 @@ import subprocess
 import sys
 import time
 
+from washbench.io.cpus import usable_cpus
+from washbench.numerics.lazyjit import LazyJit
+
 #: numba type expressions (:mod:`numba.core.types`) of the arrays the commands pass: C-contiguous, writable.
 F1, F2, F3 = "float64[::1]", "float64[:, ::1]", "float64[:, :, ::1]"
 I1, I2 = "int64[::1]", "int64[:, ::1]"
@@ -85,15 +88,13 @@ KERNELS = (LANE_BLOCK, LANE_REST)
 
 def dispatcher(module: str, name: str) -> object:
     """The numba dispatcher of ``module.name`` (a lazily compiled function handed to numba first)."""
-    from washbench.numerics.lazyjit import LazyJit
-
     fn = getattr(importlib.import_module(module), name)
     return fn.compiled() if isinstance(fn, LazyJit) else fn
 
 
 def compile_lane(entries: tuple[tuple[str, str, str], ...]) -> int:
     """Compile (or load from the cache) each entry's signature; returns how many there were."""
-    from numba.core.sigutils import normalize_signature
+    from numba.core.sigutils import normalize_signature  # deferred: numba
 
     for module, name, signature in entries:
         args, _ = normalize_signature(signature)
@@ -104,8 +105,6 @@ def compile_lane(entries: tuple[tuple[str, str, str], ...]) -> int:
 
 
 def _lanes_default() -> int:
-    from washbench.io.cpus import usable_cpus
-
     return min(len(KERNELS), max(1, usable_cpus()))
 
 
