@@ -424,3 +424,47 @@ def test_a_bode_plot_drawn_after_others_has_the_pixels_of_one_drawn_alone(tmp_pa
         alone.mkdir()
         (name,) = write_bode_plots(alone, [p for p in points if p.test == test.name], bounds, names).values()
         assert (alone / name).read_bytes() == (tmp_path / "together" / together[test.name]).read_bytes(), test.name
+
+
+def test_bode_y_labels_inside_the_figure_clear_of_wide_tick_labels(tmp_path: Path) -> None:
+    """A gain spanning less than a decade (yaw_to_yaw, small-angle, 0.1 to 6.31 rad/s: 0.2 to 1) gets its minor
+    ticks labelled (``2x10^-1``), wider than major ones: the y-labels must still lie wholly inside the figure, left
+    of every tick label drawn, and the gain and phase labels above one another (measured by matplotlib's renderer
+    at the PNG's resolution)."""
+    from washbench.review.bode import _bode_plot, new_figure
+
+    test = TESTS_BY_NAME["yaw_to_yaw"]
+    points, _ = measure([Washout("small-angle", "small-angle", PARAMS)], LIMITS, rate_hz=30.0, tests=[test],
+                        frequencies_radps=[0.1, 1.0, 6.31])  # fmt: skip
+    fig, axes = new_figure()
+    try:
+        name = _bode_plot((fig, axes), tmp_path, test, points, {}, ["small-angle"])
+        assert (tmp_path / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+        renderer = fig.canvas.get_renderer()
+        figure_box = fig.bbox
+        assert (figure_box.width, figure_box.height) == (990, 630)  # 11 x 7 in at 90 dpi, as the PNG
+        labels = {}
+        for ax in axes[:, 0]:
+            label = ax.yaxis.label
+            box = label.get_window_extent(renderer)
+            labels[label.get_text()] = box
+            assert figure_box.x0 <= box.x0 and box.x1 <= figure_box.x1, (label.get_text(), box)
+            assert figure_box.y0 <= box.y0 and box.y1 <= figure_box.y1, (label.get_text(), box)
+            low, high = sorted(ax.get_ylim())
+            drawn = []  # the tick labels drawn: those of ticks within the axis' limits
+            for minor in (False, True):
+                ticks = zip(ax.yaxis.get_ticklocs(minor=minor), ax.yaxis.get_ticklabels(minor=minor), strict=True)
+                drawn += [(t.get_text(), t.get_window_extent(renderer)) for loc, t in ticks if low <= loc <= high]
+            drawn = [(text, tick_box) for text, tick_box in drawn if text]
+            assert drawn
+            for text, tick_box in drawn:
+                assert box.x1 < tick_box.x0 and not box.overlaps(tick_box), (label.get_text(), text, box, tick_box)
+        assert set(labels) == {"gain (-)", "phase (deg)"}
+        minor_gain = [t.get_text() for t in axes[0, 0].yaxis.get_ticklabels(minor=True) if t.get_text()]
+        assert any("times" in t for t in minor_gain), minor_gain  # the case of the bug: minor ticks labelled
+        gain, phase = labels["gain (-)"], labels["phase (deg)"]
+        assert abs(gain.x0 - phase.x0) < 0.5 and abs(gain.x1 - phase.x1) < 0.5, (gain, phase)
+    finally:
+        import matplotlib.pyplot as plt
+
+        plt.close(fig)

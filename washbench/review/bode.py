@@ -8,6 +8,12 @@ dotted line of the washout's colour, labelled "cue head estimate": a separate cu
 column: what the pilot perceives through the vestibular models, each simulator pilot against the aircraft pilot
 (black, dashed) for the same input. Non-linear points are drawn as crosses, points outside the boundaries get a red
 ring. matplotlib is imported lazily with the Agg backend (no display needed).
+
+Layout: fixed for every test, whatever the data. The left column's y-labels ("gain (-)", "phase (deg)") stand at one
+fixed distance from the figure's left edge (``_YLABEL_X``, a figure fraction), so they are always inside the
+figure and above one another; the axes start at ``_LEFT``, which leaves room between the labels and the axes
+for the widest tick labels these axes get: a log gain axis spanning less than a decade labels its minor ticks
+(``6x10^-1``, 53 px wide at the PNGs' 90 dpi), which matplotlib's own label placement would push off the figure.
 """
 
 from __future__ import annotations
@@ -24,6 +30,15 @@ from washbench.io.outfolder import uninterrupted
 
 _COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown", "tab:pink", "tab:olive")
 _STYLES = (("-", "o"), ("--", "s"), (":", "^"), ("-.", "D"))  # washouts that coincide stay visible
+_SIZE_IN = (11.0, 7.0)  # figure width, height [in]
+_DPI = 90  # of the figure and its PNG [pixels per inch]
+# The left column's y-labels: their right edge (the text's bottom, turned) at this fraction of the figure's width
+# from its left edge, 17.8 px; the label (10 pt) is 13 px wide turned, so it spans 4.8 to 17.8 px. The axes begin
+# at _LEFT, 87.1 px; the tick labels end 7 px before it. Measured gaps between a label and the left end of its
+# tick labels: 9 px for the widest minor label of gains in [1e-9, 10) (``2x10^-1``, 53 px), 3 px for gains below
+# 1e-9 (``2x10^-10``, 59 px), 18 px for a phase axis labelled ``-1000`` (42 px) (tests/test_omct.py checks one).
+_YLABEL_X = 0.018
+_LEFT = 0.088
 
 
 def _pyplot() -> Any:
@@ -70,7 +85,7 @@ def write_bode_plots(
     if not tests:
         return {}
     plt = _pyplot()
-    fig_axes = plt.subplots(2, 2, figsize=(11, 7), sharex=True)  # one figure, emptied for each next test
+    fig_axes = new_figure()  # one figure, emptied for each next test
     files: dict[str, str] = {}
     try:
         for k, test in enumerate(tests):
@@ -80,6 +95,12 @@ def write_bode_plots(
     finally:
         plt.close(fig_axes[0])
     return files
+
+
+def new_figure() -> tuple[Any, Any]:
+    """A new empty figure and its 2 x 2 axes (gain above phase; platform motion left, perceived right) for
+    :func:`_bode_plot`: the figure's size and resolution are those of the PNG."""
+    return _pyplot().subplots(2, 2, figsize=_SIZE_IN, dpi=_DPI, sharex=True)
 
 
 def _empty(axes: Any) -> None:
@@ -171,15 +192,18 @@ def _bode_plot(
         ax.set_xscale("log")
         ax.grid(True, which="both", alpha=0.3)
         ax.set_xlabel("frequency (rad/s)")
-    ag.set_ylabel("gain (-)")
-    aph.set_ylabel("phase (deg)")
+    from matplotlib.transforms import blended_transform_factory
+
+    for ax, label in ((ag, "gain (-)"), (aph, "phase (deg)")):  # at a fixed place, not pushed by the tick labels
+        ax.set_ylabel(label)
+        ax.yaxis.set_label_coords(_YLABEL_X, 0.5, transform=blended_transform_factory(fig.transFigure, ax.transAxes))
     ag.set_title(f"{test.input_axis} -> {test.output_axis}: platform motion at the pilot's head")
     apg.set_title("perceived (vestibular models)")
     ag.legend(fontsize=8, loc="best")
     apg.legend(fontsize=8, loc="best")
     fig.suptitle(f"OMCT {test.name}  (x: non-linear point; red ring: outside the boundaries)", fontsize=11)
-    fig.subplots_adjust(left=0.065, right=0.985, bottom=0.075, top=0.895, wspace=0.16, hspace=0.07)  # as tight
+    fig.subplots_adjust(left=_LEFT, right=0.985, bottom=0.075, top=0.895, wspace=0.16, hspace=0.07)  # as tight
     name = f"bode_{test.name}.png"
     with atomic_path(Path(out_dir) / name) as tmp:
-        fig.savefig(tmp, format="png", dpi=90)
+        fig.savefig(tmp, format="png", dpi=_DPI)
     return name
