@@ -11,6 +11,7 @@ and the cache filled (at install, or by the test session's warm-up, tests/warm_k
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -101,3 +102,21 @@ def test_the_list_names_compiled_functions_with_types_numba_reads() -> None:
             assert ret is None and args, signature
             assert (module, name, signature) not in seen
             seen.add((module, name, signature))
+
+
+def test_the_stale_cache_stamp_sits_where_numba_caches_the_kernels(tmp_path: Path) -> None:
+    """``drop_stale_cache`` keeps its stamp, and deletes stale files, in the folder numba caches a module's kernels in:
+    the package's ``__pycache__``, or ``NUMBA_CACHE_DIR`` where one is set (a read-only install's user cache)."""
+    code = (
+        "import sys; from pathlib import Path; from washbench.cueing import kernel; "
+        "from washbench.numerics.jitcache import _cache_dir; "
+        "print(_cache_dir(Path(kernel.__file__).resolve())); print(kernel.bank_block._cache._cache_path)"
+    )
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "numba")}
+    for environ in (env, {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}):
+        proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=environ, timeout=120)
+        assert proc.returncode == 0, proc.stderr
+        stamp_dir, numba_dir = proc.stdout.split()
+        assert Path(stamp_dir).resolve() == Path(numba_dir).resolve()
+    assert Path(stamp_dir).name == "__pycache__"  # the second: numba's default, next to the sources
+    assert (Path(numba_dir).parent / "kernel.py").is_file()

@@ -53,13 +53,19 @@ def configure_cache() -> None:
         numba.config.CACHE_DIR = folder
 
 
+def _any_function() -> None:
+    """A function to ask numba's cache locators with (see :func:`_cache_dir`)."""
+
+
 def _cache_dir(module_file: Path) -> Path:
     """The folder numba caches ``module_file``'s functions in (numba's own choice of locator)."""
     try:
         from numba.core.caching import FunctionCache
 
         for cls in FunctionCache._impl_class._locator_classes:
-            locator = cls.from_function(None, str(module_file))
+            # a locator reads its function's first line number (a disambiguator, not part of the folder): any
+            # function serves (``None`` raised AttributeError in numba 0.68, which sent every stamp to __pycache__)
+            locator = cls.from_function(_any_function, str(module_file))
             if locator is not None:
                 return Path(locator.get_cache_path())
     except (ImportError, AttributeError, TypeError):  # pragma: no cover - another numba's internals
