@@ -87,8 +87,15 @@ KERNELS = (LANE_BLOCK, LANE_REST)
 
 
 def dispatcher(module: str, name: str) -> object:
-    """The numba dispatcher of ``module.name`` (a lazily compiled function handed to numba first)."""
-    fn = getattr(importlib.import_module(module), name)
+    """The numba dispatcher of ``module.name``: through the module's own ``compiled_<name>()`` where it has one (the
+    flight step's drops a cache made stale by the pilot's source first, and stamps it, as a command's call does:
+    without the stamp the first command would drop the cache made here); else a lazily compiled function handed to
+    numba, or the dispatcher itself."""
+    mod = importlib.import_module(module)
+    accessor = getattr(mod, f"compiled_{name}", None)
+    if callable(accessor):
+        return accessor()
+    fn = getattr(mod, name)
     return fn.compiled() if isinstance(fn, LazyJit) else fn
 
 
