@@ -7,6 +7,9 @@
 - Stale: numba keys a cached function on its own source file only: when a jitted function inlines jitted
   helpers from another file and that file changes, the stale machine code would still be loaded. Each module
   that compiles in helpers from elsewhere calls :func:`drop_stale_cache` at import, before anything is compiled.
+- Compiled at install: building the package compiles every kernel into its cache
+  (:mod:`washbench.numerics.precompile`, run by ``setup.py``). What follows is for where that did not happen or
+  does not apply (another CPU or numba, a read-only install, ``WASHBENCH_NO_PRECOMPILE``).
 - Saying so: the first command after an install or upgrade that needs a compiled function compiles it (the
   washout kernel 13-20 s of CPU; the flight step, perception and metric sums, the recording's thinning a few
   seconds each: a first ``washbench run`` took 22-23 s of CPU, 25-29 s on two idle cores and 60-80 s on a busy
@@ -132,9 +135,10 @@ def announce_compile(*dispatchers: object) -> None:
         if compiles:
             _announced = True
             print(
-                "washbench: compiling the numerical kernels for this machine (first use after an install or upgrade, "
-                f"about 25 s on two idle cores, a minute or more on a busy machine; kept in {_cache_place(folder)} for "
-                "later commands)",
+                "washbench: compiling the numerical kernels for this machine (not compiled when washbench was "
+                "installed here: about 25 s on two idle cores, a minute or more on a busy machine; kept in "
+                f"{_cache_place(folder)} for later commands; `python -m washbench.numerics.precompile` compiles them "
+                "all)",
                 file=sys.stderr,
                 flush=True,
             )
