@@ -136,7 +136,7 @@ def announce_compile(*dispatchers: object) -> None:
             _announced = True
             print(
                 "washbench: compiling the numerical kernels for this machine (not compiled when washbench was "
-                "installed here: about 25 s on two idle cores, a minute or more on a busy machine; kept in "
+                "installed here: about 30 s on two idle cores, a minute or more on a busy machine; kept in "
                 f"{_cache_place(folder)} for later commands; `python -m washbench.numerics.precompile` compiles them "
                 "all)",
                 file=sys.stderr,
