@@ -9,9 +9,14 @@ column: what the pilot perceives through the vestibular models, each simulator p
 (black, dashed) for the same input. Non-linear points are drawn as crosses, points outside the boundaries get a red
 ring. matplotlib is imported lazily with the Agg backend (no display needed).
 
-Layout: fixed for every test, whatever the data. The left column's y-labels ("gain (-)", "phase (deg)") stand at one
-fixed distance from the figure's left edge (``_YLABEL_X``, a figure fraction), so they are always inside the
-figure and above one another; the axes start at ``_LEFT``, which leaves room between the labels and the axes
+One legend for both columns, outside every axes, in a strip between the suptitle and the panels' titles: each entry
+once (each washout's line style with its marker, its cue head estimate, the aircraft pilot), read row by row, in as
+many columns as fit the figure's width; the strip is as tall as the legend's rows and the panels' tops come
+down by as much, so the legend never covers a curve or a red ring, whatever the number of washouts.
+
+Layout: fixed for every test but for the legend's height. The left column's y-labels ("gain (-)", "phase (deg)")
+stand at one fixed distance from the figure's left edge (``_YLABEL_X``, a figure fraction), so they are always
+inside the figure and above one another; the axes start at ``_LEFT``, which leaves room between the labels and the axes
 for the widest tick labels these axes get: a log gain axis spanning less than a decade labels its minor ticks
 (``6x10^-1``, 53 px wide at the PNGs' 90 dpi), which matplotlib's own label placement would push off the figure.
 """
