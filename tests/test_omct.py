@@ -468,3 +468,59 @@ def test_bode_y_labels_inside_the_figure_clear_of_wide_tick_labels(tmp_path: Pat
         import matplotlib.pyplot as plt
 
         plt.close(fig)
+
+
+@pytest.mark.parametrize("copies", [1, 2])
+def test_bode_legend_covers_no_data_and_no_text(tmp_path: Path, copies: int) -> None:
+    """Four washouts (and eight: the four twice, under other names), each with its test line and its dotted "cue
+    head estimate" line, and the aircraft pilot: every legend of the Bode figure must lie wholly inside the figure
+    and outside every axes' data area (where the curves and the red rings are drawn), clear of the suptitle, the
+    titles, the axis labels and every tick label drawn; every washout named once (measured by matplotlib's renderer
+    at the PNG's resolution, after the PNG is written)."""
+    from matplotlib.transforms import Bbox
+
+    from washbench.review.bode import _bode_plot, new_figure
+    from washbench.runs.omct import load_boundaries
+
+    test = TESTS_BY_NAME["pitch_to_pitch"]
+    bounds = load_boundaries(EXAMPLE_BOUNDARIES).bounds()
+    kinds = ("small-angle", "large-angle", "unrestricted", "adaptive")
+    entries = [Washout(f"{k}-{c}" if c else k, k, PARAMS) for c in range(copies) for k in kinds]
+    points, _ = measure(entries, LIMITS, rate_hz=30.0, tests=[test], frequencies_radps=[0.1, 0.4, 0.63, 1.0, 6.31],
+                        boundaries=bounds)  # fmt: skip
+    assert any(p.gain_inside is False for p in points)  # a red ring is drawn: what the legend must not hide
+    names = [e.name for e in entries]
+    fig, axes = new_figure()
+    try:
+        _bode_plot((fig, axes), tmp_path, test, points, {test.name: bounds[test.name]}, names)
+        renderer = fig.canvas.get_renderer()
+        figure_box = fig.bbox
+        legends = [*fig.legends, *(ax.get_legend() for ax in axes.flat if ax.get_legend() is not None)]
+        assert legends
+        labels = [t.get_text() for legend in legends for t in legend.get_texts()]
+        assert len(labels) == len(set(labels)), labels  # the two columns' entries once
+        assert set(names) <= set(labels) and "aircraft pilot" in labels, labels
+        estimates = [n for n in names if f"{n}: cue head estimate (not the test)" in labels]
+        assert len(estimates) >= len(kinds), labels  # the long entries are there
+        texts = [fig._suptitle]  # the suptitle, the titles, the axis labels and the tick labels drawn
+        for ax in axes.flat:
+            texts += [ax.title, ax.xaxis.label, ax.yaxis.label]
+            for axis, (low, high) in ((ax.xaxis, ax.get_xlim()), (ax.yaxis, ax.get_ylim())):
+                low, high = sorted((low, high))
+                for locs, get_ticks in ((axis.get_majorticklocs(), axis.get_major_ticks),
+                                        (axis.get_minorticklocs(), axis.get_minor_ticks)):  # fmt: skip
+                    texts += [tick.label1 for tick in get_ticks(len(locs)) if low <= tick.get_loc() <= high]
+        texts = [t for t in texts if t is not None and t.get_visible() and t.get_text()]
+        assert len(texts) > 20
+        for legend in legends:
+            box = legend.get_window_extent(renderer)
+            assert figure_box.x0 <= box.x0 and box.x1 <= figure_box.x1, box
+            assert figure_box.y0 <= box.y0 and box.y1 <= figure_box.y1, box
+            for ax in axes.flat:
+                assert Bbox.intersection(box, ax.get_window_extent(renderer)) is None, (box, ax.get_title())
+            for t in texts:
+                assert not box.overlaps(t.get_window_extent(renderer)), (t.get_text(), box)
+    finally:
+        import matplotlib.pyplot as plt
+
+        plt.close(fig)
