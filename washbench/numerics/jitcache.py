@@ -120,6 +120,11 @@ def _cache_place(folder: str | None) -> str:
     return folder
 
 
+def cache_place() -> str:
+    """Where the package's kernels are cached, in words (:func:`_cache_place` of the package folder)."""
+    return _cache_place(str(_PACKAGE_DIR))
+
+
 def announce_compile(*dispatchers: object) -> None:
     """Print one line to stderr, once per process, if any of these jitted functions is about to be compiled.
 

@@ -1,6 +1,6 @@
 """Compile washbench's numba kernels ahead of their first use: at install (``setup.py``) or by hand.
 
-    python -m washbench.numerics.precompile [--lanes N]
+    python -m washbench.numerics.precompile [--lanes {1,2}]
 
 Every compiled function a command calls, with the argument types the commands pass (:data:`KERNELS`), is compiled
 into numba's on-disk cache (:mod:`washbench.numerics.jitcache` says where), so the first command after an install
@@ -16,20 +16,21 @@ read-only (the cache then goes to the user's cache folder), a kernel is compiled
 announced in one line (:func:`washbench.numerics.jitcache.announce_compile`). Run this module there to compile
 them all at once.
 
-The compiles are spread over ``--lanes`` processes (default: two where two CPUs are usable): the washout kernel's
-block step (the largest, about 18 s of CPU) and what builds on it in one, everything else in the other.
+The compiles run in two lanes, side by side in two processes where two CPUs are usable (``--lanes 1``: one after
+the other in this process): the washout kernel's block step (the largest, about 18 s of CPU) and what builds on
+it in one, everything else in the other.
 """
 
 from __future__ import annotations
 
 import argparse
 import importlib
-import os
 import subprocess
 import sys
 import time
 
 from washbench.io.cpus import usable_cpus
+from washbench.numerics.jitcache import cache_place
 from washbench.numerics.lazyjit import LazyJit
 
 #: numba type expressions (:mod:`numba.core.types`) of the arrays the commands pass: C-contiguous, writable.
@@ -99,8 +100,8 @@ def dispatcher(module: str, name: str) -> object:
     return fn.compiled() if isinstance(fn, LazyJit) else fn
 
 
-def compile_lane(entries: tuple[tuple[str, str, str], ...]) -> int:
-    """Compile (or load from the cache) each entry's signature; returns how many there were."""
+def compile_lane(entries: tuple[tuple[str, str, str], ...]) -> None:
+    """Compile (or load from the cache) each entry's signature."""
     from numba.core.sigutils import normalize_signature  # deferred: numba
 
     for module, name, signature in entries:
@@ -108,7 +109,6 @@ def compile_lane(entries: tuple[tuple[str, str, str], ...]) -> int:
         # a tuple of types, as a call passes them: numba keys its cache on the signature as given (a string would
         # be a key no call ever looks up)
         dispatcher(module, name).compile(tuple(args))
-    return len(entries)
 
 
 def _lanes_default() -> int:
@@ -120,8 +120,10 @@ def main(argv: list[str] | None = None) -> int:
         prog="python -m washbench.numerics.precompile", description=__doc__.splitlines()[0]
     )
     parser.add_argument(
-        "--lanes", type=int, default=None, help="processes side by side (default: usable CPUs, at most 2)"
-    )
+        "--lanes", type=int, choices=(1, len(KERNELS)), default=None,
+        help=f"{len(KERNELS)}: the lanes in processes side by side; 1: one after the other in this process (default: "
+        f"{len(KERNELS)} where as many CPUs are usable)",
+    )  # fmt: skip
     parser.add_argument("--lane", type=int, default=None, help=argparse.SUPPRESS)  # one lane, in this process
     args = parser.parse_args(argv)
     if args.lane is not None:
@@ -140,8 +142,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"washbench: precompiling lane(s) {failed} failed", file=sys.stderr)
             return 1
     n = sum(len(lane) for lane in KERNELS)
-    where = os.environ.get("NUMBA_CACHE_DIR") or "the __pycache__ folders of the package"
-    print(f"washbench: {n} compiled functions in numba's cache ({where}) in {time.monotonic() - t0:.0f} s",
+    print(f"washbench: {n} compiled functions in numba's cache ({cache_place()}) in {time.monotonic() - t0:.0f} s",
           file=sys.stderr)  # fmt: skip
     return 0
 
