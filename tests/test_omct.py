@@ -31,6 +31,7 @@ from __future__ import annotations
 import csv
 import math
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -426,6 +427,22 @@ def test_a_bode_plot_drawn_after_others_has_the_pixels_of_one_drawn_alone(tmp_pa
         assert (alone / name).read_bytes() == (tmp_path / "together" / together[test.name]).read_bytes(), test.name
 
 
+def _tick_labels_drawn(axis: Any, limits: tuple[float, float]) -> list[Any]:
+    """The tick labels (Text) a matplotlib ``axis`` draws: major and minor, of ticks within ``limits``, with text."""
+    low, high = sorted(limits)
+    labels = []
+    for locs, get_ticks in ((axis.get_majorticklocs(), axis.get_major_ticks),
+                            (axis.get_minorticklocs(), axis.get_minor_ticks)):  # fmt: skip
+        labels += [tick.label1 for tick in get_ticks(len(locs)) if low <= tick.get_loc() <= high]
+    return [t for t in labels if t.get_text()]
+
+
+def _assert_inside(box: Any, figure_box: Any, what: str) -> None:
+    """``box`` (a window extent) lies wholly inside ``figure_box``."""
+    assert figure_box.x0 <= box.x0 and box.x1 <= figure_box.x1, (what, box)
+    assert figure_box.y0 <= box.y0 and box.y1 <= figure_box.y1, (what, box)
+
+
 def test_bode_y_labels_inside_the_figure_clear_of_wide_tick_labels(tmp_path: Path) -> None:
     """A gain spanning less than a decade (yaw_to_yaw, small-angle, 0.1 to 6.31 rad/s: 0.2 to 1) gets its minor
     ticks labelled (``2x10^-1``), wider than major ones: the y-labels must still lie wholly inside the figure, left
@@ -448,17 +465,12 @@ def test_bode_y_labels_inside_the_figure_clear_of_wide_tick_labels(tmp_path: Pat
             label = ax.yaxis.label
             box = label.get_window_extent(renderer)
             labels[label.get_text()] = box
-            assert figure_box.x0 <= box.x0 and box.x1 <= figure_box.x1, (label.get_text(), box)
-            assert figure_box.y0 <= box.y0 and box.y1 <= figure_box.y1, (label.get_text(), box)
-            low, high = sorted(ax.get_ylim())
-            drawn = []  # the tick labels drawn: those of ticks within the axis' limits
-            for minor in (False, True):
-                ticks = zip(ax.yaxis.get_ticklocs(minor=minor), ax.yaxis.get_ticklabels(minor=minor), strict=True)
-                drawn += [(t.get_text(), t.get_window_extent(renderer)) for loc, t in ticks if low <= loc <= high]
-            drawn = [(text, tick_box) for text, tick_box in drawn if text]
+            _assert_inside(box, figure_box, label.get_text())
+            drawn = _tick_labels_drawn(ax.yaxis, ax.get_ylim())
             assert drawn
-            for text, tick_box in drawn:
-                assert box.x1 < tick_box.x0 and not box.overlaps(tick_box), (label.get_text(), text, box, tick_box)
+            for t in drawn:
+                tick_box = t.get_window_extent(renderer)
+                assert box.x1 < tick_box.x0 and not box.overlaps(tick_box), (label.get_text(), t.get_text(), box)
         assert set(labels) == {"gain (-)", "phase (deg)"}
         minor_gain = [t.get_text() for t in axes[0, 0].yaxis.get_ticklabels(minor=True) if t.get_text()]
         assert any("times" in t for t in minor_gain), minor_gain  # the case of the bug: minor ticks labelled
@@ -505,17 +517,12 @@ def test_bode_legend_covers_no_data_and_no_text(tmp_path: Path, copies: int) -> 
         texts = [fig._suptitle]  # the suptitle, the titles, the axis labels and the tick labels drawn
         for ax in axes.flat:
             texts += [ax.title, ax.xaxis.label, ax.yaxis.label]
-            for axis, (low, high) in ((ax.xaxis, ax.get_xlim()), (ax.yaxis, ax.get_ylim())):
-                low, high = sorted((low, high))
-                for locs, get_ticks in ((axis.get_majorticklocs(), axis.get_major_ticks),
-                                        (axis.get_minorticklocs(), axis.get_minor_ticks)):  # fmt: skip
-                    texts += [tick.label1 for tick in get_ticks(len(locs)) if low <= tick.get_loc() <= high]
+            texts += _tick_labels_drawn(ax.xaxis, ax.get_xlim()) + _tick_labels_drawn(ax.yaxis, ax.get_ylim())
         texts = [t for t in texts if t is not None and t.get_visible() and t.get_text()]
         assert len(texts) > 20
         for legend in legends:
             box = legend.get_window_extent(renderer)
-            assert figure_box.x0 <= box.x0 and box.x1 <= figure_box.x1, box
-            assert figure_box.y0 <= box.y0 and box.y1 <= figure_box.y1, box
+            _assert_inside(box, figure_box, "legend")
             for ax in axes.flat:
                 assert Bbox.intersection(box, ax.get_window_extent(renderer)) is None, (box, ax.get_title())
             for t in texts:
