@@ -58,6 +58,21 @@ def test_chunks_give_the_whole_trace_bit_for_bit(tmp_path: Path, filter_start: s
     assert streamed.review_table().keys() == whole.review_table().keys()
 
 
+def test_one_row_chunks_written_beside_the_next_one_are_not_overwritten(tmp_path: Path) -> None:
+    """Rows of one sample are contiguous views into the chunk buffer, which pyarrow takes without a copy; the
+    traces' writer thread still reads a chunk while the next is cued (write_trace_chunks), so a buffer reused at
+    once would be written over. The table must still be the whole-trace path's."""
+    m = motion(40)
+    specs = select_washouts(None, (), None)
+    limits = load_platform_limits(None)
+    path = tmp_path / "traces.parquet"
+    stream_cue(m, specs, limits, path, chunk_rows=1)
+    table = pq.read_table(path)
+    assert pq.ParquetFile(path).num_row_groups == m.n
+    for name, values in cue_motion(m, specs, None, limits).columns().items():
+        assert np.array_equal(table.column(name).to_numpy(), np.asarray(values)), name
+
+
 def test_progress_lines_when_stderr_is_not_a_terminal(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:

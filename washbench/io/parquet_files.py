@@ -6,6 +6,7 @@ The columns of the traces table are named in :mod:`washbench.io.columns`.
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
+from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -40,16 +41,34 @@ def write_trace_chunks(
     to Parquet at ``path`` (not atomic by itself), one row group each, with :func:`write_parquet`'s settings.
 
     ``metadata``: the schema's key-value metadata (provenance, :func:`washbench.io.provenance.parquet_metadata`).
+
+    Each chunk is converted and written (encoded and compressed: pyarrow releases the GIL for most of it) by a
+    writer thread while ``chunks`` makes the next one, so a second core is not left idle. The file is the same,
+    byte for byte, as written one chunk after another: the row groups are written in order, one at a time. So
+    a chunk's arrays must stay as they are until the chunk after the next one is asked for (a producer may fill
+    two buffers in turn, not one).
     """
-    writer = None
+    writer: pq.ParquetWriter | None = None
+    schema: pa.Schema | None = None
+
+    def write(chunk: Mapping[str, np.ndarray]) -> None:
+        nonlocal writer, schema
+        arrow = pa.table({name: pa.array(np.asarray(col)) for name, col in chunk.items()})
+        if writer is None:
+            schema = arrow.schema.with_metadata(dict(metadata)) if metadata else arrow.schema
+            writer = parquet_writer(path, schema)
+        writer.write_table(arrow.replace_schema_metadata(schema.metadata))
+
     try:
-        for chunk in chunks:
-            arrow = pa.table({name: pa.array(np.asarray(col)) for name, col in chunk.items()})
-            if writer is None:
-                schema = arrow.schema.with_metadata(dict(metadata)) if metadata else arrow.schema
-                writer = parquet_writer(path, schema)
-            writer.write_table(arrow.replace_schema_metadata(schema.metadata))
-    finally:
+        with ThreadPoolExecutor(max_workers=1, thread_name_prefix="washbench-traces") as pool:
+            pending: Future[None] | None = None
+            for chunk in chunks:  # made here while the writer writes the one before
+                if pending is not None:
+                    pending.result()  # one chunk in the writer at a time; its error raised here
+                pending = pool.submit(write, chunk)
+            if pending is not None:
+                pending.result()
+    finally:  # after the pool's end, which waits for a write still under way (an error in ``chunks``)
         if writer is not None:
             writer.close()
     if writer is None:

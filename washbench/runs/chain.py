@@ -365,13 +365,15 @@ def stream_cue(
         keep = tuple(dict.fromkeys(keep + _RELAXATION_FIELDS))
     kept = {w: {f: np.empty((n, _width(f, bank.platform))) for f in keep} for w in names}
     flags: dict[str, dict[str, np.ndarray]] = {w: {} for w in names}
-    buf = np.empty((len(names), min(chunk_rows, n), len(CueingBank.FIELDS)))
+    # two chunk buffers filled in turn: the traces' writer thread still reads the one before (write_trace_chunks)
+    bufs = [np.empty((len(names), min(chunk_rows, n), len(CueingBank.FIELDS))) for _ in range(2)]
 
     def tables() -> Iterator[dict[str, np.ndarray]]:
         """Cue the next chunk, keep what the review needs of it, and yield its traces.parquet rows."""
         for a in range(0, n, chunk_rows):
             b = min(n, a + chunk_rows)
             rows = slice(a, b)
+            buf = bufs[(a // chunk_rows) % 2]
             block = bank.steps(motion.f_mps2[rows], motion.omega_radps[rows], buf if b - a == buf.shape[1] else None)
             perceived = {AIRCRAFT: streams[AIRCRAFT].perceive(motion.f_mps2[rows], motion.omega_radps[rows])}
             sick[AIRCRAFT].update(motion.f_mps2[rows], motion.omega_radps[rows])
