@@ -1,7 +1,10 @@
 """The command-line front end: sub-commands exist and usage errors are one line."""
 
+import os
 import subprocess
 import sys
+
+from washbench.runs.beside import NO_BESIDE_ENV
 
 
 def run(*args: str) -> subprocess.CompletedProcess[str]:
@@ -39,7 +42,9 @@ HEAVY = ("scipy.linalg", "scipy.signal", "scipy.stats", "scipy.spatial", "rerun.
 
 
 def imported_by(args: list[str]) -> set[str]:
-    """The heavy packages a washbench command imports (it runs in a fresh interpreter)."""
+    """The heavy packages a washbench command imports (it runs in a fresh interpreter), all in one process: the
+    figures are not drawn in a child beside the recording (washbench.runs.beside), where their imports would not
+    be seen here (the child's are the command's, forked)."""
     code = (
         "import sys, contextlib, io\n"
         "from washbench.cli import main\n"
@@ -48,7 +53,8 @@ def imported_by(args: list[str]) -> set[str]:
         f"print(status, *sorted({{'.'.join(m.split('.')[:2 if m.startswith('scipy.') else 1])"
         f" for m in sys.modules if m.startswith({HEAVY!r}) or m in ('rerun', 'matplotlib')}}))\n"
     )
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    env = {**os.environ, NO_BESIDE_ENV: "1"}
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, env=env)
     assert out.returncode == 0, out.stderr
     status, *names = out.stdout.split()
     assert status == "0", out.stdout

@@ -23,6 +23,10 @@ class WashbenchError(Exception):
         text = message if not more else f"{message} (and {len(more)} more problem{'s' if len(more) > 1 else ''})"
         super().__init__(text)
 
+    def __reduce__(self) -> tuple[type[WashbenchError], tuple[str, tuple[str, ...]]]:
+        """Pickled with every problem (an error raised in a child process, :mod:`washbench.runs.beside`)."""
+        return type(self), (self.problems[0], self.problems[1:])
+
 
 class Terminated(BaseException):
     """SIGTERM arrived: raised in the main thread by the CLI's handler so cleanup code runs (exit 143).

@@ -491,9 +491,18 @@ def _image(png: Path, start: Path, alt: str, vector: bool | None = None) -> list
 
 
 def result_sections(
-    data: ResultData, figures: dict[str, Path], start: Path, level: int, brief: bool = False, vector: bool | None = None
+    data: ResultData,
+    figures: dict[str, Path],
+    start: Path,
+    level: int,
+    brief: bool = False,
+    vector: bool | None = None,
+    recording: bool | None = None,
 ) -> list[str]:
     """The body of one result's report; links relative to ``start`` (the folder report.md is in).
+
+    ``recording``: whether the result has a recording.rrd to link (None: whether the folder holds one now; a
+    report drawn while the recording is still being written, :mod:`washbench.runs.beside`, is told).
 
     ``brief`` (the suite report): without the envelope figure, checks and phases (they are in the result's own
     report, which the suite report links).
@@ -534,9 +543,9 @@ def result_sections(
         lines += [f"{h} Phases", "", "| phase | start (s) | end (s) |", "|---|---|---|"]
         lines += [f"| {n} | {t0:.2f} | {t1:.2f} |" for n, t0, t1 in data.phases]
         lines.append("")
-    recording = data.folder / RECORDING_FILE
-    if recording.exists():
-        rel = _rel(recording, start)
+    rrd = data.folder / RECORDING_FILE
+    if rrd.exists() if recording is None else recording:
+        rel = _rel(rrd, start)
         lines += [f"Recording: [{rel}]({rel}) (`washbench replay {rel}`).", ""]
     return lines
 
@@ -548,25 +557,30 @@ def _status_line(data: ResultData) -> list[str]:
 
 
 def write_result_report(
-    result_dir: Path, table: Mapping[str, np.ndarray] | None = None, pdf: bool = False, figures: bool = True
+    result_dir: Path,
+    table: Mapping[str, np.ndarray] | None = None,
+    pdf: bool = False,
+    figures: bool = True,
+    recording: bool | None = None,
 ) -> Path:
     """Write ``report.md`` and ``figures/`` for one result folder from its files; return the report's path.
 
     ``table``: the traces.parquet columns already in memory (not read again); ``pdf``: PDF figures besides the PNG;
-    ``figures=False``: none drawn (``--no-figures``; figures of an earlier run in the folder are removed).
+    ``figures=False``: none drawn (``--no-figures``; figures of an earlier run in the folder are removed);
+    ``recording``: whether recording.rrd is linked (None: whether the folder holds one now).
     """
 
     data = load_result(Path(result_dir), table, series=figures)
     stage = make_stage(data.folder)  # report.md and figures/ replace the previous ones together (links never followed)
     try:
-        _write_result_report(data, stage, pdf, figures)
+        _write_result_report(data, stage, pdf, figures, recording)
         replace_entries(data.folder, stage, [REPORT_FILE, FIGURES_DIR])
     finally:
         discard_stage(stage)
     return data.folder / REPORT_FILE
 
 
-def _write_result_report(data: ResultData, stage: Path, pdf: bool, figures: bool) -> None:
+def _write_result_report(data: ResultData, stage: Path, pdf: bool, figures: bool, recording: bool | None) -> None:
     drawn = result_figures(data, pdf, into=stage) if figures else {}
     lines = [f"# {data.title}", "", *_status_line(data)]
     checks = f", checks {sum(bool(c.get('passed')) for c in data.checks)}/{len(data.checks)}" if data.checks else ""
@@ -580,5 +594,5 @@ def _write_result_report(data: ResultData, stage: Path, pdf: bool, figures: bool
     lines += input_section(data.folder, pdf, _image, stage) if figures else []  # a cue result: the input as read, first
     lines += provenance_lines(data.provenance, data.created_utc)
     final = {k: data.folder / p.relative_to(stage) for k, p in drawn.items()}  # where they will be
-    lines += result_sections(data, final, data.folder, 2, vector=pdf)
+    lines += result_sections(data, final, data.folder, 2, vector=pdf, recording=recording)
     write_text_atomic(stage / REPORT_FILE, "\n".join(lines).rstrip() + "\n")

@@ -11,6 +11,7 @@ together), :func:`run_cue` (all of it, the whole set published at once).
 from __future__ import annotations
 
 import contextlib
+import functools
 import math
 import sys
 import time
@@ -38,6 +39,7 @@ from washbench.io.readers import Samples, read_samples
 from washbench.io.resample import check_gaps, check_step, resample, split_resets, to_motion, window
 from washbench.io.result_files import METRICS_FILE, RECORDING_FILE, RUN_FILE, TRACES_FILE
 from washbench.review.input_figure import draw_for_result, input_labels
+from washbench.runs.beside import beside
 from washbench.runs.bound_stage import bound_outputs
 from washbench.runs.chain import CueResult, aircraft_attitude, stream_cue
 from washbench.runs.options import RunOptions, load_options
@@ -181,10 +183,12 @@ def write_outputs(
     """Cueing and outputs: per segment (``out_dir`` itself, or ``out_dir/<segment>/`` when there are several) the
     files of a ``run`` result folder: traces.parquet (written as it is cued, :func:`stream_cue`), metrics.csv,
     run.json, ranking.csv, report.md and recording.rrd (unless ``run.outputs`` says not). Every file is written
-    under a temporary name and all are renamed into place together, then ranking.csv and report.md are written
-    (atomically) last, so a failure leaves no half-written file. Returns (summary, result) per segment;
-    ``start``: the command's start (``time.perf_counter()``) for run.json's wall time; ``run``: the washouts, the
-    platform, the filters' start state, the vestibular model and the optional outputs."""
+    under a temporary name and renamed into place once complete: traces.parquet, metrics.csv and run.json
+    together, then the recording, while the figures, ranking.csv and report.md are drawn from those beside it (in a
+    child process where a core is free, :mod:`washbench.runs.beside`), so a failure leaves no half-written file
+    (``out_dir`` is the command's stage, published whole). Returns (summary, result) per segment; ``start``: the
+    command's start (``time.perf_counter()``) for run.json's wall time; ``run``: the washouts, the platform, the
+    filters' start state, the vestibular model and the optional outputs."""
     recording, figures = run.outputs.recording, run.outputs.figures
     out_dir = Path(out_dir)
     if out_dir.exists() and not out_dir.is_dir():
@@ -200,55 +204,63 @@ def write_outputs(
             for seg in segments:
                 folder = result_path(out_dir, seg.name) if seg.name else out_dir
                 folder.mkdir(parents=True, exist_ok=True)
-                names = (TRACES_FILE, METRICS_FILE, RUN_FILE) + ((RECORDING_FILE,) if recording else ())
-                tmp = {name: stack.enter_context(atomic_path(folder / name)) for name in names}
-                meta = parquet_metadata(provenance) if provenance else None
-                if shown is not None:
-                    shown.offset = offset
-                result = stream_cue(
-                    seg.motion, run.washouts, run.limits, tmp[TRACES_FILE], meta,
-                    filter_start=run.filter_start, recording=recording, figures=figures, progress=shown,
-                    vestibular=run.vestibular_params,
-                )  # fmt: skip
-                offset += seg.motion.n
-                summary = segment_summary(input_path, seg, result, folder)
-                write_metrics_csv(tmp[METRICS_FILE], result.metrics)
-                extra = {
-                    "input": str(input_path),
-                    "segment": seg.name,
-                    "t_start_s": float(seg.motion.t_s[0]),
-                    "t_end_s": float(seg.motion.t_s[-1]),
-                    "filter_start": run.filter_start,
-                    "conversions": list(seg.notes),
-                    "input_labels": list(seg.labels),
-                    "warnings": [f.text for f in seg.findings],
-                    "algorithms": dict(result.algorithms),
-                }
+                with contextlib.ExitStack() as files:  # renamed into place together when all three are complete
+                    tmp = {name: files.enter_context(atomic_path(folder / name))
+                           for name in (TRACES_FILE, METRICS_FILE, RUN_FILE)}  # fmt: skip
+                    meta = parquet_metadata(provenance) if provenance else None
+                    if shown is not None:
+                        shown.offset = offset
+                    result = stream_cue(
+                        seg.motion, run.washouts, run.limits, tmp[TRACES_FILE], meta,
+                        filter_start=run.filter_start, recording=recording, figures=figures, progress=shown,
+                        vestibular=run.vestibular_params,
+                    )  # fmt: skip
+                    offset += seg.motion.n
+                    summary = segment_summary(input_path, seg, result, folder)
+                    write_metrics_csv(tmp[METRICS_FILE], result.metrics)
+                    extra = {
+                        "input": str(input_path),
+                        "segment": seg.name,
+                        "t_start_s": float(seg.motion.t_s[0]),
+                        "t_end_s": float(seg.motion.t_s[-1]),
+                        "filter_start": run.filter_start,
+                        "conversions": list(seg.notes),
+                        "input_labels": list(seg.labels),
+                        "warnings": [f.text for f in seg.findings],
+                        "algorithms": dict(result.algorithms),
+                    }
 
-                bound = bound_outputs(folder, result, run.washouts, run.limits, run.vestibular_params,
-                                      run.rank_rule, run.filter_start)  # fmt: skip
-                extra |= {"bound": bound} if bound else {}
-                if provenance:
-                    extra |= {"created_utc": created, "provenance": provenance}
-                write_run_json(tmp[RUN_FILE], summary, time.perf_counter() - start, extra)
-                if recording:
-                    title = f"{summary.aircraft} / {summary.manoeuvre}"
-                    q = recorded_attitude(seg.motion)
-                    props = flat_strings(provenance, created) if provenance else None
-                    write_run_recording(tmp[RECORDING_FILE], title, seg.motion, result, run.limits, q, [], props,
-                                        run.rank_rule, bound)
+                    bound = bound_outputs(folder, result, run.washouts, run.limits, run.vestibular_params,
+                                          run.rank_rule, run.filter_start)  # fmt: skip
+                    extra |= {"bound": bound} if bound else {}
+                    if provenance:
+                        extra |= {"created_utc": created, "provenance": provenance}
+                    write_run_json(tmp[RUN_FILE], summary, time.perf_counter() - start, extra)
+                if not recording:  # a recording of an earlier set would mislead
+                    (folder / RECORDING_FILE).unlink(missing_ok=True)
+                review = functools.partial(_review, input_path, seg, summary, result, figures, recording)
+                with beside(review, fork=figures and recording):
+                    if recording:
+                        with atomic_path(folder / RECORDING_FILE) as rrd:
+                            title = f"{summary.aircraft} / {summary.manoeuvre}"
+                            q = recorded_attitude(seg.motion)
+                            props = flat_strings(provenance, created) if provenance else None
+                            write_run_recording(rrd, title, seg.motion, result, run.limits, q, [], props,
+                                                run.rank_rule, bound)  # fmt: skip
                 done.append((summary, result))
-        for seg, (summary, result) in zip(segments, done, strict=True):  # last, as a suite's report: each written
-            if not recording:  # atomically once the rest is in place; an earlier recording would mislead
-                (summary.run_dir / RECORDING_FILE).unlink(missing_ok=True)
-            if figures and seg.labels:  # what was read, linked first in the report
-
-                title = f"{input_path.name}{f' {seg.name}' if seg.name else ''}"
-                draw_for_result(summary.run_dir, title, seg.motion, seg.labels, seg.notes)
-            write_run_review(summary.run_dir, summary, str(input_path), result.review_table(), figures)
     except OSError as exc:
         raise WashbenchError(located(out_dir, f"cannot write results: {exc.strerror or exc}")) from None
     return done
+
+
+def _review(
+    input_path: Path, seg: Segment, summary: RunSummary, result: CueResult, figures: bool, recording: bool
+) -> None:
+    """A cued segment's figures (the input as read first), ranking.csv and report.md, from its folder's files."""
+    if figures and seg.labels:  # what was read, linked first in the report
+        title = f"{input_path.name}{f' {seg.name}' if seg.name else ''}"
+        draw_for_result(summary.run_dir, title, seg.motion, seg.labels, seg.notes)
+    write_run_review(summary.run_dir, summary, str(input_path), result.review_table(), figures, recording)
 
 
 def run_cue(

@@ -24,6 +24,7 @@ looks complete; it replaces only a previous ``washbench run`` result of the same
 from __future__ import annotations
 
 import dataclasses
+import functools
 import sys
 import time
 from pathlib import Path
@@ -51,6 +52,7 @@ from washbench.io.provenance import flat_strings, utc_now
 from washbench.io.publish import check_replaceable
 from washbench.io.result_files import FLIGHT_FILE, RECORDING_FILE, REPORT_FILE, RUN_FILE
 from washbench.review.numbers import pct, sig
+from washbench.runs.beside import beside
 from washbench.runs.bound_stage import bound_outputs, lockstep_result, split_whole
 from washbench.runs.chain import (
     LOCKSTEP_BLOCK,
@@ -153,11 +155,6 @@ def write_cued_folder(
     bound = bound_outputs(folder, result, options.washouts, options.limits, options.vestibular_params,
                           options.rank_rule, options.filter_start)  # fmt: skip
     extra = {**(extra or {}), "bound": bound} if bound else extra
-    if options.outputs.recording:
-        title = f"{summary.aircraft} / {summary.manoeuvre}"
-        props = flat_strings(provenance, str((extra or {}).get("created_utc") or "")) if provenance else None
-        write_run_recording(folder / RECORDING_FILE, title, motion, result, options.limits, aircraft_q, phases, props,
-                            options.rank_rule, bound)
     ac = result.perceived["aircraft"]
     summary = dataclasses.replace(
         summary,
@@ -168,8 +165,16 @@ def write_cued_folder(
         saturations={w: dict(result.traces[w].saturation_counts) for w in options.washout_order},
     )
     write_run_json(folder / RUN_FILE, summary, time.perf_counter() - start, extra)
-    write_run_review(folder, dataclasses.replace(summary, run_dir=folder), table=result.columns(),
-                     figures=options.outputs.figures)  # fmt: skip
+    review = functools.partial(write_run_review, folder, dataclasses.replace(summary, run_dir=folder),
+                               table=result.columns(), figures=options.outputs.figures,
+                               recording=options.outputs.recording)  # fmt: skip
+    # the figures and report are drawn in a child process while the recording is written here (runs.beside)
+    with beside(review, fork=options.outputs.figures and options.outputs.recording):
+        if options.outputs.recording:
+            title = f"{summary.aircraft} / {summary.manoeuvre}"
+            props = flat_strings(provenance, str((extra or {}).get("created_utc") or "")) if provenance else None
+            write_run_recording(folder / RECORDING_FILE, title, motion, result, options.limits, aircraft_q, phases,
+                                props, options.rank_rule, bound)  # fmt: skip
     return summary
 
 

@@ -264,12 +264,14 @@ def write_run_review(
     source: str = "",
     table: Mapping[str, Any] | None = None,
     figures: bool = True,
+    recording: bool | None = None,
 ) -> None:
     """``ranking.csv`` and ``report.md`` of one result folder (the same tables as a suite's, for one run).
 
     The one call site for a result folder's report (``washbench run`` and ``washbench cue``); the report and its
     figures are built from the folder's files (:func:`washbench.review.report.write_result_report`), with the
-    traces.parquet columns taken from ``table`` when the caller still holds them; ``figures=False``: none drawn.
+    traces.parquet columns taken from ``table`` when the caller still holds them; ``figures=False``: none drawn;
+    ``recording``: whether the report links recording.rrd (None: whether the folder holds one now).
     """
     prov = (read_marker(run_dir, RUN_MARKER) or {}).get("provenance")
     rule = rule_from_record(prov.get("ranking") if isinstance(prov, dict) else None)
@@ -277,6 +279,6 @@ def write_run_review(
         {(summary.aircraft, summary.manoeuvre): rank(summary.metrics, summary.motion, rule)} if summary.metrics else {}
     )
     write_text_atomic(run_dir / RANKING_FILE, ranking_table(rankings, rule))
-    write_result_report(run_dir, table, figures=figures)
+    write_result_report(run_dir, table, figures=figures, recording=recording)
 
 

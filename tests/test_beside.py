@@ -1,0 +1,172 @@
+"""Work beside the command in a forked child (washbench.runs.beside): where it runs, what comes back, what a
+failure on either side leaves; and a cued result the same, file for file, with the figures drawn beside the
+recording or after it in one process."""
+
+from __future__ import annotations
+
+import os
+import signal
+import time
+from pathlib import Path
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.csv as pacsv
+import pytest
+
+from washbench.errors import WashbenchError
+from washbench.runs import beside as beside_mod
+from washbench.runs.beside import NO_BESIDE_ENV, beside, can_fork
+
+pytestmark = pytest.mark.skipif(not can_fork(), reason="no second usable CPU, or not Linux: nothing is forked")
+
+
+def _write_pid(path: Path) -> None:
+    path.write_text(str(os.getpid()))
+
+
+def test_the_work_runs_in_another_process_while_the_block_runs(tmp_path: Path) -> None:
+    mark, order = tmp_path / "pid", []
+    with beside(lambda: (_write_pid(mark), time.sleep(0.2))) as forked:
+        order.append("block")
+    assert forked
+    pid = int(mark.read_text())  # written by the time the block's end has waited for the child
+    assert pid != os.getpid()
+    with pytest.raises(ProcessLookupError):  # reaped: no zombie left
+        os.kill(pid, 0)
+
+
+def test_without_a_fork_the_work_runs_here_after_the_block(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv(NO_BESIDE_ENV, "1")
+    mark, order = tmp_path / "pid", []
+    with beside(lambda: (order.append("work"), _write_pid(mark))) as forked:
+        order.append("block")
+    assert not forked and order == ["block", "work"] and int(mark.read_text()) == os.getpid()
+    monkeypatch.delenv(NO_BESIDE_ENV)
+    with beside(lambda: order.append("small"), fork=False) as forked:  # not worth a process
+        assert not forked
+
+
+def _fail_with_problems() -> None:
+    raise WashbenchError("a.yaml:3: bank_deg: expected a number", ["a.yaml:4: second problem"])
+
+
+def test_the_childs_error_is_raised_here_with_every_problem() -> None:
+    with pytest.raises(WashbenchError) as info, beside(_fail_with_problems):
+        pass
+    assert info.value.problems == ("a.yaml:3: bank_deg: expected a number", "a.yaml:4: second problem")
+    assert str(info.value) == "a.yaml:3: bank_deg: expected a number (and 1 more problem)"
+    assert any("_fail_with_problems" in note for note in info.value.__notes__)  # the child's traceback
+
+
+def _disk_full() -> None:
+    raise OSError(28, "No space left on device")
+
+
+def test_an_os_error_stays_an_os_error() -> None:
+    with pytest.raises(OSError) as info, beside(_disk_full):
+        pass
+    assert info.value.errno == 28 and info.value.strerror == "No space left on device"
+
+
+def _unpicklable() -> None:
+    class LocalError(Exception):
+        pass
+
+    raise LocalError("made inside a function: pickle cannot find its class")
+
+
+def test_an_exception_that_cannot_be_pickled_comes_back_as_its_text() -> None:
+    with pytest.raises(RuntimeError, match="LocalError: made inside a function"), beside(_unpicklable):
+        pass
+
+
+def test_a_child_killed_by_a_signal_is_named() -> None:
+    with pytest.raises(RuntimeError, match="ended with signal 9"), beside(lambda: os.kill(os.getpid(), signal.SIGKILL)):
+        pass
+
+
+def test_an_error_in_the_block_kills_the_child_at_once(tmp_path: Path) -> None:
+    mark = tmp_path / "pid"
+    start = time.monotonic()
+    with pytest.raises(KeyError), beside(lambda: (_write_pid(mark), time.sleep(60))):
+        while not mark.exists():
+            time.sleep(0.01)
+        raise KeyError("the recording failed")
+    assert time.monotonic() - start < 30  # not the child's 60 s: killed, not waited for
+    with pytest.raises(ProcessLookupError):
+        os.kill(int(mark.read_text()), 0)
+
+
+def test_the_child_ignores_sigint_and_writes_nothing_to_the_terminal(
+    tmp_path: Path, capfd: pytest.CaptureFixture[str]
+) -> None:
+    """Ctrl-C reaches the whole process group: the command decides, the child goes on until it is told."""
+    mark = tmp_path / "done"
+
+    def work() -> None:
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(0.1)
+        mark.write_text("went on")
+
+    print("buffered before the fork", end="")
+    with beside(work):
+        pass
+    assert mark.read_text() == "went on"
+    assert capfd.readouterr().out.count("buffered before the fork") == 1  # flushed once, by this process
+
+
+def test_no_fork_with_a_second_thread_or_in_a_daemonic_process(monkeypatch: pytest.MonkeyPatch) -> None:
+    import threading
+
+    stop = threading.Event()
+    thread = threading.Thread(target=stop.wait)
+    thread.start()
+    try:
+        assert not can_fork()  # a lock another thread holds at the fork would stay held in the child
+    finally:
+        stop.set()
+        thread.join()
+    assert can_fork()
+    monkeypatch.setattr(beside_mod.multiprocessing.current_process(), "daemon", True, raising=False)
+    assert not can_fork()
+
+
+def _log(path: Path, n: int) -> None:
+    t = np.arange(n) / 120.0
+    cols = {
+        "t_s": t,
+        "f_x_mps2": 1.5 * np.sin(0.3 * t),
+        "f_y_mps2": 0.8 * np.sin(0.17 * t + 1.0),
+        "f_z_mps2": -9.80665 * (1.0 + 0.3 * np.sin(0.11 * t)),
+        "omega_x_degps": 15.0 * np.sin(0.5 * t),
+        "omega_y_degps": 5.0 * np.sin(0.23 * t + 0.4),
+        "omega_z_degps": 3.0 * np.sin(0.07 * t),
+    }
+    pacsv.write_csv(pa.table(cols), path)
+
+
+def test_a_cue_result_is_the_same_drawn_beside_or_after(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The figures, ranking and report drawn in the child while the recording is written are the bytes drawn in
+    one process after it; the report links the recording either way."""
+    from washbench.runs.cue import run_cue
+
+    src = tmp_path / "log.csv"
+    _log(src, 2400)
+    forks, fork = [], beside_mod._fork
+    monkeypatch.setattr(beside_mod, "_fork", lambda work: forks.append(work) or fork(work))
+    assert run_cue(src, tmp_path / "beside") == 0
+    assert len(forks) == 1
+    monkeypatch.setenv(NO_BESIDE_ENV, "1")
+    assert run_cue(src, tmp_path / "after") == 0
+    assert len(forks) == 1
+    names = ["metrics.csv", "ranking.csv", "figures/input.png", "figures/perceived.png", "figures/cues.png",
+             "figures/envelope.png"]  # fmt: skip
+    for name in names:
+        assert (tmp_path / "beside" / name).read_bytes() == (tmp_path / "after" / name).read_bytes(), name
+    report = [(tmp_path / d / "report.md").read_text().splitlines() for d in ("beside", "after")]
+    strip = [[line for line in r if not line.startswith("| created |")] for r in report]  # the clock's minute
+    assert strip[0] == strip[1]
+    assert "Recording: [recording.rrd](recording.rrd) (`washbench replay recording.rrd`)." in report[0]
+    assert (tmp_path / "beside" / "recording.rrd").stat().st_size > 0
+
