@@ -42,30 +42,27 @@ def write_trace_chunks(
 
     ``metadata``: the schema's key-value metadata (provenance, :func:`washbench.io.provenance.parquet_metadata`).
 
-    Each chunk is converted and written (encoded and compressed: pyarrow releases the GIL for most of it) by a
-    writer thread while ``chunks`` makes the next one, so a second core is not left idle. The file is the same,
-    byte for byte, as written one chunk after another: the row groups are written in order, one at a time. So
-    a chunk's arrays must stay as they are until the chunk after the next one is asked for (a producer may fill
-    two buffers in turn, not one).
+    Each chunk is converted to Arrow here (without a copy where a column is contiguous), then encoded, compressed
+    and written by a writer thread while ``chunks`` makes the next one: pyarrow releases the GIL while it writes,
+    so a second core is not left idle. (The conversion stays here: done in the writer it would take the GIL back
+    once per column, waiting each time for this thread to let go of it, and took longer than writing in turn.)
+    The file is the same, byte for byte, as written one chunk after another: the row groups are written in
+    order, one at a time. So a chunk's arrays must stay as they are until the chunk after the next one is asked
+    for (a producer may fill two buffers in turn, not one).
     """
     writer: pq.ParquetWriter | None = None
-    schema: pa.Schema | None = None
-
-    def write(chunk: Mapping[str, np.ndarray]) -> None:
-        nonlocal writer, schema
-        arrow = pa.table({name: pa.array(np.asarray(col)) for name, col in chunk.items()})
-        if writer is None:
-            schema = arrow.schema.with_metadata(dict(metadata)) if metadata else arrow.schema
-            writer = parquet_writer(path, schema)
-        writer.write_table(arrow.replace_schema_metadata(schema.metadata))
-
     try:
         with ThreadPoolExecutor(max_workers=1, thread_name_prefix="washbench-traces") as pool:
             pending: Future[None] | None = None
             for chunk in chunks:  # made here while the writer writes the one before
+                arrow = pa.table({name: pa.array(np.asarray(col)) for name, col in chunk.items()})
+                if writer is None:
+                    schema = arrow.schema.with_metadata(dict(metadata)) if metadata else arrow.schema
+                    writer = parquet_writer(path, schema)
+                arrow = arrow.replace_schema_metadata(schema.metadata)
                 if pending is not None:
                     pending.result()  # one chunk in the writer at a time; its error raised here
-                pending = pool.submit(write, chunk)
+                pending = pool.submit(writer.write_table, arrow)
             if pending is not None:
                 pending.result()
     finally:  # after the pool's end, which waits for a write still under way (an error in ``chunks``)
