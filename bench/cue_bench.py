@@ -9,10 +9,17 @@ Baselines measured in the same run, printed as ratios:
   ``lfilter`` over axis 0) against ``scipy.signal.lsim`` of the continuous transfer functions on the same 6 axes;
 * whole command: read + cue_trace + analyse + write against the bare CSV read;
 * the ``washbench cue`` command itself (its own process, start-up included) against bare JSBSim ``fdm.run()``
-  for as many steps as the input has rows (c172p in the air, this process), both as CPU time (on a shared
-  machine wall time counts other processes), minimum of ``--repeat`` runs; the aim is at most 1.5x; as it is,
-  without the recording, without the figures, without both; and the cost of one more row without both (an input
-  twice as long minus this one, against bare JSBSim the same way: start-up cancels).
+  for as many steps as the input has rows (c172p in the air, this process), minimum of ``--repeat`` runs; as it
+  is, without the recording, without the figures, without both; and the cost of one more row without both (an
+  input twice as long minus this one, against bare JSBSim the same way: start-up cancels). Two ratios each:
+
+  - wall time, what the user waits for (issue 39's aims: at most 2.0x with every output, at most 1.0x with
+    ``--no-recording --no-figures``). The command writes the traces in a thread beside the cueing and draws the
+    figures in child processes beside the cueing and the recording (:mod:`washbench.runs.beside`), so on two
+    cores its wall time is less than its CPU time. Bare JSBSim runs on one core: its wall time is its CPU time
+    (both are timed; the ratio is over its wall time). On a loaded machine wall times count other processes:
+    run it on a quiet one.
+  - CPU time (the command's process and its children), the work done, steadier on a shared machine.
 """
 
 from __future__ import annotations
@@ -22,13 +29,14 @@ import resource
 import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 import numpy as np
 import pyarrow as pa
 import pyarrow.csv as pacsv
 import scipy.signal
-from baseline import DT_S, best_of, c172p_in_air, run_cpu_s
+from baseline import DT_S, best_of, c172p_in_air, run_cpu_s, run_wall_s
 
 from washbench.cueing import WASHOUT_NAMES, cue_trace, load_washout_params
 from washbench.cueing.variants import select_washouts
@@ -54,13 +62,21 @@ def write_input(path: Path, n: int) -> None:
     pacsv.write_csv(pa.table(cols), path)
 
 
-def command_cpu_s(src: Path, out: Path, *extra: str) -> float:
-    """CPU time (user + system) of one ``washbench cue`` process on ``src`` (``extra``: more options)."""
+def command_s(src: Path, out: Path, *extra: str) -> tuple[float, float]:
+    """(wall, CPU) time of one ``washbench cue`` process on ``src`` (``extra``: more options); CPU: user + system,
+    of the command and the children it waited for (its figures' processes)."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.perf_counter()
     subprocess.run([sys.executable, "-m", "washbench", "cue", str(src), "--out", str(out), *extra], check=True,
                    stdout=subprocess.DEVNULL)  # fmt: skip
+    wall = time.perf_counter() - t0
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+
+
+def best(runs: list[tuple[float, float]]) -> tuple[float, float]:
+    """The shortest wall time and the least CPU time of several runs (each its own minimum)."""
+    return min(w for w, _ in runs), min(c for _, c in runs)
 
 
 def main() -> None:
@@ -99,17 +115,21 @@ def main() -> None:
                 scipy.signal.lsim(can, motion.omega_radps[:, i], t)
 
         t_lsim = best_of(lsim_all, 1)
-        cmd = min(command_cpu_s(src, Path(tmp) / f"cmd{i}") for i in range(args.repeat))
-        no_rec = min(command_cpu_s(src, Path(tmp) / f"norec{i}", "--no-recording") for i in range(args.repeat))
-        no_fig = min(command_cpu_s(src, Path(tmp) / f"nofig{i}", "--no-figures") for i in range(args.repeat))
-        lean = min(command_cpu_s(src, Path(tmp) / f"lean{i}", "--no-recording", "--no-figures")
-                   for i in range(args.repeat))  # fmt: skip
+        commands = {
+            "with recording, report and figures": (),
+            "the same, --no-recording": ("--no-recording",),
+            "the same, --no-figures": ("--no-figures",),
+            "the same, both": ("--no-recording", "--no-figures"),
+        }
+        timed = {k: best([command_s(src, Path(tmp) / f"c{j}_{i}", *extra) for i in range(args.repeat)])
+                 for j, (k, extra) in enumerate(commands.items())}  # fmt: skip
+        bare_wall = min(run_wall_s(c172p_in_air(), n) for _ in range(args.repeat))
         bare = min(run_cpu_s(c172p_in_air(), n) for _ in range(args.repeat))
         # the cost of more rows: the lean command on an input twice as long, minus the one above (start-up cancels)
         src2 = Path(tmp) / "in2.csv"
         write_input(src2, 2 * n)
-        lean2 = min(command_cpu_s(src2, Path(tmp) / f"lean2_{i}", "--no-recording", "--no-figures")
-                    for i in range(args.repeat))  # fmt: skip
+        lean2 = best([command_s(src2, Path(tmp) / f"lean2_{i}", "--no-recording", "--no-figures")
+                      for i in range(args.repeat)])  # fmt: skip
         bare2 = min(run_cpu_s(c172p_in_air(), 2 * n) for _ in range(args.repeat))
 
     total = t_read + t_cue + t_analyse + t_write
@@ -124,13 +144,14 @@ def main() -> None:
           f"{t_stream:.3f} s, {t_stream / t_bare:.2f} x baseline")  # fmt: skip
     print(f"  vestibular, one pilot        {t_vest:7.3f} s   (baseline: scipy.signal.lsim {t_lsim:.3f} s,", end=" ")
     print(f"{t_lsim / t_vest:.1f}x slower)")
-    print(f"washbench cue command, CPU s   {cmd:7.3f} s   {cmd / bare:6.2f} x bare JSBSim for {n} steps "
-          f"({bare:.3f} s CPU; aim <= 1.5x; with recording, report and figures)")  # fmt: skip
-    print(f"  the same, --no-recording     {no_rec:7.3f} s   {no_rec / bare:6.2f} x bare JSBSim")
-    print(f"  the same, --no-figures       {no_fig:7.3f} s   {no_fig / bare:6.2f} x bare JSBSim")
-    print(f"  the same, both               {lean:7.3f} s   {lean / bare:6.2f} x bare JSBSim")
-    per_row, per_step = (lean2 - lean) / n, (bare2 - bare) / n
-    print(f"  both, one more row           {per_row * 1e6:7.3f} us  {per_row / per_step:6.2f} x bare JSBSim per step "
+    print(f"bare JSBSim, {n} steps: {bare_wall:.3f} s wall, {bare:.3f} s CPU (the baselines)")
+    print("washbench cue command                     wall      x bare      CPU      x bare")
+    for label, (wall, cpu) in timed.items():
+        print(f"  {label:<38} {wall:7.3f} s {wall / bare_wall:6.2f} x  {cpu:7.3f} s {cpu / bare:6.2f} x")
+    print("  aims (wall): at most 2.0x with every output, at most 1.0x with both left out")
+    lean = timed["the same, both"][1]
+    per_row, per_step = (lean2[1] - lean) / n, (bare2 - bare) / n
+    print(f"  both, one more row  {per_row * 1e6:7.3f} us CPU {per_row / per_step:6.2f} x bare JSBSim per step "
           f"({2 * n} rows minus {n}: start-up cancels)")  # fmt: skip
 
 

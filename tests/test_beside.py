@@ -22,7 +22,9 @@ pytestmark = pytest.mark.skipif(not can_fork(), reason="no second usable CPU, or
 
 
 def _write_pid(path: Path) -> None:
-    path.write_text(str(os.getpid()))
+    """This process's PID into ``path``, whole the moment it exists (written aside, then renamed)."""
+    path.with_suffix(".tmp").write_text(str(os.getpid()))
+    path.with_suffix(".tmp").replace(path)
 
 
 def test_the_work_runs_in_another_process_while_the_block_runs(tmp_path: Path) -> None:
@@ -147,8 +149,8 @@ def _log(path: Path, n: int) -> None:
 
 
 def test_a_cue_result_is_the_same_drawn_beside_or_after(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    """The figures, ranking and report drawn in the child while the recording is written are the bytes drawn in
-    one process after it; the report links the recording either way."""
+    """The figures, ranking and report drawn in children while the traces and the recording are written are the
+    bytes drawn in one process after them; the report links the recording either way."""
     from washbench.runs.cue import run_cue
 
     src = tmp_path / "log.csv"
@@ -156,10 +158,10 @@ def test_a_cue_result_is_the_same_drawn_beside_or_after(tmp_path: Path, monkeypa
     forks, fork = [], beside_mod._fork
     monkeypatch.setattr(beside_mod, "_fork", lambda work: forks.append(work) or fork(work))
     assert run_cue(src, tmp_path / "beside") == 0
-    assert len(forks) == 1
+    assert len(forks) == 2  # the input figure beside the cueing, the result's beside the recording
     monkeypatch.setenv(NO_BESIDE_ENV, "1")
     assert run_cue(src, tmp_path / "after") == 0
-    assert len(forks) == 1
+    assert len(forks) == 2
     names = ["metrics.csv", "ranking.csv", "figures/input.png", "figures/perceived.png", "figures/cues.png",
              "figures/envelope.png"]  # fmt: skip
     for name in names:

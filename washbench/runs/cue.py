@@ -205,6 +205,8 @@ def write_outputs(
                 folder = result_path(out_dir, seg.name) if seg.name else out_dir
                 folder.mkdir(parents=True, exist_ok=True)
                 with contextlib.ExitStack() as files:  # renamed into place together when all three are complete
+                    if figures and seg.labels:  # the input as read (it needs nothing else), drawn beside the cueing
+                        files.enter_context(beside(functools.partial(_input_figure, input_path, seg, folder)))
                     tmp = {name: files.enter_context(atomic_path(folder / name))
                            for name in (TRACES_FILE, METRICS_FILE, RUN_FILE)}  # fmt: skip
                     meta = parquet_metadata(provenance) if provenance else None
@@ -238,7 +240,8 @@ def write_outputs(
                     write_run_json(tmp[RUN_FILE], summary, time.perf_counter() - start, extra)
                 if not recording:  # a recording of an earlier set would mislead
                     (folder / RECORDING_FILE).unlink(missing_ok=True)
-                review = functools.partial(_review, input_path, seg, summary, result, figures, recording)
+                review = functools.partial(write_run_review, folder, summary, str(input_path), result.review_table(),
+                                           figures, recording)  # fmt: skip
                 with beside(review, fork=figures and recording):
                     if recording:
                         with atomic_path(folder / RECORDING_FILE) as rrd:
@@ -253,14 +256,10 @@ def write_outputs(
     return done
 
 
-def _review(
-    input_path: Path, seg: Segment, summary: RunSummary, result: CueResult, figures: bool, recording: bool
-) -> None:
-    """A cued segment's figures (the input as read first), ranking.csv and report.md, from its folder's files."""
-    if figures and seg.labels:  # what was read, linked first in the report
-        title = f"{input_path.name}{f' {seg.name}' if seg.name else ''}"
-        draw_for_result(summary.run_dir, title, seg.motion, seg.labels, seg.notes)
-    write_run_review(summary.run_dir, summary, str(input_path), result.review_table(), figures, recording)
+def _input_figure(input_path: Path, seg: Segment, folder: Path) -> None:
+    """A cued segment's figure of the input as read (``figures/input.png``), linked first in its report."""
+    title = f"{input_path.name}{f' {seg.name}' if seg.name else ''}"
+    draw_for_result(folder, title, seg.motion, seg.labels, seg.notes)
 
 
 def run_cue(
