@@ -83,6 +83,20 @@ def test_an_exception_that_cannot_be_pickled_comes_back_as_its_text() -> None:
         pass
 
 
+class NeedsTwoError(Exception):
+    def __init__(self, where: str, what: str) -> None:
+        super().__init__(f"{where}: {what}")
+
+
+def _rebuilt_otherwise() -> None:
+    raise NeedsTwoError("figures/input.png", "pickles, but its arguments do not rebuild it")
+
+
+def test_an_exception_that_pickles_but_does_not_rebuild_comes_back_as_its_text() -> None:
+    with pytest.raises(RuntimeError, match=r"NeedsTwoError: figures/input\.png: pickles"), beside(_rebuilt_otherwise):
+        pass
+
+
 def test_a_child_killed_by_a_signal_is_named() -> None:
     with pytest.raises(RuntimeError, match="ended with signal 9"), beside(lambda: os.kill(os.getpid(), signal.SIGKILL)):
         pass

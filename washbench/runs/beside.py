@@ -37,6 +37,7 @@ import traceback
 from collections.abc import Callable, Iterator
 from typing import Any
 
+from washbench.io import collector
 from washbench.io.cpus import usable_cpus
 from washbench.runs.parent_death import die_with_parent
 
@@ -100,12 +101,12 @@ class _Child:
         status = self._reap()
         if data:
             exc, tb = pickle.loads(data)
-            exc.add_note(f"in the child process that drew the figures:\n{tb}")
+            exc.add_note(f"raised in the child process beside the command (washbench.runs.beside):\n{tb}")
             raise exc
         if status != 0:
             code = os.waitstatus_to_exitcode(status)
             how = f"signal {-code}" if code < 0 else f"exit code {code}"
-            raise RuntimeError(f"the process drawing the figures ended with {how}")
+            raise RuntimeError(f"the child process beside the command (its figures) ended with {how}")
 
     def _reap(self) -> int:
         if self.fd >= 0:
@@ -133,12 +134,14 @@ def _fork(work: Callable[[], Any]) -> _Child:
         signal.signal(signal.SIGINT, signal.SIG_IGN)
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
         die_with_parent(parent)
+        collector.freeze_loaded()  # the command's objects are never scanned (nor their pages copied) by the child
         work()
     except BaseException as exc:  # every error goes back to the command
         code = 1
         tb = traceback.format_exc()
         try:
             payload = pickle.dumps((exc, tb))
+            pickle.loads(payload)  # an exception class whose arguments do not rebuild it fails here, not there
         except Exception:  # an exception that cannot be pickled: its text
             payload = pickle.dumps((RuntimeError(f"{type(exc).__name__}: {exc}"), tb))
         with contextlib.suppress(OSError):
