@@ -28,6 +28,7 @@ command's "cannot write results" line).
 from __future__ import annotations
 
 import contextlib
+import functools
 import multiprocessing
 import os
 import pickle
@@ -38,9 +39,9 @@ import traceback
 from collections.abc import Callable, Iterator
 from typing import Any
 
-from washbench.io import collector
 from washbench.io.cpus import usable_cpus
 from washbench.runs.parent_death import die_with_parent
+from washbench.runs.pool import worker_init
 
 NO_BESIDE_ENV = "WASHBENCH_NO_BESIDE"
 """Set (to anything but empty): :func:`beside` does its work in this process, after the block."""
@@ -132,10 +133,9 @@ def _fork(work: Callable[[], Any]) -> _Child:
     code = 0
     try:  # the child: never returns
         os.close(read_fd)
-        signal.signal(signal.SIGINT, signal.SIG_IGN)
-        signal.signal(signal.SIGTERM, signal.SIG_DFL)
-        die_with_parent(parent)
-        collector.freeze_loaded()  # the command's objects are never scanned (nor their pages copied) by the child
+        # as a pool worker starts: SIGINT ignored, SIGTERM stops it, dies with the command, and the command's objects
+        # are never scanned (nor their pages copied) by its collector
+        worker_init(functools.partial(die_with_parent, parent))
         work()
     except BaseException as exc:  # every error goes back to the command
         code = 1

@@ -31,8 +31,9 @@ FIGURE_MODULES = ("matplotlib.figure", "matplotlib.backends.backend_agg")
 """Preloaded by the process server besides :mod:`washbench.runs.preload` when the runs draw figures."""
 
 
-def _worker_init(then: Callable[[], None] | None = None) -> None:
-    """In each worker: Ctrl-C is for the main process (it stops the workers); SIGTERM stops a worker at once.
+def worker_init(then: Callable[[], None] | None = None) -> None:
+    """In each worker (and each child of :mod:`washbench.runs.beside`): Ctrl-C is for the main process (it stops
+    the workers); SIGTERM stops a worker at once.
 
     ``then``: the start method's own initializer (:func:`pool_context`). Then what the worker has loaded (the
     process server's preloaded modules, forked) is frozen: the worker's collector never scans it
@@ -126,7 +127,7 @@ def worker_pool(jobs: int, *, recording: bool = True, figures: bool = True) -> I
     Leaving the block normally waits for the workers; leaving it by any exception stops them at once first.
     """
     ctx, initializer = pool_context(recording, main_stops_workers=True, figures=figures)
-    pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_init, initargs=(initializer,))
+    pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=worker_init, initargs=(initializer,))
     try:
         yield pool
     except BaseException:
