@@ -628,8 +628,22 @@ def test_workers_end_when_the_suite_is_killed(tmp_path: Path) -> None:
     while len(live_processes(proc.pid)) < 4 and time.monotonic() < deadline:  # main, server, 2 workers
         time.sleep(0.1)
     assert len(live_processes(proc.pid)) >= 4
-    time.sleep(1.0)
-    pids = {line.split()[0] for line in live_processes(proc.pid)}
+    from washbench.flight.jsbsim_xml import _SCRATCH_PREFIX
+
+    scratch = tmp_path / "tmp"  # the suite's TMPDIR (hostile.long_suite)
+
+    def killed_scratch() -> list[Path]:
+        return [d for d in scratch.glob(f"{_SCRATCH_PREFIX}*") if d.name[len(_SCRATCH_PREFIX) :].split("-")[0] in pids]
+
+    # the workers flying: each has made its JSBSim scratch folder (seconds after it starts on a loaded machine)
+    deadline = time.monotonic() + 60
+    while True:
+        pids = {line.split()[0] for line in live_processes(proc.pid)}
+        if len(killed_scratch()) >= 2 or time.monotonic() > deadline:
+            break
+        time.sleep(0.1)
+    assert len(killed_scratch()) >= 2
+    time.sleep(0.5)
     proc.kill()
     proc.wait()
     deadline = time.monotonic() + 10
@@ -641,14 +655,7 @@ def test_workers_end_when_the_suite_is_killed(tmp_path: Path) -> None:
     time.sleep(1.0)
     assert (digest(stage[0]) if stage else {}) == sizes  # nobody writes into the stage any more
     # the killed workers' JSBSim scratch folders (no exit handler ran) go with the next process that makes one
-    from washbench.flight.jsbsim_xml import _SCRATCH_PREFIX
-
-    scratch = tmp_path / "tmp"  # the suite's TMPDIR (hostile.long_suite)
-
-    def killed_scratch() -> list[Path]:
-        return [d for d in scratch.glob(f"{_SCRATCH_PREFIX}*") if d.name[len(_SCRATCH_PREFIX) :].split("-")[0] in pids]
-
-    assert killed_scratch()
+    assert len(killed_scratch()) >= 2
     code = "from washbench.flight.jsbsim_xml import scratch_output_dir; scratch_output_dir()"
     subprocess.run([sys.executable, "-c", code], check=True, timeout=60, env={**os.environ, "TMPDIR": str(scratch)})
     assert killed_scratch() == []
