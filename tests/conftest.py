@@ -24,6 +24,9 @@ import pytest
 from hypothesis import settings
 
 from washbench.io.cpus import usable_cpus
+from washbench.io.pages import small_pages
+
+small_pages()  # as every washbench command (washbench.io.pages): the tests' own arrays and the processes they start
 
 settings.register_profile("washbench", derandomize=True)
 settings.load_profile("washbench")

@@ -15,12 +15,13 @@ import signal
 import sys
 
 from washbench.errors import Terminated
-from washbench.io import collector, interrupts
+from washbench.io import collector, interrupts, pages
 
 
 def entry() -> int:
     """Import the CLI and run it; the console script's entry point."""
     collector.tune()  # before the imports, which allocate most of the objects the collector would scan
+    pages.small_pages()  # before numpy is imported (it reads the setting then)
     signal.signal(signal.SIGTERM, interrupts.terminate)  # the CLI installs the same for the command
     signal.signal(signal.SIGINT, interrupts.interrupt)  # Python's own, counted: a plugin's KeyboardInterrupt is not one
     sys.unraisablehook = interrupts.signal_in_finalizer

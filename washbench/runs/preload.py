@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import os
 
-from washbench.io import collector
+from washbench.io import collector, pages
 from washbench.runs import parent_death
 
 # First, before the slow imports: the process server ends with the washbench command that started it (even on
@@ -19,6 +19,7 @@ from washbench.runs import parent_death
 parent_death.die_with_parent(parent_death.main_pid())
 parent_death.SERVER_PID = os.getpid()  # the parent every worker forked from here must have
 collector.tune()  # the server is a new interpreter: its own settings, before its imports; its workers inherit them
+pages.small_pages()  # inherited from the command already; set here too for a suite started from Python
 
 import jsbsim  # noqa: E402, F401
 import pyarrow.parquet  # noqa: E402, F401
