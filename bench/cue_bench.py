@@ -41,6 +41,7 @@ from baseline import DT_S, best_of, c172p_in_air, run_cpu_s, run_wall_s
 from washbench.cueing import WASHOUT_NAMES, cue_trace, load_washout_params
 from washbench.cueing.variants import select_washouts
 from washbench.io.motion_file import read_motion
+from washbench.io.pages import small_pages
 from washbench.perception import VestibularModel
 from washbench.perception.vestibular import CanalParams, OtolithParams, canal_tf, otolith_tf
 from washbench.platform import load_platform_limits
@@ -84,6 +85,7 @@ def main() -> None:
     ap.add_argument("--minutes", type=float, default=30.0)
     ap.add_argument("--repeat", type=int, default=3, help="runs of the command and of bare JSBSim (minimum)")
     args = ap.parse_args()
+    small_pages()  # as a washbench command does (washbench.io.pages): the stages timed in this process
     n = round(args.minutes * 60 / DT_S)
     params, limits = load_washout_params(None), load_platform_limits(None)
     with tempfile.TemporaryDirectory() as tmp:

@@ -22,6 +22,7 @@ from pathlib import Path
 from baseline import manoeuvre_wall_s
 
 from washbench.io.cpus import usable_cpus
+from washbench.io.pages import small_pages
 
 
 def main() -> None:
@@ -31,6 +32,7 @@ def main() -> None:
     parser.add_argument("--no-recording", action="store_true", help="run the suite without recording.rrd files")
     parser.add_argument("--no-figures", action="store_true", help="run the suite without the reports' figures")
     args = parser.parse_args()
+    small_pages()  # as a washbench command does (washbench.io.pages): the stages timed in this process
 
     from washbench.runs.inputs import find_manoeuvres
     from washbench.runs.options import load_options
