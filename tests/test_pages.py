@@ -49,6 +49,11 @@ def test_the_users_own_choice_stands() -> None:
     assert advice("", CALL, "1").split() == ["True", "1"]
 
 
+def test_an_empty_setting_is_no_choice() -> None:
+    """``NUMPY_MADVISE_HUGEPAGE=`` (empty) would make numpy's own import fail (int('')): taken as unset."""
+    assert advice(CALL, "", "").split() == ["False", "0"]
+
+
 def test_the_command_and_what_it_starts_inherit_it() -> None:
     """``python -m washbench``: the entry point sets it before the command imports numpy (a stand-in command
     here, which reports numpy's switch and what a process it starts sees)."""

@@ -27,9 +27,9 @@ NUMPY_HUGEPAGE_ENV = "NUMPY_MADVISE_HUGEPAGE"
 
 def small_pages() -> None:
     """No huge-page advice for numpy's arrays in this process and the processes it starts, unless the user has set
-    :data:`NUMPY_HUGEPAGE_ENV`. Called before numpy is imported (numpy reads the variable then); if numpy is
-    imported already (a caller's process), its switch is set directly."""
-    if NUMPY_HUGEPAGE_ENV in os.environ:
+    :data:`NUMPY_HUGEPAGE_ENV` (to anything but blanks). Called before numpy is imported (numpy reads the variable
+    then); if numpy is imported already (a caller's process), its switch is set directly."""
+    if os.environ.get(NUMPY_HUGEPAGE_ENV, "").strip():  # the user's (empty: unset; numpy's import would fail on it)
         return
     os.environ[NUMPY_HUGEPAGE_ENV] = "0"
     numpy = sys.modules.get("numpy")
