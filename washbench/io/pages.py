@@ -7,8 +7,8 @@ that first touches each such page, in the command's own time. A washbench comman
 megabytes all the time (a 30-minute cue's columns are 1.7 MB each, its review arrays 7 MB), so it paid this again
 and again: measured here (issue 39), the recording of a 30-minute cue took 2.4-2.8 s with numpy's default against
 1.6-2.0 s with 4 KiB pages (three alternated pairs); gathering its 12 motion arrays of 216,000 x 4 took 0.42-0.81 s
-(0.35-0.68 s of it in the kernel) against 0.10 s; the whole ``washbench cue`` with every output spent 2.4-2.8 s in
-the kernel against 1.4 s.
+(0.35-0.68 s of it in the kernel) against 0.10 s; the whole ``washbench cue`` with every output took 6.9-7.6 s
+(2.7-3.3 s of it in the kernel) against 5.3-6.4 s (1.1-1.6 s), four alternated pairs (docs/development.md).
 
 :func:`small_pages`, at the start of every washbench process (the command's :func:`washbench.__main__.entry`; the
 test session), sets numpy's own switch, the environment variable ``NUMPY_MADVISE_HUGEPAGE`` = 0, which numpy reads
