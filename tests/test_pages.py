@@ -21,12 +21,16 @@ PROBE = (
 CALL = "from washbench.io.pages import small_pages; small_pages()"
 
 
-def advice(before: str, after: str, env_value: str | None) -> str:
+def python(code: str, env_value: str | None = None) -> str:
+    """The output of ``python -c code`` with ``NUMPY_MADVISE_HUGEPAGE`` = ``env_value`` (None: unset)."""
     env = {k: v for k, v in os.environ.items() if k != NUMPY_HUGEPAGE_ENV}
     if env_value is not None:
         env[NUMPY_HUGEPAGE_ENV] = env_value
-    code = PROBE.format(before=before, after=after)
     return subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True).stdout
+
+
+def advice(before: str, after: str, env_value: str | None) -> str:
+    return python(PROBE.format(before=before, after=after), env_value)
 
 
 @pytest.mark.skipif(sys.platform != "linux", reason="numpy advises huge pages on Linux only")
@@ -72,6 +76,4 @@ def test_the_command_and_what_it_starts_inherit_it() -> None:
         "sys.modules['washbench.cli'] = cli\n"
         "sys.exit(entry())\n"
     )
-    env = {k: v for k, v in os.environ.items() if k != NUMPY_HUGEPAGE_ENV}
-    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True).stdout
-    assert out.split() == ["False", "0"]
+    assert python(code).split() == ["False", "0"]

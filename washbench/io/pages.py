@@ -32,8 +32,7 @@ def small_pages() -> None:
     if os.environ.get(NUMPY_HUGEPAGE_ENV, "").strip():  # the user's (empty: unset; numpy's import would fail on it)
         return
     os.environ[NUMPY_HUGEPAGE_ENV] = "0"
-    numpy = sys.modules.get("numpy")
-    if numpy is not None:  # numpy has read the variable already: its switch (what it calls itself at import)
-        switch = getattr(getattr(getattr(numpy, "_core", None), "multiarray", None), "_set_madvise_hugepage", None)
-        if switch is not None:
-            switch(False)
+    if "numpy" in sys.modules:  # numpy has read the variable already: its switch (what it calls itself at import)
+        from numpy._core import multiarray
+
+        multiarray._set_madvise_hugepage(False)
