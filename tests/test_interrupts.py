@@ -125,3 +125,32 @@ def test_what_a_run_killed_outright_leaves_goes_with_the_next_run(manoeuvres: Pa
     assert nxt.returncode == 0, err
     assert sorted(p.name for p in (out / "c172p").iterdir()) == ["earlier", "level"]
     assert sorted(p.name for p in out.iterdir()) == ["c172p"]  # the killed run's lock file went with it too
+
+
+def _wrapped_interrupt(by_signal: bool) -> None:
+    """What Python makes of Ctrl-C landing while a module imported mid-command creates a pydantic model (seen in
+    CI: ``RuntimeError: Error calling __set_name__ ...``, the KeyboardInterrupt as its cause)."""
+    from washbench.io import interrupts
+
+    try:
+        if by_signal:
+            interrupts.interrupt(signal.SIGINT, None)  # what the handler does when the signal lands: counted, raised
+        raise KeyboardInterrupt  # raised by code, no signal
+    except KeyboardInterrupt as exc:
+        raise RuntimeError("Error calling __set_name__ on 'PydanticDescriptorProxy' instance") from exc
+
+
+def test_a_signal_wrapped_by_python_still_ends_in_one_line(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import washbench.cli as cli
+    from washbench.io.paths import MANOEUVRES_DIR
+
+    manoeuvre = str(MANOEUVRES_DIR / "c172" / "takeoff.yaml")
+    monkeypatch.setattr(cli, "_dispatch", lambda args: _wrapped_interrupt(by_signal=True))
+    assert cli.main(["validate", manoeuvre]) == 130
+    assert capsys.readouterr().err.strip().splitlines()[-1] == "washbench: interrupted"
+    # no signal received: a KeyboardInterrupt raised by code beneath another error is that error, as before
+    monkeypatch.setattr(cli, "_dispatch", lambda args: _wrapped_interrupt(by_signal=False))
+    with pytest.raises(RuntimeError, match="__set_name__"):
+        cli.main(["validate", manoeuvre])

@@ -610,6 +610,7 @@ def main(argv: list[str] | None = None) -> int:
         os.environ[project_config.CONFIG_USED_ENV] = str(config.path)
     signal.signal(signal.SIGTERM, interrupts.terminate)
     sigint_before = signal.signal(signal.SIGINT, interrupts.interrupt)  # counted (a plugin's KeyboardInterrupt is not)
+    signals_before = interrupts.received()
     hook, sys.unraisablehook = sys.unraisablehook, interrupts.signal_in_finalizer
     try:
         try:
@@ -634,6 +635,11 @@ def main(argv: list[str] | None = None) -> int:
             print("washbench: error: out of memory (an input or option asks for more than this machine has)",
                   file=sys.stderr)  # fmt: skip
             return 2
+        except Exception as exc:  # a signal's exception wrapped by Python (a class made mid-import): the signal
+            signalled = interrupts.signal_beneath(exc, signals_before)
+            if signalled is None:
+                raise
+            raise signalled from None
     except KeyboardInterrupt:
         print("washbench: interrupted", file=sys.stderr)
         return 130

@@ -91,6 +91,27 @@ def _send_again(signum: int) -> None:
         os.kill(os.getpid(), signum)
 
 
+def signal_beneath(exc: BaseException, since: int) -> BaseException | None:
+    """The KeyboardInterrupt or Terminated that a signal raised beneath ``exc`` (its ``__cause__`` or
+    ``__context__``, at any depth), if this process's handlers have received a signal since :func:`received` was
+    ``since``; else None.
+
+    Python wraps an exception raised in some of its own machinery: a signal's exception raised while a class is
+    being created (a module imported mid-command, a pydantic model's ``__set_name__``) reaches the command as
+    ``RuntimeError: Error calling __set_name__ ...``, the interrupt as its cause.
+    """
+    if received() == since:
+        return None
+    seen: set[int] = set()
+    inner: BaseException | None = exc
+    while inner is not None and id(inner) not in seen:
+        if isinstance(inner, (KeyboardInterrupt, Terminated)):
+            return inner
+        seen.add(id(inner))
+        inner = inner.__cause__ or inner.__context__
+    return None
+
+
 def raise_pending() -> None:
     """Raise KeyboardInterrupt or Terminated now if a signal swallowed in a finalizer has not been sent again yet
     (a command that finished its work before the timer fired: it still ends as signalled)."""
