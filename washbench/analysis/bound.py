@@ -45,6 +45,7 @@ from scipy import sparse
 from washbench.analysis.lp_rows import Rows
 from washbench.cueing.motion_model import discretise_foh
 from washbench.io.yamlio import StrictModel
+from washbench.numerics.statespace import tf2ss
 from washbench.perception.vestibular import VestibularModel, VestibularParams, canal_tf, otolith_tf
 from washbench.platform.limits import PlatformLimits
 
@@ -162,9 +163,7 @@ def washout_cost(
 
 
 def _vest_discrete(num: np.ndarray, den: np.ndarray, dt: float):
-    from scipy import signal
-
-    a, b, c, _ = signal.tf2ss(num, den)
+    a, b, c, _ = tf2ss(num, den)
     phi, g0, g1 = discretise_foh(a, b, dt)
     steady = -np.linalg.solve(a, b)  # state per unit constant input
     return phi, g0, g1, c, steady

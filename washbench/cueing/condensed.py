@@ -23,9 +23,10 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import linalg, signal
+from scipy import linalg
 
 from washbench.cueing.motion_model import discretise_zoh
+from washbench.numerics.statespace import tf2ss
 
 
 @dataclass(frozen=True)
@@ -42,7 +43,7 @@ class SisoPrediction:
 
 def siso_state_space(num: np.ndarray, den: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(A (n, n), B (n,), C (n,)) of a strictly proper transfer function ``num/den`` (coefficients in s)."""
-    a, b, c, d = signal.tf2ss(num, den)
+    a, b, c, d = tf2ss(num, den)
     if np.any(np.abs(d) > 0.0):
         raise ValueError("the model must be strictly proper")
     return a, b[:, 0], c[0]

@@ -25,6 +25,7 @@ import numpy as np
 from numba import njit
 
 from washbench.numerics.numbastart import prepare
+from washbench.numerics.statespace import tf2ss
 
 prepare()
 
@@ -73,7 +74,7 @@ def _discretise(num: tuple[float, ...], den: tuple[float, ...], dt_s: float) -> 
     n = len(den) - 1
     if n > 2:
         raise ValueError(f"filter order {n} > 2 is not supported")
-    a, b, c, d = _tf2ss(num, den)
+    a, b, c, d = tf2ss(num, den)
     # bilinear transform (generalised bilinear with alpha = 1/2), as scipy.signal.cont2discrete does it
     ima = np.eye(n) - 0.5 * dt_s * a
     ad = np.linalg.solve(ima, np.eye(n) + 0.5 * dt_s * a)
@@ -87,23 +88,6 @@ def _discretise(num: tuple[float, ...], den: tuple[float, ...], dt_s: float) -> 
     coef[6 : 6 + n] = cd[0, :]
     coef[8] = dd[0, 0]
     return coef
-
-
-def _tf2ss(num: list[float], den: list[float]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Controllable canonical state space of a proper SISO ``num(s) / den(s)`` (scipy.signal.tf2ss's form)."""
-    den_a = np.asarray(den, dtype=np.float64)
-    num_a = np.asarray(num, dtype=np.float64)
-    n = len(den_a) - 1
-    num_a = np.concatenate([np.zeros(n + 1 - len(num_a)), num_a]) / den_a[0]
-    den_a = den_a / den_a[0]
-    d = np.array([[num_a[0]]])
-    a = np.zeros((n, n))
-    a[0, :] = -den_a[1:]
-    a[1:, :-1] += np.eye(n - 1)
-    b = np.zeros((n, 1))
-    b[0, 0] = 1.0
-    c = (num_a[1:] - num_a[0] * den_a[1:]).reshape(1, n)
-    return a, b, c, d
 
 
 @njit(cache=True)

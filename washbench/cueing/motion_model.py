@@ -35,8 +35,9 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy import linalg, signal
+from scipy import linalg
 
+from washbench.numerics.statespace import tf2ss
 from washbench.perception.vestibular import CanalParams, OtolithParams, canal_tf, otolith_tf
 
 CHANNELS: tuple[str, ...] = ("pitch", "roll", "heave", "yaw")
@@ -98,7 +99,7 @@ def with_position_integral(model: ChannelModel) -> ChannelModel:
 
 
 def _ss(num: np.ndarray, den: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    a, b, c, d = signal.tf2ss(num, den)
+    a, b, c, d = tf2ss(num, den)
     if np.any(np.abs(d) > 0.0):
         raise ValueError("vestibular model must be strictly proper")
     return a, b, c
