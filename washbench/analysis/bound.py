@@ -42,7 +42,7 @@ import numpy as np
 from pydantic import Field
 from scipy import sparse
 
-from washbench.analysis.lp_rows import Rows
+from washbench.analysis.lp_rows import Rows, solve
 from washbench.cueing.motion_model import discretise_foh
 from washbench.io.yamlio import StrictModel
 from washbench.numerics.statespace import tf2ss
@@ -184,8 +184,6 @@ def _solve_channel(
     """One channel's QP. Per sample k the variables are a, w, ang, p, v, z_o (2), z_c (3), restricted to those the
     channel has (each a block of n), and the start variables ang_-1, p_-1, v_-1, w_-1. Returns the optimal sequences
     and the status. The rows are built a block of samples at a time (:class:`washbench.analysis.lp_rows.Rows`)."""
-    import clarabel
-
 
     has_f = r_f is not None
     has_w = r_w is not None
@@ -276,12 +274,7 @@ def _solve_channel(
         pc += [a_i[:-1], a_i[1:], a_i[1:]]
         pv += [np.full(n - 1, cj), np.full(n - 1, cj), np.full(n - 1, -cj)]
     P = sparse.csc_matrix((np.concatenate(pv), (np.concatenate(pr), np.concatenate(pc))), shape=(nz, nz))
-    settings = clarabel.DefaultSettings()
-    settings.verbose = False
-    settings.max_iter = params.max_iter
-    settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = params.eps
-    cones = [clarabel.ZeroConeT(n_eq), clarabel.NonnegativeConeT(n_le)]
-    sol = clarabel.DefaultSolver(sparse.triu(P, format="csc"), np.zeros(nz), a_mat, b_vec, cones, settings).solve()
+    sol = solve(sparse.triu(P, format="csc"), np.zeros(nz), a_mat, b_vec, n_eq, n_le, params.eps, params.max_iter)
     status = str(sol.status)
     x = np.asarray(sol.x, dtype=np.float64)
     out = {name: x[idx[name]] for name in names if not name.startswith("z")}

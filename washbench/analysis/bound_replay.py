@@ -28,7 +28,7 @@ import numpy as np
 from scipy import sparse
 
 from washbench.analysis.bound import MAX_BOUND_SAMPLES, BoundParams, oracle_bound
-from washbench.analysis.lp_rows import Rows, trapezoid
+from washbench.analysis.lp_rows import Rows, solve, trapezoid
 from washbench.analysis.ranking import MOTION_FLOOR, perceived_motion
 from washbench.errors import WashbenchError
 from washbench.io.units import G0_MPS2
@@ -105,8 +105,6 @@ def translation_plan(
     """Stage 2 (module docstring): the stage's positions (N, 3) m, NED, for the attitudes ``q`` (N, 4), and the
     solver's status. ``f_air`` (N, 3) m/s^2 the aircraft pilot's specific force; ``jerk_weight`` per (m/s^3)^2,
     ``position_weight`` per m^2 s (``w_p dt sum |p_k|^2``: centring)."""
-    import clarabel
-
     vest = vestibular if vestibular is not None else VestibularParams()
     n = f_air.shape[0]
     dt = float(dt_s)
@@ -190,12 +188,7 @@ def translation_plan(
             pv.append(np.full(n, 2.0 * position_weight * dt))
     pmat = (sparse.csc_matrix((np.concatenate(pv), (np.concatenate(pr), np.concatenate(pc))), shape=(nvar, nvar))
             if pr else sparse.csc_matrix((nvar, nvar)))  # fmt: skip
-    settings = clarabel.DefaultSettings()
-    settings.verbose = False
-    settings.max_iter = 200
-    settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = tolerance
-    cones = [clarabel.ZeroConeT(n_eq), clarabel.NonnegativeConeT(n_le)]
-    sol = clarabel.DefaultSolver(sparse.triu(pmat, format="csc"), cost, a_mat, b_vec, cones, settings).solve()
+    sol = solve(sparse.triu(pmat, format="csc"), cost, a_mat, b_vec, n_eq, n_le, tolerance, 200)
     z = np.asarray(sol.x, dtype=np.float64)
     pos = np.column_stack([z[idx("p", ax)] for ax in range(3)])
     return pos, str(sol.status)

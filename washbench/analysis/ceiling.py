@@ -55,6 +55,7 @@ import numpy as np
 from scipy import sparse
 
 from washbench.analysis.lp_rows import Rows as _Rows
+from washbench.analysis.lp_rows import solve
 from washbench.analysis.lp_rows import trapezoid as _trapezoid
 from washbench.analysis.metrics import DOFS
 from washbench.analysis.relaxation import Relaxation, relaxation_of
@@ -124,17 +125,8 @@ def _perception_rows(
 
 
 def _solve(c: np.ndarray, rows: _Rows, nvar: int) -> tuple[float, str]:
-    import clarabel
-
     a, b, n_eq, n_le = rows.matrices(nvar)
-    settings = clarabel.DefaultSettings()
-    settings.verbose = False
-    settings.max_iter = 200
-    settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = CEILING_TOL
-    settings.tol_ktratio = 1e-8
-    cones = [clarabel.ZeroConeT(n_eq), clarabel.NonnegativeConeT(n_le)]
-    p = sparse.csc_matrix((nvar, nvar))
-    sol = clarabel.DefaultSolver(p, c, a, b, cones, settings).solve()
+    sol = solve(sparse.csc_matrix((nvar, nvar)), c, a, b, n_eq, n_le, CEILING_TOL, 200, tol_ktratio=1e-8)
     status = str(sol.status)
     if status != "Solved":
         return math.nan, status
