@@ -42,7 +42,7 @@ import numpy as np
 from pydantic import Field
 from scipy import sparse
 
-from washbench.analysis.lp_rows import Rows, solve
+from washbench.analysis.lp_rows import Rows, solve_qp
 from washbench.cueing.motion_model import discretise_foh
 from washbench.io.yamlio import StrictModel
 from washbench.numerics.statespace import tf2ss
@@ -184,7 +184,6 @@ def _solve_channel(
     """One channel's QP. Per sample k the variables are a, w, ang, p, v, z_o (2), z_c (3), restricted to those the
     channel has (each a block of n), and the start variables ang_-1, p_-1, v_-1, w_-1. Returns the optimal sequences
     and the status. The rows are built a block of samples at a time (:class:`washbench.analysis.lp_rows.Rows`)."""
-
     has_f = r_f is not None
     has_w = r_w is not None
     tilt = has_f and has_w
@@ -253,7 +252,6 @@ def _solve_channel(
             rows.box(np.array([scol[name]]), -bound, bound)
     if start_at_rest and has_f:  # the replay also ends at rest: the stage can stop within its travel at the end
         rows.add([(idx["v"][-1:], 1.0)], np.zeros(1), equal=True)
-    a_mat, b_vec, n_eq, n_le = rows.matrices(nz)
     # cost: dt (w_f (C_o z_o)^2 + w_w (C_c z_c)^2) per sample (Clarabel minimises 1/2 z' P z; P's upper triangle)
     pr, pc, pv = [], [], []
     for model, nzv, pre, wgt in ((oto, no, "zo", params.force_weight), (can, nc, "zc", params.rate_weight)):
@@ -274,7 +272,7 @@ def _solve_channel(
         pc += [a_i[:-1], a_i[1:], a_i[1:]]
         pv += [np.full(n - 1, cj), np.full(n - 1, cj), np.full(n - 1, -cj)]
     P = sparse.csc_matrix((np.concatenate(pv), (np.concatenate(pr), np.concatenate(pc))), shape=(nz, nz))
-    sol = solve(sparse.triu(P, format="csc"), np.zeros(nz), a_mat, b_vec, n_eq, n_le, params.eps, params.max_iter)
+    sol = solve_qp(sparse.triu(P, format="csc"), np.zeros(nz), rows, params.eps, params.max_iter)
     status = str(sol.status)
     x = np.asarray(sol.x, dtype=np.float64)
     out = {name: x[idx[name]] for name in names if not name.startswith("z")}

@@ -28,7 +28,7 @@ import numpy as np
 from scipy import sparse
 
 from washbench.analysis.bound import MAX_BOUND_SAMPLES, BoundParams, oracle_bound
-from washbench.analysis.lp_rows import Rows, solve, trapezoid
+from washbench.analysis.lp_rows import Rows, solve_qp, trapezoid
 from washbench.analysis.ranking import MOTION_FLOOR, perceived_motion
 from washbench.errors import WashbenchError
 from washbench.io.units import G0_MPS2
@@ -171,7 +171,6 @@ def translation_plan(
         dof = ("surge", "sway", "heave")[bx]
         weight = 1.0 if felt[dof] >= MOTION_FLOOR[dof] else UNFELT_WEIGHT
         cost[t] = weight * trap
-    a_mat, b_vec, n_eq, n_le = rows.matrices(nvar)
     pr, pc, pv = [], [], []
     if jerk_weight > 0.0 and n > 1:
         cj = 2.0 * jerk_weight / dt
@@ -188,7 +187,7 @@ def translation_plan(
             pv.append(np.full(n, 2.0 * position_weight * dt))
     pmat = (sparse.csc_matrix((np.concatenate(pv), (np.concatenate(pr), np.concatenate(pc))), shape=(nvar, nvar))
             if pr else sparse.csc_matrix((nvar, nvar)))  # fmt: skip
-    sol = solve(sparse.triu(pmat, format="csc"), cost, a_mat, b_vec, n_eq, n_le, tolerance, 200)
+    sol = solve_qp(sparse.triu(pmat, format="csc"), cost, rows, tolerance, 200)
     z = np.asarray(sol.x, dtype=np.float64)
     pos = np.column_stack([z[idx("p", ax)] for ax in range(3)])
     return pos, str(sol.status)

@@ -55,7 +55,7 @@ import numpy as np
 from scipy import sparse
 
 from washbench.analysis.lp_rows import Rows as _Rows
-from washbench.analysis.lp_rows import solve
+from washbench.analysis.lp_rows import solve_qp as _solve_qp
 from washbench.analysis.lp_rows import trapezoid as _trapezoid
 from washbench.analysis.metrics import DOFS
 from washbench.analysis.relaxation import Relaxation, relaxation_of
@@ -125,8 +125,7 @@ def _perception_rows(
 
 
 def _solve(c: np.ndarray, rows: _Rows, nvar: int) -> tuple[float, str]:
-    a, b, n_eq, n_le = rows.matrices(nvar)
-    sol = solve(sparse.csc_matrix((nvar, nvar)), c, a, b, n_eq, n_le, CEILING_TOL, 200, tol_ktratio=1e-8)
+    sol = _solve_qp(sparse.csc_matrix((nvar, nvar)), c, rows, CEILING_TOL, 200, tol_ktratio=1e-8)
     status = str(sol.status)
     if status != "Solved":
         return math.nan, status

@@ -1,6 +1,6 @@
 """Sparse linear constraints assembled a block of rows at a time, for the bound's, the ceiling's and the replay's
 programmes (Clarabel's form: equalities in a zero cone, inequalities ``A x <= b`` in a non-negative cone), and the
-one way they are solved (:func:`solve`)."""
+one way they are solved (:func:`solve_qp`)."""
 
 from __future__ import annotations
 
@@ -71,20 +71,21 @@ def trapezoid(n: int, dt: float) -> np.ndarray:
 
 REFINEMENT_TOL = 1e-10
 """Clarabel's iterative refinement of each linear solve stops once its residual is this small, absolute and
-relative (Clarabel's defaults: 1e-12 and 1e-13). These programmes have 10^5 variables, their factors tens of
-millions of entries, and with the defaults the refinement's solves took more time than the factorisations (up to
-ten per solve, two solves per iteration): 1e-10 took the five programmes of the bound on a 61 s flight from 16.1 s
-to 13.0 s; the objectives moved by 2e-7 of themselves at most, within the 1e-4 to 1e-6 the solver is asked for
-(docs/yardstick.md)."""
+relative (Clarabel's defaults: 1e-12 and 1e-13). These programmes have 10^5 variables and factors of tens of
+millions of entries; with the defaults the refinement (up to ten solves with the factors, twice an iteration) took
+more time than the factorisations. 1e-10 took the five programmes of the bound on a 61 s flight from 16.1 s to
+13.0 s; their objectives moved by 2e-7 of themselves at most, well within the tolerances they are solved to (the
+bound's ``eps``, 1e-4 by default, for the attitude plan and the replay; 1e-7 for the ceiling). docs/optimal-mpc.md,
+"What it costs"."""
 
 
-def solve(p_upper: sparse.csc_matrix, q: np.ndarray, a: sparse.csc_matrix, b: np.ndarray, n_eq: int, n_le: int,
-          tol: float, max_iter: int, tol_ktratio: float | None = None) -> Any:  # fmt: skip
-    """Clarabel's solution of min 1/2 x' P x + q' x subject to the rows of :meth:`Rows.matrices` (``n_eq``
-    equalities, then ``n_le`` inequalities), ``p_upper`` P's upper triangle; ``tol`` the gap and feasibility
-    tolerances, ``tol_ktratio`` Clarabel's if given."""
+def solve_qp(p_upper: sparse.csc_matrix, q: np.ndarray, rows: Rows, tol: float, max_iter: int,
+             tol_ktratio: float | None = None) -> Any:  # fmt: skip
+    """Clarabel's solution of min 1/2 x' P x + q' x subject to ``rows`` (``len(q)`` variables); ``p_upper`` is P's
+    upper triangle, ``tol`` the gap and feasibility tolerances, ``tol_ktratio`` Clarabel's if given."""
     import clarabel  # deferred: only the bound and the ceiling need it
 
+    a, b, n_eq, n_le = rows.matrices(len(q))
     settings = clarabel.DefaultSettings()
     settings.verbose = False
     settings.max_iter = max_iter
@@ -96,4 +97,4 @@ def solve(p_upper: sparse.csc_matrix, q: np.ndarray, a: sparse.csc_matrix, b: np
     return clarabel.DefaultSolver(p_upper, q, a, b, cones, settings).solve()
 
 
-__all__ = ["REFINEMENT_TOL", "Rows", "solve", "trapezoid"]
+__all__ = ["REFINEMENT_TOL", "Rows", "solve_qp", "trapezoid"]

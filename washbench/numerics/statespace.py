@@ -28,8 +28,8 @@ def tf2ss(num: Sequence[float] | np.ndarray, den: Sequence[float] | np.ndarray) 
     if n == 0:
         raise ValueError("tf2ss: a static gain has no state")
     num_a, den_a = num_a / den_a[0], den_a / den_a[0]
-    lead = int(np.argmax(np.abs(num_a) > 1e-14)) if np.any(np.abs(num_a) > 1e-14) else num_a.size - 1
-    num_a = num_a[lead:]  # leading (near-)zeros dropped, one kept: scipy's normalize
+    kept = np.flatnonzero(np.abs(num_a) > 1e-14)
+    num_a = num_a[kept[0] if kept.size else num_a.size - 1 :]  # leading (near-)zeros dropped, one kept: scipy's
     if num_a.size > n + 1:
         raise ValueError("tf2ss: improper transfer function (numerator of higher order than the denominator)")
     num_a = np.concatenate([np.zeros(n + 1 - num_a.size), num_a])
