@@ -57,7 +57,7 @@ KNOWN_UPWARD_EDGES: frozenset[tuple[str, str]] = frozenset()
 
 #: The heavy dependencies a washbench import inside a function may be deferred for (``# deferred: <name>``).
 DEFERRED_FOR = (
-    "matplotlib", "rerun", "jsbsim", "numba", "pyarrow", "numpy", "pydantic", "dask", "daqp", "clarabel",
+    "matplotlib", "rerun", "jsbsim", "numba", "pyarrow", "numpy", "pydantic", "dask", "daqp", "piqp",
     "scipy.signal", "scipy.linalg", "scipy.optimize", "scipy.sparse",
 )  # fmt: skip
 #: The deferral that names no dependency: the import must run under the command's signal handling.

@@ -40,7 +40,7 @@ What it does not charge (so where it is loose, docs/metrics.md): tilting costs n
 direction and the canal input are separate variables), every DOF may use the whole of gravity and of the stage,
 and the turning frame's terms are bounded by the largest turn, not by the turn actually made.
 
-The LPs are solved by Clarabel (interior point); the bound taken is the dual objective (weak duality: a valid
+The LPs are solved by PIQP (proximal interior point); the bound taken is the dual objective (weak duality: a valid
 lower bound of the LP whatever the solver's last iterate), made a little smaller for its tolerance.
 """
 
@@ -125,7 +125,7 @@ def _perception_rows(
 
 
 def _solve(c: np.ndarray, rows: _Rows, nvar: int) -> tuple[float, str]:
-    sol = _solve_qp(sparse.csc_matrix((nvar, nvar)), c, rows, CEILING_TOL, 200, tol_ktratio=1e-8)
+    sol = _solve_qp(sparse.csc_matrix((nvar, nvar)), c, rows, CEILING_TOL, 200)
     status = str(sol.status)
     if status != "Solved":
         return math.nan, status

@@ -1,10 +1,10 @@
 """Sparse linear constraints assembled a block of rows at a time, for the bound's, the ceiling's and the replay's
-programmes (Clarabel's form: equalities in a zero cone, inequalities ``A x <= b`` in a non-negative cone), and the
-one way they are solved (:func:`solve_qp`)."""
+programmes (equalities ``A x = b`` and inequalities ``A x <= b``), and the one way they are solved (:func:`solve_qp`:
+PIQP, the inequalities of one variable as its bounds)."""
 
 from __future__ import annotations
 
-from typing import Any
+from dataclasses import dataclass
 
 import numpy as np
 from scipy import sparse
@@ -69,32 +69,89 @@ def trapezoid(n: int, dt: float) -> np.ndarray:
     return w
 
 
-REFINEMENT_TOL = 1e-10
-"""Clarabel's iterative refinement of each linear solve stops once its residual is this small, absolute and
-relative (Clarabel's defaults: 1e-12 and 1e-13). These programmes have 10^5 variables and factors of tens of
-millions of entries; with the defaults the refinement (up to ten solves with the factors, twice an iteration) took
-more time than the factorisations. 1e-10 took the five programmes of the bound on a 61 s flight from 16.1 s to
-13.0 s; their objectives moved by 2e-7 of themselves at most, well within the tolerances they are solved to (the
-bound's ``eps``, 1e-4 by default, for the attitude plan and the replay; 1e-7 for the ceiling). docs/optimal-mpc.md,
-"What it costs"."""
+SOLVER_STATUS = {
+    "PIQP_SOLVED": "Solved",
+    "PIQP_MAX_ITER_REACHED": "MaxIterations",
+    "PIQP_PRIMAL_INFEASIBLE": "PrimalInfeasible",
+    "PIQP_DUAL_INFEASIBLE": "DualInfeasible",
+    "PIQP_NUMERICS": "NumericalError",
+    "PIQP_UNSOLVED": "Unsolved",
+}
+"""PIQP's statuses as the files name them (``ceiling.csv``, ``run.json``: the names the files had with the interior-
+point solver used before, Clarabel; ``Solved`` is the one a result is taken from)."""
 
 
-def solve_qp(p_upper: sparse.csc_matrix, q: np.ndarray, rows: Rows, tol: float, max_iter: int,
-             tol_ktratio: float | None = None) -> Any:  # fmt: skip
-    """Clarabel's solution of min 1/2 x' P x + q' x subject to ``rows`` (``len(q)`` variables); ``p_upper`` is P's
-    upper triangle, ``tol`` the gap and feasibility tolerances, ``tol_ktratio`` Clarabel's if given."""
-    import clarabel  # deferred: only the bound and the ceiling need it
+INFEASIBILITY_EPS = 1e-12
+"""PIQP's primal and dual infeasibility tolerances (its defaults: 1e-8 and 1e-8). Every programme here is feasible
+and bounded by construction (a still platform satisfies them all), but with the defaults PIQP declared a ceiling's
+LP primal infeasible part-way (the heave of a 2.2 g doublet, ``tests/test_ceiling.py``) that it solves in 37
+iterations with this tolerance, to Clarabel's objective within 3e-7: a certificate of infeasibility here would be a
+numerical artefact, not a fact about the flight."""
 
-    a, b, n_eq, n_le = rows.matrices(len(q))
-    settings = clarabel.DefaultSettings()
+
+@dataclass(frozen=True)
+class QpSolution:
+    """A programme's solution: ``x`` the last iterate, ``status`` (:data:`SOLVER_STATUS`), the primal and dual
+    objectives and the interior-point iterations."""
+
+    x: np.ndarray
+    status: str
+    obj_val: float
+    obj_val_dual: float
+    iterations: int
+
+
+def split_bounds(a: sparse.csc_matrix, b: np.ndarray, n_eq: int) -> tuple[
+        sparse.csc_matrix, np.ndarray, sparse.csc_matrix, np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+    """``A x = b`` over ``a``'s first ``n_eq`` rows and ``A x <= b`` over the rest, as PIQP takes them: the equalities
+    ``(A_eq, b_eq)``, the inequalities of more than one variable ``(G, h)``, and the rest as bounds ``x_l <= x <= x_u``
+    (-inf and +inf where none; the tightest where several rows bound one variable)."""
+    csr = a.tocsr()
+    le, h = csr[n_eq:], b[n_eq:]
+    counts = np.diff(le.indptr)
+    nz = np.zeros(len(counts), dtype=bool)
+    nz[counts == 1] = le.data[le.indptr[:-1][counts == 1]] != 0.0
+    single = (counts == 1) & nz
+    starts = le.indptr[:-1][single]
+    col, coef = le.indices[starts], le.data[starts]
+    limit = h[single] / coef
+    x_u = np.full(a.shape[1], np.inf)
+    x_l = np.full(a.shape[1], -np.inf)
+    up = coef > 0.0
+    np.minimum.at(x_u, col[up], limit[up])
+    np.maximum.at(x_l, col[~up], limit[~up])
+    return csr[:n_eq].tocsc(), b[:n_eq], le[~single].tocsc(), h[~single], x_l, x_u
+
+
+def solve_qp(p_upper: sparse.csc_matrix, q: np.ndarray, rows: Rows, tol: float, max_iter: int) -> QpSolution:
+    """PIQP's solution (a proximal interior-point method) of min 1/2 x' P x + q' x subject to ``rows`` (``len(q)``
+    variables); ``p_upper`` is P's upper triangle, ``tol`` the absolute and relative tolerances of the residuals and
+    of the duality gap.
+
+    PIQP, not Clarabel as before: it takes the rows of one variable as bounds of that variable instead of as rows of
+    the KKT system (most of these programmes' inequalities), and on the bound's five programmes of a 61 s flight it
+    took 4.5 s where Clarabel took 12.5 s, its objectives within the tolerance of Clarabel's (docs/optimal-mpc.md,
+    "What it costs")."""
+    import piqp  # deferred: only the bound and the ceiling need it
+
+    a, b, n_eq, _ = rows.matrices(len(q))
+    a_eq, b_eq, g, h, x_l, x_u = split_bounds(a, b, n_eq)
+    solver = piqp.SparseSolver()
+    settings = solver.settings
     settings.verbose = False
     settings.max_iter = max_iter
-    settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = tol
-    if tol_ktratio is not None:
-        settings.tol_ktratio = tol_ktratio
-    settings.iterative_refinement_abstol = settings.iterative_refinement_reltol = REFINEMENT_TOL
-    cones = [clarabel.ZeroConeT(n_eq), clarabel.NonnegativeConeT(n_le)]
-    return clarabel.DefaultSolver(p_upper, q, a, b, cones, settings).solve()
+    settings.eps_abs = settings.eps_rel = tol
+    settings.eps_duality_gap_abs = settings.eps_duality_gap_rel = tol
+    settings.eps_primal_inf = settings.eps_dual_inf = INFEASIBILITY_EPS
+    solver.setup(sparse.csc_matrix(p_upper), np.asarray(q, dtype=np.float64), a_eq, b_eq, g,
+                 np.full(len(h), -np.inf), h, x_l, x_u)  # fmt: skip
+    status = solver.solve()
+    info = solver.result.info
+    name = SOLVER_STATUS.get(status.name)
+    if name is None:  # PIQP_INVALID_SETTINGS: a tolerance or a count out of PIQP's range, not the programme
+        raise ValueError(f"PIQP refused the settings: {status.name}")
+    return QpSolution(np.array(solver.result.x, dtype=np.float64), name, float(info.primal_obj),
+                      float(info.dual_obj), int(info.iter))  # fmt: skip
 
 
-__all__ = ["REFINEMENT_TOL", "Rows", "solve_qp", "trapezoid"]
+__all__ = ["INFEASIBILITY_EPS", "SOLVER_STATUS", "QpSolution", "Rows", "solve_qp", "split_bounds", "trapezoid"]
