@@ -130,7 +130,7 @@ def solve_qp(p_upper: sparse.csc_matrix, q: np.ndarray, rows: Rows, tol: float, 
 
     PIQP, not Clarabel as before: it takes the rows of one variable as bounds of that variable instead of as rows of
     the KKT system (most of these programmes' inequalities), and on the bound's five programmes of a 61 s flight it
-    took 4.5 s where Clarabel took 12.5 s, its objectives within the tolerance of Clarabel's (docs/optimal-mpc.md,
+    took 4.6 s where Clarabel took 12.5 s, its objectives within the tolerance of Clarabel's (docs/optimal-mpc.md,
     "What it costs")."""
     import piqp  # deferred: only the bound and the ceiling need it
 
