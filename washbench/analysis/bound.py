@@ -50,10 +50,10 @@ from washbench.perception.vestibular import VestibularModel, VestibularParams, c
 from washbench.platform.limits import PlatformLimits
 
 MAX_BOUND_SAMPLES = 500_000
-"""The longest recording the bound replays as a washout (69 min at 120 Hz; about 20 min of solving)."""
-BOUND_S_PER_SAMPLE = 2e-3
-"""What the bound's solve costs per sample, s (measured: 1,200 samples 2.3 s, 19,200 samples 37 s on the 2-core
-development machine): the order of magnitude of the estimates printed before long work."""
+"""The longest recording the bound replays as a washout (69 min at 120 Hz). The bound costs about 0.7 ms of CPU per
+sample with its ceiling (7,340 samples 5.3 s, 36,000 samples 21 s on the 2-core development machine, the solver
+PIQP) and about 40 kB of memory per sample at its peak (1.4 GB for 36,000): about 6 minutes and 19 GB at this
+limit."""
 
 
 class BoundParams(StrictModel):
