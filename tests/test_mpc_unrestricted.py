@@ -275,3 +275,39 @@ def test_an_axis_given_in_part_keeps_the_other_defaults():
     assert p.position.xyz == (1.0, d.position.y, d.position.z)
     with pytest.raises(Exception, match="w"):
         MpcUnrestrictedParams.model_validate({"rate": {"w": 2.0}})
+
+
+def test_the_share_figure_splits_the_force_into_stage_and_tilt_exactly(tmp_path):
+    """``tools/mpc_share_figure.py`` (docs/optimal-mpc.md, "How it shares a cue"): on a real ``washbench cue`` of a
+    sway doublet with ``mpc-unrestricted``, the head's specific force in ``traces.parquet`` is the stage's
+    acceleration and gravity seen in the cockpit (scipy's rotation of the recorded attitude), with nothing left
+    over on the bundled Atlas; gravity's part has the magnitude g; the tool writes its figure."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    import pyarrow.parquet as pq
+    from ceiling_helpers import washbench
+
+    root = Path(__file__).resolve().parents[1]
+    sys.path.insert(0, str(root / "tools"))
+    from mpc_share_figure import split_force
+
+    sig = tmp_path / "in.csv"
+    proc = washbench("signal", "doublet", "--axis", "f_y", "--amplitude", "3", "--frequency-hz", "0.2",
+                     "--duration-s", "12", "--rate-hz", "60", "--out", sig)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    out = tmp_path / "c"
+    proc = washbench("cue", sig, "--out", out, "--washout", "small-angle", "--washout", "mpc-unrestricted",
+                     "--no-recording", "--no-figures", "--quiet")  # fmt: skip
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    table = pq.read_table(out / "traces.parquet")
+    parts = split_force(table, "mpc-unrestricted")
+    assert np.abs(parts["rotation"]).max() < 1e-9
+    np.testing.assert_allclose(np.linalg.norm(parts["tilt"], axis=1), G, rtol=1e-12)
+    assert np.abs(parts["translation"][:, 1]).max() > 0.1  # the stage does move in sway
+    png = tmp_path / "share.png"
+    done = subprocess.run([sys.executable, str(root / "tools" / "mpc_share_figure.py"), str(png), str(out)],
+                          capture_output=True, text=True, timeout=120)  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
