@@ -14,16 +14,18 @@ from scipy.optimize import linprog
 from washbench.analysis.lp_rows import SOLVER_STATUS, Rows, solve_qp, split_bounds
 
 
-def random_rows(rng: np.random.Generator, n: int) -> Rows:
-    """Equalities, inequalities of several variables and of one (some repeated, one with a zero coefficient)."""
+def random_rows(rng: np.random.Generator, n: int) -> tuple[Rows, np.ndarray]:
+    """Equalities ``c_k x_k + x_(k+2) = 0`` (k = 0, 1; the ``c`` returned), inequalities of several variables and of
+    one (some repeated, one with a zero coefficient)."""
     rows = Rows()
     idx = np.arange(n)
-    rows.add([(idx[:2], rng.normal(size=2)), (idx[2:4], 1.0)], np.zeros(2), equal=True)  # x = 0 is feasible
+    c = rng.normal(size=2)
+    rows.add([(idx[:2], c), (idx[2:4], 1.0)], np.zeros(2), equal=True)  # x = 0 is feasible
     rows.add([(idx, rng.normal(size=n)), (np.roll(idx, 1), rng.normal(size=n))], rng.uniform(0.5, 2.0, n), equal=False)
     rows.box(idx, -rng.uniform(0.5, 2.0, n), rng.uniform(0.5, 2.0, n))
     rows.box(idx[: n // 2], -rng.uniform(0.5, 2.0, n // 2), rng.uniform(0.5, 2.0, n // 2))  # tighter or not
     rows.add([(idx[:1], 0.0)], np.array([1.0]), equal=False)  # 0 <= 1: a row, not a bound
-    return rows
+    return rows, c
 
 
 @settings(max_examples=40, deadline=None, derandomize=True)
@@ -31,14 +33,16 @@ def random_rows(rng: np.random.Generator, n: int) -> Rows:
 def test_split_keeps_the_feasible_set(seed: int, n: int) -> None:
     """A point satisfies every original row iff it satisfies the equalities, G x <= h and x_l <= x <= x_u."""
     rng = np.random.default_rng(seed)
-    rows = random_rows(rng, n)
-    a, b, n_eq, _ = rows.matrices(n)
-    a_eq, b_eq, g, h, x_l, x_u = split_bounds(a, b, n_eq)
-    dense = a.toarray()
-    assert np.array_equal(a_eq.toarray(), dense[:n_eq]) and np.array_equal(b_eq, b[:n_eq])
+    rows, c = random_rows(rng, n)
+    a_eq, b_eq, a_le, b_le = rows.matrices(n)
+    g, h, x_l, x_u = split_bounds(a_le, b_le)
+    expected_eq = np.zeros((2, n))
+    expected_eq[[0, 1], [0, 1]], expected_eq[[0, 1], [2, 3]] = c, 1.0
+    assert np.array_equal(a_eq.toarray(), expected_eq) and np.array_equal(b_eq, np.zeros(2))
     assert g.shape[0] == n + 1  # the two-variable rows and the zero-coefficient one
+    dense = a_le.toarray()
     for x in rng.uniform(-2.5, 2.5, (400, n)):
-        original = bool(np.all(dense[n_eq:] @ x <= b[n_eq:]))
+        original = bool(np.all(dense @ x <= b_le))
         split = bool(np.all(g @ x <= h) and np.all(x_l <= x) and np.all(x <= x_u))
         assert original == split
 
@@ -48,17 +52,17 @@ def test_an_lp_has_highs_optimum_and_a_dual_bound_below_it() -> None:
     tolerance above it."""
     rng = np.random.default_rng(7)
     n = 30
-    rows = random_rows(rng, n)
-    a, b, n_eq, _ = rows.matrices(n)
+    rows, _ = random_rows(rng, n)
+    a_eq, b_eq, a_le, b_le = rows.matrices(n)
     c = rng.normal(size=n)
-    ref = linprog(c, A_ub=a[n_eq:].toarray(), b_ub=b[n_eq:], A_eq=a[:n_eq].toarray(), b_eq=b[:n_eq],
-                  bounds=(None, None), method="highs")  # fmt: skip
+    ref = linprog(c, A_ub=a_le.toarray(), b_ub=b_le, A_eq=a_eq.toarray(), b_eq=b_eq, bounds=(None, None),
+                  method="highs")  # fmt: skip
     assert ref.status == 0
     sol = solve_qp(sparse.csc_matrix((n, n)), c, rows, 1e-9, 200)
     assert sol.status == "Solved"
     assert sol.obj_val == pytest.approx(ref.fun, rel=1e-6, abs=1e-8)
     assert sol.obj_val_dual <= ref.fun + 1e-6 * max(1.0, abs(ref.fun))
-    assert np.all(a[n_eq:] @ sol.x <= b[n_eq:] + 1e-7)
+    assert np.all(a_le @ sol.x <= b_le + 1e-7)
 
 
 def test_a_projection_onto_a_box_and_a_plane_is_the_closed_form() -> None:

@@ -59,8 +59,8 @@ def main() -> None:
             ("heave specific force [m/s^2]", "f", 2)]  # fmt: skip
     fig, axes = plt.subplots(len(rows), len(args.runs), figsize=(6.4 * len(args.runs), 11.0), sharex="col",
                              squeeze=False, layout="constrained")  # fmt: skip
-    parts = (("translation", "#d9822b", "--"), ("tilt", "#2a9d4b", "--"), ("rotation", "#8e44ad", ":"))
-    names = {"translation": "translation (stage)", "tilt": "tilt (gravity)", "rotation": "head offset"}
+    parts = (("translation", "translation (stage)", "#d9822b", "--"), ("tilt", "tilt (gravity)", "#2a9d4b", "--"),
+             ("rotation", "head offset", "#8e44ad", ":"))  # fmt: skip
     for col, run in enumerate(args.runs):
         table = pq.read_table(run / "traces.parquet")
         t = table.column("t_s").to_numpy()
@@ -81,10 +81,10 @@ def main() -> None:
                 ax.plot(t, table.column(f"aircraft.f_{a}_mps2").to_numpy(), color="black", lw=1.3,
                         label="aircraft pilot")  # fmt: skip
                 ax.plot(t, split["total"][:, axis], color="#1f5fbf", lw=1.1, label=f"{args.washout}: total")
-                for name, colour, style in parts:
+                for name, label_part, colour, style in parts:
                     if name != "rotation" or np.abs(split[name][:, axis]).max() > 1e-6:
                         ax.plot(t, split[name][:, axis], color=colour, lw=1.0, ls=style,
-                                label=f"of which {names[name]}")  # fmt: skip
+                                label=f"of which {label_part}")  # fmt: skip
                 if ref:
                     ax.plot(t, table.column(f"{ref}.f_{a}_mps2").to_numpy(), color="#999999", lw=0.8,
                             label=f"{ref}: total")  # fmt: skip

@@ -47,18 +47,23 @@ class Rows:
         self.add([(idx, 1.0)], np.broadcast_to(np.asarray(hi, dtype=np.float64), (m,)).copy(), equal=False)
         self.add([(idx, -1.0)], -np.broadcast_to(np.asarray(lo, dtype=np.float64), (m,)), equal=False)
 
-    def matrices(self, nvar: int) -> tuple[sparse.csc_matrix, np.ndarray, int, int]:
-        def stack(blocks, nrows):
+    def matrices(self, nvar: int) -> tuple[sparse.csc_matrix, np.ndarray, sparse.csr_matrix, np.ndarray]:
+        """``(A_eq, b_eq, A_le, b_le)`` over ``nvar`` variables (the inequalities by rows, for :func:`split_bounds`);
+        duplicate entries of a row are summed."""
+
+        def stack(blocks: list, nrows: int, fmt: type) -> sparse.spmatrix:
             if not blocks:
-                return sparse.csc_matrix((0, nvar))
+                return fmt((0, nvar))
             r = np.concatenate([b[0] for b in blocks])
             c = np.concatenate([b[1] for b in blocks])
             v = np.concatenate([b[2] for b in blocks])
-            return sparse.csc_matrix((v, (r, c)), shape=(nrows, nvar))
+            return fmt((v, (r, c)), shape=(nrows, nvar))
 
-        a = sparse.vstack([stack(self.eq, self.n_eq), stack(self.le, self.n_le)], format="csc")
-        b = np.concatenate(self.eq_rhs + self.le_rhs) if (self.eq_rhs or self.le_rhs) else np.zeros(0)
-        return a, b, self.n_eq, self.n_le
+        def rhs(parts: list[np.ndarray]) -> np.ndarray:
+            return np.concatenate(parts) if parts else np.zeros(0)
+
+        return (stack(self.eq, self.n_eq, sparse.csc_matrix), rhs(self.eq_rhs),
+                stack(self.le, self.n_le, sparse.csr_matrix), rhs(self.le_rhs))  # fmt: skip
 
 
 def trapezoid(n: int, dt: float) -> np.ndarray:
@@ -101,26 +106,22 @@ class QpSolution:
     iterations: int
 
 
-def split_bounds(a: sparse.csc_matrix, b: np.ndarray, n_eq: int) -> tuple[
-        sparse.csc_matrix, np.ndarray, sparse.csc_matrix, np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
-    """``A x = b`` over ``a``'s first ``n_eq`` rows and ``A x <= b`` over the rest, as PIQP takes them: the equalities
-    ``(A_eq, b_eq)``, the inequalities of more than one variable ``(G, h)``, and the rest as bounds ``x_l <= x <= x_u``
-    (-inf and +inf where none; the tightest where several rows bound one variable)."""
-    csr = a.tocsr()
-    le, h = csr[n_eq:], b[n_eq:]
-    counts = np.diff(le.indptr)
-    nz = np.zeros(len(counts), dtype=bool)
-    nz[counts == 1] = le.data[le.indptr[:-1][counts == 1]] != 0.0
-    single = (counts == 1) & nz
-    starts = le.indptr[:-1][single]
-    col, coef = le.indices[starts], le.data[starts]
+def split_bounds(le: sparse.csr_matrix, h: np.ndarray) -> tuple[
+        sparse.csc_matrix, np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+    """The inequalities ``le x <= h`` as PIQP takes them: those of more than one variable ``(G, h_G)``, and those of
+    one (a non-zero coefficient) as bounds ``x_l <= x <= x_u`` (-inf and +inf where none; the tightest where several
+    rows bound one variable)."""
+    starts = le.indptr[:-1]
+    single = np.diff(le.indptr) == 1
+    single[single] = le.data[starts[single]] != 0.0
+    col, coef = le.indices[starts[single]], le.data[starts[single]]
     limit = h[single] / coef
-    x_u = np.full(a.shape[1], np.inf)
-    x_l = np.full(a.shape[1], -np.inf)
+    x_u = np.full(le.shape[1], np.inf)
+    x_l = np.full(le.shape[1], -np.inf)
     up = coef > 0.0
     np.minimum.at(x_u, col[up], limit[up])
     np.maximum.at(x_l, col[~up], limit[~up])
-    return csr[:n_eq].tocsc(), b[:n_eq], le[~single].tocsc(), h[~single], x_l, x_u
+    return le[~single].tocsc(), h[~single], x_l, x_u
 
 
 def solve_qp(p_upper: sparse.csc_matrix, q: np.ndarray, rows: Rows, tol: float, max_iter: int) -> QpSolution:
@@ -134,8 +135,8 @@ def solve_qp(p_upper: sparse.csc_matrix, q: np.ndarray, rows: Rows, tol: float, 
     "What it costs")."""
     import piqp  # deferred: only the bound and the ceiling need it
 
-    a, b, n_eq, _ = rows.matrices(len(q))
-    a_eq, b_eq, g, h, x_l, x_u = split_bounds(a, b, n_eq)
+    a_eq, b_eq, a_le, b_le = rows.matrices(len(q))
+    g, h, x_l, x_u = split_bounds(a_le, b_le)
     solver = piqp.SparseSolver()
     settings = solver.settings
     settings.verbose = False
