@@ -89,20 +89,19 @@ class HexapodModel(StrictModel):
         angular rate (norm, any axis) that make the most affected leg reach its limit at neutral. Inside the box
         the hexapod is not guaranteed to follow (the legs couple the axes); the hexapod's own limits always hold."""
         jac = leg_jacobian(self, np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0]))
-        reach = []
-        for axis in range(3):
-            ends = []
-            for sign in (1.0, -1.0):
-                lo, hi = 0.0, 50.0
-                for _ in range(60):
-                    mid = 0.5 * (lo + hi)
-                    p = np.zeros((1, 3))
-                    p[0, axis] = sign * mid
-                    legs = leg_lengths(self, p, np.array([[1.0, 0.0, 0.0, 0.0]]))[0]
-                    ok = bool(np.all((legs >= self.leg_length_m.min) & (legs <= self.leg_length_m.max)))
-                    lo, hi = (mid, hi) if ok else (lo, mid)
-                ends.append(lo)
-            reach.append(max(min(ends), 1e-3))
+        # the six searches (each axis, each way) side by side: one leg_lengths call of six poses per halving
+        axis = np.repeat(np.arange(3), 2)
+        sign = np.tile([1.0, -1.0], 3)
+        lo, hi = np.zeros(6), np.full(6, 50.0)
+        upright = np.tile([1.0, 0.0, 0.0, 0.0], (6, 1))
+        p = np.zeros((6, 3))
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            p[np.arange(6), axis] = sign * mid
+            legs = leg_lengths(self, p, upright)
+            ok = np.all((legs >= self.leg_length_m.min) & (legs <= self.leg_length_m.max), axis=1)
+            lo, hi = np.where(ok, mid, lo), np.where(ok, hi, mid)
+        reach = [max(min(lo[2 * i], lo[2 * i + 1]), 1e-3) for i in range(3)]
         trans = np.abs(jac[:, :3]).max(axis=0)
         rot = np.linalg.norm(jac[:, 3:], axis=1).max()
         v, a = self.leg_velocity_limit_mps, self.leg_acceleration_limit_mps2
@@ -142,13 +141,22 @@ def leg_lengths(model: HexapodModel, pos_m: np.ndarray, q: np.ndarray) -> np.nda
     n = np.asarray(model.neutral_m, dtype=np.float64)
     q = np.asarray(q, dtype=np.float64)
     w, v = q[:, :1], q[:, 1:]
+    base = n + np.asarray(pos_m, dtype=np.float64)
     out = np.empty((len(q), 6))
     for i in range(6):
-        ai = np.broadcast_to(a[i], v.shape)
-        t = 2.0 * np.cross(v, ai)
-        ra = ai + w * t + np.cross(v, t)
-        out[:, i] = np.linalg.norm(n + np.asarray(pos_m) + ra - b[i], axis=1)
+        t = 2.0 * _cross(v, a[i])
+        ra = a[i] + w * t + _cross(v, t)
+        d = base + ra - b[i]
+        out[:, i] = np.sqrt(np.add.reduce(d * d, axis=1))
     return out
+
+
+def _cross(u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """u x v of rows (N, 3) and (N, 3) or (3,): ``np.cross``'s products and differences, without its
+    broadcasting set-up (which cost more than the arithmetic on the envelope's few poses)."""
+    u0, u1, u2 = u[..., 0], u[..., 1], u[..., 2]
+    v0, v1, v2 = v[..., 0], v[..., 1], v[..., 2]
+    return np.stack([u1 * v2 - u2 * v1, u2 * v0 - u0 * v2, u0 * v1 - u1 * v0], axis=-1)
 
 
 def leg_jacobian(model: HexapodModel, pos_m: np.ndarray, q: np.ndarray) -> np.ndarray:
