@@ -31,8 +31,11 @@ from washbench.cueing.bank import build_arrays, cue_trace
 from washbench.cueing.kernel import C_KIND, NFIELDS, NSTATE, O_HEAD_F, O_HEAD_OMEGA, O_SAT, SAT_KINDS, bank_block
 from washbench.io.metrics_csv import MetricRow
 from washbench.numerics.jitcache import announce_compile, drop_stale_cache
+from washbench.numerics.numbastart import prepare
 from washbench.perception.sections import sections_init, sections_step
 from washbench.perception.vestibular import VestibularModel
+
+prepare()  # numba's cache loads made light, its BLAS probe skipped (washbench.numerics.numbastart)
 
 PLATFORM_SAT = tuple(SAT_KINDS.index(k) for k in ("pos", "vel", "acc", "rate", "angacc"))
 """Indices of the platform's own limits among the saturation kinds (the tilt-rate and rotational limits are the

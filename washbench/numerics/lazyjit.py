@@ -16,6 +16,8 @@ import functools
 from collections.abc import Callable
 from typing import Any
 
+from washbench.numerics.numbastart import prepare
+
 
 class LazyJit:
     """A function to be compiled by ``numba.njit(**options)`` when its module's first lazy function is called."""
@@ -28,6 +30,8 @@ class LazyJit:
     def compiled(self) -> Any:
         """This function's numba dispatcher (the module's lazy functions all replaced by theirs first)."""
         from numba import njit  # (numba's cache folder was set when this package was imported)
+
+        prepare()  # numba's cache loads made light
 
         namespace = self.py_func.__globals__
         for name, obj in list(namespace.items()):

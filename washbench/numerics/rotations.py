@@ -15,6 +15,10 @@ import math
 
 from numba import njit
 
+from washbench.numerics.numbastart import prepare
+
+prepare()  # numba's cache loads made light, its BLAS probe skipped (washbench.numerics.numbastart)
+
 Vec3 = tuple[float, float, float]
 Quat = tuple[float, float, float, float]
 

@@ -21,6 +21,9 @@ import numpy as np
 from numba import njit
 
 from washbench.numerics.jitcache import announce_compile
+from washbench.numerics.numbastart import prepare
+
+prepare()  # numba's cache loads made light, its BLAS probe skipped (washbench.numerics.numbastart)
 
 __all__ = ["keep_changes", "keep_samples"]
 
