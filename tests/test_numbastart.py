@@ -22,7 +22,7 @@ pytestmark = pytest.mark.skipif(
 # a cue in a fresh process, with numba's cache loads as washbench makes them ("light") or with numba's whole context
 # refreshed first, as its own cache load does ("full": the registries installed, so every later load finds them)
 CUE = """
-import json, sys
+import hashlib, json, sys
 mode, src, out = sys.argv[1:4]
 if mode == "full":
     from numba.core.registry import cpu_target
@@ -30,9 +30,23 @@ if mode == "full":
 from washbench.cli import main
 status = main(["cue", src, "--out", out, "--no-recording", "--no-figures", "--quiet",
                "--washout", "small-angle", "--washout", "large-angle", "--washout", "unrestricted"])
+# the whole-trace bank (bank_trace: one washout per thread, prange) on numba's threads
+import numpy as np
+from washbench.cueing import WASHOUT_NAMES, cue_trace, load_washout_params
+from washbench.platform import load_platform_limits
+t = np.arange(3000) / 120.0
+f = np.column_stack([np.sin(t), 0.5 * np.cos(0.3 * t), -9.80665 + 0.2 * np.sin(2 * t)])
+w = np.column_stack([0.2 * np.sin(t), 0.1 * np.cos(t), 0.05 * np.sin(0.5 * t)])
+traces = cue_trace(f, w, 1 / 120.0, WASHOUT_NAMES, load_washout_params(None), load_platform_limits(None))
+digest = hashlib.sha256()
+for name in sorted(traces):
+    for field in ("pos_m", "q", "head_f_mps2", "head_omega_radps"):
+        digest.update(np.ascontiguousarray(getattr(traces[name], field)).tobytes())
+import numba.np.ufunc.parallel as parallel
 from numba.core import caching
 print(json.dumps({"status": status, "light": getattr(caching.Cache.load_overload, "washbench_light", False),
-                  "registries": "numba.np.npyimpl" in sys.modules}))
+                  "registries": "numba.np.npyimpl" in sys.modules, "parallel": digest.hexdigest(),
+                  "threads": parallel.threading_layer()}))
 """
 
 
@@ -60,11 +74,15 @@ def _cue(mode: str, src: Path, out: Path) -> dict[str, object]:
 
 
 def test_a_light_load_gives_the_bits_of_numbas_own_load_without_its_registries(tmp_path: Path) -> None:
+    """A cue (the streamed bank, perception, metrics) and the whole-trace bank on numba's threads, in a process
+    loading light and in one after numba's full refresh: the same bytes in every column, metrics.csv and digest."""
     src = _input(tmp_path / "in.csv")
     light = _cue("light", src, tmp_path / "light")
     full = _cue("full", src, tmp_path / "full")
-    assert light == {"status": 0, "light": True, "registries": False}  # the kernels ran; no registry was loaded
-    assert full == {"status": 0, "light": True, "registries": True}
+    assert (light["status"], light["light"], light["registries"]) == (0, True, False)  # no registry loaded
+    assert (full["status"], full["light"], full["registries"]) == (0, True, True)
+    assert light["parallel"] == full["parallel"]  # the parallel kernel's traces
+    assert light["threads"] == full["threads"] != ""  # it started numba's threading layer
     a, b = pq.read_table(tmp_path / "light" / "traces.parquet"), pq.read_table(tmp_path / "full" / "traces.parquet")
     assert a.column_names == b.column_names and a.num_rows == 2400
     for name in a.column_names:
@@ -92,3 +110,4 @@ def test_a_function_compiled_after_a_light_load_finds_the_registries() -> None:
     loaded, compiled = proc.stdout.strip().splitlines()
     assert loaded == "(0.0, 1.0, 0.0, 0.0)"
     assert compiled == f"({float(np.sum(np.cumsum(np.arange(5.0))))}, {float(np.linalg.norm(np.arange(5.0)))})"
+
