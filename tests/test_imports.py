@@ -86,7 +86,7 @@ def import_edges(known: dict[str, Path]) -> dict[str, set[str]]:
     """Importer -> the washbench modules it imports (see the module docstring for what counts)."""
     edges: dict[str, set[str]] = defaultdict(set)
     for name, path in known.items():
-        tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+        tree = parsed(path)
         package = name if path.name == "__init__.py" else name.rpartition(".")[0]
         for node in ast.walk(tree):
             targets: list[str] = []
@@ -187,7 +187,7 @@ def header_imports(known: dict[str, Path]) -> dict[str, set[str]]:
     for name, path in known.items():
         package = name if path.name == "__init__.py" else name.rpartition(".")[0]
         found: set[str] = set()
-        stack = list(ast.parse(path.read_text(encoding="utf-8")).body)
+        stack = list(parsed(path).body)
         while stack:
             node = stack.pop()
             if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda)) or _is_type_checking(node):
@@ -199,6 +199,25 @@ def header_imports(known: dict[str, Path]) -> dict[str, set[str]]:
     return out
 
 
+@functools.cache
+def parsed(path: Path) -> ast.Module:
+    """The syntax tree of one of the package's files, parsed once for all the checks here."""
+    return ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+
+
+def _imports_in_functions(tree: ast.Module) -> list[ast.Import | ast.ImportFrom]:
+    """The import statements anywhere inside a function or lambda of ``tree`` (each once, in one walk)."""
+    found: list[ast.Import | ast.ImportFrom] = []
+    stack: list[tuple[ast.AST, bool]] = [(tree, False)]
+    while stack:
+        node, inside = stack.pop()
+        inside = inside or isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda))
+        if inside and isinstance(node, (ast.Import, ast.ImportFrom)):
+            found.append(node)
+        stack.extend((child, inside) for child in ast.iter_child_nodes(node))
+    return found
+
+
 def lazy_names(known: dict[str, Path]) -> dict[tuple[str, str], str]:
     """(package, name) -> the submodule it comes from, for names a package's ``__init__`` provides lazily
     (declared under ``if TYPE_CHECKING:`` there, loaded by its module ``__getattr__``)."""
@@ -206,7 +225,7 @@ def lazy_names(known: dict[str, Path]) -> dict[tuple[str, str], str]:
     for name, path in known.items():
         if path.name != "__init__.py":
             continue
-        for node in ast.parse(path.read_text(encoding="utf-8")).body:
+        for node in parsed(path).body:
             if _is_type_checking(node):
                 for sub in ast.walk(node):
                     if isinstance(sub, ast.ImportFrom) and sub.module and not sub.level:
@@ -237,11 +256,7 @@ def deferred_imports(known: dict[str, Path]) -> list[tuple[str, int, str, list[s
     for name, path in known.items():
         package = name if path.name == "__init__.py" else name.rpartition(".")[0]
         lines = path.read_text(encoding="utf-8").splitlines()
-        tree = ast.parse("\n".join(lines))
-        functions = [n for n in ast.walk(tree) if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda))]
-        for node in {id(n): n for f in functions for n in ast.walk(f)}.values():
-            if not isinstance(node, (ast.Import, ast.ImportFrom)):
-                continue
+        for node in _imports_in_functions(parsed(path)):
             names = _imported_names(node, package)
             if not any(n == "washbench" or n.startswith("washbench.") for n in names):
                 continue
