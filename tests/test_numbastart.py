@@ -51,15 +51,18 @@ print(json.dumps({"status": status, "light": getattr(caching.Cache.load_overload
 
 
 def _input(path: Path) -> Path:
+    """20 s at 120 Hz of a manoeuvre-like motion: a pull-up, a roll and a yaw on level flight's 1 g."""
     t = np.arange(2400) / 120.0
+    g = 9.80665
+    pulse = np.exp(-(((t - 8.0) / 2.0) ** 2))
     cols = {
         "t_s": t,
-        "f_x_mps2": 1.5 * np.sin(0.3 * t) + 0.3 * np.sin(7.1 * t),
-        "f_y_mps2": 0.8 * np.sin(0.17 * t + 1.0),
-        "f_z_mps2": -9.80665 * (1.0 + 0.3 * np.sin(0.11 * t)),
-        "omega_x_degps": 15.0 * np.sin(0.5 * t),
-        "omega_y_degps": 5.0 * np.sin(0.23 * t + 0.4),
-        "omega_z_degps": 3.0 * np.sin(0.07 * t),
+        "f_x_mps2": 0.6 * np.tanh(t - 4.0),
+        "f_y_mps2": 0.9 * np.sin(0.8 * t) * pulse,
+        "f_z_mps2": -g * (1.0 + 0.8 * pulse),
+        "omega_x_degps": 20.0 * np.sin(1.1 * t) * np.exp(-(((t - 12.0) / 3.0) ** 2)),
+        "omega_y_degps": 6.0 * np.gradient(pulse, t),
+        "omega_z_degps": 4.0 * pulse,
     }
     lines = [",".join(cols)] + [",".join(repr(float(v)) for v in row) for row in zip(*cols.values(), strict=True)]
     path.write_text("\n".join(lines) + "\n")
