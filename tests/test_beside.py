@@ -188,3 +188,53 @@ def test_a_cue_result_is_the_same_drawn_beside_or_after(tmp_path: Path, monkeypa
     assert "Recording: [recording.rrd](recording.rrd) (`washbench replay recording.rrd`)." in report[0]
     assert (tmp_path / "beside" / "recording.rrd").stat().st_size > 0
 
+
+
+HOLD_AND_FORK = """
+import os, sys, time
+from washbench.io.lock import output_lock
+from washbench.runs.beside import beside
+
+folder, report = sys.argv[1:3]
+
+def child():  # the descriptors this child has open, then it lives on (until the command's death ends it)
+    with open(report + ".tmp", "w") as f:
+        f.write("\\n".join(os.readlink(f"/proc/self/fd/{fd}") for fd in os.listdir("/proc/self/fd")
+                          if os.path.islink(f"/proc/self/fd/{fd}")))
+    os.replace(report + ".tmp", report)
+    time.sleep(60)
+
+with output_lock(folder):
+    with beside(child):
+        print("forked", flush=True)
+        time.sleep(60)
+"""
+
+
+def test_a_command_killed_outright_leaves_no_lock_in_its_child(tmp_path: Path) -> None:
+    """The child forked beside a command does not hold the command's output lock (washbench.io.lock): killed
+    outright (SIGKILL), the command's folder can be written by the next command at once, while its child may still
+    be dying. (flock holds while any copy of the descriptor is open: the child closes the copy it was forked with.)"""
+    import subprocess
+    import sys
+
+    from washbench.io.lock import output_lock
+    from washbench.io.result_files import LOCK_NAME
+
+    folder, report = tmp_path / "out", tmp_path / "child_fds"
+    proc = subprocess.Popen([sys.executable, "-c", HOLD_AND_FORK, str(folder), str(report)], stdout=subprocess.PIPE,
+                            text=True)  # fmt: skip
+    try:
+        assert proc.stdout is not None and proc.stdout.readline().strip() == "forked"
+        deadline = time.monotonic() + 60
+        while not report.exists() and time.monotonic() < deadline:
+            time.sleep(0.01)
+        child_fds = report.read_text().splitlines()
+        assert str(folder / LOCK_NAME) not in child_fds  # the child has no copy of the lock
+        with pytest.raises(WashbenchError, match="another washbench command"), output_lock(folder):
+            pass  # the command itself holds it
+    finally:
+        proc.kill()
+        proc.wait()
+    with output_lock(folder):  # at once, whether or not the child has died yet
+        pass

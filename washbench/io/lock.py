@@ -7,6 +7,13 @@ holder's PID), which the kernel releases when the process ends, however it ends.
 with one name: a symbolic link (or hard link) planted as the lock is refused, never followed or truncated.
 The file is removed when the command finishes; a lock taken on a file that was removed meanwhile is detected
 (inode check) and taken again on the new file, so two processes never both hold it.
+
+A child forked while the lock is held (:mod:`washbench.runs.beside`'s, a pool's workers) inherits the lock's
+descriptor, and the kernel keeps an ``flock`` while any copy of it is open: a command killed outright would leave
+its folder locked until its children had died too, and a command started at once in the same folder was refused
+(seen in the test of exactly that). Every such child therefore closes its copies first
+(:func:`close_inherited`, called by :func:`washbench.runs.pool.worker_init`): the lock is the command's alone and
+ends with it.
 """
 
 from __future__ import annotations
@@ -22,6 +29,18 @@ from pathlib import Path
 from washbench.errors import WashbenchError, located
 from washbench.io.publish import prepare_output_dir
 from washbench.io.result_files import LOCK_NAME
+
+_HELD: set[int] = set()
+"""The lock descriptors this process holds (:func:`output_lock`)."""
+
+
+def close_inherited() -> None:
+    """In a child forked while a lock was held: close this process's copies of the lock's descriptors (the parent's
+    stay open, so the lock holds while the parent lives, and ends with it)."""
+    for fd in tuple(_HELD):
+        with contextlib.suppress(OSError):
+            os.close(fd)
+    _HELD.clear()
 
 
 def _open_lock(out_dir: Path, path: Path) -> int:
@@ -87,6 +106,7 @@ def output_lock(out_dir: str | Path) -> Iterator[Path]:
     out_dir = prepare_output_dir(out_dir)
     path = out_dir / LOCK_NAME
     fd = _acquire(out_dir, path)
+    _HELD.add(fd)
     try:
         try:
             os.ftruncate(fd, 0)
@@ -97,6 +117,7 @@ def output_lock(out_dir: str | Path) -> Iterator[Path]:
     finally:
         with contextlib.suppress(OSError):
             os.unlink(path)  # while still holding it: a waiting process then finds the inode changed
+        _HELD.discard(fd)
         os.close(fd)
         if not existed:
             with contextlib.suppress(OSError):
