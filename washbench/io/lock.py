@@ -8,12 +8,12 @@ with one name: a symbolic link (or hard link) planted as the lock is refused, ne
 The file is removed when the command finishes; a lock taken on a file that was removed meanwhile is detected
 (inode check) and taken again on the new file, so two processes never both hold it.
 
-A child forked while the lock is held (:mod:`washbench.runs.beside`'s, a pool's workers) inherits the lock's
-descriptor, and the kernel keeps an ``flock`` while any copy of it is open: a command killed outright would leave
-its folder locked until its children had died too, and a command started at once in the same folder was refused
-(seen in the test of exactly that). Every such child therefore closes its copies first
-(:func:`close_inherited`, called by :func:`washbench.runs.pool.worker_init`): the lock is the command's alone and
-ends with it.
+A child forked while the lock is held (:mod:`washbench.runs.beside`'s, or any other ``os.fork``) inherits the
+lock's descriptor, and the kernel keeps an ``flock`` while any copy of it is open: a command killed outright would
+leave its folder locked until its children had died too, and a command started at once in the same folder was
+refused (seen in the test of exactly that). Every forked child therefore closes its copies at once
+(:func:`close_inherited`, registered with :func:`os.register_at_fork`): the lock is the command's alone and ends
+with it.
 """
 
 from __future__ import annotations
@@ -41,6 +41,10 @@ def close_inherited() -> None:
         with contextlib.suppress(OSError):
             os.close(fd)
     _HELD.clear()
+
+
+if hasattr(os, "register_at_fork"):  # POSIX: run in every child this process forks, before anything else
+    os.register_at_fork(after_in_child=close_inherited)
 
 
 def _open_lock(out_dir: Path, path: Path) -> int:

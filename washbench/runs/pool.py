@@ -21,7 +21,6 @@ from concurrent.futures import Future, ProcessPoolExecutor
 from typing import Any
 
 from washbench.io import collector
-from washbench.io.lock import close_inherited
 from washbench.io.outfolder import signals_held
 from washbench.runs import parent_death
 from washbench.runs.parent_death import note_main_pid
@@ -34,8 +33,7 @@ FIGURE_MODULES = ("matplotlib.figure", "matplotlib.backends.backend_agg")
 
 def worker_init(then: Callable[[], None] | None = None) -> None:
     """In each worker (and each child of :mod:`washbench.runs.beside`): Ctrl-C is for the main process (it stops
-    the workers); SIGTERM stops a worker at once; the copies of the command's output lock a fork gave it are closed
-    (:func:`washbench.io.lock.close_inherited`).
+    the workers); SIGTERM stops a worker at once.
 
     ``then``: the start method's own initializer (:func:`pool_context`). Then what the worker has loaded (the
     process server's preloaded modules, forked) is frozen: the worker's collector never scans it
@@ -43,7 +41,6 @@ def worker_init(then: Callable[[], None] | None = None) -> None:
     """
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
-    close_inherited()  # the command's output lock stays the command's (washbench.io.lock)
     if then is not None:
         then()
     collector.freeze_loaded()
