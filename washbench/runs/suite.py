@@ -147,9 +147,11 @@ def run_suite(
     start = time.perf_counter()
     shown = Progress("suite", len(files), "manoeuvres") if progress else None
     if progress:
+        loading = ", ".join(["JSBSim", *(["matplotlib"] if opts.outputs.figures else []),
+                             *(["rerun"] if opts.outputs.recording else [])])  # fmt: skip
         print(
             f"suite: {len(files)} manoeuvres on {jobs} process{'es' if jobs > 1 else ''} -> {_destination(out_dir)}\n"
-            "suite: loading JSBSim, rerun and the compiled kernels",
+            f"suite: loading {loading} and the compiled kernels",
             file=sys.stderr,
         )
     try:
