@@ -78,22 +78,3 @@ def test_commands_import_only_what_they_need(tmp_path) -> None:
     assert imported_by(["run", str(tmp_path / "m.yaml"), "--out", str(tmp_path / "r2"), "--quiet"]) == {
         "rerun", "matplotlib"
     }  # fmt: skip
-
-
-def test_a_suite_starts_its_process_server_first_only_where_it_will_have_workers(tmp_path, monkeypatch) -> None:
-    """``washbench suite`` starts the workers' server before it loads the suite (it loads JSBSim, the kernels, ...
-    meanwhile): with more than one process, no --dask and inputs that may be several files; never for one file."""
-    from washbench.cli import _suite_needs_workers, build_parser
-
-    one = tmp_path / "one.yaml"
-    one.write_text("name: x\n")
-    monkeypatch.setattr("washbench.cli.usable_cpus", lambda: 2)
-    parse = build_parser().parse_args
-    assert _suite_needs_workers(parse(["suite", "--out", str(tmp_path / "o")]))  # the bundled set
-    assert _suite_needs_workers(parse(["suite", str(tmp_path), "--out", str(tmp_path / "o")]))  # a folder
-    assert _suite_needs_workers(parse(["suite", "c172", "--out", str(tmp_path / "o")]))  # a group by name
-    assert not _suite_needs_workers(parse(["suite", str(one), "--out", str(tmp_path / "o")]))
-    assert not _suite_needs_workers(parse(["suite", "--jobs", "1", "--out", str(tmp_path / "o")]))
-    assert not _suite_needs_workers(parse(["suite", "--dask", "tcp://127.0.0.1:1", "--out", str(tmp_path / "o")]))
-    monkeypatch.setattr("washbench.cli.usable_cpus", lambda: 1)
-    assert not _suite_needs_workers(parse(["suite", "--out", str(tmp_path / "o")]))

@@ -22,13 +22,11 @@ from washbench.cueing.params import WASHOUT_KINDS
 from washbench.errors import Terminated, WashbenchError, printable
 from washbench.io import config as project_config
 from washbench.io import interrupts
-from washbench.io.cpus import usable_cpus
 from washbench.io.examples import copy_examples
 from washbench.io.paths import resolve_manoeuvre
 from washbench.live import FORMATS
 from washbench.review.replay import replay_command
 from washbench.runs.outputs import Outputs
-from washbench.runs.pool import start_server
 
 _VARIANT_HELP = "add a washout NAME of KIND with dotted-key overrides of the parameter file, repeatable"
 
@@ -63,11 +61,8 @@ def _rank_option(p: argparse.ArgumentParser) -> None:
     p.add_argument("--rank-by", choices=("score", "false-cue", "weighted"),
                    help="ranking rule (default: the parameter file's ranking: section, else score); weighted uses "
                    "its ranking.dof_weights")  # fmt: skip
-    p.add_argument(
-        "--vestibular",
-        choices=("young-meiry", "telban-cardullo"),
-        help="vestibular models (default young-meiry: Meiry-Young otolith, Young-Oman canals)",
-    )
+    p.add_argument("--vestibular", choices=("young-meiry", "telban-cardullo"),
+                   help="vestibular models (default young-meiry: Meiry-Young otolith, Young-Oman canals)")
 
 
 def _platform_options(p: argparse.ArgumentParser) -> None:
@@ -75,11 +70,8 @@ def _platform_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--platform", type=Path,
                    help="platform file, its kind: key picks the model: atlas, hexapod, rig or a plugin's (default: "
                    "bundled Atlas)")  # fmt: skip
-    p.add_argument(
-        "--platform-plugin",
-        metavar="FILE.py:NAME",
-        help="load a platform from a Python file (docs/platforms.md); without --platform it is the platform",
-    )
+    p.add_argument("--platform-plugin", metavar="FILE.py:NAME",
+                   help="load a platform from a Python file (docs/platforms.md); without --platform it is the platform")
 
 
 def _study_options(p: argparse.ArgumentParser) -> None:
@@ -274,10 +266,8 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--out", type=_out_path, required=True, help="output folder (tuned.yaml, tune.csv, report.md)")
     _study_options(p)
-    p = sub.add_parser(
-        "examples",
-        help="copy the bundled manoeuvres, pilot profiles, parameter and platform files into a folder to edit",
-    )
+    p = sub.add_parser("examples", help="copy the bundled manoeuvres, pilot profiles, parameter and platform files "
+                       "into a folder to edit")
     p.add_argument("folder", type=Path, help="destination (created; existing files are never overwritten)")
 
     p = sub.add_parser("report", help="write report.md and its figures (PNG and PDF) again from existing results")
@@ -456,14 +446,6 @@ def _version_line() -> str:
     )
 
 
-def _suite_needs_workers(args: argparse.Namespace) -> bool:
-    """Whether ``washbench suite`` will run in local worker processes, as far as the arguments tell before anything
-    is loaded: no ``--dask``, more than one process, and not a single manoeuvre file (a folder, a group or the bundled
-    set may hold several; :func:`washbench.runs.suite.suite_command` decides on the files found)."""
-    one_file = len(args.inputs) == 1 and not args.jsbsim_scripts and args.inputs[0].is_file()
-    return args.dask is None and (args.jobs or usable_cpus()) > 1 and not one_file
-
-
 def _dispatch(args: argparse.Namespace) -> int:
     if hasattr(args, "manoeuvre") or hasattr(args, "manoeuvres"):
         if hasattr(args, "manoeuvre"):
@@ -489,8 +471,6 @@ def _dispatch(args: argparse.Namespace) -> int:
 
         return run_command(args.manoeuvre, args.out, _run_options(args), progress=not args.quiet)
     if args.command == "suite":
-        if _suite_needs_workers(args):  # their server loads JSBSim, the kernels, ... while this process loads the suite
-            start_server(recording=not args.no_recording, figures=not args.no_figures)
         from washbench.runs.suite import suite_command  # deferred: pyarrow
 
         return suite_command(
