@@ -154,3 +154,41 @@ def test_a_signal_wrapped_by_python_still_ends_in_one_line(
     monkeypatch.setattr(cli, "_dispatch", lambda args: _wrapped_interrupt(by_signal=False))
     with pytest.raises(RuntimeError, match="__set_name__"):
         cli.main(["validate", manoeuvre])
+
+
+class _InterruptsItsSchema:
+    """A field type whose schema sends this process SIGINT the first time pydantic builds it (as a Ctrl-C that lands
+    while a deferred model is built at its first use)."""
+
+    sent = False
+
+    @classmethod
+    def __get_pydantic_core_schema__(cls, source: object, handler: object) -> object:
+        from pydantic_core import core_schema
+
+        if not cls.sent:
+            cls.sent = True
+            os.kill(os.getpid(), signal.SIGINT)  # the handler runs at the next bytecode, inside the build
+        return core_schema.no_info_plain_validator_function(int, serialization=core_schema.to_string_ser_schema())
+
+
+def test_a_ctrl_c_while_a_model_is_built_acts_once_it_is_built() -> None:
+    """A model's schema is built at its first use (``defer_build``); pydantic-core turned a KeyboardInterrupt raised
+    inside that build into a SchemaError traceback. Held back (``StrictModel.model_rebuild``), the Ctrl-C is a
+    KeyboardInterrupt after the build, and the model is complete: the next use does not build it again."""
+    from washbench.io import interrupts
+    from washbench.io.yamlio import StrictModel
+
+    class Model(StrictModel):
+        value: _InterruptsItsSchema
+
+    assert not Model.__pydantic_complete__
+    before = signal.signal(signal.SIGINT, interrupts.interrupt)  # the command's handler
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            Model.model_validate({"value": 3})
+        assert _InterruptsItsSchema.sent
+        assert Model.__pydantic_complete__  # built whole, then interrupted
+        assert Model.model_validate({"value": 4}).value == 4
+    finally:
+        signal.signal(signal.SIGINT, before)

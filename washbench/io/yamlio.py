@@ -29,6 +29,7 @@ from pydantic import BaseModel, ConfigDict
 
 from washbench.errors import WashbenchError, located
 from washbench.io import budget
+from washbench.io.interrupts import signals_held
 
 M = TypeVar("M", bound=BaseModel)
 
@@ -46,6 +47,19 @@ class StrictModel(BaseModel):
         extra="forbid", strict=True, frozen=True, allow_inf_nan=False, defer_build=True
     )  # built at a model's first use, so a command builds only what it reads; the attribute docstrings are read by
     # ``washbench schema`` alone (washbench.flight.json_schema)
+
+    @classmethod
+    def model_rebuild(cls, *args: Any, _parent_namespace_depth: int = 2, **kwargs: Any) -> bool | None:
+        """pydantic's, with SIGINT and SIGTERM held back while it builds the model's schema (at the model's first
+        use, ``defer_build``; a few milliseconds) and acted on once it is built.
+
+        pydantic-core calls back into Python while it builds a validator or serializer, and a KeyboardInterrupt
+        raised in such a call came out of it as a ``SchemaError`` chain: a traceback instead of "washbench:
+        interrupted" (a suite signalled as its workers start, beside two busy loops). The namespace pydantic reads
+        the annotations in is its caller's, one frame further out than for pydantic's own method.
+        """
+        with signals_held():
+            return super().model_rebuild(*args, _parent_namespace_depth=_parent_namespace_depth + 1, **kwargs)
 
     def model_copy(self, *, update: Mapping[str, Any] | None = None, deep: bool = False) -> Self:
         """A copy; with ``update``, a new validated instance (raises ``pydantic.ValidationError``)."""
