@@ -189,7 +189,6 @@ def test_a_cue_result_is_the_same_drawn_beside_or_after(tmp_path: Path, monkeypa
     assert (tmp_path / "beside" / "recording.rrd").stat().st_size > 0
 
 
-
 HOLD_AND_FORK = """
 import os, sys, time
 from washbench.io.lock import output_lock
