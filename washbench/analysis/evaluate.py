@@ -22,7 +22,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from numba import njit, prange
 
 from washbench.analysis.metric_sums import NACC, acc_update, finish
 from washbench.analysis.metrics import DOFS, npc_from_pc
@@ -30,12 +29,10 @@ from washbench.analysis.ranking import dof_weights, perceived_motion, score_of
 from washbench.cueing.bank import build_arrays, cue_trace
 from washbench.cueing.kernel import C_KIND, NFIELDS, NSTATE, O_HEAD_F, O_HEAD_OMEGA, O_SAT, SAT_KINDS, bank_block
 from washbench.io.metrics_csv import MetricRow
+from washbench.numerics.jit import njit, prange
 from washbench.numerics.jitcache import announce_compile, drop_stale_cache
-from washbench.numerics.numbastart import prepare
 from washbench.perception.sections import sections_init, sections_step
 from washbench.perception.vestibular import VestibularModel
-
-prepare()  # numba's cache loads made light, its BLAS probe skipped (washbench.numerics.numbastart)
 
 PLATFORM_SAT = tuple(SAT_KINDS.index(k) for k in ("pos", "vel", "acc", "rate", "angacc"))
 """Indices of the platform's own limits among the saturation kinds (the tilt-rate and rotational limits are the

@@ -14,12 +14,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
-import washbench.numerics.jitcache  # noqa: F401  (numba's cache folder is set before anything here is compiled)
-from washbench.numerics.numbastart import prepare
-
-prepare()  # numba's cache loads made light, its BLAS probe skipped (washbench.numerics.numbastart)
+from washbench.numerics.jit import njit
 
 A_N, A_SUM, A_FIRST, A_LAST, A_MAX, A_MX, A_MY, A_M2X, A_M2Y, A_CXY, A_PX, A_PY = range(12)
 NACC = 12

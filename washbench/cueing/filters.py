@@ -22,12 +22,9 @@ from __future__ import annotations
 import functools
 
 import numpy as np
-from numba import njit
 
-from washbench.numerics.numbastart import prepare
+from washbench.numerics.jit import njit
 from washbench.numerics.statespace import tf2ss
-
-prepare()
 
 NCOEF = 9
 

@@ -23,11 +23,10 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numba import njit, prange
 
 from washbench.cueing.filters import filt_init, filt_step
+from washbench.numerics.jit import njit, prange
 from washbench.numerics.jitcache import drop_stale_cache
-from washbench.numerics.numbastart import prepare
 from washbench.numerics.rotations import (
     body_rates,
     cross,
@@ -47,8 +46,6 @@ from washbench.numerics.rotations import (
 from washbench.platform.hexapod_kinematics import NGEO, NWORK, hexapod_track
 from washbench.platform.kinematics import track_axis, track_rotation, wheel_speeds
 from washbench.platform.rig_kinematics import NRIG_STATE, rig_track
-
-prepare()  # numba's cache loads made light, its BLAS probe skipped (washbench.numerics.numbastart)
 
 KIND_SMALL, KIND_LARGE, KIND_UNRESTRICTED = 0, 1, 2
 KIND_SETPOINT = -1  # an algorithm outside the kernel gives the set points (:func:`setpoint_step`)

@@ -60,7 +60,6 @@ from washbench.flight.manoeuvre_schema import Hold, Runway
 from washbench.flight.profile import PilotProfile
 from washbench.numerics.jitcache import announce_compile
 from washbench.numerics.lazyjit import LazyJit, lazy_njit  # numba imported at the first step, not here
-from washbench.numerics.numbastart import prepare
 
 D2R = math.pi / 180.0
 G_FPS2 = 32.174
@@ -382,7 +381,6 @@ for _i, _name in enumerate(PARAMS + STATE):
 
 def compiled_step() -> Any:
     """:func:`pilot_step`'s numba dispatcher (compiled, or loaded from numba's cache, at its first call; announced)."""
-    prepare()  # numba's first import without the scipy BLAS probe
     fn = pilot_step
     if isinstance(fn, LazyJit):
         fn = fn.compiled()

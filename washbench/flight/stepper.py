@@ -58,7 +58,6 @@ from washbench.flight.pilot import (
 )
 from washbench.numerics.jitcache import announce_compile, drop_stale_cache
 from washbench.numerics.lazyjit import LazyJit, lazy_njit  # numba imported at the first step, not here
-from washbench.numerics.numbastart import prepare
 
 FT_S2_TO_M_S2 = 0.3048  # as washbench.flight.fly (which imports this module)
 R2D = 180.0 / math.pi
@@ -148,7 +147,6 @@ _cache_checked = False
 
 def compiled_flight_step() -> object:
     """:func:`flight_step`'s numba dispatcher (compiled, or loaded from numba's cache, at its first call; announced)."""
-    prepare()  # numba's first import without the scipy BLAS probe
     global _cache_checked
     if not _cache_checked:  # here, not at import: it imports numba (0.4 s) and fly's module is imported by validate
         # the compiled step inlines the pilot's: its cache is stale when pilot.py changes

@@ -24,7 +24,8 @@ loop for those two functions. If scipy's BLAS is already loaded, or numba's arra
 is changed. Functions that really need BLAS (``np.dot`` and ``np.linalg`` in numba code) still import it when they
 are compiled.
 
-Every washbench module that imports numba calls :func:`prepare` next.
+It is called in two places: :mod:`washbench.numerics.jit`, whose ``njit`` and ``prange`` every module compiled at its
+import takes, and :meth:`washbench.numerics.lazyjit.LazyJit.compiled`, for those compiled at their first call.
 """
 
 from __future__ import annotations

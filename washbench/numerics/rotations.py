@@ -13,11 +13,7 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
-
-from washbench.numerics.numbastart import prepare
-
-prepare()  # numba's cache loads made light, its BLAS probe skipped (washbench.numerics.numbastart)
+from washbench.numerics.jit import njit
 
 Vec3 = tuple[float, float, float]
 Quat = tuple[float, float, float, float]

@@ -11,12 +11,8 @@ so both give the same bits. A filter starts in the steady state of its first sam
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
 
-import washbench.numerics.jitcache  # noqa: F401  (numba's cache folder is set before anything here is compiled)
-from washbench.numerics.numbastart import prepare
-
-prepare()
+from washbench.numerics.jit import njit, prange
 
 
 @njit(cache=True, inline="always")

@@ -25,14 +25,10 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from numba import njit
-
+from washbench.numerics.jit import njit
 from washbench.numerics.jitcache import drop_stale_cache
-from washbench.numerics.numbastart import prepare
 from washbench.numerics.rotations import cross, norm3, qmul, qnormalize, qrot, qrotvec
 from washbench.platform.kinematics import track_axis
-
-prepare()  # numba's cache loads made light, its BLAS probe skipped (washbench.numerics.numbastart)
 
 drop_stale_cache(
     __file__,

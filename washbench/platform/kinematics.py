@@ -25,13 +25,10 @@ import math
 from pathlib import Path
 
 import numpy as np
-from numba import njit
 
+from washbench.numerics.jit import njit
 from washbench.numerics.jitcache import drop_stale_cache
-from washbench.numerics.numbastart import prepare
 from washbench.numerics.rotations import limit_norm, norm3, qconj, qintegrate, qmul, qrotvec
-
-prepare()  # numba's cache loads made light, its BLAS probe skipped (washbench.numerics.numbastart)
 
 drop_stale_cache(__file__, [Path(__file__).resolve().parent.parent / "numerics" / "rotations.py"])
 

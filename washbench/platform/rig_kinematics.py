@@ -12,14 +12,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from numba import njit
-
+from washbench.numerics.jit import njit
 from washbench.numerics.jitcache import drop_stale_cache
-from washbench.numerics.numbastart import prepare
 from washbench.numerics.rotations import euler_from_quat, quat_from_euler, wrap_near
 from washbench.platform.kinematics import track_axis
-
-prepare()  # numba's cache loads made light, its BLAS probe skipped (washbench.numerics.numbastart)
 
 drop_stale_cache(
     __file__,

@@ -18,12 +18,9 @@ the tolerance.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from washbench.numerics.jit import njit
 from washbench.numerics.jitcache import announce_compile
-from washbench.numerics.numbastart import prepare
-
-prepare()  # numba's cache loads made light, its BLAS probe skipped (washbench.numerics.numbastart)
 
 __all__ = ["keep_changes", "keep_samples"]
 
