@@ -369,6 +369,26 @@ def test_the_deferral_check_catches_an_unmarked_or_false_deferral(tmp_path: Path
     assert "not a heavy dependency" in found[2]
 
 
+
+#: The modules whose header may import numba: the one that hands its decorators to the compiled modules, prepared
+#: first (washbench.numerics.jit), and the suite's preloader, which names kernel signatures with numba's types.
+NUMBA_IN_HEADER = {"washbench.numerics.jit", "washbench.runs.preload"}
+
+
+def test_numba_s_decorators_come_prepared_from_one_module() -> None:
+    """A module compiled at its import takes ``njit``/``prange`` from :mod:`washbench.numerics.jit`, which sets
+    numba's cache folder and makes its start light before any kernel is defined, not from numba itself (where that
+    start would be left to the module to remember)."""
+    known, _ = graph()
+    header = header_imports(known)
+    direct = {m for m, names in header.items() if any(n == "numba" or n.startswith("numba.") for n in names)}
+    assert direct == NUMBA_IN_HEADER
+    prepared = {m for m, names in header.items() if "washbench.numerics.jit.njit" in names}
+    assert len(prepared) >= 10  # the kernels: rotations, filters, the washout kernel, platforms, perception, metrics
+    jit_source = known["washbench.numerics.jit"].read_text(encoding="utf-8")
+    assert "\nprepare()\n" in jit_source
+
+
 if __name__ == "__main__":
     KNOWN, EDGES = graph()
     wings: dict[str, set[str]] = defaultdict(set)
