@@ -57,10 +57,14 @@ def _washout_options(p: argparse.ArgumentParser, variants: bool = True) -> None:
 
 
 def _rank_option(p: argparse.ArgumentParser) -> None:
-    """--rank-by and --vestibular (cue, live, run, suite), recorded in the provenance (docs/fidelity.md)."""
-    p.add_argument("--rank-by", choices=("score", "false-cue", "weighted"),
-                   help="ranking rule (default: the parameter file's ranking: section, else score); weighted uses "
-                   "its ranking.dof_weights")  # fmt: skip
+    """--rank-by, --thresholds and --vestibular (cue, live, run, suite), recorded in the provenance
+    (docs/metrics.md)."""
+    p.add_argument("--rank-by", choices=("felt", "score", "false-cue", "weighted"),
+                   help="ranking rule (default: the parameter file's ranking: section, else felt: the felt error); "
+                   "score is the rule before it; weighted uses the section's ranking.dof_weights")  # fmt: skip
+    p.add_argument("--thresholds", choices=("zacharias", "none"),
+                   help="perception thresholds of the felt error (default: the parameter file's ranking: section, "
+                   "else zacharias: Zacharias 1978); none: no dead band")  # fmt: skip
     p.add_argument("--vestibular", choices=("young-meiry", "telban-cardullo"),
                    help="vestibular models (default young-meiry: Meiry-Young otolith, Young-Oman canals)")
 
@@ -397,7 +401,7 @@ def _run_options(args: argparse.Namespace) -> Any:
                         variants=args.variant, aircraft_dirs=getattr(args, "aircraft_dir", ()), outputs=_outputs(args),
                         filter_start=getattr(args, "filter_start", "steady"),
                         max_time_s=getattr(args, "max_time_s", None), rank_by=args.rank_by,
-                        vestibular=args.vestibular)  # fmt: skip
+                        vestibular=args.vestibular, thresholds=args.thresholds)  # fmt: skip
 
 
 def _cue(args: argparse.Namespace) -> int:

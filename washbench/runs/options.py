@@ -44,7 +44,9 @@ class RunOptions:
     As given (the command line): ``params_path``, ``platform_path`` (None: the bundled files), ``washout_names``
     (``--washout``; None: the default), ``variants`` (``--variant`` texts), ``aircraft_dirs``, ``outputs``,
     ``filter_start`` (``steady`` or ``rest``), ``max_time_s`` (JSBSim scripts), ``rank_by``, ``vestibular`` (the
-    model's name; None: the default). Loaded: ``params`` (the parameter file's base set), ``washouts`` (what runs,
+    model's name; None: the default), ``thresholds`` (the felt error's: ``zacharias``, ``none``; None: the
+    parameter file's ``ranking:`` section, else Zacharias).
+    Loaded: ``params`` (the parameter file's base set), ``washouts`` (what runs,
     :func:`washbench.cueing.variants.select_washouts`), ``limits``, ``rank_rule``, ``vestibular_params``,
     ``plugins`` (the washout plugins loaded in this process, ``FILE.py:NAME``, for worker processes) and
     ``provenance`` (the run-wide records: parameters, washouts, platform, ranking, vestibular model; no date).
@@ -60,6 +62,7 @@ class RunOptions:
     max_time_s: float | None = None
     rank_by: str | None = None
     vestibular: str | None = None
+    thresholds: str | None = None
     params: WashoutParams
     washouts: tuple[Washout, ...]
     limits: PlatformModel
@@ -102,6 +105,7 @@ def load_options(
     max_time_s: float | None = None,
     rank_by: str | None = None,
     vestibular: str | None = None,
+    thresholds: str | None = None,
 ) -> RunOptions:
     """The options of a run (:class:`RunOptions`), each file read once.
 
@@ -120,7 +124,7 @@ def load_options(
     if washouts is None and not variants:  # the default set: those of its washouts that can drive this platform
         chosen = tuple(w for w in chosen if platform_refusal(w, limits) is None)
     check_platform(chosen, limits)  # a washout named that cannot drive this platform: refused before anything is flown
-    rule = rank_rule_from_data(params_path, data, lines, rank_by)
+    rule = rank_rule_from_data(params_path, data, lines, rank_by, thresholds)
     vestibular_params = model_params(vestibular)
     provenance = build_provenance(
         params_path=source,
@@ -147,6 +151,7 @@ def load_options(
         max_time_s=max_time_s,
         rank_by=rank_by,
         vestibular=vestibular,
+        thresholds=thresholds,
         params=params,
         washouts=chosen,
         limits=limits,
