@@ -72,7 +72,8 @@ def main(argv: list[str] | None = None) -> int:
             if args.markdown:
                 print(f"| {w}{mark} | {felt_values[w]:.3f} | {100 * share:.0f} % | {score_values[w]:.3f} |")
             else:
-                print(f"  {w:24s} felt {felt_values[w]:8.3f}  (jolts {100 * share:3.0f} %)   score {score_values[w]:7.3f}")
+                print(f"  {w:24s} felt {felt_values[w]:8.3f}  (jolts {100 * share:3.0f} %)   "
+                      f"score {score_values[w]:7.3f}")
         for rule, values in (("felt", felt_values), ("score", score_values)):
             if refs and causal and min(values[r] for r in refs) < min(values[c] for c in causal):
                 wins[rule] += 1
