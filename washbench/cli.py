@@ -48,8 +48,10 @@ def _washout_options(p: argparse.ArgumentParser, variants: bool = True) -> None:
         "--washout",
         action="append",
         metavar="NAME",
-        help=f"washout to run, repeatable: {', '.join(WASHOUT_KINDS)}, optimal, mpc, mpc-unrestricted, bound (whole "
-        "recordings), or a plugin's name (default: the first three, or none with a variant)",
+        help=f"washout to run, repeatable: {', '.join(WASHOUT_KINDS)}, optimal, mpc, mpc-unrestricted, the naive "
+        "references replay, replay-rotation, still, bound (whole recordings), a plugin's name, or all (every "
+        "built-in, the references and the bound) (default: small-angle, large-angle, unrestricted and the three "
+        "references, or none with a variant)",
     )
     if variants:
         p.add_argument("--variant", action="append", default=[], metavar="NAME=KIND[,KEY=VALUE...]", help=_VARIANT_HELP)

@@ -288,11 +288,11 @@ def translational_floor(
                 raise ValueError("the jolt term needs the aircraft pilot's head specific force")
             j = idx["j"]
             rows.box(j, 0.0, np.inf)
-            # j_k >= |f_k - f_{k-1}| - |F_k - F_{k-1}| - J_T dt, k >= 1 (j_0 unused: its cost is 0)
-            allow = np.abs(np.diff(np.asarray(aircraft_head, dtype=np.float64))) + terms.jerk_deadband_mps3 * dt
+            # j_k >= |f_k - f_{k-1}| / dt - |F_k - F_{k-1}| / dt - J_T, k >= 1 (m/s^3; j_0 unused: its cost is 0)
+            allow = np.abs(np.diff(np.asarray(aircraft_head, dtype=np.float64))) / dt + terms.jerk_deadband_mps3
             for sign in (1.0, -1.0):
-                rows.add([(f[k], sign), (f[k - 1], -sign), (j[k], -1.0)], allow, equal=False)
-            c[j[1:]] = terms.jolt_time_s
+                rows.add([(f[k], sign / dt), (f[k - 1], -sign / dt), (j[k], -1.0)], allow, equal=False)
+            c[j[1:]] = terms.jolt_time_s * dt
     return _solve(c, rows, nvar)
 
 

@@ -34,10 +34,12 @@ from pydantic import BaseModel
 from washbench.cueing import registry
 from washbench.cueing.params import (
     DEFAULT_PARAMS_PATH,
+    WASHOUT_KINDS,
     WASHOUT_NAMES,
     WashoutParams,
     load_base_params,
 )
+from washbench.cueing.references import REFERENCE_KINDS
 from washbench.errors import WashbenchError, located
 from washbench.io.names import identifier_problem
 from washbench.io.yamlio import Loc, _problem, line_of, read_yaml, validate_data
@@ -335,6 +337,26 @@ def as_washouts(washouts: Sequence[str | Washout], params: WashoutParams | None)
     return tuple(out)
 
 
+ALL_WASHOUTS = "all"
+"""``--washout all``: every built-in washout, the naive references and the bound (:data:`EVERY_BUILTIN`)."""
+
+EVERY_BUILTIN: tuple[str, ...] = (*WASHOUT_KINDS, "optimal", "mpc", "mpc-unrestricted", *REFERENCE_KINDS, "bound")
+"""What ``--washout all`` runs, in order (on a platform one cannot drive, it is left out and said so)."""
+
+DEFAULT_WASHOUTS: tuple[str, ...] = (*WASHOUT_NAMES, *REFERENCE_KINDS)
+"""What runs without ``--washout``: the paper's three classical washouts and the naive references (cheap; every
+verdict says whether the best washout beats them); the report says what was not compared and that ``--washout all``
+compares everything."""
+
+
+def expand_all(names: Sequence[str]) -> list[str]:
+    """``names`` with ``all`` replaced by :data:`EVERY_BUILTIN`."""
+    out: list[str] = []
+    for n in names:
+        out.extend(EVERY_BUILTIN if n == ALL_WASHOUTS else [n])
+    return out
+
+
 def select_washouts(
     washouts: Sequence[str] | None = None,
     variants: Sequence[str] = (),
@@ -355,7 +377,7 @@ def select_from(
     """:func:`select_washouts` with the parameter file already loaded (its base set and ``variants:`` section)."""
     parsed = [parse_variant(v) for v in variants]
     extra = from_file + tuple(resolve(v, base) for v in parsed)
-    named = list(dict.fromkeys(washouts)) if washouts else ([] if extra else list(WASHOUT_NAMES))
+    named = list(dict.fromkeys(expand_all(washouts))) if washouts else ([] if extra else list(DEFAULT_WASHOUTS))
     return as_washouts([*builtin(named, base), *extra] if named else list(extra), None)
 
 

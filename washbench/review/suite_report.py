@@ -202,9 +202,8 @@ def _write_suite_report(
               metrics=d.metrics, motion=d.motion, ceiling=read_ceiling(d.folder))
         for d in loaded
     ]  # fmt: skip
-    lines += verdict_lines(verdict, washouts, reference)
     failed = [(e, d) for e, d in results if not e.get("ok", d.ok if d else False)]
-    if failed:
+    if failed:  # failures first: what did not run comes before any verdict on what did
         lines += ["## Failures", ""]
         for e, d in failed:
             name = e.get("file") or (d.title if d else "?")
@@ -212,6 +211,7 @@ def _write_suite_report(
             kept = f" (results kept in `{e['result']}/`)" if d is not None else ""
             lines.append(f"- `{name}`: {reason}{kept}")
         lines.append("")
+    lines += verdict_lines(verdict, washouts, reference, rule, failed=len(failed))
     lines += provenance_lines(doc.get("provenance"), doc.get("created_utc"))
     lines += ["## Summary", ""]
     head = ["aircraft", "manoeuvre", "status", "checks", "duration (s)", "best washout"]

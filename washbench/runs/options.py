@@ -21,6 +21,7 @@ from washbench.analysis.ranking import RankRule
 from washbench.cueing import registry
 from washbench.cueing.params import DEFAULT_PARAMS_PATH, WashoutParams, check_filter_start
 from washbench.cueing.variants import (
+    ALL_WASHOUTS,
     Washout,
     check_platform,
     defaulted_sections,
@@ -121,7 +122,8 @@ def load_options(
     chosen = select_from(washouts, variants, params, from_file)
     limits, resolved, platform_sha = resolve_platform(platform_path)
     platform_source = platform_path or resolved
-    if washouts is None and not variants:  # the default set: those of its washouts that can drive this platform
+    if (washouts is None and not variants) or ALL_WASHOUTS in (washouts or ()):
+        # the default set, or all: those of its washouts that can drive this platform
         chosen = tuple(w for w in chosen if platform_refusal(w, limits) is None)
     check_platform(chosen, limits)  # a washout named that cannot drive this platform: refused before anything is flown
     rule = rank_rule_from_data(params_path, data, lines, rank_by, thresholds)
