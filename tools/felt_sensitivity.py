@@ -22,9 +22,8 @@ import numpy as np
 import pyarrow.parquet as pq
 
 from washbench.analysis.felt import DEFAULT_MEASURE, FeltMeasure, felt_errors, felt_motion, felt_score, jolt
+from washbench.cueing.registry import REFERENCE_KINDS as REFERENCES
 from washbench.io.columns import AIRCRAFT, f_columns, perceived_f_columns, perceived_omega_columns
-
-REFERENCES = ("replay", "replay-rotation", "still")
 
 
 def _arrays(table: dict, pilot: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -56,6 +56,9 @@ BUILTIN_PYTHON: dict[str, str] = {
 }
 """Built-in Python algorithms: kind -> ``module:attribute`` of the factory (imported on first use)."""
 
+REFERENCE_KINDS: tuple[str, ...] = ("replay", "replay-rotation", "still")
+"""The naive references' washout names (:mod:`washbench.cueing.references`)."""
+
 
 @dataclass(frozen=True)
 class Algorithm:

@@ -39,7 +39,6 @@ from washbench.cueing.params import (
     WashoutParams,
     load_base_params,
 )
-from washbench.cueing.references import REFERENCE_KINDS
 from washbench.errors import WashbenchError, located
 from washbench.io.names import identifier_problem
 from washbench.io.yamlio import Loc, _problem, line_of, read_yaml, validate_data
@@ -340,10 +339,11 @@ def as_washouts(washouts: Sequence[str | Washout], params: WashoutParams | None)
 ALL_WASHOUTS = "all"
 """``--washout all``: every built-in washout, the naive references and the bound (:data:`EVERY_BUILTIN`)."""
 
-EVERY_BUILTIN: tuple[str, ...] = (*WASHOUT_KINDS, "optimal", "mpc", "mpc-unrestricted", *REFERENCE_KINDS, "bound")
+EVERY_BUILTIN: tuple[str, ...] = (*WASHOUT_KINDS, "optimal", "mpc", "mpc-unrestricted", *registry.REFERENCE_KINDS,
+                                  "bound")  # fmt: skip
 """What ``--washout all`` runs, in order (on a platform one cannot drive, it is left out and said so)."""
 
-DEFAULT_WASHOUTS: tuple[str, ...] = (*WASHOUT_NAMES, *REFERENCE_KINDS)
+DEFAULT_WASHOUTS: tuple[str, ...] = (*WASHOUT_NAMES, *registry.REFERENCE_KINDS)
 """What runs without ``--washout``: the paper's three classical washouts and the naive references (cheap; every
 verdict says whether the best washout beats them); the report says what was not compared and that ``--washout all``
 compares everything."""

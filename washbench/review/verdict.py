@@ -38,16 +38,16 @@ from washbench.analysis.ranking import (
     RankRule,
     tie_groups,
 )
+from washbench.cueing.registry import REFERENCE_KINDS
+from washbench.cueing.variants import EVERY_BUILTIN
 from washbench.io.metrics_csv import MetricRow
 from washbench.review.numbers import sig
 
-REFERENCES = ("replay", "replay-rotation", "still")
-"""The naive references' names (:data:`washbench.cueing.references.REFERENCE_KINDS`; written out here so that the
-report imports no cueing code)."""
+REFERENCES = REFERENCE_KINDS
+"""The naive references' names (:data:`washbench.cueing.registry.REFERENCE_KINDS`)."""
 
-BUILT_IN = ("small-angle", "large-angle", "unrestricted", "adaptive", "adaptive-large-angle", "adaptive-unrestricted",
-            "optimal", "mpc", "mpc-unrestricted")  # fmt: skip
-"""The built-in causal washouts, for "not compared" (:data:`washbench.cueing.registry` lists them)."""
+BUILT_IN = tuple(w for w in EVERY_BUILTIN if w not in REFERENCE_KINDS and w != BOUND_WASHOUT)
+"""The built-in causal washouts, for "not compared"."""
 
 VACUOUS = 0.05
 """A ceiling below this fraction of the best achieved says nothing the best achieved does not (chosen): the verdict
