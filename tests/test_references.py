@@ -9,6 +9,7 @@ Also: Sinacori's and Schroeder's ordering of motion fidelity (gain towards 1 and
 from __future__ import annotations
 
 import csv
+import itertools
 import math
 from pathlib import Path
 
@@ -133,7 +134,7 @@ def test_sinacori_ordering(phase_deg: float) -> None:
         return felt_score(e, fa, jolt(sim, air, DT), m)
 
     values = [score(k, phase_deg) for k in (0.0, 0.25, 0.5, 0.75)]
-    assert all(a > b for a, b in zip(values, values[1:], strict=False)), values
+    assert all(a > b for a, b in itertools.pairwise(values)), values
     assert score(1.0, phase_deg + 20.0) > score(1.0, phase_deg)
     if phase_deg == 0.0:
         assert values[-1] > score(1.0, 0.0) == 0.0
