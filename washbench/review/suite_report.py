@@ -31,7 +31,7 @@ from washbench.io.atomic import write_text_atomic
 from washbench.io.outfolder import discard_stage, make_stage, refuse_links, replace_entries
 from washbench.io.readback import SuiteDoc, read_doc, suite_member
 from washbench.io.result_files import FIGURES_DIR, METRICS_FILE, RECORDING_FILE, REPORT_FILE, SUITE_FILE
-from washbench.review.bound_section import CEILING_NOTE, read_ceiling
+from washbench.review.bound_section import CEILING_NOTE, VACUOUS, read_ceiling
 from washbench.review.figures import score_heatmap, table4_figure
 from washbench.review.numbers import sig
 from washbench.review.report import (
@@ -262,7 +262,8 @@ def _write_suite_report(
     lines += ["## How to read the numbers", "", *_HOW_TO_READ, f"Ranked by {rule.label()}.", "",
               PERCEIVED_NOTE, "", CUE_NOTE, "", MSDV_NOTE, "", MSI_NOTE, ""]  # fmt: skip
     if any(e.ceiling for e in verdict):
-        lines += [CEILING_NOTE.format(measure=rule.by), ""]
+        name = "felt error" if rule.by == "felt" else rule.by
+        lines += [CEILING_NOTE.format(measure=name, vacuous=100 * VACUOUS), ""]
     for d in loaded:
         rel = _rel(d.folder, suite_dir)
         lines += [f"## {d.title}", ""]

@@ -41,6 +41,7 @@ from washbench.analysis.ranking import (
 from washbench.cueing.registry import REFERENCE_KINDS
 from washbench.cueing.variants import EVERY_BUILTIN
 from washbench.io.metrics_csv import MetricRow
+from washbench.review.bound_section import VACUOUS
 from washbench.review.numbers import sig
 
 REFERENCES = REFERENCE_KINDS
@@ -49,9 +50,6 @@ REFERENCES = REFERENCE_KINDS
 BUILT_IN = tuple(w for w in EVERY_BUILTIN if w not in REFERENCE_KINDS and w != BOUND_WASHOUT)
 """The built-in causal washouts, for "not compared"."""
 
-VACUOUS = 0.05
-"""A ceiling below this fraction of the best achieved says nothing the best achieved does not (chosen): the verdict
-calls it too loose to mean anything there."""
 
 STILL_MARK = "▲"
 """Marks a manoeuvre on which every washout is worse than a platform standing still (value above 1)."""
