@@ -80,12 +80,18 @@ def test_rule_from_the_parameter_file_and_rank_by_override(runs: dict[str, Path]
 
     assert _prov(runs["tc"])["ranking"]["by"] == "false-cue"
     metrics = read_metrics_csv(runs["tc"] / "metrics.csv")
-    false_time = {w: sum(m.cue_false_frac for m in metrics if m.washout == w) for w in {m.washout for m in metrics}}
+    # false cues by size and duration: each DOF's false part over its threshold, over the felt motion (both in
+    # threshold-seconds), worked out here from the files
+    units = {"surge": 0.17, "sway": 0.17, "heave": 0.28, "roll": 3.0, "pitch": 3.6, "yaw": 2.6}
+    motion = json.loads((runs["tc"] / "run.json").read_text())["perceived_motion"]
+    felt = max(sum(motion[f"felt_{d}"]["value"] / u for d, u in units.items()), 1.0)
+    false = {w: sum(m.felt_false / units[m.dof] for m in metrics if m.washout == w) / felt
+             for w in {m.washout for m in metrics}}  # fmt: skip
     rows = _ranking(runs["tc"])
-    assert {r["washout"]: float(r["score"]) for r in rows} == pytest.approx(false_time)
+    assert {r["washout"]: float(r["score"]) for r in rows} == pytest.approx(false)
     ranks = [int(r["rank"]) for r in rows]
     assert ranks == sorted(ranks) and ranks[0] == 1
-    assert _prov(runs["default"])["ranking"]["by"] == "score"
+    assert _prov(runs["default"])["ranking"]["by"] == "felt"  # the default rule
 
 
 def test_cue_classification_columns_are_consistent(runs: dict[str, Path]) -> None:

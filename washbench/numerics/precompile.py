@@ -70,6 +70,7 @@ LANE_REST: tuple[tuple[str, str, str], ...] = (
     ("washbench.analysis.metric_sums", "signal_metrics", _sig(F1, F1, F)),
     ("washbench.analysis.metric_sums", "finish", _sig(F1, F)),
     ("washbench.analysis.metric_sums", "felt_sums", _sig(F2, F2, F1, F, F2)),
+    ("washbench.analysis.metric_sums", "felt_finish", _sig(F1, F)),
     ("washbench.analysis.metric_sums", "jolt_sums", _sig(F2, F2, F, F1)),
     ("washbench.cueing.references", "reference_block", _sig(F2, F2, F, F, F1, "boolean", "boolean", F1, F2, F2)),
     ("washbench.review.thinning", "_keep", _sig(F1, F2, F1, F)),

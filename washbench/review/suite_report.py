@@ -53,11 +53,12 @@ from washbench.review.verdict import Entry, verdict_lines
 _HOW_TO_READ = [
     "Metrics compare the aircraft pilot's perceived motion with each simulator pilot's, per degree of freedom: NPC",
     "(normalized Pearson correlation, 1 perfect, larger worse), the integral and the maximum of |error|; surge, sway,",
-    "heave in m/s² (integral m/s²·s), roll, pitch, yaw in deg/s (integral deg). The score (lower is better) is the",
-    "weighted relative integral error of `washbench/analysis/ranking.py`: each DOF's error over the aircraft pilot's",
-    "own perceived motion in it (what a simulator standing still would get wrong), DOFs weighted by how much was felt",
-    "there (half the weight to specific force, half to rotation). Numbers have 3 significant digits; full precision",
-    "is in `metrics.csv`, `comparison.csv` and `ranking.csv`. Best values are bold.",
+    "heave in m/s² (integral m/s²·s), roll, pitch, yaw in deg/s (integral deg). The ranking's value (lower is",
+    "better) is by default the felt error of `washbench/analysis/felt.py` (docs/metrics.md): the perceived error",
+    "beyond the perception thresholds, its false part counted again and the jolts the platform adds at the head, in",
+    "threshold units, over what the aircraft pilot felt above threshold (1: a platform standing still; each DOF weighs",
+    "what was felt there). `--rank-by score` ranks by the rule before it. Numbers have 3 significant digits; full",
+    "precision is in `metrics.csv`, `comparison.csv` and `ranking.csv`. Best values are bold.",
     "",
 ]
 
