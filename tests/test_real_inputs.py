@@ -29,9 +29,9 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
+from washbench.analysis.ranking import MOTION_FLOOR
 from washbench.cueing.registry import REFERENCE_KINDS
 from washbench.cueing.variants import DEFAULT_WASHOUTS
-from washbench.analysis.ranking import MOTION_FLOOR
 from washbench.errors import WashbenchError
 from washbench.flight.scripts import bundled_script, fly_script
 from washbench.io.input_format import InputFormat, input_format
