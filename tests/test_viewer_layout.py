@@ -242,6 +242,18 @@ def test_the_metrics_panel_ranks_and_keeps_the_bound_a_reference() -> None:
         assert best.count("**") == 2 * len(DOFS)  # the best washout in every DOF
 
 
+def test_without_the_bound_the_metrics_panel_does_not_speak_of_it() -> None:
+    """Run without ``--washout bound``, the Metrics panel said "(the oracle bound, in italics, is a reference)" all
+    the same: no word of the bound or the ceiling now; with it, the note stays."""
+    rows = [MetricRow(w, d, 1.0 + 0.1 * i, 2.0, 3.0) for i, w in enumerate(THREE) for d in DOFS]
+    ranking = [RankRow(w, 0.9 + 0.1 * i, i + 1, {}) for i, w in enumerate(THREE)]
+    text = metrics_table_markdown("c172p / steep_turn", rows, ranking, "score")
+    assert "bound" not in text.lower() and "ceiling" not in text.lower() and "oracle" not in text.lower()
+    rows += [MetricRow("bound", d, 0.5, 0.5, 0.5) for d in DOFS]
+    with_bound = metrics_table_markdown("c172p / steep_turn", rows, [*ranking, RankRow("bound", 0.4, 0, {})], "score")
+    assert "(the oracle bound, in italics, is a reference)" in with_bound
+
+
 def test_the_metrics_panel_gives_the_ceiling_and_each_washouts_share_recovered() -> None:
     """With the bound's record (run.json ``bound``), the ranking ends with the ceiling, and each washout's recovered
     share is the record's: (still - score) / (still - ceiling), here with still = 1 (one DOF weighted 1)."""
