@@ -580,7 +580,7 @@ def test_blueprint_stacks_the_perceived_panels_on_the_whole_manoeuvre(written):
     assert views[phase_id]["ViewBlueprint:class_identifier"] == ["StateTimeline"]
     assert views[phase_id]["ViewContents:query"] == [f"+ {phase_lane_path()}"]
     assert views[legend_id]["ViewBlueprint:class_identifier"] == ["2D"]
-    assert views[legend_id]["ViewBlueprint:space_origin"] == ["/legend/wide"]
+    assert views[legend_id]["ViewBlueprint:space_origin"] == ["/legend/perceived"]
     columns = [containers[c.split("/")[1]] for c in containers[columns_id]["ContainerBlueprint:contents"]]
     assert len(columns) == 2
     shown = [c.split("/")[1] for column in columns for c in column["ContainerBlueprint:contents"]]

@@ -303,29 +303,35 @@ def _rgba(rgb: tuple[int, int, int]) -> int:
 
 
 def test_the_legend_names_every_line_in_its_colour_without_an_empty_plot(recording: tuple[Path, object]) -> None:
-    """The legend is the names in their lines' colours in a 2-D view, once over the motion tabs' right column (over
-    the roll, pitch and yaw panels: its rows fit the top row in both windows) and once beside the envelope tab's lanes;
-    no time-series view is left for it (an empty plot a quarter of the 1920x1080 screen). Each name in a cell of its
-    own inside the view's bounds, the cells as wide as the longest name needs (6.6 px a character and 24 px)."""
+    """A legend is the names in their lines' colours in a 2-D view, one for each tab with coloured lines, naming what
+    that tab draws: over the perceived tab's right column (over the roll, pitch and yaw panels; the aircraft pilot, the
+    washouts, the perception threshold), over the raw tab's (no threshold there), beside the envelope tab's lanes (the
+    washouts: the aircraft has no platform). No time-series view is left for a legend (it was an empty plot a quarter
+    of the 1920x1080 screen). Each name in a cell of its own inside the view's bounds, the cells as wide as the longest
+    name needs (6.6 px a character and 24 px); the motion tabs' legends' rows fit their top row."""
     path, data = recording
     views = _views(path)
-    names = ["aircraft", *data.washouts, "perception threshold"]
+    washouts = list(data.washouts)
     lines = read_static(path, "SeriesLines:colors")
-    colours = [_rgba(series_color("aircraft")), *[_rgba(series_color(w, list(data.washouts))) for w in data.washouts],
-               lines["/perceived/surge/threshold"][0]]  # fmt: skip
-    assert lines["/perceived/surge"] == colours[1:-1] + colours[:1]  # the same colours as the lines
+    threshold = lines["/perceived/surge/threshold"][0]
+    colour = {"aircraft": lines["/perceived/surge"][-1], "perception threshold": threshold}
+    colour |= {w: lines["/perceived/surge"][i] for i, w in enumerate(washouts)}  # the lines' own colours
+    assert colour["aircraft"] == _rgba(series_color("aircraft"))
+    expected = {"/legend/perceived": ["aircraft", *washouts, "perception threshold"],
+                "/legend/raw": ["aircraft", *washouts], "/legend/envelope": washouts}  # fmt: skip
     labels, positions = read_static(path, "Points2D:labels"), read_static(path, "Points2D:positions")
     point_colours = read_static(path, "Points2D:colors")
     legend_views = {v["ViewBlueprint:space_origin"][0]: v for v in views.values()
                     if v["ViewBlueprint:class_identifier"] == ["2D"]}  # fmt: skip
-    assert set(legend_views) == {"/legend/wide", "/legend/narrow"}
+    assert set(legend_views) == set(expected)
     assert not any(v["ViewBlueprint:space_origin"][0].startswith("/legend") for v in views.values()
                    if v["ViewBlueprint:class_identifier"] == ["TimeSeries"])  # fmt: skip
-    top_share = _shares(_tab(path, "Perceived"))[0]
-    widths = {"/legend/wide": 0.5 * TABS_WIDTH_PX["1920x1080"], "/legend/narrow": 0.25 * TABS_WIDTH_PX["1920x1080"]}
+    half, quarter = 0.5 * TABS_WIDTH_PX["1920x1080"], 0.25 * TABS_WIDTH_PX["1920x1080"]
+    widths = {"/legend/perceived": half, "/legend/raw": half, "/legend/envelope": quarter}
     for origin, view in legend_views.items():
+        names = expected[origin]
         assert view["ViewBlueprint:titlebar"] == [False]
-        assert labels[origin] == names and point_colours[origin] == colours
+        assert labels[origin] == names and point_colours[origin] == [colour[n] for n in names]
         (bounds,) = view["VisualBounds2D:range"]
         (x0, x1), (y0, y1) = bounds["x_range"], bounds["y_range"]
         xy = np.asarray(positions[origin], dtype=float)
@@ -335,9 +341,9 @@ def test_the_legend_names_every_line_in_its_colour_without_an_empty_plot(recordi
         columns, rows = len({round(x, 6) for x, _ in xy}), len({math.floor(y) for _, y in xy})
         cell_px = 6.6 * max(len(n) for n in names) + 24
         assert columns * cell_px <= widths[origin] + 1e-6 and y1 - y0 == rows
-        if origin == "/legend/wide":  # its rows fit the motion tabs' top row in both windows
-            for size in ("1920x1080", "1280x720"):
-                assert rows * LEGEND_ROW_PX <= top_share * TAB_PX[size] + 0.5 or (size == "1280x720" and rows > 3)
+        if origin != "/legend/envelope":  # the motion tabs' top row holds its rows
+            tab = _tab(path, "Perceived" if origin == "/legend/perceived" else "Raw motion")
+            assert rows * LEGEND_ROW_PX <= _shares(tab)[0] * TAB_PX["1920x1080"] + 0.5
 
 
 def _egui_labelled(lo: float, hi: float, plot_px: float) -> list[float]:
@@ -403,7 +409,7 @@ def test_the_envelope_tab_holds_every_lane_and_gives_its_panels_the_room(recordi
     shares = _shares(tab)
     lanes_px = shares[0] * TAB_PX["1920x1080"]
     assert views[lanes_id]["ViewContents:query"] == [f"+ {washout_lane_path(data, w)}" for w in data.washouts]
-    assert views[legend_id]["ViewBlueprint:space_origin"] == ["/legend/narrow"]
+    assert views[legend_id]["ViewBlueprint:space_origin"] == ["/legend/envelope"]
     n = len(data.washouts)
     assert lane_view_px(n) - 0.5 <= lanes_px <= lane_view_px(n) + LANE_PX  # every lane, and no lane's worth empty
     grid = containers[grid_id]

@@ -49,6 +49,7 @@ __all__ = [
     "DESIGN_SIZE",
     "LIMIT_COLOR",
     "THRESHOLD_COLOR",
+    "THRESHOLD_NAME",
     "WASHOUT_WIDTH",
     "Layout",
     "LegendView",
@@ -117,10 +118,11 @@ class UsageView:
 
 @dataclass(frozen=True)
 class LegendView:
-    """One legend (a 2-D view of the names at ``origin``): its grid, ``columns`` x ``rows`` cells each ``cell``
-    legend rows wide (:func:`washbench.review.viewer_geometry.legend_positions`)."""
+    """One legend (a 2-D view of ``names`` in their colours, logged at ``origin``): its grid, ``columns`` x ``rows``
+    cells each ``cell`` legend rows wide (:func:`washbench.review.viewer_geometry.legend_positions`)."""
 
     origin: str
+    names: tuple[str, ...]
     columns: int
     rows: int
     cell: float
@@ -134,8 +136,8 @@ class Layout:
     all traces inside. ``camera``: (eye, target) in the scene's NED frame, metres. ``usage``: the envelope tab's
     panels. ``platform_quantities``: (name, unit) of each washout's platform panels. ``platform_name``: the word the
     titles use for the platform. Lanes: the phases' (None without phases), one limit lane and one false-cue lane per
-    washout, and the key each lane view's title gives to the words on its bars. ``legends``: the motion tabs' legend
-    (wide) and the envelope tab's (narrow), :func:`legend_views`.
+    washout, and the key each lane view's title gives to the words on its bars. ``legends``: the perceived tab's,
+    the raw tab's and the envelope tab's (:func:`legend_views`).
     """
 
     washouts: tuple[str, ...]
@@ -150,7 +152,7 @@ class Layout:
     phase_lane: str | None
     limit_lanes: tuple[str, ...]
     cue_lanes: tuple[str, ...]
-    legends: tuple[LegendView, LegendView]
+    legends: tuple[LegendView, LegendView, LegendView]
     limit_key: str = ""
     cue_key: str = ""
 
@@ -213,7 +215,7 @@ def motion_top_share(layout: Layout) -> float:
     """The motion tabs' top row (the phase lane beside the legend) as a share of the tab: the phase lane whole in the
     smallest window (its view without title bar: 84 px of 635) and the legend's rows in the design window."""
     phase = lane_view_px(1, title=False) / TAB_PX[SMALL_SIZE] if layout.phase_lane is not None else 0.0
-    return max(phase, legend_px(layout.legends[0]) / TAB_PX[DESIGN_SIZE])
+    return max(phase, *(legend_px(v) / TAB_PX[DESIGN_SIZE] for v in layout.legends[:2]))
 
 
 def motion_plot_px(layout: Layout, size: str = DESIGN_SIZE) -> float:
@@ -221,8 +223,8 @@ def motion_plot_px(layout: Layout, size: str = DESIGN_SIZE) -> float:
     return TAB_PX[size] * (1.0 - motion_top_share(layout)) / MOTION_PANELS - PANEL_CHROME_PX
 
 
-def _motion_tab(layout: Layout, prefix: str, ranges: Sequence[tuple[float, float]], title: str, name: str
-                ) -> rrb.Vertical:  # fmt: skip
+def _motion_tab(layout: Layout, prefix: str, ranges: Sequence[tuple[float, float]], title: str, name: str,
+                legend: LegendView) -> rrb.Vertical:  # fmt: skip
     """The top row (the phase lane over the left column, the legend over the right one), then two columns, the
     translational DOFs (surge, sway, heave) and the rotational ones (roll, pitch, yaw), each panel half the tab's width
     (stacked in one column, seven washouts left each panel about 75 px and a single tick). The phase lane once: over
@@ -233,11 +235,10 @@ def _motion_tab(layout: Layout, prefix: str, ranges: Sequence[tuple[float, float
         panels = [_panel(layout, f"/{prefix}/{dof}", f"{title}{dof} [{unit}]", rng)
                   for (dof, unit), rng in zip(layout.dofs[part], ranges[part], strict=True)]  # fmt: skip
         columns.append(rrb.Vertical(*panels))
-    legend = _legend(layout.legends[0])
     if layout.phase_lane is not None:
-        top = rrb.Horizontal(_lanes(layout, "Phases", [layout.phase_lane], titlebar=False), legend)
+        top = rrb.Horizontal(_lanes(layout, "Phases", [layout.phase_lane], titlebar=False), _legend(legend))
     else:
-        top = legend
+        top = _legend(legend)
     share = motion_top_share(layout)
     return rrb.Vertical(top, rrb.Horizontal(*columns), row_shares=[share, 1.0 - share], name=name)
 
@@ -255,7 +256,7 @@ def envelope_shares(layout: Layout) -> tuple[float, float]:
     """(the lanes' row, the usage grid) as shares of the envelope tab: the lanes' view as tall as its lanes (and
     the legend beside it as tall as its rows) in the design window, at most :data:`ENVELOPE_LANES_MAX`; the grid the
     rest (the lane view had 60 % of the tab, half of it empty, the six usage panels 170 px each)."""
-    top = max(lane_view_px(len(layout.limit_lanes)), legend_px(layout.legends[1])) / TAB_PX[DESIGN_SIZE]
+    top = max(lane_view_px(len(layout.limit_lanes)), legend_px(layout.legends[2])) / TAB_PX[DESIGN_SIZE]
     top = min(top, ENVELOPE_LANES_MAX)
     return top, 1.0 - top
 
@@ -274,13 +275,24 @@ ENVELOPE_LEGEND_SHARE = 0.25
 """The envelope tab's legend: this share of the row it shares with the lane view."""
 
 
-def legend_views(names: Sequence[str]) -> tuple[LegendView, LegendView]:
-    """The two legends of ``names`` (the aircraft, the washouts, the threshold): the motion tabs' (over the right
-    column: half the tabs' width) and the envelope tab's (beside the lanes), their grids for the design window."""
+THRESHOLD_NAME = "perception threshold"
+"""The legend's name for the perception thresholds' lines."""
+
+
+def legend_views(washouts: Sequence[str]) -> tuple[LegendView, LegendView, LegendView]:
+    """The legends, each naming what its tab draws: the perceived tab's (the aircraft pilot, the washouts, the
+    perception threshold) and the raw tab's (no threshold there) over the right column, half the tabs' width; the
+    envelope tab's (the washouts: the aircraft has no platform) beside its lanes. Their grids for the design
+    window."""
     half = 0.5 * TABS_WIDTH_PX[DESIGN_SIZE]
     side = ENVELOPE_LEGEND_SHARE * TABS_WIDTH_PX[DESIGN_SIZE]
-    wide, narrow = legend_grid(names, half), legend_grid(names, side)
-    return LegendView("/legend/wide", *wide), LegendView("/legend/narrow", *narrow)
+    pilots = ("aircraft", *washouts)
+
+    def view(origin: str, names: tuple[str, ...], width_px: float) -> LegendView:
+        return LegendView(origin, names, *legend_grid(names, width_px))
+
+    return (view("/legend/perceived", (*pilots, THRESHOLD_NAME), half), view("/legend/raw", pilots, half),
+            view("/legend/envelope", tuple(washouts), side))  # fmt: skip
 
 
 def build_blueprint(layout: Layout) -> rrb.Blueprint:
@@ -296,8 +308,8 @@ def build_blueprint(layout: Layout) -> rrb.Blueprint:
         line_grid=rrb.LineGrid3D(visible=False),
     )
     metrics = rrb.TextDocumentView(origin="/metrics", name="Metrics: ranking, ceiling and metrics")
-    perceived = _motion_tab(layout, "perceived", layout.perceived_ranges, "perceived ", "Perceived")
-    raw = _motion_tab(layout, "raw", layout.raw_ranges, "", "Raw motion")
+    perceived = _motion_tab(layout, "perceived", layout.perceived_ranges, "perceived ", "Perceived", layout.legends[0])
+    raw = _motion_tab(layout, "raw", layout.raw_ranges, "", "Raw motion", layout.legends[1])
     phase = [layout.phase_lane] if layout.phase_lane is not None else []
     cue_view = _lanes(layout, f"False cues, one lane per washout: a bar where its pilot feels false cues "
                               f"({layout.cue_key})", layout.cue_lanes)  # fmt: skip
@@ -310,7 +322,7 @@ def build_blueprint(layout: Layout) -> rrb.Blueprint:
     )
     usage = [_panel(layout, u.origin, u.title, u.y_range) for u in layout.usage]
     limits = _lanes(layout, f"Limits held, one lane per washout ({layout.limit_key})", layout.limit_lanes)
-    top = rrb.Horizontal(limits, _legend(layout.legends[1]),
+    top = rrb.Horizontal(limits, _legend(layout.legends[2]),
                          column_shares=[1.0 - ENVELOPE_LEGEND_SHARE, ENVELOPE_LEGEND_SHARE])  # fmt: skip
     envelope = rrb.Vertical(
         top,

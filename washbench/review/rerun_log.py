@@ -63,6 +63,7 @@ from washbench.review.blueprint import (
     AXIS_COLORS,
     LIMIT_COLOR,
     THRESHOLD_COLOR,
+    THRESHOLD_NAME,
     WASHOUT_WIDTH,
     Layout,
     LegendView,
@@ -480,7 +481,7 @@ def _send_motion(
             f"/perceived/{dof}/threshold",
             t_s,
             [centre + th, centre - th],
-            ["perception threshold", "perception threshold"],
+            [THRESHOLD_NAME, THRESHOLD_NAME],
             [THRESHOLD_COLOR, THRESHOLD_COLOR],
         )
 
@@ -758,28 +759,19 @@ def _send_text(rec: rr.RecordingStream, data: RecordingData) -> None:
         )
 
 
-def _legend_names(data: RecordingData) -> list[str]:
-    """The legend's entries: the aircraft pilot (the reference) first, every washout, the perception threshold."""
-    return [AIRCRAFT, *data.washouts, LEGEND_THRESHOLD]
-
-
 def _send_legend(rec: rr.RecordingStream, data: RecordingData, views: Sequence[LegendView]) -> None:
-    """The legend: each name in its line's colour (the viewer draws a point's label centred on it, in the point's
-    colour), once for each legend view's grid; the points themselves too small to see."""
-    names = _legend_names(data)
-    colors = [*source_colors(list(data.washouts)), THRESHOLD_COLOR]
+    """The legends: each name in its line's colour (the viewer draws a point's label under it, in the point's
+    colour), in each legend view's grid; the points themselves too small to see."""
+    colour = {AIRCRAFT: AIRCRAFT_COLOR, THRESHOLD_NAME: THRESHOLD_COLOR}
+    colour |= {w: series_color(w, list(data.washouts)) for w in data.washouts}
     for view in views:
         rec.log(
             view.origin,
-            rr.Points2D(legend_positions(len(names), view.columns, view.cell), labels=names, colors=colors,
-                        radii=rr.Radius.ui_points(0.1), show_labels=True),
+            rr.Points2D(legend_positions(len(view.names), view.columns, view.cell), labels=list(view.names),
+                        colors=[colour[n] for n in view.names], radii=rr.Radius.ui_points(0.1), show_labels=True),
             static=True,
             strict=True,
         )  # fmt: skip
-
-
-LEGEND_THRESHOLD = "perception threshold"
-"""The legend's name for the threshold lines."""
 
 
 def _layout(data: RecordingData, perceived: list[np.ndarray], raw: list[np.ndarray], panels: list[UsagePanel]
@@ -807,7 +799,7 @@ def _layout(data: RecordingData, perceived: list[np.ndarray], raw: list[np.ndarr
         phase_lane=phase_lane_path() if data.phases else None,
         limit_lanes=tuple(washout_lane_path(data, w) for w in data.washouts),
         cue_lanes=tuple(cue_lane_path(data, w) for w in data.washouts),
-        legends=legend_views(_legend_names(data)),
+        legends=legend_views(list(data.washouts)),
         limit_key=", ".join(f"{k} {labels[k]}" for k in kinds) or "none reached",
         cue_key=", ".join(f"{code} {dof}" for dof, code in DOF_CODES.items()),
     )
