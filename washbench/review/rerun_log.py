@@ -17,12 +17,17 @@ the nanosecond):
 - ``/platform/<washout>/<quantity>/axes``: the platform's stage position, velocity, acceleration (NED, SI) and
   omni-wheel speeds (rad/s), three scalars per row, with ``limit_max`` and ``limit_min`` lines where the platform has
   that limit;
-- state lanes, each labelled by the viewer with its path: ``/phase`` (flight phases), ``/limits/<i>_<washout>`` (the
-  limits a washout is held at, joined by "+") and ``/false_cues/<i>_<washout>`` (the DOFs felt falsely); i = 1, 2, ...
-  in washout order, as the viewer sorts lanes by name;
+- state lanes, each labelled by the viewer with its path: ``/phase`` (flight phases), ``/limits/<i>_<washout>`` (a
+  state per stretch a washout is held at limits: the kinds joined by "+") and ``/false_cues/<i>_<washout>`` (a state
+  per stretch of false cues: the DOFs joined by "+", shown in two-letter words); stretches less than
+  :data:`washbench.analysis.cues.MERGE_GAP_S` apart joined (:mod:`washbench.review.lane_bars`); i = 1, 2, ... in
+  washout order, as the viewer sorts lanes by name;
+- ``/legend/perceived``, ``/legend/raw``, ``/legend/envelope``: the legends, static ``Points2D`` whose labels are the
+  names in their lines' colours, in the grids of :func:`washbench.review.blueprint.legend_views`;
 - ``/world/...``: the 3D scene (:mod:`washbench.review.scene3d`);
-- ``/events/phases`` and ``/events/saturation``: text log entries at phase starts and limit onsets, each text
-  starting with its time (the viewer's time column is narrow);
+- ``/events/phases``, ``/events/saturation`` and ``/events/false_cues``: text log entries at phase starts, limit
+  onsets and false-cue events, each text starting with its time, right-aligned (the events table hides the viewer's
+  time column, which it cut to "+3...");
 - ``/metrics``: the metric table as a Markdown document; the recording properties ``provenance`` (strings).
 
 Precision: every time-varying scalar is rounded to float32 (:data:`VALUE_DTYPE`; rerun stores it as float64) after
