@@ -73,7 +73,10 @@ def test_suite_report_puts_failures_first_and_embeds_valid_figures(
     out, _ = first
     report = out / "report.md"
     text = report.read_text()
-    assert text.index("## Failures") < text.index("## Summary") < text.index("## c172p / coordinated_turn")
+    # failures first: before any verdict on what ran, which says on how many it is
+    assert text.index("## Failures") < text.index("## Verdict") < text.index("## Summary")
+    assert text.index("## Summary") < text.index("## c172p / coordinated_turn")
+    assert "**1 of 3 manoeuvres failed**" in text
     assert "![score per manoeuvre and washout](figures/scores.png)" in text and "figures/table4.png" in text
     assert "c172p/coordinated_turn/figures/perceived.png" in text
     assert check_images(report) == 2 + 2 * 2  # scores, Table 4; perceived motion and cue lanes per manoeuvre
