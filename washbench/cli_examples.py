@@ -54,7 +54,6 @@ EXAMPLES: dict[str, tuple[str, ...]] = {
     "suite": (
         "washbench suite --out results",
         "washbench suite --out results-all --washout all",
-        "washbench suite c172 columbia400/takeoff --out results --jobs 2 --rank-by score --thresholds none",
         "washbench suite --jsbsim-scripts c1723 c172_cross_wind --out results/jsbsim",
     ),
     "omct": (
