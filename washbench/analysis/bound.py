@@ -75,6 +75,16 @@ class BoundParams(StrictModel):
     replay's stages (an achieved motion, not a bound: the platform keeps every limit whatever the plan; on the 22
     bundled manoeuvres 1e-4 and 1e-6 give replay scores within 9e-4 of each other; 1e-6 takes 1.3 times as long)"""
     max_iter: Annotated[int, Field(ge=10, le=10_000)] = 200
+    search_steps: Annotated[int, Field(ge=0, le=100)] = 3
+    """the best achieved's search (:mod:`washbench.analysis.best_motion`): linear programmes at most, each flown
+    through the platform model and taken only if it scores better (0: the best of the motions known, no search;
+    CHOSEN: the 70 s aerobatics within a minute of CPU with the ceiling, docs/yardstick.md)"""
+    search_trust_rad: Annotated[float, Field(gt=0.0, le=1.0)] = 0.05
+    """the search's first trust region on the cockpit's attitude per step, rad (CHOSEN, docs/yardstick.md)"""
+    search_iterations: Annotated[int, Field(ge=5, le=1000)] = 30
+    """PIQP's iterations per programme of the search (a step is a proposal judged by its flight: a loose solve)"""
+    search_tolerance: Annotated[float, Field(gt=0.0, le=0.1)] = 1e-3
+    """PIQP's gap and feasibility tolerances in the search"""
 
 
 @dataclass(frozen=True)

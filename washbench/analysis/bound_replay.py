@@ -27,9 +27,12 @@ import math
 import numpy as np
 from scipy import sparse
 
+from washbench.analysis import best_motion
 from washbench.analysis.bound import MAX_BOUND_SAMPLES, BoundParams, oracle_bound
 from washbench.analysis.lp_rows import Rows, solve_qp, trapezoid
 from washbench.analysis.ranking import MOTION_FLOOR, perceived_motion
+from washbench.cueing.algorithm import Alongside
+from washbench.cueing.variants import Washout, load_washout_params
 from washbench.errors import WashbenchError
 from washbench.io.units import G0_MPS2
 from washbench.perception.vestibular import VestibularModel, VestibularParams, otolith_model
@@ -221,11 +224,13 @@ def replay(
 
 class BoundWashout:
     """The bound as a washout (kind ``bound``, ``whole_only``: it needs the whole recording; ``run`` cues it after
-    the flight on the flight read back, ``cue`` and the whole-trace paths give it the input at once,
-    :class:`washbench.cueing.CueingBank` ``future``): its ``trace`` solves the bound for the whole recording,
-    started centred, level and still, and returns its positions and attitudes (ZYX Euler from the integrated roll,
-    pitch and yaw) as set points, so the platform, head motion, perception, metrics, ranking, report and figures
-    treat it like any washout. It knows the future; ``step`` (a live stream) cannot and raises."""
+    the flight on the flight read back, ``cue`` and the whole-trace paths give it the input at once): the **best
+    achieved** (:mod:`washbench.analysis.best_motion`). Told the run's other motions (``consider``, before its
+    ``trace``), it plans the replay (:func:`replay`), flies every motion known for the flight again (the other
+    washouts', the naive references', the replay's) and searches from the best of them against the run's own rule,
+    so the platform, head motion, perception, metrics, ranking, report and figures treat its result like any
+    washout's and its value is at most every one of theirs. It knows the future; ``step`` (a live stream) cannot and
+    raises."""
 
     Params = BoundParams
     name = "bound"
@@ -235,30 +240,86 @@ class BoundWashout:
         self.params = params if params is not None else BoundParams()
         self.context = context
         self.solved: dict[str, float] = {}
+        self.alongside = None
+        self.found: best_motion.Result | None = None
+
+    def consider(self, alongside) -> None:
+        """The run's other motions, how to fly set points as the bench will, how the run scores
+        (:class:`washbench.cueing.algorithm.Alongside`)."""
+        self.alongside = alongside
 
     def report(self) -> dict[str, float]:
-        """The replay's solves: 1 per stage solved (the attitude's four channels, the translation), 0 otherwise."""
-        return dict(self.solved)
+        """The replay's solves (1 per stage solved: the attitude's channels, the translation) and the search's
+        numbers (:meth:`washbench.analysis.best_motion.Result.report`)."""
+        return {**self.solved, **(self.found.report() if self.found is not None else {})}
 
     def start(self, f_mps2: np.ndarray, omega_radps: np.ndarray):
-        return np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0])  # the plan starts level (oracle_bound start_at_rest)
+        """The start set point: the centre, and the attitude the motion found turns from (asked after ``trace``);
+        level before it (the replay's)."""
+        if self.found is None:
+            return np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0])
+        return np.zeros(3), self.found.start_q.copy()
 
     def step(self, f_mps2: np.ndarray, omega_radps: np.ndarray):
         raise RuntimeError("the oracle bound needs the whole recording in advance (run, cue, suite, omct, sweep, "
                            "tune), not a live stream")  # fmt: skip
 
     def trace(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The replay's set points (:func:`replay`): positions (N, 3) m, attitudes
-        (N, 4), scalar first."""
+        """The best achieved's set points: positions (N, 3) m, attitudes (N, 4), scalar first (its start:
+        :meth:`start`)."""
         c = self.context
-        if len(f_mps2) > MAX_BOUND_SAMPLES:
-            raise WashbenchError(f"washout bound: {len(f_mps2):,} samples in one recording, more than the bound's "
+        n = len(f_mps2)
+        if n > MAX_BOUND_SAMPLES:
+            raise WashbenchError(f"washout bound: {n:,} samples in one recording, more than the bound's "
                                  f"limit of {MAX_BOUND_SAMPLES:,} (its replay is planned over the whole recording "
                                  "at once: about 0.7 ms and 40 kB per sample); cut the recording or lower its "
                                  "rate")  # fmt: skip
-        pos, q_sp, self.solved = replay(f_mps2, omega_radps, c.dt_s, c.limits, c.gravity_mps2, self.params,
-                                        c.filter_start)  # fmt: skip
-        return pos, q_sp
+        refusal = best_motion.search_refusal(n, self.params.search_steps)
+        if refusal is not None:
+            raise WashbenchError(f"washout bound: {refusal}")
+        f = np.asarray(f_mps2, dtype=np.float64)
+        w = np.asarray(omega_radps, dtype=np.float64)
+        pos, q_sp, self.solved = replay(f, w, c.dt_s, c.limits, c.gravity_mps2, self.params, c.filter_start)
+        along = self.alongside if self.alongside is not None else _alone(c)
+        motions = dict(along.motions)
+        candidates = best_motion.flown_candidates(motions, c.dt_s)
+        candidates += [cand for cand in _references(f, w, c) if cand.name not in motions]
+        candidates.append(best_motion.Candidate(best_motion.REPLAY, np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0]), pos,
+                                                q_sp))  # fmt: skip
+        yard = best_motion.Yardstick(f, w, c.dt_s, along.scoring, c.filter_start)
+        settings = best_motion.Settings(self.params.search_steps, self.params.search_trust_rad,
+                                        self.params.search_iterations, self.params.search_tolerance)  # fmt: skip
+        self.found = best_motion.search(yard, candidates, along.fly, c.limits, c.gravity_mps2, settings)
+        return self.found.pos.copy(), self.found.q.copy()
+
+
+def _references(f: np.ndarray, w: np.ndarray, context) -> list[best_motion.Candidate]:
+    """The naive references' set points on this recording (:mod:`washbench.cueing.references`), as candidates."""
+    from washbench.cueing.references import ReplayRotationWashout, ReplayWashout, StillWashout  # deferred: numba
+
+    out = []
+    rest = context.filter_start == "rest"
+    f0 = np.array([0.0, 0.0, -context.gravity_mps2]) if rest else f[0]
+    w0 = np.zeros(3) if rest else w[0]
+    for name, cls in (("replay", ReplayWashout), ("replay-rotation", ReplayRotationWashout), ("still", StillWashout)):
+        ref = cls(None, context)
+        p0, q0 = ref.start(f0, w0)
+        pos, q = ref.trace(f, w)
+        out.append(best_motion.Candidate(name, np.asarray(p0, dtype=np.float64), np.asarray(q0, dtype=np.float64),
+                                         pos, q))  # fmt: skip
+    return out
+
+
+def _alone(context):
+    """What a bound made outside the bench is told (no other motion; the default scoring; flown as the bench flies a
+    washout named ``bound`` with the bundled parameters' head and this context's gravity and head offset)."""
+    from washbench.cueing.bank import flyer  # deferred: numba
+
+    base = load_washout_params()
+    params = base.model_copy(update={"gravity_mps2": float(context.gravity_mps2),
+                                     "head": base.head.model_copy(update={"offset_m": tuple(context.head_offset_m)})})
+    platform = context.platform if context.platform is not None else context.limits
+    return Alongside({}, flyer(Washout("bound", "bound", params), platform, context.dt_s, context.filter_start))
 
 
 __all__ = ["REPLAY_TOL", "UNFELT_WEIGHT", "BoundWashout", "attitudes", "replay", "track_attitudes", "translation_plan"]

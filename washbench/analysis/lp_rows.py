@@ -124,10 +124,12 @@ def split_bounds(le: sparse.csr_matrix, h: np.ndarray) -> tuple[
     return le[~single].tocsc(), h[~single], x_l, x_u
 
 
-def solve_qp(p_upper: sparse.csc_matrix, q: np.ndarray, rows: Rows, tol: float, max_iter: int) -> QpSolution:
+def solve_qp(p_upper: sparse.csc_matrix, q: np.ndarray, rows: Rows, tol: float, max_iter: int,
+             reg_lower_limit: float | None = None) -> QpSolution:  # fmt: skip
     """PIQP's solution (a proximal interior-point method) of min 1/2 x' P x + q' x subject to ``rows`` (``len(q)``
     variables); ``p_upper`` is P's upper triangle, ``tol`` the absolute and relative tolerances of the residuals and
-    of the duality gap.
+    of the duality gap; ``reg_lower_limit``: the least proximal regularisation (PIQP's default, 1e-10, without it;
+    the best achieved's search takes 1e-8, :data:`washbench.analysis.felt_programme.REG_LOWER_LIMIT`).
 
     PIQP, not Clarabel as before: it takes the rows of one variable as bounds of that variable instead of as rows of
     the KKT system (most of these programmes' inequalities), and on the bound's five programmes of a 61 s flight it
@@ -144,6 +146,8 @@ def solve_qp(p_upper: sparse.csc_matrix, q: np.ndarray, rows: Rows, tol: float, 
     settings.eps_abs = settings.eps_rel = tol
     settings.eps_duality_gap_abs = settings.eps_duality_gap_rel = tol
     settings.eps_primal_inf = settings.eps_dual_inf = INFEASIBILITY_EPS
+    if reg_lower_limit is not None:
+        settings.reg_lower_limit = reg_lower_limit
     solver.setup(sparse.csc_matrix(p_upper), np.asarray(q, dtype=np.float64), a_eq, b_eq, g,
                  np.full(len(h), -np.inf), h, x_l, x_u)  # fmt: skip
     status = solver.solve()

@@ -35,6 +35,12 @@ form, the next M samples from where it is (after :meth:`~WashoutAlgorithm.start`
 numbers as M steps; the bench then calls it once per block of samples (a flight's lockstep takes 120 at a time)
 instead of ``step`` per sample. Its set points are checked as a step's are; it gives no flags.
 
+Optionally a whole-recording algorithm (``whole_only``) has ``consider(alongside)``: before its ``trace`` the bench
+gives it an :class:`Alongside`, the motions the run's other washouts made on the same recording, a way to fly set
+points of its own through the run's platform model exactly as the bench will fly its result, and how the run scores
+a motion; its :meth:`~WashoutAlgorithm.start` is then asked after its ``trace`` (its start may come from its plan).
+The bound (the best achieved, :mod:`washbench.analysis.best_motion`) is such an algorithm.
+
 Optionally an algorithm has ``flags() -> tuple[bool, bool]``: whether its own tilt-rate and rotational-rate limits
 acted on the last step (the ``sat_tilt_rate`` and ``sat_rot_rate`` columns); without it both are False.
 
@@ -46,8 +52,9 @@ section of the parameter file named after the plugin (an instance of the class's
 
 from __future__ import annotations
 
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Protocol, runtime_checkable
+from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
@@ -84,6 +91,23 @@ class WashoutContext:
     platform: PlatformModel | PluginPlatform | None = None
 
 
+@dataclass(frozen=True)
+class Alongside:
+    """What a whole-recording algorithm with ``consider`` is told before its ``trace`` (module docstring).
+
+    motions: washout name -> its trace (:class:`washbench.cueing.bank.WashoutTrace`: the platform's motion and the
+    simulator pilot's head on this recording, as the bench flew them): every other washout of the run, or of the
+    call (the streaming :class:`washbench.cueing.bank.CueingBank` knows none: empty). fly: ``fly(start_pos (3,),
+    start_q (4,), pos (N, 3), q (N, 4))`` -> the trace of these set points (from that start set point) flown through
+    the run's platform model with this washout's configuration (its head, the filters' start): what the bench will
+    make of them, bit for bit. scoring: how the run scores a motion (its ranking rule and vestibular model, opaque
+    to the cueing stage: :class:`washbench.analysis.best_motion.Scoring`), or None (the defaults)."""
+
+    motions: Mapping[str, Any]
+    fly: Callable[[Any, Any, Any, Any], Any]
+    scoring: object | None = None
+
+
 @runtime_checkable
 class WashoutAlgorithm(Protocol):
     """One washout, sample by sample (see the module docstring for units, frames and state)."""
@@ -98,4 +122,4 @@ class WashoutAlgorithm(Protocol):
         ...
 
 
-__all__ = ["SetPoint", "WashoutAlgorithm", "WashoutContext"]
+__all__ = ["Alongside", "SetPoint", "WashoutAlgorithm", "WashoutContext"]

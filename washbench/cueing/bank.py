@@ -15,12 +15,13 @@ and angular velocity (rad/s) at the simulator pilot's head in simulator body axe
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from washbench.cueing import filters
+from washbench.cueing.algorithm import Alongside
 from washbench.cueing.kernel import (
     C_ADAPT,
     C_ALPHA,
@@ -420,6 +421,7 @@ class CueingBank:
         self._out = np.zeros((n, NFIELDS))
         self._py = python_sources(self.specs, limits, self.dt_s, filter_start)
         self._plugin = PluginPass(limits, len(self.washouts), self.dt_s, filter_start, self.specs)
+        self._limits, self._filter_start = limits, filter_start
         self._started = False
         self._k = 0  # samples stepped so far
         self._whole = self._whole_setpoints(future)
@@ -429,7 +431,9 @@ class CueingBank:
     def _whole_setpoints(self, future: tuple[np.ndarray, np.ndarray] | None) -> dict[int, tuple[np.ndarray, ...]]:
         """index -> (start pos, start q, pos (N, 3), q (N, 4), flags (N, 2)) of every whole-only washout, and, given
         the whole recording (``future``), of every Python washout with a whole-trace form (``trace()``: used for
-        recorded files, as the interface promises, in :func:`cue_trace` and here alike)."""
+        recorded files, as the interface promises, in :func:`cue_trace` and here alike). A washout that considers the
+        others (``consider``) is told none here (a stream does not fly the others first: :func:`cue_trace` does) and
+        asked its start after its trace."""
         out: dict[int, tuple[np.ndarray, ...]] = {}
         for i, src in self._py:
             if not (src.whole_only or (future is not None and src.has_trace)):
@@ -441,6 +445,11 @@ class CueingBank:
             w = np.ascontiguousarray(future[1], dtype=np.float64)
             if f.ndim != 2 or f.shape[1] != 3 or w.shape != f.shape or not len(f):
                 raise ValueError(f"future: f and omega must both be (N, 3), N > 0, got {f.shape} and {w.shape}")
+            if src.considers:
+                src.consider(Alongside({}, flyer(self.specs[i], self._limits, self.dt_s, self._filter_start)))
+                planned = src.run(f, w, whole=True)
+                out[i] = (*src.start(f[0], w[0]), *planned)
+                continue
             p0, q0 = src.start(f[0], w[0])
             out[i] = (p0, q0, *src.run(f, w, whole=True))
         return out
@@ -576,6 +585,9 @@ def cue_trace(
     limits: PlatformModel,
     filter_start: str = "steady",
     fields_out: np.ndarray | None = None,
+    reports: dict[str, dict[str, float | int]] | None = None,
+    motions: Mapping[str, WashoutTrace] | None = None,
+    scoring: object | None = None,
 ) -> dict[str, WashoutTrace]:
     """Whole-trace form: run the washouts over arrays f (N, 3) m/s^2 and omega (N, 3) rad/s sampled every dt_s.
 
@@ -585,7 +597,12 @@ def cue_trace(
     limited here (the platform stays within its limits whatever the input); the readers refuse physically
     absurd recordings at the file edge.
     ``filter_start``: see :data:`FILTER_STARTS`. ``fields_out``: for one washout, a (N_FIELDS, N) float64 array to
-    write its outputs into (the traces are views of it).
+    write its outputs into (the traces are views of it). ``reports``: filled with what the Python washouts report of
+    themselves (:meth:`CueingBank.algorithm_reports`), when given.
+
+    A washout that considers the others (``consider``, e.g. the bound) is cued after every other and told their
+    traces: ``motions`` (washouts flown before this call on the same recording, e.g. a flight's lockstep) and those
+    of this call, with ``scoring`` (how the run scores a motion, :class:`washbench.cueing.algorithm.Alongside`).
     """
     specs = as_washouts(washouts, params)
     names = [w.name for w in specs]
@@ -607,19 +624,59 @@ def cue_trace(
         out = fields_out[None]
     announce_compile(bank_trace)
     bank_trace(f, w, cfg, coef, state, counts, out)
+    kind = platform_kind(limits)
     if len(f):
-        for i, src in python_sources(specs, limits, dt, filter_start):
-            _set_start(state[i], *src.start(f[0], w[0]))
-            pos, q, flags = src.run(f, w, whole=True)
+        sources = python_sources(specs, limits, dt, filter_start)
+        considering = {i for i, src in sources if src.considers}
+        for i, src in sorted(sources, key=lambda s: s[0] in considering):  # those that consider the others last
+            if i in considering:
+                flown = {**(motions or {}), **{names[j]: WashoutTrace.from_fields(out[j], kind)
+                                               for j in range(len(names)) if j not in considering}}  # fmt: skip
+                src.consider(Alongside(flown, flyer(specs[i], limits, dt, filter_start), scoring))
+                pos, q, flags = src.run(f, w, whole=True)
+                _set_start(state[i], *src.start(f[0], w[0]))
+            else:
+                _set_start(state[i], *src.start(f[0], w[0]))
+                pos, q, flags = src.run(f, w, whole=True)
             setpoint_trace(pos, q, flags, cfg[i], coef[i], state[i], counts[i], out[i])
+            reported = src.report() if reports is not None else None
+            if reported is not None:
+                reports[src.name] = reported
     plugin = PluginPass(limits, len(names), dt, filter_start, specs)
     if plugin and len(f):
         for i in range(len(names)):
             rows = np.ascontiguousarray(out[i].T)
             plugin.rows(i, rows, cfg[i], coef[i])
             out[i][:] = rows.T
-    kind = platform_kind(limits)
     return {name: WashoutTrace.from_fields(out[i], kind) for i, name in enumerate(names)}
+
+
+def flyer(washout: Washout, limits: PlatformModel, dt_s: float, filter_start: str = "steady"
+          ) -> Callable[[np.ndarray, np.ndarray, np.ndarray, np.ndarray], WashoutTrace]:  # fmt: skip
+    """``fly(start_pos (3,), start_q (4,), pos (N, 3), q (N, 4))`` -> the :class:`WashoutTrace` of set points flown
+    from that start set point through the platform ``limits`` with ``washout``'s configuration (its head, gravity,
+    the filters' start ``filter_start``): the same compiled steps, the same bits, as :func:`cue_trace` makes of a
+    Python washout that returns them (a plugin's platform included)."""
+    dt = _check_dt(dt_s)
+    cfg, coef = build_arrays([washout], limits, dt, filter_start)
+    kind = platform_kind(limits)
+
+    def fly(start_pos: np.ndarray, start_q: np.ndarray, pos: np.ndarray, q: np.ndarray) -> WashoutTrace:
+        n = len(pos)
+        state = np.zeros(NSTATE)
+        counts = np.zeros(len(SAT_KINDS), dtype=np.int64)
+        _set_start(state, np.asarray(start_pos, dtype=np.float64), np.asarray(start_q, dtype=np.float64))
+        out = np.empty((NFIELDS, n))
+        setpoint_trace(np.ascontiguousarray(pos, dtype=np.float64), np.ascontiguousarray(q, dtype=np.float64),
+                       np.zeros((n, 2), dtype=np.int64), cfg[0], coef[0], state, counts, out)  # fmt: skip
+        plugin = PluginPass(limits, 1, dt, filter_start, [washout])
+        if plugin and n:
+            rows = np.ascontiguousarray(out.T)
+            plugin.rows(0, rows, cfg[0], coef[0])
+            out[:] = rows.T
+        return WashoutTrace.from_fields(out, kind)
+
+    return fly
 
 
 def python_sources(

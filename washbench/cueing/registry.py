@@ -210,6 +210,12 @@ def whole_only(kind: str, spec: str | None = None, section: Any = None) -> bool:
     return is_python(kind) and needs_whole(get(kind, spec).factory, section)
 
 
+def considers(kind: str, spec: str | None = None) -> bool:
+    """Whether the Python algorithm ``kind``'s factory has ``consider`` (it is told the run's other motions before its
+    trace: :class:`washbench.cueing.algorithm.Alongside`, e.g. the bound); compiled kinds never do."""
+    return is_python(kind) and callable(getattr(get(kind, spec).factory, "consider", None))
+
+
 def plugin_spec(kind: str) -> str | None:
     """``FILE.py:NAME`` of a plugin loaded from a file, for worker processes (None otherwise)."""
     return _PLUGIN_SPECS.get(kind)
@@ -316,6 +322,7 @@ __all__ = [
     "RESERVED_NAMES",
     "Algorithm",
     "check_washouts",
+    "considers",
     "get",
     "identity",
     "is_python",

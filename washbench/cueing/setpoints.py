@@ -54,6 +54,13 @@ class SetPointSource:
 
         self.has_flags, self.has_trace, self.has_steps, whole = plugin_call(where, methods)
         self.whole_only = whole and self.has_trace
+        self.considers = self.whole_only and plugin_call(where, lambda: callable(getattr(self.algo, "consider", None)))
+        """Whether the algorithm is told the run's other motions before its trace (``consider``, an
+        :class:`washbench.cueing.algorithm.Alongside`; its start is then asked after its trace)."""
+
+    def consider(self, alongside: Any) -> None:
+        """Give the algorithm ``alongside`` (:class:`washbench.cueing.algorithm.Alongside`) inside the guard."""
+        plugin_call(self._where("consider()"), lambda: self.algo.consider(alongside))
 
     def _where(self, what: str | None = None) -> str:
         label = self.name if self.source == "built-in" else f"{self.name} ({self.source})"

@@ -27,6 +27,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from washbench.analysis.best_motion import Scoring
 from washbench.analysis.felt import felt_key
 from washbench.analysis.metrics import DOFS
 from washbench.analysis.ranking import BOUND_WASHOUT, DEFAULT_RULE, MOTION_FLOOR, perceived_motion, rule_values
@@ -55,15 +56,18 @@ def split_whole(specs: Sequence[Any]) -> tuple[list[Any], list[Any]]:
 
 
 def with_whole(
-    traces: Mapping[str, Any], motion: Any, whole: Sequence[Any], order: Sequence[str], limits: Any, filter_start: str
+    traces: Mapping[str, Any], motion: Any, whole: Sequence[Any], order: Sequence[str], limits: Any, filter_start: str,
+    scoring: Scoring | None = None,
 ) -> dict[str, Any]:
     """``traces`` (the lockstep's) and the whole-only washouts cued on ``motion`` (the flight read back), in the
-    order ``order`` (every washout's name, as listed)."""
+    order ``order`` (every washout's name, as listed). One that considers the others (the bound) is told
+    ``traces`` and how the run scores (``scoring``)."""
     from washbench.cueing import cue_trace  # deferred: numba
 
     if not whole:
         return dict(traces)
-    extra = cue_trace(motion.f_mps2, motion.omega_radps, motion.dt_s, whole, None, limits, filter_start)
+    extra = cue_trace(motion.f_mps2, motion.omega_radps, motion.dt_s, whole, None, limits, filter_start,
+                      motions=traces, scoring=scoring)  # fmt: skip
     both = {**traces, **extra}
     return {name: both[name] for name in order}
 
@@ -82,7 +86,8 @@ def lockstep_result(motion: Any, rows: list[Any], options: Any) -> Any:
     kind = platform_kind(options.limits)
     traces = {w.name: WashoutTrace.from_rows(block[i], platform=kind) for i, w in enumerate(stepped)}
     del block
-    traces = with_whole(traces, motion, whole, options.washout_order, options.limits, options.filter_start)
+    traces = with_whole(traces, motion, whole, options.washout_order, options.limits, options.filter_start,
+                        Scoring(options.rank_rule, options.vestibular_params))  # fmt: skip
     return analyse(motion, traces, options.vestibular_params, options.filter_start, options.rank_rule.measure)
 
 

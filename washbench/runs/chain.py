@@ -27,9 +27,12 @@ from typing import Any, Protocol
 
 import numpy as np
 
+from washbench.analysis.best_motion import Scoring
 from washbench.analysis.cues import classified_rows
 from washbench.analysis.felt import DEFAULT_MEASURE, FeltMeasure, felt_errors, jolt
 from washbench.analysis.metrics import dof_metrics
+from washbench.analysis.ranking import RankRule
+from washbench.cueing.registry import considers
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import atomic_path
 from washbench.io.columns import (
@@ -310,15 +313,18 @@ def cue_motion(
     vestibular: VestibularParams | None = None,
     filter_start: str = "steady",
     measure: FeltMeasure = DEFAULT_MEASURE,
+    scoring: Scoring | None = None,
 ) -> CueResult:
     """Run the washouts (names with ``params``, or Washout variants) and the Atlas model over ``motion``
     (``cueing.cue_trace``, one compiled call), then :func:`analyse`.
 
-    ``filter_start``: ``steady`` (every filter in the first sample's steady state) or ``rest``.
+    ``filter_start``: ``steady`` (every filter in the first sample's steady state) or ``rest``. ``scoring``: how the
+    run scores a motion, for a washout that considers the others (the bound; None: the felt error with ``measure``).
     """
     from washbench.cueing import cue_trace  # deferred: numba
 
-    traces = cue_trace(motion.f_mps2, motion.omega_radps, motion.dt_s, washouts, params, limits, filter_start)
+    traces = cue_trace(motion.f_mps2, motion.omega_radps, motion.dt_s, washouts, params, limits, filter_start,
+                       scoring=scoring if scoring is not None else Scoring(RankRule(measure=measure), vestibular))
     return analyse(motion, traces, vestibular, filter_start, measure)
 
 
@@ -344,9 +350,14 @@ def stream_cue(
     progress: Progress | None = None,
     vestibular: VestibularParams | None = None,
     measure: FeltMeasure = DEFAULT_MEASURE,
+    scoring: Scoring | None = None,
 ) -> CueResult:
     """:func:`cue_motion` and the traces.parquet of :func:`write_results` in one pass, ``chunk_rows`` samples at a
     time (washouts, vestibular models, one Parquet row group per chunk): the same columns and metrics, bit for bit.
+
+    With a washout that considers the others (the bound: it is cued after every other, told their motions and
+    ``scoring``), the washouts are cued whole first (:func:`cue_motion`) and the table written from the result in the
+    same chunks: the result then holds every trace whole.
 
     ``washouts``: Washout variants (:func:`washbench.cueing.variants.select_washouts`). ``traces_path`` is written
     (not atomically: the caller's temporary name). Held whole are only the input, every pilot's perceived motion
@@ -362,6 +373,9 @@ def stream_cue(
     n = motion.n
     if n < 1:
         raise WashbenchError("nothing to cue: the input has no rows")
+    if any(considers(w.kind, w.source) for w in washouts):
+        return _whole_cue(motion, washouts, limits, traces_path, metadata, filter_start, chunk_rows, progress,
+                          vestibular, measure, scoring)  # fmt: skip
     bank = CueingBank(washouts, None, limits, motion.dt_s, filter_start, future=(motion.f_mps2, motion.omega_radps))
     names = bank.washouts
     model = VestibularModel(motion.dt_s, vestibular)
@@ -412,6 +426,24 @@ def stream_cue(
     counts = bank.saturation_counts()
     traces = {w: SimpleNamespace(**kept[w], saturated=flags[w], saturation_counts=counts[w]) for w in names}
     return CueResult(motion=motion, traces=traces, perceived=felt, metrics=metrics, algorithms=bank.algorithm_reports())
+
+
+def _whole_cue(motion: Motion, washouts: Sequence[Any], limits: Any, traces_path: Path,
+               metadata: Mapping[bytes, bytes] | None, filter_start: str, chunk_rows: int, progress: Progress | None,
+               vestibular: VestibularParams | None, measure: FeltMeasure, scoring: Scoring | None) -> CueResult:
+    """:func:`stream_cue` with a washout that considers the others: cued whole (:func:`cue_trace` with the washouts'
+    reports), analysed, and its table written in chunks."""
+    from washbench.cueing import cue_trace  # deferred: numba
+
+    reports: dict[str, dict[str, float | int]] = {}
+    traces = cue_trace(motion.f_mps2, motion.omega_radps, motion.dt_s, washouts, None, limits, filter_start,
+                       reports=reports,
+                       scoring=scoring if scoring is not None else Scoring(RankRule(measure=measure), vestibular))
+    result = analyse(motion, traces, vestibular, filter_start, measure)
+    write_trace_chunks(traces_path, result.column_chunks(chunk_rows), metadata)
+    if progress is not None:
+        progress.update(motion.n)
+    return dataclasses.replace(result, algorithms=reports)
 
 
 def write_results(out_dir: Path, result: CueResult, provenance: Mapping[str, Any] | None = None) -> tuple[Path, Path]:

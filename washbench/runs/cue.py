@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from washbench.analysis.best_motion import Scoring
 from washbench.analysis.felt import DEFAULT_MEASURE, FeltMeasure
 from washbench.analysis.ranking import perceived_motion
 from washbench.errors import WashbenchError, located, printable
@@ -220,6 +221,7 @@ def write_outputs(
                         seg.motion, run.washouts, run.limits, tmp[TRACES_FILE], meta,
                         filter_start=run.filter_start, recording=recording, figures=figures, progress=shown,
                         vestibular=run.vestibular_params, measure=run.rank_rule.measure,
+                        scoring=Scoring(run.rank_rule, run.vestibular_params),
                     )  # fmt: skip
                     offset += seg.motion.n
                     summary = segment_summary(input_path, seg, result, folder, run.rank_rule.measure)
