@@ -272,12 +272,14 @@ def search(
     return result
 
 
-SEARCH_MEMORY = (60e6, 90_000.0)
+SEARCH_MEMORY = (20e6, 100_000.0)
 """The search's peak memory above what the process holds when it starts: bytes a + b per sample (one programme:
-PIQP's KKT system and its factor; measured by ``bench/best_bench.py``, docs/yardstick.md)."""
-SEARCH_SECONDS = 1.4e-3
-"""The search's CPU seconds per sample and programme (measured by ``bench/best_bench.py`` on the two-core
-development machine; docs/yardstick.md)."""
+PIQP's KKT system and its factor, about 48 variables and 54 rows a sample). Measured by ``bench/best_bench.py
+--calibrate``: +106, +312 and +694 MB on 2,000, 4,000 and 8,000 samples of the Columbia 400 aerobatics (a slope of
+103 kB per sample); +798 MB for the whole search on its 8,369 samples (docs/yardstick.md)."""
+SEARCH_SECONDS = 1.6e-3
+"""The search's CPU seconds per sample and programme: 1.06, 1.49 and 1.61 ms on the pieces above (14 to 24 PIQP
+iterations), on the two-core development machine under load (docs/yardstick.md)."""
 SEARCH_MAX_BYTES = 4e9
 """The largest peak the search may take (bytes): a search estimated above it is refused before it starts."""
 
