@@ -22,6 +22,7 @@ fallbacks and iterations), :func:`washbench.cueing.bank.CueingBank.algorithm_rep
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -57,17 +58,18 @@ def split_whole(specs: Sequence[Any]) -> tuple[list[Any], list[Any]]:
 
 def with_whole(
     traces: Mapping[str, Any], motion: Any, whole: Sequence[Any], order: Sequence[str], limits: Any, filter_start: str,
-    scoring: Scoring | None = None,
+    scoring: Scoring | None = None, reports: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
     """``traces`` (the lockstep's) and the whole-only washouts cued on ``motion`` (the flight read back), in the
     order ``order`` (every washout's name, as listed). One that considers the others (the bound) is told
-    ``traces`` and how the run scores (``scoring``)."""
+    ``traces`` and how the run scores (``scoring``); ``reports`` (when given) receives what the whole-only washouts
+    report of themselves (run.json ``algorithms``: the bound's search)."""
     from washbench.cueing import cue_trace  # deferred: numba
 
     if not whole:
         return dict(traces)
     extra = cue_trace(motion.f_mps2, motion.omega_radps, motion.dt_s, whole, None, limits, filter_start,
-                      motions=traces, scoring=scoring)  # fmt: skip
+                      reports=reports, motions=traces, scoring=scoring)  # fmt: skip
     both = {**traces, **extra}
     return {name: both[name] for name in order}
 
@@ -75,7 +77,8 @@ def with_whole(
 def lockstep_result(motion: Any, rows: list[Any], options: Any) -> Any:
     """:func:`washbench.runs.chain.from_lockstep` with the whole-only washouts of ``options`` (a
     :class:`washbench.runs.options.RunOptions`; they were not in the lockstep) cued here on ``motion``, the flight
-    read back, and put in their listed order."""
+    read back, and put in their listed order; the result's ``algorithms`` hold what those report of themselves (the
+    lockstep's own washouts report through the lockstep's ``reports``)."""
     from washbench.cueing import WashoutTrace  # deferred: numba
 
     stepped, whole = split_whole(options.washouts)
@@ -86,9 +89,11 @@ def lockstep_result(motion: Any, rows: list[Any], options: Any) -> Any:
     kind = platform_kind(options.limits)
     traces = {w.name: WashoutTrace.from_rows(block[i], platform=kind) for i, w in enumerate(stepped)}
     del block
+    reports: dict[str, Any] = {}
     traces = with_whole(traces, motion, whole, options.washout_order, options.limits, options.filter_start,
-                        Scoring(options.rank_rule, options.vestibular_params))  # fmt: skip
-    return analyse(motion, traces, options.vestibular_params, options.filter_start, options.rank_rule.measure)
+                        Scoring(options.rank_rule, options.vestibular_params), reports)  # fmt: skip
+    result = analyse(motion, traces, options.vestibular_params, options.filter_start, options.rank_rule.measure)
+    return dataclasses.replace(result, algorithms=reports)
 
 
 def bound_spec(specs: Sequence[Any]) -> Any | None:
