@@ -6,10 +6,12 @@ SUITE_FOLDER: a ``washbench suite`` folder made with ``--washout bound`` (every 
 PAGE the tables are printed; with it, the text between ``<!-- yardstick:begin -->`` and ``<!-- yardstick:end -->``
 is replaced (the page written atomically), so the page says what this run shows and nothing typed by hand.
 
-Tables: every washout's score per manoeuvre with its rank, the replay's and the ceiling's; the recovered fraction
-(``(1 - score) / (1 - ceiling)``); per DOF the median relative error of each washout and of the ceiling over the
-manoeuvres that felt it; and the counts (first places alone and shared, manoeuvres at least 20 % better than CW1,
-washouts below the ceiling, which must be none).
+Tables: per manoeuvre the bracket [ceiling, best achieved] (the ceiling marked vacuous below 5 % of the best
+achieved, as the verdict marks it), its width, the motion the best achieved's search started from, the best causal
+washout and the best naive reference; every washout's value per manoeuvre with its rank; per DOF the median relative
+error of each washout and of the ceiling over the manoeuvres that felt it; and the counts (the best achieved at or
+below every washout and reference, its gain over the best causal washout, vacuous ceilings, first places, a
+reference below every causal washout, values below the ceiling, which must be none).
 """
 
 from __future__ import annotations
@@ -21,13 +23,19 @@ import statistics
 import sys
 from pathlib import Path
 
+from washbench.analysis.best_motion import REPLAY as REPLAY_NAME
+from washbench.analysis.felt import DEFAULT_MEASURE
+from washbench.analysis.ranking import BOUND_WASHOUT as BOUND
+from washbench.cueing.registry import REFERENCE_KINDS as REFERENCES
 from washbench.io.atomic import write_text_atomic
+from washbench.review.bound_section import VACUOUS
 from washbench.review.numbers import sig
 
 BEGIN = "<!-- yardstick:begin -->"
 END = "<!-- yardstick:end -->"
 DOFS = ("surge", "sway", "heave", "roll", "pitch", "yaw")
-REFERENCE = "small-angle"
+UNITS = tuple(float(u) for u in DEFAULT_MEASURE.units())
+"""The felt motion's units per DOF (m/s^2, deg/s): its total in threshold-seconds (the default thresholds)."""
 
 
 def read_csv(path: Path) -> list[dict[str, str]]:
@@ -50,6 +58,17 @@ def median(xs: list[float]) -> float:
     return statistics.median(xs) if xs else math.nan
 
 
+def _value(ranking: dict[str, dict[str, str]], w: str) -> float:
+    r = ranking.get(w)
+    return num(r["score"]) if r else math.nan
+
+
+def _least(ranking: dict[str, dict[str, str]], names: list[str]) -> tuple[str, float]:
+    """The name and value of the least value among ``names`` (ties: the first listed)."""
+    vals = [(w, _value(ranking, w)) for w in names if w in ranking and math.isfinite(_value(ranking, w))]
+    return min(vals, key=lambda x: x[1]) if vals else ("-", math.nan)
+
+
 def tables(suite: Path) -> str:
     doc = json.loads((suite / "suite.json").read_text())
     runs = [(e, suite / e["result"]) for e in doc["manoeuvres"] if e.get("result")]
@@ -58,29 +77,63 @@ def tables(suite: Path) -> str:
         raise SystemExit(f"yardstick_tables: no ceiling.csv in {missing[0]} (run the suite with --washout bound)")
     prov = doc.get("provenance") or {}
     software = prov.get("software") or {}
+    rule = (prov.get("ranking") or {}).get("by", "score")
     washouts: list[str] = []
     rows = []
     for e, run in runs:
         ranking = {r["washout"]: r for r in read_csv(run / "ranking.csv")}
         ceiling = {(r["washout"], r["dof"]): r for r in read_csv(run / "ceiling.csv")}
+        info = json.loads((run / "run.json").read_text())
+        search = (info.get("algorithms") or {}).get(BOUND) or {}
+        felt = sum(float(v["value"]) / unit for d, unit in zip(DOFS, UNITS, strict=True)
+                   for k, v in (info.get("perceived_motion") or {}).items() if k == f"felt_{d}")  # fmt: skip
         for w in dict.fromkeys(r["washout"] for r in read_csv(run / "metrics.csv")):  # as listed
             if w not in washouts:
                 washouts.append(w)
-        rows.append((f"{e.get('aircraft')}/{e.get('manoeuvre')}", ranking, ceiling))
-    causal = [w for w in washouts if w != "bound"]
+        rows.append((f"{e.get('aircraft')}/{e.get('manoeuvre')}", ranking, ceiling, search, felt))
+    causal = [w for w in washouts if w != BOUND and w not in REFERENCES]
+    refs = [w for w in washouts if w in REFERENCES]
     out = [
         f"Suite of {len(rows)} manoeuvres made {doc.get('created_utc', '?')} by washbench "
         f"{software.get('washbench', '?')} (git `{str(software.get('washbench_git', '?'))[:12]}`), JSBSim "
-        f"{software.get('jsbsim', '?')}; washouts {', '.join(washouts)}; ranking rule "
-        f"`{(prov.get('ranking') or {}).get('by', 'score')}`. Command: `washbench suite "
-        + " ".join(f"--washout {w}" for w in washouts) + " --out SUITE`.",
+        f"{software.get('jsbsim', '?')}; washouts {', '.join(washouts)}; ranking rule `{rule}`. Command: "
+        "`washbench suite --washout all --out SUITE`" + (" (every washout, the naive references and the bound)."
+                                                         if set(washouts) >= set(REFERENCES) else "."),
         "",
-        "**Score per manoeuvre** (rank in brackets; the replay has none; lower is better, 1 = standing still):",
+        "**The bracket per manoeuvre** (lower is better; 1 = a platform standing still): the ceiling (certified; "
+        f"*vacuous* below {100 * VACUOUS:.0f} % of the best achieved), the best achieved (the `bound`: its search's "
+        "value, the motion it started from and that motion's value flown again), the bracket's width (best achieved "
+        "- ceiling), the best causal washout, the best naive reference and the bound's replay:",
         "",
-        "| manoeuvre | " + " | ".join(washouts) + " | ceiling |",
-        "|---|" + "---:|" * (len(washouts) + 1),
+        "| manoeuvre | felt (threshold-s) | ceiling | best achieved | started from | width | best causal | best "
+        "reference | replay |",
+        "|---|---:|---:|---:|---|---:|---|---|---:|",
     ]
-    for label, ranking, ceiling in rows:
+    widths, gains, vacuous, beaten, at_best = [], [], 0, [], 0
+    for label, ranking, ceiling, search, felt in rows:
+        best = _value(ranking, BOUND)
+        ceil = num(ceiling[(BOUND, "score")]["ceiling"]) if (BOUND, "score") in ceiling else math.nan
+        loose = math.isfinite(ceil) and best > 0.0 and ceil < VACUOUS * best
+        vacuous += loose
+        cands = {k.split(":", 1)[1]: float(v) for k, v in search.items() if k.startswith("candidate:")}
+        start = min(cands, key=lambda k: cands[k]) if cands else "-"
+        cw, cv = _least(ranking, causal)
+        rw, rv = _least(ranking, refs)
+        others = [_value(ranking, w) for w in washouts if w != BOUND and w in ranking]
+        beaten += [f"{label} {w}" for w in washouts if w != BOUND and _value(ranking, w) < best - 1e-9 * max(1, best)]
+        at_best += all(best <= v * (1 + 1e-9) for v in others)
+        width = best - ceil
+        widths.append(width)
+        if math.isfinite(cv) and cv > 0:
+            gains.append((cv - best) / cv)
+        replay = search.get("candidate:" + REPLAY_NAME, math.nan)
+        out.append(f"| {label} | {felt:.0f} | {sig(ceil)}{' *vacuous*' if loose else ''} | {sig(best)} | "
+                   f"{start} ({sig(cands.get(start, math.nan))}) | {sig(width)} | {cw} ({sig(cv)}) | {rw} ({sig(rv)}) "
+                   f"| {sig(float(replay))} |")  # fmt: skip
+    out += ["", f"**Every washout's value per manoeuvre** (rank in brackets; the best achieved has none; `{rule}`):",
+            "", "| manoeuvre | " + " | ".join(washouts) + " | ceiling |",
+            "|---|" + "---:|" * (len(washouts) + 1)]  # fmt: skip
+    for label, ranking, ceiling, _, _ in rows:
         cells = []
         for w in washouts:
             r = ranking.get(w)
@@ -91,27 +144,14 @@ def tables(suite: Path) -> str:
             cells.append(sig(num(r["score"])) + rank)
         ceil = num(next(iter(v for (w, d), v in ceiling.items() if d == "score"))["ceiling"])
         out.append(f"| {label} | " + " | ".join(cells) + f" | {sig(ceil)} |")
-    out += ["", "**Recovered fraction of the score** ((1 - score) / (1 - ceiling): 100 % = the ceiling, 0 % = "
-            "standing still):", "", "| manoeuvre | " + " | ".join(washouts) + " |",
-            "|---|" + "---:|" * len(washouts)]  # fmt: skip
-    rec: dict[str, list[float]] = {w: [] for w in washouts}
-    for label, _, ceiling in rows:
-        cells = []
-        for w in washouts:
-            r = ceiling.get((w, "score"))
-            x = num(r["recovered"]) if r else math.nan
-            rec[w].append(x)
-            cells.append(pct(x))
-        out.append(f"| {label} | " + " | ".join(cells) + " |")
-    out.append("| **median** | " + " | ".join(pct(median(rec[w])) for w in washouts) + " |")
-    out += ["", "**Per DOF: median relative error** over the manoeuvres that felt the DOF (the integral error over the "
-            "aircraft pilot's own perceived motion; 1 = standing still), and the median ceiling:", "",
+    out += ["", "**Per DOF: median relative error** over the manoeuvres that felt the DOF (the rule's terms of the DOF "
+            "over what the aircraft pilot felt there; 1 = standing still), and the median ceiling:", "",
             "| DOF | felt on | " + " | ".join(washouts) + " | ceiling |", "|---|---:|" + "---:|" * (len(washouts) + 1)]
     below = []
     for d in DOFS:
-        vals = {w: [] for w in washouts}
+        vals: dict[str, list[float]] = {w: [] for w in washouts}
         ceils = []
-        for label, _, ceiling in rows:
+        for label, _, ceiling, _, _ in rows:
             first = ceiling.get((washouts[0], d))
             if first is None or first["ceiling"] == "":
                 continue
@@ -124,31 +164,32 @@ def tables(suite: Path) -> str:
                         below.append(f"{label} {w} {d}")
         out.append(f"| {d} | {len(ceils)} | " + " | ".join(sig(median(vals[w])) for w in washouts)
                    + f" | {sig(median(ceils))} |")  # fmt: skip
-    for label, _, ceiling in rows:
+    for label, _, ceiling, _, _ in rows:
         for w in washouts:
             r = ceiling.get((w, "score"))
-            if r and num(r["relative_error"]) < num(r["ceiling"]) - 1e-9:
+            if r and r["ceiling"] != "" and num(r["relative_error"]) < num(r["ceiling"]) - 1e-9:
                 below.append(f"{label} {w} score")
     alone = dict.fromkeys(causal, 0)
     shared = 0
-    at_aim = dict.fromkeys(causal, 0)
-    for _, ranking, _ in rows:
+    ref_wins = []
+    for label, ranking, _, _, _ in rows:
         firsts = [w for w, r in ranking.items() if r["rank"] == "1"]
-        if len(firsts) == 1:
+        if len(firsts) == 1 and firsts[0] in alone:
             alone[firsts[0]] += 1
         else:
             shared += 1
-        ref = num(ranking[REFERENCE]["score"]) if REFERENCE in ranking else math.nan
-        for w in causal:
-            if w in ranking and ref > 0 and (ref - num(ranking[w]["score"])) / ref >= 0.2:
-                at_aim[w] += 1
+        if refs and _least(ranking, refs)[1] < _least(ranking, causal)[1]:
+            ref_wins.append(label)
     out += [
         "",
-        f"First place alone: {', '.join(f'{w} {n}' for w, n in alone.items())}; shared: {shared} (together "
-        f"{sum(alone.values()) + shared} of {len(rows)}). At least 20 % better than {REFERENCE} (CW1): "
-        + ", ".join(f"{w} {n} of {len(rows)}" for w, n in at_aim.items() if w != REFERENCE)
-        + f". Scores or relative errors below the ceiling: {len(below)}"
-        + (f" ({'; '.join(below)})" if below else "") + ".",
+        f"The best achieved is at or below every washout's and every reference's value on {at_best} of {len(rows)} "
+        f"manoeuvres" + (f" (beaten: {'; '.join(beaten)})" if beaten else "") + f"; below the best causal washout by "
+        f"a median {pct(median(gains))} (least {pct(min(gains) if gains else math.nan)}, most "
+        f"{pct(max(gains) if gains else math.nan)}). Median bracket's width {sig(median(widths))}; vacuous ceilings "
+        f"{vacuous} of {len(rows)}. First place alone: {', '.join(f'{w} {n}' for w, n in alone.items())}; shared "
+        f"or a reference's: {shared}. A naive reference below every causal washout: {len(ref_wins)} of {len(rows)}"
+        + (f" ({', '.join(ref_wins)})" if ref_wins else "") + f". Values or relative errors below the ceiling: "
+        f"{len(below)}" + (f" ({'; '.join(below)})" if below else "") + ".",
     ]
     return "\n".join(out) + "\n"
 
