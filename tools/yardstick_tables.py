@@ -109,7 +109,7 @@ def tables(suite: Path) -> str:
         "reference | replay |",
         "|---|---:|---:|---:|---|---:|---|---|---:|",
     ]
-    widths, gains, vacuous, beaten, at_best = [], [], 0, [], 0
+    widths, gains, vacuous, beaten, at_best, replay_beaten = [], [], 0, [], 0, []
     for label, ranking, ceiling, search, felt in rows:
         best = _value(ranking, BOUND)
         ceil = num(ceiling[(BOUND, "score")]["ceiling"]) if (BOUND, "score") in ceiling else math.nan
@@ -127,6 +127,8 @@ def tables(suite: Path) -> str:
         if math.isfinite(cv) and cv > 0:
             gains.append((cv - best) / cv)
         replay = search.get("candidate:" + REPLAY_NAME, math.nan)
+        if math.isfinite(cv) and cv < float(replay):
+            replay_beaten.append(f"{label} ({cw})")
         out.append(f"| {label} | {felt:.0f} | {sig(ceil)}{' *vacuous*' if loose else ''} | {sig(best)} | "
                    f"{start} ({sig(cands.get(start, math.nan))}) | {sig(width)} | {cw} ({sig(cv)}) | {rw} ({sig(rv)}) "
                    f"| {sig(float(replay))} |")  # fmt: skip
@@ -187,7 +189,9 @@ def tables(suite: Path) -> str:
         f"a median {pct(median(gains))} (least {pct(min(gains) if gains else math.nan)}, most "
         f"{pct(max(gains) if gains else math.nan)}). Median bracket's width {sig(median(widths))}; vacuous ceilings "
         f"{vacuous} of {len(rows)}. First place alone: {', '.join(f'{w} {n}' for w, n in alone.items())}; shared "
-        f"or a reference's: {shared}. A naive reference below every causal washout: {len(ref_wins)} of {len(rows)}"
+        f"or a reference's: {shared}. The bound's replay alone beaten by a causal washout: {len(replay_beaten)} of "
+        f"{len(rows)}" + (f" ({', '.join(replay_beaten)})" if replay_beaten else "") + ". A naive reference below "
+        f"every causal washout: {len(ref_wins)} of {len(rows)}"
         + (f" ({', '.join(ref_wins)})" if ref_wins else "") + f". Values or relative errors below the ceiling: "
         f"{len(below)}" + (f" ({'; '.join(below)})" if below else "") + ".",
     ]

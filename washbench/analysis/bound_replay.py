@@ -1,4 +1,6 @@
-"""The bound's replay: a physical Atlas motion planned with the whole flight known (the ``bound`` washout).
+"""The bound's replay: a physical Atlas motion planned with the whole flight known, one of the motions the ``bound``
+washout (the best achieved, :mod:`washbench.analysis.best_motion`, :class:`BoundWashout` below) starts its search
+from.
 
 Two stages, each a convex programme:
 
@@ -283,7 +285,7 @@ class BoundWashout:
         along = self.alongside if self.alongside is not None else _alone(c)
         motions = dict(along.motions)
         candidates = best_motion.flown_candidates(motions, c.dt_s)
-        candidates += [cand for cand in _references(f, w, c) if cand.name not in motions]
+        candidates += [cand for cand in reference_candidates(f, w, c) if cand.name not in motions]
         candidates.append(best_motion.Candidate(best_motion.REPLAY, np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0]), pos,
                                                 q_sp))  # fmt: skip
         yard = best_motion.Yardstick(f, w, c.dt_s, along.scoring, c.filter_start)
@@ -293,7 +295,7 @@ class BoundWashout:
         return self.found.pos.copy(), self.found.q.copy()
 
 
-def _references(f: np.ndarray, w: np.ndarray, context) -> list[best_motion.Candidate]:
+def reference_candidates(f: np.ndarray, w: np.ndarray, context) -> list[best_motion.Candidate]:
     """The naive references' set points on this recording (:mod:`washbench.cueing.references`), as candidates."""
     from washbench.cueing.references import ReplayRotationWashout, ReplayWashout, StillWashout  # deferred: numba
 
@@ -322,4 +324,5 @@ def _alone(context):
     return Alongside({}, flyer(Washout("bound", "bound", params), platform, context.dt_s, context.filter_start))
 
 
-__all__ = ["REPLAY_TOL", "UNFELT_WEIGHT", "BoundWashout", "attitudes", "replay", "track_attitudes", "translation_plan"]
+__all__ = ["REPLAY_TOL", "UNFELT_WEIGHT", "BoundWashout", "attitudes", "reference_candidates", "replay",
+           "track_attitudes", "translation_plan"]  # fmt: skip
