@@ -26,6 +26,7 @@ from pathlib import Path
 from washbench.analysis.best_motion import REPLAY as REPLAY_NAME
 from washbench.analysis.felt import DEFAULT_MEASURE
 from washbench.analysis.ranking import BOUND_WASHOUT as BOUND
+from washbench.analysis.ranking import TIE_ABSOLUTE
 from washbench.cueing.registry import REFERENCE_KINDS as REFERENCES
 from washbench.io.atomic import write_text_atomic
 from washbench.review.bound_section import VACUOUS
@@ -101,7 +102,8 @@ def tables(suite: Path) -> str:
                                                          if set(washouts) >= set(REFERENCES) else "."),
         "",
         "**The bracket per manoeuvre** (lower is better; 1 = a platform standing still): the ceiling (certified; "
-        f"*vacuous* below {100 * VACUOUS:.0f} % of the best achieved), the best achieved (the `bound`: its search's "
+        f"*vacuous* below {100 * VACUOUS:.0f} % of the best achieved, where that is above the ranking's tie margin "
+        f"{TIE_ABSOLUTE:g}: below it the bracket is closed), the best achieved (the `bound`: its search's "
         "value, the motion it started from and that motion's value flown again), the bracket's width (best achieved "
         "- ceiling), the best causal washout, the best naive reference and the bound's replay:",
         "",
@@ -113,7 +115,9 @@ def tables(suite: Path) -> str:
     for label, ranking, ceiling, search, felt in rows:
         best = _value(ranking, BOUND)
         ceil = num(ceiling[(BOUND, "score")]["ceiling"]) if (BOUND, "score") in ceiling else math.nan
-        loose = math.isfinite(ceil) and best > 0.0 and ceil < VACUOUS * best
+        # vacuous as the verdict says (below 5 % of the best achieved), unless the best achieved is itself within the
+        # ranking's absolute tie margin of 0: then the bracket is closed
+        loose = math.isfinite(ceil) and best > TIE_ABSOLUTE and ceil < VACUOUS * best
         vacuous += loose
         cands = {k.split(":", 1)[1]: float(v) for k, v in search.items() if k.startswith("candidate:")}
         start = min(cands, key=lambda k: cands[k]) if cands else "-"
