@@ -2,7 +2,8 @@
 
 The list of (function, argument types) is written by hand; these tests hold it to what the commands ask numba for:
 in a fresh interpreter, a flight with every compiled washout, its recorded traces cued on a hexapod with a set-point
-washout (the MPC) and the bound, and a parameter sweep request their kernels (another platform, the OMCT and a
+washout (the MPC) and the bound (cued whole: the bound is told the others' motions), streamed with the MPC alone,
+and a parameter sweep request their kernels (another platform, the OMCT and a
 suite's workers run the same ones: the platform is a branch of the block step), and every request
 (numba's own per-dispatcher count of cache hits and misses) must be one the list compiles. With the list complete
 and the cache filled (at install, or by the test session's warm-up, tests/warm_kernels.py) nothing is compiled.
@@ -41,6 +42,8 @@ flight = f"{out}/run/c172p/short/flight.parquet"
 from washbench.io.paths import DATA_DIR
 command("cue", flight, "--out", f"{out}/cue", "--platform", f"{DATA_DIR}/hexapod.yaml", "--washout", "small-angle",
         "--washout", "mpc", "--washout", "bound", "--no-recording", "--no-figures")
+command("cue", flight, "--out", f"{out}/cue-streamed", "--platform", f"{DATA_DIR}/hexapod.yaml", "--washout", "mpc",
+        "--no-recording", "--no-figures")
 command("sweep", m, "--set", "tilt.gain_per_s=1,2", "--out", f"{out}/sweep")
 
 from numba.core.registry import CPUDispatcher
@@ -80,9 +83,11 @@ def test_every_kernel_a_command_asks_for_is_precompiled_and_none_is_compiled(tmp
     asked = {(k, s) for k, d in requested.items() for s in d["hits"] + d["misses"]}
     missing = sorted((k, s) for k, s in asked if s not in listed.get(k, set()))
     assert not missing, f"kernels the commands ask for that washbench.numerics.precompile does not compile: {missing}"
-    # the probe measured something: the block step and the set-point path (hexapod, MPC), a flight, an evaluation
+    # the probe measured something: the block step and the set-point paths (hexapod, MPC, streamed and whole), a
+    # flight, an evaluation
     for key in ("washbench.cueing.kernel.bank_block", "washbench.cueing.kernel.setpoint_block",
-                "washbench.flight.stepper.flight_step", "washbench.analysis.evaluate.evaluate_batch"):  # fmt: skip
+                "washbench.cueing.kernel.setpoint_trace", "washbench.flight.stepper.flight_step",
+                "washbench.analysis.evaluate.evaluate_batch"):  # fmt: skip
         assert requested.get(key, {}).get("hits"), (key, requested.get(key))
     compiled = sorted((k, s) for k, d in requested.items() for s in d["misses"])
     assert not compiled, f"compiled although the cache was filled: {compiled}"

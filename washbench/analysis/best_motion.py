@@ -93,7 +93,7 @@ class Yardstick:
         self.rule = self.scoring.rule
         self.dt = float(dt_s)
         self.filter_start = filter_start
-        self.f_air = np.asarray(f_mps2, dtype=np.float64)
+        self.f_air = np.array(f_mps2, dtype=np.float64)  # a writable copy: the compiled jolt's one signature
         self.model = VestibularModel(self.dt, self.scoring.vestibular)
         self.aircraft = self.model.perceive(self.f_air, np.asarray(omega_radps, dtype=np.float64), filter_start)
         measure = self.rule.measure

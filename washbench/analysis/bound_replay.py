@@ -279,8 +279,9 @@ class BoundWashout:
         refusal = best_motion.search_refusal(n, self.params.search_steps)
         if refusal is not None:
             raise WashbenchError(f"washout bound: {refusal}")
-        f = np.asarray(f_mps2, dtype=np.float64)
-        w = np.asarray(omega_radps, dtype=np.float64)
+        # writable copies (the bench gives read-only ones): the compiled references and sums take one signature
+        f = np.array(f_mps2, dtype=np.float64)
+        w = np.array(omega_radps, dtype=np.float64)
         pos, q_sp, self.solved = replay(f, w, c.dt_s, c.limits, c.gravity_mps2, self.params, c.filter_start)
         along = self.alongside if self.alongside is not None else _alone(c)
         motions = dict(along.motions)
