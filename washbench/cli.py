@@ -23,7 +23,7 @@ from washbench.errors import Terminated, WashbenchError, printable
 from washbench.io import config as project_config
 from washbench.io import interrupts
 from washbench.io.examples import copy_examples
-from washbench.io.paths import resolve_manoeuvre
+from washbench.io.paths import resolve_data_file, resolve_manoeuvre, unknown_manoeuvre
 from washbench.live import FORMATS
 from washbench.review.replay import replay_command
 from washbench.runs.outputs import Outputs
@@ -67,9 +67,9 @@ def _rank_option(p: argparse.ArgumentParser) -> None:
 
 def _platform_options(p: argparse.ArgumentParser) -> None:
     """--platform and --platform-plugin (docs/platforms.md)."""
-    p.add_argument("--platform", type=Path,
-                   help="platform file, its kind: key picks the model: atlas, hexapod, rig or a plugin's (default: "
-                   "bundled Atlas)")  # fmt: skip
+    p.add_argument("--platform", type=Path, metavar="FILE|NAME",
+                   help="platform file, its kind: key picks the model: atlas, hexapod, rig or a plugin's; or a bundled "
+                   "one by name from any folder: atlas, hexapod, rig2dof (default: atlas)")  # fmt: skip
     p.add_argument("--platform-plugin", metavar="FILE.py:NAME",
                    help="load a platform from a Python file (docs/platforms.md); without --platform it is the platform")
 
@@ -77,7 +77,7 @@ def _platform_options(p: argparse.ArgumentParser) -> None:
 def _study_options(p: argparse.ArgumentParser) -> None:
     """What sweep and tune share."""
     _plugin_option(p)
-    p.add_argument("--params", type=Path, help="base washout parameter YAML (default: bundled CW1)")
+    p.add_argument("--params", type=Path, help="base washout parameter YAML (default: the bundled cw1)")
     _platform_options(p)
     p.add_argument(
         "--from",
@@ -150,7 +150,7 @@ def build_parser() -> argparse.ArgumentParser:
     _cue_input_options(p)
     _washout_options(p)
     _rank_option(p)
-    p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
+    p.add_argument("--params", type=Path, help="washout parameter YAML (default: the bundled cw1)")
     _platform_options(p)
 
     p = sub.add_parser("fly", help="fly a manoeuvre file with JSBSim and the scripted pilot")
@@ -168,7 +168,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("run", help="fly a manoeuvre with the washouts in lockstep; write traces, metrics, recording")
     p.add_argument(
-        "manoeuvre", type=Path, help="manoeuvre YAML file, a bundled one by name (c172/takeoff), or a JSBSim script"
+        "manoeuvre", type=Path,
+        help="manoeuvre YAML file, a bundled one by name (c172/takeoff), or a JSBSim script (a file, or one shipped "
+        "with JSBSim by name: c1723)",
     )
     p.add_argument("--out", type=_out_path, required=True, help="results folder; writes OUT/<aircraft>/<manoeuvre>/")
     _washout_options(p)
@@ -176,7 +178,7 @@ def build_parser() -> argparse.ArgumentParser:
     _aircraft_dir_option(p)
     p.add_argument("--max-time-s", type=float, metavar="S", help="JSBSim script: stop after S s (default 1200)")
     p.add_argument("--filter-start", choices=("steady", "rest"), default="steady", help="filters' start state")
-    p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
+    p.add_argument("--params", type=Path, help="washout parameter YAML (default: the bundled cw1)")
     _platform_options(p)
     p.add_argument("--quiet", action="store_true", help="no progress display")
     _output_options(p)
@@ -196,7 +198,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--jobs", type=_jobs, help="parallel processes (default: the CPUs this process may use)")
     _washout_options(p)
     _rank_option(p)
-    p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
+    p.add_argument("--params", type=Path, help="washout parameter YAML (default: the bundled cw1)")
     _platform_options(p)
     p.add_argument("--dask", metavar="ADDRESS", help="run on this Dask scheduler instead of local processes")
     p.add_argument("--quiet", action="store_true", help="no progress display")
@@ -205,7 +207,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("omct", help="Objective Motion Cueing Test: gain and phase of each washout, Bode plots")
     p.add_argument("--out", type=_out_path, required=True, help="output folder (omct.csv, bode_<test>.png, report.md)")
     _washout_options(p)
-    p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
+    p.add_argument("--params", type=Path, help="washout parameter YAML (default: the bundled cw1)")
     _platform_options(p)
     p.add_argument("--boundaries", type=Path, help="gain/phase boundaries YAML, drawn and checked (docs: OMCT)")
     p.add_argument("--rate-hz", type=float, default=120.0, help="washout sample rate (default 120)")
@@ -305,7 +307,7 @@ def _live_parsers(sub: Any) -> None:
     p.add_argument("--filter-start", choices=("steady", "rest"), default="steady", help="filters' start state")
     p.add_argument("--print-flightgear-protocol", action="store_true", help="print FlightGear's protocol file, exit")
     _washout_options(p)
-    p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
+    p.add_argument("--params", type=Path, help="washout parameter YAML (default: the bundled cw1)")
     _platform_options(p)
     _rank_option(p)
     _output_options(p)
@@ -450,8 +452,13 @@ def _dispatch(args: argparse.Namespace) -> int:
     if hasattr(args, "manoeuvre") or hasattr(args, "manoeuvres"):
         if hasattr(args, "manoeuvre"):
             args.manoeuvre = resolve_manoeuvre(args.manoeuvre)
+            if not args.manoeuvre.exists():
+                raise unknown_manoeuvre(args.manoeuvre)
         else:
             args.manoeuvres = [resolve_manoeuvre(m) for m in args.manoeuvres]
+    for option in ("platform", "params"):  # a bundled file by name from any folder (hexapod, washbench:data/...)
+        if getattr(args, option, None) is not None:
+            setattr(args, option, resolve_data_file(getattr(args, option), f"--{option}"))
     if args.command == "cue":
         return _cue(args)
     if args.command == "fly":
