@@ -647,11 +647,11 @@ def main(argv: list[str] | None = None) -> int:
             if signalled is None:
                 raise
             raise signalled from None
-    except KeyboardInterrupt:
-        print("washbench: interrupted", file=sys.stderr)
+    except KeyboardInterrupt as exc:
+        print(printable(f"washbench: interrupted{_what_it_cost(exc)}"), file=sys.stderr)
         return 130
-    except Terminated:
-        print("washbench: terminated", file=sys.stderr)
+    except Terminated as exc:
+        print(printable(f"washbench: terminated{_what_it_cost(exc)}"), file=sys.stderr)
         return 143
     finally:
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
@@ -660,6 +660,12 @@ def main(argv: list[str] | None = None) -> int:
         os.environ.pop(project_config.CONFIG_USED_ENV, None)
         if env_before is not None:
             os.environ[project_config.CONFIG_USED_ENV] = env_before
+
+
+def _what_it_cost(exc: BaseException) -> str:
+    """``: TEXT`` when the interrupted command said what the interruption cost (:func:`interrupts.explain`)."""
+    text = interrupts.explanation(exc)
+    return f": {text}" if text else ""
 
 
 def _config_defaults(parser: argparse.ArgumentParser, config: project_config.ProjectConfig) -> None:

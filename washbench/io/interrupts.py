@@ -158,3 +158,14 @@ def uninterrupted(func: Callable[P, R]) -> Callable[P, R]:
             return func(*args, **kwargs)
 
     return held
+
+
+def explain(exc: BaseException, text: str) -> None:
+    """Say what a KeyboardInterrupt or Terminated cost: ``text`` ends the command's one last line, ``washbench:
+    interrupted: TEXT`` (:func:`explanation`; a suite's "8 of 10 manoeuvres had finished; ... nothing was written")."""
+    exc.washbench_explanation = text  # type: ignore[attr-defined]
+
+
+def explanation(exc: BaseException) -> str:
+    """What :func:`explain` attached to ``exc`` (empty when nothing was)."""
+    return str(getattr(exc, "washbench_explanation", ""))

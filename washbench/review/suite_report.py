@@ -71,7 +71,7 @@ def write_suite_json(
 ) -> None:
     """``suite.json``: one entry per manoeuvre file (file, ok, reason, aircraft, manoeuvre, result folder, checks),
     the provenance and, once the suite is complete, ``entries``: every top-level name it wrote (the marker by which
-    the next suite recognises what it may replace, :func:`washbench.runs.suite.previous_results`)."""
+    the next suite recognises what it may replace, :func:`washbench.runs.suite_place.previous_results`)."""
     doc: dict[str, Any] = {"washbench": "suite", "created_utc": created_utc, "provenance": provenance}
     doc["manoeuvres"] = entries
     if top_level is not None:
