@@ -30,7 +30,7 @@ from washbench.analysis.bound import MAX_BOUND_SAMPLES, BoundParams
 from washbench.analysis.bound_replay import replay
 from washbench.analysis.omct_boundaries import BoundaryFile
 from washbench.analysis.signals import SignalSpec, amplitude_unit, canonical_axis, generate
-from washbench.cueing.variants import Washout, check_platform, platform_refusal, select_washouts
+from washbench.cueing.variants import Washout, check_platform, default_on, select_washouts
 from washbench.errors import WashbenchError, printable
 from washbench.io.atomic import write_text_atomic
 from washbench.io.budget import check_samples
@@ -314,8 +314,11 @@ def run_omct(
     """
     entries = select_washouts(washouts, variants, params_path)
     limits = load_platform_model(platform_path)
-    if washouts is None and not variants:  # the default set: those that can drive this platform
-        entries = [w for w in entries if platform_refusal(w, limits) is None]
+    if washouts is None and not variants:  # the default set: those that can drive this platform, never silently
+        kept, left_out = default_on(entries, limits)
+        entries = list(kept)
+        if left_out:
+            print(f"washbench: note: {left_out}", file=sys.stderr)
     check_platform(entries, limits)
     boundary = load_boundaries(boundaries_path) if boundaries_path is not None else None
     return run_entries(
