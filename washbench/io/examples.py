@@ -67,8 +67,8 @@ def copy_examples(dest: Path) -> int:
     n_platforms = len(BUNDLED_PLATFORMS)
     print(f"{n_m} manoeuvres, {n_p} pilot profiles, a washout parameter file and {n_platforms} platform files "
           f"({', '.join(BUNDLED_PLATFORMS)}) copied to {dest}")  # fmt: skip
-    print(f"  run one:   washbench run {dest / 'manoeuvres' / 'c172' / 'coordinated_turn.yaml'} --out results")
-    print(f"  run all:   washbench suite {dest / 'manoeuvres'} --out results")
+    print(f"  run one:   washbench run {dest / 'manoeuvres' / 'c172' / 'coordinated_turn.yaml'} --out my-runs")
+    print(f"  run all:   washbench suite {dest / 'manoeuvres'} --out my-suite")
     print(f"  profiles:  {dest / 'aircraft'}/<aircraft>/pilot.yaml are used by the manoeuvres under {dest}")
     print(f"  params:    --params {dest / 'params' / 'cw1.yaml'} --platform {dest / 'params' / 'hexapod.yaml'} (a "
           "parameter file may hold only the sections it changes)")  # fmt: skip
