@@ -93,8 +93,9 @@ def test_replacing_earlier_results_is_said_before_it_starts(tmp_path: Path) -> N
     first = washbench("suite", m, short(tmp_path, name="other"), "--out", out, *flags, timeout=180)
     assert first.returncode == 0 and "note" not in first.stderr, first.stderr
     written = json.loads((out / "suite.json").read_text())["created_utc"]
-    again = washbench("suite", m, "--out", out, *flags, timeout=180)
+    again = washbench("suite", m, "--out", out, *flags[:-1], timeout=180)  # with its progress lines
     assert again.returncode == 0, again.stderr
+    assert f"suite: 1 manoeuvre on 1 process -> {out}" in again.stderr.splitlines()  # (issue 52, item 10)
     assert again.stderr.splitlines()[0] == (
         f"washbench: note: {out} holds a suite of 2 manoeuvres, written {written}: this suite of 1 manoeuvre "
         "replaces it when it is complete (until then, and after a failure or Ctrl-C, it stays as it is)")

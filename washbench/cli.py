@@ -8,6 +8,7 @@ printed here as one line (no traceback) with exit status 2.
 from __future__ import annotations
 
 import argparse
+import difflib
 import errno
 import os
 import signal
@@ -93,10 +94,26 @@ def _study_options(p: argparse.ArgumentParser) -> None:
 
 
 class _Parser(argparse.ArgumentParser):
-    """ArgumentParser whose usage errors are one line and exit 2 (as argparse does)."""
+    """ArgumentParser whose usage errors are one line and exit 2 (as argparse does), naming the option meant for
+    one it does not know (``--output``: did you mean ``--out``?)."""
+
+    def parse_known_args(self, args: Any = None, namespace: Any = None) -> Any:  # type: ignore[override]
+        self._given = list(sys.argv[1:] if args is None else args)
+        return super().parse_known_args(args, namespace)
 
     def error(self, message: str) -> None:  # type: ignore[override]
-        self.exit(2, f"{self.prog}: error: {message}\n")
+        self.exit(2, f"{self.prog}: error: {message}{self._meant()}\n")
+
+    def _meant(self) -> str:
+        """`` (--output: did you mean --out?)`` for each option given that this command does not know."""
+        given = getattr(self, "_given", [])
+        command = subcommands(self).get(next((w for w in given if not w.startswith("-")), ""), self)
+        known = [s for a in command._actions for s in a.option_strings]
+        meant = []
+        for word in dict.fromkeys(w.partition("=")[0] for w in given if w.startswith("--")):
+            close = difflib.get_close_matches(word, known, n=1, cutoff=0.6) if word not in known else []
+            meant += [f"{word}: did you mean {close[0]}?"] if close else []
+        return f" ({'; '.join(meant)})" if meant else ""
 
 
 def _out_path(text: str) -> Path:
@@ -456,6 +473,12 @@ def _dispatch(args: argparse.Namespace) -> int:
                 raise unknown_manoeuvre(args.manoeuvre)
         else:
             args.manoeuvres = [resolve_manoeuvre(m) for m in args.manoeuvres]
+    washouts = getattr(args, "washout", None)
+    for name in [washouts] if isinstance(washouts, str) else washouts or []:
+        if "," in name:  # --washout a,b: one name per --washout
+            parts = [f"--washout {n.strip()}" for n in name.split(",") if n.strip()]
+            how = f"one at a time ({parts[0]})" if isinstance(washouts, str) else f"repeat it: {' '.join(parts)}"
+            raise WashbenchError(f"--washout {name}: one washout per --washout; {how}")
     for option in ("platform", "params"):  # a bundled file by name from any folder (hexapod, washbench:data/...)
         if getattr(args, option, None) is not None:
             setattr(args, option, resolve_data_file(getattr(args, option), f"--{option}"))

@@ -39,6 +39,7 @@ from washbench.review.report import (
     FLAG,
     MSDV_NOTE,
     MSI_NOTE,
+    NO_PDF_NOTE,
     PERCEIVED_NOTE,
     SCORE_NOTE,
     _image,
@@ -271,6 +272,7 @@ def _write_suite_report(
         if d.ok is False:
             lines += [f"> **FAILED**: {d.reason or 'a check failed'}", ""]
         lines += result_sections(d, _existing_figures(d) if figures else {}, suite_dir, 3, brief=True)
+    lines += [NO_PDF_NOTE, ""] if figures and not regenerate_results else []  # once, not under every figure
     for future in drawing.values():  # drawn (or failed: raised here) before the report that shows them
         future.result()
     write_text_atomic(stage / REPORT_FILE, "\n".join(lines).rstrip() + "\n")

@@ -148,7 +148,8 @@ def run_suite(
         loading = ", ".join(["JSBSim", *(["matplotlib"] if opts.outputs.figures else []),
                              *(["rerun"] if opts.outputs.recording else [])])  # fmt: skip
         print(
-            f"suite: {len(files)} manoeuvres on {jobs} process{'es' if jobs > 1 else ''} -> {_destination(out_dir)}\n"
+            f"suite: {len(files)} manoeuvre{'s' if len(files) != 1 else ''} on {jobs} "
+            f"process{'es' if jobs > 1 else ''} -> {_destination(out_dir)}\n"
             f"suite: loading {loading} and the compiled kernels",
             file=sys.stderr,
         )

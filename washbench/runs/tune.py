@@ -26,7 +26,7 @@ import numpy as np
 import yaml
 
 from washbench.analysis.sweep import format_value
-from washbench.analysis.tune import Bound, minimise, parse_tune
+from washbench.analysis.tune import EDGE_FRACTION, Bound, at_edges, minimise, parse_tune
 from washbench.cueing import registry
 from washbench.cueing.params import WashoutParams
 from washbench.cueing.variants import (
@@ -124,6 +124,8 @@ def tune_command(
     )
     for line in score_lines(base.name, table):
         print(line)
+    for line in at_edges(bounds, best_x):  # the optimum may lie beyond what was searched: say so
+        print(f"tune: note: {line}: the best may lie outside it; widen --tune {line.split(' ')[0]}=LOW:HIGH")
     return 0
 
 
@@ -279,6 +281,10 @@ def _report(
     ]
     for b, x in zip(bounds, best_x, strict=True):
         lines.append(f"| `{b.key}` | {b.low:g} .. {b.high:g} | {_value(base, b.key):.6g} | {x:.6g} |")
+    edges = at_edges(bounds, best_x)
+    if edges:
+        lines += ["", f"**At an end of its interval** (within {100 * EDGE_FRACTION:g} % of its width): "
+                  + "; ".join(edges) + ". The best may lie outside the interval searched: widen it and tune again."]
     lines += [
         "",
         f"| set | aircraft | manoeuvre | score {base.name} | score tuned | saturated s {base.name} "
