@@ -130,3 +130,32 @@ def test_every_docs_command_works_as_copied(page: str, line: str, argv: list[str
     out = str(getattr(args, "out", None) or "").rstrip("/")
     if out == "results" or out.startswith("results/"):
         assert args.command == "suite" and out == "results", f"{page}: {line}: results holds the main job's suite"
+
+
+def test_the_descriptions_name_what_the_code_has() -> None:
+    """Issue 52, item 14: ``washbench --help``, the README, the tutorial and the packages' docstrings described the
+    project as it was three washouts ago ("the three washouts", "the Atlas"). Every built-in washout is named in the
+    README (a washout added to the registry must be added there too: the marked sentence says where), every
+    platform model and bundled platform file in the README and the platform package's docstring, and no description
+    counts the washouts as three."""
+    import washbench.cueing
+    import washbench.platform
+    from washbench.cueing.params import WASHOUT_KINDS
+    from washbench.cueing.registry import BUILTIN_PYTHON
+    from washbench.io.paths import BUNDLED_PLATFORMS
+    from washbench.platform.model import KINDS
+
+    readme = (ROOT / "README.md").read_text()
+    tutorial = (ROOT / "docs" / "tutorial" / "getting-started.md").read_text()
+    top_help = " ".join(build_parser().format_help().split())
+    for kind in (*WASHOUT_KINDS, *BUILTIN_PYTHON):
+        assert f"`{kind}`" in readme, kind
+    cueing_doc = washbench.cueing.__doc__ or ""
+    assert all(f"``{kind}``" in cueing_doc for kind in (*WASHOUT_KINDS[:3], *BUILTIN_PYTHON)), cueing_doc
+    platform_doc = " ".join((washbench.platform.__doc__ or "").split())
+    for name in (*KINDS, *BUNDLED_PLATFORMS):
+        assert name in platform_doc.lower() and name in readme.lower(), name
+    for text in (readme, tutorial, top_help, cueing_doc, platform_doc):
+        prose = re.sub(r"<!--.*?-->", "", text, flags=re.S)  # (the marked notes quote the old wording)
+        assert not re.search(r"\b(?:three|3) washout", prose, flags=re.I), text[:80]
+    assert "hexapod" in top_help and "model-predictive" in top_help and "adaptive" in top_help

@@ -150,13 +150,15 @@ def build_parser() -> argparse.ArgumentParser:
     """The full command-line interface."""
     parser = _Parser(
         prog="washbench",
-        description="A testbed for flight-simulator motion cueing: JSBSim manoeuvres, three washouts, a kinematic "
-        "Atlas platform, vestibular models and metrics.",
+        description="A testbed for flight-simulator motion cueing: JSBSim manoeuvres, recorded logs or a simulator's "
+        "live output through washouts (classical small-angle, large-angle and unrestricted, their adaptive forms, "
+        "optimal, model-predictive, the oracle bound, your own plugins: `washbench run --help` lists them) on a "
+        "kinematic platform (the Atlas, a hexapod, a rig or your own), vestibular models, metrics and a ranking.",
     )
     parser.add_argument("--version", action="version", version=_version_line())
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
-    p = sub.add_parser("cue", help="run washouts, Atlas model, vestibular models and metrics on a recorded trace")
+    p = sub.add_parser("cue", help="run washouts, platform model, vestibular models and metrics on a recorded trace")
     p.add_argument(
         "input",
         type=Path,
