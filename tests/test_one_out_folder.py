@@ -74,7 +74,8 @@ def test_a_run_never_replaces_a_result_of_a_suite(suite_folder: tuple[Path, Path
     suite into the suite's own aircraft folder is refused saying what that folder is (never "did not write")."""
     out, m = suite_folder
     before = digest(out)
-    proc = washbench("run", m, "--out", out, "--platform", "hexapod", "--no-recording", "--no-figures", timeout=120)
+    proc = washbench("run", m, "--out", out, "--platform", "hexapod", "--washout", "small-angle", "--no-recording",
+                     "--no-figures", timeout=120)  # fmt: skip
     assert_clean_error(proc, f"{out / 'c172p' / 'short'}: a result of the suite in {out} (suite.json)", "report.md")
     proc = washbench("suite", m, "--out", out / "c172p", "--jobs", "1", "--no-recording", "--no-figures",
                      timeout=120)  # fmt: skip
