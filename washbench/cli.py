@@ -49,8 +49,10 @@ def _washout_options(p: argparse.ArgumentParser, variants: bool = True) -> None:
         "--washout",
         action="append",
         metavar="NAME",
-        help=f"washout to run, repeatable: {', '.join(WASHOUT_KINDS)}, optimal, mpc, mpc-unrestricted, bound (whole "
-        "recordings), or a plugin's name (default: the first three, or none with a variant)",
+        help=f"washout to run, repeatable: {', '.join(WASHOUT_KINDS)}, optimal, mpc, mpc-unrestricted, the naive "
+        "references replay, replay-rotation, still, bound (whole recordings), a plugin's name, or all (every "
+        "built-in, the references and the bound) (default: small-angle, large-angle, unrestricted and the three "
+        "references, or none with a variant)",
     )
     if variants:
         p.add_argument("--variant", action="append", default=[], metavar="NAME=KIND[,KEY=VALUE...]", help=_VARIANT_HELP)
@@ -58,10 +60,14 @@ def _washout_options(p: argparse.ArgumentParser, variants: bool = True) -> None:
 
 
 def _rank_option(p: argparse.ArgumentParser) -> None:
-    """--rank-by and --vestibular (cue, live, run, suite), recorded in the provenance (docs/fidelity.md)."""
-    p.add_argument("--rank-by", choices=("score", "false-cue", "weighted"),
-                   help="ranking rule (default: the parameter file's ranking: section, else score); weighted uses "
-                   "its ranking.dof_weights")  # fmt: skip
+    """--rank-by, --thresholds and --vestibular (cue, live, run, suite), recorded in the provenance
+    (docs/metrics.md)."""
+    p.add_argument("--rank-by", choices=("felt", "score", "false-cue", "weighted"),
+                   help="ranking rule (default: the parameter file's ranking: section, else felt: the felt error); "
+                   "score is the rule before it; weighted uses the section's ranking.dof_weights")  # fmt: skip
+    p.add_argument("--thresholds", choices=("zacharias", "none"),
+                   help="perception thresholds of the felt error (default: the parameter file's ranking: section, "
+                   "else zacharias: Zacharias 1978); none: no dead band")  # fmt: skip
     p.add_argument("--vestibular", choices=("young-meiry", "telban-cardullo"),
                    help="vestibular models (default young-meiry: Meiry-Young otolith, Young-Oman canals)")
 
@@ -152,7 +158,8 @@ def build_parser() -> argparse.ArgumentParser:
         prog="washbench",
         description="A testbed for flight-simulator motion cueing: JSBSim manoeuvres, recorded logs or a simulator's "
         "live output through washouts (classical small-angle, large-angle and unrestricted, their adaptive forms, "
-        "optimal, model-predictive, the oracle bound, your own plugins: `washbench run --help` lists them) on a "
+        "optimal, model-predictive, the oracle bound, naive references, your own plugins: `washbench run --help` "
+        "lists them) on a "
         "kinematic platform (the Atlas, a hexapod, a rig or your own), vestibular models, metrics and a ranking.",
     )
     parser.add_argument("--version", action="version", version=_version_line())
@@ -418,7 +425,7 @@ def _run_options(args: argparse.Namespace) -> Any:
                         variants=args.variant, aircraft_dirs=getattr(args, "aircraft_dir", ()), outputs=_outputs(args),
                         filter_start=getattr(args, "filter_start", "steady"),
                         max_time_s=getattr(args, "max_time_s", None), rank_by=args.rank_by,
-                        vestibular=args.vestibular)  # fmt: skip
+                        vestibular=args.vestibular, thresholds=args.thresholds)  # fmt: skip
 
 
 def _cue(args: argparse.Namespace) -> int:

@@ -53,7 +53,7 @@ EXAMPLES: dict[str, tuple[str, ...]] = {
     ),
     "suite": (
         "washbench suite --out results",
-        "washbench suite c172 columbia400/takeoff --out results --jobs 2",
+        "washbench suite --out results-all --washout all",
         "washbench suite --jsbsim-scripts c1723 c172_cross_wind --out jsbsim-suite",
     ),
     "omct": (

@@ -54,6 +54,7 @@ from typing import Any
 import numpy as np
 from scipy import sparse
 
+from washbench.analysis.felt import FELT_PREFIX, FeltMeasure, felt_total
 from washbench.analysis.lp_rows import Rows as _Rows
 from washbench.analysis.lp_rows import solve_qp as _solve_qp
 from washbench.analysis.lp_rows import trapezoid as _trapezoid
@@ -76,16 +77,40 @@ EXACT = "Exact"
 
 
 @dataclass(frozen=True)
+class FloorTerms:
+    """The felt error's terms on one DOF (:mod:`washbench.analysis.felt`): its dead band (m/s^2 or deg/s), the false
+    part's weight lambda, the jolt time tau_j (s) and the jerk dead band J_T (m/s^3)."""
+
+    band: float
+    false_weight: float
+    jolt_time_s: float
+    jerk_deadband_mps3: float
+
+
+@dataclass(frozen=True)
 class Ceiling:
     """The ceiling of one flight: per DOF the least integral error any platform motion can reach (``floor``, in
-    the units of ``metrics.csv``: m/s^2*s, deg) and its solver status."""
+    the units of ``metrics.csv``: m/s^2*s, deg) and its solver status; with ``measure``, the least of the felt
+    error's terms on that DOF, ``E + lambda F + tau_j J`` (the same units; :mod:`washbench.analysis.felt`)."""
 
     floor: dict[str, float]
     status: dict[str, str]
+    measure: FeltMeasure | None = None
 
     def relative(self, motion: Mapping[str, float]) -> dict[str, float]:
-        """``r_d = floor_d / M_d`` (NaN where the DOF was not felt: ``M_d`` 0)."""
-        return {d: (self.floor[d] / motion[d] if motion.get(d, 0.0) > 0.0 else math.nan) for d in DOFS}
+        """``r_d = floor_d / M_d`` (NaN where the DOF was not felt: ``M_d`` 0); with the felt error's measure, ``M_d``
+        the felt motion above threshold (``felt_<dof>`` of ``motion``)."""
+        key = (lambda d: FELT_PREFIX + d) if self.measure is not None else (lambda d: d)
+        return {d: (self.floor[d] / motion[key(d)] if motion.get(key(d), 0.0) > 0.0 else math.nan) for d in DOFS}
+
+    def felt_score(self, motion: Mapping[str, float]) -> float:
+        """The ceiling of the felt error's score: ``sum_d floor_d / T_d`` over the felt motion's total (NaN without
+        the measure)."""
+        if self.measure is None:
+            return math.nan
+        m = np.array([float(motion[FELT_PREFIX + d]) for d in DOFS])
+        return float(np.sum(np.array([self.floor[d] for d in DOFS]) / self.measure.units())) / felt_total(
+            m, self.measure)
 
 
 def _sections(model: DiscreteModel) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -103,9 +128,14 @@ def _perception_rows(
     reference: np.ndarray,
     scale: float,
     rest_input: float | None,
+    band: float = 0.0,
+    false0: int | None = None,
 ) -> None:
     """The model's sections driven by input variables ``u`` (indices, length n) with states at ``x0 + s n + k``,
-    and ``t_k >= |scale * y_k - reference_k|`` with ``t`` at ``t0 + k``."""
+    and ``t_k >= |scale * y_k - reference_k| - band``, ``t_k >= 0`` with ``t`` at ``t0 + k`` (the felt error's
+    integrand, :mod:`washbench.analysis.felt`); with ``false0``, the false part's integrand ``v_k`` at
+    ``false0 + k``: ``v_k >= -s_k (y_k - reference_0) - band`` where the aircraft's cue ``s_k`` (its sign beyond
+    ``band``) is not 0, ``v_k >= |y_k - reference_0| - band`` where it is, ``v_k >= 0``."""
     b, phi, steady = _sections(model)
     ns = len(phi)
     k = np.arange(1, n)
@@ -120,8 +150,21 @@ def _perception_rows(
                  equal=True)  # fmt: skip
     t = t0 + np.arange(n)
     y_terms = [(x0 + s * n + np.arange(n), scale) for s in range(ns)]
-    rows.add([*y_terms, (t, -1.0)], reference.copy(), equal=False)
-    rows.add([*[(i, -c) for i, c in y_terms], (t, -1.0)], -reference, equal=False)
+    rows.add([*y_terms, (t, -1.0)], reference + band, equal=False)
+    rows.add([*[(i, -c) for i, c in y_terms], (t, -1.0)], -reference + band, equal=False)
+    if band > 0.0:
+        rows.box(t, 0.0, np.inf)
+    if false0 is None:
+        return
+    v = false0 + np.arange(n)
+    rows.box(v, 0.0, np.inf)
+    dx = reference - reference[0]
+    s_k = np.where(np.abs(dx) > band, np.sign(dx), 0.0)
+    for sign in (1.0, -1.0):  # where the aircraft's cue is s: -s y_k - v_k <= band - s x_0; where none: both signs
+        sel = np.flatnonzero((s_k == -sign) | (s_k == 0.0))
+        if len(sel):
+            rows.add([*[(i[sel], sign * c) for i, c in y_terms], (v[sel], -1.0)],
+                     np.full(len(sel), band + sign * reference[0]), equal=False)  # fmt: skip
 
 
 def _solve(c: np.ndarray, rows: _Rows, nvar: int) -> tuple[float, str]:
@@ -183,10 +226,14 @@ def translational_floor(
     model: DiscreteModel,
     rest_start: bool,
     head_offset_m: float = 0.0,
+    terms: FloorTerms | None = None,
+    aircraft_head: np.ndarray | None = None,
 ) -> tuple[float, str]:
     """The least integral of |perceived specific-force error| (m/s^2*s) on body axis ``axis`` over the relaxation
     (module docstring); ``reference`` (N,) the aircraft pilot's perceived specific force on that axis, m/s^2;
-    ``limits``: the platform (Atlas limits, a hexapod, a rig) or its :class:`Relaxation`."""
+    ``limits``: the platform (Atlas limits, a hexapod, a rig) or its :class:`Relaxation`. With ``terms``, the least
+    of the felt error's terms on that axis instead, ``E + lambda F + tau_j J`` (:mod:`washbench.analysis.felt`; the
+    jolt needs ``aircraft_head`` (N,), the aircraft pilot's head specific force on the axis, m/s^2)."""
     n = len(reference)
     dt = float(dt_s)
     relax = relaxation_of(limits, dt, gravity_mps2)
@@ -196,7 +243,7 @@ def translational_floor(
     w_max = max(relax.rate)
     o_bar = abs(head_offset_m) * (relax.ang_acc + w_max * w_max)
     ns = len(model.phi)
-    names = ["f", "gam", "V", "P", "o", "t"]
+    names = ["f", "gam", "V", "P", "o", "t", "v", "j"] if terms is not None else ["f", "gam", "V", "P", "o", "t"]
     off = {nm: i * n for i, nm in enumerate(names)}
     x0 = len(names) * n
     nvar = x0 + ns * n
@@ -229,9 +276,23 @@ def translational_floor(
     else:  # from rest at neutral
         rows.add([(pp[:1], 1.0), (vv[:1], -dt)], np.zeros(1), equal=True)
     rest_input = float(np.array((0.0, 0.0, -G0_MPS2))[axis]) if rest_start else None
-    _perception_rows(rows, f, x0, off["t"], n, model, np.asarray(reference, dtype=np.float64), 1.0, rest_input)
+    band = terms.band if terms is not None else 0.0
+    _perception_rows(rows, f, x0, off["t"], n, model, np.asarray(reference, dtype=np.float64), 1.0, rest_input,
+                     band, off["v"] if terms is not None else None)  # fmt: skip
     c = np.zeros(nvar)
     c[idx["t"]] = _trapezoid(n, dt)
+    if terms is not None:
+        c[idx["v"]] = terms.false_weight * _trapezoid(n, dt)
+        if terms.jolt_time_s > 0.0 and n > 1:
+            if aircraft_head is None:
+                raise ValueError("the jolt term needs the aircraft pilot's head specific force")
+            j = idx["j"]
+            rows.box(j, 0.0, np.inf)
+            # j_k >= |f_k - f_{k-1}| / dt - |F_k - F_{k-1}| / dt - J_T, k >= 1 (m/s^3; j_0 unused: its cost is 0)
+            allow = np.abs(np.diff(np.asarray(aircraft_head, dtype=np.float64))) / dt + terms.jerk_deadband_mps3
+            for sign in (1.0, -1.0):
+                rows.add([(f[k], sign / dt), (f[k - 1], -sign / dt), (j[k], -1.0)], allow, equal=False)
+            c[j[1:]] = terms.jolt_time_s * dt
     return _solve(c, rows, nvar)
 
 
@@ -242,9 +303,11 @@ def rotational_floor(
     model: DiscreteModel,
     rest_start: bool,
     axis: int = 0,
+    terms: FloorTerms | None = None,
 ) -> tuple[float, str]:
     """The least integral of |perceived angular-velocity error| (deg) on body axis ``axis`` over the relaxation;
-    ``reference_radps`` (N,) the aircraft pilot's perceived angular velocity on that axis, rad/s."""
+    ``reference_radps`` (N,) the aircraft pilot's perceived angular velocity on that axis, rad/s. With ``terms``
+    (their band in deg/s), the least of the felt error's terms on that axis, ``E + lambda F`` (deg), instead."""
     n = len(reference_radps)
     dt = float(dt_s)
     relax = relaxation_of(limits, dt, G0_MPS2)
@@ -254,7 +317,8 @@ def rotational_floor(
     ns = len(model.phi)
     w = np.arange(n)
     t0 = n
-    x0 = 2 * n
+    v0 = 2 * n if terms is not None else None
+    x0 = (3 if terms is not None else 2) * n
     nvar = x0 + ns * n
     rows = _Rows()
     k = np.arange(1, n)
@@ -264,10 +328,13 @@ def rotational_floor(
         rows.add([(w[k], -1.0), (w[k - 1], 1.0)], np.full(n - 1, dw), equal=False)
     # solved in rad (70 interior-point iterations on the aerobatics' roll, against 95 with the error in deg), given
     # in deg as metrics.csv gives it
+    band = math.radians(terms.band) if terms is not None else 0.0
     _perception_rows(rows, w, x0, t0, n, model, np.asarray(reference_radps, dtype=np.float64), 1.0,
-                     0.0 if rest_start else None)  # fmt: skip
+                     0.0 if rest_start else None, band, v0)  # fmt: skip
     c = np.zeros(nvar)
     c[t0 : t0 + n] = _trapezoid(n, dt)
+    if terms is not None and v0 is not None:
+        c[v0 : v0 + n] = terms.false_weight * _trapezoid(n, dt)
     value, status = _solve(c, rows, nvar)
     return math.degrees(value), status
 
@@ -283,12 +350,15 @@ def ceiling(
     head_offset_m: tuple[float, float, float] = (0.0, 0.0, 0.0),
     f_mps2: np.ndarray | None = None,
     omega_radps: np.ndarray | None = None,
+    measure: FeltMeasure | None = None,
 ) -> Ceiling:
     """The ceiling of a flight from the aircraft pilot's perceived motion (N, 3) each (module docstring).
 
     ``limits``: the platform (Atlas limits, a hexapod, a rig: :func:`washbench.analysis.relaxation.relaxation_of`)
     or its relaxation. ``f_mps2``, ``omega_radps`` (N, 3): the aircraft pilot's head motion itself, when known: a
     DOF where the relaxation holds a motion equal to it has the ceiling 0 without a programme (status ``Exact``).
+    ``measure``: the ceiling of the felt error (:mod:`washbench.analysis.felt`: its terms per DOF; its jolt needs
+    ``f_mps2``) instead of the integral error's.
 
     Raises ValueError for perception thresholds (a dead band makes the error non-convex in the head motion: the
     ceiling is not defined for them)."""
@@ -302,19 +372,30 @@ def ceiling(
     relax = relaxation_of(limits, dt_s, gravity_mps2)
     floor: dict[str, float] = {}
     status: dict[str, str] = {}
+    if measure is not None and f_mps2 is None and measure.jolt_time_s > 0.0:
+        raise ValueError("the felt error's ceiling needs the aircraft pilot's head specific force (its jolt term)")
+    bands = measure.bands() if measure is not None else np.zeros(6)
+
+    def terms(i: int) -> FloorTerms | None:
+        if measure is None:
+            return None
+        return FloorTerms(float(bands[i]), measure.false_weight, measure.jolt_time_s, measure.jerk_deadband_mps3)
+
     for axis, dof in enumerate(DOFS[:3]):
         if f_mps2 is not None and _follows_exactly_force(f_mps2[:, axis], dt_s, relax, axis):
             floor[dof], status[dof] = 0.0, EXACT
             continue
         floor[dof], status[dof] = translational_floor(
-            perceived_f_mps2[:, axis], axis, dt_s, relax, gravity_mps2, oto, rest, r
-        )
+            perceived_f_mps2[:, axis], axis, dt_s, relax, gravity_mps2, oto, rest, r, terms(axis),
+            f_mps2[:, axis] if f_mps2 is not None else None,
+        )  # fmt: skip
     for axis, dof in enumerate(DOFS[3:]):
         if omega_radps is not None and _follows_exactly_rotation(omega_radps[:, axis], dt_s, relax, axis):
             floor[dof], status[dof] = 0.0, EXACT
             continue
-        floor[dof], status[dof] = rotational_floor(perceived_omega_radps[:, axis], dt_s, relax, can, rest, axis)
-    return Ceiling(floor=floor, status=status)
+        floor[dof], status[dof] = rotational_floor(perceived_omega_radps[:, axis], dt_s, relax, can, rest, axis,
+                                                   terms(3 + axis))  # fmt: skip
+    return Ceiling(floor=floor, status=status, measure=measure)
 
 
 __all__ = ["CEILING_TOL", "EXACT", "Ceiling", "ceiling", "rotational_floor", "translational_floor"]

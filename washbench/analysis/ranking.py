@@ -31,12 +31,16 @@ rule but no rank: it is not a washout a simulator could run (it knows the future
 cost, not for this score. Its row comes last with ``rank`` 0 ("not ranked"); the washouts are ranked among
 themselves as if it were not there.
 
-Other rules (:class:`RankRule`, ``--rank-by`` and the parameter file's ``ranking:`` section), all lower is better:
+The rules (:class:`RankRule`, ``--rank-by`` and the parameter file's ``ranking:`` section), all lower is better:
 
-- ``score``: the rule above (the default).
-- ``false-cue``: the false-cue time, ``sum over DOFs of cue_false_frac`` (:mod:`washbench.analysis.cues`): the
-  time during which the simulator pilot feels a false cue, in DOF-manoeuvre lengths (0: never; 6: always, in
-  every DOF).
+- ``felt`` (the default): the felt error of :mod:`washbench.analysis.felt`: the perceived error beyond the
+  perception thresholds, its false part counted again, and the jolts the platform adds at the head, in threshold
+  units, divided by what the aircraft pilot felt above threshold (1: a still platform; 0: the aircraft's own motion
+  as felt). Its DOF weights follow what the pilot felt above threshold, in threshold units.
+- ``score``: the rule above, the ranking before the felt error (kept for comparison with earlier results).
+- ``false-cue``: the false cues by size and duration, ``sum_d F_d / T_d`` over the felt motion ``sum_d M_d / T_d``
+  (:func:`washbench.analysis.felt.felt_errors`: the simulator pilot's cue beyond threshold in the wrong direction,
+  or where the aircraft pilot felt none, integrated; 0: no false cue).
 - ``weighted``: ``sum_d u_d E(W, d) / M_d`` with the user's DOF weights ``u_d`` (the parameter file's
   ``ranking: dof_weights:``), over the DOFs the aircraft pilot felt (``M_d`` at least ``MOTION_FLOOR``), the
   weights renormalised to sum 1 over those DOFs.
@@ -57,6 +61,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from washbench.analysis.felt import (
+    DEFAULT_MEASURE,
+    FeltMeasure,
+    dof_terms,
+    felt_key,
+    felt_motion,
+    felt_total,
+    felt_weights,
+)
 from washbench.analysis.metrics import DOFS, integral_abs_error
 from washbench.io.metrics_csv import MetricRow
 
@@ -67,8 +80,8 @@ REFERENCE_WASHOUT = "small-angle"
 BOUND_WASHOUT = "bound"
 """The oracle bound's name in every output: scored, never ranked (module doc)."""
 
-RANK_BY: tuple[str, ...] = ("score", "false-cue", "weighted")
-"""The ranking rules (module docstring)."""
+RANK_BY: tuple[str, ...] = ("felt", "score", "false-cue", "weighted")
+"""The ranking rules (module docstring); the first is the default."""
 
 TIE_RELATIVE = 0.03
 """Relative margin within which two values tie (chosen, docs/fidelity.md)."""
@@ -111,10 +124,11 @@ class RankRow:
 class RankRule:
     """How washouts are ranked: ``by`` one of RANK_BY; ``dof_weights`` (DOF -> weight >= 0) for ``weighted``."""
 
-    by: str = "score"
+    by: str = "felt"
     dof_weights: tuple[tuple[str, float], ...] = ()
     tie_relative: float = TIE_RELATIVE
     tie_absolute: float = TIE_ABSOLUTE
+    measure: FeltMeasure = DEFAULT_MEASURE
 
     def __post_init__(self) -> None:
         if self.by not in RANK_BY:
@@ -129,13 +143,19 @@ class RankRule:
             "dof_weights": dict(self.dof_weights) if self.by == "weighted" else None,
             "tie_relative": self.tie_relative,
             "tie_absolute": self.tie_absolute,
+            "measure": self.measure.record(),
         }
 
     def label(self) -> str:
         """One line for reports: the rule and its tie margin."""
+        band = "above the perception thresholds" if self.measure.deadband else "without perception thresholds"
         what = {
-            "score": "score (weighted relative integral error)",
-            "false-cue": "false-cue time (sum of the DOFs' false-cue time fractions)",
+            "felt": f"felt error (perceived error {band}, false cues twice, the platform's jolts; relative to a "
+            "still platform)" if self.measure.false_weight == 1.0 else
+            f"felt error (perceived error {band}, false cues x{1 + self.measure.false_weight:g}, the platform's "
+            "jolts; relative to a still platform)",
+            "score": "score (weighted relative integral error, the rule before the felt error)",
+            "false-cue": "false cues by size and duration, relative to the felt motion",
             "weighted": "user-weighted relative integral error ("
             + ", ".join(f"{d} {w:g}" for d, w in self.dof_weights)
             + ")",
@@ -152,10 +172,11 @@ DEFAULT_RULE = RankRule()
 def rule_from_record(record: object) -> RankRule:
     """The rule of a provenance's ``ranking`` entry (the default for a result written before rules existed)."""
     if not isinstance(record, Mapping):
-        return DEFAULT_RULE
+        return RankRule(by="score")  # a result written before rules existed was ranked by the score
     weights = record.get("dof_weights") or {}
     return RankRule(
         by=str(record.get("by", "score")),
+        measure=FeltMeasure.from_record(record.get("measure")),
         dof_weights=tuple((str(d), float(w)) for d, w in weights.items()) if isinstance(weights, Mapping) else (),
         tie_relative=float(record.get("tie_relative", TIE_RELATIVE)),
         tie_absolute=float(record.get("tie_absolute", TIE_ABSOLUTE)),
@@ -205,13 +226,41 @@ def dof_weights(motion: Mapping[str, float]) -> dict[str, float]:
     return weights
 
 
-def perceived_motion(perceived_f_mps2: np.ndarray, perceived_omega_radps: np.ndarray, dt_s: float) -> dict[str, float]:
-    """How much the aircraft pilot felt per DOF (the M_d): integral of |perceived(t) - perceived(0)| dt.
+def perceived_motion(
+    perceived_f_mps2: np.ndarray,
+    perceived_omega_radps: np.ndarray,
+    dt_s: float,
+    measure: FeltMeasure = DEFAULT_MEASURE,
+) -> dict[str, float]:
+    """How much the aircraft pilot felt per DOF: under the DOF's name the M_d of the ``score`` rule, integral of
+    |perceived(t) - perceived(0)| dt; under :func:`felt_key` the felt motion above threshold of the ``felt`` rule
+    (:func:`washbench.analysis.felt.felt_motion` with ``measure``).
 
     Surge, sway, heave in m/s^2*s; roll, pitch, yaw in deg (the units of metrics.csv).
     """
     columns = np.column_stack([perceived_f_mps2, np.degrees(perceived_omega_radps)])
-    return {dof: integral_abs_error(x, np.full_like(x, x[0]), dt_s) for dof, x in zip(DOFS, columns.T, strict=True)}
+    out = {dof: integral_abs_error(x, np.full_like(x, x[0]), dt_s) for dof, x in zip(DOFS, columns.T, strict=True)}
+    felt = felt_motion(perceived_f_mps2, perceived_omega_radps, dt_s, measure)
+    return out | {felt_key(d): float(v) for d, v in zip(DOFS, felt, strict=True)}
+
+
+def felt_of(motion: Mapping[str, float]) -> np.ndarray | None:
+    """The felt motion above threshold (6,) from a motion mapping, or None when it has none (a result written
+    before the felt error)."""
+    if not all(felt_key(d) in motion for d in DOFS):
+        return None
+    return np.array([float(motion[felt_key(d)]) for d in DOFS])
+
+
+def felt_value(by_dof: Mapping[str, MetricRow], felt: np.ndarray, measure: FeltMeasure) -> float:
+    """The ``felt`` rule's value of one washout (its six rows by DOF): :func:`washbench.analysis.felt.felt_score`;
+    NaN when a row has no felt error (written before it)."""
+    e = np.array([by_dof[d].felt_error for d in DOFS])
+    f = np.array([by_dof[d].felt_false for d in DOFS])
+    j = np.nan_to_num(np.array([by_dof[d].jolt for d in DOFS[:3]]), nan=0.0)
+    if not (np.all(np.isfinite(e)) and np.all(np.isfinite(f))):
+        return math.nan
+    return float(np.sum(dof_terms(e, f, j, measure))) / felt_total(felt, measure)
 
 
 def score_of(integral_error: np.ndarray, weights: Mapping[str, float], motion: Mapping[str, float]) -> np.ndarray:
@@ -260,9 +309,17 @@ def rule_values(
     """Each washout's value of ``rule`` (lower is better) and the DOF weights it used."""
     washouts = washout_order(rows)
     by_key = {(r.washout, r.dof): r for r in rows}
-    if rule.by == "false-cue":
-        values = {w: float(sum(by_key[(w, d)].cue_false_frac for d in DOFS)) for w in washouts}
-        return values, dict.fromkeys(DOFS, 1.0 / len(DOFS))
+    if rule.by in ("felt", "false-cue"):
+        felt = felt_of(motion)
+        if felt is None:
+            return dict.fromkeys(washouts, math.nan), dict.fromkeys(DOFS, math.nan)
+        m = rule.measure
+        if rule.by == "felt":
+            values = {w: felt_value({d: by_key[(w, d)] for d in DOFS}, felt, m) for w in washouts}
+            return values, felt_weights(felt, m)
+        values = {w: float(sum(by_key[(w, d)].felt_false / u for d, u in zip(DOFS, m.units(), strict=True)))
+                  / felt_total(felt, m) for w in washouts}  # fmt: skip
+        return values, felt_weights(felt, m)
     weights = dof_weights(motion) if rule.by == "score" else user_weights(motion, dict(rule.dof_weights))
     values = {w: float(score_of(np.array([by_key[(w, d)].integral_error for d in DOFS]), weights, motion))
               for w in washouts}  # fmt: skip

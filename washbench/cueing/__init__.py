@@ -5,8 +5,9 @@ classical washouts of Micomonaco et al. (``small-angle``, Reid and Nahon's; its 
 the ``unrestricted`` angular washout) and the coordinated adaptive washout in the same three forms, compiled
 (``kernel``, ``bank``); the optimal (LQ) washout (``optimal``); the model-predictive ones (``mpc``,
 ``mpc-unrestricted``); the oracle bound (``bound``, computed over a whole recording: :mod:`washbench.analysis.bound`);
-and any plugin (``--washout-plugin FILE.py:NAME`` or the ``washbench.washouts`` entry points). Each drives any
-platform (:mod:`washbench.platform`) that it can, through the same interface (``algorithm``).
+the naive references (``replay``, ``replay-rotation``, ``still``: :mod:`washbench.cueing.references`); and any
+plugin (``--washout-plugin FILE.py:NAME`` or the ``washbench.washouts`` entry points). Each drives any platform
+(:mod:`washbench.platform`) that it can, through the same interface (``algorithm``).
 
 Public API::
 

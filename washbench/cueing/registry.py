@@ -49,8 +49,15 @@ BUILTIN_PYTHON: dict[str, str] = {
     "mpc-unrestricted": "washbench.cueing.mpc_unrestricted:MpcUnrestrictedWashout",
     # the oracle bound replayed as a washout (whole recordings only); by name, so cueing imports no analysis module
     "bound": "washbench.analysis.bound_replay:BoundWashout",
+    # the naive references (cueing/references.py)
+    "replay": "washbench.cueing.references:ReplayWashout",
+    "replay-rotation": "washbench.cueing.references:ReplayRotationWashout",
+    "still": "washbench.cueing.references:StillWashout",
 }
 """Built-in Python algorithms: kind -> ``module:attribute`` of the factory (imported on first use)."""
+
+REFERENCE_KINDS: tuple[str, ...] = ("replay", "replay-rotation", "still")
+"""The naive references' washout names (:mod:`washbench.cueing.references`)."""
 
 
 @dataclass(frozen=True)

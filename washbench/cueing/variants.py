@@ -34,6 +34,7 @@ from pydantic import BaseModel
 from washbench.cueing import registry
 from washbench.cueing.params import (
     DEFAULT_PARAMS_PATH,
+    WASHOUT_KINDS,
     WASHOUT_NAMES,
     WashoutParams,
     load_base_params,
@@ -335,6 +336,27 @@ def as_washouts(washouts: Sequence[str | Washout], params: WashoutParams | None)
     return tuple(out)
 
 
+ALL_WASHOUTS = "all"
+"""``--washout all``: every built-in washout, the naive references and the bound (:data:`EVERY_BUILTIN`)."""
+
+EVERY_BUILTIN: tuple[str, ...] = (*WASHOUT_KINDS, "optimal", "mpc", "mpc-unrestricted", *registry.REFERENCE_KINDS,
+                                  "bound")  # fmt: skip
+"""What ``--washout all`` runs, in order (on a platform one cannot drive, it is left out and said so)."""
+
+DEFAULT_WASHOUTS: tuple[str, ...] = (*WASHOUT_NAMES, *registry.REFERENCE_KINDS)
+"""What runs without ``--washout``: the paper's three classical washouts and the naive references (cheap; every
+verdict says whether the best washout beats them); the report says what was not compared and that ``--washout all``
+compares everything."""
+
+
+def expand_all(names: Sequence[str]) -> list[str]:
+    """``names`` with ``all`` replaced by :data:`EVERY_BUILTIN`."""
+    out: list[str] = []
+    for n in names:
+        out.extend(EVERY_BUILTIN if n == ALL_WASHOUTS else [n])
+    return out
+
+
 def select_washouts(
     washouts: Sequence[str] | None = None,
     variants: Sequence[str] = (),
@@ -355,7 +377,7 @@ def select_from(
     """:func:`select_washouts` with the parameter file already loaded (its base set and ``variants:`` section)."""
     parsed = [parse_variant(v) for v in variants]
     extra = from_file + tuple(resolve(v, base) for v in parsed)
-    named = list(dict.fromkeys(washouts)) if washouts else ([] if extra else list(WASHOUT_NAMES))
+    named = list(dict.fromkeys(expand_all(washouts))) if washouts else ([] if extra else list(DEFAULT_WASHOUTS))
     return as_washouts([*builtin(named, base), *extra] if named else list(extra), None)
 
 
@@ -386,9 +408,12 @@ def platform_refusal(washout: Washout, platform: Any) -> str | None:
     return f"washout {washout.name} ({washout.kind}): {why}" + (f"; {instead}" if instead else "")
 
 
-def default_on(specs: Sequence[Washout], platform: Any) -> tuple[tuple[Washout, ...], str | None]:
-    """The default washouts that can drive ``platform`` (:func:`platform_refusal`), and the one line that says which
-    were left out and why (None when none was): a default set is never cut silently."""
+def default_on(
+    specs: Sequence[Washout], platform: Any, which: str = "the default"
+) -> tuple[tuple[Washout, ...], str | None]:
+    """The washouts of a set not named one by one (``which``: "the default", "all the") that can drive ``platform``
+    (:func:`platform_refusal`), and the one line that says which were left out and why (None when none was): such
+    a set is never cut silently."""
     kept = tuple(w for w in specs if _unfit(w, platform) is None)
     left = [w for w in specs if w not in kept]
     if not left:
@@ -396,7 +421,7 @@ def default_on(specs: Sequence[Washout], platform: Any) -> tuple[tuple[Washout, 
     why = {w.name: _unfit(w, platform)[0] for w in left}  # type: ignore[index]
     reasons = "; ".join(f"{', '.join(n for n in why if why[n] == r)} {r}" for r in dict.fromkeys(why.values()))
     kind = getattr(platform, "kind", "atlas")
-    return kept, (f"the default washouts run without {', '.join(why)} on this {kind}: {reasons} (--washout names "
+    return kept, (f"{which} washouts run without {', '.join(why)} on this {kind}: {reasons} (--washout names "
                   "the washouts to run)")  # fmt: skip
 
 

@@ -5,7 +5,9 @@ Columns ``washout,dof,npc,integral_error,max_error`` (:mod:`washbench.analysis.m
 fractions), on the heave row the motion sickness dose values ``msdv_mps15,msdv_aircraft_mps15`` (ISO 2631-1 Wf,
 m/s^1.5: the simulator pilot's and the aircraft pilot's, :mod:`washbench.perception.sickness`),
 ``false_cue_events`` (``start_s-end_s@peak`` joined by ``;``) and on the heave row the predicted motion-sickness
-incidence ``msi_pct,msi_aircraft_pct`` (%, subjective vertical conflict, :mod:`washbench.perception.svc`), one row
+incidence ``msi_pct,msi_aircraft_pct`` (%, subjective vertical conflict, :mod:`washbench.perception.svc`), then the
+felt error's terms ``felt_error,felt_false,jolt`` (:mod:`washbench.analysis.felt`: the error beyond the perception
+threshold and its false part, m/s^2*s or deg; on surge, sway and heave the jolt the platform adds, m/s^2), one row
 per washout and DOF (surge, sway, heave, roll, pitch, yaw). Floats are written with ``repr`` (exact round trip); an
 undefined NPC (flat signal) is an empty field; PC = -1 gives ``inf``.
 """
@@ -27,12 +29,14 @@ METRICS_COLUMNS = (
     "washout", "dof", "npc", "integral_error", "max_error",
     "cue_correct_frac", "cue_scaled_frac", "cue_false_frac", "cue_missing_frac",
     "msdv_mps15", "msdv_aircraft_mps15", "false_cue_events", "msi_pct", "msi_aircraft_pct",
+    "felt_error", "felt_false", "jolt",
 )  # fmt: skip
 """metrics.csv columns; files written before the cue classification have the first five only, before the MSI the
-first twelve (both still read)."""
+first twelve, before the felt error the first fourteen (all still read)."""
 METRICS_TEXT_COLUMNS = ("washout", "dof", "false_cue_events")
 N_BASE_METRICS_COLUMNS = 5
 N_PRE_MSI_METRICS_COLUMNS = 12
+N_PRE_FELT_METRICS_COLUMNS = 14
 
 
 @dataclass(frozen=True)
@@ -44,7 +48,8 @@ class MetricRow:
     the motion sickness dose values (MSDV, m/s^1.5, ISO 2631-1 Wf) of the simulator pilot and of the aircraft pilot
     and their predicted motion-sickness incidence at the end of the manoeuvre (MSI, %, the 6-DOF subjective
     vertical conflict model of :mod:`washbench.perception.svc`: one value per pilot, of all six DOFs) (NaN on the
-    other rows).
+    other rows). The felt error's terms (:mod:`washbench.analysis.felt`): ``felt_error`` and ``felt_false`` (m/s^2*s;
+    deg), ``jolt`` (m/s^2; NaN on the rotational rows) (NaN where not computed, e.g. a file written before them).
     """
 
     washout: str
@@ -61,6 +66,9 @@ class MetricRow:
     false_cue_events: str = ""
     msi_pct: float = math.nan
     msi_aircraft_pct: float = math.nan
+    felt_error: float = math.nan
+    felt_false: float = math.nan
+    jolt: float = math.nan
 
 
 
@@ -90,7 +98,8 @@ def read_metrics_csv(path: str | Path) -> list[MetricRow]:
         raise WashbenchError(located(path, f"cannot read: {getattr(exc, 'strerror', None) or exc}")) from None
     reader = csv.reader(io.StringIO(text))
     header = next(reader, None)
-    known = (METRICS_COLUMNS, METRICS_COLUMNS[:N_PRE_MSI_METRICS_COLUMNS], METRICS_COLUMNS[:N_BASE_METRICS_COLUMNS])
+    known = (METRICS_COLUMNS, METRICS_COLUMNS[:N_PRE_FELT_METRICS_COLUMNS], METRICS_COLUMNS[:N_PRE_MSI_METRICS_COLUMNS],
+             METRICS_COLUMNS[:N_BASE_METRICS_COLUMNS])  # fmt: skip
     if header is None or tuple(header) not in known:
         raise WashbenchError(located(path, f"expected header {','.join(METRICS_COLUMNS)}", line=1))
     ncol = len(header)

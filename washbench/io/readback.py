@@ -58,17 +58,41 @@ class Turbulence(_Loose):
 
 #: The ranking rules and DOFs a recorded ``ranking`` may name (:data:`washbench.analysis.ranking.RANK_BY`, ``DOFS``;
 #: written out here so that this module imports no analysis code; a test keeps them equal).
-RANK_RULES = ("score", "false-cue", "weighted")
+RANK_RULES = ("felt", "score", "false-cue", "weighted")
 RANK_DOFS = ("surge", "sway", "heave", "roll", "pitch", "yaw")
+
+
+class FeltMeasureDoc(_Loose):
+    """The felt error's parameters a result was ranked with (:class:`washbench.analysis.felt.FeltMeasure`)."""
+
+    thresholds: dict[Literal["f_x_mps2", "f_y_mps2", "f_z_mps2", "omega_x_degps", "omega_y_degps", "omega_z_degps"],
+                     Number] | None = None  # fmt: skip
+    deadband: StrictBool | None = None
+    false_weight: Number | None = None
+    jolt_time_s: Number | None = None
+    jerk_deadband_mps3: Number | None = None
+    felt_floor_s: Number | None = None
+
+    @model_validator(mode="after")
+    def _sensible(self) -> FeltMeasureDoc:
+        for name, v in (*(self.thresholds or {}).items(), ("false_weight", self.false_weight),
+                        ("jolt_time_s", self.jolt_time_s), ("jerk_deadband_mps3", self.jerk_deadband_mps3),
+                        ("felt_floor_s", self.felt_floor_s)):  # fmt: skip
+            if v is not None and not (math.isfinite(v) and 0.0 <= v <= 1e6):
+                raise ValueError(f"{name}: expected a finite number from 0 to 1e6, got {v!r}")
+        if any(v <= 0.0 for v in (self.thresholds or {}).values()) or (self.felt_floor_s or 1.0) <= 0.0:
+            raise ValueError("thresholds and felt_floor_s must be above 0")
+        return self
 
 
 class Ranking(_Loose):
     """The ranking rule a result was written with; ``report`` ranks by it again, so it is checked as an input."""
 
-    by: Literal["score", "false-cue", "weighted"] = "score"
+    by: Literal["felt", "score", "false-cue", "weighted"] = "score"
     dof_weights: dict[Literal["surge", "sway", "heave", "roll", "pitch", "yaw"], Number] | None = None
     tie_relative: Number | None = None
     tie_absolute: Number | None = None
+    measure: FeltMeasureDoc | None = None
 
     @model_validator(mode="after")
     def _sensible(self) -> Ranking:

@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from washbench.analysis.felt import DEFAULT_MEASURE, FeltMeasure, felt_key, felt_motion
 from washbench.analysis.metrics import DOFS, integral_abs_error
 from washbench.errors import WashbenchError, located
 from washbench.io.columns import (
@@ -95,12 +96,17 @@ def _washout_order(metrics: list[MetricRow]) -> list[str]:
     return list(dict.fromkeys(r.washout for r in metrics))
 
 
-def perceived_motion_of(perceived_aircraft: np.ndarray, dt_s: float) -> dict[str, float]:
-    """Integral of |perceived(t) - perceived(0)| dt per DOF from the (N, 6) aircraft columns (metrics.csv units)."""
-    return {
+def perceived_motion_of(
+    perceived_aircraft: np.ndarray, dt_s: float, measure: FeltMeasure = DEFAULT_MEASURE
+) -> dict[str, float]:
+    """Integral of |perceived(t) - perceived(0)| dt per DOF from the (N, 6) aircraft columns (metrics.csv units:
+    m/s^2 and deg/s), and under ``felt_<dof>`` the felt motion above threshold (``measure``'s)."""
+    plain = {
         d: integral_abs_error(x, np.full_like(x, x[0]), dt_s)
         for d, x in zip(DOFS, np.ascontiguousarray(perceived_aircraft.T), strict=True)
     }
+    felt = felt_motion(perceived_aircraft[:, :3], np.radians(perceived_aircraft[:, 3:]), dt_s, measure)
+    return plain | {felt_key(d): float(v) for d, v in zip(DOFS, felt, strict=True)}
 
 
 def _limits_from(prov: dict[str, Any] | None) -> Any:
@@ -317,9 +323,10 @@ def load_result(folder: Path, table: Mapping[str, np.ndarray] | None = None, *, 
         usage = envelope_usage(table, washouts, limits)
     motion_doc = run.get("perceived_motion")
     if isinstance(motion_doc, dict) and set(motion_doc) >= set(DOFS):
-        motion = {d: float(motion_doc[d]["value"]) for d in DOFS}  # as the suite ranked it
+        motion = {d: float(v["value"]) for d, v in motion_doc.items()}  # as the suite ranked it
     else:
-        motion = perceived_motion_of(perceived[AIRCRAFT], dt)
+        measure = FeltMeasure.from_record(((prov or {}).get("ranking") or {}).get("measure"))
+        motion = perceived_motion_of(perceived[AIRCRAFT], dt, measure)
     aircraft, manoeuvre = run.get("aircraft") or flight.get("aircraft"), run.get("manoeuvre") or flight.get("name")
     title = f"{aircraft} / {manoeuvre}" if aircraft and manoeuvre else folder.name
     ok = run.get("ok")

@@ -27,6 +27,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from washbench.analysis.felt import felt_key
 from washbench.analysis.metrics import DOFS
 from washbench.analysis.ranking import BOUND_WASHOUT, DEFAULT_RULE, MOTION_FLOOR, perceived_motion, rule_values
 from washbench.analysis.relaxation import observed, relaxation_of, widened
@@ -39,11 +40,12 @@ from washbench.runs.chain import analyse, from_lockstep, stacked_rows
 CEILING_FILE = "ceiling.csv"
 CEILING_COLUMNS = ("washout", "dof", "relative_error", "ceiling", "recovered")
 """``ceiling.csv``: per washout (the bound's replay included, as ``bound``) one row for the ranking's value
-(``dof`` ``score``) and one per degree of freedom: its relative error (E_d / M_d, the score's terms), the ceiling
-there (the least any motion of this platform can reach, :mod:`washbench.analysis.ceiling`) and the fraction of what
-a still platform leaves to recover that it recovers, ``(still - value) / (still - ceiling)`` (still: 1 per DOF, the
-sum of the weights for the score). Empty cells: a DOF the aircraft pilot did not feel (no weight), or a rule with
-no ceiling (``false-cue``)."""
+(``dof`` ``score``) and one per degree of freedom: its relative error (the rule's term of that DOF over what the
+aircraft pilot felt there: ``(E_d + lambda F_d + tau_j J_d) / M_d`` for the felt error, ``E_d / M_d`` for the score),
+the ceiling there (the least any motion of this platform can reach, :mod:`washbench.analysis.ceiling`) and the
+fraction of what a still platform leaves to recover that it recovers, ``(still - value) / (still - ceiling)``
+(still: 1 per DOF, the sum of the weights for the score). Empty cells: a DOF the aircraft pilot did not feel (no
+weight), or a rule with no ceiling (``false-cue``)."""
 
 def split_whole(specs: Sequence[Any]) -> tuple[list[Any], list[Any]]:
     """The washouts (``Washout`` variants) that run sample by sample, and those that need the whole recording."""
@@ -75,13 +77,13 @@ def lockstep_result(motion: Any, rows: list[Any], options: Any) -> Any:
     stepped, whole = split_whole(options.washouts)
     if not whole:
         return from_lockstep(motion, rows, options.washout_order, options.vestibular_params, options.filter_start,
-                             platform_kind(options.limits))  # fmt: skip
+                             platform_kind(options.limits), options.rank_rule.measure)  # fmt: skip
     block = stacked_rows(rows)  # (washouts, N, fields)
     kind = platform_kind(options.limits)
     traces = {w.name: WashoutTrace.from_rows(block[i], platform=kind) for i, w in enumerate(stepped)}
     del block
     traces = with_whole(traces, motion, whole, options.washout_order, options.limits, options.filter_start)
-    return analyse(motion, traces, options.vestibular_params, options.filter_start)
+    return analyse(motion, traces, options.vestibular_params, options.filter_start, options.rank_rule.measure)
 
 
 def bound_spec(specs: Sequence[Any]) -> Any | None:
@@ -112,7 +114,8 @@ def bound_outputs(
     rule = DEFAULT_RULE if rule is None else rule
     dt_s = result.motion.dt_s
     ac = result.perceived["aircraft"]
-    motion = perceived_motion(ac.f_mps2, ac.omega_radps, dt_s)
+    motion = perceived_motion(ac.f_mps2, ac.omega_radps, dt_s, rule.measure)
+    felt_rule = rule.by == "felt"
     # the relaxation must hold every washout's head: the largest head offset any of them uses
     offsets = [tuple(s.params.head.offset_m) for s in specs if hasattr(s.params, "head")]
     offset = max(offsets, key=lambda o: math.hypot(*o)) if offsets else (0.0, 0.0, 0.0)
@@ -124,14 +127,28 @@ def bound_outputs(
     if relax.kind != "atlas":  # (the Atlas's bounds are its limits; a streamed cue keeps no attitudes for it)
         relax, grown = widened(relax, observed(result.traces, dt_s, gravity))
     ceil = ceiling(ac.f_mps2, ac.omega_radps, dt_s, relax, gravity, vestibular, filter_start, offset, head.f_mps2,
-                   head.omega_radps)  # fmt: skip
+                   head.omega_radps, rule.measure if felt_rule else None)  # fmt: skip
     floor = ceil.relative(motion)
     values, weights = rule_values(result.metrics, motion, rule)
     scored = rule.by != "false-cue"
     still = sum(weights.values()) if scored else math.nan
-    total_ceiling = sum(weights[d] * floor[d] for d in DOFS if weights[d] > 0.0) if scored else math.nan
+    if felt_rule:
+        total_ceiling = ceil.felt_score(motion)
+    else:
+        total_ceiling = sum(weights[d] * floor[d] for d in DOFS if weights[d] > 0.0) if scored else math.nan
     by_key = {(r.washout, r.dof): r for r in result.metrics}
     names = [s.name for s in specs]
+
+    def relative(n: str, d: str) -> float:
+        """The washout's relative error in DOF d under the rule (NaN where the pilot felt nothing there)."""
+        if felt_rule:
+            m = motion[felt_key(d)]
+            if m <= 0.0:
+                return math.nan
+            r, ms = by_key[(n, d)], rule.measure
+            jolt = 0.0 if math.isnan(r.jolt) else r.jolt
+            return (r.felt_error + ms.false_weight * r.felt_false + ms.jolt_time_s * jolt) / m
+        return by_key[(n, d)].integral_error / motion[d] if motion[d] >= MOTION_FLOOR[d] else math.nan
 
     def recovered(value: float, top: float, low: float) -> float:
         span = top - low
@@ -142,9 +159,8 @@ def bound_outputs(
         rows = {"score": {"relative_error": values[n], "ceiling": total_ceiling,
                           "recovered": recovered(values[n], still, total_ceiling)}}  # fmt: skip
         for d in DOFS:
-            felt = motion[d] >= MOTION_FLOOR[d]
-            rel = by_key[(n, d)].integral_error / motion[d] if felt else math.nan
-            low = floor[d] if felt else math.nan
+            rel = relative(n, d)
+            low = floor[d] if math.isfinite(rel) else math.nan
             rows[d] = {"relative_error": rel, "ceiling": low, "recovered": recovered(rel, 1.0, low)}
         table[n] = rows
     lines = [",".join(CEILING_COLUMNS)]

@@ -28,6 +28,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from washbench.analysis.cues import classified_rows
+from washbench.analysis.felt import DEFAULT_MEASURE, FeltMeasure, felt_errors, jolt
 from washbench.analysis.metrics import dof_metrics
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import atomic_path
@@ -194,12 +195,14 @@ def analyse(
     traces: Mapping[str, TraceLike],
     vestibular: VestibularParams | None = None,
     filter_start: str = "steady",
+    measure: FeltMeasure = DEFAULT_MEASURE,
 ) -> CueResult:
     """Vestibular models for the aircraft pilot and each simulator pilot, metrics, and the traces table.
 
     ``traces`` maps washout name -> its trace on the same time grid as ``motion``. Perception
     starts each filter in the steady state of its first sample, or of rest (``filter_start="rest"``;
-    see :mod:`washbench.perception`).
+    see :mod:`washbench.perception`). ``measure``: the felt error's thresholds and terms (the metrics' ``felt_*``
+    and ``jolt`` columns, :mod:`washbench.analysis.felt`).
     """
     model = VestibularModel(motion.dt_s, vestibular)
     n = motion.n
@@ -212,11 +215,10 @@ def analyse(
                 raise ValueError(f"washout {name!r}: saturated[{kind!r}] has shape {np.shape(flags)}, expected ({n},)")
         perceived[name] = model.perceive(arr["head_f_mps2"], arr["head_omega_radps"], filter_start)
         checked[name] = arr
-    vertical = {AIRCRAFT: motion.f_mps2[:, 2], **{w: a["head_f_mps2"][:, 2] for w, a in checked.items()}}
     heads = {AIRCRAFT: (motion.f_mps2, motion.omega_radps)}
     heads |= {w: (a["head_f_mps2"], a["head_omega_radps"]) for w, a in checked.items()}
     msi = {p: head_msi(f, w, motion.dt_s, start=filter_start) for p, (f, w) in heads.items()}
-    rows = _metric_rows(perceived, motion.dt_s, vertical, msi)
+    rows = _metric_rows(perceived, motion.dt_s, {p: f for p, (f, _) in heads.items()}, msi, measure)
     result = CueResult(motion=motion, traces=dict(traces), perceived=perceived, metrics=rows, arrays=checked)
     result.columns(0, 0)  # an input column that clashes with a result column fails now, before anything is written
     return result
@@ -225,25 +227,30 @@ def analyse(
 def _metric_rows(
     perceived: Mapping[str, Perceived],
     dt_s: float,
-    vertical: Mapping[str, np.ndarray],
+    head_f: Mapping[str, np.ndarray],
     msi: Mapping[str, float],
+    measure: FeltMeasure = DEFAULT_MEASURE,
 ) -> list[MetricRow]:
     """Six metric rows per washout: each simulator pilot's perceived motion against the aircraft pilot's, the cue
-    classification, and on the heave row the MSDV of each pilot's head (``vertical``: pilot -> body-z specific
-    force (N,), m/s^2) and the predicted incidence (``msi``: pilot -> MSI at the end, %)."""
+    classification, the felt error's terms (``measure``), and on the heave row the MSDV of each pilot's head
+    (``head_f``: pilot -> head specific force (N, 3), body axes, m/s^2) and the predicted incidence (``msi``: pilot
+    -> MSI at the end, %)."""
     ac = perceived[AIRCRAFT]
-    msdv_ac = head_msdv(vertical[AIRCRAFT], dt_s)
+    msdv_ac = head_msdv(head_f[AIRCRAFT][:, 2], dt_s)
     rows: list[MetricRow] = []
     for name, p in perceived.items():
         if name != AIRCRAFT:
             base = dof_metrics(name, ac.f_mps2, ac.omega_radps, p.f_mps2, p.omega_radps, dt_s)
-            msdv = head_msdv(vertical[name], dt_s)
-            rows += [
-                dataclasses.replace(
-                    r, msdv_mps15=msdv, msdv_aircraft_mps15=msdv_ac, msi_pct=msi[name], msi_aircraft_pct=msi[AIRCRAFT]
-                ) if r.dof == "heave" else r
-                for r in classified_rows(base, ac.f_mps2, ac.omega_radps, p.f_mps2, p.omega_radps, dt_s)
-            ]
+            msdv = head_msdv(head_f[name][:, 2], dt_s)
+            felt, false = felt_errors(ac.f_mps2, ac.omega_radps, p.f_mps2, p.omega_radps, dt_s, measure)
+            jolts = np.concatenate([jolt(head_f[name], head_f[AIRCRAFT], dt_s, measure), np.full(3, math.nan)])
+            classified = classified_rows(base, ac.f_mps2, ac.omega_radps, p.f_mps2, p.omega_radps, dt_s)
+            for i, r in enumerate(classified):
+                r = dataclasses.replace(r, felt_error=float(felt[i]), felt_false=float(false[i]), jolt=float(jolts[i]))
+                if r.dof == "heave":
+                    r = dataclasses.replace(r, msdv_mps15=msdv, msdv_aircraft_mps15=msdv_ac, msi_pct=msi[name],
+                                            msi_aircraft_pct=msi[AIRCRAFT])  # fmt: skip
+                rows.append(r)
     return rows
 
 
@@ -302,6 +309,7 @@ def cue_motion(
     limits: Any,
     vestibular: VestibularParams | None = None,
     filter_start: str = "steady",
+    measure: FeltMeasure = DEFAULT_MEASURE,
 ) -> CueResult:
     """Run the washouts (names with ``params``, or Washout variants) and the Atlas model over ``motion``
     (``cueing.cue_trace``, one compiled call), then :func:`analyse`.
@@ -311,7 +319,7 @@ def cue_motion(
     from washbench.cueing import cue_trace  # deferred: numba
 
     traces = cue_trace(motion.f_mps2, motion.omega_radps, motion.dt_s, washouts, params, limits, filter_start)
-    return analyse(motion, traces, vestibular, filter_start)
+    return analyse(motion, traces, vestibular, filter_start, measure)
 
 
 _REVIEW_FIELDS = ("pos_m", "vel_mps", "acc_mps2", "omega_radps", "wheel_radps", "leg_m")
@@ -335,6 +343,7 @@ def stream_cue(
     chunk_rows: int = CHUNK_ROWS,
     progress: Progress | None = None,
     vestibular: VestibularParams | None = None,
+    measure: FeltMeasure = DEFAULT_MEASURE,
 ) -> CueResult:
     """:func:`cue_motion` and the traces.parquet of :func:`write_results` in one pass, ``chunk_rows`` samples at a
     time (washouts, vestibular models, one Parquet row group per chunk): the same columns and metrics, bit for bit.
@@ -358,7 +367,7 @@ def stream_cue(
     model = VestibularModel(motion.dt_s, vestibular)
     streams = {p: PerceptionStream(model, filter_start) for p in (AIRCRAFT, *names)}
     felt = {p: Perceived(np.empty((n, 3)), np.empty((n, 3))) for p in streams}
-    vertical = {p: np.empty(n) for p in streams}  # body-z specific force at each pilot's head (MSDV)
+    heads = {p: np.empty((n, 3)) for p in names}  # each simulator pilot's head specific force (MSDV, jolts)
     sick = {p: SvcStream(motion.dt_s, start=filter_start) for p in streams}  # predicted incidence (MSI)
     keep = (_REVIEW_FIELDS if figures or recording else ()) + (_RECORDING_FIELDS if recording else ())
     if bank.platform != "atlas":  # the ceiling's relaxation is widened to what each washout did (bound_stage)
@@ -384,7 +393,7 @@ def stream_cue(
                 fields[w] = {f: getattr(tr, f) for f in _TRACE_FIELDS} if finite else _checked_trace(w, tr, b - a, a)
                 saturated[w] = tr.saturated
                 perceived[w] = streams[w].perceive(fields[w]["head_f_mps2"], fields[w]["head_omega_radps"])
-                vertical[w][rows] = fields[w]["head_f_mps2"][:, 2]
+                heads[w][rows] = fields[w]["head_f_mps2"]
                 sick[w].update(fields[w]["head_f_mps2"], fields[w]["head_omega_radps"])
                 for f in keep:
                     kept[w][f][rows] = fields[w][f]
@@ -398,8 +407,8 @@ def stream_cue(
                 progress.update(b)
 
     write_trace_chunks(traces_path, tables(), metadata)
-    vertical[AIRCRAFT][:] = motion.f_mps2[:, 2]
-    metrics = _metric_rows(felt, motion.dt_s, vertical, {p: st.msi_pct for p, st in sick.items()})
+    heads[AIRCRAFT] = motion.f_mps2
+    metrics = _metric_rows(felt, motion.dt_s, heads, {p: st.msi_pct for p, st in sick.items()}, measure)
     counts = bank.saturation_counts()
     traces = {w: SimpleNamespace(**kept[w], saturated=flags[w], saturation_counts=counts[w]) for w in names}
     return CueResult(motion=motion, traces=traces, perceived=felt, metrics=metrics, algorithms=bank.algorithm_reports())
@@ -532,6 +541,7 @@ def from_lockstep(
     vestibular: VestibularParams | None = None,
     filter_start: str = "steady",
     platform: str = "atlas",
+    measure: FeltMeasure = DEFAULT_MEASURE,
 ) -> CueResult:
     """The chain entered with a flight flown in lockstep: the washout traces the lockstep filled (``rows`` of
     :func:`lockstep_blocks` or :func:`lockstep_washouts`, emptied here; ``washouts`` their names in order) on
@@ -542,4 +552,4 @@ def from_lockstep(
     block = stacked_rows(rows)  # (washouts, N, fields); the lockstep's blocks are freed
     traces = {w: WashoutTrace.from_rows(block[i], platform=platform) for i, w in enumerate(washouts)}  # contiguous
     del block
-    return analyse(motion, traces, vestibular, filter_start)
+    return analyse(motion, traces, vestibular, filter_start, measure)

@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from washbench.analysis.felt import DEFAULT_MEASURE, FeltMeasure
 from washbench.analysis.ranking import perceived_motion
 from washbench.errors import WashbenchError, located, printable
 from washbench.io.atomic import atomic_path
@@ -143,8 +144,11 @@ def prepare_segments(samples: Samples, opts: CueOptions) -> list[Segment]:
     return out
 
 
-def segment_summary(input_path: Path, seg: Segment, result: CueResult, out_dir: Path) -> RunSummary:
-    """The run summary (``run.json``, report) of one cued segment; a crash in the data makes it failed."""
+def segment_summary(
+    input_path: Path, seg: Segment, result: CueResult, out_dir: Path, measure: FeltMeasure = DEFAULT_MEASURE
+) -> RunSummary:
+    """The run summary (``run.json``, report) of one cued segment; a crash in the data makes it failed
+    (``measure``: the felt error's, for the aircraft pilot's felt motion)."""
     crash = [f.text for f in seg.findings if f.crash]
     ac = result.perceived[AIRCRAFT]
     return RunSummary(
@@ -156,7 +160,7 @@ def segment_summary(input_path: Path, seg: Segment, result: CueResult, out_dir: 
         steps=seg.motion.n,
         dt_s=seg.motion.dt_s,
         metrics=list(result.metrics),
-        motion=perceived_motion(ac.f_mps2, ac.omega_radps, seg.motion.dt_s),
+        motion=perceived_motion(ac.f_mps2, ac.omega_radps, seg.motion.dt_s, measure),
         saturations={w: dict(t.saturation_counts) for w, t in result.traces.items()},
     )
 
@@ -216,10 +220,10 @@ def write_outputs(
                     result = stream_cue(
                         seg.motion, run.washouts, run.limits, tmp[TRACES_FILE], meta,
                         filter_start=run.filter_start, recording=recording, figures=figures, progress=shown,
-                        vestibular=run.vestibular_params,
+                        vestibular=run.vestibular_params, measure=run.rank_rule.measure,
                     )  # fmt: skip
                     offset += seg.motion.n
-                    summary = segment_summary(input_path, seg, result, folder)
+                    summary = segment_summary(input_path, seg, result, folder, run.rank_rule.measure)
                     write_metrics_csv(tmp[METRICS_FILE], result.metrics)
                     extra = {
                         "input": str(input_path),

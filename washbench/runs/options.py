@@ -22,6 +22,7 @@ from washbench.analysis.ranking import RankRule
 from washbench.cueing import registry
 from washbench.cueing.params import DEFAULT_PARAMS_PATH, WashoutParams, check_filter_start
 from washbench.cueing.variants import (
+    ALL_WASHOUTS,
     Washout,
     check_platform,
     default_on,
@@ -45,7 +46,9 @@ class RunOptions:
     As given (the command line): ``params_path``, ``platform_path`` (None: the bundled files), ``washout_names``
     (``--washout``; None: the default), ``variants`` (``--variant`` texts), ``aircraft_dirs``, ``outputs``,
     ``filter_start`` (``steady`` or ``rest``), ``max_time_s`` (JSBSim scripts), ``rank_by``, ``vestibular`` (the
-    model's name; None: the default). Loaded: ``params`` (the parameter file's base set), ``washouts`` (what runs,
+    model's name; None: the default), ``thresholds`` (the felt error's: ``zacharias``, ``none``; None: the
+    parameter file's ``ranking:`` section, else Zacharias).
+    Loaded: ``params`` (the parameter file's base set), ``washouts`` (what runs,
     :func:`washbench.cueing.variants.select_washouts`), ``limits``, ``rank_rule``, ``vestibular_params``,
     ``plugins`` (the washout plugins loaded in this process, ``FILE.py:NAME``, for worker processes) and
     ``provenance`` (the run-wide records: parameters, washouts, platform, ranking, vestibular model; no date).
@@ -61,6 +64,7 @@ class RunOptions:
     max_time_s: float | None = None
     rank_by: str | None = None
     vestibular: str | None = None
+    thresholds: str | None = None
     params: WashoutParams
     washouts: tuple[Washout, ...]
     limits: PlatformModel
@@ -103,6 +107,7 @@ def load_options(
     max_time_s: float | None = None,
     rank_by: str | None = None,
     vestibular: str | None = None,
+    thresholds: str | None = None,
 ) -> RunOptions:
     """The options of a run (:class:`RunOptions`), each file read once.
 
@@ -118,12 +123,13 @@ def load_options(
     chosen = select_from(washouts, variants, params, from_file)
     limits, resolved, platform_sha = resolve_platform(platform_path)
     platform_source = platform_path or resolved
-    if washouts is None and not variants:  # the default set: those of its washouts that can drive this platform
-        chosen, left_out = default_on(chosen, limits)
-        if left_out:  # never silently (issue 52, item 8)
+    if (washouts is None and not variants) or ALL_WASHOUTS in (washouts or ()):
+        # the default set, or all: those of its washouts that can drive this platform, never silently (issue 52, item 8)
+        chosen, left_out = default_on(chosen, limits, "the default" if washouts is None else "all the")
+        if left_out:
             print(f"washbench: note: {left_out}", file=sys.stderr)
     check_platform(chosen, limits)  # a washout named that cannot drive this platform: refused before anything is flown
-    rule = rank_rule_from_data(params_path, data, lines, rank_by)
+    rule = rank_rule_from_data(params_path, data, lines, rank_by, thresholds)
     vestibular_params = model_params(vestibular)
     provenance = build_provenance(
         params_path=source,
@@ -150,6 +156,7 @@ def load_options(
         max_time_s=max_time_s,
         rank_by=rank_by,
         vestibular=vestibular,
+        thresholds=thresholds,
         params=params,
         washouts=chosen,
         limits=limits,

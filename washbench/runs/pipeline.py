@@ -192,7 +192,7 @@ def write_cued_folder(
         steps=motion.n,
         dt_s=motion.dt_s,
         metrics=list(result.metrics),
-        motion=perceived_motion(ac.f_mps2, ac.omega_radps, motion.dt_s),
+        motion=perceived_motion(ac.f_mps2, ac.omega_radps, motion.dt_s, options.rank_rule.measure),
         saturations={w: dict(result.traces[w].saturation_counts) for w in options.washout_order},
     )
     write_run_json(folder / RUN_FILE, summary, time.perf_counter() - start, extra)

@@ -25,7 +25,16 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from washbench.analysis.ranking import DEFAULT_RULE, DOFS, RankRow, RankRule, perceived_motion, rank, rule_from_record
+from washbench.analysis.felt import FELT_PREFIX
+from washbench.analysis.ranking import (
+    DEFAULT_RULE,
+    DOFS,
+    RankRow,
+    RankRule,
+    perceived_motion,
+    rank,
+    rule_from_record,
+)
 from washbench.io.atomic import write_text_atomic
 from washbench.io.csv_numbers import csv_number
 from washbench.io.metrics_csv import MetricRow
@@ -104,7 +113,8 @@ def write_run_json(path: Path, s: RunSummary, wall_s: float, extra: dict[str, ob
         "checks_passed": s.checks_passed,
         "checks_total": s.checks_total,
         "perceived_motion": {
-            d: {"value": v, "unit": "m/s^2*s" if d in DOFS[:3] else "deg"} for d, v in s.motion.items()
+            d: {"value": v, "unit": "m/s^2*s" if d.removeprefix(FELT_PREFIX) in DOFS[:3] else "deg"}
+            for d, v in s.motion.items()
         },
         "saturations": s.saturations,
     }
@@ -174,7 +184,8 @@ def write_run_recording(
         envelope=platform_envelope(limits),
         phases=[(p[0], float(p[1]), float(p[2])) for p in phases],
         metrics_markdown=metrics_markdown(title, list(result.metrics),
-                                          perceived_motion(ac.f_mps2, ac.omega_radps, float(motion.dt_s)), rule,
+                                          perceived_motion(ac.f_mps2, ac.omega_radps, float(motion.dt_s),
+                                                           rule.measure), rule,
                                           ceiling),
         hexapod=hexapod,
         platform=kind,
