@@ -72,6 +72,11 @@ EXAMPLES: dict[str, tuple[str, ...]] = {
         "washbench tune c172/takeoff c172/stall_recovery --washout large-angle --tune tilt.gain_per_s=0.2:5 --out t",
         "washbench tune c172 --washout unrestricted --tune tilt.gain_per_s=0.2:5 --budget 50 --out tuned",
     ),
+    "track": (
+        "washbench track c172/roll --out track-roll",
+        "washbench track c172/pitch --out track-pitch --washout large-angle --washout unrestricted --runs 3",
+        "washbench track my_task.yaml --out t --variant half=small-angle,scale.angular_velocity=0.5",
+    ),
     "examples": (
         "washbench examples my-study",
         "washbench examples . && washbench validate manoeuvres/c172/*.yaml",

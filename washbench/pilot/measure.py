@@ -83,7 +83,8 @@ class Calibration:
         )  # fmt: skip
 
 
-def _signals(r: RunSignals) -> dict[str, np.ndarray]:
+def signals_of(r: RunSignals) -> dict[str, np.ndarray]:
+    """A run's signals as :func:`washbench.pilot.identify.identify` takes them."""
     return {"error": r.error_rad, "control": r.control, "attitude": r.attitude_rad, "disturbance": r.disturbance,
             "aircraft_rate": r.aircraft_rate_radps, "head_rate": r.head_rate_radps}  # fmt: skip
 
@@ -112,7 +113,7 @@ def calibrate(task: Task, manoeuvre: Manoeuvre, params: MultimodalParams, vestib
     silent = Multisine(target.multiples, np.zeros_like(target.amplitudes), target.phases_rad, task.measurement_s)
     run = _checked(fly_run(task, probe_manoeuvre(task), Condition(AIRCRAFT), None, silent, probe, vestibular),
                    task, AIRCRAFT, "the calibration probe")  # fmt: skip
-    found = identify([_signals(run)], task.window_steps, w_b, kt, kd)
+    found = identify([signals_of(run)], task.window_steps, w_b, kt, kd)
     plant = Measured(*found.plant())
     calib = Calibration(target, unit.scaled(1.0 / np.abs(plant(unit.frequencies_radps))), plant)
     adapted = adapt(params, calib.setting(task, Constant(1.0), vestibular), settings)[0]
@@ -121,7 +122,7 @@ def calibrate(task: Task, manoeuvre: Manoeuvre, params: MultimodalParams, vestib
         ctx = PilotContext(dt_s=task.dt_s, axis=task.axis, steps=task.steps, seed=run_seed(task, 0))
         run = _checked(fly_run(task, manoeuvre, Condition(AIRCRAFT), MultimodalPilot(pilot, ctx), target,
                                calib.disturbance, vestibular), task, AIRCRAFT, "the calibration run")  # fmt: skip
-        found = identify([_signals(run)], task.window_steps, w_b, kt, kd)
+        found = identify([signals_of(run)], task.window_steps, w_b, kt, kd)
         plant = Measured(*found.plant())
         calib = Calibration(target, unit.scaled(1.0 / np.abs(plant(unit.frequencies_radps))), plant)
         adapted = adapt(params, calib.setting(task, Constant(1.0), vestibular), settings)[0]
@@ -213,7 +214,7 @@ def measure_condition(
         described = dict(describe()) if describe is not None else {}
     kt, kd = np.asarray(task.target.multiples), np.asarray(task.disturbance.multiples)
     window = task.window_steps
-    found = identify([_signals(r) for r in runs], window, base_frequency(task.measurement_s), kt, kd)
+    found = identify([signals_of(r) for r in runs], window, base_frequency(task.measurement_s), kt, kd)
 
     def parts(key: str) -> Decomposition:
         return decompose([window_spectrum(getattr(r, key), window) for r in runs], window, kt, kd)

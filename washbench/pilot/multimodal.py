@@ -33,6 +33,9 @@ class _Filter:
     def __init__(self, num: list[float], den: list[float], dt_s: float) -> None:
         from scipy import signal  # deferred: scipy's signal module (a tenth of a second) for a run's set-up only
 
+        if not any(num):  # a channel switched off (gain 0): no state, no output
+            self.a, self.b, self.c, self.d, self.x, self.n = [], [], [], 0.0, [], 0
+            return
         a, b, c, d, _ = signal.cont2discrete(signal.tf2ss(num, den), dt_s, method="foh")
         self.a = [[float(v) for v in row] for row in np.atleast_2d(a)]
         self.b = [float(v) for v in np.asarray(b).reshape(-1)]

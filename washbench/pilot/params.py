@@ -33,10 +33,11 @@ Gain = Annotated[float, Field(ge=0.0, le=1.0e3)]
 Delay = Annotated[float, Field(ge=0.0, le=1.0)]
 TimeConstant = Annotated[float, Field(ge=0.0, le=10.0)]
 
-#: Vestibular (roll- or pitch-rate) perception noise, rad^2/s: calibrated once so that the adapted model at full
-#: motion on the bundled c172p roll task has K_m / K_v = 0.10 s, the middle of the 0.05-0.12 s Pool et al. (2016)
-#: identified (docs/pilot-model.md, "Calibration"); kept fixed for every condition, task and aircraft.
-CALIBRATED_VESTIBULAR_NOISE = 2.0e-4
+#: Vestibular (roll- or pitch-rate) perception noise, rad^2/s: calibrated once (tools/calibrate_pilot_noise.py) so
+#: that the model adapted to the aircraft's own motion on the bundled c172p roll task has K_m / K_v = 0.10 s, within
+#: the 0.05-0.12 s Pool et al. (2016) identified (docs/pilot-model.md, "Calibration"); kept fixed for every
+#: condition, task and aircraft.
+CALIBRATED_VESTIBULAR_NOISE = 8.1e-5
 #: Visual (displayed-error) perception noise, rad^2 s: chosen, the optimal-control model's observation noise of
 #: -20 dB (rho = 0.01 pi) for a 0.5 deg RMS error: 0.01 pi (0.5 pi / 180)^2 = 2.4e-6.
 VISUAL_NOISE = 2.4e-6
