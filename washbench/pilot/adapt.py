@@ -13,12 +13,13 @@ with the perception noises of :mod:`washbench.pilot.params` (they keep ``K_m`` f
 product ``K_m H_mf`` matters), the delays as the discrete model realises them, over stable closed loops only
 (Nyquist's criterion). The delays and the neuromuscular dynamics keep their published values: pilots adapt gain and
 equalisation to motion, the cited compilation found (Pool et al. 2011), while their delays are limits of
-perception. Minimised with Nelder-Mead from a fixed set of starting points: deterministic.
+perception. Minimised from a coarse grid (100 points) with Nelder-Mead from its two best: deterministic.
 """
 
 from __future__ import annotations
 
 import functools
+import itertools
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -60,7 +61,7 @@ class LoopSetting:
         out = {}
         for name, w in (
             ("stability", _STABILITY_GRID),
-            ("noise", fq.noise_grid(self.dt_s, 600)),
+            ("noise", fq.noise_grid(self.dt_s, 400)),
             ("target", np.asarray(self.w_target)),
             ("disturbance", np.asarray(self.w_disturbance)),
         ):
@@ -99,7 +100,7 @@ class Prediction:
         return self.control_target + self.control_disturbance + self.control_remnant
 
 
-_STABILITY_GRID = np.geomspace(1e-3, 1e3, 4000)
+_STABILITY_GRID = np.geomspace(1e-3, 1e3, 2000)
 _UPPER = {"visual_gain": 1.0e3, "lead_s": 10.0, "vestibular_gain": 1.0e3}
 """The adapted parameters' upper bounds (:class:`washbench.pilot.params.MultimodalParams`)."""
 _UNSTABLE = 1e6
@@ -162,9 +163,13 @@ def adapt(p: MultimodalParams, s: LoopSetting, settings: AdaptParams) -> tuple[M
     def cost(x: np.ndarray) -> float:
         return predict(params(x), s, w).cost
 
+    # a coarse grid first (the criterion can have a local minimum at K_m = 0 beside a better one), then
+    # Nelder-Mead from the two best points of it
+    grid = list(itertools.product(*(_GRID[n] for n in names)))
+    values = np.array([cost(np.array(g) / scale) for g in grid])
     best = None
-    for start in _starts(len(names)):
-        r = minimize(cost, start, method="Nelder-Mead",
+    for i in np.argsort(values, kind="stable")[:2]:
+        r = minimize(cost, np.array(grid[i]) / scale + 1e-3, method="Nelder-Mead",
                      options={"xatol": 1e-4, "fatol": 1e-12, "maxiter": 600 * len(names)})  # fmt: skip
         if best is None or r.fun < best.fun:
             best = r
@@ -172,9 +177,12 @@ def adapt(p: MultimodalParams, s: LoopSetting, settings: AdaptParams) -> tuple[M
     return chosen, predict(chosen, s, w)
 
 
-def _starts(n: int) -> list[np.ndarray]:
-    """Starting points (multiples of the parameters given): the given set, and each halved and doubled."""
-    return [np.ones(n), np.full(n, 0.5), np.full(n, 2.0)]
+_GRID = {
+    "visual_gain": (0.5, 1.0, 2.0, 4.0, 8.0),
+    "lead_s": (0.0, 0.1, 0.2, 0.4, 0.8),
+    "vestibular_gain": (0.0, 0.1, 0.3, 0.9),
+}
+"""The coarse grid the adaptation starts from (control units per rad, s, control units per rad/s): 100 points."""
 
 
 def canal_response(canals: object) -> Response:

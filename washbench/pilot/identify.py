@@ -11,9 +11,9 @@ identically, the remnant does not). At the disturbance's frequencies (``n`` in i
     H_mf(w)    = W_sim / W_ac            the motion filter: the simulator over the aircraft pilot's rate
 
 and the crossover frequencies and phase margins of the two open loops (:func:`washbench.pilot.frequency.
-crossover`). Variances (Parseval over the window, each run's then the mean) are split into what lies at the
-target's frequencies, at the disturbance's, and the rest (the remnant): ``var = (2 / N^2) sum_{n=1}^{N/2-1} |X[n]|^2
-(+ the Nyquist bin)``.
+crossover`). Variances (Parseval over the window: ``var = (2 / N^2) sum_{n=1}^{N/2-1} |X[n]|^2`` plus the Nyquist
+bin once, the mean over the runs) are split into what lies at the target's frequencies and at the disturbance's
+(the power of the averaged coefficients there) and the rest, the remnant.
 """
 
 from __future__ import annotations
@@ -47,18 +47,22 @@ class Decomposition:
 
 def decompose(spectra: Sequence[np.ndarray], window: int, target: np.ndarray, disturbance: np.ndarray) -> Decomposition:
     """:class:`Decomposition` of runs' window spectra (:func:`window_spectrum`); ``target`` and ``disturbance``:
-    the bins (the multiples)."""
-    parts = []
-    for spec in spectra:
-        power = np.abs(spec) ** 2 * (2.0 / window**2)
-        power[0] = 0.0  # the mean is not variance
+    the bins (the multiples). The parts at the forcing frequencies are the power of the runs' averaged Fourier
+    coefficients (what repeats from run to run; the remnant's share of those bins averages out), the remnant is
+    the rest of the runs' mean variance."""
+
+    def power(spec: np.ndarray) -> np.ndarray:
+        p = np.abs(spec) ** 2 * (2.0 / window**2)
+        p[0] = 0.0  # the mean is not variance
         if window % 2 == 0:
-            power[-1] /= 2.0  # the Nyquist bin is counted once
-        t = float(power[target].sum())
-        d = float(power[disturbance].sum())
-        parts.append((t, d, float(power.sum()) - t - d))
-    t, d, r = np.mean(np.array(parts), axis=0)
-    return Decomposition(float(t), float(d), float(r))
+            p[-1] /= 2.0  # the Nyquist bin is counted once
+        return p
+
+    mean_power = power(np.mean(spectra, axis=0))
+    total = float(np.mean([power(s).sum() for s in spectra]))
+    t = float(mean_power[target].sum())
+    d = float(mean_power[disturbance].sum())
+    return Decomposition(t, d, total - t - d)
 
 
 @dataclass(frozen=True)
