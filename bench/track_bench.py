@@ -45,9 +45,9 @@ def main() -> None:
     from washbench.pilot.compare import measures
     from washbench.pilot.loop import AIRCRAFT, Condition
     from washbench.pilot.params import MultimodalParams
+    from washbench.pilot.senses import DEFAULT_VESTIBULAR
     from washbench.pilot.task import load_task
     from washbench.runs.options import load_options
-    from washbench.runs.track import DEFAULT_VESTIBULAR
 
     options = load_options(washouts=[args.washout])
     vestibular = model_params(DEFAULT_VESTIBULAR)

@@ -211,3 +211,19 @@ def test_fly_command_hook_sees_each_sample_and_sends_what_it_returns(tmp_path: P
     phi = np.radians(result.columns["phi_deg"][: n - 1])
     assert np.allclose([s[1] for s in seen], phi, rtol=0, atol=1e-12)
     assert np.allclose(result.columns["aileron"][: n - 1], 0.01 * np.sin(0.01 * np.arange(n - 1)), atol=0)
+
+
+def test_sweep_takes_the_pilot_model_as_an_objective(tracked: tuple[Path, Path], tmp_path: Path) -> None:
+    """``sweep --pilot TASK``: the pilot model's predicted measures for every grid point (sweep_pilot.csv): less
+    roll motion, farther from flight, and the full-motion candidate within a few percent of the aircraft."""
+    task, _ = tracked
+    out = tmp_path / "sweep"
+    done = washbench("sweep", "c172/elevator_doublet", "--set", "scale.angular_velocity=0.25,1", "--washout",
+                     "unrestricted", "--pilot", task, "--out", out, "--quiet", timeout=300)  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    rows = list(csv.DictReader(io_text(out / "sweep_pilot.csv")))
+    assert [float(r["scale.angular_velocity"]) for r in rows] == [0.25, 1.0]
+    far, near = (float(r["distance_pct"]) for r in rows)
+    assert far > near
+    assert float(rows[1]["motion_gain_1radps"]) > 3.0 * float(rows[0]["motion_gain_1radps"])
+    assert float(rows[1]["vestibular_gain"]) > float(rows[0]["vestibular_gain"])

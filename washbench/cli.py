@@ -90,6 +90,8 @@ def _study_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--dask", metavar="ADDRESS", help="send the work to this Dask scheduler (washbench[cluster])")
     p.add_argument("--quiet", action="store_true", help="no progress display")
     _aircraft_dir_option(p)
+    p.add_argument("--pilot", type=Path, metavar="TASK",
+                   help="the pilot model's measures on this tracking task too (docs/pilot-model.md)")  # fmt: skip
 
 
 class _Parser(argparse.ArgumentParser):
@@ -265,6 +267,8 @@ def build_parser() -> argparse.ArgumentParser:
         help="penalty per unit fraction of time at a platform limit (default 1)",
     )
     p.add_argument("--out", type=_out_path, required=True, help="output folder (tuned.yaml, tune.csv, report.md)")
+    p.add_argument("--pilot-weight", type=float, default=1.0,
+                   help="with --pilot: weight of the pilot's distance from flight (%%/100) (default 1)")  # fmt: skip
     _study_options(p)
     _track_parser(sub)
     p = sub.add_parser("examples", help="copy the bundled manoeuvres, pilot profiles, parameter and platform files "
@@ -565,6 +569,7 @@ def _study(args: argparse.Namespace) -> int:
         dask=args.dask,
         progress=not args.quiet,
         aircraft_dirs=args.aircraft_dir,
+        pilot=resolve_task(args.pilot) if args.pilot is not None else None,
     )
     if args.command == "sweep":
         from washbench.runs.sweep import sweep_command  # deferred: numba
@@ -583,6 +588,7 @@ def _study(args: argparse.Namespace) -> int:
         budget=args.budget,
         seed=args.seed,
         saturation_weight=args.saturation_weight,
+        pilot_weight=args.pilot_weight,
         **common,
     )
 

@@ -1,5 +1,5 @@
 """The conditions side by side: each condition's measures, their differences from the aircraft's own motion, the
-distance that ranks the washouts and the verdict (pure functions over :class:`washbench.pilot.measure.
+distance that ranks the washouts and the verdict (functions over :class:`washbench.pilot.measure.
 ConditionResult`).
 
 Measures (docs/pilot-model.md, "Measures"), each the mean over the runs where it is measured per run:
@@ -15,7 +15,8 @@ Measures (docs/pilot-model.md, "Measures"), each the mean over the runs where it
 Distance from flight: ``D = 100 sqrt(mean_m ln(x_m / x_m,aircraft)^2)`` over the six measures of
 :data:`DISTANCE_MEASURES` (the issue's performance and control-behaviour measures), in percent for small
 differences; 0 for the aircraft's own motion. The verdict names the washout of least D, and checks the bracket:
-a washout is expected between the aircraft's own motion and no motion on every measure.
+a washout is expected between the aircraft's own motion and no motion on every measure, within what the runs
+resolve (:func:`bracketed`).
 """
 
 from __future__ import annotations
@@ -66,6 +67,13 @@ def measures(result: ConditionResult, task: Task) -> dict[str, float]:
     per_run = [identify([signals_of(r)], task.window_steps, base_frequency(task.measurement_s),
                         np.asarray(task.target.multiples), np.asarray(task.disturbance.multiples))
                for r in result.runs]  # fmt: skip
+    window = task.window_steps
+    per_run_var = {
+        "error_var_deg2": [float(np.var(r.error_rad[-window:])) * _DEG2 for r in result.runs],
+        "control_var": [float(np.var(r.control[-window:])) for r in result.runs],
+    }
+    for key, values in per_run_var.items():
+        out[f"{key}_sd"] = float(np.std(values, ddof=1)) if len(values) > 1 else math.nan
     for key, get in (
         ("target_crossover_radps", lambda i: i.target_crossover.frequency_radps),
         ("target_phase_margin_deg", lambda i: i.target_crossover.phase_margin_deg),
@@ -111,20 +119,23 @@ def distance(m: Mapping[str, float], reference: Mapping[str, float]) -> float:
     return 100.0 * math.sqrt(sum(terms) / len(terms))
 
 
-def bracketed(m: Mapping[str, float], aircraft: Mapping[str, float], none: Mapping[str, float],
+def bracketed(m: Mapping[str, float], aircraft: Mapping[str, float], none: Mapping[str, float], runs: int,
               slack: float = 0.05) -> dict[str, bool]:  # fmt: skip
-    """Per distance measure: whether ``m`` lies between the aircraft's own motion and no motion (with ``slack``, a
-    fraction of their gap, on either side)."""
+    """Per distance measure: whether ``m`` lies between the aircraft's own motion and no motion, beyond what the
+    runs resolve: with ``slack`` (a fraction of their gap) or two standard errors of the measure over ``runs``
+    single runs (``<measure>_sd``), whichever is larger, on either side."""
     out = {}
     for key in DISTANCE_MEASURES:
         a, n, v = aircraft.get(key, math.nan), none.get(key, math.nan), m.get(key, math.nan)
         lo, hi = min(a, n), max(a, n)
-        pad = slack * (hi - lo)
+        sd = m.get(f"{key}_sd", math.nan)
+        noise = 2.0 * sd / math.sqrt(runs) if math.isfinite(sd) and runs > 0 else 0.0
+        pad = max(slack * (hi - lo), noise)
         out[key] = bool(lo - pad <= v <= hi + pad)
     return out
 
 
-def verdict(table: Mapping[str, Mapping[str, float]], washouts: Sequence[str]) -> dict[str, Any]:
+def verdict(table: Mapping[str, Mapping[str, float]], washouts: Sequence[str], runs: int = 1) -> dict[str, Any]:
     """The verdict over a table ``condition -> measures`` (with :data:`AIRCRAFT` and, if flown, :data:`NO_MOTION`):
     the washouts ordered by their distance from flight, the closest, no motion's distance."""
     ref = table[AIRCRAFT]
@@ -133,5 +144,5 @@ def verdict(table: Mapping[str, Mapping[str, float]], washouts: Sequence[str]) -
     out: dict[str, Any] = {"order": order, "distance_pct": dist, "closest": order[0] if order else None}
     if NO_MOTION in table:
         out["no_motion_distance_pct"] = distance(table[NO_MOTION], ref)
-        out["bracketed"] = {w: bracketed(table[w], ref, table[NO_MOTION]) for w in washouts}
+        out["bracketed"] = {w: bracketed(table[w], ref, table[NO_MOTION], runs) for w in washouts}
     return out

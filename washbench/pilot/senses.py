@@ -17,6 +17,11 @@ import math
 from washbench.perception.thresholds import STANDARD_GRAVITY_MPS2
 from washbench.perception.vestibular import DiscreteModel, VestibularParams, canal_model, otolith_model
 
+DEFAULT_VESTIBULAR = "telban-cardullo"
+"""The vestibular models the pilot model feels with unless told (docs/pilot-model.md, "Perception": the project's
+canal model with a lead, as the multimodal pilot-model literature's; the Young-Oman canals have none and the
+vestibular channel then gains almost nothing over the visual one)."""
+
 SENSED = {"roll": (0, 1), "pitch": (1, 2)}
 """Task axis -> (the angular velocity's body axis, the specific force's body axis): roll: x and y; pitch: y and z."""
 

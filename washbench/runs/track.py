@@ -52,16 +52,12 @@ from washbench.pilot.loop import AIRCRAFT, NO_MOTION, Condition
 from washbench.pilot.measure import ConditionResult, calibrate, measure_condition, motion_filter
 from washbench.pilot.params import MultimodalParams
 from washbench.pilot.plugins import load_pilot_plugin
+from washbench.pilot.senses import DEFAULT_VESTIBULAR
 from washbench.pilot.task import Task, load_task, pilot_params
 from washbench.review.track_report import write_track_report
 from washbench.runs.bound_stage import split_whole
 from washbench.runs.options import RunOptions
 from washbench.runs.outputs import DEFAULT_OUTPUTS, Outputs
-
-DEFAULT_VESTIBULAR = "telban-cardullo"
-"""The vestibular models ``track`` uses unless told (docs/pilot-model.md, "Perception": the canal model with a
-lead, as the multimodal pilot-model literature's; the Young-Oman canals have none and the vestibular channel then
-gains almost nothing over the visual one)."""
 
 
 @dataclass(frozen=True)
@@ -209,6 +205,7 @@ def _summary(
                 }
         rows.append(entry)
     washouts = [c.name for c in conds if c.kind == "washout" and c.name in table]
+    no_verdict = {"order": [], "distance_pct": {}, "closest": None}
     w, h = calib.plant.w, calib.plant.h
     summary = {
         "task": {
@@ -223,7 +220,7 @@ def _summary(
             "adaptation": task.adaptation.model_dump(mode="json"),
         },
         "conditions": rows,
-        "verdict": verdict(table, washouts) if washouts else {"order": [], "distance_pct": {}, "closest": None},
+        "verdict": verdict(table, washouts, task.runs) if washouts else no_verdict,
         "calibration": {
             "frequencies_radps": list(w), "gain": list(np.abs(h)),
             "phase_deg": list(np.degrees(np.unwrap(np.angle(h)))),
