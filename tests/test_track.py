@@ -227,3 +227,32 @@ def test_sweep_takes_the_pilot_model_as_an_objective(tracked: tuple[Path, Path],
     assert far > near
     assert float(rows[1]["motion_gain_1radps"]) > 3.0 * float(rows[0]["motion_gain_1radps"])
     assert float(rows[1]["vestibular_gain"]) > float(rows[0]["vestibular_gain"])
+
+
+def test_the_docs_pilot_plugin_flies_and_a_broken_one_is_one_line(tracked: tuple[Path, Path], tmp_path: Path) -> None:
+    """--pilot-plugin: the example of docs/pilot-model.md flies the task in every condition (its parameters from
+    the task file's pilot: section, its contributions reported); a plugin that raises is one line naming it."""
+    import re
+
+    task, _ = tracked
+    page = (Path(__file__).resolve().parents[1] / "docs" / "pilot-model.md").read_text()
+    section = page[page.index("## 10. Your own pilot model"):]
+    code = re.search(r"```python\n(.*?)```", section, flags=re.S).group(1)  # type: ignore[union-attr]
+    (tmp_path / "my_pilot.py").write_text(code)
+    mine = tmp_path / "task.yaml"
+    mine.write_text(task.read_text() + "pilot: {gain: 1.2}\n")
+    out = tmp_path / "out"
+    done = washbench("track", mine, "--out", out, "--washout", "small-angle", "--runs", "1", "--no-figures",
+                     "--no-recording", "--quiet", "--pilot-plugin", f"{tmp_path / 'my_pilot.py'}:ProportionalPilot",
+                     timeout=300)  # fmt: skip
+    assert done.returncode in (0, 1), done.stderr  # a proportional pilot without delay may lose a condition
+    summary = json.loads((out / "track.json").read_text())
+    assert summary["pilot"]["model"] == "plugin" and summary["pilot"]["plugin"]["sha256"]
+    ac = next(c for c in summary["conditions"] if c["name"] == "aircraft")
+    assert ac["ok"] and ac["measures"]["visual_gain"] == 1.2 and ac["measures"]["control_vestibular_var"] == 0.0
+    bad = "class Bad:\n    def __init__(self, params, context):\n        raise ValueError('no')\n"
+    (tmp_path / "bad.py").write_text(bad)
+    done = washbench("track", task, "--out", tmp_path / "bad", "--runs", "1", "--quiet", "--pilot-plugin",
+                     f"{tmp_path / 'bad.py'}:Bad", timeout=300)  # fmt: skip
+    assert done.returncode == 2
+    assert len(done.stderr.strip().splitlines()) == 1 and "pilot plugin" in done.stderr and "ValueError" in done.stderr

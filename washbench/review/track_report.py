@@ -78,10 +78,11 @@ def verdict_lines(summary: Mapping[str, Any]) -> list[str]:
         outside = {w: [k for k, ok in b.items() if not ok] for w, b in bracket.items()}
         outside = {w: ks for w, ks in outside.items() if ks}
         if bracket and not outside:
-            lines.append("Every washout lies between no motion and the aircraft's own motion on every measure.")
+            lines.append("Every washout lies between no motion and the aircraft's own motion on every measure (within "
+                         "what the runs resolve).")  # fmt: skip
         elif outside:
             lines.append(
-                "Outside the bracket of no motion and the aircraft's own motion: "
+                "Outside the bracket of no motion and the aircraft's own motion, beyond what the runs resolve: "
                 + "; ".join(f"{w} ({', '.join(MEASURE_LABELS.get(k, k) for k in ks)})" for w, ks in outside.items())
                 + "."
             )
@@ -105,6 +106,7 @@ def verdict_lines(summary: Mapping[str, Any]) -> list[str]:
 
 def track_report(summary: Mapping[str, Any], figures: Mapping[str, str] | None = None) -> str:
     """The report's Markdown (``figures``: name -> path relative to the report, as written)."""
+    summary = _numbers(summary)
     task = summary["task"]
     title = f"{task['aircraft']} / {task['name']} ({task['axis']})"
     out = [f"# Pilot in the loop: {title}", ""]
@@ -220,6 +222,32 @@ def track_report(summary: Mapping[str, Any], figures: Mapping[str, str] | None =
     return "\n".join(out).rstrip() + "\n"
 
 
+def _nan(x: Any) -> Any:
+    """JSON's null (a NaN or infinity when written) back to NaN, through dicts and lists."""
+    if x is None:
+        return math.nan
+    if isinstance(x, dict):
+        return {k: _nan(v) for k, v in x.items()}
+    if isinstance(x, list):
+        return [_nan(v) for v in x]
+    return x
+
+
+def _numbers(summary: Mapping[str, Any]) -> dict[str, Any]:
+    """``summary`` with the nulls of its numbers (measures, differences, distances, predictions) as NaN."""
+    out = dict(summary)
+    out["conditions"] = [
+        {**c, **{k: _nan(c[k]) for k in ("measures", "differences_pct", "distance_pct", "prediction") if k in c}}
+        for c in summary["conditions"]
+    ]
+    v = dict(summary.get("verdict") or {})
+    for k in ("distance_pct", "no_motion_distance_pct"):
+        if k in v:
+            v[k] = _nan(v[k])
+    out["verdict"] = v
+    return out
+
+
 def write_track_report(folder: Path, figures: bool = True, palette: str = "default") -> Path:
     """Write ``report.md`` (and, with ``figures``, the figures) of a track result folder from its ``track.json``
     and ``frf.csv``: what ``washbench track`` writes and ``washbench report DIR`` writes again."""
@@ -228,6 +256,7 @@ def write_track_report(folder: Path, figures: bool = True, palette: str = "defau
         frf = (folder / TRACK_FRF_FILE).read_text(encoding="utf-8")
     except (OSError, ValueError) as exc:
         raise WashbenchError(located(folder, f"not a readable washbench track result ({exc})")) from None
+    summary = _numbers(summary)
     drawn: dict[str, str] = {}
     if figures:
         task = summary["task"]
