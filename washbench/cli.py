@@ -308,7 +308,7 @@ def _track_parser(sub: Any) -> None:
     _aircraft_dir_option(p)
     p.add_argument("--quiet", action="store_true", help="no progress lines")
     _output_options(p)
-    p.set_defaults(rank_by=None)
+    p.set_defaults(rank_by=None, thresholds=None)  # the run options track does not take (the ranking's)
 
 
 def _track(args: argparse.Namespace) -> int:
