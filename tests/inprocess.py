@@ -42,7 +42,7 @@ IN_PROCESS = frozenset({"cue", "fly", "run", "report", "validate", "schema", "si
 #: of processes).
 STUDIES = frozenset({"sweep", "tune"})
 #: Options that load code into the process or make it serve: such a command runs as a subprocess.
-SUBPROCESS_OPTIONS = ("--washout-plugin", "--platform-plugin", "--pilot-plugin", "--jobs", "--dask")
+SUBPROCESS_OPTIONS = ("--washout-plugin", "--platform-plugin", "--jobs", "--dask")
 
 
 def in_process(args: list[str]) -> bool:

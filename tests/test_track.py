@@ -13,8 +13,11 @@ import pyarrow.parquet as pq
 import pytest
 
 from tests.inprocess import washbench
+from washbench.errors import WashbenchError
 from washbench.flight.fly import fly
 from washbench.flight.manoeuvre import load_manoeuvre
+from washbench.pilot.model import PilotContext
+from washbench.pilot.plugins import load_pilot_plugin
 from washbench.review.rrd_read import read_properties, read_scalar_series, read_text_documents
 
 SHORT_TASK = """\
@@ -114,6 +117,8 @@ def test_signals_and_recording_hold_the_runs(tracked: tuple[Path, Path]) -> None
     assert values.shape == (n, 3)
     assert np.array_equal(values[:, 0], error_deg)
     assert t[1] - t[0] == pytest.approx(0.01)
+    _, tilt = series["/track/platform"]  # the one washout's cockpit, rolling with the aircraft
+    assert tilt.shape == (n,) and 0.1 < np.max(np.abs(tilt)) < 20.0
     assert read_text_documents(out / "recording.rrd")["/report"].startswith("# Pilot in the loop")
     assert "task.sha256" in read_properties(out / "recording.rrd")
     # the commanded aileron is the trim plus the pilot's control plus the disturbance: the control moves
@@ -252,7 +257,7 @@ def test_the_docs_pilot_plugin_flies_and_a_broken_one_is_one_line(tracked: tuple
     assert ac["ok"] and ac["measures"]["visual_gain"] == 1.2 and ac["measures"]["control_vestibular_var"] == 0.0
     bad = "class Bad:\n    def __init__(self, params, context):\n        raise ValueError('no')\n"
     (tmp_path / "bad.py").write_text(bad)
-    done = washbench("track", task, "--out", tmp_path / "bad", "--runs", "1", "--quiet", "--pilot-plugin",
-                     f"{tmp_path / 'bad.py'}:Bad", timeout=300)  # fmt: skip
-    assert done.returncode == 2
-    assert len(done.stderr.strip().splitlines()) == 1 and "pilot plugin" in done.stderr and "ValueError" in done.stderr
+    plugin = load_pilot_plugin(f"{tmp_path / 'bad.py'}:Bad")
+    with pytest.raises(WashbenchError) as err:
+        plugin.make(None, PilotContext(dt_s=0.01, axis="roll", steps=10, seed=0))
+    assert str(err.value) == f"pilot plugin {tmp_path / 'bad.py'}:Bad: raised ValueError: no"

@@ -86,6 +86,7 @@ class RunSignals:
     felt_rate_radps: np.ndarray
     felt_force_mps2: np.ndarray
     flight: FlightResult
+    axis: str = "roll"
     saturated_steps: int = 0
     platform: np.ndarray | None = field(default=None, repr=False)
 
@@ -208,6 +209,6 @@ def fly_run(
         t_s=t, target_rad=np.array(ft), disturbance=np.array(fd), error_rad=out["e"], control=out["u"],
         control_visual=out["uv"], control_vestibular=out["um"], attitude_rad=out["att"],
         aircraft_rate_radps=out["ac_rate"], head_rate_radps=out["head_rate"], head_force_mps2=out["head_force"],
-        felt_rate_radps=out["felt_rate"], felt_force_mps2=out["felt_force"], flight=flight,
+        felt_rate_radps=out["felt_rate"], felt_force_mps2=out["felt_force"], flight=flight, axis=axis,
         saturated_steps=saturated[0], platform=None if rows is None else rows[:n],
     )  # fmt: skip

@@ -11,6 +11,7 @@ condition, in the order flown (the aircraft's own motion first)::
     /track/vestibular    its vestibular part
     /track/felt_rate     what the canals report of the simulator pilot's rate about the task's axis (deg/s)
     /track/head_rate     the simulator pilot's rate about the task's axis (deg/s)
+    /track/platform      the cockpit's tilt on the task's axis, each washout on its platform (deg)
     /report              report.md as a Markdown document
 
 with a blueprint of one time-series panel per entity. Every sample of the run is logged (float64, as the
@@ -29,6 +30,7 @@ import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
 
+from washbench.cueing.kernel import O_Q
 from washbench.errors import WashbenchError, located
 from washbench.io.atomic import atomic_path
 from washbench.pilot.measure import ConditionResult
@@ -47,6 +49,14 @@ PANELS: tuple[tuple[str, str, str, float], ...] = (
     ("head_rate", "simulator pilot's rate (deg/s)", "head_rate_radps", _DEG),
 )
 """(entity under /track, panel title, RunSignals attribute, factor to the unit shown)."""
+
+
+def _tilt_deg(q: np.ndarray, axis: str) -> np.ndarray:
+    """The roll (or pitch) angle of body->inertial quaternions (N, 4), scalar first, ZYX Euler angles, deg."""
+    w, x, y, z = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
+    if axis == "pitch":
+        return np.degrees(np.arcsin(np.clip(2.0 * (w * y - z * x), -1.0, 1.0)))
+    return np.degrees(np.arctan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y)))
 
 
 def _time(t_s: np.ndarray) -> rr.TimeColumn:
@@ -72,6 +82,11 @@ def write_track_recording(path: Path, results: Sequence[ConditionResult], title:
         sources = flown[:1] if entity == "target" else flown
         values = np.column_stack([getattr(r.runs[0], attr)[:n] * factor for r in sources])
         views.append((f"/track/{entity}", name, sources, values))
+    moved = [r for r in flown if r.runs[0].platform is not None]
+    if moved:  # the cockpit's tilt on the task's axis, each washout on its platform
+        axis = flown[0].runs[0].axis
+        values = np.column_stack([_tilt_deg(r.runs[0].platform[:n, O_Q : O_Q + 4], axis) for r in moved])
+        views.append(("/track/platform", "cockpit tilt on the task's axis (deg)", moved, values))
     blueprint = rrb.Blueprint(
         rrb.Horizontal(
             rrb.Vertical(*[rrb.TimeSeriesView(origin=p, name=name) for p, name, _, _ in views[:4]]),
