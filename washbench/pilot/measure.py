@@ -1,11 +1,12 @@
 """The standard measurement: the loop calibrated once per task, then each condition adapted, flown and measured.
 
 1. :func:`calibrate`: the controlled element (attitude per unit control, at every forcing frequency) measured in
-   closed loop in the aircraft's own motion, noise off, in two passes: the first with the disturbance scaled by an
-   integrator of unit gain, the second with it scaled by the first pass's measurement, so that in every run the
+   closed loop in the aircraft's own motion, noise off, in two steps: a probe, the scripted pilot holding the
+   task's axis with both sets of sines added to its command (:data:`PROBE_SCALE` of the task's amplitudes through
+   an integrator of unit gain: safe on any aircraft), then :data:`CALIBRATION_PASSES` run(s) of the loop the pilot
+   model flies, adapted to what the probe measured, with the disturbance scaled by it, so that in every run the
    disturbance moves the attitude by the task's ``rms_deg`` (its amplitudes ``A_k / |H_c(j w_k)|``, as the
-   cited designs insert their disturbance before the controlled element). The pilot of the second pass is the one
-   adapted to the first pass's measurement.
+   cited designs insert their disturbance before the controlled element).
 2. :func:`motion_filter`: a washout's describing function on the task's axis (simulator over aircraft pilot's
    rate at each forcing frequency), from the aircraft condition's recorded head motion cued through the washout
    and its platform (the same compiled washouts as in the loop, whole-trace form).
@@ -105,7 +106,7 @@ def calibrate(task: Task, manoeuvre: Manoeuvre, params: MultimodalParams, vestib
     w_b = base_frequency(task.measurement_s)
     kt, kd = np.asarray(task.target.multiples), np.asarray(task.disturbance.multiples)
     # the probe: the scripted pilot holds the axis, both sets of sines on its command through 1/(j w) (an
-    # integrator of unit gain), a tenth of the task's amplitude
+    # integrator of unit gain), PROBE_SCALE of the task's amplitude
     probe = Multisine(np.concatenate([target.multiples, unit.multiples]),
                       np.concatenate([target.amplitudes, unit.amplitudes]) * PROBE_SCALE,
                       np.concatenate([target.phases_rad, unit.phases_rad]), task.measurement_s)  # fmt: skip

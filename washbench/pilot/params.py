@@ -80,8 +80,9 @@ class AdaptParams(StrictModel):
     rule: Literal["optimal", "none"] = "optimal"
     """optimal: minimise J = var(e) + control_weight var(u_eq) over the adapted parameters; none: fly as given."""
     control_weight_s2: Annotated[float, Field(ge=0.0, le=100.0)] = 0.01
-    """w_u: weight of the control effort, s^2 (u_eq: the control as the attitude acceleration it asks, rad/s^2,
-    so J is in rad^2 whatever the aircraft's control power). Chosen (docs/pilot-model.md shows its effect)."""
+    """w_u: weight of the control effort, s^2 (u_eq = |j H_c(j 1)| u: the control as the attitude rate it asks at
+    1 rad/s, rad/s, so J is in rad^2 whatever the aircraft's control power). Chosen (docs/pilot-model.md shows its
+    effect)."""
     adapt: tuple[Literal["visual_gain", "lead_s", "vestibular_gain"], ...] = ADAPTABLE
     """Which parameters adapt (the others keep the values given)."""
 
