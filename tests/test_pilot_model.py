@@ -35,22 +35,24 @@ def _steady_response(model: MultimodalPilot, x: np.ndarray, channel: str) -> np.
 
 
 @pytest.mark.parametrize("k", [7, 26, 223])  # 0.54, 2.0, 17.1 rad/s in a window of 8192 samples
-@pytest.mark.parametrize("channel", ["visual", "vestibular"])
-def test_discrete_channels_follow_their_continuous_transfer_functions(k: int, channel: str) -> None:
-    """A sine through each channel, in steady state, against H_nms H_v (resp. -H_nms H_m) with the realised delay.
-    A first-order hold of a sampled sine attenuates it by sinc^2(w dt / 2) ~ 1 - (w dt)^2 / 12: that is the whole
-    tolerance on the magnitude (0.25 % at 17 rad/s); the phase agrees to 0.01 deg."""
+@pytest.mark.parametrize(("channel", "lag_s"), [("visual", 0.0), ("visual", 0.5), ("vestibular", 0.0)])
+def test_discrete_channels_follow_their_continuous_transfer_functions(k: int, channel: str, lag_s: float) -> None:
+    """A sine through each channel, in steady state, against H_nms H_v (resp. -H_nms H_m) with the realised delay
+    (the visual channel also with a lag T_I). A first-order hold of a sampled sine attenuates it by
+    sinc^2(w dt / 2) ~ 1 - (w dt)^2 / 12: that is the whole tolerance on the magnitude (0.25 % at 17 rad/s); the
+    phase agrees to 0.01 deg."""
     n = 8192
     w = 2.0 * math.pi * k / (n * DT)
-    model = MultimodalPilot(QUIET, PilotContext(dt_s=DT, axis="roll", steps=2 * n, seed=0, motion_lag_samples=1))
+    p = QUIET.model_copy(update={"lag_s": lag_s})
+    model = MultimodalPilot(p, PilotContext(dt_s=DT, axis="roll", steps=2 * n, seed=0, motion_lag_samples=1))
     x = np.sin(w * np.arange(2 * n) * DT)
     y = _steady_response(model, x, channel)
     h = np.fft.rfft(y[n:])[k] / np.fft.rfft(x[n:])[k]
     wv = np.array([w])
     if channel == "visual":
-        ref = fq.nms_frf(wv, QUIET) * fq.visual_frf(wv, QUIET, 0.22)
+        ref = fq.nms_frf(wv, p) * fq.visual_frf(wv, p, 0.22)
     else:  # the vestibular line is shortened by the perceived motion's lag (one sample)
-        ref = -fq.nms_frf(wv, QUIET) * fq.vestibular_frf(wv, QUIET, 0.19 - DT)
+        ref = -fq.nms_frf(wv, p) * fq.vestibular_frf(wv, p, 0.19 - DT)
     foh = (math.sin(w * DT / 2) / (w * DT / 2)) ** 2
     assert abs(abs(h) / abs(ref[0]) - foh) < 2e-4 * max(1.0, w)
     assert abs(math.degrees(np.angle(h / ref[0]))) < 0.01
