@@ -38,7 +38,7 @@ from washbench.errors import WashbenchError
 #: ``washbench/data``: the bundled parameter set (``cw1.yaml``) and platform limits (``atlas.yaml``).
 DATA_DIR = Path(str(files("washbench") / "data"))
 #: Top-level folders of the repository that the wheel ships as ``washbench/data/<name>`` (see ``setup.py``).
-BUNDLED_FOLDERS = ("aircraft", "manoeuvres")
+BUNDLED_FOLDERS = ("aircraft", "manoeuvres", "tasks")
 
 
 def bundled_folder(name: str) -> Path:
@@ -53,6 +53,8 @@ def bundled_folder(name: str) -> Path:
 AIRCRAFT_DIR = bundled_folder("aircraft")
 #: Bundled manoeuvres (``<aircraft>/<name>.yaml``): what ``washbench suite`` runs by default.
 MANOEUVRES_DIR = bundled_folder("manoeuvres")
+#: Bundled tracking tasks (``<aircraft>/<name>.yaml``): what ``washbench track`` flies by name (c172/roll).
+TASKS_DIR = bundled_folder("tasks")
 #: Environment variable with extra aircraft folders, separated by ``os.pathsep``.
 AIRCRAFT_PATH_ENV = "WASHBENCH_AIRCRAFT_PATH"
 #: Files or folders that mark a project root (where the search for ``aircraft/`` next to a manoeuvre stops).
@@ -196,6 +198,16 @@ def resolve_manoeuvre(item: Path) -> Path:
         return item
     for candidate in (MANOEUVRES_DIR / item, MANOEUVRES_DIR / f"{item}.yaml"):
         if candidate.exists():
+            return candidate
+    return item
+
+
+def resolve_task(item: Path) -> Path:
+    """A task argument as given, or, when no such file exists, the bundled one of that name (``c172/roll``)."""
+    if item.exists() or item.is_absolute():
+        return item
+    for candidate in (TASKS_DIR / item, TASKS_DIR / f"{item}.yaml"):
+        if candidate.is_file():
             return candidate
     return item
 
