@@ -32,6 +32,7 @@ from typing import Any
 
 import numpy as np
 
+from washbench.cueing.registry import REFERENCE_KINDS
 from washbench.errors import WashbenchError, printable
 from washbench.io.atomic import atomic_path, write_text_atomic
 from washbench.io.csv_numbers import csv_number
@@ -77,8 +78,12 @@ def _say(text: str, progress: bool) -> None:
 
 def conditions(options: RunOptions) -> list[Condition]:
     """The aircraft's own motion, no motion, then every washout of ``options`` that runs sample by sample (a washout
-    that needs the whole recording, the bound, cannot close a loop: refused)."""
+    that needs the whole recording, the bound, cannot close a loop: refused). The default set's naive references are
+    left out: the aircraft's own motion and no motion are their conditions in the loop (named with ``--washout``,
+    they fly)."""
     stepped, whole = split_whole(list(options.washouts))
+    if options.washout_names is None and not options.variants:
+        stepped = [w for w in stepped if w.kind not in REFERENCE_KINDS]
     if whole:
         raise WashbenchError(f"washout {whole[0].name} needs the whole recording in advance: it cannot fly in the "
                              "loop with a pilot (washbench track)")  # fmt: skip
