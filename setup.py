@@ -1,4 +1,4 @@
-"""Ships the repository's top-level ``aircraft/`` and ``manoeuvres/`` inside the wheel, and compiles the numba
+"""Ships the repository's top-level ``aircraft/``, ``manoeuvres/`` and ``tasks/`` inside the wheel, and compiles the numba
 kernels into it.
 
 - The data folders live beside ``washbench/`` in the source tree (where a user looks for them) and are copied into
@@ -27,7 +27,7 @@ from setuptools import setup
 from setuptools.command.build_py import build_py
 
 #: Top-level folders shipped as ``washbench/data/<name>`` (keep in step with ``washbench.io.paths.BUNDLED_FOLDERS``).
-BUNDLED_FOLDERS = ("aircraft", "manoeuvres")
+BUNDLED_FOLDERS = ("aircraft", "manoeuvres", "tasks")
 
 
 def precompile(package_root: Path) -> None:

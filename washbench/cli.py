@@ -24,7 +24,7 @@ from washbench.errors import Terminated, WashbenchError, printable
 from washbench.io import config as project_config
 from washbench.io import interrupts
 from washbench.io.examples import copy_examples
-from washbench.io.paths import resolve_data_file, resolve_manoeuvre, unknown_manoeuvre
+from washbench.io.paths import resolve_data_file, resolve_manoeuvre, resolve_task, unknown_manoeuvre
 from washbench.live import FORMATS
 from washbench.review.replay import replay_command
 from washbench.runs.outputs import Outputs
@@ -97,6 +97,8 @@ def _study_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--dask", metavar="ADDRESS", help="send the work to this Dask scheduler (washbench[cluster])")
     p.add_argument("--quiet", action="store_true", help="no progress display")
     _aircraft_dir_option(p)
+    p.add_argument("--pilot", type=Path, metavar="TASK",
+                   help="the pilot model's measures on this tracking task too (docs/pilot-model.md)")  # fmt: skip
 
 
 class _Parser(argparse.ArgumentParser):
@@ -293,7 +295,10 @@ def build_parser() -> argparse.ArgumentParser:
         help="penalty per unit fraction of time at a platform limit (default 1)",
     )
     p.add_argument("--out", type=_out_path, required=True, help="output folder (tuned.yaml, tune.csv, report.md)")
+    p.add_argument("--pilot-weight", type=float, default=1.0,
+                   help="with --pilot: weight of the pilot's distance from flight (%%/100) (default 1)")  # fmt: skip
     _study_options(p)
+    _track_parser(sub)
     p = sub.add_parser("examples", help="copy the bundled manoeuvres, pilot profiles, parameter and platform files "
                        "into a folder to edit")
     p.add_argument("folder", type=Path, help="destination (created; existing files are never overwritten)")
@@ -311,6 +316,34 @@ def build_parser() -> argparse.ArgumentParser:
     _live_parsers(sub)
     add_examples(parser)  # the docs named at the top level, examples at the end of each command's help
     return parser
+
+
+def _track_parser(sub: Any) -> None:
+    """``washbench track`` (docs/pilot-model.md)."""
+    p = sub.add_parser("track", help="a pilot model flies a tracking task in JSBSim through each washout: how its "
+                       "control changes from flight")  # fmt: skip
+    p.add_argument("task", type=Path, help="task YAML file, or a bundled one by name (c172/roll, columbia400/pitch)")
+    p.add_argument("--out", type=_out_path, required=True,
+                   help="output folder (report.md, track.json, measures.csv, frf.csv, signals.parquet)")  # fmt: skip
+    _washout_options(p)
+    p.add_argument("--vestibular", choices=("young-meiry", "telban-cardullo"),
+                   help="vestibular models of the pilot (default telban-cardullo: canals with a lead)")  # fmt: skip
+    p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
+    _platform_options(p)
+    p.add_argument("--runs", type=int, metavar="N", help="runs per condition (default: the task's)")
+    p.add_argument("--pilot-plugin", metavar="FILE.py:NAME",
+                   help="fly your own pilot model from a Python file (docs/pilot-model.md)")  # fmt: skip
+    _aircraft_dir_option(p)
+    p.add_argument("--quiet", action="store_true", help="no progress lines")
+    _output_options(p)
+    p.set_defaults(rank_by=None, thresholds=None)  # the run options track does not take (the ranking's)
+
+
+def _track(args: argparse.Namespace) -> int:
+    from washbench.runs.track import TrackOptions, track_command  # deferred: numba
+
+    opts = TrackOptions(runs=args.runs, outputs=_outputs(args), progress=not args.quiet, pilot_plugin=args.pilot_plugin)
+    return track_command(resolve_task(args.task), args.out, _run_options(args), opts)
 
 
 def _live_parsers(sub: Any) -> None:
@@ -557,6 +590,8 @@ def _dispatch(args: argparse.Namespace) -> int:
         from washbench.review.report_command import report_command  # deferred: numpy
 
         return report_command(args.results, args.palette)
+    if args.command == "track":
+        return _track(args)
     if args.command in ("live", "send"):
         return _live(args) if args.command == "live" else _send(args)
     if args.command == "replay":
@@ -573,6 +608,7 @@ def _study(args: argparse.Namespace) -> int:
         dask=args.dask,
         progress=not args.quiet,
         aircraft_dirs=args.aircraft_dir,
+        pilot=resolve_task(args.pilot) if args.pilot is not None else None,
     )
     if args.command == "sweep":
         from washbench.runs.sweep import sweep_command  # deferred: numba
@@ -591,6 +627,7 @@ def _study(args: argparse.Namespace) -> int:
         budget=args.budget,
         seed=args.seed,
         saturation_weight=args.saturation_weight,
+        pilot_weight=args.pilot_weight,
         **common,
     )
 

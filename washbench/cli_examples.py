@@ -67,10 +67,18 @@ EXAMPLES: dict[str, tuple[str, ...]] = {
     "sweep": (
         "washbench sweep manoeuvres --set tilt.gain_per_s=0.4,1,2,5 --out study",
         "washbench sweep c172 --set tilt.gain_per_s=1,2 --washout large-angle --from results --out study",
+        "washbench sweep c172/aileron_3211 --set rotational.highpass_wn_radps.roll=0.2,0.5,1 --pilot c172/roll --out s",
     ),
     "tune": (
         "washbench tune c172/takeoff c172/stall_recovery --washout large-angle --tune tilt.gain_per_s=0.2:5 --out t",
         "washbench tune c172 --washout unrestricted --tune tilt.gain_per_s=0.2:5 --budget 50 --out tuned",
+        "washbench tune c172/steep_turn --washout large-angle --tune scale.angular_velocity=0.3:1 --pilot c172/roll "
+        "--budget 30 --out t",
+    ),
+    "track": (
+        "washbench track c172/roll --out track-roll",
+        "washbench track c172/pitch --out track-pitch --washout large-angle --washout unrestricted --runs 3",
+        "washbench track my_task.yaml --out t --variant half=small-angle,scale.angular_velocity=0.5",
     ),
     "examples": (
         "washbench examples my-study",

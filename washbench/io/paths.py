@@ -42,7 +42,7 @@ BUNDLED_PLATFORMS = ("atlas", "hexapod", "rig2dof")
 #: The bundled washout parameter files, ``washbench/data/<name>.yaml``: ``--params cw1``.
 BUNDLED_PARAMS = ("cw1",)
 #: Top-level folders of the repository that the wheel ships as ``washbench/data/<name>`` (see ``setup.py``).
-BUNDLED_FOLDERS = ("aircraft", "manoeuvres")
+BUNDLED_FOLDERS = ("aircraft", "manoeuvres", "tasks")
 
 
 def bundled_folder(name: str) -> Path:
@@ -57,6 +57,8 @@ def bundled_folder(name: str) -> Path:
 AIRCRAFT_DIR = bundled_folder("aircraft")
 #: Bundled manoeuvres (``<aircraft>/<name>.yaml``): what ``washbench suite`` runs by default.
 MANOEUVRES_DIR = bundled_folder("manoeuvres")
+#: Bundled tracking tasks (``<aircraft>/<name>.yaml``): what ``washbench track`` flies by name (c172/roll).
+TASKS_DIR = bundled_folder("tasks")
 #: Environment variable with extra aircraft folders, separated by ``os.pathsep``.
 AIRCRAFT_PATH_ENV = "WASHBENCH_AIRCRAFT_PATH"
 #: Files or folders that mark a project root (where the search for ``aircraft/`` next to a manoeuvre stops).
@@ -281,6 +283,16 @@ def resolve_data_file(item: Path, option: str) -> Path:
     hint = f"; did you mean {option} {stem}?" if stem in names and named is None else ""
     raise WashbenchError(f"{option} {text}: {problem}, nor a bundled name ({', '.join(names)}; or "
                          f"washbench:data/NAME.yaml){hint}")  # fmt: skip
+
+
+def resolve_task(item: Path) -> Path:
+    """A task argument as given, or, when no such file exists, the bundled one of that name (``c172/roll``)."""
+    if item.exists() or item.is_absolute():
+        return item
+    for candidate in (TASKS_DIR / item, TASKS_DIR / f"{item}.yaml"):
+        if candidate.is_file():
+            return candidate
+    return item
 
 
 def plugin_file(spec: str, option: str) -> tuple[str, Path, str]:
