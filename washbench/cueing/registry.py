@@ -30,12 +30,13 @@ from typing import Any
 
 from pydantic import BaseModel
 
-from washbench.cueing.guard import plugin_call, plugin_error
 from washbench.cueing.params import WASHOUT_KINDS
 from washbench.errors import Terminated, WashbenchError, located
 from washbench.io import interrupts
+from washbench.io.entry_points import entry_points as installed_entry_points
 from washbench.io.names import identifier_problem
 from washbench.io.paths import plugin_file
+from washbench.io.plugin_guard import plugin_call, plugin_error
 from washbench.io.yamlio import line_of
 
 ENTRY_POINT_GROUP = "washbench.washouts"
@@ -168,7 +169,7 @@ def load_plugin(spec: str) -> Algorithm:
 @functools.cache
 def _entry_points() -> dict[str, importlib.metadata.EntryPoint]:
     """The ``washbench.washouts`` entry points installed, read once per process (every name check asks)."""
-    return {ep.name: ep for ep in importlib.metadata.entry_points(group=ENTRY_POINT_GROUP)}
+    return {ep.name: ep for ep in installed_entry_points(ENTRY_POINT_GROUP)}
 
 
 def python_kinds() -> tuple[str, ...]:

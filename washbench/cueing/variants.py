@@ -367,6 +367,10 @@ def platform_refusal(washout: Washout, platform: Any) -> str | None:
     kind = getattr(platform, "kind", "atlas")
     if kind == "atlas":
         return None
+    plugin = kind not in ("hexapod", "rig")
+    if washout.kind in ("mpc", "mpc-unrestricted") and plugin and platform.envelope() is None:
+        return (f"washout {washout.name} ({washout.kind}): plans against the platform's envelope (Atlas-shaped "
+                f"limits), which the {kind} platform plugin does not give (its class has no envelope(params))")
     unlimited = getattr(platform, "unlimited_rotation", False)
     if washout.kind in ("unrestricted", "adaptive-unrestricted", "mpc-unrestricted") and not unlimited:
         return (
