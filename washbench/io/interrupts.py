@@ -43,7 +43,7 @@ def received() -> int:
     """How many SIGINT/SIGTERM this process's handlers (:func:`terminate`, :func:`interrupt`) have received.
 
     A KeyboardInterrupt or Terminated raised while this count did not change was raised by code (a washout
-    plugin's ``raise KeyboardInterrupt``), not by a signal (:mod:`washbench.cueing.guard`).
+    plugin's ``raise KeyboardInterrupt``), not by a signal (:mod:`washbench.io.plugin_guard`).
     """
     return _RECEIVED[0]
 
@@ -124,7 +124,8 @@ def raise_pending() -> None:
 @contextlib.contextmanager
 def signals_held() -> Iterator[None]:
     """Hold SIGINT and SIGTERM back for a short critical section: noted, and acted on (KeyboardInterrupt or
-    :class:`washbench.errors.Terminated`) once it is over; never lost, never in the middle."""
+    :class:`washbench.errors.Terminated`) once it is over; never lost, never in the middle. A section that fails
+    after a signal was noted ends as signalled (the failure as its cause): the signal likely caused it."""
     if threading.current_thread() is not threading.main_thread():  # handlers run in the main thread only
         yield
         return
@@ -137,6 +138,13 @@ def signals_held() -> Iterator[None]:
     saved = {sig: signal.signal(sig, note) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
         yield
+    except BaseException as exc:
+        # the section failed after a signal was noted: the signal wins. A service manager's SIGTERM reaches the whole
+        # process group: the suite's process server dies of it while this process starts workers from it, whose
+        # start then fails (EOFError from multiprocessing's forkserver); the command ends as signalled, 143
+        if noted and not isinstance(exc, KeyboardInterrupt | Terminated):
+            raise (KeyboardInterrupt() if noted[0] == signal.SIGINT else Terminated()) from exc
+        raise
     finally:
         for sig, handler in saved.items():
             signal.signal(sig, handler)
