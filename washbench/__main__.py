@@ -15,7 +15,7 @@ import signal
 import sys
 
 from washbench.errors import Terminated
-from washbench.io import collector, entry_points, interrupts, pages
+from washbench.io import collector, interrupts, pages
 
 
 def entry() -> int:
@@ -30,6 +30,8 @@ def entry() -> int:
         # extension module's initialisation (pydantic-core importing datetime), it ended the process in a Rust
         # panic (status 1) instead of this one line
         with interrupts.signals_held():
+            from washbench.io import entry_points  # deferred: signals
+
             entry_points.read_pydantic_plugins()  # another package's broken metadata: a warning, not a traceback
             from washbench.cli import main  # deferred: signals
 
