@@ -66,7 +66,7 @@ MAX_WORK = 10_000_000
 horizon with 20,000 iterations)."""
 MAX_HORIZON = 500
 """The horizon's intervals at most, ``preview_s`` included (``horizon_steps``' own limit): its QP takes about 2 GB
-and a minute and a half to build there (:func:`washbench.io.cost.mpc`)."""
+and five minutes of CPU to build and set up there (:func:`washbench.io.cost.mpc`, ``bench/cost_calibration.md``)."""
 REMEDY = "fewer mpc.horizon_steps, a longer mpc.prediction_step_s or a shorter mpc.preview_s"
 """What makes the MPC's QP smaller (the messages of :mod:`washbench.io.cost`)."""
 ESTIMATE_AFTER_STEPS = 20
@@ -120,7 +120,8 @@ class MpcParams(StrictModel):
     """The ``mpc:`` section of the parameter file."""
 
     horizon_steps: Annotated[int, Field(ge=1, le=500)] = 20
-    """N, the number of prediction intervals"""
+    """N, the number of prediction intervals (with ``preview_s``, N = max(horizon_steps, preview_s /
+    prediction_step_s), at most 500 intervals in all)"""
     prediction_step_s: Annotated[float, Field(gt=0.0, le=5.0, allow_inf_nan=False)] = 0.1
     """the prediction interval (s); at least the sample step"""
     reference_decay_per_s: Annotated[float, Field(ge=0.0, le=100.0, allow_inf_nan=False)] = 0.5
@@ -131,8 +132,9 @@ class MpcParams(StrictModel):
     """the time constant of that recent mean (s): a first-order low-pass of the aircraft's input, started at the first
     sample (a steady flight is predicted to stay as it is)"""
     preview_s: Annotated[float, Field(ge=0.0, le=20.0, allow_inf_nan=False)] = 0.0
-    """how far ahead the aircraft's motion is known (s; the horizon is extended to cover it): 0 none; > 0 needs the
-    recording in advance (run, suite, cue), not a live stream"""
+    """how far ahead the aircraft's motion is known (s; the horizon is extended to cover it, at most 500 intervals:
+    20 s needs prediction_step_s of at least 0.04 s): 0 none; > 0 needs the recording in advance (run, suite, cue),
+    not a live stream"""
     limit_margin: Annotated[float, Field(gt=0.0, le=1.0)] = 0.95
     """the QP's limits are this fraction of the platform's"""
     tilt_rate_limit_degps: Annotated[float, Field(gt=0.0, le=1000.0)] | None = 3.0

@@ -99,11 +99,12 @@ class MpcUnrestrictedParams(StrictModel):
     """The ``mpc-unrestricted:`` section of the parameter file (SI; axis triples are x, y, z)."""
 
     horizon_steps: Annotated[int, Field(ge=1, le=200)] = 20
-    """N, prediction intervals (extended to cover ``preview_s``)"""
+    """N, prediction intervals (extended to cover ``preview_s``: at most 200 intervals in all)"""
     prediction_step_s: Annotated[float, Field(gt=0.0, le=5.0, allow_inf_nan=False)] = 0.1
     """the prediction interval tp (s); at least the sample step"""
     preview_s: Annotated[float, Field(ge=0.0, le=20.0, allow_inf_nan=False)] = 0.0
-    """how far ahead the aircraft's motion is known (s): 0 none; > 0 needs the recording in advance"""
+    """how far ahead the aircraft's motion is known (s; 20 s needs prediction_step_s of at least 0.1 s, the horizon
+    being at most 200 intervals): 0 none; > 0 needs the recording in advance"""
     reference_decay_per_s: Annotated[float, Field(ge=0.0, le=100.0, allow_inf_nan=False)] = 0.5
     """gamma: beyond what is previewed, the aircraft's specific force and rate are predicted to return from the last
     known value to their recent mean as e^{-gamma t} (0: held)"""

@@ -141,20 +141,22 @@ def memory_room() -> Room:
     (``ulimit -v``) and its data limit."""
     cap = cap_bytes()
     rss = resident_bytes()
-    source = f"{CAP_ENV} = {cap / GB:g}" if os.environ.get(CAP_ENV, "").strip() else f"its default, {CAP_ENV} sets it"
-    rooms = [Room(cap - rss, f"washbench's cap of {gb_text(cap)} of memory per process ({source})")]
+    if os.environ.get(CAP_ENV, "").strip():
+        rooms = [Room(cap - rss, f"the cap {CAP_ENV}={cap / GB:g} sets ({gb_text(cap)} per process)")]
+    else:
+        rooms = [Room(cap - rss, f"washbench's cap of {gb_text(cap)} per process ({CAP_ENV} changes it)")]
     avail = available_bytes()
     if avail is not None:
-        rooms.append(Room(avail, f"what this machine has available, {gb_text(avail)}"))
+        rooms.append(Room(avail, f"what this machine has available ({gb_text(avail)})"))
     group = _cgroup_room()
     if group is not None:
-        rooms.append(Room(group[1], f"this process's control group's limit of {gb_text(group[0])}"))
+        rooms.append(Room(group[1], f"this process's control group's memory limit ({gb_text(group[0])})"))
     status = _status()
-    for which, used, name in ((resource.RLIMIT_AS, status.get("VmSize"), "address-space limit (ulimit -v)"),
-                              (resource.RLIMIT_DATA, status.get("VmData"), "data-size limit (ulimit -d)")):  # fmt: skip
+    for which, used, name in ((resource.RLIMIT_AS, status.get("VmSize"), "address-space limit, ulimit -v"),
+                              (resource.RLIMIT_DATA, status.get("VmData"), "data-size limit, ulimit -d")):  # fmt: skip
         soft = resource.getrlimit(which)[0]
         if soft != resource.RLIM_INFINITY and used is not None:
-            rooms.append(Room(soft - used, f"this process's {name} of {gb_text(soft)}"))
+            rooms.append(Room(soft - used, f"this process's {name} ({gb_text(soft)})"))
     return min(rooms, key=lambda r: r.bytes)
 
 
@@ -194,7 +196,7 @@ def refusal(est: Estimate, room: Room) -> str | None:
         return None
     hint = est.fits(room.bytes) if est.fits is not None else None
     return (f"{est.what}: {est.size}: about {gb_text(est.memory_bytes)} at the peak ({est.peak}), more than the "
-            f"{gb_text(room.bytes)} this process may still take ({room.why}); {est.remedy}"
+            f"{gb_text(room.bytes)} this process may still take under {room.why}; {est.remedy}"
             + (f" ({hint})" if hint else ""))  # fmt: skip
 
 
@@ -244,10 +246,10 @@ def _linear_fit(a: float, b: float) -> Callable[[float], str | None]:
 
 
 # --- the bound (bench/cost_calibration.md): peak bytes a + b n and CPU seconds c n of each part, n the samples
-BOUND_ATTITUDE = (45e6, 14_700.0, 0.22e-3)
+BOUND_ATTITUDE = (45e6, 14_700.0, 0.23e-3)
 """The replay's attitude plan (:func:`washbench.analysis.bound.oracle_bound`, pitch, roll, yaw): bytes a, bytes per
 sample b, seconds per sample c."""
-BOUND_TRANSLATION = (120e6, 30_000.0, 0.40e-3)
+BOUND_TRANSLATION = (110e6, 30_500.0, 0.45e-3)
 """The replay's translation plan (:func:`washbench.analysis.bound_replay.translation_plan`): the bound's peak."""
 CEILING_LP = (5e6, 14_000.0, 0.20e-3)
 """The ceiling (:func:`washbench.analysis.ceiling.ceiling`): its largest linear programme (b), all six (c)."""
@@ -290,12 +292,13 @@ MPC_HEXAPOD_MEMORY = (42e6, 11_200.0)
 """mpc on a hexapod (the whitened QP and the legs' rows besides)."""
 MPC_UNRESTRICTED_MEMORY = (40e6, 200.0)
 """mpc-unrestricted (its moves are blocked: a QP of a few dozen variables; N x N prediction matrices)."""
-MPC_BUILD_S = ((20, 0.03), (50, 0.77), (100, 2.4), (200, 11.0), (300, 27.0), (500, 89.0))
-MPC_HEXAPOD_BUILD_S = ((50, 1.11), (100, 3.45), (200, 19.1), (300, 44.7), (500, 200.0))
+MPC_BUILD_S = ((20, 0.025), (50, 0.68), (100, 1.79), (200, 14.3), (300, 59.5), (500, 305.0))
+MPC_HEXAPOD_BUILD_S = ((50, 1.11), (100, 3.45), (200, 19.1), (300, 44.7), (500, 174.0))
 MPC_UNRESTRICTED_BUILD_S = ((50, 0.05), (100, 0.054), (200, 0.117))
-"""Seconds to build the QP (mpc: the condensed Hessian's accumulation; the solver's first factorisation)."""
-MPC_STEP_S = ((20, 0.00019), (50, 0.00089), (100, 0.0118), (200, 0.0247), (300, 0.463), (500, 2.99))
-MPC_HEXAPOD_STEP_S = ((50, 0.00206), (100, 0.0327), (200, 0.0861), (300, 0.146), (500, 1.5))
+"""Seconds to build the QP and set its solver up (mpc: the condensed Hessian's accumulation, then DAQP's
+factorisation at the first solve; on a hexapod the whitening, its first solve cheap)."""
+MPC_STEP_S = ((20, 0.00019), (50, 0.00047), (100, 0.0070), (200, 0.030), (300, 0.049), (500, 0.121))
+MPC_HEXAPOD_STEP_S = ((50, 0.00206), (100, 0.0327), (200, 0.0861), (300, 0.146), (500, 0.418))
 MPC_UNRESTRICTED_STEP_S = ((50, 0.00074), (100, 0.00145), (200, 0.00207))
 """Seconds per sample: this sample's QP data and a warm-started solve of a few iterations (a hard flight needs
 more; the washout times its first samples and says so, :mod:`washbench.cueing.mpc`)."""
