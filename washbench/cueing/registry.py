@@ -87,7 +87,8 @@ class Algorithm:
             loc = tuple(err["loc"])
             line = line_of(lines, (self.kind, *loc)) if lines else None
             field = ".".join((self.kind, *(str(p) for p in loc)))
-            raise WashbenchError(located(where, err["msg"], line=line, field=field)) from None
+            msg = str(err["msg"]).removeprefix("Value error, ")  # (a model validator's own words)
+            raise WashbenchError(located(where, msg, line=line, field=field)) from None
 
 
 _LOADED: dict[str, Algorithm] = {}
