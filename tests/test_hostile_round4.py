@@ -586,3 +586,32 @@ def test_a_signal_during_a_held_section_that_then_fails_ends_as_the_signal() -> 
             raise EOFError("unexpected EOF")
     finally:
         signal.signal(signal.SIGTERM, old)
+
+
+HELD_IN_A_WORKER = """
+import os, signal, sys
+from washbench.io import interrupts
+
+signal.signal(signal.SIGINT, signal.SIG_IGN)  # a suite's worker and process server: SIGINT is the main process's
+signal.signal(signal.SIGTERM, signal.SIG_DFL)  # and SIGTERM ends them
+with interrupts.signals_held():
+    os.kill(os.getpid(), signal.SIGINT)
+print("SIGINT ignored", flush=True)
+with interrupts.signals_held():
+    os.kill(os.getpid(), signal.SIGTERM)
+print("still alive", flush=True)
+"""
+
+
+def test_a_signal_held_in_a_worker_is_acted_on_as_the_worker_would() -> None:
+    """Found running the process-group SIGTERM of item 9 (once in 45 suites: exit 143 with a traceback ending in
+    ``washbench.errors.Terminated``): a held section acted on a held signal by raising KeyboardInterrupt or
+    Terminated whatever the process did with that signal, so a suite's process server or worker (SIGINT ignored,
+    SIGTERM its default) building a model when the group's SIGTERM came printed a traceback, and a Ctrl-C raised
+    in a worker that ignores it. Now the held signal is acted on as the handler the section replaced would have:
+    ignored stays ignored, the default ends the process (by the signal, silently), washbench's raise."""
+    proc = subprocess.run([sys.executable, "-c", HELD_IN_A_WORKER], capture_output=True, text=True, timeout=120)
+    assert proc.stdout == "SIGINT ignored\n" and proc.returncode == -signal.SIGTERM, (proc.returncode, proc.stdout,
+                                                                                        proc.stderr)  # fmt: skip
+    assert proc.stderr == "", proc.stderr
+
