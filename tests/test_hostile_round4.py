@@ -615,3 +615,19 @@ def test_a_signal_held_in_a_worker_is_acted_on_as_the_worker_would() -> None:
                                                                                         proc.stderr)  # fmt: skip
     assert proc.stderr == "", proc.stderr
 
+
+def test_tune_announces_its_evaluations_when_they_take_long(capsys: pytest.CaptureFixture[str]) -> None:
+    """The offline optimiser (``tune``, differential evolution): once the starting set is evaluated, the rest of the
+    budget is announced at that evaluation's time when it is long, before the optimiser starts; nothing when short."""
+    from types import SimpleNamespace
+
+    from washbench.runs import tune
+
+    flights = [SimpleNamespace(evaluator=SimpleNamespace(n=7200)), SimpleNamespace(evaluator=SimpleNamespace(n=3600))]
+    tune._announce(0.1, 199, flights)  # 20 s: not long
+    assert capsys.readouterr().err == ""
+    tune._announce(2.0, 199, flights)  # 6 min 38 s
+    err = capsys.readouterr().err
+    assert err.startswith("washbench: note: tune: 199 more evaluation(s) on 2 training flight(s) (10,800 samples): at "
+                          "most about 6 min 38 s at the starting set's 2 s each"), err  # fmt: skip
+
