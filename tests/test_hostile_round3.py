@@ -724,7 +724,7 @@ def test_a_slow_mpc_says_how_long_a_minute_of_flight_takes(monkeypatch: pytest.M
     a = [algo.step(f, w) for _ in range(mpc.ESTIMATE_AFTER_STEPS + 5)]
     err = capsys.readouterr().err
     # (round four: with SLOW_FACTOR 0 the model's note when the washout is made speaks too; the timed one, once)
-    assert err.count("(timed on its first 20): a minute of flight takes about") == 1, err
+    assert err.count("(timed on 20 after the first): a minute of flight takes about") == 1, err
     monkeypatch.setattr(mpc, "SLOW_FACTOR", 10.0)
     algo2 = mpc.MpcWashout(None, WashoutContext(DT, 9.80665, limits, "steady", (0.0, 0.0, 0.0)))
     algo2.start(f, w)

@@ -242,7 +242,7 @@ def test_a_slow_mpc_says_so_on_a_whole_recording_too(monkeypatch: pytest.MonkeyP
     monkeypatch.setattr(mpc, "SLOW_FACTOR", 0.0)  # any speed is slow: the timed note is tested
     timed = trace()
     err = capsys.readouterr().err
-    assert err.count("(timed on its first 20): a minute of flight takes about") == 1, err
+    assert err.count("(timed on 20 after the first): a minute of flight takes about") == 1, err
     from washbench.io import cost
 
     monkeypatch.setattr(cost, "LONG_S", -1.0)  # any estimate is long: the model's notes are tested
