@@ -9,11 +9,12 @@ Every computation whose memory or time grows with the input's length or with its
   building grows with its cube;
 - ``omct`` of a washout that costs that much per run (the sum of its runs).
 
-Each model (:func:`bound`, :func:`ceiling`, :func:`mpc`, :func:`mpc_unrestricted`, :func:`total`) gives an
-:class:`Estimate`: the peak memory the computation adds to what the process holds when it starts, and its wall time,
-from the input's length and the parameters alone. The constants are measured (``bench/cost_calibration.py``, its
-figures in ``bench/cost_calibration.md``): each memory model is the largest peak measured per unit of size, times
-:data:`MEMORY_MARGIN`; each time model the median, so it is an estimate, not a promise.
+Each model (:func:`bound`, :func:`ceiling`, :func:`mpc` with :func:`mpc_step_s`; ``omct`` and ``tune`` add up
+theirs) gives an :class:`Estimate`: the peak memory the computation adds to what the process holds when it starts,
+and its CPU time, from the input's length and the parameters alone. The constants are measured
+(``bench/cost_calibration.py``, its figures in ``bench/cost_calibration.md``): each memory model is the largest peak
+measured per unit of size, times :data:`MEMORY_MARGIN`; each time model the measured CPU time, so it is an estimate,
+not a promise (on a shared machine the wall time is longer).
 
 :func:`check` then refuses, in one line, what would not fit (:func:`memory_room`: the least of washbench's cap,
 :data:`DEFAULT_CAP_GB` of resident memory for the whole process unless ``WASHBENCH_MAX_MEMORY_GB`` says otherwise,
@@ -27,7 +28,6 @@ from __future__ import annotations
 import contextlib
 import math
 import os
-import resource
 import sys
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
@@ -35,6 +35,11 @@ from pathlib import Path
 
 from washbench.errors import WashbenchError, printable
 from washbench.io.progress import duration_text
+
+try:
+    import resource  # (POSIX: the limits of ulimit; on Windows only the cap and the machine count)
+except ImportError:  # pragma: no cover - Windows
+    resource = None  # type: ignore[assignment]
 
 CAP_ENV = "WASHBENCH_MAX_MEMORY_GB"
 """The environment variable that sets washbench's memory cap (GB of resident memory per process)."""
@@ -72,8 +77,8 @@ def resident_bytes() -> int:
     """The resident memory of this process now (bytes): ``VmRSS``; without /proc its peak so far
     (``ru_maxrss``, an over-estimate)."""
     rss = _status().get("VmRSS")
-    if rss is not None:
-        return rss
+    if rss is not None or resource is None:
+        return rss or 0
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
     return int(peak if sys.platform == "darwin" else peak * 1024)
 
@@ -152,8 +157,10 @@ def memory_room() -> Room:
     if group is not None:
         rooms.append(Room(group[1], f"this process's control group's memory limit ({gb_text(group[0])})"))
     status = _status()
-    for which, used, name in ((resource.RLIMIT_AS, status.get("VmSize"), "address-space limit, ulimit -v"),
-                              (resource.RLIMIT_DATA, status.get("VmData"), "data-size limit, ulimit -d")):  # fmt: skip
+    limits = () if resource is None else (
+        (resource.RLIMIT_AS, status.get("VmSize"), "address-space limit, ulimit -v"),
+        (resource.RLIMIT_DATA, status.get("VmData"), "data-size limit, ulimit -d"))  # fmt: skip
+    for which, used, name in limits:
         soft = resource.getrlimit(which)[0]
         if soft != resource.RLIM_INFINITY and used is not None:
             rooms.append(Room(soft - used, f"this process's {name} ({gb_text(soft)})"))
@@ -173,7 +180,7 @@ def gb_text(n: float) -> str:
 @dataclass(frozen=True)
 class Estimate:
     """What a computation will cost: ``memory_bytes`` at its peak above what the process holds when it starts (its
-    largest part: ``peak``), ``seconds`` of wall time; ``what`` (``washout bound``), ``size`` (``216,000 samples``),
+    largest part: ``peak``), ``seconds`` of CPU; ``what`` (``washout bound``), ``size`` (``216,000 samples``),
     ``remedy`` (what makes it smaller: the options), ``fits`` (given the room in bytes, a phrase saying how large an
     input would fit, or None)."""
 
