@@ -386,6 +386,10 @@ def _unfit(washout: Washout, platform: Any) -> tuple[str, str] | None:
     kind = getattr(platform, "kind", "atlas")
     if kind == "atlas":
         return None
+    plugin = kind not in ("hexapod", "rig")
+    if washout.kind in ("mpc", "mpc-unrestricted") and plugin and platform.envelope() is None:
+        return (f"plans against the platform's envelope (Atlas-shaped limits), which the {kind} platform plugin does "
+                "not give (its class has no envelope(params))"), ""  # fmt: skip
     unlimited = getattr(platform, "unlimited_rotation", False)
     if washout.kind in ("unrestricted", "adaptive-unrestricted", "mpc-unrestricted") and not unlimited:
         why = f"cannot drive a {kind}, whose rotation is limited: its attitude set point is never washed back to level"

@@ -182,6 +182,10 @@ def write_cued_folder(
 
     motion = read_motion(folder / FLIGHT_FILE)
     result = lockstep_result(motion, rows, options)
+    if result.algorithms:  # the whole-only washouts' own statistics, beside the lockstep's, in the listed order
+        both = {**dict((extra or {}).get("algorithms") or {}), **result.algorithms}
+        order = [n for n in options.washout_order if n in both]
+        extra = {**(extra or {}), "algorithms": {n: both[n] for n in order}}
     write_results(folder, result, provenance)
     bound = bound_outputs(folder, result, options.washouts, options.limits, options.vestibular_params,
                           options.rank_rule, options.filter_start)  # fmt: skip

@@ -44,10 +44,11 @@ from washbench.cueing.variants import (
     value_of,
 )
 from washbench.errors import WashbenchError, printable
+from washbench.io import cost
 from washbench.io.atomic import write_text_atomic
 from washbench.io.csv_numbers import csv_number
 from washbench.io.outfolder import result_set
-from washbench.io.progress import Progress
+from washbench.io.progress import Progress, duration_text
 from washbench.io.result_files import REPORT_FILE
 from washbench.pilot.surrogate import PilotObjective
 from washbench.pilot.task import load_task
@@ -149,6 +150,17 @@ def tune_command(
     return 0
 
 
+def _announce(each_s: float, left: int, train: Sequence[Any]) -> None:
+    """Before the optimiser's evaluations, when they take long (:data:`washbench.io.cost.LONG_S`): how many, on how
+    much flight, and at most how long at the starting set's time each (a population is evaluated at once, on the
+    processes of ``--jobs``: less)."""
+    if each_s * left > cost.LONG_S:
+        samples = sum(f.evaluator.n for f in train)
+        cost.note(f"tune: {left} more evaluation(s) on {len(train)} training flight(s) ({samples:,} samples): at most "
+                  f"about {duration_text(each_s * left)} at the starting set's {each_s:.2g} s each (a population "
+                  "at once on the --jobs processes takes less; a smaller --budget, fewer or shorter flights, less)")
+
+
 def _tune(
     out_dir: Path, base: Any, kind: str, bounds: list[Any], keys: list[str], train_files: list[Path],
     test_files: list[Path], limits: Any, budget: int, seed: int, saturation_weight: float,
@@ -194,7 +206,9 @@ def _tune(
 
     x0 = np.array([_value(base, k) for k in keys])
     try:
+        t0 = time.perf_counter()
         [base_obj] = objective(x0[None, :])  # evaluation 0: the starting set
+        _announce(time.perf_counter() - t0, budget - 1, train)
         best_x = minimise(objective, bounds, budget - 1, seed, x0)
     finally:
         if shown is not None:
