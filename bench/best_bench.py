@@ -1,6 +1,6 @@
 """The bracket's cost: the ceiling and the best achieved (the ``bound`` washout: the replay, every motion known for the
 flight flown again and scored, the search) on a real flight, against bare JSBSim timed in the same run; and the
-search's cost model (``washbench.analysis.best_motion.SEARCH_MEMORY``, ``SEARCH_SECONDS``) measured on pieces of it.
+search's cost model (``washbench.io.cost.BOUND_SEARCH``) measured on pieces of it.
 
 Input: a real flight (the bundled Columbia 400 ``aerobatics``, 70 s at 120 Hz, unless ``--manoeuvre`` names
 another), flown once by JSBSim; every other built-in washout and the naive references cued on it (not timed: they
@@ -12,8 +12,8 @@ resident memory above what the process held before (``VmHWM`` reset through ``/p
 - bare JSBSim ``fdm.run()`` for as many steps (bench/baseline.py), the ratio's baseline.
 
 With ``--calibrate``, one programme of the search on the first 2,000, 4,000 and 8,000 samples (started from a still
-platform): its CPU seconds per sample and its peak memory, the figures ``SEARCH_SECONDS`` and ``SEARCH_MEMORY``
-hold (a + b per sample, b the largest slope measured).
+platform): its CPU seconds per sample and its peak memory, the figures ``BOUND_SEARCH`` holds (a + b bytes per
+sample, b the slope measured; c seconds per sample and programme).
 
     python bench/best_bench.py [--manoeuvre PATH] [--calibrate]
 """
@@ -37,6 +37,7 @@ from washbench.cueing.bank import cue_trace, flyer
 from washbench.cueing.variants import EVERY_BUILTIN, Washout, as_washouts, load_washout_params
 from washbench.flight.fly import fly
 from washbench.flight.manoeuvre import load_manoeuvre
+from washbench.io import cost
 from washbench.io.paths import MANOEUVRES_DIR
 from washbench.perception.vestibular import VestibularModel
 from washbench.platform.limits import load_platform_limits
@@ -99,8 +100,9 @@ def main() -> None:
           f"{rep['accepted']} taken, {rep['iterations']} PIQP iterations)")
     print(f"  together:                         {total:6.2f} s CPU ({total / jsb:5.1f}x JSBSim), peak "
           f"+{max(m_ceiling, m_best):5.0f} MB (aim: 60 s, 2,000 MB)")
-    est_mem, est_s = best_motion.estimate(n, BoundParams().search_steps)
-    print(f"  the search's estimate (best_motion.estimate): {est_s:.1f} s CPU, {est_mem / 1e6:.0f} MB")
+    est = cost.bound(n, dt, with_ceiling=True, search_steps=BoundParams().search_steps)
+    print(f"  the estimate before it starts (washbench.io.cost.bound, the ceiling included): {est.seconds:.1f} s "
+          f"CPU, {est.memory_bytes / 1e6:.0f} MB at the peak ({est.peak})")
     if args.calibrate:
         calibrate(f, w, dt, limits, fly_bound)
 

@@ -170,3 +170,21 @@ def test_the_programme_predicts_what_the_platform_flies_where_it_is_exact(flown)
     assert step.value == pytest.approx(flown_value, rel=1e-7, abs=1e-10), (step.value, flown_value)
     still = fly_it(np.zeros(3), q0, np.zeros((n, 3)), ref.q)
     assert flown_value < yard.value(still.head_f_mps2, still.head_omega_radps)  # the stage's plan gains
+
+
+def test_the_search_s_model_is_above_what_a_programme_takes() -> None:
+    """The cost model (washbench.io.cost.BOUND_SEARCH, with its margin) is an upper estimate of one programme's peak,
+    measured in a fresh process as bench/cost_calibration.py measures it (2,400 samples: measured 0.78 of it)."""
+    import json
+    import subprocess
+    import sys
+
+    from washbench.io import cost
+
+    root = Path(__file__).resolve().parents[1]
+    proc = subprocess.run([sys.executable, str(root / "bench" / "cost_calibration.py"), "--one", "search", "2400"],
+                          capture_output=True, text=True, timeout=600)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    measured = json.loads(proc.stdout.strip().splitlines()[-1])["memory"]
+    model, _ = cost._part(cost.BOUND_SEARCH, 2400)
+    assert 0.3 * model < measured < model, (measured, model)

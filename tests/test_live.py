@@ -697,7 +697,7 @@ def test_a_viewer_closed_while_running(tmp_path: Path, monkeypatch: pytest.Monke
     # the values at each logged time are those of the result (the same step, the same filters chunk by chunk)
     table = pq.read_table(tmp_path / "o" / "traces.parquet").to_pydict()
     row_of = {round(v, 9): i for i, v in enumerate(table["t_s"])}
-    names = ("small-angle", "large-angle", "unrestricted", "aircraft")
+    names = (*DEFAULT_WASHOUTS, "aircraft")
     tp, perceived = series["/perceived/surge"]
     np.testing.assert_array_equal(tp, t)
     for ti, raw, felt in zip(t, surge, perceived, strict=True):

@@ -15,7 +15,8 @@ and every step it reports is a motion the platform made.
 
 The search is a heuristic with a guarantee on one side only: at or below every motion it started from; how far
 above the true best it stays is what the bracket [ceiling, best achieved] shows (the ceiling,
-:mod:`washbench.analysis.ceiling`; docs/yardstick.md, "What the ceiling cannot say").
+:mod:`washbench.analysis.ceiling`; docs/yardstick.md, "What the ceiling cannot say"). What it costs is estimated
+before it starts, with the bound's other parts (:func:`washbench.io.cost.bound`, ``BOUND_SEARCH``).
 """
 
 from __future__ import annotations
@@ -272,47 +273,10 @@ def search(
     return result
 
 
-SEARCH_MEMORY = (20e6, 100_000.0)
-"""The search's peak memory above what the process holds when it starts: bytes a + b per sample (one programme:
-PIQP's KKT system and its factor, about 48 variables and 54 rows a sample). Measured by ``bench/best_bench.py
---calibrate``: +106, +312 and +694 MB on 2,000, 4,000 and 8,000 samples of the Columbia 400 aerobatics (a slope of
-103 kB per sample); +798 MB for the whole search on its 8,369 samples (docs/yardstick.md)."""
-SEARCH_SECONDS = 1.6e-3
-"""The search's CPU seconds per sample and programme: 1.06, 1.49 and 1.61 ms on the pieces above (14 to 24 PIQP
-iterations), on the two-core development machine under load (docs/yardstick.md)."""
-SEARCH_MAX_BYTES = 4e9
-"""The largest peak the search may take (bytes): a search estimated above it is refused before it starts."""
-
-
-def estimate(n: int, steps: int) -> tuple[float, float]:
-    """The search's estimated peak memory (bytes) and CPU time (s) on ``n`` samples with ``steps`` programmes (the
-    candidates' flights and scores, about 1 % of a programme each, not counted). Pure: the one place its cost model
-    lives (:data:`SEARCH_MEMORY`, :data:`SEARCH_SECONDS`)."""
-    if steps <= 0:
-        return 0.0, 0.0
-    a, b = SEARCH_MEMORY
-    return a + b * n, SEARCH_SECONDS * n * steps
-
-
-def search_refusal(n: int, steps: int, cap_bytes: float = SEARCH_MAX_BYTES) -> str | None:
-    """One line refusing a search of ``steps`` programmes on ``n`` samples whose estimated peak is above
-    ``cap_bytes``, with how many samples would fit; None when it fits (or does not search)."""
-    memory, seconds = estimate(n, steps)
-    if memory <= cap_bytes:
-        return None
-    a, b = SEARCH_MEMORY
-    fits = max(0, math.floor((cap_bytes - a) / b))
-    return (f"the best achieved's search on {n:,} samples needs about {memory / 1e9:.3g} GB at its peak and "
-            f"{seconds / 60.0:.3g} min of CPU, more than its {cap_bytes / 1e9:.3g} GB; {fits:,} samples would fit "
-            "(cut the recording or lower its rate, or set the parameter file's bound: search_steps: 0 for the best "
-            "of the motions known without a search)")
-
-
 def flown_candidates(motions: Mapping[str, Any], dt_s: float) -> list[Candidate]:
     """The run's other motions as candidates (:func:`candidate_of`), in the run's order."""
     return [candidate_of(name, tr, dt_s) for name, tr in motions.items()]
 
 
-__all__ = ["REPLAY", "SEARCH_MAX_BYTES", "SEARCH_MEMORY", "SEARCH_SECONDS", "Candidate", "Fly", "Result", "Scoring",
-           "Settings", "Yardstick", "candidate_of", "estimate", "flown_candidates", "search", "search_refusal",
-           "sphere_of"]  # fmt: skip
+__all__ = ["REPLAY", "Candidate", "Fly", "Result", "Scoring", "Settings", "Yardstick", "candidate_of",
+           "flown_candidates", "search", "sphere_of"]  # fmt: skip

@@ -30,12 +30,12 @@ import numpy as np
 from scipy import sparse
 
 from washbench.analysis import best_motion
-from washbench.analysis.bound import MAX_BOUND_SAMPLES, BoundParams, oracle_bound
+from washbench.analysis.bound import BoundParams, oracle_bound
 from washbench.analysis.lp_rows import Rows, solve_qp, trapezoid
 from washbench.analysis.ranking import MOTION_FLOOR, perceived_motion
 from washbench.cueing.algorithm import Alongside
 from washbench.cueing.variants import Washout, load_washout_params
-from washbench.errors import WashbenchError
+from washbench.io import cost
 from washbench.io.units import G0_MPS2
 from washbench.perception.vestibular import VestibularModel, VestibularParams, otolith_model
 from washbench.platform.limits import PlatformLimits
@@ -270,15 +270,9 @@ class BoundWashout:
         """The best achieved's set points: positions (N, 3) m, attitudes (N, 4), scalar first (its start:
         :meth:`start`)."""
         c = self.context
-        n = len(f_mps2)
-        if n > MAX_BOUND_SAMPLES:
-            raise WashbenchError(f"washout bound: {n:,} samples in one recording, more than the bound's "
-                                 f"limit of {MAX_BOUND_SAMPLES:,} (its replay is planned over the whole recording "
-                                 "at once: about 0.7 ms and 40 kB per sample); cut the recording or lower its "
-                                 "rate")  # fmt: skip
-        refusal = best_motion.search_refusal(n, self.params.search_steps)
-        if refusal is not None:
-            raise WashbenchError(f"washout bound: {refusal}")
+        # planned over the whole recording at once, the search's programmes too, and the ceiling after it: refused
+        # before it starts if it would not fit (washbench.io.cost), announced if it takes long
+        cost.check(cost.bound(len(f_mps2), c.dt_s, search_steps=self.params.search_steps))
         # writable copies (the bench gives read-only ones): the compiled references and sums take one signature
         f = np.array(f_mps2, dtype=np.float64)
         w = np.array(omega_radps, dtype=np.float64)

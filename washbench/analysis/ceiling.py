@@ -60,6 +60,7 @@ from washbench.analysis.lp_rows import solve_qp as _solve_qp
 from washbench.analysis.lp_rows import trapezoid as _trapezoid
 from washbench.analysis.metrics import DOFS
 from washbench.analysis.relaxation import Relaxation, relaxation_of
+from washbench.io import cost
 from washbench.io.units import G0_MPS2
 from washbench.perception.vestibular import (
     DiscreteModel,
@@ -365,6 +366,8 @@ def ceiling(
     vest = vestibular if vestibular is not None else VestibularParams()
     if vest.thresholds is not None:
         raise ValueError("the ceiling is not defined with perception thresholds (a dead band)")
+    # its programmes must fit before they are built (announced with the bound, :func:`washbench.io.cost.bound`)
+    cost.check(cost.ceiling(len(perceived_f_mps2), dt_s), announce=False)
     oto = otolith_model(vest.otolith, dt_s)
     can = canal_model(vest.canals, dt_s)
     rest = filter_start == "rest"

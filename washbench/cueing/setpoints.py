@@ -16,8 +16,9 @@ import numpy as np
 
 from washbench.cueing import registry
 from washbench.cueing.algorithm import WashoutContext
-from washbench.cueing.guard import plugin_call
 from washbench.errors import WashbenchError
+from washbench.io.plugin_guard import plugin_call
+from washbench.io.plugin_guard import read_only as _ro
 from washbench.platform.model import planning_limits
 
 
@@ -175,14 +176,6 @@ class SetPointSource:
             raise WashbenchError(f"{self._where()}: set point is not finite or q is zero")
         self.k = first + m - 1
         return pos, q / norms[:, None], np.zeros((m, 2), dtype=np.int64)
-
-
-def _ro(a: np.ndarray) -> np.ndarray:
-    """A read-only float64 copy for the algorithm: a view could be made writeable again (its base is the bench's
-    array) and written into, changing what the other washouts and the metrics see; a copy cannot."""
-    v = np.array(a, dtype=np.float64, order="C")
-    v.flags.writeable = False
-    return v
 
 
 def _number(v: object) -> float | int:

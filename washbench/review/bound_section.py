@@ -156,6 +156,12 @@ def bound_lines(folder: Path, order: list[str] | None = None, explain: bool = Tr
         lines += ["On a hexapod the relaxation's workspace and rate bounds (its largest tilt, travel, speeds and "
                   "rates) are found numerically, not proved (docs/yardstick.md), and " + seen + "; its rate bounds are "
                   "the leg Jacobian's worst pose, which makes this ceiling looser than the Atlas's.", ""]  # fmt: skip
+        open_ = [name for name, key in (("rate", "rate_radps"), ("speed", "vel_mps"), ("acceleration", "acc_mps2"))
+                 if None in (relax.get(key) or [])]  # fmt: skip
+        if open_:
+            lines += [f"**This hexapod reaches singular poses inside its legs' stroke** (its leg Jacobian cannot be "
+                      f"inverted there): its {', '.join(open_)} bounds are unbounded (null in run.json), and the "
+                      "ceiling does not limit them.", ""]  # fmt: skip
     return [*lines, CEILING_NOTE.format(measure=measure, vacuous=100 * VACUOUS), ""] if explain else lines
 
 

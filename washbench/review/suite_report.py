@@ -39,6 +39,7 @@ from washbench.review.report import (
     FLAG,
     MSDV_NOTE,
     MSI_NOTE,
+    NO_PDF_NOTE,
     PERCEIVED_NOTE,
     SCORE_NOTE,
     _image,
@@ -72,7 +73,7 @@ def write_suite_json(
 ) -> None:
     """``suite.json``: one entry per manoeuvre file (file, ok, reason, aircraft, manoeuvre, result folder, checks),
     the provenance and, once the suite is complete, ``entries``: every top-level name it wrote (the marker by which
-    the next suite recognises what it may replace, :func:`washbench.runs.suite.previous_results`)."""
+    the next suite recognises what it may replace, :func:`washbench.runs.suite_place.previous_results`)."""
     doc: dict[str, Any] = {"washbench": "suite", "created_utc": created_utc, "provenance": provenance}
     doc["manoeuvres"] = entries
     if top_level is not None:
@@ -273,6 +274,7 @@ def _write_suite_report(
         if d.ok is False:
             lines += [f"> **FAILED**: {d.reason or 'a check failed'}", ""]
         lines += result_sections(d, _existing_figures(d) if figures else {}, suite_dir, 3, brief=True)
+    lines += [NO_PDF_NOTE, ""] if figures and not regenerate_results else []  # once, not under every figure
     for future in drawing.values():  # drawn (or failed: raised here) before the report that shows them
         future.result()
     write_text_atomic(stage / REPORT_FILE, "\n".join(lines).rstrip() + "\n")
