@@ -7,7 +7,7 @@ measured controlled element and the condition's motion filter, for a model that 
 task file's ``pilot:`` section validated by the class's ``Params`` pydantic model, or ``None`` without one. The
 bench does not adapt a plugin (the built-in model's rule, :mod:`washbench.pilot.adapt`, is about its own
 parameters): the plugin flies every condition as it is made. Every call into it goes through
-:func:`washbench.cueing.guard.plugin_call`: whatever it raises is one line.
+:func:`washbench.io.plugin_guard.plugin_call`: whatever it raises is one line.
 """
 
 from __future__ import annotations
@@ -20,9 +20,9 @@ from typing import Any
 
 from pydantic import BaseModel
 
-from washbench.cueing.guard import plugin_call, plugin_error
 from washbench.errors import WashbenchError
 from washbench.io.paths import plugin_file
+from washbench.io.plugin_guard import plugin_call, plugin_error
 from washbench.pilot.model import PilotContext
 
 
