@@ -146,7 +146,7 @@ def test_the_search_never_ends_worse_than_its_start(flown, trust: float, steps: 
     result = best_motion.search(yard, [cand], fly_it, flown["limits"], G, best_motion.Settings(steps=steps,
                                 trust_rad=trust))  # fmt: skip
     assert result.value <= result.candidates["large-angle"]
-    again = fly_it(np.zeros(3), result.start_q, result.pos, result.q)
+    again = fly_it(result.start_pos, result.start_q, result.pos, result.q)
     assert yard.value(again.head_f_mps2, again.head_omega_radps) == result.value
 
 

@@ -3,7 +3,7 @@ flight, searched for with the whole flight known (docs/yardstick.md, "The best a
 
 It starts from the best of every motion the bench knows for the flight: every other washout the run flew on it
 (given by the bench, :class:`washbench.cueing.algorithm.Alongside`), the naive references
-(:mod:`washbench.cueing.references`, made here when the run did not select them) and the bound's replay
+(:mod:`washbench.cueing.references`, made by the bound when the run did not select them) and the bound's replay
 (:mod:`washbench.analysis.bound_replay`); each is flown again through the platform model from its own start
 (:func:`candidate_of`: the same motion, to the platform's rounding) and scored by the run's rule
 (:class:`Yardstick`). From the best, **sequential convex programming**: the rule's value as a linear programme with
@@ -167,10 +167,12 @@ def candidate_of(name: str, trace: Any, dt_s: float) -> Candidate:
 
 @dataclass
 class Result:
-    """The search's result: the start attitude and set points of the best motion found (``start_q`` (4,), ``pos``
-    (N, 3), ``q`` (N, 4)), its value, the candidate it started from and every candidate's value (flown again), the
-    programmes solved (``steps``), the steps taken (``accepted``) and PIQP's iterations in all."""
+    """The search's result: the start set point and set points of the best motion found (``start_pos`` (3,),
+    ``start_q`` (4,), ``pos`` (N, 3), ``q`` (N, 4)), its value, the candidate it started from and every candidate's
+    value (flown again), the programmes solved (``steps``), the steps taken (``accepted``) and PIQP's iterations in
+    all."""
 
+    start_pos: np.ndarray
     start_q: np.ndarray
     pos: np.ndarray
     q: np.ndarray
@@ -228,7 +230,7 @@ def search(
     if best is None:
         raise ValueError("no candidate motion has a finite value")
     value, start, flown = best
-    result = Result(start.start_q, start.pos, start.q, value, start.name, values)
+    result = Result(start.start_pos, start.start_q, start.pos, start.q, value, start.name, values)
     n = len(start.pos)
     if st.steps <= 0 or n < 2:
         return result
@@ -256,7 +258,7 @@ def search(
         if usable:
             q_sp = qmul(ref.q, qexp(step.turn))
             q_sp /= np.linalg.norm(q_sp, axis=1)[:, None]
-            tr = fly(np.zeros(3), result.start_q, step.pos, q_sp)
+            tr = fly(result.start_pos, result.start_q, step.pos, q_sp)
             v = yard.value(tr.head_f_mps2, tr.head_omega_radps)
             result.history.append((step.value, v, bool(v < value)))
             if v < value:  # taken: the motion flown is the new current one

@@ -260,7 +260,7 @@ class BoundWashout:
         level before it (the replay's)."""
         if self.found is None:
             return np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0])
-        return np.zeros(3), self.found.start_q.copy()
+        return self.found.start_pos.copy(), self.found.start_q.copy()
 
     def step(self, f_mps2: np.ndarray, omega_radps: np.ndarray):
         raise RuntimeError("the oracle bound needs the whole recording in advance (run, cue, suite, omct, sweep, "
