@@ -2,14 +2,16 @@
 (on a hexapod or a rig: over that platform's relaxation, :mod:`washbench.analysis.relaxation`, whose bounds a rig
 gives in closed form and a hexapod's are found numerically; docs/yardstick.md).
 
-The ranking scores a washout by ``score = sum_d w_d E_d / M_d`` (:mod:`washbench.analysis.ranking`): ``E_d`` the
-integral of |perceived error| in DOF d (trapezoid rule), ``M_d`` the aircraft pilot's own perceived motion there,
-``w_d`` weights from ``M_d`` alone. The weights and ``M_d`` do not depend on the platform, and the score is a sum
-over DOFs, so
+The ranking's default rule, the felt error (:mod:`washbench.analysis.felt`), is ``S = sum_d N_d / T_d / D`` with
+``N_d = E_d + lambda F_d + tau_j J_d`` each DOF's terms (the dead-banded perceived error, its false part and, on
+surge, sway and heave, the jolts; LP-representable, :class:`FloorTerms`), ``T_d`` the thresholds and ``D`` the felt
+motion, which does not depend on the platform; the rule before it, the score, is ``sum_d w_d E_d / M_d`` with
+``E_d`` the integral of |perceived error| and ``w_d``, ``M_d`` from the aircraft alone. Either is a sum over DOFs of
+terms of one DOF's motion over constants, so
 
-    min over platform motions of score  >=  sum_d w_d min_d E_d / M_d
+    min over platform motions of score  >=  sum_d w_d min_d E_d / M_d      (the felt error: sum_d min N_d / T_d / D)
 
-and each ``min_d E_d`` is bounded below by a linear programme over a **relaxation** of what the platform can do
+and each ``min_d E_d`` (``min N_d``) is bounded below by a linear programme over a **relaxation** of what the platform can do
 in that DOF. A relaxation contains every head-motion trace the platform model can produce; its minimum is therefore
 at most every washout's ``E_d``, whatever the washout (classical, optimal, MPC, a plugin, the bound's own replay).
 The ceiling of a DOF is ``r_d = min E_d / M_d``; the ceiling of the score is ``sum_d w_d r_d``.

@@ -8,6 +8,7 @@ import json
 import math
 from pathlib import Path
 
+from washbench.analysis.ranking import TIE_ABSOLUTE
 from washbench.review.numbers import sig
 
 CEILING_FILE = "ceiling.csv"
@@ -30,8 +31,10 @@ suite verdict's threshold too, :data:`washbench.review.verdict.VACUOUS`)."""
 
 
 def vacuous(ceiling: float, best: float) -> bool:
-    """Whether a ceiling says nothing the best achieved does not: below :data:`VACUOUS` of it."""
-    return math.isfinite(ceiling) and math.isfinite(best) and best > 0.0 and ceiling < VACUOUS * best
+    """Whether a ceiling says nothing the best achieved does not: below :data:`VACUOUS` of it, where the best
+    achieved is not itself within the ranking's absolute tie margin of 0 (then the bracket is closed, not vacuous)."""
+    return (math.isfinite(ceiling) and math.isfinite(best) and best > TIE_ABSOLUTE
+            and ceiling < VACUOUS * best)  # fmt: skip
 
 _ORDER = ("score", "surge", "sway", "heave", "roll", "pitch", "yaw")
 

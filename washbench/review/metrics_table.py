@@ -58,7 +58,7 @@ def _ranking_lines(ranking: Sequence[RankRow], rule_label: str, ceiling: Mapping
                   "that the washout recovers (100 %: the ceiling, 0 %: no better than standing still, below 0: "
                   "worse)."]  # fmt: skip
     if any(r.washout == BOUND_WASHOUT for r in ranking):
-        lines += ["", "*bound*: the oracle bound's replay, planned with the whole flight known: a reference, not "
+        lines += ["", "*bound*: the best achieved, a motion searched for with the whole flight known: a reference, not "
                   "ranked."]  # fmt: skip
     return lines
 

@@ -169,8 +169,8 @@ def _score_cell(score: float, best: bool) -> str:
     return f"{text} {FLAG}" if score > 1.0 else text
 
 
-BOUND_NOTE = ("the bound's replay (planned with the whole flight known), not ranked: an achieved motion, above the "
-              "ceiling")  # fmt: skip
+BOUND_NOTE = ("the bound (the best achieved: a motion searched for with the whole flight known), not ranked: an "
+              "achieved motion, above the ceiling")  # fmt: skip
 
 
 def result_rule(data: ResultData) -> RankRule:

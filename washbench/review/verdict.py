@@ -11,11 +11,13 @@ ran, the ceilings (``ceiling.csv``, :mod:`washbench.analysis.ceiling`). Every fi
   once, as shared;
 - the **bracket** (with ``--washout bound``): the ceiling (the least value any motion of the platform could reach,
   certified) and the **best achieved** (the least value of every motion run on the flight: the washouts, the naive
-  references and the bound's replay); the best washout's distance to each.
+  references and the bound: with ``--washout bound`` a motion searched for from the best of all of them, never worse);
+  the best washout's distance to each.
 
 The **naive references** (``replay``, ``replay-rotation``, ``still``: :mod:`washbench.cueing.references`) are ranked
 with the washouts but are not candidates for "the best washout": the verdict says whether the best washout beats the
-best of them, and marks the manoeuvres where one does better. The bound's replay is scored, never ranked.
+best of them, and marks the manoeuvres where one does better. The bound (the best achieved) is scored, never
+ranked.
 
 Manoeuvres keep the suite's order, washouts the order they were listed in, everywhere on the page.
 """
@@ -41,7 +43,7 @@ from washbench.analysis.ranking import (
 from washbench.cueing.registry import REFERENCE_KINDS
 from washbench.cueing.variants import EVERY_BUILTIN
 from washbench.io.metrics_csv import MetricRow
-from washbench.review.bound_section import VACUOUS
+from washbench.review.bound_section import VACUOUS, vacuous
 from washbench.review.numbers import sig
 
 REFERENCES = REFERENCE_KINDS
@@ -90,7 +92,7 @@ def firsts(ranking: Sequence[RankRow]) -> list[str]:
 
 
 def values(ranking: Sequence[RankRow]) -> dict[str, float]:
-    """Every motion's value of the rule on the manoeuvre (the bound's replay included)."""
+    """Every motion's value of the rule on the manoeuvre (the bound's included)."""
     return {r.washout: r.score for r in ranking}
 
 
@@ -162,7 +164,7 @@ def compared_lines(washouts: Sequence[str], command: str = "washbench suite --ou
     missing_refs = [w for w in REFERENCES if w not in washouts]
     text = f"Compared: {len(causal)} washout{'s' if len(causal) != 1 else ''} ({_list(causal)})"
     text += f" and {len(refs)} naive reference{'s' if len(refs) != 1 else ''} ({_list(refs)})" if refs else ""
-    text += "; the bound's replay and the ceiling." if BOUND_WASHOUT in washouts else "."
+    text += "; the best achieved (the bound) and the ceiling." if BOUND_WASHOUT in washouts else "."
     gaps = []
     if missing:
         gaps.append(f"{len(missing)} built-in washout{'s' if len(missing) != 1 else ''} ({_list(missing)})")
@@ -297,12 +299,13 @@ def _bracket_summary(ranked: Sequence[Entry], causal: Sequence[str], refs: Seque
     for e in ranked:
         c = ceiling_value(e)
         _, achieved = best_of(e, [r.washout for r in e.ranking])
-        if math.isfinite(c) and math.isfinite(achieved) and achieved > 0.0 and c < VACUOUS * achieved:
+        if vacuous(c, achieved):
             loose.append(e.label)
     text = ("How much better could one be: per manoeuvre below, the **bracket** [ceiling, best achieved]: the best any "
             "motion of this platform could reach lies inside it. The ceiling is certified (no motion can score below "
             "it); the best achieved is the least value of every motion run on the flight (the washouts, the "
-            "references, the bound's replay). The best washout is at most its value minus the ceiling from the best "
+            "references, and the bound, a motion searched for from the best of them on the ranking's own measure and "
+            "flown through the platform model). The best washout is at most its value minus the ceiling from the best "
             "possible, and at least its value minus the best achieved.")
     if loose:
         text += (f" On {len(loose)} of {len(ranked)} manoeuvres the ceiling is below {100 * VACUOUS:.0f} % of the best "
@@ -332,8 +335,7 @@ def _table(ranked: Sequence[Entry], causal: Sequence[str], refs: Sequence[str], 
         if has_ceiling:
             c = ceiling_value(e)
             an, av = best_of(e, [r.washout for r in e.ranking])
-            vacuous = math.isfinite(c) and math.isfinite(av) and av > 0.0 and c < VACUOUS * av
-            row += [f"{sig(c)}{' (vacuous)' if vacuous else ''}", f"{sig(av)} ({an})" if an else "-",
+            row += [f"{sig(c)}{' (vacuous)' if vacuous(c, av) else ''}", f"{sig(av)} ({an})" if an else "-",
                     sig(av - c) if math.isfinite(av) and math.isfinite(c) else "-"]  # fmt: skip
         lines.append("| " + " | ".join(row) + " |")
     lines.append("")
