@@ -12,8 +12,9 @@ terms of one DOF's motion over constants, so
     min over platform motions of score  >=  sum_d w_d min_d E_d / M_d      (the felt error: sum_d min N_d / T_d / D)
 
 and each ``min_d E_d`` (``min N_d``) is bounded below by a linear programme over a **relaxation** of what the
-platform can do in that DOF. A relaxation contains every head-motion trace the platform model can produce; its minimum is therefore
-at most every washout's ``E_d``, whatever the washout (classical, optimal, MPC, a plugin, the bound's own replay).
+platform can do in that DOF. A relaxation contains every head-motion trace the platform model can produce; its
+minimum is therefore at most every washout's ``E_d``, whatever the washout (classical, optimal, MPC, a plugin, the
+bound's own motion).
 The ceiling of a DOF is ``r_d = min E_d / M_d``; the ceiling of the score is ``sum_d w_d r_d``.
 
 The relaxation of one DOF on the Atlas (docs/yardstick.md, "The ceiling", derives each line; the same rows with
