@@ -12,6 +12,7 @@ from scipy import signal
 from scipy.spatial.transform import Rotation
 from test_mpc import STRESS, _check_limits, _far_limits, _run
 
+from washbench.analysis.felt import DEFAULT_MEASURE, false_part, jolt
 from washbench.analysis.signals import SignalSpec, generate
 from washbench.cueing.algorithm import WashoutAlgorithm, WashoutContext
 from washbench.cueing.condensed import blocking_matrix, default_blocks, siso_prediction
@@ -78,7 +79,8 @@ def _gravity_jacobian(q: np.ndarray) -> np.ndarray:
 def _simulated_cost(w: MpcUnrestrictedWashout, z: np.ndarray, f_air: np.ndarray, w_air: np.ndarray) -> float:
     """The plan's cost by stepping the linearised model interval by interval: otolith and canal error models
     discretised by scipy (cont2discrete, ZOH at tp) per body axis, the stage integrated exactly, the head force
-    linearised with the scipy-Rotation Jacobian, the attitude change at each interval's midpoint."""
+    linearised with the scipy-Rotation Jacobian, the attitude change at each interval's midpoint; with the felt
+    error's weight > 0, plus its prediction (:func:`_felt_part`)."""
     p = w.params
     tp, n_int, blocks = w.tp, w.N, w.blocks
     m = len(blocks)
@@ -99,6 +101,9 @@ def _simulated_cost(w: MpcUnrestrictedWashout, z: np.ndarray, f_air: np.ndarray,
     wo, wd, wc = (np.array(x.xyz) for x in (p.force, p.direct_force, p.rate))
     wp, wv = np.array(p.position.xyz), np.array(p.velocity.xyz)
     cost = 0.0
+    xa_o, xa_c = w._air_o.copy(), w._air_c.copy()  # the aircraft pilot's own perception, for the false part
+    ends = set(np.cumsum(blocks) - 1)
+    nodes: list[np.ndarray] = []
     for j in range(n_int):
         mid = dth + 0.5 * tp * w_int[j]
         f_sim = r0.inv().apply(a_int[j]) + f0 + jac @ mid
@@ -112,16 +117,83 @@ def _simulated_cost(w: MpcUnrestrictedWashout, z: np.ndarray, f_air: np.ndarray,
         dth = dth + tp * w_int[j]
         e_o, e_c = (co @ xo)[0], (cc @ xc)[0]
         cost += tp * (np.sum(wo * e_o**2) + np.sum(wc * e_c**2) + np.sum(wp * pos**2) + np.sum(wv * vel**2))
+        xa_o = ao @ xa_o + bo @ f_air[None, :]
+        xa_c = ac @ xa_c + bc @ w_air[None, :]
+        if j in ends:
+            nodes.append(np.concatenate([e_o, e_c, (co @ xa_o)[0], (cc @ xa_c)[0]]))
+    if p.felt_weight > 0.0:
+        cost += _felt_part(w, np.array(nodes), a_mv[0], f_air)
     return float(cost)
 
 
+def _felt_part(w: MpcUnrestrictedWashout, nodes: np.ndarray, a0: np.ndarray, f_air: np.ndarray) -> float:
+    """The felt error of the plan by the ranking's own functions (``washbench.analysis.felt``): at each node (the
+    end of each move), the perceived error beyond the threshold and the false part against the aircraft pilot's
+    start, each node standing for its move's duration; the jolt of the first move; plus the slacks' small
+    quadratic (``slack_regularisation``) at the slacks' optimal values. ``nodes`` (K, 12): perceived error (force,
+    rate; SI), then the aircraft pilot's perceived motion (SI)."""
+    p = w.params
+    to_dof = np.array([1.0, 1.0, 1.0, *(3 * [180.0 / math.pi])])  # the measure's units: m/s^2, deg/s
+    err = nodes[:, :6] * to_dof
+    x = np.vstack([np.concatenate(w._air_0) * to_dof, nodes[:, 6:] * to_dof])  # row 0: the aircraft's start
+    y = x + np.vstack([np.zeros(6), err])
+    band = DEFAULT_MEASURE.bands()
+    seconds = w.tp * np.array(w.blocks)
+    t = np.maximum(np.abs(err) - band, 0.0) / band
+    false = false_part(x, y, band)[1:] / band
+    cost = p.felt_weight * float(seconds @ (t + p.false_weight * false).sum(axis=1))
+    v = (y - x[:1])[1:] / band
+    slacks = [t, np.maximum(v - 1.0, 0.0), np.maximum(-v - 1.0, 0.0)]
+    r0t = Rotation.from_quat(w.q[[1, 2, 3, 0]]).inv().as_matrix()
+    jolts = jolt(np.array([np.zeros(3), r0t @ (a0 - w._a_prev)]), np.array([w._f_prev, f_air]), w.dt)
+    cost += p.felt_weight * p.jolt_time_s * float(np.sum(jolts / band[:3]))
+    return cost + p.slack_regularisation * (sum(float(np.sum(a * a)) for a in slacks) + float(jolts @ jolts))
+
+
+def test_the_plan_minimises_the_simulated_felt_error(limits):
+    """With the felt error (the default cost): from a tilted cockpit with every error model, the aircraft pilot's
+    perception and the stage away from rest (perceived errors beyond the thresholds, cues of both signs), the QP's
+    plan minimises the cost simulated step by step with the ranking's own dead band, false part and jolt
+    (:func:`_felt_part`): no move of any single decision, nor a random move, lowers it (it is convex)."""
+    params = MpcUnrestrictedParams(reference_decay_per_s=0.0, rate_decay_per_s=0.0, terminal_rest=False,
+                                   relinearise_deg=0.0)  # fmt: skip
+    w = MpcUnrestrictedWashout(params, _context(_far_limits(limits)))
+    rng = np.random.default_rng(11)
+    w.start(np.array([0.0, 0.0, -G]), np.zeros(3))
+    w.q = Rotation.from_euler("ZYX", [-30.0, 8.0, 15.0], degrees=True).as_quat()[[3, 0, 1, 2]]
+    w.xo = 0.5 * rng.standard_normal(w.xo.shape)
+    w.xc = 0.2 * rng.standard_normal(w.xc.shape)
+    w._air_o = 0.5 * rng.standard_normal(w._air_o.shape)
+    w._air_c = 0.2 * rng.standard_normal(w._air_c.shape)
+    w._air_0 = (np.array([0.1, -0.1, -G]), np.zeros(3))
+    w.p = np.array([0.2, -0.1, 0.05])
+    w.v = np.array([-0.1, 0.2, 0.0])
+    w._a_prev = np.array([0.5, -1.5, 0.2])
+    w._f_prev = np.array([0.9, -0.2, -10.0])
+    f_air = np.array([1.2, -0.5, -10.3])
+    w_air = np.array([0.1, -0.05, 0.15])
+    ok, a_mv, w_mv = w._plan(f_air, w_air)
+    assert ok
+    z = np.concatenate([a_mv.ravel(), w_mv.ravel()])
+    j0 = _simulated_cost(w, z, f_air, w_air)
+    assert j0 > 1.0  # the felt part is far from zero here
+    for h in (1e-3, 1e-2):
+        for i in range(z.size):
+            e = np.zeros_like(z)
+            e[i] = h
+            assert _simulated_cost(w, z + e, f_air, w_air) > j0 - 1e-9 * j0
+            assert _simulated_cost(w, z - e, f_air, w_air) > j0 - 1e-9 * j0
+    for _ in range(10):
+        assert _simulated_cost(w, z + 0.02 * rng.standard_normal(z.size), f_air, w_air) > j0
+
+
 def test_the_plan_minimises_the_independently_simulated_cost(limits):
-    """From a banked, pitched and yawed cockpit with the error models, the stage and the rate away from rest and the
-    limits out of reach (no constraint active but the plan's end at rest, dropped here), the QP's plan is the
-    minimiser of the cost simulated step by step: its gradient there, by central differences, vanishes against the
-    cost's scale, and random moves away from it cost more."""
+    """The quadratic part alone (no felt error): from a banked, pitched and yawed cockpit with the error models, the
+    stage and the rate away from rest and the limits out of reach (no constraint active but the plan's end at rest,
+    dropped here), the QP's plan is the minimiser of the cost simulated step by step: its gradient there, by central
+    differences, vanishes against the cost's scale, and random moves away from it cost more."""
     params = MpcUnrestrictedParams(
-        reference_decay_per_s=0.0, terminal_rest=False, relinearise_deg=0.0, yardstick_weights=False
+        reference_decay_per_s=0.0, rate_decay_per_s=0.0, terminal_rest=False, relinearise_deg=0.0, felt_weight=0.0
     )
     w = MpcUnrestrictedWashout(params, _context(_far_limits(limits)))
     rng = np.random.default_rng(7)
