@@ -109,8 +109,11 @@ class FeltSlacks:
         f = self._f.copy()
         cue = dx / self.row_unit  # the aircraft pilot's cue in threshold units
         w = self.weight * self.false_weight * self.row_s
-        f[E : 2 * E] = np.where(cue > 1.0, 0.0, w)  # a positive simulator cue is false unless the aircraft's is
-        f[2 * E : 3 * E] = np.where(cue < -1.0, 0.0, w)
+        plus, minus = cue > 1.0, cue < -1.0  # a positive simulator cue is false unless the aircraft's is positive
+        f[E : 2 * E] = np.where(plus, 0.0, w)
+        f[2 * E : 3 * E] = np.where(minus, 0.0, w)
+        lo[2 * E : 3 * E][plus] = -INF  # a slack that costs nothing is not bound either (else its eps would)
+        lo[3 * E : 4 * E][minus] = -INF
         return lo, f
 
 

@@ -396,6 +396,7 @@ class MpcUnrestrictedWashout:
         self.xo = np.zeros((ao.shape[0], 3))
         self.xc = np.zeros((ac.shape[0], 3))
         self.solves = 0
+        self.relinearisations = 0
         self.fallbacks = 0
         self.iterations: list[int] = []
         self._sat_rot = False
@@ -454,6 +455,7 @@ class MpcUnrestrictedWashout:
         d0 = rotation_vector(quat_mul(quat_conj(self._q_lin), self.q)) if self._H is not None else None
         relinearise = d0 is None or float(_norm(d0)) > self._relin_rad
         if relinearise:  # a new linearisation point: the Hessian and its 3 x 3 factors are rebuilt
+            self.relinearisations += 1
             self._q_lin = self.q.copy()
             d0 = np.zeros(3)
             R0 = quat_matrix(self.q)
@@ -604,13 +606,15 @@ class MpcUnrestrictedWashout:
         return False, self._sat_rot
 
     def report(self) -> dict[str, float]:
-        """Solver statistics: solves, fallbacks (failed or unsafe solves: braking), iterations (median, max)."""
+        """Solver statistics: solves, fallbacks (failed or unsafe solves: braking), iterations (median, max),
+        relinearisations (new linearisation points: the QP's Hessian and rows rebuilt, DAQP factorised again)."""
         it = np.array(self.iterations) if self.iterations else np.zeros(1)
         return {
             "solves": float(self.solves),
             "fallbacks": float(self.fallbacks),
             "iterations_median": float(np.median(it)),
             "iterations_max": float(np.max(it)),
+            "relinearisations": float(self.relinearisations),
         }
 
 
