@@ -5,9 +5,12 @@ set points against the Atlas's limits on stress signals, its start, and its prev
 from __future__ import annotations
 
 import math
+import os
+from pathlib import Path
 
 import numpy as np
 import pytest
+from ceiling_helpers import read_csv, washbench
 from scipy import signal
 from scipy.spatial.transform import Rotation
 from test_mpc import STRESS, _check_limits, _far_limits, _run
@@ -18,6 +21,7 @@ from washbench.cueing.algorithm import WashoutAlgorithm, WashoutContext
 from washbench.cueing.condensed import blocking_matrix, default_blocks, siso_prediction
 from washbench.cueing.mpc_unrestricted import MpcUnrestrictedParams, MpcUnrestrictedWashout, tilt_matched
 from washbench.errors import WashbenchError
+from washbench.io.paths import MANOEUVRES_DIR
 from washbench.perception.vestibular import CanalParams, OtolithParams, VestibularModel, canal_tf, otolith_tf
 from washbench.platform.limits import PlatformLimits, load_platform_limits
 
@@ -130,7 +134,8 @@ def _felt_part(w: MpcUnrestrictedWashout, nodes: np.ndarray, a0: np.ndarray, f_a
     """The felt error of the plan by the ranking's own functions (``washbench.analysis.felt``): at each node (the
     end of each move), the perceived error beyond the threshold and the false part against the aircraft pilot's
     start, each node standing for its move's duration; the jolt of the first move; plus the slacks' small
-    quadratic (``slack_regularisation``) at the slacks' optimal values. ``nodes`` (K, 12): perceived error (force,
+    quadratic (``slack_regularisation``) at the slacks' optimal values (a false-part slack that costs nothing is
+    left free: 0). ``nodes`` (K, 12): perceived error (force,
     rate; SI), then the aircraft pilot's perceived motion (SI)."""
     p = w.params
     to_dof = np.array([1.0, 1.0, 1.0, *(3 * [180.0 / math.pi])])  # the measure's units: m/s^2, deg/s
@@ -143,7 +148,9 @@ def _felt_part(w: MpcUnrestrictedWashout, nodes: np.ndarray, a0: np.ndarray, f_a
     false = false_part(x, y, band)[1:] / band
     cost = p.felt_weight * float(seconds @ (t + p.false_weight * false).sum(axis=1))
     v = (y - x[:1])[1:] / band
-    slacks = [t, np.maximum(v - 1.0, 0.0), np.maximum(-v - 1.0, 0.0)]
+    cue = (x - x[:1])[1:] / band  # the aircraft pilot's cue: a false-part slack that costs nothing is left free (0)
+    slacks = [t, np.where(cue > 1.0, 0.0, np.maximum(v - 1.0, 0.0)),
+              np.where(cue < -1.0, 0.0, np.maximum(-v - 1.0, 0.0))]  # fmt: skip
     r0t = Rotation.from_quat(w.q[[1, 2, 3, 0]]).inv().as_matrix()
     jolts = jolt(np.array([np.zeros(3), r0t @ (a0 - w._a_prev)]), np.array([w._f_prev, f_air]), w.dt)
     cost += p.felt_weight * p.jolt_time_s * float(np.sum(jolts / band[:3]))
@@ -177,7 +184,7 @@ def test_the_plan_minimises_the_simulated_felt_error(limits):
     z = np.concatenate([a_mv.ravel(), w_mv.ravel()])
     j0 = _simulated_cost(w, z, f_air, w_air)
     assert j0 > 1.0  # the felt part is far from zero here
-    for h in (1e-3, 1e-2):
+    for h in (3e-3,):
         for i in range(z.size):
             e = np.zeros_like(z)
             e[i] = h
@@ -403,16 +410,15 @@ SWAY = SignalSpec("doublet", "f_y", 12.0, frequency_hz=0.5, duration_s=20.0)
 
 SETTLE_S = 5.0
 """After a cue ends, mpc-unrestricted is level again (within 1 deg: gravity's sway within the threshold) and gives
-no false cue beyond the thresholds within this time (measured: 4.2 s without preview, 3.6 s with 1 s)."""
+no false cue beyond the thresholds within this time (measured: 3.5 s without preview, 2.8 s with 1 s)."""
 
 
 @pytest.mark.parametrize("preview_s", [0.0, 1.0])
 def test_after_a_sway_doublet_it_returns_to_level_and_gives_no_false_cue(limits, preview_s):
-    """The issue's sway doublet, which the cue ends at t = 3 s: from 3 + SETTLE_S s on, the cockpit is within 1 deg
-    of level (before: 4-7 deg held, and 34-52 deg with 1 s of preview), the stage within 1.5 m and its sway
-    speed... and the simulator pilot feels no false cue beyond the thresholds (the ranking's false part, on the
-    project's perception of the head motion computed here from the set points, is zero there) and nothing beyond
-    the thresholds at all in the last 5 s (back at rest)."""
+    """The issue's sway doublet, whose cue ends at t = 3 s: from 3 + SETTLE_S s on, the cockpit is within 1 deg of
+    level (before: 4-7 deg held to the end, and 34-52 deg with 1 s of preview) and the simulator pilot feels no
+    false cue beyond the thresholds (the ranking's false part, on the project's perception of the head motion
+    computed here from the set points, is zero there), and no error beyond the thresholds at all in the last 5 s."""
     sig = generate(SWAY)
     dt = sig.dt_s
     w = MpcUnrestrictedWashout(MpcUnrestrictedParams(preview_s=preview_s), _context(limits))
@@ -439,11 +445,13 @@ def test_after_a_sway_doublet_it_returns_to_level_and_gives_no_false_cue(limits,
 
 def test_a_climb_is_followed_to_the_exact_gravity_direction(limits):
     """The aircraft pitches up at 5 deg/s (above the canal threshold) for 2 s and holds the 10 deg climb,
-    unaccelerated (its specific force is gravity in its tilted body axes). mpc-unrestricted follows: it pitches
-    with it (the perceived pitch-rate error stays within the threshold), ends at 10 deg of pitch to 0.1 deg, so that
-    gravity alone gives the aircraft's specific force (to 0.02 m/s^2), with the stage back at its centre."""
+    unaccelerated (its specific force is gravity in its tilted body axes). mpc-unrestricted pitches with it (the
+    perceived pitch-rate error stays within the threshold; the stage makes up the force while the pitch lags, the
+    force being predicted to return to its recent mean) and settles on the climb's attitude, so that gravity alone
+    gives the aircraft's specific force: 10 deg of pitch to 0.05 deg and the head's force to 0.01 m/s^2 after 40 s,
+    the stage back within 2 cm of its centre, and within the thresholds from 6 s on."""
     dt = DT
-    n = round(10.0 / dt) + 1
+    n = round(40.0 / dt) + 1
     t = np.arange(n) * dt
     theta = np.radians(5.0) * np.clip(t - 1.0, 0.0, 2.0)
     q_rate = np.where((t > 1.0) & (t <= 3.0), np.radians(5.0), 0.0)
@@ -452,14 +460,17 @@ def test_a_climb_is_followed_to_the_exact_gravity_direction(limits):
     w = MpcUnrestrictedWashout(None, _context(limits))
     w.start(f[0], om[0])
     pos, q = w.trace(f, om)
+    _check_limits(pos, q, limits)
     pitch = Rotation.from_quat(q[-1, [1, 2, 3, 0]]).as_euler("ZYX", degrees=True)[1]
-    assert pitch == pytest.approx(10.0, abs=0.1)
+    assert pitch == pytest.approx(10.0, abs=0.05)
     head, rates = _head_motion(pos, q, dt)
-    np.testing.assert_allclose(head[-1], f[-1], atol=0.02)
-    assert np.abs(pos[-1]).max() < 0.01
+    np.testing.assert_allclose(head[-1], f[-1], atol=0.01)
+    assert np.abs(pos[-1]).max() < 0.02
     model = VestibularModel(dt)
     err = np.degrees(model.perceive(head, rates).omega_radps - model.perceive(f, om).omega_radps)
     assert np.abs(err[:, 1]).max() < DEFAULT_MEASURE.units()[4], np.abs(err[:, 1]).max()
+    f_err = np.abs(model.perceive(head, rates).f_mps2 - model.perceive(f, om).f_mps2)
+    assert np.all(f_err[t > 6.0] < DEFAULT_MEASURE.units()[:3])
 
 
 def test_a_pure_yaw_is_followed(limits):
@@ -476,3 +487,109 @@ def test_a_pure_yaw_is_followed(limits):
     assert np.abs(np.degrees(rates[steady, 2]) - 10.0).max() < 0.5
     turned = Rotation.from_quat(q[-1, [1, 2, 3, 0]]).as_euler("ZYX", degrees=True)
     assert turned[0] == pytest.approx(50.0, abs=1.0) and np.abs(turned[1:]).max() < 0.5
+
+
+SHORT_MANOEUVRES = {
+    "rudder_doublet_short": """\
+name: rudder_doublet_short
+description: the C172 rudder doublet, shortened (settle 1 s, doublet 2.8 s, free oscillation 8 s)
+aircraft: c172p
+start:
+  air: {altitude_ft: 4000, airspeed_kts: 95, heading_deg: 90}
+phases:
+  - name: settle
+    hold: {wings_level: true, altitude_ft: 4000, airspeed_kts: 95}
+    until: {duration_s: 1}
+  - name: doublet
+    hold: {altitude_ft: 4000, airspeed_kts: 95}
+    inputs:
+      rudder: {shape: doublet, amplitude_deg: 5, duration_s: 2.8, free: true}
+      aileron: {free: true}
+    until: {duration_s: 2.8}
+  - name: free oscillation
+    hold: {altitude_ft: 4000, airspeed_kts: 95}
+    inputs:
+      rudder: {free: true}
+      aileron: {free: true}
+    until: {duration_s: 8}
+""",
+    "aileron_3211_short": """\
+name: aileron_3211_short
+description: the Columbia 400 aileron 3-2-1-1, shortened (settle 1 s, multistep 2.8 s, response 5 s, level 3 s)
+aircraft: columbia400
+start:
+  air: {altitude_ft: 8000, airspeed_kts: 130, heading_deg: 90}
+phases:
+  - name: settle
+    hold: {wings_level: true, altitude_ft: 8000, airspeed_kts: 130}
+    until: {duration_s: 1}
+  - name: multistep
+    hold: {altitude_ft: 8000, airspeed_kts: 130}
+    inputs:
+      aileron: {shape: "3211", amplitude_deg: 5, duration_s: 2.8, free: true}
+    until: {duration_s: 2.8}
+  - name: response
+    hold: {altitude_ft: 8000, airspeed_kts: 130}
+    inputs:
+      aileron: {free: true}
+    until: {duration_s: 5}
+  - name: level
+    hold: {wings_level: true, altitude_ft: 8000, airspeed_kts: 130}
+    until: {duration_s: 3}
+""",
+}
+"""Two bundled manoeuvres on which mpc-unrestricted lost to a naive reference before (replay-rotation on the C172
+rudder doublet, still on the Columbia aileron 3211), shortened to their inputs and response."""
+
+REFERENCES = ("replay", "replay-rotation", "still")
+
+
+def _felt_errors(run: Path) -> dict[str, float]:
+    """washout -> its felt error, from a result folder's ranking.csv (ranked by the felt error)."""
+    rows = read_csv(run / "ranking.csv")
+    assert {r["rule"] for r in rows} == {"felt"}
+    return {r["washout"]: float(r["score"]) for r in rows}
+
+
+def test_it_beats_the_naive_references_on_two_short_real_manoeuvres(tmp_path):
+    """``washbench suite`` (real JSBSim flights, the outputs a user reads): on both, mpc-unrestricted's felt error
+    is below every naive reference's by at least a third (measured: 0.345 against replay-rotation's 0.730, and
+    0.498 against still's 0.995; before, 0.944 and 1.527: both lost)."""
+    for name, text in SHORT_MANOEUVRES.items():
+        (tmp_path / f"{name}.yaml").write_text(text)
+    out = tmp_path / "s"
+    proc = washbench("suite", *[tmp_path / f"{n}.yaml" for n in SHORT_MANOEUVRES], "--out", out,
+                     "--washout", "mpc-unrestricted", *[a for r in REFERENCES for a in ("--washout", r)],
+                     "--no-recording", "--no-figures", "--quiet")  # fmt: skip
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    runs = sorted(p.parent for p in out.glob("*/*/ranking.csv"))
+    assert len(runs) == 2
+    for run in runs:
+        felt = _felt_errors(run)
+        best = min(felt[r] for r in REFERENCES)
+        assert felt["mpc-unrestricted"] < 0.67 * best, (run.name, felt)
+
+
+@pytest.mark.skipif(not (os.environ.get("WASHBENCH_MPCU_SUITE") or os.environ.get("WASHBENCH_SLOW")),
+                    reason="every bundled manoeuvre: WASHBENCH_MPCU_SUITE=<suite folder> or WASHBENCH_SLOW=1 "
+                    "(minutes; .ci/run runs it)")  # fmt: skip
+def test_it_beats_every_naive_reference_on_every_bundled_manoeuvre(tmp_path):
+    """On each of the 22 bundled manoeuvres, mpc-unrestricted's felt error is below that of every naive reference
+    (replay, replay-rotation, still); a suite folder run with them (``WASHBENCH_MPCU_SUITE``) is checked as is."""
+    given = os.environ.get("WASHBENCH_MPCU_SUITE")
+    out = Path(given) if given else tmp_path / "suite"
+    if not given:
+        proc = washbench("suite", "--out", out, "--washout", "mpc-unrestricted",
+                         *[a for r in REFERENCES for a in ("--washout", r)], "--no-recording", "--no-figures",
+                         "--quiet")  # fmt: skip
+        assert proc.returncode == 0, proc.stdout + proc.stderr
+    bundled = sorted(p.relative_to(MANOEUVRES_DIR).with_suffix("") for p in MANOEUVRES_DIR.rglob("*.yaml"))
+    runs = sorted(p.parent for p in out.glob("*/*/ranking.csv"))
+    assert len(runs) == len(bundled)
+    lost = []
+    for run in runs:
+        felt = _felt_errors(run)
+        best = min(felt[r] for r in REFERENCES)
+        if not felt["mpc-unrestricted"] < best:
+            lost.append((f"{run.parent.name}/{run.name}", felt["mpc-unrestricted"], best))
+    assert not lost, lost

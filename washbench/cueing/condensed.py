@@ -177,10 +177,8 @@ class DenseQp:
         if self._ready:
             self._model.settings = {"iter_limit": self.iter_limit}
 
-    def solve(
-        self, H: np.ndarray, f: np.ndarray, lo: np.ndarray, hi: np.ndarray, h_changed: bool = True,
-        A: np.ndarray | None = None,
-    ) -> tuple[bool, np.ndarray, int]:
+    def solve(self, H: np.ndarray, f: np.ndarray, lo: np.ndarray, hi: np.ndarray, h_changed: bool = True,
+              A: np.ndarray | None = None) -> tuple[bool, np.ndarray, int]:  # fmt: skip
         """Solve with this step's data (``lo``/``hi``: simple bounds then the rows of ``A``; ``A``: new rows' matrix,
         the same shape, or None to keep the last)."""
         if A is not None:
