@@ -10,23 +10,28 @@ rotation ``dtheta`` (body axes, rad) is, to first order,
 and ``d(dtheta)/dt = omega`` (the sphere's body rate, rad/s). The washout solves, by DAQP (a dual active-set solver
 for small dense QPs, warm-started: :class:`washbench.cueing.condensed.DenseQp`), over N intervals of ``tp``
 
-    minimise  sum_k  |e_oto,k|^2_Wo + |e_f,k|^2_Wd + |e_can,k|^2_Wc + |p_k|^2_Wp + |v_k|^2_Wv
-                     + r_a |a_k|^2 + r_w |omega_k|^2                            (times tp)
+    minimise  kappa F(z)  +  sum_k tp ( |e_oto,k|^2_Wo + |e_f,k|^2_Wd + |e_can,k|^2_Wc + |p_k|^2_Wp + |v_k|^2_Wv
+                                         + r_a |a_k|^2 + r_w |omega_k|^2 )
     subject to  |a| <= margin a_max per inertial axis, |p|, |v| likewise (nodes 1..N), v_N = 0 (optional),
                 |omega|_1 <= margin rate limit (inside the Atlas's 2-norm ball), and its change per move
                 (from the current rate over one sample for the first move) within margin alpha_max,
 
 where ``e_oto`` and ``e_can`` are the perceived errors (the paper's otolith and canal models, Eqs. 11-12, driven by
-simulator minus aircraft head signals in body axes), ``e_f`` the specific-force error at the head itself, and the
-aircraft input over the horizon returns from its last value to its recent mean as ``e^{-gamma t}``, or, with
-``preview_s`` > 0 and the recording known (``run``, ``suite``, ``cue``: :meth:`MpcUnrestrictedWashout.trace`), the
-aircraft's own future. Decisions are held over blocks of intervals (move blocking). There is no attitude cost and no
-tilt-rate limit: the sphere may turn without limit, and tilt is paid for only by what the canals perceive of it.
-The canal weights follow the ranking's score (``yardstick_weights``): multiplied by the squared ratio of the
-aircraft pilot's mean felt force to mean felt rate so far (to the power ``yardstick_power``). The first move is
-applied for one sample, exactly: the stage integrates ``a``, the attitude ``q <- q exp(omega dt / 2)``, and the error
-models are driven by the head signals of that exact motion. See docs/optimal-mpc.md ("mpc-unrestricted") for the
-derivation, the references and the choices.
+simulator minus aircraft head signals in body axes), ``e_f`` the specific-force error at the head itself, and
+``F(z)`` the ranking's felt error predicted over the horizon (:mod:`washbench.cueing.felt_qp`: at the end of each
+move, the perceived error beyond the perception thresholds and its false part against the aircraft pilot's own
+perceived motion, in threshold-seconds, and the jolt of the first move; slack variables represent it exactly). The
+quadratic terms are small (0.1 per threshold squared): they make the plan unique and bring the cockpit back to
+level and the stage to its centre where the felt error is indifferent (below the thresholds). The aircraft's
+specific force over the horizon returns from its last value to its recent mean as ``e^{-gamma t}``, its angular
+velocity likewise with ``gamma_w``, or, with ``preview_s`` > 0 and the recording known (``run``, ``suite``, ``cue``:
+:meth:`MpcUnrestrictedWashout.trace`), the aircraft's own future is used. Decisions are held over blocks of
+intervals (move blocking). There is no attitude cost and no tilt-rate limit: the sphere may turn without limit, a
+rotation is paid for by what the canals perceive of it beyond their threshold and by the force its tilt adds. The
+first move is applied for one sample: the stage integrates ``a`` as the platform does (semi-implicit Euler, so the
+head feels ``a`` in the same sample), the attitude ``q <- q exp(omega dt / 2)``, and the error models are driven by
+the head signals of that motion. See docs/optimal-mpc.md ("mpc-unrestricted") for the derivation, the references
+and the choices.
 """
 
 from __future__ import annotations
@@ -107,13 +112,13 @@ class MpcUnrestrictedParams(StrictModel):
     preview_s: Annotated[float, Field(ge=0.0, le=20.0, allow_inf_nan=False)] = 0.0
     """how far ahead the aircraft's motion is known (s): 0 none; > 0 needs the recording in advance"""
     reference_decay_per_s: Annotated[float, Field(ge=0.0, le=100.0, allow_inf_nan=False)] = 0.5
-    """gamma: beyond what is previewed, the aircraft's specific force and rate are predicted to return from the last
-    known value to their recent mean as e^{-gamma t} (0: held)"""
+    """gamma: beyond what is previewed, the aircraft's specific force is predicted to return from the last known value
+    to its recent mean as e^{-gamma t} (0: held)"""
     rate_decay_per_s: Annotated[float, Field(ge=0.0, le=100.0, allow_inf_nan=False)] = 4.0
-    """gamma_w: the same for the aircraft's angular velocity (faster: an aircraft's rates are transients, its
-    specific force is held)"""
+    """gamma_w: the same for the aircraft's angular velocity (chosen faster: a rate is predicted to fade within about
+    0.25 s, so a tilt that following it would add is not overrated)"""
     reference_mean_s: Annotated[float, Field(gt=0.0, le=600.0, allow_inf_nan=False)] = 5.0
-    """the time constant of that recent mean (s): a first-order low-pass of the aircraft's input, started at the
+    """the time constant of those recent means (s): a first-order low-pass of the aircraft's input, started at the
     first sample, so a steady flight is predicted to stay as it is"""
     limit_margin: Annotated[float, Field(gt=0.0, le=1.0)] = 0.95
     """the QP's limits are this fraction of the platform's"""
@@ -129,9 +134,9 @@ class MpcUnrestrictedParams(StrictModel):
     """quadratic weights of the perceived angular-velocity error (canals), body roll, pitch, yaw, per (rad/s)^2
     (default 0.1 / T^2)"""
     position: AxisWeights = _axes(0.1, 0.1, 0.5)
-    """stage position, inertial north, east, down, per m^2"""
+    """quadratic weights of the stage's position, inertial north, east, down, per m^2"""
     velocity: AxisWeights = _axes(0.1, 0.1, 0.125)
-    """stage velocity, per (m/s)^2"""
+    """quadratic weights of the stage's velocity, per (m/s)^2"""
     acceleration: PositiveWeight = 0.05
     """stage acceleration (control), per (m/s^2)^2"""
     angular_rate: PositiveWeight = 0.05
@@ -141,17 +146,22 @@ class MpcUnrestrictedParams(StrictModel):
     0: every sample); in between the turn so far enters the prediction as an offset (first order: an error of at
     most g (1 - cos x) ~ 0.006 m/s^2 at 2 deg)"""
     felt_weight: Weight = 1.0
-    """kappa: the weight of the felt error's prediction in the cost (threshold-seconds; 0: the quadratic cost alone)"""
+    """kappa: the weight of the felt error's prediction in the cost, per threshold-second (0: the quadratic terms
+    alone, a QP without slacks)"""
     false_weight: Weight = 1.0
-    """lambda: the false part counted again (the ranking's, analysis/felt.py)"""
+    """lambda: the false part counted again (the ranking's: washbench.analysis.felt.FALSE_WEIGHT)"""
     jolt_time_s: Weight = 1.0
-    """tau_j (s): a jolt counts as a felt error held this long (the ranking's)"""
+    """tau_j (s): a jolt counts as a felt error held this long (the ranking's: JOLT_TIME_S)"""
     jerk_deadband_mps3: Weight = 50.0
-    """J_T: jerk the stage may add at the head beyond the aircraft's without cost (the ranking's)"""
+    """J_T (m/s^3): jerk the stage may add at the head beyond the aircraft's without cost (the ranking's:
+    JERK_DEADBAND_MPS3)"""
     thresholds: Thresholds = ZACHARIAS
-    """the DOFs' perception thresholds, the felt error's units and dead bands"""
+    """the DOFs' perception thresholds (Zacharias 1978 by default, as the ranking's): the felt error's units and
+    dead bands"""
     slack_regularisation: PositiveWeight = 1e-3
-    """eps: the slacks' quadratic cost (keeps the Hessian positive definite), per unit^2"""
+    """eps: the slacks' quadratic cost, per (threshold units)^2 or (m/s^2)^2 for a jolt: keeps the Hessian
+    positive definite for the dual active-set solver (chosen small against the slacks' linear costs, 0.1-0.5 per
+    threshold unit: 10 thresholds beyond the dead band cost 2-10 % more)"""
     solver: DaqpSettings = DaqpSettings()
 
     @model_validator(mode="before")
@@ -242,8 +252,9 @@ class MpcUnrestrictedWashout:
     """``mpc-unrestricted`` per step (:class:`washbench.cueing.algorithm.WashoutAlgorithm`), see the module docstring.
 
     State: attitude ``q`` (body to inertial, scalar first), stage position ``p`` and velocity ``v`` (inertial, from
-    the centre), the applied rate ``w``, the otolith (2, 3) and canal (3, 3) error-model states per body axis.
-    Counters (:meth:`report`): solves, fallbacks (failed or unsafe solves: braking), iterations.
+    the centre), the applied rate ``w`` and acceleration, the otolith (2, 3) and canal (3, 3) error-model states per
+    body axis, and the aircraft pilot's own otolith and canal states (for the felt error's false part). Counters
+    (:meth:`report`): solves, fallbacks (failed or unsafe solves: braking), iterations, relinearisations.
     """
 
     Params = MpcUnrestrictedParams
