@@ -37,15 +37,28 @@ def check_ceiling_below_every_washout(run_dir: Path) -> dict[str, float]:
     rows = read_csv(run_dir / "ceiling.csv")
     assert rows, run_dir
     ranking = {r["washout"]: float(r["score"]) for r in read_csv(run_dir / "ranking.csv")}
-    errors = {(r["washout"], r["dof"]): float(r["integral_error"]) for r in read_csv(run_dir / "metrics.csv")}
-    motion = {d: v["value"] for d, v in json.loads((run_dir / "run.json").read_text())["perceived_motion"].items()}
+    run = json.loads((run_dir / "run.json").read_text())
+    motion = {d: v["value"] for d, v in run["perceived_motion"].items()}
+    rule = run["provenance"]["ranking"]
+    measure = rule.get("measure") or {}
+
+    def term(m: dict[str, str]) -> float:
+        """The rule's term of a DOF (m/s^2*s or deg) from metrics.csv's row, worked out here from the file."""
+        if rule["by"] != "felt":
+            return float(m["integral_error"])
+        jolt = float(m["jolt"]) if m["jolt"] else 0.0
+        return (float(m["felt_error"]) + measure["false_weight"] * float(m["felt_false"])
+                + measure["jolt_time_s"] * jolt)  # fmt: skip
+
+    errors = {(r["washout"], r["dof"]): term(r) for r in read_csv(run_dir / "metrics.csv")}
+    felt = "felt_" if rule["by"] == "felt" else ""
     scores = {}
     for r in rows:
         if r["dof"] == "score":
             assert float(r["relative_error"]) == ranking[r["washout"]]  # the ranking's own measure
             scores[r["washout"]] = float(r["relative_error"])
         elif r["relative_error"]:
-            rel = errors[(r["washout"], r["dof"])] / float(motion[r["dof"]])
+            rel = errors[(r["washout"], r["dof"])] / float(motion[felt + r["dof"]])
             assert float(r["relative_error"]) == pytest.approx(rel, rel=1e-12)
         if not r["ceiling"]:
             continue

@@ -37,7 +37,7 @@ from pathlib import Path
 
 #: The commands run in the test process: they start no process of their own (``suite`` does, ``live`` serves and
 #: starts viewers) and read no plugin (a washout or platform plugin is registered for the process).
-IN_PROCESS = frozenset({"cue", "fly", "run", "report", "validate", "schema", "signal", "examples", "omct"})
+IN_PROCESS = frozenset({"cue", "fly", "run", "report", "validate", "schema", "signal", "examples", "omct", "track"})
 #: ... and these with ``--from`` (the flights already flown) or one manoeuvre file to fly (more are flown in a pool
 #: of processes).
 STUDIES = frozenset({"sweep", "tune"})

@@ -281,8 +281,9 @@ def test_the_suite_report_opens_with_a_verdict_whose_counts_add_up(replay_suite:
     text = (replay_suite / "report.md").read_text()
     assert text.index("## Verdict") < text.index("## Summary") < text.index("## How to read the numbers")
     verdict = text[text.index("## Verdict") : text.index("## Summary")]
-    assert "gain over small-angle" in verdict and "ceiling reached" in verdict
-    line = next(x for x in verdict.splitlines() if x.startswith("First place alone:"))
+    assert "gain over small-angle" in verdict and "| ceiling | best achieved | bracket's width |" in verdict
+    assert "**Not compared**" in verdict and "--washout all" in verdict  # it says what it did not compare
+    line = next(x for x in verdict.splitlines() if x.startswith("First place alone among the washouts:"))
     counts = [int(n) for n in __import__("re").findall(r" (\d+)[,;]", line.split("together")[0])]
     total = int(line.split("together ")[1].split(" of ")[0])
     assert sum(counts) == total == 2 and line.rstrip().endswith("of 2 manoeuvres.")

@@ -78,3 +78,34 @@ def test_commands_import_only_what_they_need(tmp_path) -> None:
     assert imported_by(["run", str(tmp_path / "m.yaml"), "--out", str(tmp_path / "r2"), "--quiet"]) == {
         "rerun", "matplotlib"
     }  # fmt: skip
+
+
+def test_hints_a_new_user_expects(tmp_path, capsys) -> None:
+    """Issue 52, item 10: one line each, naming what was meant: an option misspelt (``--output``), washouts given as
+    one list, a manoeuvre file given to ``cue`` (``run`` flies it), a Python file given to ``--platform``."""
+    from washbench.cli import main
+    from washbench.io.paths import MANOEUVRES_DIR
+
+    manoeuvre = MANOEUVRES_DIR / "c172" / "takeoff.yaml"
+    cases = [
+        (["suite", "--output", "r"], "the following arguments are required: --out (--output: did you mean --out?)"),
+        (["run", "c172/takeoff", "--out", "r", "--output", "x"], "(--output: did you mean --out?)"),
+        (["run", "c172/takeoff", "--out", str(tmp_path / "r"), "--washout", "small-angle,large-angle"],
+         "--washout small-angle,large-angle: one washout per --washout; repeat it: --washout small-angle --washout "
+         "large-angle"),
+        (["cue", str(manoeuvre), "--out", str(tmp_path / "c")],
+         f"{manoeuvre}: a manoeuvre file, which cue does not read (cue takes a recorded trace: CSV, Parquet, X-Plane "
+         f"Data.txt, JSBSim CSV); fly it with the washouts: washbench run {manoeuvre} --out DIR"),
+        (["cue", "c172/takeoff", "--out", str(tmp_path / "c")], "c172/takeoff: a bundled manoeuvre's name"),
+        (["run", "c172/steep_trun", "--out", str(tmp_path / "r")], "did you mean c172/steep_turn?"),
+        (["run", "c172/takeoff", "--out", str(tmp_path / "r"), "--platform", "mywork/box.py"],
+         "load a plugin with --platform-plugin mywork/box.py:CLASS"),
+    ]  # fmt: skip
+    for argv, expected in cases:
+        try:
+            status = main(argv)
+        except SystemExit as exc:  # argparse's usage errors
+            status = exc.code
+        err = capsys.readouterr().err.strip().splitlines()
+        assert status == 2 and len(err) == 1 and expected in err[0], (argv, err)
+    assert not (tmp_path / "r").exists() and not (tmp_path / "c").exists()

@@ -55,9 +55,10 @@ def test_top_level_help_names_the_docs() -> None:
     assert "docs/reference/commands.md" in proc.stdout
 
 
-RUN_AS_WRITTEN = [("validate", 0), ("examples", 0), ("examples", 1)]
+RUN_AS_WRITTEN = [("validate", 0), ("examples", 0), ("examples", 1), ("run", 2)]
 """Examples that need no file of the user's: each must work as written, in a shell, in an empty folder (the
-first example of ``validate --help`` named ``manoeuvres/*.yaml``, which is nowhere: issue 38, item 6)."""
+first example of ``validate --help`` named ``manoeuvres/*.yaml``, which is nowhere: issue 38, item 6; ``run``'s
+JSBSim script by name was "no such file": issue 52, item 9)."""
 
 
 @pytest.mark.parametrize(("command", "index"), RUN_AS_WRITTEN)

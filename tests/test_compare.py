@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 import numpy as np
@@ -98,3 +99,24 @@ def test_cli_errors_are_one_line_before_any_viewer_starts(pair, tmp_path, capsys
         assert main(["replay", "--web", *map(str, args)]) == 2
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and err[0].startswith("washbench: error:"), err
+
+
+def test_an_atlas_and_a_hexapod_compare_on_what_both_hold(pair, tmp_path):
+    """Issue 52, item 7: a hexapod's recording (no wheels) against an Atlas's ended in ``KeyError:
+    '/envelope/wheels'``; now both are compared on what both hold, and what one lacks is said."""
+    a, _, _ = pair
+    base = make_data(n=240, seed=3)
+    no_wheels = dataclasses.replace(base.envelope, wheel_radps=None)
+    hexapod = tmp_path / "hexapod.rrd"
+    write_recording(hexapod, dataclasses.replace(base, envelope=no_wheels), {"platform.name": "a hexapod"})
+    assert "/envelope/wheels" in read_scalar_series(a) and "/envelope/wheels" not in read_scalar_series(hexapod)
+    for first, second in ((a, hexapod), (hexapod, a)):
+        out = tmp_path / f"{first.stem}-{second.stem}.rrd"
+        notes = write_comparison(first, second, out)
+        assert notes == [f"{hexapod} (a hexapod) has no wheels envelope panel, which {a} (its platform) has: "
+                         "compared without it"]  # fmt: skip
+        series = read_scalar_series(out)
+        assert "/envelope/wheels" not in series
+        assert {"/envelope/position", "/envelope/velocity", "/envelope/acceleration"} <= set(series)
+        _, usage = series["/envelope/position"]
+        assert usage.shape[1] == 6  # both recordings' washouts

@@ -155,3 +155,17 @@ def test_jobs_and_precedence_in_one_folder(tmp_path: Path) -> None:
     (tmp_path / "sub" / "pyproject.toml").write_text('[project]\nname = "x"\n')
     found = discover(tmp_path / "sub")
     assert found is not None and found.path == tmp_path / "washbench.toml"
+
+
+def test_a_bundled_platform_by_name(tmp_path: Path) -> None:
+    """Issue 52, item 5: the file's ``platform`` takes the bundled names ``--platform`` takes (a file beside the
+    configuration of that name would win)."""
+    (tmp_path / "washbench.toml").write_text('platform = "rig2dof"\nout = "r"\n')
+    small_csv(tmp_path / "small.csv")
+    proc = washbench(tmp_path, "cue", "small.csv", "--no-recording", "--no-figures")
+    assert proc.returncode == 0, proc.stderr
+    prov = json.loads((tmp_path / "r" / "run.json").read_text())["provenance"]
+    assert prov["platform"]["path"] == "washbench:data/rig2dof.yaml"
+    (tmp_path / "washbench.toml").write_text('platform = "rig3"\nout = "r"\n')
+    line = one_error_line(washbench(tmp_path, "cue", "small.csv"))
+    assert "washbench.toml:1: platform: no such file" in line and "nor a bundled name (atlas, hexapod, rig2dof)" in line

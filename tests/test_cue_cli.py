@@ -13,6 +13,7 @@ import pytest
 
 from washbench.analysis.metrics import DOFS
 from washbench.cueing import WASHOUT_NAMES
+from washbench.cueing.variants import DEFAULT_WASHOUTS
 from washbench.io.columns import INPUT_COLUMNS, washout_columns
 from washbench.io.metrics_csv import read_metrics_csv
 from washbench.io.motion_file import read_motion
@@ -77,8 +78,8 @@ def test_cue_writes_traces_and_metrics(kind: str, inputs: dict[str, Path], tmp_p
     ]
 
     rows = read_metrics_csv(out / "metrics.csv")
-    assert len(rows) == 18
-    assert [(r.washout, r.dof) for r in rows] == [(w, d) for w in WASHOUT_NAMES for d in DOFS]
+    assert len(rows) == 6 * len(DEFAULT_WASHOUTS)
+    assert [(r.washout, r.dof) for r in rows] == [(w, d) for w in DEFAULT_WASHOUTS for d in DOFS]
     for r in rows:
         assert math.isnan(r.npc) or r.npc >= 1.0 - 1e-12
         assert r.integral_error >= 0.0 and r.max_error >= 0.0
@@ -96,7 +97,7 @@ def test_cue_writes_traces_and_metrics(kind: str, inputs: dict[str, Path], tmp_p
     sat = [c.removeprefix("small-angle.sat_") for c in table if c.startswith("small-angle.sat_")]
     assert sat
     expected = ["t_s", *(c for c in table if c.startswith("aircraft."))]
-    for w in WASHOUT_NAMES:
+    for w in DEFAULT_WASHOUTS:
         expected += washout_columns(w, sat)
     assert list(table) == [*expected, "altitude_ft"]
     assert set(np.unique(table["small-angle.sat_tilt_rate"])) <= {0, 1}

@@ -41,6 +41,7 @@ FLOORS: dict[str, int] = {
     "perception": 3,
     "cueing": 4,
     "analysis": 5,
+    "pilot": 5,
     "review": 6,
     "live": 7,
     "runs": 8,

@@ -85,11 +85,39 @@ def test_suite_stops_at_once_and_leaves_the_previous_results(
     else:
         assert proc.returncode == status, err
         assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
-        assert err.strip().splitlines()[-1] == f"washbench: {word}", err
+        # once the runs had begun, the line says what was lost and that nothing was written (issue 52, item 6d)
+        lost = (f"washbench: {word}: 0 of 3 manoeuvres had finished; their runs are discarded and nothing was "
+                f"written to {out} (its earlier results stay as they were)")  # fmt: skip
+        last = err.strip().splitlines()[-1]
+        assert last == lost if group else last in (f"washbench: {word}", lost), err
     assert wait_for_no_process(proc.pid) == []
     assert tree(out) == before  # no half-built folder, no lock, nothing new
     time.sleep(1.0)
     assert tree(out) == before  # and nothing appears later
+
+
+def test_an_interrupted_suite_says_how_many_runs_it_discards(manoeuvres: Path, tmp_path: Path) -> None:
+    """Issue 52, item 6 (d): Ctrl-C after the first of three manoeuvres finished: the last line says that one had
+    finished, that its run is discarded and that nothing was written (the earlier results stay as they were)."""
+    out = tmp_path / "out"
+    before = previous_suite(out)
+    first = short(tmp_path, name="first", seconds=1)
+    proc = start("suite", first, manoeuvres / "long_0.yaml", manoeuvres / "long_1.yaml", "--out", out, "--jobs", "1",
+                 "--no-recording", "--no-figures")  # fmt: skip
+    seen = []
+    assert proc.stderr is not None
+    for line in proc.stderr:  # the progress lines (plain: stderr is a pipe); the first run's comes once it is counted
+        seen.append(line)
+        if line.startswith("[ 1/3] ok"):
+            break
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    err = "".join(seen) + err
+    assert proc.returncode == 130, err
+    assert err.strip().splitlines()[-1] == (
+        f"washbench: interrupted: 1 of 3 manoeuvres had finished; their runs are discarded and nothing was written to "
+        f"{out} (its earlier results stay as they were)"), err
+    assert tree(out) == before
 
 
 def test_run_terminated_in_flight_removes_its_half_built_folder(manoeuvres: Path, tmp_path: Path) -> None:

@@ -26,6 +26,7 @@ import pyarrow.parquet as pq
 import pytest
 
 from washbench.cli import main
+from washbench.cueing.variants import DEFAULT_WASHOUTS
 from washbench.errors import WashbenchError
 from washbench.io.readers import read_samples
 from washbench.live import commands, packets
@@ -690,12 +691,13 @@ def test_a_viewer_closed_while_running(tmp_path: Path, monkeypatch: pytest.Monke
 
     series = read_scalar_series(rrd)
     t, surge = series["/raw/surge"]
-    assert 1 <= len(t) < 180 and surge.shape == (len(t), 4)  # at most 30 rows a second, none after the close
+    # at most 30 rows a second, none after the close; the default washouts and the aircraft
+    assert 1 <= len(t) < 180 and surge.shape == (len(t), 1 + len(DEFAULT_WASHOUTS))
     assert t[-1] <= m[200][0]  # seen ended at the next sample (rows at most 30 a second)
     # the values at each logged time are those of the result (the same step, the same filters chunk by chunk)
     table = pq.read_table(tmp_path / "o" / "traces.parquet").to_pydict()
     row_of = {round(v, 9): i for i, v in enumerate(table["t_s"])}
-    names = ("small-angle", "large-angle", "unrestricted", "aircraft")
+    names = (*DEFAULT_WASHOUTS, "aircraft")
     tp, perceived = series["/perceived/surge"]
     np.testing.assert_array_equal(tp, t)
     for ti, raw, felt in zip(t, surge, perceived, strict=True):

@@ -206,3 +206,18 @@ def test_wind_is_from_direction_and_model_is_frozen() -> None:
     assert m.environment.wind is not None and m.environment.wind.from_deg == 340.0
     with pytest.raises(Exception):  # noqa: B017 - pydantic raises its own ValidationError for frozen models
         m.name = "x"  # type: ignore[misc]
+
+
+def test_no_turbulence_needs_no_seed(tmp_path: Path) -> None:
+    """Issue 52, item 10: ``turbulence: {severity: none}`` was refused for a missing seed; any other severity still
+    needs one (the same seed, the same gusts), said in one line with the file's line and field."""
+    text = (MANOEUVRES_DIR / "c172" / "steep_turn.yaml").read_text()
+    calm = tmp_path / "calm.yaml"
+    calm.write_text(text + "environment:\n  turbulence: {severity: none}\n")
+    assert load_manoeuvre(calm).environment.turbulence.seed is None
+    gusty = tmp_path / "gusty.yaml"
+    gusty.write_text(text + "environment:\n  turbulence: {severity: light}\n")
+    line = len(text.splitlines()) + 2
+    with pytest.raises(WashbenchError, match=rf"^{gusty}:{line}: environment\.turbulence\.seed: missing required field "
+                       r"\(severity light needs a seed"):  # fmt: skip
+        load_manoeuvre(gusty)

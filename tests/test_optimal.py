@@ -84,11 +84,21 @@ def _euler(q: np.ndarray) -> np.ndarray:
 
 
 def _designed_tf(designs, channel: str, inp: int, out: str):
+    """The designed transfer function from input ``inp`` to output ``out``, its numerator without the leading
+    coefficients that are zero by structure: as many as the Markov parameters D, C B, C A B, ... that vanish (the
+    relative degree: D = 0 and, for a position, C B = 0). ss2tf leaves them as 0 and ~1e-16 (rounding of an exact 0),
+    and TransferFunction warned of badly conditioned coefficients (scipy's BadCoefficients) and stripped them."""
     d = designs[channel]
     c, dmat, names = d.outputs()
     row = names.index(out)
     num, den = signal.ss2tf(d.A_w, d.B_w, c[row : row + 1], dmat[row : row + 1], input=inp)
-    return signal.TransferFunction(num[0], den)
+    b, cr = d.B_w[:, inp], c[row]
+    powers = [np.linalg.matrix_power(d.A_w, k) for k in range(len(b))]
+    markov = [(dmat[row, inp], 1.0), *((cr @ a @ b, np.linalg.norm(cr) * np.linalg.norm(a) * np.linalg.norm(b))
+                                       for a in powers)]  # fmt: skip
+    lead = next(i for i, (m, size) in enumerate(markov) if abs(m) > 1e-9 * size)  # each against its own size
+    assert np.all(np.abs(num[0][:lead]) <= 1e-12 * np.max(np.abs(num[0])))  # zero but for rounding, as they must be
+    return signal.TransferFunction(num[0][lead:], den)
 
 
 def test_step_response_matches_the_designed_transfer_functions(context, designs):

@@ -23,13 +23,20 @@ from washbench.flight.manoeuvre import load_manoeuvre
 from washbench.io.paths import (
     AIRCRAFT_DIR,
     AIRCRAFT_PATH_ENV,
+    BUNDLED_PARAMS,
+    BUNDLED_PLATFORMS,
+    DATA_DIR,
     MANOEUVRES_DIR,
+    bundled_file,
     find_aircraft,
     find_profile,
     jsbsim_root,
+    resolve_data_file,
     resolve_manoeuvre,
     search_places,
+    unknown_manoeuvre,
 )
+from washbench.io.provenance import bundled_name
 
 BUNDLED_C400 = AIRCRAFT_DIR / "columbia400"
 
@@ -143,6 +150,64 @@ def test_bundled_manoeuvres_by_name(tmp_path: Path) -> None:
     assert resolve_manoeuvre(Path("no/such")) == Path("no/such")
 
 
+def test_jsbsim_scripts_and_provenance_names_name_manoeuvres(tmp_path: Path) -> None:
+    """Issue 52, items 5 and 9: ``run c172_cruise_8K.xml`` (its ``--help`` example), ``c1723`` and the provenance's
+    spellings name the same files from any folder; a misspelt name gets the closest ones."""
+    script = jsbsim_root() / "scripts" / "c1723.xml"
+    for name in ("c1723", "c1723.xml", "jsbsim:scripts/c1723.xml"):
+        assert resolve_manoeuvre(Path(name)) == script
+    assert resolve_manoeuvre(Path("washbench:manoeuvres/c172/takeoff.yaml")) == MANOEUVRES_DIR / "c172" / "takeoff.yaml"
+    assert "did you mean c172/steep_turn?" in str(unknown_manoeuvre(Path("c172/steep_trun")))
+    assert "did you mean c172_cruise_8K?" in str(unknown_manoeuvre(Path("c172_cruise_8k.xml")))
+
+
+def test_bundled_data_files_by_name(tmp_path: Path) -> None:
+    """Issue 52, item 5: ``--platform hexapod``, ``hexapod.yaml`` or the provenance's ``washbench:data/hexapod.yaml``
+    name the bundled file from any folder (an existing file of the user's wins); every bundled YAML file has a name,
+    and every file the provenance names as bundled resolves back to itself."""
+    assert sorted(p.stem for p in DATA_DIR.glob("*.yaml")) == sorted((*BUNDLED_PLATFORMS, *BUNDLED_PARAMS))
+    for name in BUNDLED_PLATFORMS:
+        for spelt in (name, f"{name}.yaml", f"washbench:data/{name}.yaml"):
+            assert resolve_data_file(Path(spelt), "--platform") == DATA_DIR / f"{name}.yaml"
+    assert resolve_data_file(Path("cw1"), "--params") == DATA_DIR / "cw1.yaml"
+    mine = tmp_path / "hexapod.yaml"
+    mine.write_text("kind: hexapod\n")
+    assert resolve_data_file(mine, "--platform") == mine
+    bundled = [*DATA_DIR.glob("*.yaml"), *MANOEUVRES_DIR.glob("*/*.yaml"), *AIRCRAFT_DIR.glob("*/pilot.yaml"),
+               jsbsim_root() / "scripts" / "c1723.xml"]  # fmt: skip
+    for path in bundled:
+        named = bundled_name(path)
+        assert named is not None and bundled_file(named[1]) == path, path
+    with pytest.raises(WashbenchError, match=r"washbench/data/hexapod\.yaml: no such file.*did you mean --platform "
+                       r"hexapod\?"):  # fmt: skip
+        resolve_data_file(tmp_path / "washbench/data/hexapod.yaml", "--platform")  # (the checkout's: elsewhere)
+    with pytest.raises(WashbenchError, match=r"load a plugin with --platform-plugin mywork/box\.py:CLASS"):
+        resolve_data_file(Path("mywork/box.py"), "--platform")
+    with pytest.raises(WashbenchError, match=r"--params cw2: no such file, nor a bundled name \(cw1"):
+        resolve_data_file(Path("cw2"), "--params")
+
+
+def test_bundled_platforms_by_name_from_an_empty_folder(tmp_path: Path) -> None:
+    """Issue 52, item 5: the bundled hexapod and rig named from a folder that is not a checkout, recorded by the same
+    name (``washbench:data/...``) in the provenance; ``washbench examples`` copies every platform file."""
+    out = _cli("run", "c172/elevator_doublet", "--out", "r", "--platform", "hexapod", "--no-recording",
+               "--no-figures", "--quiet", cwd=tmp_path)  # fmt: skip
+    assert out.returncode == 0, out.stderr
+    run = json.loads((tmp_path / "r" / "c172p" / "elevator_doublet" / "run.json").read_text())
+    assert run["provenance"]["platform"]["path"] == "washbench:data/hexapod.yaml"
+    rows = ["t_s,f_x_mps2,f_y_mps2,f_z_mps2,omega_x_degps,omega_y_degps,omega_z_degps"]
+    rows += [f"{k / 100},{0.5 * (k > 50)},0,-9.80665,{2.0 * (k > 100)},0,0" for k in range(300)]
+    (tmp_path / "step.csv").write_text("\n".join(rows) + "\n")
+    out = _cli("cue", "step.csv", "--out", "c", "--platform", "washbench:data/rig2dof.yaml", "--params", "cw1",
+               "--no-recording", "--no-figures", "--quiet", cwd=tmp_path)  # fmt: skip
+    assert out.returncode == 0, out.stderr
+    provenance = json.loads((tmp_path / "c" / "run.json").read_text())["provenance"]
+    assert provenance["platform"]["path"] == "washbench:data/rig2dof.yaml"
+    assert provenance["params"]["path"] == "washbench:data/cw1.yaml"
+    out = _cli("run", "c172/elevator_doublet", "--out", "r", "--platform", "washbench/data/hexapod.yaml", cwd=tmp_path)
+    assert out.returncode == 2 and "did you mean --platform hexapod?" in out.stderr
+
+
 def _cli(*args: str, cwd: Path, env: dict[str, str] | None = None) -> subprocess.CompletedProcess[str]:
     return inprocess.washbench(*args, cwd=cwd, timeout=300, env={**os.environ, **(env or {})})
 
@@ -170,6 +235,8 @@ def test_examples_copies_a_runnable_project_and_never_overwrites(tmp_path: Path,
     assert copied == sorted(p.relative_to(MANOEUVRES_DIR) for p in MANOEUVRES_DIR.glob("*/*.yaml"))
     profile = tmp_path / "ex" / "aircraft" / "c172p" / "pilot.yaml"
     assert profile.read_text() == (AIRCRAFT_DIR / "c172p" / "pilot.yaml").read_text()
+    for name in ("cw1", *BUNDLED_PLATFORMS):  # the parameter file and every platform file (issue 52, item 5)
+        assert (tmp_path / "ex" / "params" / f"{name}.yaml").read_bytes() == (DATA_DIR / f"{name}.yaml").read_bytes()
     m = load_manoeuvre(tmp_path / "ex" / "manoeuvres" / "c172" / "takeoff.yaml")
     assert m.aircraft_files.profile == profile  # the copy's own profile is the one flown
     profile.write_text("edited\n")

@@ -14,6 +14,7 @@ import pyarrow.parquet as pq
 import pytest
 from test_rerun_log import assert_recorded, motion_tolerances
 
+from washbench.cueing.variants import DEFAULT_WASHOUTS
 from washbench.io.paths import MANOEUVRES_DIR
 from washbench.review.rerun_log import read_scalar_series, read_text_documents
 from washbench.review.rrd_read import read_static
@@ -66,8 +67,8 @@ def test_run_writes_every_file_and_nothing_else(run_dir: Path) -> None:
     assert all(c["passed"] for c in flight["checks"])
     with (run_dir / "metrics.csv").open() as f:
         rows = list(csv.DictReader(f))
-    assert len(rows) == 18
-    assert {r["washout"] for r in rows} == {"small-angle", "large-angle", "unrestricted"}
+    assert len(rows) == 6 * len(DEFAULT_WASHOUTS)
+    assert {r["washout"] for r in rows} == set(DEFAULT_WASHOUTS)
     for r in rows:
         assert float(r["integral_error"]) >= 0.0 and float(r["max_error"]) >= 0.0
         assert r["npc"] == "" or float(r["npc"]) >= 0.5  # NPC >= K/2 for K = 1
@@ -110,7 +111,7 @@ def test_recording_holds_the_computed_traces(run_dir: Path) -> None:
     t = traces.column("t_s").to_numpy()
     rrd = run_dir / "recording.rrd"
     series = read_scalar_series(rrd)
-    sources = ("small-angle", "large-angle", "unrestricted", "aircraft")  # the aircraft last, drawn on top
+    sources = (*DEFAULT_WASHOUTS, "aircraft")  # the aircraft last, drawn on top
     assert read_static(rrd, "SeriesLines:names")["/perceived/surge"] == list(sources)
     rows = 0
     for dof, col in DOF_COLUMNS.items():
@@ -128,7 +129,7 @@ def test_recording_holds_the_computed_traces(run_dir: Path) -> None:
     text = "\n".join(read_text_documents(rrd).values())
     assert "integral of |error|" in text and "| washout | surge | sway | heave | roll | pitch | yaw |" in text
     ranked = [line.split(" | ")[1] for line in text.splitlines() if re.match(r"^\| \d+( \(tie\))? \| ", line)]
-    assert sorted(ranked) == ["large-angle", "small-angle", "unrestricted"]  # the ranking, first (issue 38, item 10)
+    assert sorted(ranked) == sorted(DEFAULT_WASHOUTS)  # the ranking, first (issue 38, item 10)
     size_per_step = rrd.stat().st_size / len(t)
     print(f"\nrecording: {size_per_step:.0f} bytes per step ({len(t)} steps), {rows / 12 / t.size:.1%} of the rows")
     assert size_per_step < 250  # was 2,030, then 1,122 (takeoff) before float32 and thinning (issue 14)
@@ -141,7 +142,7 @@ def test_run_summary_is_consistent(run_dir: Path) -> None:
     assert summary["checks_total"] == len(flight["checks"])
     n = pq.read_metadata(run_dir / "traces.parquet").num_rows
     assert summary["steps"] == n
-    assert set(summary["perceived_motion"]) == set(DOF_COLUMNS)
+    assert set(summary["perceived_motion"]) == set(DOF_COLUMNS) | {f"felt_{d}" for d in DOF_COLUMNS}
 
 
 def test_aircraft_attitude_matches_scipy_rotation() -> None:

@@ -13,6 +13,7 @@ from pathlib import Path
 import pytest
 from hostile import short
 
+from washbench.cueing.variants import DEFAULT_WASHOUTS
 from washbench.review.replay import _has_display
 from washbench.runs import pool, suite
 
@@ -26,7 +27,7 @@ def test_suite_runs_with_spawn_where_forkserver_does_not_exist(tmp_path: Path, m
     outcomes = suite.run_suite(files, tmp_path / "out", jobs=2, progress=False)
     assert [o.run.ok for o in outcomes] == [True, True]
     with open(tmp_path / "out" / "c172p" / "spawn_a" / "metrics.csv", newline="") as f:
-        assert len(list(csv.DictReader(f))) == 18  # 3 washouts x 6 DOFs
+        assert len(list(csv.DictReader(f))) == 6 * len(DEFAULT_WASHOUTS)  # the default washouts x 6 DOFs
     assert (tmp_path / "out" / "c172p" / "spawn_b" / "figures" / "perceived.png").is_file()
     assert (tmp_path / "out" / "c172p" / "spawn_b" / "recording.rrd").is_file()
 

@@ -4,8 +4,11 @@ import math
 
 import pytest
 
-from washbench.analysis.ranking import DOFS, compare, dof_weights, rank, wins
+from washbench.analysis.ranking import DOFS, RankRule, compare, dof_weights, rank, wins
 from washbench.io.metrics_csv import MetricRow
+
+SCORE = RankRule("score")
+"""The rule before the felt error (the felt error's own hand-worked values: tests/test_felt.py)."""
 
 
 def rows_for(washout: str, ie: dict[str, float], npc: float = 1.2, max_error: float = 1.0) -> list[MetricRow]:
@@ -32,7 +35,7 @@ def test_rank_by_weighted_relative_error() -> None:
     a = rows_for("small-angle", {"surge": 1.0, "heave": 1.0, "roll": 5.0, "yaw": 30.0, "sway": 99.0})
     b = rows_for("large-angle", {"surge": 1.0, "heave": 1.0, "roll": 5.0, "yaw": 15.0})
     c = rows_for("unrestricted", {"surge": 1.5, "heave": 1.5, "roll": 0.0, "yaw": 0.0})
-    ranking = rank(a + b + c, MOTION)
+    ranking = rank(a + b + c, MOTION, SCORE)
     scores = {r.washout: r.score for r in ranking}
     assert scores["small-angle"] == pytest.approx(0.125 + 0.125 + 0.0625 + 0.375)
     assert scores["large-angle"] == pytest.approx(0.125 + 0.125 + 0.0625 + 0.1875)
@@ -44,9 +47,9 @@ def test_rank_by_weighted_relative_error() -> None:
 
 def test_ties_are_broken_by_the_order_the_washouts_were_listed() -> None:
     same = {"surge": 1.0}
-    ranking = rank(rows_for("unrestricted", same) + rows_for("small-angle", same), {"surge": 1.0})
+    ranking = rank(rows_for("unrestricted", same) + rows_for("small-angle", same), {"surge": 1.0}, SCORE)
     assert [r.washout for r in ranking] == ["unrestricted", "small-angle"]
-    ranking = rank(rows_for("small-angle", same) + rows_for("unrestricted", same), {"surge": 1.0})
+    ranking = rank(rows_for("small-angle", same) + rows_for("unrestricted", same), {"surge": 1.0}, SCORE)
     assert [r.washout for r in ranking] == ["small-angle", "unrestricted"]
     assert [(r.rank, r.tied) for r in ranking] == [(1, True), (1, True)]  # equal scores share the rank
 
@@ -83,35 +86,40 @@ def test_rank_marks_ties_and_counts_undecided_first_places() -> None:
     a = rows_for("small-angle", {"surge": 0.605})
     b = rows_for("large-angle", {"surge": 0.595})
     c = rows_for("unrestricted", {"surge": 0.9})
-    ranking = rank(a + b + c, motion)
+    ranking = rank(a + b + c, motion, SCORE)
     assert [(r.washout, r.rank, r.tied) for r in ranking] == [  # within the tie by value
         ("large-angle", 1, True), ("small-angle", 1, True), ("unrestricted", 3, False)
     ]
     assert undecided(ranking)
     assert wins([ranking]) == {"small-angle": 1, "large-angle": 1, "unrestricted": 0}
-    clear = rank(rows_for("small-angle", {"surge": 0.5}) + c, motion)
+    clear = rank(rows_for("small-angle", {"surge": 0.5}) + c, motion, SCORE)
     assert [(r.rank, r.tied) for r in clear] == [(1, False), (2, False)] and not undecided(clear)
 
 
-def test_rank_by_false_cue_time_and_by_user_dof_weights() -> None:
+def test_rank_by_false_cues_by_size_and_by_user_dof_weights() -> None:
     import dataclasses
 
-    from washbench.analysis.ranking import RankRule, rule_from_record
+    from washbench.analysis.felt import felt_key
+    from washbench.analysis.ranking import rule_from_record
 
-    def with_false(rows, frac):
-        return [dataclasses.replace(r, cue_false_frac=frac.get(r.dof, 0.0)) for r in rows]
+    def with_false(rows, false):
+        return [dataclasses.replace(r, felt_error=0.0, felt_false=false.get(r.dof, 0.0)) for r in rows]
 
-    a = with_false(rows_for("small-angle", {"surge": 1.0, "roll": 1.0}), {"surge": 0.1, "yaw": 0.05})
-    b = with_false(rows_for("large-angle", {"surge": 0.5, "roll": 8.0}), {"roll": 0.3})
-    motion = {"surge": 2.0, "roll": 10.0}
+    # false parts (m/s^2*s, deg) over their thresholds (0.17 m/s^2, 2.6 deg/s, 3.0 deg/s), over the felt motion in
+    # threshold-seconds (surge 1.7 / 0.17 + roll 30 / 3.0 = 20)
+    a = with_false(rows_for("small-angle", {"surge": 1.0, "roll": 1.0}), {"surge": 0.17, "yaw": 2.6})
+    b = with_false(rows_for("large-angle", {"surge": 0.5, "roll": 8.0}), {"roll": 12.0})
+    motion = {"surge": 2.0, "roll": 10.0} | {felt_key(d): 0.0 for d in DOFS} | {felt_key("surge"): 1.7,
+                                                                                 felt_key("roll"): 30.0}
     by_false = rank(a + b, motion, RankRule("false-cue"))
-    assert [(r.washout, r.score) for r in by_false] == [("small-angle", pytest.approx(0.15)),
-                                                        ("large-angle", pytest.approx(0.3))]
+    assert [(r.washout, r.score) for r in by_false] == [("small-angle", pytest.approx((1.0 + 1.0) / 20.0)),
+                                                        ("large-angle", pytest.approx(4.0 / 20.0))]
     # user weights surge 3, roll 1 (yaw unfelt, its weight dropped): score = 0.75 E_surge/2 + 0.25 E_roll/10
     rule = RankRule("weighted", (("surge", 3.0), ("roll", 1.0), ("yaw", 5.0)))
     by_user = {r.washout: r.score for r in rank(a + b, motion, rule)}
     assert by_user == pytest.approx({"small-angle": 0.75 * 0.5 + 0.25 * 0.1, "large-angle": 0.75 * 0.25 + 0.25 * 0.8})
     assert rule_from_record(rule.record()) == rule
-    assert rule_from_record(None) == RankRule()
+    assert rule_from_record(None) == SCORE  # a result written before rules existed was ranked by the score
+    assert RankRule().by == "felt"
     with pytest.raises(ValueError, match="unknown ranking rule"):
         RankRule("best")

@@ -30,6 +30,8 @@ import pyarrow.parquet as pq
 import pytest
 
 from washbench.analysis.ranking import MOTION_FLOOR
+from washbench.cueing.registry import REFERENCE_KINDS
+from washbench.cueing.variants import DEFAULT_WASHOUTS
 from washbench.errors import WashbenchError
 from washbench.flight.scripts import bundled_script, fly_script
 from washbench.io.input_format import InputFormat, input_format
@@ -87,10 +89,14 @@ def clean(trace: dict[str, np.ndarray], tmp_path_factory: pytest.TempPathFactory
 
 
 def assert_same_metrics(doc: dict, ref: dict, rel: float) -> float:
-    """Every integral error within ``rel`` of the aircraft's perceived motion (at least the floor); the worst."""
+    """Every washout's integral error within ``rel`` of the aircraft's perceived motion (at least the floor); the
+    worst. Not the naive references': the replay integrates the specific force twice into its stage, so where it runs
+    into a stop moves with the input's last digits (what these tests vary), not with how the input was read."""
     felt = {d: v["value"] for d, v in ref["perceived_motion"].items()}
     worst = 0.0
     for key, r in ref["metrics"].items():
+        if key[0] in REFERENCE_KINDS:
+            continue
         m = doc["metrics"][key]
         scale = max(felt[key[1]], MOTION_FLOOR[key[1]])
         worst = max(worst, abs(m.integral_error - r.integral_error) / scale)
@@ -102,7 +108,7 @@ def test_clean_trace_is_cued_from_the_window(clean: dict, trace: dict[str, np.nd
     assert clean["exit"] == 0 and clean["ok"] and clean["warnings"] == []
     assert clean["t_start_s"] == pytest.approx(START_S, abs=1 / 120) and clean["t_end_s"] == trace["t_s"][-1]
     assert clean["steps"] == int(np.sum(trace["t_s"] >= START_S))
-    assert len(clean["ranking"]) == 3
+    assert len(clean["ranking"]) == len(DEFAULT_WASHOUTS)
 
 
 def test_xplane_style_csv_20hz_jittered_3_decimals(trace: dict[str, np.ndarray], clean: dict, tmp_path: Path) -> None:

@@ -331,3 +331,23 @@ def test_recording_properties_hold_the_provenance(run_dir: Path, inputs: dict[st
     assert props["params.sha256"] == sha256(inputs["params"]) and props["params.name"] == "CW1-report-test"
     assert props["platform.sha256"] == sha256(inputs["platform"]) and props["turbulence.seed"] == "7"
     assert props["software.jsbsim"] == "1.3.3" and props["created_utc"] == doc["created_utc"]
+
+
+def test_false_cue_time_is_given_in_seconds(run_dir: Path) -> None:
+    """Issue 52, item 10: "False-cue time (sum over DOFs, manoeuvre lengths): 0.262" could not be read; it is the
+    time with a false cue in seconds, added up over the DOFs, against the manoeuvre's length, each washout's equal to
+    the false-cue time fractions of metrics.csv times that length."""
+    text = (run_dir / "report.md").read_text()
+    line = next(ln for ln in text.splitlines() if ln.startswith("Time with a false cue"))
+    n = pq.read_table(run_dir / "traces.parquet").num_rows
+    length_s = (n - 1) / 120.0
+    m = re.fullmatch(r"Time with a false cue, added up over the six DOFs \(a second with false cues in two DOFs "
+                     r"counts twice\): (.*), of a ([\d.]+) s manoeuvre\.", line)  # fmt: skip
+    assert m is not None, line
+    assert float(m[2]) == pytest.approx(length_s, rel=5e-3)
+    rows = list(csv.DictReader((run_dir / "metrics.csv").open()))
+    for part in m[1].split(", "):
+        washout, seconds = re.fullmatch(r"(\S+) ([\d.]+) s", part).groups()
+        frac = sum(float(r["cue_false_frac"]) for r in rows if r["washout"] == washout)
+        assert float(seconds) == pytest.approx(frac * length_s, rel=5e-3, abs=1e-9), washout
+    assert "False-cue time (sum over DOFs" not in text

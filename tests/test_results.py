@@ -178,8 +178,8 @@ def test_metrics_csv_exact_round_trip_nan_empty_inf(tmp_path: Path) -> None:
     lines = text.splitlines()
     assert lines[0] == ("washout,dof,npc,integral_error,max_error,cue_correct_frac,cue_scaled_frac,"
                         "cue_false_frac,cue_missing_frac,msdv_mps15,msdv_aircraft_mps15,false_cue_events,"
-                        "msi_pct,msi_aircraft_pct")
-    assert lines[2] == "small-angle,sway,,2.0,3.0,,,,,,,,,"  # no cue classification, no dose: empty fields
+                        "msi_pct,msi_aircraft_pct,felt_error,felt_false,jolt")
+    assert lines[2] == "small-angle,sway,,2.0,3.0,,,,,,,,,,,,"  # no cue classification, no dose: empty fields
     assert lines[3].split(",")[2] == "inf"
     back = read_metrics_csv(path)
     first5 = lambda r: (r.washout, r.dof, r.npc, r.integral_error, r.max_error)  # noqa: E731

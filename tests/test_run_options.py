@@ -107,3 +107,26 @@ def test_the_options_travel_to_a_worker_as_they_are(params: Path) -> None:
     assert again == opts and again.washout_order == ("sa_gain2", "la2")  # a variant: no built-in unless named
     with pytest.raises(AttributeError):
         opts.filter_start = "rest"  # type: ignore[misc]  (frozen)
+
+
+def test_a_default_set_cut_for_the_platform_says_so(capsys: pytest.CaptureFixture[str]) -> None:
+    """Issue 52, item 8: on a hexapod (or a rig) the default set leaves out the unrestricted washout, which cannot
+    drive it; one line says which and why. Named washouts are not cut (a refused one stops the command), and the
+    Atlas's default set is whole: no line."""
+    from washbench.cueing.variants import DEFAULT_WASHOUTS
+    from washbench.io.paths import DATA_DIR
+
+    for name in ("hexapod", "rig2dof"):
+        opts = load_options(platform_path=DATA_DIR / f"{name}.yaml")
+        kind = opts.limits.kind
+        assert opts.washout_order == tuple(w for w in DEFAULT_WASHOUTS if w != "unrestricted")
+        assert capsys.readouterr().err == (
+            f"washbench: note: the default washouts run without unrestricted on this {kind}: unrestricted cannot "
+            f"drive a {kind}, whose rotation is limited: its attitude set point is never washed back to level "
+            "(--washout names the washouts to run)\n")
+    load_options(platform_path=DATA_DIR / "hexapod.yaml", washouts=["all"])  # --washout all: the same, said
+    assert capsys.readouterr().err.startswith("washbench: note: all the washouts run without unrestricted, "
+                                              "adaptive-unrestricted, mpc-unrestricted on this hexapod: ")  # fmt: skip
+    load_options(platform_path=DATA_DIR / "hexapod.yaml", washouts=["small-angle"])
+    load_options()
+    assert capsys.readouterr().err == ""

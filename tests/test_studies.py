@@ -17,6 +17,7 @@ import pytest
 import yaml
 
 from washbench.analysis.ranking import perceived_motion, rank
+from washbench.analysis.tune import Bound, at_edges
 from washbench.cli import main
 from washbench.io.metrics_csv import MetricRow, read_metrics_csv
 from washbench.io.paths import DATA_DIR
@@ -342,3 +343,20 @@ def test_dask_cluster_gives_the_local_results(sweep_dir: Path, variant_run: Path
             assert (tmp_path / "t" / "tune.csv").read_bytes() == (tuned / "tune.csv").read_bytes()
         finally:
             close_all()
+
+
+def test_a_tuned_value_at_an_end_of_its_interval_is_said(tuned: Path) -> None:
+    """Issue 52, item 10: ``tune`` ending at the edge of its range (0.200343 against a lower bound of 0.2) said
+    nothing; within 1 % of the interval's width of an end it is named, on the console and in report.md."""
+    bounds = [Bound("tilt.gain_per_s", 0.2, 5.0), Bound("scale.x", 0.0, 1.0)]
+    assert at_edges(bounds, np.array([0.200343, 0.5])) == [
+        "tilt.gain_per_s = 0.200343 is at the lower end of its interval 0.2..5"]
+    assert at_edges(bounds, np.array([4.96, 0.995])) == [  # 0.04 <= 1 % of 4.8; 0.005 <= 1 % of 1
+        "tilt.gain_per_s = 4.96 is at the upper end of its interval 0.2..5",
+        "scale.x = 0.995 is at the upper end of its interval 0..1"]
+    assert at_edges(bounds, np.array([0.3, 0.02])) == []  # 0.1 and 0.02 from the ends: inside
+    best = min(read_csv(tuned / "tune.csv"), key=lambda r: float(r["objective"]))
+    edges = at_edges(bounds[:1], np.array([float(best["tilt.gain_per_s"])]))
+    report = (tuned / "report.md").read_text()
+    assert ("**At an end of its interval**" in report) == bool(edges)
+    assert all(e in report for e in edges)

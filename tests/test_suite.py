@@ -13,6 +13,7 @@ from pathlib import Path
 import pytest
 from report_helpers import check_images, check_tables, without_pdf_links
 
+from washbench.cueing.variants import DEFAULT_WASHOUTS
 from washbench.io.paths import MANOEUVRES_DIR
 from washbench.review.report import NO_FIGURES
 
@@ -54,11 +55,11 @@ def test_broken_file_is_reported_and_the_others_complete(first: tuple[Path, subp
     assert "broken.yaml" in report and "unknown key" in report
     with (out / "metrics.csv").open() as f:
         rows = list(csv.DictReader(f))
-    assert len(rows) == 2 * 3 * 6
+    assert len(rows) == 2 * len(DEFAULT_WASHOUTS) * 6
     assert list(rows[0]) == ["aircraft", "manoeuvre", "washout", "dof", "npc", "integral_error", "max_error",
                              "cue_correct_frac", "cue_scaled_frac", "cue_false_frac", "cue_missing_frac",
                              "msdv_mps15", "msdv_aircraft_mps15", "false_cue_events", "msi_pct",
-                             "msi_aircraft_pct"]  # fmt: skip
+                             "msi_aircraft_pct", "felt_error", "felt_false", "jolt"]  # fmt: skip
     assert {r["manoeuvre"] for r in rows} == {"coordinated_turn", "stall_recovery"}
     for name in ("coordinated_turn", "stall_recovery"):
         run = out / "c172p" / name
@@ -72,7 +73,10 @@ def test_suite_report_puts_failures_first_and_embeds_valid_figures(
     out, _ = first
     report = out / "report.md"
     text = report.read_text()
-    assert text.index("## Failures") < text.index("## Summary") < text.index("## c172p / coordinated_turn")
+    # failures first: before any verdict on what ran, which says on how many it is
+    assert text.index("## Failures") < text.index("## Verdict") < text.index("## Summary")
+    assert text.index("## Summary") < text.index("## c172p / coordinated_turn")
+    assert "**1 of 3 manoeuvres failed**" in text
     assert "![score per manoeuvre and washout](figures/scores.png)" in text and "figures/table4.png" in text
     assert "c172p/coordinated_turn/figures/perceived.png" in text
     assert check_images(report) == 2 + 2 * 2  # scores, Table 4; perceived motion and cue lanes per manoeuvre
@@ -82,7 +86,7 @@ def test_suite_report_puts_failures_first_and_embeds_valid_figures(
     suite_doc = json.loads((out / "suite.json").read_text())
     assert [e["ok"] for e in suite_doc["manoeuvres"]].count(False) == 1
     assert suite_doc["provenance"]["params"]["name"] == "CW1"
-    assert suite_doc["provenance"]["ranking"]["by"] == "score"  # the ranking rule is recorded
+    assert suite_doc["provenance"]["ranking"]["by"] == "felt"  # the ranking rule is recorded
     decided = re.search(r"First place shared \(decided by less than that margin\): (\d) of 2 manoeuvres", text)
     with (out / "ranking.csv").open() as f:
         ranking = list(csv.DictReader(f))
@@ -116,14 +120,14 @@ def test_ranking_and_comparison_tables(first: tuple[Path, subprocess.CompletedPr
     out, _ = first
     with (out / "ranking.csv").open() as f:
         ranking = list(csv.DictReader(f))
-    assert len(ranking) == 2 * 3
+    assert len(ranking) == 2 * len(DEFAULT_WASHOUTS)
     for name in ("coordinated_turn", "stall_recovery"):
         rows = [r for r in ranking if r["manoeuvre"] == name]
         ranks = sorted((int(r["rank"]), float(r["score"])) for r in rows)
         assert ranks[0][0] == 1 and [s for _, s in ranks] == sorted(s for _, s in ranks)
         for r in rows:  # honest ties: a shared rank only within the documented margin, "tied" says so
             same = [float(x["score"]) for x in rows if x["rank"] == r["rank"]]
-            assert (r["tied"] == "true") == (len(same) > 1) and r["rule"] == "score"
+            assert (r["tied"] == "true") == (len(same) > 1) and r["rule"] == "felt"
             assert max(same) - min(same) <= max(0.03 * min(same), 0.005)
             better = sum(1 for x in rows if int(x["rank"]) < int(r["rank"]))
             assert int(r["rank"]) == better + 1  # competition ranking: 1, 1, 3

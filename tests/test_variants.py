@@ -75,8 +75,13 @@ def test_bad_variants_are_one_line_naming_the_key(
 
 
 def test_selection_rules(tmp_path: Path) -> None:
-    assert [w.name for w in select_washouts()] == ["small-angle", "large-angle", "unrestricted"]
+    assert [w.name for w in select_washouts()] == ["small-angle", "large-angle", "unrestricted", "replay",
+                                                   "replay-rotation", "still"]  # fmt: skip
     assert [w.name for w in select_washouts(["large-angle"])] == ["large-angle"]
+    every = [w.name for w in select_washouts(["all"])]  # every built-in washout, the references and the bound
+    assert every[:3] == ["small-angle", "large-angle", "unrestricted"] and every[-1] == "bound"
+    assert {"optimal", "mpc", "mpc-unrestricted", "replay", "replay-rotation", "still"} <= set(every)
+    assert len(every) == len(set(every)) == 13
     only = select_washouts(None, ["b=large-angle,tilt.gain_per_s=2"])
     assert [(w.name, w.kind) for w in only] == [("b", "large-angle")]  # with a variant, only the variants run ...
     both = select_washouts(["small-angle"], ["b=large-angle"])

@@ -22,7 +22,7 @@ import numpy as np
 
 from washbench.analysis.felt import FeltMeasure, felt_total
 from washbench.analysis.ranking import BOUND_WASHOUT, DOFS, RankRule, felt_of, rule_from_record, rule_values
-from washbench.cueing.references import REFERENCE_KINDS
+from washbench.cueing.registry import REFERENCE_KINDS
 from washbench.io.metrics_csv import read_metrics_csv
 
 

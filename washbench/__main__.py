@@ -30,6 +30,9 @@ def entry() -> int:
         # extension module's initialisation (pydantic-core importing datetime), it ended the process in a Rust
         # panic (status 1) instead of this one line
         with interrupts.signals_held():
+            from washbench.io import entry_points  # deferred: signals
+
+            entry_points.read_pydantic_plugins()  # another package's broken metadata: a warning, not a traceback
             from washbench.cli import main  # deferred: signals
 
         return main()

@@ -8,6 +8,7 @@ printed here as one line (no traceback) with exit status 2.
 from __future__ import annotations
 
 import argparse
+import difflib
 import errno
 import os
 import signal
@@ -23,7 +24,7 @@ from washbench.errors import Terminated, WashbenchError, printable
 from washbench.io import config as project_config
 from washbench.io import interrupts
 from washbench.io.examples import copy_examples
-from washbench.io.paths import resolve_manoeuvre
+from washbench.io.paths import resolve_data_file, resolve_manoeuvre, resolve_task, unknown_manoeuvre
 from washbench.live import FORMATS
 from washbench.review.replay import replay_command
 from washbench.runs.outputs import Outputs
@@ -48,8 +49,10 @@ def _washout_options(p: argparse.ArgumentParser, variants: bool = True) -> None:
         "--washout",
         action="append",
         metavar="NAME",
-        help=f"washout to run, repeatable: {', '.join(WASHOUT_KINDS)}, optimal, mpc, mpc-unrestricted, bound (whole "
-        "recordings), or a plugin's name (default: the first three, or none with a variant)",
+        help=f"washout to run, repeatable: {', '.join(WASHOUT_KINDS)}, optimal, mpc, mpc-unrestricted, the naive "
+        "references replay, replay-rotation, still, bound (whole recordings), a plugin's name, or all (every "
+        "built-in, the references and the bound) (default: small-angle, large-angle, unrestricted and the three "
+        "references, or none with a variant)",
     )
     if variants:
         p.add_argument("--variant", action="append", default=[], metavar="NAME=KIND[,KEY=VALUE...]", help=_VARIANT_HELP)
@@ -71,9 +74,9 @@ def _rank_option(p: argparse.ArgumentParser) -> None:
 
 def _platform_options(p: argparse.ArgumentParser) -> None:
     """--platform and --platform-plugin (docs/platforms.md)."""
-    p.add_argument("--platform", type=Path,
-                   help="platform file, its kind: key picks the model: atlas, hexapod, rig or a plugin's (default: "
-                   "bundled Atlas)")  # fmt: skip
+    p.add_argument("--platform", type=Path, metavar="FILE|NAME",
+                   help="platform file, its kind: key picks the model: atlas, hexapod, rig or a plugin's; or a bundled "
+                   "one by name from any folder: atlas, hexapod, rig2dof (default: atlas)")  # fmt: skip
     p.add_argument("--platform-plugin", metavar="FILE.py:NAME",
                    help="load a platform from a Python file (docs/platforms.md); without --platform it is the platform")
 
@@ -81,7 +84,7 @@ def _platform_options(p: argparse.ArgumentParser) -> None:
 def _study_options(p: argparse.ArgumentParser) -> None:
     """What sweep and tune share."""
     _plugin_option(p)
-    p.add_argument("--params", type=Path, help="base washout parameter YAML (default: bundled CW1)")
+    p.add_argument("--params", type=Path, help="base washout parameter YAML (default: the bundled cw1)")
     _platform_options(p)
     p.add_argument(
         "--from",
@@ -94,13 +97,31 @@ def _study_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--dask", metavar="ADDRESS", help="send the work to this Dask scheduler (washbench[cluster])")
     p.add_argument("--quiet", action="store_true", help="no progress display")
     _aircraft_dir_option(p)
+    p.add_argument("--pilot", type=Path, metavar="TASK",
+                   help="the pilot model's measures on this tracking task too (docs/pilot-model.md)")  # fmt: skip
 
 
 class _Parser(argparse.ArgumentParser):
-    """ArgumentParser whose usage errors are one line and exit 2 (as argparse does)."""
+    """ArgumentParser whose usage errors are one line and exit 2 (as argparse does), naming the option meant for
+    one it does not know (``--output``: did you mean ``--out``?)."""
+
+    def parse_known_args(self, args: Any = None, namespace: Any = None) -> Any:  # type: ignore[override]
+        self._given = list(sys.argv[1:] if args is None else args)
+        return super().parse_known_args(args, namespace)
 
     def error(self, message: str) -> None:  # type: ignore[override]
-        self.exit(2, f"{self.prog}: error: {message}\n")
+        self.exit(2, f"{self.prog}: error: {message}{self._meant()}\n")
+
+    def _meant(self) -> str:
+        """`` (--output: did you mean --out?)`` for each option given that this command does not know."""
+        given = getattr(self, "_given", [])
+        command = subcommands(self).get(next((w for w in given if not w.startswith("-")), ""), self)
+        known = [s for a in command._actions for s in a.option_strings]
+        meant = []
+        for word in dict.fromkeys(w.partition("=")[0] for w in given if w.startswith("--")):
+            close = difflib.get_close_matches(word, known, n=1, cutoff=0.6) if word not in known else []
+            meant += [f"{word}: did you mean {close[0]}?"] if close else []
+        return f" ({'; '.join(meant)})" if meant else ""
 
 
 def _out_path(text: str) -> Path:
@@ -137,13 +158,16 @@ def build_parser() -> argparse.ArgumentParser:
     """The full command-line interface."""
     parser = _Parser(
         prog="washbench",
-        description="A testbed for flight-simulator motion cueing: JSBSim manoeuvres, three washouts, a kinematic "
-        "Atlas platform, vestibular models and metrics.",
+        description="A testbed for flight-simulator motion cueing: JSBSim manoeuvres, recorded logs or a simulator's "
+        "live output through washouts (classical small-angle, large-angle and unrestricted, their adaptive forms, "
+        "optimal, model-predictive, the oracle bound, naive references, your own plugins: `washbench run --help` "
+        "lists them) on a "
+        "kinematic platform (the Atlas, a hexapod, a rig or your own), vestibular models, metrics and a ranking.",
     )
     parser.add_argument("--version", action="version", version=_version_line())
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
-    p = sub.add_parser("cue", help="run washouts, Atlas model, vestibular models and metrics on a recorded trace")
+    p = sub.add_parser("cue", help="run washouts, platform model, vestibular models and metrics on a recorded trace")
     p.add_argument(
         "input",
         type=Path,
@@ -154,7 +178,7 @@ def build_parser() -> argparse.ArgumentParser:
     _cue_input_options(p)
     _washout_options(p)
     _rank_option(p)
-    p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
+    p.add_argument("--params", type=Path, help="washout parameter YAML (default: the bundled cw1)")
     _platform_options(p)
 
     p = sub.add_parser("fly", help="fly a manoeuvre file with JSBSim and the scripted pilot")
@@ -172,7 +196,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("run", help="fly a manoeuvre with the washouts in lockstep; write traces, metrics, recording")
     p.add_argument(
-        "manoeuvre", type=Path, help="manoeuvre YAML file, a bundled one by name (c172/takeoff), or a JSBSim script"
+        "manoeuvre", type=Path,
+        help="manoeuvre YAML file, a bundled one by name (c172/takeoff), or a JSBSim script (a file, or one shipped "
+        "with JSBSim by name: c1723)",
     )
     p.add_argument("--out", type=_out_path, required=True, help="results folder; writes OUT/<aircraft>/<manoeuvre>/")
     _washout_options(p)
@@ -180,7 +206,7 @@ def build_parser() -> argparse.ArgumentParser:
     _aircraft_dir_option(p)
     p.add_argument("--max-time-s", type=float, metavar="S", help="JSBSim script: stop after S s (default 1200)")
     p.add_argument("--filter-start", choices=("steady", "rest"), default="steady", help="filters' start state")
-    p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
+    p.add_argument("--params", type=Path, help="washout parameter YAML (default: the bundled cw1)")
     _platform_options(p)
     p.add_argument("--quiet", action="store_true", help="no progress display")
     _output_options(p)
@@ -200,7 +226,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--jobs", type=_jobs, help="parallel processes (default: the CPUs this process may use)")
     _washout_options(p)
     _rank_option(p)
-    p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
+    p.add_argument("--params", type=Path, help="washout parameter YAML (default: the bundled cw1)")
     _platform_options(p)
     p.add_argument("--dask", metavar="ADDRESS", help="run on this Dask scheduler instead of local processes")
     p.add_argument("--quiet", action="store_true", help="no progress display")
@@ -209,7 +235,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("omct", help="Objective Motion Cueing Test: gain and phase of each washout, Bode plots")
     p.add_argument("--out", type=_out_path, required=True, help="output folder (omct.csv, bode_<test>.png, report.md)")
     _washout_options(p)
-    p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
+    p.add_argument("--params", type=Path, help="washout parameter YAML (default: the bundled cw1)")
     _platform_options(p)
     p.add_argument("--boundaries", type=Path, help="gain/phase boundaries YAML, drawn and checked (docs: OMCT)")
     p.add_argument("--rate-hz", type=float, default=120.0, help="washout sample rate (default 120)")
@@ -269,7 +295,10 @@ def build_parser() -> argparse.ArgumentParser:
         help="penalty per unit fraction of time at a platform limit (default 1)",
     )
     p.add_argument("--out", type=_out_path, required=True, help="output folder (tuned.yaml, tune.csv, report.md)")
+    p.add_argument("--pilot-weight", type=float, default=1.0,
+                   help="with --pilot: weight of the pilot's distance from flight (%%/100) (default 1)")  # fmt: skip
     _study_options(p)
+    _track_parser(sub)
     p = sub.add_parser("examples", help="copy the bundled manoeuvres, pilot profiles, parameter and platform files "
                        "into a folder to edit")
     p.add_argument("folder", type=Path, help="destination (created; existing files are never overwritten)")
@@ -287,6 +316,34 @@ def build_parser() -> argparse.ArgumentParser:
     _live_parsers(sub)
     add_examples(parser)  # the docs named at the top level, examples at the end of each command's help
     return parser
+
+
+def _track_parser(sub: Any) -> None:
+    """``washbench track`` (docs/pilot-model.md)."""
+    p = sub.add_parser("track", help="a pilot model flies a tracking task in JSBSim through each washout: how its "
+                       "control changes from flight")  # fmt: skip
+    p.add_argument("task", type=Path, help="task YAML file, or a bundled one by name (c172/roll, columbia400/pitch)")
+    p.add_argument("--out", type=_out_path, required=True,
+                   help="output folder (report.md, track.json, measures.csv, frf.csv, signals.parquet)")  # fmt: skip
+    _washout_options(p)
+    p.add_argument("--vestibular", choices=("young-meiry", "telban-cardullo"),
+                   help="vestibular models of the pilot (default telban-cardullo: canals with a lead)")  # fmt: skip
+    p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
+    _platform_options(p)
+    p.add_argument("--runs", type=int, metavar="N", help="runs per condition (default: the task's)")
+    p.add_argument("--pilot-plugin", metavar="FILE.py:NAME",
+                   help="fly your own pilot model from a Python file (docs/pilot-model.md)")  # fmt: skip
+    _aircraft_dir_option(p)
+    p.add_argument("--quiet", action="store_true", help="no progress lines")
+    _output_options(p)
+    p.set_defaults(rank_by=None, thresholds=None)  # the run options track does not take (the ranking's)
+
+
+def _track(args: argparse.Namespace) -> int:
+    from washbench.runs.track import TrackOptions, track_command  # deferred: numba
+
+    opts = TrackOptions(runs=args.runs, outputs=_outputs(args), progress=not args.quiet, pilot_plugin=args.pilot_plugin)
+    return track_command(resolve_task(args.task), args.out, _run_options(args), opts)
 
 
 def _live_parsers(sub: Any) -> None:
@@ -309,7 +366,7 @@ def _live_parsers(sub: Any) -> None:
     p.add_argument("--filter-start", choices=("steady", "rest"), default="steady", help="filters' start state")
     p.add_argument("--print-flightgear-protocol", action="store_true", help="print FlightGear's protocol file, exit")
     _washout_options(p)
-    p.add_argument("--params", type=Path, help="washout parameter YAML (default: bundled CW1)")
+    p.add_argument("--params", type=Path, help="washout parameter YAML (default: the bundled cw1)")
     _platform_options(p)
     _rank_option(p)
     _output_options(p)
@@ -454,8 +511,19 @@ def _dispatch(args: argparse.Namespace) -> int:
     if hasattr(args, "manoeuvre") or hasattr(args, "manoeuvres"):
         if hasattr(args, "manoeuvre"):
             args.manoeuvre = resolve_manoeuvre(args.manoeuvre)
+            if not args.manoeuvre.exists():
+                raise unknown_manoeuvre(args.manoeuvre)
         else:
             args.manoeuvres = [resolve_manoeuvre(m) for m in args.manoeuvres]
+    washouts = getattr(args, "washout", None)
+    for name in [washouts] if isinstance(washouts, str) else washouts or []:
+        if "," in name:  # --washout a,b: one name per --washout
+            parts = [f"--washout {n.strip()}" for n in name.split(",") if n.strip()]
+            how = f"one at a time ({parts[0]})" if isinstance(washouts, str) else f"repeat it: {' '.join(parts)}"
+            raise WashbenchError(f"--washout {name}: one washout per --washout; {how}")
+    for option in ("platform", "params"):  # a bundled file by name from any folder (hexapod, washbench:data/...)
+        if getattr(args, option, None) is not None:
+            setattr(args, option, resolve_data_file(getattr(args, option), f"--{option}"))
     if args.command == "cue":
         return _cue(args)
     if args.command == "fly":
@@ -522,6 +590,8 @@ def _dispatch(args: argparse.Namespace) -> int:
         from washbench.review.report_command import report_command  # deferred: numpy
 
         return report_command(args.results, args.palette)
+    if args.command == "track":
+        return _track(args)
     if args.command in ("live", "send"):
         return _live(args) if args.command == "live" else _send(args)
     if args.command == "replay":
@@ -538,6 +608,7 @@ def _study(args: argparse.Namespace) -> int:
         dask=args.dask,
         progress=not args.quiet,
         aircraft_dirs=args.aircraft_dir,
+        pilot=resolve_task(args.pilot) if args.pilot is not None else None,
     )
     if args.command == "sweep":
         from washbench.runs.sweep import sweep_command  # deferred: numba
@@ -556,6 +627,7 @@ def _study(args: argparse.Namespace) -> int:
         budget=args.budget,
         seed=args.seed,
         saturation_weight=args.saturation_weight,
+        pilot_weight=args.pilot_weight,
         **common,
     )
 
@@ -644,11 +716,11 @@ def main(argv: list[str] | None = None) -> int:
             if signalled is None:
                 raise
             raise signalled from None
-    except KeyboardInterrupt:
-        print("washbench: interrupted", file=sys.stderr)
+    except KeyboardInterrupt as exc:
+        print(printable(f"washbench: interrupted{_what_it_cost(exc)}"), file=sys.stderr)
         return 130
-    except Terminated:
-        print("washbench: terminated", file=sys.stderr)
+    except Terminated as exc:
+        print(printable(f"washbench: terminated{_what_it_cost(exc)}"), file=sys.stderr)
         return 143
     finally:
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
@@ -657,6 +729,12 @@ def main(argv: list[str] | None = None) -> int:
         os.environ.pop(project_config.CONFIG_USED_ENV, None)
         if env_before is not None:
             os.environ[project_config.CONFIG_USED_ENV] = env_before
+
+
+def _what_it_cost(exc: BaseException) -> str:
+    """``: TEXT`` when the interrupted command said what the interruption cost (:func:`interrupts.explain`)."""
+    text = interrupts.explanation(exc)
+    return f": {text}" if text else ""
 
 
 def _config_defaults(parser: argparse.ArgumentParser, config: project_config.ProjectConfig) -> None:

@@ -21,9 +21,9 @@ DOCS = (
 #: Command name -> example command lines (each one starts with ``washbench``).
 EXAMPLES: dict[str, tuple[str, ...]] = {
     "cue": (
-        "washbench cue flight.csv --out results",
-        "washbench cue Data.txt --out results --resample 120",
-        "washbench cue imu.csv.gz --out results --columns t=Time:ms,f_x=ax:g,omega_x=p:radps --axes flu",
+        "washbench cue flight.csv --out cued",
+        "washbench cue Data.txt --out cued-xplane --resample 120",
+        "washbench cue imu.csv.gz --out cued-imu --columns t=Time:ms,f_x=ax:g,omega_x=p:radps --axes flu",
     ),
     "fly": (
         "washbench fly c172/coordinated_turn --out out/turn",
@@ -38,8 +38,8 @@ EXAMPLES: dict[str, tuple[str, ...]] = {
         "washbench schema | python -m json.tool",
     ),
     "live": (
-        "washbench live --listen 127.0.0.1:49005 --format xplane --out results/live",
-        "washbench live --listen 0.0.0.0:5500 --format flightgear --out results/fg --sink udp://192.0.2.10:6000",
+        "washbench live --listen 127.0.0.1:49005 --format xplane --out live",
+        "washbench live --listen 0.0.0.0:5500 --format flightgear --out live-fg --sink udp://192.0.2.10:6000",
         "washbench live --print-flightgear-protocol",
     ),
     "send": (
@@ -47,14 +47,14 @@ EXAMPLES: dict[str, tuple[str, ...]] = {
         "washbench send --fly c172/takeoff --to 127.0.0.1:49005 --format washbench",
     ),
     "run": (
-        "washbench run c172/takeoff --out results --washout large-angle --washout adaptive-large-angle",
-        "washbench run my_turn.yaml --out results --washout-plugin my_washout.py:MyWashout --washout my-washout",
-        "washbench run c172_cruise_8K.xml --out results --max-time-s 60 --no-recording",
+        "washbench run c172/takeoff --out runs --washout large-angle --washout adaptive-large-angle",
+        "washbench run my_turn.yaml --out runs --washout-plugin my_washout.py:MyWashout --washout my-washout",
+        "washbench run c172_cruise_8K.xml --out runs --max-time-s 60 --no-recording",
     ),
     "suite": (
         "washbench suite --out results",
-        "washbench suite c172 columbia400/takeoff --out results --jobs 2",
-        "washbench suite --jsbsim-scripts c1723 c172_cross_wind --out results/jsbsim",
+        "washbench suite --out results-all --washout all",
+        "washbench suite --jsbsim-scripts c1723 c172_cross_wind --out jsbsim-suite",
     ),
     "omct": (
         "washbench omct --out omct",
@@ -67,10 +67,18 @@ EXAMPLES: dict[str, tuple[str, ...]] = {
     "sweep": (
         "washbench sweep manoeuvres --set tilt.gain_per_s=0.4,1,2,5 --out study",
         "washbench sweep c172 --set tilt.gain_per_s=1,2 --washout large-angle --from results --out study",
+        "washbench sweep c172/aileron_3211 --set rotational.highpass_wn_radps.roll=0.2,0.5,1 --pilot c172/roll --out s",
     ),
     "tune": (
         "washbench tune c172/takeoff c172/stall_recovery --washout large-angle --tune tilt.gain_per_s=0.2:5 --out t",
         "washbench tune c172 --washout unrestricted --tune tilt.gain_per_s=0.2:5 --budget 50 --out tuned",
+        "washbench tune c172/steep_turn --washout large-angle --tune scale.angular_velocity=0.3:1 --pilot c172/roll "
+        "--budget 30 --out t",
+    ),
+    "track": (
+        "washbench track c172/roll --out track-roll",
+        "washbench track c172/pitch --out track-pitch --washout large-angle --washout unrestricted --runs 3",
+        "washbench track my_task.yaml --out t --variant half=small-angle,scale.angular_velocity=0.5",
     ),
     "examples": (
         "washbench examples my-study",

@@ -49,12 +49,6 @@ from washbench.numerics.statespace import tf2ss
 from washbench.perception.vestibular import VestibularModel, VestibularParams, canal_tf, otolith_tf
 from washbench.platform.limits import PlatformLimits
 
-MAX_BOUND_SAMPLES = 500_000
-"""The longest recording the bound replays as a washout (69 min at 120 Hz). The bound costs about 0.7 ms of CPU per
-sample with its ceiling (7,340 samples 5.3 s, 36,000 samples 21 s on the 2-core development machine, the solver
-PIQP) and about 40 kB of memory per sample at its peak (1.4 GB for 36,000): about 6 minutes and 19 GB at this
-limit."""
-
 
 class BoundParams(StrictModel):
     """The bound's cost weights and its solver's tolerances."""

@@ -27,10 +27,10 @@ import math
 import numpy as np
 from scipy import sparse
 
-from washbench.analysis.bound import MAX_BOUND_SAMPLES, BoundParams, oracle_bound
+from washbench.analysis.bound import BoundParams, oracle_bound
 from washbench.analysis.lp_rows import Rows, solve_qp, trapezoid
 from washbench.analysis.ranking import MOTION_FLOOR, perceived_motion
-from washbench.errors import WashbenchError
+from washbench.io import cost
 from washbench.io.units import G0_MPS2
 from washbench.perception.vestibular import VestibularModel, VestibularParams, otolith_model
 from washbench.platform.limits import PlatformLimits
@@ -251,11 +251,9 @@ class BoundWashout:
         """The replay's set points (:func:`replay`): positions (N, 3) m, attitudes
         (N, 4), scalar first."""
         c = self.context
-        if len(f_mps2) > MAX_BOUND_SAMPLES:
-            raise WashbenchError(f"washout bound: {len(f_mps2):,} samples in one recording, more than the bound's "
-                                 f"limit of {MAX_BOUND_SAMPLES:,} (its replay is planned over the whole recording "
-                                 "at once: about 0.7 ms and 40 kB per sample); cut the recording or lower its "
-                                 "rate")  # fmt: skip
+        # planned over the whole recording at once, and the ceiling after it: refused before it starts if it would
+        # not fit (washbench.io.cost), announced if it takes long
+        cost.check(cost.bound(len(f_mps2), c.dt_s))
         pos, q_sp, self.solved = replay(f_mps2, omega_radps, c.dt_s, c.limits, c.gravity_mps2, self.params,
                                         c.filter_start)  # fmt: skip
         return pos, q_sp

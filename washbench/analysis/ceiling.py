@@ -60,6 +60,7 @@ from washbench.analysis.lp_rows import solve_qp as _solve_qp
 from washbench.analysis.lp_rows import trapezoid as _trapezoid
 from washbench.analysis.metrics import DOFS
 from washbench.analysis.relaxation import Relaxation, relaxation_of
+from washbench.io import cost
 from washbench.io.units import G0_MPS2
 from washbench.perception.vestibular import (
     DiscreteModel,
@@ -288,11 +289,11 @@ def translational_floor(
                 raise ValueError("the jolt term needs the aircraft pilot's head specific force")
             j = idx["j"]
             rows.box(j, 0.0, np.inf)
-            # j_k >= |f_k - f_{k-1}| - |F_k - F_{k-1}| - J_T dt, k >= 1 (j_0 unused: its cost is 0)
-            allow = np.abs(np.diff(np.asarray(aircraft_head, dtype=np.float64))) + terms.jerk_deadband_mps3 * dt
+            # j_k >= |f_k - f_{k-1}| / dt - |F_k - F_{k-1}| / dt - J_T, k >= 1 (m/s^3; j_0 unused: its cost is 0)
+            allow = np.abs(np.diff(np.asarray(aircraft_head, dtype=np.float64))) / dt + terms.jerk_deadband_mps3
             for sign in (1.0, -1.0):
-                rows.add([(f[k], sign), (f[k - 1], -sign), (j[k], -1.0)], allow, equal=False)
-            c[j[1:]] = terms.jolt_time_s
+                rows.add([(f[k], sign / dt), (f[k - 1], -sign / dt), (j[k], -1.0)], allow, equal=False)
+            c[j[1:]] = terms.jolt_time_s * dt
     return _solve(c, rows, nvar)
 
 
@@ -365,6 +366,8 @@ def ceiling(
     vest = vestibular if vestibular is not None else VestibularParams()
     if vest.thresholds is not None:
         raise ValueError("the ceiling is not defined with perception thresholds (a dead band)")
+    # its programmes must fit before they are built (announced with the bound, :func:`washbench.io.cost.bound`)
+    cost.check(cost.ceiling(len(perceived_f_mps2), dt_s), announce=False)
     oto = otolith_model(vest.otolith, dt_s)
     can = canal_model(vest.canals, dt_s)
     rest = filter_start == "rest"

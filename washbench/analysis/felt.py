@@ -47,6 +47,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from washbench.numerics.jitcache import announce_compile
 from washbench.perception.thresholds import ZACHARIAS, Thresholds
 
 DOFS = ("surge", "sway", "heave", "roll", "pitch", "yaw")
@@ -139,19 +140,20 @@ def felt_key(dof: str) -> str:
     return FELT_PREFIX + dof
 
 
-def trapezoid_weights(n: int, dt_s: float) -> np.ndarray:
-    """The trapezoid rule's weights (n,) on a uniform grid of step ``dt_s`` (s): dt, halved at both ends."""
-    c = np.full(n, float(dt_s))
-    if n >= 1:
-        c[0] = c[-1] = 0.5 * dt_s
-    if n == 1:
-        c[0] = 0.0
-    return c
+def _compiled() -> tuple:
+    """The compiled sums (:mod:`washbench.analysis.metric_sums`), imported at the first use: numba is paid only by a
+    command that computes a metric, and the studies' evaluation kernel adds the same sums in the same order (the same
+    bits as ``washbench cue``)."""
+    from washbench.analysis.metric_sums import felt_sums, jolt_sums  # deferred: numba
+
+    announce_compile(felt_sums)
+    return felt_sums, jolt_sums
 
 
 def _columns(f_mps2: np.ndarray, omega_radps: np.ndarray) -> np.ndarray:
-    """(N, 6): specific force in m/s^2, angular velocity in deg/s (the DOFs' units)."""
-    return np.column_stack([np.asarray(f_mps2, dtype=np.float64), np.degrees(np.asarray(omega_radps, np.float64))])
+    """(N, 6), contiguous: specific force in m/s^2, angular velocity in deg/s (the DOFs' units)."""
+    return np.ascontiguousarray(np.column_stack([np.asarray(f_mps2, dtype=np.float64),
+                                                 np.degrees(np.asarray(omega_radps, dtype=np.float64))]))  # fmt: skip
 
 
 def felt_motion(
@@ -159,8 +161,11 @@ def felt_motion(
 ) -> np.ndarray:
     """M_d (6,): the aircraft pilot's felt motion per DOF, ``integral max(|x - x0| - T_d, 0) dt`` (m/s^2*s; deg)."""
     x = _columns(perceived_f_mps2, perceived_omega_radps)
-    c = trapezoid_weights(len(x), dt_s)
-    return c @ np.maximum(np.abs(x - x[:1]) - measure.bands(), 0.0) if len(x) else np.zeros(6)
+    if len(x) == 0:
+        return np.zeros(6)
+    out = np.empty((2, 6))
+    _compiled()[0](x, np.ascontiguousarray(np.broadcast_to(x[:1], x.shape)), measure.bands(), float(dt_s), out)
+    return out[0]
 
 
 def felt_errors(
@@ -171,43 +176,31 @@ def felt_errors(
     dt_s: float,
     measure: FeltMeasure = DEFAULT_MEASURE,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """(E, F), each (6,): the felt error and its false part per DOF (m/s^2*s; deg), from the perceived signals."""
+    """(E, F), each (6,): the felt error and its false part per DOF (m/s^2*s; deg), from the perceived signals
+    (trapezoid rule of the pointwise values, summed in sample order)."""
     x = _columns(aircraft_f_mps2, aircraft_omega_radps)
     y = _columns(sim_f_mps2, sim_omega_radps)
     if x.shape != y.shape:
         raise ValueError(f"aircraft and simulator signals differ in shape: {x.shape} and {y.shape}")
-    band = measure.bands()
-    c = trapezoid_weights(len(x), dt_s)
-    e = c @ np.maximum(np.abs(x - y) - band, 0.0)
-    return e, c @ false_part(x, y, band)
-
-
-def cue_sign(x: np.ndarray, band: np.ndarray) -> np.ndarray:
-    """s (N, 6): the sign of the aircraft pilot's cue ``x - x0`` where it is above the dead band, else 0."""
-    dx = x - x[:1]
-    return np.where(np.abs(dx) > band, np.sign(dx), 0.0)
-
-
-def false_part(x: np.ndarray, y: np.ndarray, band: np.ndarray) -> np.ndarray:
-    """The false part's integrand (N, 6) (module docstring) of perceived signals x, y (N, 6) in the DOFs' units."""
-    s = cue_sign(x, band)
-    dy = y - x[:1]
-    return np.where(s != 0.0, np.maximum(-s * dy - band, 0.0), np.maximum(np.abs(dy) - band, 0.0))
+    if len(x) == 0:
+        return np.zeros(6), np.zeros(6)
+    out = np.empty((2, 6))
+    _compiled()[0](x, y, measure.bands(), float(dt_s), out)
+    return out[0].copy(), out[1].copy()
 
 
 def jolt(sim_head_f_mps2: np.ndarray, aircraft_head_f_mps2: np.ndarray, dt_s: float,
          measure: FeltMeasure = DEFAULT_MEASURE) -> np.ndarray:  # fmt: skip
     """J (3,): the jerk the platform adds at the head beyond the aircraft's and the dead band, integrated, per body
     axis (m/s^2) (module docstring), from the head specific forces (N, 3), m/s^2."""
-    f = np.asarray(sim_head_f_mps2, dtype=np.float64)
-    a = np.asarray(aircraft_head_f_mps2, dtype=np.float64)
+    f = np.ascontiguousarray(sim_head_f_mps2, dtype=np.float64)
+    a = np.ascontiguousarray(aircraft_head_f_mps2, dtype=np.float64)
     if f.shape != a.shape:
         raise ValueError(f"aircraft and simulator head signals differ in shape: {a.shape} and {f.shape}")
-    if len(f) < 2:
-        return np.zeros(3)
-    dt = float(dt_s)
-    excess = np.abs(np.diff(f, axis=0)) - np.abs(np.diff(a, axis=0)) - measure.jerk_deadband_mps3 * dt
-    return np.maximum(excess, 0.0).sum(axis=0)
+    out = np.zeros(3)
+    if len(f) >= 2:
+        _compiled()[1](f, a, measure.jerk_deadband_mps3 * float(dt_s), out)
+    return out
 
 
 def dof_terms(e: np.ndarray, f: np.ndarray, j: np.ndarray, measure: FeltMeasure = DEFAULT_MEASURE) -> np.ndarray:

@@ -20,6 +20,11 @@ from washbench.numerics.jit import njit
 A_N, A_SUM, A_FIRST, A_LAST, A_MAX, A_MX, A_MY, A_M2X, A_M2Y, A_CXY, A_PX, A_PY = range(12)
 NACC = 12
 
+F_N, F_SUM, F_FIRST, F_LAST, F_FSUM, F_FFIRST, F_FLAST = range(7)
+NFELT = 7
+"""One DOF's accumulator of the felt error (:mod:`washbench.analysis.felt`): the count, the sum, first and last of
+the dead-banded error, and the same of the false part (for the trapezoid rule)."""
+
 FLAT_RTOL = 1e-9
 """A signal whose standard deviation is at most this fraction of its peak |value| is flat."""
 MIN_PC_SAMPLES = 3
@@ -70,6 +75,73 @@ def finish(acc, dt):
         pc = acc[A_CXY] / (math.sqrt(acc[A_M2X]) * math.sqrt(acc[A_M2Y]))
         pc = min(1.0, max(-1.0, pc))
     return pc, integral, acc[A_MAX]
+
+
+@njit(cache=True, inline="always")
+def felt_update(acc, x, y, band, sign, x0):
+    """Add one sample to a felt-error accumulator ``acc`` (NFELT,): ``max(|x - y| - band, 0)`` and the false part,
+    ``max(-sign (y - x0) - band, 0)`` where ``sign`` (the aircraft pilot's cue beyond the band) is not 0, else
+    ``max(|y - x0| - band, 0)`` (x aircraft, y simulator, x0 the aircraft's first sample; the DOF's units)."""
+    n = acc[F_N] + 1.0
+    acc[F_N] = n
+    g = max(abs(x - y) - band, 0.0)
+    h = max(-sign * (y - x0) - band, 0.0) if sign != 0.0 else max(abs(y - x0) - band, 0.0)
+    if n == 1.0:
+        acc[F_FIRST] = g
+        acc[F_FFIRST] = h
+    acc[F_SUM] += g
+    acc[F_LAST] = g
+    acc[F_FSUM] += h
+    acc[F_FLAST] = h
+
+
+@njit(cache=True)
+def felt_finish(acc, dt):
+    """(felt error, false part): the trapezoid integrals over dt of a felt-error accumulator."""
+    e = dt * (acc[F_SUM] - 0.5 * (acc[F_FIRST] + acc[F_LAST]))
+    f = dt * (acc[F_FSUM] - 0.5 * (acc[F_FFIRST] + acc[F_FLAST]))
+    return e, f
+
+
+@njit(cache=True, inline="always")
+def cue_sign(x, x0, band):
+    """The sign of the aircraft pilot's cue ``x - x0`` where it is beyond ``band``, else 0."""
+    d = x - x0
+    if abs(d) > band:
+        return 1.0 if d > 0.0 else -1.0
+    return 0.0
+
+
+@njit(cache=True)
+def felt_sums(x, y, band, dt, out):
+    """The felt error and its false part per column (``out`` (2, C)) of the aircraft's ``x`` and the simulator's
+    ``y`` (N, C) in the DOFs' units, with dead bands ``band`` (C,)."""
+    acc = np.zeros(NFELT)
+    for j in range(x.shape[1]):
+        acc[:] = 0.0
+        for k in range(x.shape[0]):
+            felt_update(acc, x[k, j], y[k, j], band[j], cue_sign(x[k, j], x[0, j], band[j]), x[0, j])
+        e, f = felt_finish(acc, dt)
+        out[0, j] = e
+        out[1, j] = f
+
+
+@njit(cache=True, inline="always")
+def jolt_step(f_now, f_before, a_now, a_before, allow):
+    """One sample's jolt: ``max(|f_now - f_before| - |a_now - a_before| - allow, 0)`` (simulator f, aircraft a;
+    ``allow`` the jerk dead band times dt)."""
+    return max(abs(f_now - f_before) - abs(a_now - a_before) - allow, 0.0)
+
+
+@njit(cache=True)
+def jolt_sums(f, a, allow, out):
+    """The jolt per column (``out`` (C,)) of the simulator's head specific force ``f`` against the aircraft's ``a``
+    (N, C), m/s^2; ``allow`` = J_T dt (m/s^2)."""
+    for j in range(f.shape[1]):
+        total = 0.0
+        for k in range(1, f.shape[0]):
+            total += jolt_step(f[k, j], f[k - 1, j], a[k, j], a[k - 1, j], allow)
+        out[j] = total
 
 
 @njit(cache=True)

@@ -148,7 +148,7 @@ class RankRule:
 
     def label(self) -> str:
         """One line for reports: the rule and its tie margin."""
-        band = "beyond the perception thresholds" if self.measure.deadband else "without perception thresholds"
+        band = "above the perception thresholds" if self.measure.deadband else "without perception thresholds"
         what = {
             "felt": f"felt error (perceived error {band}, false cues twice, the platform's jolts; relative to a "
             "still platform)" if self.measure.false_weight == 1.0 else

@@ -78,15 +78,29 @@ class Relaxation:
         return 2.0 * math.sin(min(self.turn_step_rad, math.pi) / 2.0)
 
     def record(self) -> dict[str, Any]:
-        """The values for run.json (SI)."""
+        """The values for run.json (SI); a bound that is not finite (no row: a rig's rate step, a hexapod whose leg
+        Jacobian is singular somewhere inside its stroke) is null, as JSON has no infinity."""
+
+        def num(x: float) -> float | None:
+            return float(x) if math.isfinite(x) else None
+
+        def nums(xs: Vec3) -> list[float | None]:
+            return [num(x) for x in xs]
+
         return {
-            "kind": self.kind, "gravity_lo_mps2": list(self.gravity_lo), "gravity_hi_mps2": list(self.gravity_hi),
-            "turn_step_rad": self.turn_step_rad, "acc_mps2": list(self.acc), "vel_mps": list(self.vel),
-            "pos_m": list(self.pos), "vel_norm_mps": self.vel_norm, "pos_norm_m": self.pos_norm,
-            "start_pos_m": list(self.start_pos), "rate_radps": list(self.rate),
-            "rate_step_radps": self.rate_step if math.isfinite(self.rate_step) else None,
-            "ang_acc_radps2": self.ang_acc, "source": self.source,
+            "kind": self.kind, "gravity_lo_mps2": nums(self.gravity_lo), "gravity_hi_mps2": nums(self.gravity_hi),
+            "turn_step_rad": num(self.turn_step_rad), "acc_mps2": nums(self.acc), "vel_mps": nums(self.vel),
+            "pos_m": nums(self.pos), "vel_norm_mps": num(self.vel_norm), "pos_norm_m": num(self.pos_norm),
+            "start_pos_m": nums(self.start_pos), "rate_radps": nums(self.rate), "rate_step_radps": num(self.rate_step),
+            "ang_acc_radps2": num(self.ang_acc), "source": self.source,
         }  # fmt: skip
+
+    @property
+    def unbounded(self) -> tuple[str, ...]:
+        """The bounds that are not finite (of rate, acc, vel, ang_acc: a singular leg Jacobian inside the stroke)."""
+        values = {"rate": self.rate, "acceleration": self.acc, "velocity": self.vel, "angular acceleration":
+                  (self.ang_acc,)}  # fmt: skip
+        return tuple(k for k, v in values.items() if not all(math.isfinite(x) for x in v))
 
 
 def atlas_relaxation(limits: Any, dt_s: float, gravity_mps2: float) -> Relaxation:

@@ -102,3 +102,21 @@ def minimise(
         x0=start,
     )
     return np.asarray(result.x, dtype=float)
+
+
+#: How close to an end of its interval a tuned value counts as at that end: this fraction of the interval's width.
+#: Chosen (not published): 1 % is far below the spread of a differential-evolution population over its budget, so a
+#: value that close to an end was pushed there, and the best may lie beyond it.
+EDGE_FRACTION = 0.01
+
+
+def at_edges(bounds: list[Bound], x: np.ndarray) -> list[str]:
+    """One line for each tuned value within :data:`EDGE_FRACTION` of an end of its interval, e.g. ``tilt.gain_per_s
+    = 0.200343 is at the lower end of its interval 0.2..5``: the optimum may lie outside the interval searched."""
+    lines = []
+    for b, v in zip(bounds, np.asarray(x, dtype=float), strict=True):
+        margin = EDGE_FRACTION * (b.high - b.low)
+        end = "lower" if v - b.low <= margin else "upper" if b.high - v <= margin else None
+        if end is not None:
+            lines.append(f"{b.key} = {v:.6g} is at the {end} end of its interval {b.low:g}..{b.high:g}")
+    return lines

@@ -1,4 +1,13 @@
-"""Motion cueing: the three washouts of Micomonaco et al. on a kinematic Atlas platform.
+"""Motion cueing: the washout stage, from the aircraft's pilot-head motion to the platform's set points.
+
+The washouts, each a kind in :mod:`washbench.cueing.registry` (``washbench run --help`` lists their names): the
+classical washouts of Micomonaco et al. (``small-angle``, Reid and Nahon's; its ``large-angle`` quaternion extension;
+the ``unrestricted`` angular washout) and the coordinated adaptive washout in the same three forms, compiled
+(``kernel``, ``bank``); the optimal (LQ) washout (``optimal``); the model-predictive ones (``mpc``,
+``mpc-unrestricted``); the oracle bound (``bound``, computed over a whole recording: :mod:`washbench.analysis.bound`);
+the naive references (``replay``, ``replay-rotation``, ``still``: :mod:`washbench.cueing.references`); and any
+plugin (``--washout-plugin FILE.py:NAME`` or the ``washbench.washouts`` entry points). Each drives any platform
+(:mod:`washbench.platform`) that it can, through the same interface (``algorithm``).
 
 Public API::
 

@@ -30,6 +30,11 @@ Optionally an algorithm has ``trace(f_mps2 (N, 3), omega_radps (N, 3)) -> (pos_m
 whole-trace form, called instead of N steps after :meth:`~WashoutAlgorithm.start` (it must give the same numbers
 as the steps; the bench uses it for recorded files, studies and the OMCT).
 
+Optionally an algorithm has ``steps(f_mps2 (M, 3), omega_radps (M, 3)) -> (pos_m (M, 3), q (M, 4))``: the block
+form, the next M samples from where it is (after :meth:`~WashoutAlgorithm.start` or earlier steps), the same
+numbers as M steps; the bench then calls it once per block of samples (a flight's lockstep takes 120 at a time)
+instead of ``step`` per sample. Its set points are checked as a step's are; it gives no flags.
+
 Optionally an algorithm has ``flags() -> tuple[bool, bool]``: whether its own tilt-rate and rotational-rate limits
 acted on the last step (the ``sat_tilt_rate`` and ``sat_rot_rate`` columns); without it both are False.
 

@@ -576,6 +576,7 @@ def cue_trace(
     limits: PlatformModel,
     filter_start: str = "steady",
     fields_out: np.ndarray | None = None,
+    reports: dict[str, dict[str, float | int]] | None = None,
 ) -> dict[str, WashoutTrace]:
     """Whole-trace form: run the washouts over arrays f (N, 3) m/s^2 and omega (N, 3) rad/s sampled every dt_s.
 
@@ -585,7 +586,8 @@ def cue_trace(
     limited here (the platform stays within its limits whatever the input); the readers refuse physically
     absurd recordings at the file edge.
     ``filter_start``: see :data:`FILTER_STARTS`. ``fields_out``: for one washout, a (N_FIELDS, N) float64 array to
-    write its outputs into (the traces are views of it).
+    write its outputs into (the traces are views of it). ``reports``: filled with what the Python washouts report of
+    themselves (:meth:`CueingBank.algorithm_reports`), when given.
     """
     specs = as_washouts(washouts, params)
     names = [w.name for w in specs]
@@ -612,6 +614,9 @@ def cue_trace(
             _set_start(state[i], *src.start(f[0], w[0]))
             pos, q, flags = src.run(f, w, whole=True)
             setpoint_trace(pos, q, flags, cfg[i], coef[i], state[i], counts[i], out[i])
+            reported = src.report() if reports is not None else None
+            if reported is not None:
+                reports[src.name] = reported
     plugin = PluginPass(limits, len(names), dt, filter_start, specs)
     if plugin and len(f):
         for i in range(len(names)):

@@ -26,6 +26,8 @@ import numpy as np
 from scipy import linalg
 
 from washbench.cueing.motion_model import discretise_zoh
+from washbench.errors import WashbenchError
+from washbench.io.cost import horizon_intervals
 from washbench.numerics.statespace import tf2ss
 
 
@@ -137,11 +139,32 @@ def stage_limits(limits: object) -> tuple[np.ndarray, np.ndarray, np.ndarray, fl
     """The limits an MPC plans against, in SI: the stage's position, velocity and acceleration limits per inertial
     axis (3,) each (m, m/s, m/s^2) and the rotation's rate and angular-acceleration limits (rad/s, rad/s^2), from
     Atlas-shaped ``limits`` (:class:`washbench.platform.limits.PlatformLimits`, or the box about neutral that stands
-    for another platform)."""
+    for another platform); WashbenchError (one line) without them (a platform plugin without ``envelope``)."""
+    if not (hasattr(limits, "translation") and hasattr(limits, "rotation")):
+        raise WashbenchError("an MPC washout plans against the platform's envelope (Atlas-shaped limits), which this "
+                             "platform does not give (a platform plugin needs envelope(params))")  # fmt: skip
     t, r = limits.translation, limits.rotation
     return (np.array(t.position_limit_m.xyz), np.array(t.velocity_limit_mps.xyz),
             np.array(t.acceleration_limit_mps2.xyz), math.radians(r.rate_limit_degps),
             math.radians(r.acceleration_limit_degps2))  # fmt: skip
+
+
+def horizon_problem(horizon_steps: int, preview_s: float, prediction_step_s: float, iter_limit: int, largest: int,
+                    max_work: int) -> str | None:  # fmt: skip
+    """Why an MPC section's horizon is too large (one phrase), or None: its intervals (:func:`horizon_intervals`,
+    preview included) at most ``largest``, and the intervals times ``iter_limit`` at most ``max_work``."""
+    n = horizon_intervals(horizon_steps, preview_s, prediction_step_s)
+    if n > largest:
+        return (f"preview_s {preview_s:g} / prediction_step_s {prediction_step_s:g} makes {n:,} prediction intervals, "
+                f"more than the horizon's limit of {largest} (the QP grows with the square of the intervals and its "
+                f"building with their cube); a prediction_step_s of at least {preview_s / largest:.4g} s or a "
+                f"preview_s of at most {largest * prediction_step_s:.4g} s")  # fmt: skip
+    work = n * iter_limit
+    if work > max_work:
+        what = f"horizon_steps {horizon_steps}" if n == horizon_steps else f"a horizon of {n} intervals (preview_s)"
+        return (f"{what} x solver.iter_limit {iter_limit} = {work:,}: more than {max_work:,} (the QP's size times "
+                "its iterations, per sample: hours per minute of flight); lower one of them")  # fmt: skip
+    return None
 
 
 def preview_needs_recording(section: dict) -> bool:
@@ -270,6 +293,7 @@ __all__ = [
     "WhitenedQp",
     "blocking_matrix",
     "default_blocks",
+    "horizon_problem",
     "horizon_reference",
     "preview_needs_recording",
     "rows_kron3",

@@ -32,7 +32,6 @@ depend on the aircraft input) or, without one, by braking (counted: :meth:`MpcWa
 from __future__ import annotations
 
 import math
-import sys
 import time
 from dataclasses import dataclass, replace
 from typing import Annotated, Any, Literal
@@ -45,6 +44,7 @@ from washbench.cueing.algorithm import SetPoint, WashoutContext
 from washbench.cueing.condensed import (
     DenseQp,
     WhitenedQp,
+    horizon_problem,
     horizon_reference,
     preview_needs_recording,
     stage_limits,
@@ -53,6 +53,7 @@ from washbench.cueing.motion_model import CHANNELS, ChannelModel, channel_inputs
 from washbench.cueing.mpc_legs import LEG_RATE_MOVES, LegRows
 from washbench.cueing.optimal import merge_channel_defaults
 from washbench.errors import WashbenchError
+from washbench.io import cost
 from washbench.io.progress import duration_text
 from washbench.io.yamlio import StrictModel
 from washbench.numerics.rotations import quat_from_euler
@@ -61,7 +62,13 @@ from washbench.platform.hexapod import HexapodModel
 from washbench.platform.kinematics import brake_speed
 
 MAX_WORK = 10_000_000
-"""horizon_steps x solver.iter_limit at most this (the defaults: 20,000; a 500-step horizon with 20,000 iterations)."""
+"""The horizon's intervals (preview included) x solver.iter_limit at most this (the defaults: 20,000; a 500-step
+horizon with 20,000 iterations)."""
+MAX_HORIZON = 500
+"""The horizon's intervals at most, ``preview_s`` included (``horizon_steps``' own limit): its QP takes about 2 GB
+and five minutes of CPU to build and set up there (:func:`washbench.io.cost.mpc`, ``bench/cost_calibration.md``)."""
+REMEDY = "fewer mpc.horizon_steps, a longer mpc.prediction_step_s or a shorter mpc.preview_s"
+"""What makes the MPC's QP smaller (the messages of :mod:`washbench.io.cost`)."""
 ESTIMATE_AFTER_STEPS = 20
 """The MPC times its first this-many steps and says how long a minute of flight will take when it is slow."""
 SLOW_FACTOR = 10.0
@@ -113,7 +120,8 @@ class MpcParams(StrictModel):
     """The ``mpc:`` section of the parameter file."""
 
     horizon_steps: Annotated[int, Field(ge=1, le=500)] = 20
-    """N, the number of prediction intervals"""
+    """N, the number of prediction intervals (with ``preview_s``, N = max(horizon_steps, preview_s /
+    prediction_step_s), at most 500 intervals in all)"""
     prediction_step_s: Annotated[float, Field(gt=0.0, le=5.0, allow_inf_nan=False)] = 0.1
     """the prediction interval (s); at least the sample step"""
     reference_decay_per_s: Annotated[float, Field(ge=0.0, le=100.0, allow_inf_nan=False)] = 0.5
@@ -124,8 +132,9 @@ class MpcParams(StrictModel):
     """the time constant of that recent mean (s): a first-order low-pass of the aircraft's input, started at the first
     sample (a steady flight is predicted to stay as it is)"""
     preview_s: Annotated[float, Field(ge=0.0, le=20.0, allow_inf_nan=False)] = 0.0
-    """how far ahead the aircraft's motion is known (s; the horizon is extended to cover it): 0 none; > 0 needs the
-    recording in advance (run, suite, cue), not a live stream"""
+    """how far ahead the aircraft's motion is known (s; the horizon is extended to cover it, at most 500 intervals:
+    20 s needs prediction_step_s of at least 0.04 s): 0 none; > 0 needs the recording in advance (run, suite, cue),
+    not a live stream"""
     limit_margin: Annotated[float, Field(gt=0.0, le=1.0)] = 0.95
     """the QP's limits are this fraction of the platform's"""
     tilt_rate_limit_degps: Annotated[float, Field(gt=0.0, le=1000.0)] | None = 3.0
@@ -143,13 +152,12 @@ class MpcParams(StrictModel):
 
     @model_validator(mode="after")
     def _bounded_work(self) -> MpcParams:
-        """The worst case of one step's solve, horizon_steps x iter_limit, within :data:`MAX_WORK`."""
-        work = self.horizon_steps * self.solver.iter_limit
-        if work > MAX_WORK:
-            raise ValueError(f"horizon_steps {self.horizon_steps} x solver.iter_limit {self.solver.iter_limit} = "
-                             f"{work:,}: "
-                             f"more than {MAX_WORK:,} (the QP's size times its iterations, per sample: hours per "
-                             "minute of flight); lower one of them")  # fmt: skip
+        """The horizon's intervals, preview included, within :data:`MAX_HORIZON`, and the worst case of one step's
+        solve, those intervals x iter_limit, within :data:`MAX_WORK`."""
+        problem = horizon_problem(self.horizon_steps, self.preview_s, self.prediction_step_s,
+                                  self.solver.iter_limit, MAX_HORIZON, MAX_WORK)  # fmt: skip
+        if problem is not None:
+            raise ValueError(problem)
         return self
 
     @model_validator(mode="before")
@@ -296,7 +304,10 @@ class MpcWashout:
         self.p_max, self.v_max, self.a_max, self.w_max, self.alpha_max = stage_limits(lim)
         self.n, self.m = sm.B.shape
         self.tp = p.prediction_step_s
-        self.N = max(p.horizon_steps, math.ceil(p.preview_s / self.tp - 1e-9))
+        self.N = cost.horizon_intervals(p.horizon_steps, p.preview_s, self.tp)
+        self._cost = cost.mpc("mpc", self.N, self.dt, hexapod=self.hexapod is not None, remedy=REMEDY)
+        cost.check(self._cost, announce=False)  # its QP must fit before it is built
+        self._announce()
         ab = np.hstack([sm.B, sm.E])
         self.phi_p, gam = discretise_zoh(sm.A, ab, self.tp)
         self.gam_p, self.gam_rp = gam[:, : self.m], gam[:, self.m :]
@@ -323,6 +334,7 @@ class MpcWashout:
         self._sat_rot = False
         self._timed_steps = 0
         self._timed_s = 0.0
+        self._first_done = False
         self._future: tuple[np.ndarray, np.ndarray] | None = None
         self._k = 0
 
@@ -594,6 +606,16 @@ class MpcWashout:
         if self.params.preview_s > 0.0 and self._future is None:
             raise WashbenchError("washout mpc: preview_s > 0 needs the recording in advance (run, suite, cue), not a "
                                  "live stream; set mpc.preview_s: 0")  # fmt: skip
+        return self._timed_step(f_mps2, omega_radps)
+
+    def _timed_step(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> SetPoint:
+        """:meth:`_step`, the :data:`ESTIMATE_AFTER_STEPS` after the first timed (:meth:`_estimate`), by :meth:`step`
+        and :meth:`trace` alike. The first is not: the solver sets itself up there (DAQP factorises the QP: 200 s of
+        a 500-interval horizon's first sample, then 0.12 s a sample), which is the building's, not a minute of
+        flight's."""
+        if not self._first_done:
+            self._first_done = True
+            return self._step(f_mps2, omega_radps)
         if self._timed_steps < ESTIMATE_AFTER_STEPS:
             t0 = time.perf_counter()
             out = self._step(f_mps2, omega_radps)
@@ -604,6 +626,11 @@ class MpcWashout:
             return out
         return self._step(f_mps2, omega_radps)
 
+    def _announce(self, samples: int | None = None) -> None:
+        """Before the work, on stderr when it is long (:func:`washbench.io.cost.announce_mpc`): building the QP and a
+        minute of flight (``samples`` None: when it is made), or the ``samples`` of a recording (:meth:`trace`)."""
+        cost.announce_mpc(self._cost, "mpc", self.N, self.dt, samples, SLOW_FACTOR, self.hexapod is not None)
+
     def _estimate(self) -> None:
         """Say on stderr how long a minute of flight takes, when the MPC runs far slower than real time (timed on its
         first steps; only a message: the set points never depend on time)."""
@@ -611,9 +638,9 @@ class MpcWashout:
         if per_step <= SLOW_FACTOR * self.dt:
             return
         minute = per_step * 60.0 / self.dt
-        print(f"washbench: note: washout mpc: {per_step:.3g} s per sample (timed on its first {self._timed_steps}): "
-              f"a minute of flight takes about {duration_text(minute)}; fewer mpc.horizon_steps or "
-              "mpc.solver.iter_limit make it faster", file=sys.stderr, flush=True)  # fmt: skip
+        cost.note(f"washout mpc: {per_step:.3g} s per sample (timed on {self._timed_steps} after the first): a "
+                  f"minute of flight takes about {duration_text(minute)}; fewer mpc.horizon_steps or "
+                  "mpc.solver.iter_limit make it faster")  # fmt: skip
 
     def _step(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> SetPoint:
         r = stacked_inputs(f_mps2, omega_radps, self.g)
@@ -644,9 +671,10 @@ class MpcWashout:
         pos = np.empty((len(f), 3))
         q = np.empty((len(f), 4))
         self._future = stacked_inputs(f, w, self.g)
+        self._announce(len(f))
         try:
             for i in range(len(f)):
-                pos[i], q[i] = self._step(f[i], w[i])
+                pos[i], q[i] = self._timed_step(f[i], w[i])
         finally:
             self._future = None
         return pos, q

@@ -47,6 +47,7 @@ from washbench.cueing.condensed import (
     DenseQp,
     blocking_matrix,
     default_blocks,
+    horizon_problem,
     horizon_reference,
     preview_needs_recording,
     siso_prediction,
@@ -55,13 +56,19 @@ from washbench.cueing.condensed import (
 )
 from washbench.cueing.felt_qp import INF, FeltSlacks
 from washbench.cueing.motion_model import discretise_zoh
-from washbench.cueing.mpc import VestibularChoice
+from washbench.cueing.mpc import MAX_WORK, SLOW_FACTOR, VestibularChoice
 from washbench.errors import WashbenchError
+from washbench.io import cost
 from washbench.io.yamlio import StrictModel
 from washbench.numerics.rotations import quat_from_euler
 from washbench.perception.thresholds import ZACHARIAS, Thresholds
 from washbench.perception.vestibular import canal_tf, otolith_tf
 from washbench.platform.kinematics import brake_speed
+
+MAX_HORIZON = 200
+"""The horizon's intervals at most, ``preview_s`` included (``horizon_steps``' own limit)."""
+REMEDY = ("fewer mpc-unrestricted.horizon_steps, a longer mpc-unrestricted.prediction_step_s or a shorter "
+          "mpc-unrestricted.preview_s")  # fmt: skip
 
 Weight = Annotated[float, Field(ge=0.0, le=1e9, allow_inf_nan=False)]
 PositiveWeight = Annotated[float, Field(gt=0.0, le=1e9, allow_inf_nan=False)]
@@ -106,11 +113,12 @@ class MpcUnrestrictedParams(StrictModel):
     """The ``mpc-unrestricted:`` section of the parameter file (SI; axis triples are x, y, z)."""
 
     horizon_steps: Annotated[int, Field(ge=1, le=200)] = 20
-    """N, prediction intervals (extended to cover ``preview_s``)"""
+    """N, prediction intervals (extended to cover ``preview_s``: at most 200 intervals in all)"""
     prediction_step_s: Annotated[float, Field(gt=0.0, le=5.0, allow_inf_nan=False)] = 0.1
     """the prediction interval tp (s); at least the sample step"""
     preview_s: Annotated[float, Field(ge=0.0, le=20.0, allow_inf_nan=False)] = 0.0
-    """how far ahead the aircraft's motion is known (s): 0 none; > 0 needs the recording in advance"""
+    """how far ahead the aircraft's motion is known (s; 20 s needs prediction_step_s of at least 0.1 s, the horizon
+    being at most 200 intervals): 0 none; > 0 needs the recording in advance"""
     reference_decay_per_s: Annotated[float, Field(ge=0.0, le=100.0, allow_inf_nan=False)] = 0.5
     """gamma: beyond what is previewed, the aircraft's specific force is predicted to return from the last known value
     to its recent mean as e^{-gamma t} (0: held)"""
@@ -163,6 +171,16 @@ class MpcUnrestrictedParams(StrictModel):
     positive definite for the dual active-set solver (chosen small against the slacks' linear costs, 0.1-0.5 per
     threshold unit: 10 thresholds beyond the dead band cost 2-10 % more)"""
     solver: DaqpSettings = DaqpSettings()
+
+    @model_validator(mode="after")
+    def _bounded_horizon(self) -> MpcUnrestrictedParams:
+        """The horizon's intervals, preview included, within :data:`MAX_HORIZON`; those intervals x iter_limit
+        within :data:`washbench.cueing.mpc.MAX_WORK`."""
+        problem = horizon_problem(self.horizon_steps, self.preview_s, self.prediction_step_s,
+                                  self.solver.iter_limit, MAX_HORIZON, MAX_WORK)  # fmt: skip
+        if problem is not None:
+            raise ValueError(problem)
+        return self
 
     @model_validator(mode="before")
     @classmethod
@@ -271,12 +289,13 @@ class MpcUnrestrictedWashout:
             raise ValueError(f"mpc-unrestricted: prediction_step_s {p.prediction_step_s} s is shorter than the "
                              f"sample {self.dt} s")  # fmt: skip
         lim = context.limits
-        if not hasattr(lim, "rotation") or not hasattr(lim, "translation"):
-            raise WashbenchError("mpc-unrestricted: needs a platform of unlimited rotation (the Atlas)")
         mg = p.limit_margin
         self.p_max, self.v_max, self.a_max, self.w_max, self.alpha_max = stage_limits(lim)
         self.tp = tp = p.prediction_step_s
-        self.N = N = max(p.horizon_steps, math.ceil(p.preview_s / tp - 1e-9))
+        self.N = N = cost.horizon_intervals(p.horizon_steps, p.preview_s, tp)
+        self._cost = cost.mpc("mpc-unrestricted", N, self.dt, remedy=REMEDY)
+        cost.check(self._cost, announce=False)  # its QP must fit before it is built
+        cost.announce_mpc(self._cost, "mpc-unrestricted", N, self.dt, None, SLOW_FACTOR)
         self.blocks = default_blocks(N)
         Bk = blocking_matrix(self.blocks)
         self.M = M = len(self.blocks)
@@ -605,6 +624,7 @@ class MpcUnrestrictedWashout:
         pos = np.empty((n, 3))
         q = np.empty((n, 4))
         self._future = np.hstack([f, w])
+        cost.announce_mpc(self._cost, "mpc-unrestricted", self.N, self.dt, n, SLOW_FACTOR)
         try:
             for i in range(n):
                 pos[i], q[i] = self._advance(f[i], w[i])

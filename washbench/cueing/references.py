@@ -18,8 +18,9 @@ selectable like any other:
 - ``still``: the platform held at its first pose (the tilt of the first sample, or level), never moving: the
   ranking's "1" (docs/metrics.md).
 
-Integration is the bench's own (explicit, one sample at a time); nothing is tuned. Each has the whole-trace form
-(``trace``), the same numbers as its steps.
+Integration is explicit, one sample at a time, compiled (:func:`reference_block`); nothing is tuned. Each has the
+block form (``steps``, a flight's lockstep block at a time) and the whole-trace form (``trace``), the same numbers as
+its steps.
 """
 
 from __future__ import annotations
@@ -29,9 +30,9 @@ import math
 import numpy as np
 
 from washbench.cueing.algorithm import SetPoint, WashoutContext
-
-REFERENCE_KINDS = ("replay", "replay-rotation", "still")
-"""The naive references' washout names (module docstring)."""
+from washbench.cueing.registry import REFERENCE_KINDS
+from washbench.numerics.jit import njit
+from washbench.numerics.jitcache import announce_compile
 
 
 def tilt_of(f_mps2: np.ndarray) -> np.ndarray:
@@ -51,30 +52,44 @@ def tilt_of(f_mps2: np.ndarray) -> np.ndarray:
     return q / np.linalg.norm(q)
 
 
-def _qmul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    aw, ax, ay, az = a
-    bw, bx, by, bz = b
-    return np.array([aw * bw - ax * bx - ay * by - az * bz, aw * bx + ax * bw + ay * bz - az * by,
-                     aw * by - ax * bz + ay * bw + az * bx, aw * bz + ax * by - ay * bx + az * bw])  # fmt: skip
-
-
-def _qexp(w_radps: np.ndarray, dt_s: float) -> np.ndarray:
-    """exp(omega dt / 2) (4,): the rotation by body rate ``omega`` held over ``dt``."""
-    angle = float(np.linalg.norm(w_radps)) * dt_s
-    if angle < 1e-12:
-        return np.array([1.0, 0.5 * dt_s * w_radps[0], 0.5 * dt_s * w_radps[1], 0.5 * dt_s * w_radps[2]])
-    axis = np.asarray(w_radps) * (dt_s / angle)
-    s = math.sin(0.5 * angle)
-    return np.array([math.cos(0.5 * angle), s * axis[0], s * axis[1], s * axis[2]])
-
-
-def _rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """q v q* (3,): a body vector in inertial axes."""
-    w, x, y, z = q
-    r = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-                  [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-                  [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])  # fmt: skip
-    return r @ v
+@njit(cache=True)
+def reference_block(f, w, dt, g, travel, rotate, translate, state, pos_out, q_out):
+    """The references' steps over a block (compiled): ``f``, ``w`` (M, 3) the aircraft's specific force (m/s^2)
+    and body rates (rad/s); ``state`` (10,) the attitude q (4, scalar first, body to inertial), the stage's position
+    and velocity (3 + 3, inertial, m and m/s), updated in place; set points into ``pos_out`` (M, 3), clipped to
+    ``travel`` (3,), and ``q_out`` (M, 4). ``rotate``: q turns at the body rates, ``q exp(w dt / 2)``;
+    ``translate``: the stage integrates ``a = R f + [0, 0, g]`` (explicit: v, then p)."""
+    for k in range(f.shape[0]):
+        qw, qx, qy, qz = state[0], state[1], state[2], state[3]
+        if rotate:
+            wx, wy, wz = w[k, 0], w[k, 1], w[k, 2]
+            angle = math.sqrt(wx * wx + wy * wy + wz * wz) * dt
+            if angle < 1e-12:
+                dw, dx, dy, dz = 1.0, 0.5 * dt * wx, 0.5 * dt * wy, 0.5 * dt * wz
+            else:
+                s = math.sin(0.5 * angle) * dt / angle
+                dw, dx, dy, dz = math.cos(0.5 * angle), s * wx, s * wy, s * wz
+            nw = qw * dw - qx * dx - qy * dy - qz * dz
+            nx = qw * dx + qx * dw + qy * dz - qz * dy
+            ny = qw * dy - qx * dz + qy * dw + qz * dx
+            nz = qw * dz + qx * dy - qy * dx + qz * dw
+            n = math.sqrt(nw * nw + nx * nx + ny * ny + nz * nz)
+            qw, qx, qy, qz = nw / n, nx / n, ny / n, nz / n
+            state[0], state[1], state[2], state[3] = qw, qx, qy, qz
+        if translate:
+            fx, fy, fz = f[k, 0], f[k, 1], f[k, 2]
+            ax = (1 - 2 * (qy * qy + qz * qz)) * fx + 2 * (qx * qy - qw * qz) * fy + 2 * (qx * qz + qw * qy) * fz
+            ay = 2 * (qx * qy + qw * qz) * fx + (1 - 2 * (qx * qx + qz * qz)) * fy + 2 * (qy * qz - qw * qx) * fz
+            az = 2 * (qx * qz - qw * qy) * fx + 2 * (qy * qz + qw * qx) * fy + (1 - 2 * (qx * qx + qy * qy)) * fz + g
+            state[7] += ax * dt
+            state[8] += ay * dt
+            state[9] += az * dt
+            state[4] += state[7] * dt
+            state[5] += state[8] * dt
+            state[6] += state[9] * dt
+        for j in range(3):
+            pos_out[k, j] = min(max(state[4 + j], -travel[j]), travel[j])
+        q_out[k, 0], q_out[k, 1], q_out[k, 2], q_out[k, 3] = qw, qx, qy, qz
 
 
 class _Reference:
@@ -89,34 +104,31 @@ class _Reference:
         self.g = float(context.gravity_mps2)
         travel = context.limits.translation.position_limit_m
         self.travel = np.array(travel.xyz, dtype=np.float64)
-        self.q = np.array([1.0, 0.0, 0.0, 0.0])
-        self.p = np.zeros(3)
-        self.v = np.zeros(3)
+        self.state = np.zeros(10)
+        self.state[0] = 1.0
 
     def start(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> SetPoint:
-        self.q = tilt_of(f_mps2)
-        self.p = np.zeros(3)
-        self.v = np.zeros(3)
-        return self.p.copy(), self.q.copy()
+        self.state[:] = 0.0
+        self.state[:4] = tilt_of(f_mps2)
+        return np.zeros(3), self.state[:4].copy()
+
+    def steps(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The next M samples' set points (M, 3) and (M, 4) (the block form)."""
+        f = np.ascontiguousarray(f_mps2, dtype=np.float64).reshape(-1, 3)
+        w = np.ascontiguousarray(omega_radps, dtype=np.float64).reshape(-1, 3)
+        pos = np.empty((len(f), 3))
+        q = np.empty((len(f), 4))
+        announce_compile(reference_block)
+        reference_block(f, w, self.dt, self.g, self.travel, self.rotate, self.translate, self.state, pos, q)
+        return pos, q
 
     def step(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> SetPoint:
-        if self.rotate:
-            q = _qmul(self.q, _qexp(np.asarray(omega_radps, dtype=np.float64), self.dt))
-            self.q = q / np.linalg.norm(q)
-        if self.translate:
-            a = _rotate(self.q, np.asarray(f_mps2, dtype=np.float64)) + np.array([0.0, 0.0, self.g])
-            self.v = self.v + a * self.dt
-            self.p = self.p + self.v * self.dt
-        return np.clip(self.p, -self.travel, self.travel), self.q.copy()
+        pos, q = self.steps(f_mps2, omega_radps)
+        return pos[0], q[0]
 
     def trace(self, f_mps2: np.ndarray, omega_radps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The whole-trace form: the steps' set points (N, 3) and (N, 4) for inputs (N, 3) each."""
-        n = len(f_mps2)
-        pos = np.empty((n, 3))
-        q = np.empty((n, 4))
-        for k in range(n):
-            pos[k], q[k] = self.step(f_mps2[k], omega_radps[k])
-        return pos, q
+        """The whole-trace form: the steps' set points (N, 3) and (N, 4) for inputs (N, 3) each (after start)."""
+        return self.steps(f_mps2, omega_radps)
 
 
 class ReplayWashout(_Reference):

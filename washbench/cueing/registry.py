@@ -30,12 +30,13 @@ from typing import Any
 
 from pydantic import BaseModel
 
-from washbench.cueing.guard import plugin_call, plugin_error
 from washbench.cueing.params import WASHOUT_KINDS
 from washbench.errors import Terminated, WashbenchError, located
 from washbench.io import interrupts
+from washbench.io.entry_points import entry_points as installed_entry_points
 from washbench.io.names import identifier_problem
 from washbench.io.paths import plugin_file
+from washbench.io.plugin_guard import plugin_call, plugin_error
 from washbench.io.yamlio import line_of
 
 ENTRY_POINT_GROUP = "washbench.washouts"
@@ -55,6 +56,9 @@ BUILTIN_PYTHON: dict[str, str] = {
     "still": "washbench.cueing.references:StillWashout",
 }
 """Built-in Python algorithms: kind -> ``module:attribute`` of the factory (imported on first use)."""
+
+REFERENCE_KINDS: tuple[str, ...] = ("replay", "replay-rotation", "still")
+"""The naive references' washout names (:mod:`washbench.cueing.references`)."""
 
 
 @dataclass(frozen=True)
@@ -90,7 +94,8 @@ class Algorithm:
             loc = tuple(err["loc"])
             line = line_of(lines, (self.kind, *loc)) if lines else None
             field = ".".join((self.kind, *(str(p) for p in loc)))
-            raise WashbenchError(located(where, err["msg"], line=line, field=field)) from None
+            msg = str(err["msg"]).removeprefix("Value error, ")  # (a model validator's own words)
+            raise WashbenchError(located(where, msg, line=line, field=field)) from None
 
 
 _LOADED: dict[str, Algorithm] = {}
@@ -172,7 +177,7 @@ def load_plugin(spec: str) -> Algorithm:
 @functools.cache
 def _entry_points() -> dict[str, importlib.metadata.EntryPoint]:
     """The ``washbench.washouts`` entry points installed, read once per process (every name check asks)."""
-    return {ep.name: ep for ep in importlib.metadata.entry_points(group=ENTRY_POINT_GROUP)}
+    return {ep.name: ep for ep in installed_entry_points(ENTRY_POINT_GROUP)}
 
 
 def python_kinds() -> tuple[str, ...]:

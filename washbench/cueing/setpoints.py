@@ -16,8 +16,9 @@ import numpy as np
 
 from washbench.cueing import registry
 from washbench.cueing.algorithm import WashoutContext
-from washbench.cueing.guard import plugin_call
 from washbench.errors import WashbenchError
+from washbench.io.plugin_guard import plugin_call
+from washbench.io.plugin_guard import read_only as _ro
 from washbench.platform.model import planning_limits
 
 
@@ -44,14 +45,15 @@ class SetPointSource:
         where = self._where("making it")
         self.algo = plugin_call(where, lambda: algo.factory(section, self.context))
 
-        def methods() -> tuple[bool, bool, bool]:  # attribute look-ups run the plugin's code too (__getattr__)
+        def methods() -> tuple[bool, bool, bool, bool]:  # attribute look-ups run the plugin's code too (__getattr__)
             missing = [m for m in ("start", "step") if not callable(getattr(self.algo, m, None))]
             if missing:
                 raise WashbenchError(f"{where}: the algorithm has no {missing[0]}() method")
             whole = registry.needs_whole(algo.factory, params.sections.get(washout.kind))
-            return callable(getattr(self.algo, "flags", None)), callable(getattr(self.algo, "trace", None)), whole
+            return (callable(getattr(self.algo, "flags", None)), callable(getattr(self.algo, "trace", None)),
+                    callable(getattr(self.algo, "steps", None)), whole)  # fmt: skip
 
-        self.has_flags, self.has_trace, whole = plugin_call(where, methods)
+        self.has_flags, self.has_trace, self.has_steps, whole = plugin_call(where, methods)
         self.whole_only = whole and self.has_trace
 
     def _where(self, what: str | None = None) -> str:
@@ -132,18 +134,23 @@ class SetPointSource:
         q = np.empty((m, 4))
         flags = np.zeros((m, 2), dtype=np.int64)
         if whole and self.has_trace and self.k == -1 and m > 0:
-            return self._trace(f, om)
+            return self._block(f, om, "trace")
+        if self.has_steps and m > 0:
+            return self._block(f, om, "steps")
         for i in range(m):
             pos[i], q[i], flags[i, 0], flags[i, 1] = self.step(f[i], om[i])
         return pos, q, flags
 
-    def _trace(self, f: np.ndarray, om: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        self.k = 0
+    def _block(self, f: np.ndarray, om: np.ndarray, method: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The algorithm's block form: ``trace`` (the whole recording from its start) or ``steps`` (the next M
+        samples from where it is), checked as :meth:`step` checks one set point; no flags (zeros)."""
+        first = 0 if method == "trace" else self.k + 1
+        self.k = first
         m = f.shape[0]
-        where = self._where("trace")
+        where = self._where(method)
 
         def converted() -> tuple[np.ndarray, np.ndarray]:  # called and converted inside the guard
-            out = self.algo.trace(_ro(f), _ro(om))
+            out = getattr(self.algo, method)(_ro(f), _ro(om))
             if not isinstance(out, tuple | list) or len(out) != 2:
                 raise WashbenchError(f"{where}: returned {type(out).__name__}, expected a tuple (pos_m, q)")
             try:
@@ -158,18 +165,10 @@ class SetPointSource:
         norms = np.sqrt((q * q).sum(axis=1))
         bad |= ~(norms >= 1e-6)
         if bad.any():
-            self.k = int(np.argmax(bad))
+            self.k = first + int(np.argmax(bad))
             raise WashbenchError(f"{self._where()}: set point is not finite or q is zero")
-        self.k = m - 1
+        self.k = first + m - 1
         return pos, q / norms[:, None], np.zeros((m, 2), dtype=np.int64)
-
-
-def _ro(a: np.ndarray) -> np.ndarray:
-    """A read-only float64 copy for the algorithm: a view could be made writeable again (its base is the bench's
-    array) and written into, changing what the other washouts and the metrics see; a copy cannot."""
-    v = np.array(a, dtype=np.float64, order="C")
-    v.flags.writeable = False
-    return v
 
 
 def _number(v: object) -> float | int:

@@ -34,6 +34,7 @@ from pydantic import BaseModel
 from washbench.cueing import registry
 from washbench.cueing.params import (
     DEFAULT_PARAMS_PATH,
+    WASHOUT_KINDS,
     WASHOUT_NAMES,
     WashoutParams,
     load_base_params,
@@ -335,6 +336,27 @@ def as_washouts(washouts: Sequence[str | Washout], params: WashoutParams | None)
     return tuple(out)
 
 
+ALL_WASHOUTS = "all"
+"""``--washout all``: every built-in washout, the naive references and the bound (:data:`EVERY_BUILTIN`)."""
+
+EVERY_BUILTIN: tuple[str, ...] = (*WASHOUT_KINDS, "optimal", "mpc", "mpc-unrestricted", *registry.REFERENCE_KINDS,
+                                  "bound")  # fmt: skip
+"""What ``--washout all`` runs, in order (on a platform one cannot drive, it is left out and said so)."""
+
+DEFAULT_WASHOUTS: tuple[str, ...] = (*WASHOUT_NAMES, *registry.REFERENCE_KINDS)
+"""What runs without ``--washout``: the paper's three classical washouts and the naive references (cheap; every
+verdict says whether the best washout beats them); the report says what was not compared and that ``--washout all``
+compares everything."""
+
+
+def expand_all(names: Sequence[str]) -> list[str]:
+    """``names`` with ``all`` replaced by :data:`EVERY_BUILTIN`."""
+    out: list[str] = []
+    for n in names:
+        out.extend(EVERY_BUILTIN if n == ALL_WASHOUTS else [n])
+    return out
+
+
 def select_washouts(
     washouts: Sequence[str] | None = None,
     variants: Sequence[str] = (),
@@ -355,8 +377,27 @@ def select_from(
     """:func:`select_washouts` with the parameter file already loaded (its base set and ``variants:`` section)."""
     parsed = [parse_variant(v) for v in variants]
     extra = from_file + tuple(resolve(v, base) for v in parsed)
-    named = list(dict.fromkeys(washouts)) if washouts else ([] if extra else list(WASHOUT_NAMES))
+    named = list(dict.fromkeys(expand_all(washouts))) if washouts else ([] if extra else list(DEFAULT_WASHOUTS))
     return as_washouts([*builtin(named, base), *extra] if named else list(extra), None)
+
+
+def _unfit(washout: Washout, platform: Any) -> tuple[str, str] | None:
+    """(why ``washout`` cannot drive ``platform``, what to use instead), or None when it can."""
+    kind = getattr(platform, "kind", "atlas")
+    if kind == "atlas":
+        return None
+    plugin = kind not in ("hexapod", "rig")
+    if washout.kind in ("mpc", "mpc-unrestricted") and plugin and platform.envelope() is None:
+        return (f"plans against the platform's envelope (Atlas-shaped limits), which the {kind} platform plugin does "
+                "not give (its class has no envelope(params))"), ""  # fmt: skip
+    unlimited = getattr(platform, "unlimited_rotation", False)
+    if washout.kind in ("unrestricted", "adaptive-unrestricted", "mpc-unrestricted") and not unlimited:
+        why = f"cannot drive a {kind}, whose rotation is limited: its attitude set point is never washed back to level"
+        return why, "use large-angle or adaptive-large-angle"
+    if washout.kind == "bound" and kind not in ("hexapod", "rig"):
+        return (f"its ceiling needs the platform's workspace, which the {kind} platform plugin does not give (the "
+                "Atlas, a hexapod and a rig have one)"), ""  # fmt: skip
+    return None
 
 
 def platform_refusal(washout: Washout, platform: Any) -> str | None:
@@ -364,19 +405,28 @@ def platform_refusal(washout: Washout, platform: Any) -> str | None:
     (hexapod, rig) the unrestricted family (its attitude set point is never washed back to level) cannot; on a
     plugin's platform the oracle bound cannot either (its ceiling needs the platform's workspace, which a plugin
     does not give)."""
-    kind = getattr(platform, "kind", "atlas")
-    if kind == "atlas":
+    unfit = _unfit(washout, platform)
+    if unfit is None:
         return None
-    unlimited = getattr(platform, "unlimited_rotation", False)
-    if washout.kind in ("unrestricted", "adaptive-unrestricted", "mpc-unrestricted") and not unlimited:
-        return (
-            f"washout {washout.name} ({washout.kind}): cannot drive a {kind} (limited rotation; its attitude set "
-            "point is never washed back to level); use large-angle or adaptive-large-angle"
-        )
-    if washout.kind == "bound" and kind not in ("hexapod", "rig"):
-        return (f"washout {washout.name} (bound): its ceiling needs the platform's workspace, which the {kind} "
-                "platform plugin does not give (the Atlas, a hexapod and a rig have one)")
-    return None
+    why, instead = unfit
+    return f"washout {washout.name} ({washout.kind}): {why}" + (f"; {instead}" if instead else "")
+
+
+def default_on(
+    specs: Sequence[Washout], platform: Any, which: str = "the default"
+) -> tuple[tuple[Washout, ...], str | None]:
+    """The washouts of a set not named one by one (``which``: "the default", "all the") that can drive ``platform``
+    (:func:`platform_refusal`), and the one line that says which were left out and why (None when none was): such
+    a set is never cut silently."""
+    kept = tuple(w for w in specs if _unfit(w, platform) is None)
+    left = [w for w in specs if w not in kept]
+    if not left:
+        return kept, None
+    why = {w.name: _unfit(w, platform)[0] for w in left}  # type: ignore[index]
+    reasons = "; ".join(f"{', '.join(n for n in why if why[n] == r)} {r}" for r in dict.fromkeys(why.values()))
+    kind = getattr(platform, "kind", "atlas")
+    return kept, (f"{which} washouts run without {', '.join(why)} on this {kind}: {reasons} (--washout names "
+                  "the washouts to run)")  # fmt: skip
 
 
 def check_platform(specs: Sequence[Washout], platform: Any) -> None:
@@ -396,6 +446,7 @@ __all__ = [
     "builtin",
     "check_key",
     "check_platform",
+    "default_on",
     "defaulted_sections",
     "load_param_file",
     "param_file_from_data",

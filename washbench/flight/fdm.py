@@ -115,7 +115,7 @@ def make_fdm(m: Manoeuvre, profile: PilotProfile) -> tuple[Any, Setup]:
         fdm["ic/u-fps"] = 0.0
     fdm["propulsion/set-running"] = -1
     _set_engine_levers(fdm, m.aircraft, profile)
-    seed = env.turbulence.seed if env.turbulence is not None else 0
+    seed = env.turbulence.seed if env.turbulence is not None and env.turbulence.seed is not None else 0
     fdm["simulation/randomseed"] = seed
     with quiet_stdout():
         fdm.run_ic()

@@ -48,6 +48,7 @@ FPS_TO_KT = 3600.0 * 0.3048 / 1852.0
 
 StepHook = Callable[[int, np.ndarray, np.ndarray], None]
 BlockHook = Callable[[int, np.ndarray, np.ndarray], None]
+CommandHook = Callable[[int, np.ndarray, tuple[float, ...]], tuple[float, ...]]
 
 #: Properties read every step (verified to exist at start-up: JSBSim ignores typos silently).
 STATE_PROPERTIES = (
@@ -140,6 +141,7 @@ def fly(
     probes: Sequence[str] = (),
     block_hook: BlockHook | None = None,
     block_size: int = 120,
+    command_hook: CommandHook | None = None,
 ) -> FlightResult:
     """Fly ``manoeuvre`` to its end (or to a crash) and return the recording and check results.
 
@@ -151,6 +153,11 @@ def fly(
     ``probes`` names JSBSim properties read after each
     step (sample ``k``: the value the step from ``k`` produced, e.g. a surface position), returned
     in ``FlightResult.probes``.
+    ``command_hook(k, state, commands) -> commands`` is called at every step that sends commands, after the
+    scripted pilot and the phase's open-loop inputs (and after ``step_hook`` got sample ``k - 1``): ``state`` is
+    a read-only view of sample ``k``'s attitude and body rates (phi, theta, psi, p, q, r; rad, rad/s) and
+    ``commands`` the (aileron, elevator, rudder, throttle) about to be sent; what it returns is sent and recorded
+    (a pilot model flying an axis the phase left free, :mod:`washbench.pilot.loop`).
     """
     m = manoeuvre
     profile = load_profile(m.aircraft_files.profile)
@@ -166,6 +173,8 @@ def fly(
     struct_gets = [n.get_double_value for n in structure]
 
     fw, pilot_slots = st.new_slots()  # the loop's slots (washbench.flight.stepper), then the pilot's
+    state_now = fw[st.I_PHI : st.I_R + 1]  # sample k's attitude and body rates, for command_hook (a view)
+    state_now.flags.writeable = False
     pilot = Pilot(profile, m.runway, dt, pilot_slots)
     pilot.set_controls(ail_w.get_double_value(), elev_w.get_double_value(), rud_w.get_double_value())
     monitor = Monitor.for_profile(profile)
@@ -284,7 +293,7 @@ def fly(
                     lbrk_w.set_double_value(pilot.brakes)
                     rbrk_w.set_double_value(pilot.brakes)
                     fw[st.F_BRAKES] = pilot.brakes
-                    fw[st.F_OPENLOOP] = openloop.active
+                    fw[st.F_OPENLOOP] = openloop.active or command_hook is not None
                     if progress:  # a line at each phase start (in place on a terminal)
                         _progress(m.name, iphase, nphases, phase.name, t, tty)
                 fw[st.F_MODE] = st.MODE_RESUME
@@ -306,6 +315,8 @@ def fly(
             if code & st.C_OPENLOOP:  # the phase's open-loop inputs, on top of or instead of the pilot's commands
                 ail, elev, rud, _, thr = unpack_commands(fw, commands_at)
                 commands = openloop.apply((k - phase_k0) * dt, ail, elev, rud, thr)
+                if command_hook is not None:
+                    commands = command_hook(k, state_now, commands)
                 fw[st.F_AIL], fw[st.F_ELEV], fw[st.F_RUD], fw[st.F_THR] = commands
                 rows[k, _AIL : _AIL + 4] = commands
             if code & st.C_MIX:

@@ -121,6 +121,11 @@ def check_semantics(m: ManoeuvreFields, where: Where, aircraft_dirs: Sequence[Pa
                 f"above the {'runway' if m.runway is not None else 'ground'} at {ground_ft:g} ft, at most the ceiling)",
             )
 
+    turbulence = m.environment.turbulence
+    if turbulence is not None and turbulence.severity != "none" and turbulence.seed is None:
+        where.add(("environment", "turbulence", "seed"), f"missing required field (severity {turbulence.severity} "
+                  "needs a seed: the same seed gives the same gusts; severity none needs none)")  # fmt: skip
+
     on_ground = m.start.runway is not None
     names = [p.name for p in m.phases]
     for i, phase in enumerate(m.phases):

@@ -118,8 +118,8 @@ class Turbulence(StrictModel):
 
     severity: Literal["none", "light", "moderate", "severe"]
     """Turbulence severity (MIL-F-8785C): none, light, moderate or severe."""
-    seed: Annotated[int, Field(ge=0, lt=2**31)]
-    """Seed of JSBSim's random generator: the same seed gives the same gusts."""
+    seed: Annotated[int, Field(ge=0, lt=2**31)] | None = None
+    """Seed of JSBSim's random generator: the same seed gives the same gusts (needed unless severity is none)."""
 
 
 class Environment(StrictModel):

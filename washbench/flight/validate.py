@@ -22,7 +22,7 @@ from pathlib import Path
 from washbench.errors import WashbenchError, located, printable
 from washbench.flight.manoeuvre import load_manoeuvre
 from washbench.flight.scripts import is_runscript, is_script, load_script_info
-from washbench.io.paths import resolve_manoeuvre
+from washbench.io.paths import resolve_manoeuvre, unknown_manoeuvre
 
 
 def manoeuvre_files(item: Path) -> list[Path]:
@@ -30,6 +30,8 @@ def manoeuvre_files(item: Path) -> list[Path]:
     says so), a folder's (recursively: ``*.yaml`` and the ``*.xml`` whose root is ``<runscript>``), or a bundled
     manoeuvre or folder by name. WashbenchError for a folder holding none."""
     item = resolve_manoeuvre(item)
+    if not item.exists() and not item.is_symlink() and not item.is_absolute():
+        raise unknown_manoeuvre(item)  # a name meant: the closest bundled ones
     if not item.is_dir():
         return [item]
     found = sorted(p for p in item.rglob("*.yaml") if p.is_file())

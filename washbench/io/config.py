@@ -5,8 +5,8 @@ Found the way ruff and pytest find theirs: from the current folder upwards, the 
 holds both; a ``pyproject.toml`` without the table is passed over). The keys are the options' names::
 
     # washbench.toml (or [tool.washbench] in pyproject.toml)
-    params = "params/my_cw.yaml"        # --params: a file, relative to this file's folder
-    platform = "params/my_atlas.yaml"   # --platform
+    params = "params/my_cw.yaml"        # --params: a file, relative to this file's folder (or a bundled name: cw1)
+    platform = "hexapod"                # --platform: the same (a bundled name: atlas, hexapod, rig2dof)
     aircraft-dir = ["aircraft", "/opt/jsbsim-models"]   # --aircraft-dir (a folder or a list of folders)
     out = "results"                     # --out of run, suite, cue, fly, omct, sweep, tune (run and suite share a
                                         # folder; the others each need their own: io.outfolder.folder_owner)
@@ -37,6 +37,7 @@ from pathlib import Path
 from typing import Any
 
 from washbench.errors import WashbenchError, printable
+from washbench.io.paths import BUNDLED_PARAMS, BUNDLED_PLATFORMS, resolve_data_file
 
 #: File names, in the order they are tried in each folder.
 CONFIG_NAME = "washbench.toml"
@@ -213,8 +214,14 @@ def load_config(path: Path, table: str = "") -> ProjectConfig:
             close = difflib.get_close_matches(key.replace("_", "-"), KEYS, n=1)
             hint = f"did you mean '{close[0]}'?" if close else f"valid keys: {', '.join(KEYS)}"
             raise fail(key, f"unknown key ({hint})")
-        if key in ("params", "platform"):
-            values[key] = a_path(key, value, want_file=True)
+        if key in ("params", "platform"):  # a file relative to this one, else a bundled name (hexapod)
+            values[key] = a_path(key, value, want_file=False)
+            if not values[key].is_file():
+                try:
+                    values[key] = resolve_data_file(Path(value), f"--{key}")
+                except WashbenchError:
+                    names = ", ".join(BUNDLED_PLATFORMS if key == "platform" else BUNDLED_PARAMS)
+                    raise fail(key, f"no such file {values[key]}, nor a bundled name ({names})") from None
         elif key == "out":
             values["out"] = a_path(key, value, want_file=False)
         elif key == "aircraft-dir":

@@ -1,12 +1,12 @@
 """``washbench examples DIR``: copy the bundled manoeuvres, pilot profiles, washout parameter file and platform
-file into a folder the user can edit.
+files into a folder the user can edit.
 
 The copy is laid out as a washbench project: ``DIR/manoeuvres/<aircraft>/<name>.yaml``,
-``DIR/aircraft/<aircraft>/pilot.yaml`` and ``DIR/params/cw1.yaml``, ``DIR/params/atlas.yaml`` (for ``--params``
-and ``--platform``). A manoeuvre in ``DIR/manoeuvres/`` finds ``DIR/aircraft/`` by the
-"``aircraft/`` next to the manoeuvre or in a parent" rule, so an edited profile there is the one flown (the
-aircraft models themselves are still found bundled or in JSBSim; copy a model folder into ``DIR/aircraft/``
-to change it too).
+``DIR/aircraft/<aircraft>/pilot.yaml`` and ``DIR/params/cw1.yaml`` (for ``--params``) with every bundled platform
+file, ``DIR/params/atlas.yaml``, ``hexapod.yaml``, ``rig2dof.yaml`` (for ``--platform``). A manoeuvre in
+``DIR/manoeuvres/`` finds ``DIR/aircraft/`` by the "``aircraft/`` next to the manoeuvre or in a parent" rule, so an
+edited profile there is the one flown (the aircraft models themselves are still found bundled or in JSBSim; copy a
+model folder into ``DIR/aircraft/`` to change it too).
 """
 
 from __future__ import annotations
@@ -18,10 +18,10 @@ from washbench.errors import WashbenchError, located
 from washbench.io.atomic import write_text_atomic
 from washbench.io.lock import output_lock
 from washbench.io.outfolder import recover, staged
-from washbench.io.paths import AIRCRAFT_DIR, DATA_DIR, MANOEUVRES_DIR, PROFILE_NAME
+from washbench.io.paths import AIRCRAFT_DIR, BUNDLED_PARAMS, BUNDLED_PLATFORMS, DATA_DIR, MANOEUVRES_DIR, PROFILE_NAME
 
-PARAM_FILES = ("cw1.yaml", "atlas.yaml")
-"""The bundled washout parameter set and platform file, copied into ``DIR/params/``."""
+PARAM_FILES = tuple(f"{name}.yaml" for name in (*BUNDLED_PARAMS, *BUNDLED_PLATFORMS))
+"""The bundled washout parameter set and platform files, copied into ``DIR/params/``."""
 TOPS = ("manoeuvres", "aircraft", "params")
 """The folders ``washbench examples`` creates in ``DIR`` (it refuses when one exists)."""
 
@@ -64,11 +64,13 @@ def copy_examples(dest: Path) -> int:
     pairs = example_files(dest)
     n_m = sum(1 for _, d in pairs if d.suffix == ".yaml" and "manoeuvres" in d.parts)
     n_p = len(pairs) - n_m - len(PARAM_FILES)
-    print(f"{n_m} manoeuvres, {n_p} pilot profiles, a washout parameter file and a platform file copied to {dest}")
-    print(f"  run one:   washbench run {dest / 'manoeuvres' / 'c172' / 'coordinated_turn.yaml'} --out results")
-    print(f"  run all:   washbench suite {dest / 'manoeuvres'} --out results")
+    n_platforms = len(BUNDLED_PLATFORMS)
+    print(f"{n_m} manoeuvres, {n_p} pilot profiles, a washout parameter file and {n_platforms} platform files "
+          f"({', '.join(BUNDLED_PLATFORMS)}) copied to {dest}")  # fmt: skip
+    print(f"  run one:   washbench run {dest / 'manoeuvres' / 'c172' / 'coordinated_turn.yaml'} --out my-runs")
+    print(f"  run all:   washbench suite {dest / 'manoeuvres'} --out my-suite")
     print(f"  profiles:  {dest / 'aircraft'}/<aircraft>/pilot.yaml are used by the manoeuvres under {dest}")
-    print(f"  params:    --params {dest / 'params' / 'cw1.yaml'} --platform {dest / 'params' / 'atlas.yaml'} (a "
+    print(f"  params:    --params {dest / 'params' / 'cw1.yaml'} --platform {dest / 'params' / 'hexapod.yaml'} (a "
           "parameter file may hold only the sections it changes)")  # fmt: skip
     sys.stdout.flush()
     return 0

@@ -25,7 +25,7 @@ import signal
 import sys
 import threading
 from collections.abc import Callable, Iterator
-from typing import ParamSpec, TypeVar
+from typing import Any, ParamSpec, TypeVar
 
 from washbench.errors import Terminated
 
@@ -43,7 +43,7 @@ def received() -> int:
     """How many SIGINT/SIGTERM this process's handlers (:func:`terminate`, :func:`interrupt`) have received.
 
     A KeyboardInterrupt or Terminated raised while this count did not change was raised by code (a washout
-    plugin's ``raise KeyboardInterrupt``), not by a signal (:mod:`washbench.cueing.guard`).
+    plugin's ``raise KeyboardInterrupt``), not by a signal (:mod:`washbench.io.plugin_guard`).
     """
     return _RECEIVED[0]
 
@@ -123,8 +123,12 @@ def raise_pending() -> None:
 
 @contextlib.contextmanager
 def signals_held() -> Iterator[None]:
-    """Hold SIGINT and SIGTERM back for a short critical section: noted, and acted on (KeyboardInterrupt or
-    :class:`washbench.errors.Terminated`) once it is over; never lost, never in the middle."""
+    """Hold SIGINT and SIGTERM back for a short critical section: noted, and acted on once it is over as the handler
+    the section replaced would have acted (washbench's: KeyboardInterrupt or :class:`washbench.errors.Terminated`;
+    an ignored signal stays ignored, a default one ends the process as it would have: a suite's process server and
+    workers, which leave SIGINT to the main process and die of SIGTERM, build models under this too); never lost,
+    never in the middle. A section that fails after a signal was noted ends as signalled, the failure as its cause
+    (the signal likely caused it)."""
     if threading.current_thread() is not threading.main_thread():  # handlers run in the main thread only
         yield
         return
@@ -135,13 +139,37 @@ def signals_held() -> Iterator[None]:
         noted.append(signum)
 
     saved = {sig: signal.signal(sig, note) for sig in (signal.SIGINT, signal.SIGTERM)}
-    try:
-        yield
-    finally:
+
+    def restore() -> None:
         for sig, handler in saved.items():
             signal.signal(sig, handler)
+
+    try:
+        yield
+    except BaseException as exc:
+        restore()
+        # the section failed after a signal was noted: the signal wins. A service manager's SIGTERM reaches the whole
+        # process group: the suite's process server dies of it while this process starts workers from it, whose
+        # start then fails (EOFError from multiprocessing's forkserver); the command ends as signalled, 143
+        if noted and not isinstance(exc, KeyboardInterrupt | Terminated):
+            try:
+                _act(noted[0], saved[noted[0]])
+            except BaseException as signalled:
+                raise signalled from exc
+        raise
+    restore()
     if noted:
-        raise KeyboardInterrupt if noted[0] == signal.SIGINT else Terminated()
+        _act(noted[0], saved[noted[0]])
+
+
+def _act(signum: int, handler: Any) -> None:
+    """Act on a held signal as ``handler`` (what was installed before the section) would have."""
+    if handler is signal.SIG_IGN:
+        return
+    if handler is signal.SIG_DFL or handler is None:  # (None: installed from C) sent again: the process ends as it
+        os.kill(os.getpid(), signum)  # would have (a signal sent to itself is delivered before kill returns)
+        return
+    handler(signum, None)
 
 
 def uninterrupted(func: Callable[P, R]) -> Callable[P, R]:
@@ -158,3 +186,14 @@ def uninterrupted(func: Callable[P, R]) -> Callable[P, R]:
             return func(*args, **kwargs)
 
     return held
+
+
+def explain(exc: BaseException, text: str) -> None:
+    """Say what a KeyboardInterrupt or Terminated cost: ``text`` ends the command's one last line, ``washbench:
+    interrupted: TEXT`` (:func:`explanation`; a suite's "8 of 10 manoeuvres had finished; ... nothing was written")."""
+    exc.washbench_explanation = text  # type: ignore[attr-defined]
+
+
+def explanation(exc: BaseException) -> str:
+    """What :func:`explain` attached to ``exc`` (empty when nothing was)."""
+    return str(getattr(exc, "washbench_explanation", ""))

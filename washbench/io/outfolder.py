@@ -48,15 +48,14 @@ from pathlib import Path
 from washbench.errors import WashbenchError, located
 from washbench.io.interrupts import signals_held, uninterrupted  # (defined there; kept importable from here)
 from washbench.io.lock import output_lock
+from washbench.io.owners import announce, folder_owner, read_manifest, refuse_nested, refuse_other_owner
 from washbench.io.result_files import (
     JOURNAL_PREFIX,
     LOCK_NAME,
     MANIFEST,
     OLD_PREFIX,
     PROBE_PREFIX,
-    RUN_FILE,
     STAGE_PREFIX,
-    SUITE_FILE,
     is_legacy_leftover,
     is_own_hidden,
     publication_pid,
@@ -155,70 +154,6 @@ def _roll_forward(out_dir: Path, journal: Path) -> None:
     remove_tree(journal)
     remove_tree(old)
     remove_tree(stage)
-
-
-def read_manifest(out_dir: Path) -> tuple[str, list[str]] | None:
-    """(command, top-level names) from ``out_dir/.washbench.json``, or None if missing or not washbench's."""
-    path = out_dir / MANIFEST
-    if path.is_symlink() or not path.is_file():
-        return None
-    try:
-        doc = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return None
-    if not isinstance(doc, dict) or not isinstance(doc.get("command"), str) or not isinstance(doc.get("entries"), list):
-        return None
-    names = [n for n in doc["entries"] if isinstance(n, str) and "/" not in n and n not in ("", ".", "..")]
-    return doc["command"], names
-
-
-def folder_owner(out_dir: Path) -> tuple[str, Path] | None:
-    """Which command's results ``out_dir`` holds, and the file that says so; None if no command's.
-
-    The one meaning of "washbench wrote this folder", for every command: a manifest ``.washbench.json`` names its
-    command (``cue``, ``fly``, ``omct``, ``sweep``, ``tune``); a suite's ``suite.json`` says ``suite``; a folder
-    ``OUT/<aircraft>/<manoeuvre>/`` holding ``run.json`` says ``run`` (a run's results gather in ``OUT`` beside
-    other runs, and a suite replaces them, so ``run`` and ``suite`` share a folder).
-    """
-    manifest = read_manifest(out_dir)
-    if manifest is not None:
-        return manifest[0], out_dir / MANIFEST
-    suite = out_dir / SUITE_FILE
-    if suite.is_file() and not suite.is_symlink():
-        with contextlib.suppress(OSError, ValueError):
-            doc = json.loads(suite.read_text(encoding="utf-8"))
-            if isinstance(doc, dict) and doc.get("washbench") == "suite":
-                return "suite", suite
-    try:
-        tops = sorted(e for e in out_dir.iterdir() if e.is_dir() and not e.is_symlink() and not is_own_hidden(e.name))
-    except OSError:
-        return None
-    for top in tops:
-        with contextlib.suppress(OSError):
-            for sub in sorted(top.iterdir()):
-                marker = sub / RUN_FILE
-                if sub.is_dir() and not sub.is_symlink() and marker.is_file() and not marker.is_symlink():
-                    return "run", marker
-    return None
-
-
-def refuse_other_owner(out_dir: Path, command: str) -> None:
-    """Raise WashbenchError (one line, naming the command and the file that says so) when ``out_dir`` holds the
-    results of a command whose results ``command``'s would not replace (:func:`folder_owner`).
-
-    A folder holds one command's results; ``run`` and ``suite`` share one (a suite is a set of runs).
-    """
-    owner = folder_owner(out_dir)
-    if owner is None:
-        return
-    sharing = {"run", "suite"}
-    if owner[0] == command or (owner[0] in sharing and command in sharing):
-        return
-    problem = (
-        f"holds the results of `washbench {owner[0]}` ({owner[1].name}), not of `washbench {command}`: a folder "
-        "holds one command's results (run and suite share one); not replaced; choose another --out"
-    )
-    raise WashbenchError(located(out_dir, problem))
 
 
 def owned_entries(out_dir: Path, command: str, adopt: Sequence[str] = ()) -> list[Path]:
@@ -340,16 +275,22 @@ def staged(
 def result_set(out: str | Path, command: str, adopt: Sequence[str] = ()) -> Iterator[Path]:
     """Own ``out`` for one result set of ``command``; yield the stage folder to write the set into.
 
-    Lock, recover, refuse foreign entries (before the caller does any work), build in the stage, then publish
-    the whole set at once with its manifest (:func:`staged`). On an exception (a signal included) nothing is
+    Refuse an ``out`` inside other results (:func:`washbench.io.owners.refuse_nested`), lock, recover, refuse
+    foreign entries (before the caller does any work), say that earlier results of ``command`` are replaced
+    (:mod:`washbench.io.owners`), build in the stage, then publish the whole set at once with its manifest
+    (:func:`staged`). On an exception (a signal included) nothing is
     published and the previous set stays as it was; a folder created here is removed again if left empty.
     ``adopt``: files the command already wrote into ``out`` for this set (``washbench live``'s saved input):
     moved into the set when it is published, left where they are otherwise.
     """
+    refuse_nested(check_out_path(out), command)  # before the lock: a refused --out is not even created
     with output_lock(check_out_path(out)) as out_dir:
         foreign = read_manifest(out_dir) is None  # not (yet) washbench's: only its own .washbench-* leftovers go
         recover(out_dir, only_washbench=foreign)
         previous = owned_entries(out_dir, command, adopt)
+        if previous:  # replacing is never silent (io.owners)
+            announce(f"{out_dir} holds earlier `washbench {command}` results: replaced when these are complete "
+                     "(until then, and after a failure or Ctrl-C, they stay as they are)")  # fmt: skip
 
         def finish(stage: Path) -> None:
             for name in adopt:

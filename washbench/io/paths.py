@@ -35,10 +35,14 @@ from pathlib import Path
 
 from washbench.errors import WashbenchError
 
-#: ``washbench/data``: the bundled parameter set (``cw1.yaml``) and platform limits (``atlas.yaml``).
+#: ``washbench/data``: the bundled parameter set (``cw1.yaml``) and platform files (``atlas.yaml``, ...).
 DATA_DIR = Path(str(files("washbench") / "data"))
+#: The bundled platform files, ``washbench/data/<name>.yaml``: ``--platform hexapod`` names one from any folder.
+BUNDLED_PLATFORMS = ("atlas", "hexapod", "rig2dof")
+#: The bundled washout parameter files, ``washbench/data/<name>.yaml``: ``--params cw1``.
+BUNDLED_PARAMS = ("cw1",)
 #: Top-level folders of the repository that the wheel ships as ``washbench/data/<name>`` (see ``setup.py``).
-BUNDLED_FOLDERS = ("aircraft", "manoeuvres")
+BUNDLED_FOLDERS = ("aircraft", "manoeuvres", "tasks")
 
 
 def bundled_folder(name: str) -> Path:
@@ -53,6 +57,8 @@ def bundled_folder(name: str) -> Path:
 AIRCRAFT_DIR = bundled_folder("aircraft")
 #: Bundled manoeuvres (``<aircraft>/<name>.yaml``): what ``washbench suite`` runs by default.
 MANOEUVRES_DIR = bundled_folder("manoeuvres")
+#: Bundled tracking tasks (``<aircraft>/<name>.yaml``): what ``washbench track`` flies by name (c172/roll).
+TASKS_DIR = bundled_folder("tasks")
 #: Environment variable with extra aircraft folders, separated by ``os.pathsep``.
 AIRCRAFT_PATH_ENV = "WASHBENCH_AIRCRAFT_PATH"
 #: Files or folders that mark a project root (where the search for ``aircraft/`` next to a manoeuvre stops).
@@ -186,16 +192,105 @@ def bundled_names() -> list[str]:
     return sorted(p.relative_to(MANOEUVRES_DIR).with_suffix("").as_posix() for p in MANOEUVRES_DIR.glob("*/*.yaml"))
 
 
+def bundled_file(text: str | Path) -> Path | None:
+    """The file a bundled name stands for, as the provenance spells it
+    (:func:`washbench.io.provenance.bundled_name`): ``washbench:data/hexapod.yaml``,
+    ``washbench:manoeuvres/c172/takeoff.yaml``, ``washbench:aircraft/c172p/pilot.yaml``, ``jsbsim:scripts/c1723.xml``;
+    None for any other text (a path). The file need not exist."""
+    package, sep, rel = str(text).partition(":")
+    if not sep or not rel or rel.startswith("/") or ".." in Path(rel).parts:
+        return None
+    if package == "jsbsim":
+        return jsbsim_root() / rel
+    if package != "washbench":
+        return None
+    top, _, rest = rel.partition("/")
+    roots = {"data": DATA_DIR, "aircraft": AIRCRAFT_DIR, "manoeuvres": MANOEUVRES_DIR}
+    return roots[top] / rest if top in roots and rest else None
+
+
+def _script_names() -> list[str]:
+    """The ``*.xml`` files in JSBSim's ``scripts/`` folder, by stem (names ``washbench run`` resolves)."""
+    return sorted(p.stem for p in (jsbsim_root() / "scripts").glob("*.xml"))
+
+
 def resolve_manoeuvre(item: Path) -> Path:
     """A manoeuvre argument as given, or, when no such file or folder exists, the bundled one of that name.
 
     ``c172/takeoff`` (or ``c172/takeoff.yaml``) names a bundled manoeuvre and ``c172`` the bundled folder of an
-    aircraft, so ``washbench run c172/takeoff`` works from any folder. An existing path always wins.
+    aircraft, ``c1723`` (or ``c1723.xml``) a script shipped with JSBSim, and the provenance's spelling
+    (``washbench:manoeuvres/c172/takeoff.yaml``, ``jsbsim:scripts/c1723.xml``) either, so ``washbench run
+    c172/takeoff`` works from any folder. An existing path always wins; a name found nowhere is returned as given
+    (:func:`unknown_manoeuvre` says what was meant).
     """
     if item.exists() or item.is_absolute():
         return item
+    named = bundled_file(item)
+    if named is not None:
+        return named
     for candidate in (MANOEUVRES_DIR / item, MANOEUVRES_DIR / f"{item}.yaml"):
         if candidate.exists():
+            return candidate
+    if len(item.parts) == 1 and item.suffix.lower() in ("", ".xml"):
+        script = jsbsim_root() / "scripts" / f"{item.name[:-4] if item.suffix else item.name}.xml"
+        if script.is_file():
+            return script
+    return item
+
+
+def unknown_manoeuvre(item: Path) -> WashbenchError:
+    """The error for a manoeuvre argument that names nothing (:func:`resolve_manoeuvre` found no file, folder or
+    bundled name): one line with the closest bundled manoeuvres or JSBSim scripts, else the bundled names."""
+    import difflib
+
+    text = str(item)
+    if item.is_absolute():  # a path, plainly: no name was meant
+        return WashbenchError(f"{text}: no such file or folder")
+    stem = text[:-5] if text.endswith(".yaml") else text[:-4] if text.endswith(".xml") else text
+    names = bundled_names()
+    close = difflib.get_close_matches(stem, [*names, *_script_names()], n=3, cutoff=0.75)
+    if close:
+        hint = f"did you mean {' or '.join(close)}?"
+    else:
+        hint = f"the bundled ones: {', '.join(names)}; or a script shipped with JSBSim by name (c1723)"
+    return WashbenchError(f"{text}: no such file or folder, nor a bundled manoeuvre; {hint}")
+
+
+def resolve_data_file(item: Path, option: str) -> Path:
+    """A ``--platform`` or ``--params`` value: an existing file as given; else a bundled file, by the provenance's
+    name (``washbench:data/hexapod.yaml``) or by its own (``hexapod``, ``hexapod.yaml``; the names of
+    :data:`BUNDLED_PLATFORMS` or :data:`BUNDLED_PARAMS`), so the bundled files are named the same from any folder
+    and from an installed wheel. WashbenchError (one line, what the option takes) for anything else, and for a Python
+    file (a plugin is loaded with ``--platform-plugin`` / ``--washout-plugin``)."""
+    names = BUNDLED_PLATFORMS if option == "--platform" else BUNDLED_PARAMS
+    text = str(item)
+    if item.suffix == ".py":
+        plugin = "--platform-plugin" if option == "--platform" else "--washout-plugin"
+        raise WashbenchError(f"{option} {text}: a Python file; {option} takes a YAML file or a bundled name "
+                             f"({', '.join(names)}); load a plugin with {plugin} {text}:CLASS")  # fmt: skip
+    if item.is_file():
+        return item
+    named = bundled_file(item)
+    if named is None and len(item.parts) == 1 and item.suffix in ("", ".yaml"):
+        stem = item.name[:-5] if item.suffix else item.name
+        named = DATA_DIR / f"{stem}.yaml" if stem in names else None
+    if named is not None and named.is_file():
+        return named
+    if item.exists() and not item.is_dir():
+        return item  # not a regular file (a fifo, a device): reading it says what is wrong
+    problem = "a folder, not a file" if item.is_dir() else "no such file"
+    stem = item.name[:-5] if item.name.endswith(".yaml") else item.name
+    hint = f"; did you mean {option} {stem}?" if stem in names and named is None else ""
+    raise WashbenchError(f"{option} {text}: {problem}, nor a bundled name ({', '.join(names)}; or "
+                         f"washbench:data/NAME.yaml){hint}")  # fmt: skip
+
+
+def resolve_task(item: Path) -> Path:
+    """A task argument as given, or, when no such file exists, the bundled one of that name (``c172/roll``)."""
+    if item.exists() or item.is_absolute():
+        return item
+    for candidate in (TASKS_DIR / item, TASKS_DIR / f"{item}.yaml"):
+        if candidate.is_file():
             return candidate
     return item
 

@@ -242,7 +242,8 @@ def turbulence_record(turbulence: Any) -> dict[str, Any] | None:
     """``{"severity", "seed"}`` of a manoeuvre's turbulence, or None when it has none."""
     if turbulence is None:
         return None
-    return {"severity": turbulence.severity, "seed": int(turbulence.seed)}
+    seed = turbulence.seed
+    return {"severity": turbulence.severity, "seed": int(seed) if seed is not None else None}
 
 
 def utc_now() -> str:

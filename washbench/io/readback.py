@@ -210,6 +210,23 @@ def _no_constant(name: str) -> None:
     raise ValueError(f"{name} is not a number washbench writes")
 
 
+def json_text(doc: Any) -> str:
+    """``doc`` as the JSON text :func:`read_doc` reads back (indented): a float that is not finite written as null
+    (JSON has no infinity; Python's ``Infinity`` and ``NaN`` are refused when read), so no result washbench writes
+    is one it refuses later."""
+
+    def finite(value: Any) -> Any:
+        if isinstance(value, float):
+            return value if math.isfinite(value) else None
+        if isinstance(value, dict):
+            return {k: finite(v) for k, v in value.items()}
+        if isinstance(value, list | tuple):
+            return [finite(v) for v in value]
+        return value
+
+    return json.dumps(finite(doc), indent=2, allow_nan=False) + "\n"
+
+
 def check_doc(doc: Any, model: type[_Loose], path: Path) -> None:
     """Validate ``doc`` against ``model``; WashbenchError naming ``path`` and the field otherwise."""
     try:

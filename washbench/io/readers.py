@@ -23,6 +23,7 @@ so a ``washbench fly`` trace is read back bit for bit.
 from __future__ import annotations
 
 import re
+import stat
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -133,6 +134,11 @@ def read_samples(path: str | Path, fmt: InputFormat | None = None) -> Samples:
         raise WashbenchError(located(path, "no such file"))
     if path.is_dir():
         raise WashbenchError(located(path, "is a folder, not a file"))
+    mode = path.stat().st_mode  # (stat opens nothing: opening a FIFO with no writer waits for one for ever)
+    if not stat.S_ISREG(mode):
+        what = "a FIFO (named pipe)" if stat.S_ISFIFO(mode) else "a device or socket"
+        raise WashbenchError(located(path, f"is {what}, not a regular file: washbench reads an input more than once "
+                                           "(its header, then its rows); write it to a file first"))  # fmt: skip
     kind, delim = detect_kind(path, fmt)
     if kind == "parquet":
         src = read_parquet_table(path)

@@ -11,6 +11,10 @@ A result folder of one flight or recorded trace (``washbench run``, ``cue``; a s
     ranking.csv      the washouts ranked by the run's rule
     report.md        the report, with its figures in figures/
 
+A ``washbench track`` result set (its own ``--out``): ``report.md``, ``figures/``, ``recording.rrd`` and
+``track.json`` (the summary), ``measures.csv`` (one row per condition), ``frf.csv`` (the responses at the forcing
+frequencies) and ``signals.parquet`` (every run's samples).
+
 A suite's folder adds, at its top: ``metrics.csv``, ``comparison.csv``, ``ranking.csv``, ``report.md``,
 ``figures/`` and ``suite.json`` (written last; it marks the folder as a suite's).
 
@@ -36,6 +40,10 @@ REPORT_FILE = "report.md"
 FIGURES_DIR = "figures"
 COMPARISON_FILE = "comparison.csv"
 SUITE_FILE = "suite.json"
+TRACK_FILE = "track.json"
+TRACK_MEASURES_FILE = "measures.csv"
+TRACK_FRF_FILE = "frf.csv"
+TRACK_SIGNALS_FILE = "signals.parquet"
 
 RUN_FILES = (FLIGHT_JSON, FLIGHT_FILE, TRACES_FILE, METRICS_FILE, RECORDING_FILE, RUN_FILE, RANKING_FILE,
              REPORT_FILE, FIGURES_DIR)  # fmt: skip

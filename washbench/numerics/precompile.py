@@ -52,8 +52,8 @@ LANE_BLOCK: tuple[tuple[str, str, str], ...] = (
     ("washbench.cueing.kernel", "bank_block", _sig(F2, F2, F2, F3, F2, I2, F3)),
     ("washbench.cueing.kernel", "bank_step", _sig(F1, F1, F2, F3, F2, I2, F2)),
     ("washbench.cueing.kernel", "bank_trace", _sig(F2, F2, F2, F3, F2, I2, F3)),
-    ("washbench.analysis.evaluate", "evaluate_batch", _sig(F2, F2, F2, F3, TRACE3, TRACE3, F2, F, F3, I2)),
-    ("washbench.analysis.evaluate", "evaluate_fields", _sig(F2, TRACE3, TRACE3, F2, F2, I1)),
+    ("washbench.analysis.evaluate", "evaluate_batch", _sig(F2, F2, F2, F3, TRACE3, TRACE3, F2, F, F3, I2, F3, F1, F)),
+    ("washbench.analysis.evaluate", "evaluate_fields", _sig(F2, TRACE3, TRACE3, F2, F2, I1, F2, F1, F2, F)),
 )
 #: Lane 1: the flight step and the scripted pilot, perception, sickness, metrics, the recording's thinning, the
 #: platforms' kinematics called from Python, then the set-point path (a washout computed outside the kernel, or
@@ -69,6 +69,10 @@ LANE_REST: tuple[tuple[str, str, str], ...] = (
     ("washbench.perception.sickness", "_sum_squares", _sig(F1)),
     ("washbench.analysis.metric_sums", "signal_metrics", _sig(F1, F1, F)),
     ("washbench.analysis.metric_sums", "finish", _sig(F1, F)),
+    ("washbench.analysis.metric_sums", "felt_sums", _sig(F2, F2, F1, F, F2)),
+    ("washbench.analysis.metric_sums", "felt_finish", _sig(F1, F)),
+    ("washbench.analysis.metric_sums", "jolt_sums", _sig(F2, F2, F, F1)),
+    ("washbench.cueing.references", "reference_block", _sig(F2, F2, F, F, F1, "boolean", "boolean", F1, F2, F2)),
     ("washbench.review.thinning", "_keep", _sig(F1, F2, F1, F)),
     ("washbench.review.thinning", "_changes", _sig(F2, F1, "int64")),
     ("washbench.cueing.filters", "run_filter", _sig(F1, F1, "boolean")),

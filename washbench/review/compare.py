@@ -5,6 +5,8 @@ one comparison recording: the six stacked perceived-motion panels (and the raw m
 (twice if the two flights differ) and each washout of A and of B, A's in the washout's own colour, B's in the same hue
 washed towards grey, labelled ``A: <washout>`` and ``B: <washout>`` with A and B the recordings' labels; the envelope
 usage of both; the phase lanes; both metric tables side by side. The two recordings must cover the same time span.
+Recordings on two platforms (an Atlas and a hexapod) are compared on what both hold: an envelope panel only one
+has (the Atlas's wheels) is left out, and the command says so.
 
 Each recorded series keeps only the samples it needs (:mod:`washbench.review.thinning`): A's and B's lines of a
 panel are put on the union of their recorded times, each line interpolated linearly from its own samples (the line
@@ -32,7 +34,7 @@ from washbench.review.rrd_read import (
     read_text_documents,
 )
 
-__all__ = ["comparison_labels", "write_comparison"]
+__all__ = ["comparison_labels", "shared_panels", "write_comparison"]
 
 
 def _time(t_s: np.ndarray) -> rr.TimeColumn:
@@ -71,14 +73,38 @@ def _columns(
     return [str(n) for n in names], np.round(t_s * 1e9).astype(np.int64), values, tolerance
 
 
-def write_comparison(a: Path, b: Path, out: Path) -> None:
-    """Write the comparison recording of ``a`` and ``b`` to ``out`` (see the module docstring)."""
+def _platform(path: Path) -> str:
+    """The recording's platform as its provenance names it (``platform.name``), or "its platform"."""
+    return str(read_properties(path).get("platform.name") or "its platform")
+
+
+def shared_panels(
+    a: Path, b: Path, sa: dict[str, tuple[np.ndarray, np.ndarray]], sb: dict[str, tuple[np.ndarray, np.ndarray]]
+) -> tuple[list[str], list[str]]:
+    """The envelope quantities both recordings hold (compared), and one line for each recording that lacks some the
+    other holds (the Atlas's wheels, say, beside a hexapod's recording, which has none): what is left out, and why."""
+    have = {p: [q for q, _, _ in ENVELOPE_QUANTITIES if f"/envelope/{q}" in s] for p, s in ((a, sa), (b, sb))}
+    shared = [q for q in have[a] if q in have[b]]
+    notes = []
+    for this, other in ((a, b), (b, a)):
+        lacks = [q for q in have[other] if q not in have[this]]
+        if lacks:
+            notes.append(f"{this} ({_platform(this)}) has no {' or '.join(lacks)} envelope panel, which {other} "
+                         f"({_platform(other)}) has: compared without it")  # fmt: skip
+    return shared, notes
+
+
+def write_comparison(a: Path, b: Path, out: Path) -> list[str]:
+    """Write the comparison recording of ``a`` and ``b`` to ``out`` (see the module docstring). Returns what was
+    left out, one line each: the envelope panels one recording lacks (two platforms: :func:`shared_panels`)."""
     la, lb = comparison_labels(a, b)
     sa, sb = read_scalar_series(a), read_scalar_series(b)
+    for key in (f"/{prefix}/{dof}" for prefix in ("perceived", "raw") for dof, _, _, _ in DOFS):
+        for path, s in ((a, sa), (b, sb)):
+            if key not in s:
+                raise WashbenchError(located(path, f"not a washbench recording (no {key})"))
+    envelope, notes = shared_panels(a, b, sa, sb)
     key = "/perceived/surge"
-    for path, s in ((a, sa), (b, sb)):
-        if key not in s:
-            raise WashbenchError(located(path, "not a washbench recording (no /perceived/surge)"))
     ta, tb = sa[key][0], sb[key][0]
     if abs(ta[0] - tb[0]) > 1e-9 or abs(ta[-1] - tb[-1]) > 1e-9:
         raise WashbenchError(
@@ -99,7 +125,7 @@ def write_comparison(a: Path, b: Path, out: Path) -> None:
 
     perceived = [panel(f"/perceived/{d}", f"perceived {d} [{u}]") for d, _, _, u in DOFS]
     raw = [panel(f"/raw/{d}", f"{d} [{u}]") for d, _, _, u in DOFS]
-    usage = [panel(f"/envelope/{q}", f"{q}: max |axis| / limit") for q, _, _ in ENVELOPE_QUANTITIES]
+    usage = [panel(f"/envelope/{q}", f"{q}: max |axis| / limit") for q in envelope]
     legend = rrb.TimeSeriesView(
         origin="/legend", name="Legend", axis_x=axis, axis_y=rrb.ScalarAxis(range=(1.0, 2.0)),
         plot_legend=rrb.PlotLegend(corner="LeftTop", visible=True),
@@ -142,7 +168,7 @@ def write_comparison(a: Path, b: Path, out: Path) -> None:
                         grey = rr.SeriesLines(colors=[(128, 128, 128)] * 2, names=["perception threshold"] * 2)
                         rec.log(threshold, grey, static=True)
                         rec.send_columns(threshold, indexes=[_time(t_th)], columns=rr.Scalars.columns(scalars=v_th))
-            for q, _, _ in ENVELOPE_QUANTITIES:
+            for q in envelope:
                 _send_pair(rec, f"/envelope/{q}", (a, sa, la), (b, sb, lb), aircraft=False, aggregation="Max")
             phases = read_component(a, "StateChange:state").get(phase_lane_path())
             if phases is not None:
@@ -156,6 +182,7 @@ def write_comparison(a: Path, b: Path, out: Path) -> None:
         except BaseException:
             rrd.abandon()
             raise
+    return notes
 
 
 def _send_legend(

@@ -38,7 +38,7 @@ from washbench.io import collector
 from washbench.io.atomic import atomic_path, write_bytes_atomic
 from washbench.io.outfolder import uninterrupted
 from washbench.review.numbers import SCORE_FLAG, sig
-from washbench.review.palette import aircraft_color, mpl, palette_name, washout_colors, washout_dashes
+from washbench.review.palette import THRESHOLD_COLOR, aircraft_color, mpl, palette_name, washout_colors, washout_dashes
 from washbench.review.png import png_bytes
 
 FIGURE_FORMATS = ("png", "pdf")
@@ -86,7 +86,7 @@ def saturation_labels(platform: str = "atlas") -> dict[str, str]:
 
 METRIC_LABELS = {"npc": "NPC", "integral_error": "integral of |error|", "max_error": "maximum |error|"}
 
-_THRESHOLD_COLOR = (0.72, 0.55, 0.18)
+_THRESHOLD_COLOR = mpl(THRESHOLD_COLOR)
 """The edges of the not-felt band: a warm sand, apart from the phases' blue-grey and every washout's colour."""
 _THRESHOLD_FILL = (0.93, 0.78, 0.40, 0.30)
 _PHASE_SHADE = (0.82, 0.86, 0.92, 0.45)

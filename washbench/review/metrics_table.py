@@ -77,8 +77,9 @@ def metrics_table_markdown(
     lines = [f"# {title}"]
     if ranking:
         lines += _ranking_lines(ranking, rule_label, ceiling)
+    reference = " (the oracle bound, in italics, is a reference)" if BOUND_WASHOUT in washouts else ""
     lines += ["", "Perceived motion of each simulator pilot against the aircraft pilot's; lower is better. Best "
-              "washout per DOF in bold (the oracle bound, in italics, is a reference)."]  # fmt: skip
+              f"washout per DOF in bold{reference}."]  # fmt: skip
     for metric in ("npc", "integral_error", "max_error"):
         f_unit, w_unit = _UNITS[metric]
         unit = f" [{f_unit} / {w_unit}]" if f_unit else ""

@@ -48,6 +48,10 @@ fixed ones, the aircraft's and the ones before it (CIE76 colour difference at le
 fixed ones, :func:`colour_difference`), and of middle lightness so it shows on white paper and on the viewer's dark
 background alike (the cyan close to small-angle's blue, and a gold close to large-angle's orange, came first before)."""
 AIRCRAFT_COLOR: RGB = (200, 0, 160)  # magenta
+THRESHOLD_COLOR: RGB = (184, 140, 46)  # sand
+"""The perception thresholds' lines (the figures' not-felt band's edges, the recording's threshold lines): apart from
+the bound's grey (CIE76 difference 55) and every bundled washout's colour, at least 3:1 (WCAG) against white and
+the viewer's near-black alike."""
 
 CB_WASHOUT_COLORS: dict[str, RGB] = {
     "small-angle": (0, 114, 178),  # blue

@@ -16,7 +16,7 @@ import warnings
 from collections import deque
 from pathlib import Path
 
-from washbench.errors import WashbenchError, located
+from washbench.errors import WashbenchError, located, printable
 
 __all__ = ["check_recording", "find_rerun", "replay_command", "start_web_viewer", "stop_viewer"]
 
@@ -193,8 +193,10 @@ def replay_command(paths: Path | list[Path], web: bool) -> int:
 
     with tempfile.TemporaryDirectory(prefix="washbench-compare-") as tmp:
         out = Path(tmp) / "comparison.rrd"
-        write_comparison(files[0], files[1], out)
+        left_out = write_comparison(files[0], files[1], out)
         print(f"washbench: comparing {files[0]} with {files[1]}", flush=True)
+        for note in left_out:
+            print(f"washbench: note: {printable(note)}", flush=True)
         return _replay(out, web)
 
 

@@ -140,7 +140,8 @@ def provenance_lines(prov: dict[str, Any] | None, created_utc: str | None) -> li
         rows.append(("ranking rule", f"`--rank-by {ranking['by']}`"))
     if "turbulence" in prov or (inp and "turbulence" in (inp.get("provenance") or {})):
         turb = prov.get("turbulence", (inp.get("provenance") or {}).get("turbulence") if inp else None)
-        rows.append(("turbulence", f"{turb['severity']}, seed {turb['seed']}" if turb else "none"))
+        seed = f", seed {turb['seed']}" if turb and turb.get("seed") is not None else ""
+        rows.append(("turbulence", f"{turb['severity']}{seed}" if turb else "none"))
     sw = prov.get("software") or {}
     parts = [
         f"washbench {sw.get('washbench', '?')}"
@@ -349,8 +350,9 @@ def cue_lines(data: ResultData, explain: bool = True) -> list[str]:
     washouts = dict.fromkeys(r.washout for r in rows)
     false_time = {w: sum(m.cue_false_frac for m in rows if m.washout == w) for w in washouts}
     lines += [""] if explain else ["False-cue time per DOF and events: in the result's own report.", ""]
-    lines += ["False-cue time (sum over DOFs, manoeuvre lengths): "
-              + ", ".join(f"{w} {sig(v)}" for w, v in false_time.items()) + ".", ""]  # fmt: skip
+    total = ", ".join(f"{w} {sig(v * data.duration_s)} s" for w, v in false_time.items())
+    lines += [f"Time with a false cue, added up over the six DOFs (a second with false cues in two DOFs counts "
+              f"twice): {total}, of a {sig(data.duration_s)} s manoeuvre.", ""]  # fmt: skip
     return lines
 
 
@@ -478,16 +480,18 @@ def platform_of(data: ResultData) -> str:
 
 
 NO_FIGURES = "_No figures were drawn (`--no-figures`): `washbench report` on this folder draws them from its files._"
+#: Said once, at the end of a report whose figures have no PDF beside them (once, not under every figure).
+NO_PDF_NOTE = "Vector versions of the figures for papers (PDF): `washbench report` on this folder draws them."
 
 
 def _image(png: Path, start: Path, alt: str, vector: bool | None = None) -> list[str]:
     """The figure embedded, and its PDF linked when there is one (``vector``: whether there is, when the figure is
-    still in a stage; else how to get it)."""
+    still in a stage); without one, the report says once how to get them (:data:`NO_PDF_NOTE`)."""
     rel = _rel(png, start)
     pdf = Path(rel).with_suffix(".pdf")
     if png.with_suffix(".pdf").is_file() if vector is None else vector:
         return [f"![{alt}]({rel})", "", f"Vector version for papers: [{pdf.name}]({pdf.as_posix()})", ""]
-    return [f"![{alt}]({rel})", "", "Vector versions for papers (PDF): `washbench report` on this folder.", ""]
+    return [f"![{alt}]({rel})", ""]
 
 
 def result_sections(
@@ -595,4 +599,5 @@ def _write_result_report(data: ResultData, stage: Path, pdf: bool, figures: bool
     lines += provenance_lines(data.provenance, data.created_utc)
     final = {k: data.folder / p.relative_to(stage) for k, p in drawn.items()}  # where they will be
     lines += result_sections(data, final, data.folder, 2, vector=pdf, recording=recording)
+    lines += [NO_PDF_NOTE, ""] if drawn and not pdf else []
     write_text_atomic(stage / REPORT_FILE, "\n".join(lines).rstrip() + "\n")

@@ -12,11 +12,12 @@ from pathlib import Path
 from washbench.errors import WashbenchError, located, printable
 from washbench.io.lock import output_lock
 from washbench.io.outfolder import recover
-from washbench.io.result_files import SUITE_FILE
+from washbench.io.result_files import SUITE_FILE, TRACK_FILE
 from washbench.review.palette import PALETTE_ENV, palette_name
 from washbench.review.report import write_result_report
 from washbench.review.result_data import is_result_folder
 from washbench.review.suite_report import write_suite_report
+from washbench.review.track_report import write_track_report
 
 
 def report_command(results_dir: Path, palette: str | None = None) -> int:
@@ -32,7 +33,9 @@ def report_command(results_dir: Path, palette: str | None = None) -> int:
         raise WashbenchError(located(folder, "no such folder"))
     with output_lock(folder):  # no other washbench command writes into it meanwhile
         recover(folder)
-        if is_result_folder(folder) and not (folder / SUITE_FILE).exists():
+        if (folder / TRACK_FILE).is_file():  # a washbench track result set
+            path = write_track_report(folder, figures=True, palette=palette_name(palette))
+        elif is_result_folder(folder) and not (folder / SUITE_FILE).exists():
             path = write_result_report(folder, pdf=True)
         else:
             path = write_suite_report(folder, regenerate_results=True)

@@ -17,12 +17,17 @@ the nanosecond):
 - ``/platform/<washout>/<quantity>/axes``: the platform's stage position, velocity, acceleration (NED, SI) and
   omni-wheel speeds (rad/s), three scalars per row, with ``limit_max`` and ``limit_min`` lines where the platform has
   that limit;
-- state lanes, each labelled by the viewer with its path: ``/phase`` (flight phases), ``/limits/<i>_<washout>`` (the
-  limits a washout is held at, joined by "+") and ``/false_cues/<i>_<washout>`` (the DOFs felt falsely); i = 1, 2, ...
-  in washout order, as the viewer sorts lanes by name;
+- state lanes, each labelled by the viewer with its path: ``/phase`` (flight phases), ``/limits/<i>_<washout>`` (a
+  state per stretch a washout is held at limits: the kinds joined by "+") and ``/false_cues/<i>_<washout>`` (a state
+  per stretch of false cues: the DOFs joined by "+", shown in two-letter words); stretches less than
+  :data:`washbench.analysis.cues.MERGE_GAP_S` apart joined (:mod:`washbench.review.lane_bars`); i = 1, 2, ... in
+  washout order, as the viewer sorts lanes by name;
+- ``/legend/perceived``, ``/legend/raw``, ``/legend/envelope``: the legends, static ``Points2D`` whose labels are the
+  names in their lines' colours, in the grids of :func:`washbench.review.blueprint.legend_views`;
 - ``/world/...``: the 3D scene (:mod:`washbench.review.scene3d`);
-- ``/events/phases`` and ``/events/saturation``: text log entries at phase starts and limit onsets, each text
-  starting with its time (the viewer's time column is narrow);
+- ``/events/phases``, ``/events/saturation`` and ``/events/false_cues``: text log entries at phase starts, limit
+  onsets and false-cue events, each text starting with its time, right-aligned (the events table hides the viewer's
+  time column, which it cut to "+3...");
 - ``/metrics``: the metric table as a Markdown document; the recording properties ``provenance`` (strings).
 
 Precision: every time-varying scalar is rounded to float32 (:data:`VALUE_DTYPE`; rerun stores it as float64) after
@@ -43,11 +48,10 @@ sample; the sources of one panel share one row (one time and one row id for all 
 from __future__ import annotations
 
 import contextlib
-import math
 import os
 import uuid
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -64,16 +68,23 @@ from washbench.review.blueprint import (
     AXIS_COLORS,
     LIMIT_COLOR,
     THRESHOLD_COLOR,
+    THRESHOLD_NAME,
     WASHOUT_WIDTH,
     Layout,
+    LegendView,
     UsageView,
     build_blueprint,
+    legend_views,
+    motion_plot_px,
     series_color,
     source_colors,
+    usage_plot_px,
 )
 from washbench.review.figures import saturation_labels
+from washbench.review.lane_bars import DOF_CODES, bars, code_text
 from washbench.review.rrd_read import read_component, read_properties, read_scalar_series, read_text_documents
 from washbench.review.thinning import keep_samples
+from washbench.review.viewer_geometry import labelled_range, legend_positions
 
 __all__ = [
     "AIRCRAFT",
@@ -430,17 +441,6 @@ def _span(values: list[np.ndarray], extra: tuple[float, ...] = ()) -> tuple[floa
     return (lo - pad, hi + pad)
 
 
-def labelled_span(span: tuple[float, float]) -> tuple[float, float]:
-    """``span`` widened, if need be, to hold two multiples of the power of ten below its height: the viewer labels
-    only gridlines at powers of ten that are far enough apart, and a panel from -8.4 to 7.4 deg/s (gridlines 10
-    apart; 1 apart too dense) showed a single "0" tick. Widened to the next multiples outward (-10 to 10)."""
-    lo, hi = span
-    step = 10.0 ** math.floor(math.log10(hi - lo))
-    if math.floor(hi / step) - math.ceil(lo / step) >= 1:  # two multiples inside already
-        return span
-    return (min(lo, math.floor(lo / step) * step), max(hi, math.ceil(hi / step) * step))
-
-
 def _dof_columns(data: RecordingData) -> tuple[list[np.ndarray], list[np.ndarray]]:
     """Per DOF, (N, sources) arrays of perceived and raw motion in the recording's units."""
     every = [*data.washouts.values(), data.aircraft]  # in sources() order
@@ -486,7 +486,7 @@ def _send_motion(
             f"/perceived/{dof}/threshold",
             t_s,
             [centre + th, centre - th],
-            ["perception threshold", "perception threshold"],
+            [THRESHOLD_NAME, THRESHOLD_NAME],
             [THRESHOLD_COLOR, THRESHOLD_COLOR],
         )
 
@@ -636,18 +636,34 @@ def _lane_style(
                                             labels=[t for _, _, t in triples]), static=True, strict=True)  # fmt: skip
 
 
-def limit_text(kinds: str, labels: Mapping[str, str]) -> str:
-    """The text a limit lane shows for a state (kinds joined by "+"): the kinds' readable names (``labels``, the
-    figures' :func:`washbench.review.figures.saturation_labels`), joined by " + "."""
-    return " + ".join(labels.get(k, k) for k in kinds.split("+"))
+def _send_bars(rec: rr.RecordingStream, path: str, t_s: np.ndarray, found: list[tuple[int, int, int]],
+               values: Sequence[str], texts: Sequence[str], color: tuple[int, int, int]) -> None:  # fmt: skip
+    """A lane of ``found`` bars (:func:`washbench.review.lane_bars.bars`): the bar's state ``values[i]`` from its first
+    sample to its last (a gap after it), its bar drawn in ``color`` with ``texts[i]`` on it; an empty lane (one gap)
+    without bars."""
+    if not found:
+        _send_states(rec, path, t_s, [""], np.array([0]))
+        return
+    states: list[str] = []
+    changes: list[int] = []
+    for (start, end, _), value in zip(found, values, strict=True):
+        states.append(value)
+        changes.append(start)
+        if end + 1 < t_s.size:
+            states.append("")
+            changes.append(end + 1)
+    _send_states(rec, path, t_s, states, np.array(changes))
+    shown = dict(zip(values, texts, strict=True))
+    _lane_style(rec, path, list(shown), [color] * len(shown), list(shown.values()))
 
 
 def _send_lanes(rec: rr.RecordingStream, data: RecordingData) -> None:
-    """Phase lane; one lane per washout, the limits it is held at joined by "+" (one lane per washout: with seven
-    washouts one lane per washout and kind ran off a 720 px window); limit onset events."""
-    labels = saturation_labels(data.platform)
+    """Phase lane; one lane per washout, a bar while it is held at a limit (gaps under MERGE_GAP_S joined, its state
+    the kinds held at inside it joined by "+", as the console's and the report's kind names: one lane per washout and
+    kind ran off a 720 px window, a bar per change of kinds was cut to a few pixels); limit onset events."""
     t_s = np.asarray(data.t_s, dtype=np.float64)
     n = t_s.size
+    dt = float(t_s[1] - t_s[0]) if n > 1 else 0.0
     if data.phases:
         starts = [t0 for _, t0, _ in data.phases]
         names = [name for name, _, _ in data.phases]
@@ -662,23 +678,16 @@ def _send_lanes(rec: rr.RecordingStream, data: RecordingData) -> None:
     for w in data.washouts:
         kinds = [(k, np.asarray(v, dtype=bool)) for k, v in data.platforms[w].saturated.items() if np.any(v)]
         code = np.zeros(n, dtype=np.int64)
-        dt = float(t_s[1] - t_s[0]) if n > 1 else 0.0
         for j, (kind, flags) in enumerate(kinds):
             code |= flags.astype(np.int64) << j
             starts, ends = _runs(flags)
             onsets.extend(
-                (float(t_s[s]), f"{t_s[s]:.2f} s  {w}: {kind} limit reached for {t_s[e] - t_s[s] + dt:.3f} s")
+                (float(t_s[s]), f"{_time_text(t_s[s])}  {w}: {kind} limit reached for {t_s[e] - t_s[s] + dt:.3f} s")
                 for s, e in zip(starts, ends, strict=True)
             )
-        change = np.flatnonzero(np.diff(code, prepend=0))
-        if change.size:
-            states = ["+".join(k for j, (k, _) in enumerate(kinds) if code[i] >> j & 1) for i in change]
-            _send_states(rec, washout_lane_path(data, w), t_s, states, change)
-            unique = list(dict.fromkeys(states))
-            _lane_style(rec, washout_lane_path(data, w), unique, [LIMIT_LANE_COLOR] * len(unique),
-                        [limit_text(u, labels) for u in unique])  # fmt: skip
-        else:  # an empty lane: never held at a limit
-            _send_states(rec, washout_lane_path(data, w), t_s, [""], np.array([0]))
+        found = bars(code, dt)
+        values = [code_text(m, [k for k, _ in kinds], "+") for _, _, m in found]
+        _send_bars(rec, washout_lane_path(data, w), t_s, found, values, values, LIMIT_LANE_COLOR)
     if onsets:
         onsets.sort(key=lambda item: item[0])
         rec.send_columns(
@@ -689,14 +698,21 @@ def _send_lanes(rec: rr.RecordingStream, data: RecordingData) -> None:
         )
 
 
+def _time_text(t_s: float) -> str:
+    """The time an event line starts with, right-aligned for the events table's monospace text ("  5.83 s")."""
+    return f"{t_s:7.2f} s"
+
+
 def cue_lane_path(data: RecordingData, washout: str) -> str:
     """State lane of the DOFs in which ``washout``'s simulator pilot feels a false cue (joined by "+")."""
     return f"/false_cues/{_lane_name(data, washout)}"
 
 
 def _send_cues(rec: rr.RecordingStream, data: RecordingData) -> None:
-    """Per washout a lane "false: surge+roll" while false cues last (:mod:`washbench.analysis.cues`), and one
-    ``/events/false_cues`` line per false-cue event (start, end, DOF, peak)."""
+    """Per washout a lane with a bar where its simulator pilot feels false cues (:mod:`washbench.analysis.cues`;
+    gaps under MERGE_GAP_S joined, as the events), its state the DOFs felt falsely inside it ("sway+heave"), its
+    text their short words ("Sw He", :data:`washbench.review.lane_bars.DOF_CODES`: whole words were cut to "sw",
+    "sur" on the narrow bars); and one ``/events/false_cues`` line per false-cue event (start, end, DOF, peak)."""
 
     t_s = np.asarray(data.t_s, dtype=np.float64)
     dt = float(t_s[1] - t_s[0]) if t_s.size > 1 else 1.0
@@ -707,6 +723,7 @@ def _send_cues(rec: rr.RecordingStream, data: RecordingData) -> None:
 
     ac = dof_cols(data.aircraft)
     lines: list[tuple[float, str]] = []
+    codes = [DOF_CODES[d] for d in DOF_NAMES]
     for w, series in data.washouts.items():
         sim = dof_cols(series)
         code = np.zeros(t_s.size, dtype=np.int64)
@@ -715,17 +732,12 @@ def _send_cues(rec: rr.RecordingStream, data: RecordingData) -> None:
             code |= (cls == FALSE).astype(np.int64) << j
             for e in false_events(cls, sim[:, j] - rest[j], dt, dof, float(t_s[0])):
                 unit = "m/s^2" if j < 3 else "deg/s"
-                lines.append((e.start_s, f"{e.start_s:.2f} s  {w}: false {dof} cue until {e.end_s:.2f} s, "
+                lines.append((e.start_s, f"{_time_text(e.start_s)}  {w}: false {dof} cue until {e.end_s:.2f} s, "
                                          f"peak {e.peak:.3g} {unit}"))  # fmt: skip
-        change = np.flatnonzero(np.diff(code, prepend=0))
-        if change.size == 0:
-            change = np.array([0])
-        states = [("false: " + "+".join(d for j, d in enumerate(DOF_NAMES) if code[i] >> j & 1)) if code[i] else ""
-                  for i in change]  # fmt: skip
-        _send_states(rec, cue_lane_path(data, w), t_s, states, change)
-        unique = list(dict.fromkeys(states))
-        _lane_style(rec, cue_lane_path(data, w), unique, [FALSE_CUE_COLOR] * len(unique),
-                    [u.removeprefix("false: ") for u in unique])  # the lane says "false cues": the DOFs only
+        found = bars(code, dt)
+        values = [code_text(m, list(DOF_NAMES), "+") for _, _, m in found]
+        texts = [code_text(m, codes, " ") for _, _, m in found]
+        _send_bars(rec, cue_lane_path(data, w), t_s, found, values, texts, FALSE_CUE_COLOR)
     if lines:
         lines.sort(key=lambda item: item[0])
         rec.send_columns(
@@ -745,51 +757,65 @@ def _send_text(rec: rr.RecordingStream, data: RecordingData) -> None:
             "/events/phases",
             indexes=[_time_column(np.array([t0 for _, t0, _ in data.phases], dtype=np.float64))],
             columns=rr.TextLog.columns(
-                text=[f"{t0:.2f} s  phase {name} ({t0:.2f}-{t1:.2f} s)" for name, t0, t1 in data.phases],
+                text=[f"{_time_text(t0)}  phase {name} ({t0:.2f}-{t1:.2f} s)" for name, t0, t1 in data.phases],
                 level=["INFO"] * len(data.phases),
             ),
             strict=True,
         )
 
 
-def _send_legend(rec: rr.RecordingStream, data: RecordingData) -> None:
-    """The one legend: a panel of its own (lines outside its y range, so it covers no data)."""
-    names = [AIRCRAFT, *data.washouts, "perception threshold"]  # the reference first
-    colors = [*source_colors(list(data.washouts)), THRESHOLD_COLOR]
-    widths = [AIRCRAFT_WIDTH] + [WASHOUT_WIDTH] * len(data.washouts) + [1.0]
-    rec.log("/legend", rr.SeriesLines(colors=colors, names=names, widths=widths), static=True, strict=True)
-    t_s = np.asarray(data.t_s, dtype=np.float64)
-    rec.send_columns(
-        "/legend",
-        indexes=[_time_column(np.array([t_s[0], t_s[-1]]))],
-        columns=rr.Scalars.columns(scalars=np.zeros((2, len(names)))),
-        strict=True,
-    )
+def _send_legend(rec: rr.RecordingStream, data: RecordingData, views: Sequence[LegendView]) -> None:
+    """The legends: each name in its line's colour (the viewer draws a point's label under it, in the point's
+    colour), in each legend view's grid; the points themselves too small to see."""
+    colour = {AIRCRAFT: AIRCRAFT_COLOR, THRESHOLD_NAME: THRESHOLD_COLOR}
+    colour |= {w: series_color(w, list(data.washouts)) for w in data.washouts}
+    for view in views:
+        rec.log(
+            view.origin,
+            rr.Points2D(legend_positions(len(view.names), view.columns, view.cell), labels=list(view.names),
+                        colors=[colour[n] for n in view.names], radii=rr.Radius.ui_points(0.1), show_labels=True),
+            static=True,
+            strict=True,
+        )  # fmt: skip
 
 
 def _layout(data: RecordingData, perceived: list[np.ndarray], raw: list[np.ndarray], panels: list[UsagePanel]
             ) -> Layout:  # fmt: skip
+    """The blueprint's data: the panels' y ranges each labelled with two gridlines at least at the plot height the
+    layout gives them in the design window (:func:`washbench.review.viewer_geometry.labelled_range`)."""
     offsets = scene3d.object_offsets(len(data.washouts), data.envelope.axes("pos_m"), data.envelope.sphere_diameter_m)
-    return Layout(
+    usage_spans = [(0.0, 1.15) if p.limit is not None else _span([p.values], (0.0,)) for p in panels]
+    kinds = [k for k in saturation_labels(data.platform)
+             if any(np.any(data.platforms[w].saturated.get(k, False)) for w in data.washouts)]  # fmt: skip
+    labels = saturation_labels(data.platform)
+    draft = Layout(
         washouts=tuple(data.washouts),
         dofs=tuple((dof, unit) for dof, _, _, unit in DOFS),
         t_end_s=float(data.t_s[-1]),
-        perceived_ranges=tuple(
-            labelled_span(_span([p], (c - th, c + th)))
-            for p, (c, th) in zip(perceived, _threshold_lines(data.thresholds), strict=True)
-        ),
-        raw_ranges=tuple(labelled_span(_span([r])) for r in raw),
-        camera=scene3d.camera(offsets, data.envelope.sphere_diameter_m),
+        perceived_ranges=(),
+        raw_ranges=(),
+        camera=scene3d.camera(offsets, data.envelope.axes("pos_m"), data.envelope.sphere_diameter_m),
         usage=tuple(
-            UsageView(envelope_usage_path(p.key), p.title if p.limit is None else f"{p.title} ({p.limit})",
-                      (0.0, 1.15) if p.limit is not None else _span([p.values], (0.0,)))
-            for p in panels
+            UsageView(envelope_usage_path(p.key), p.title if p.limit is None else f"{p.title} ({p.limit})", span)
+            for p, span in zip(panels, usage_spans, strict=True)
         ),
         platform_quantities=tuple((q, unit) for q, _, unit in platform_quantities(data)),
         platform_name=data.platform_name,
         phase_lane=phase_lane_path() if data.phases else None,
         limit_lanes=tuple(washout_lane_path(data, w) for w in data.washouts),
         cue_lanes=tuple(cue_lane_path(data, w) for w in data.washouts),
+        legends=legend_views(list(data.washouts)),
+        limit_key=", ".join(f"{k} {labels[k]}" for k in kinds) or "none reached",
+        cue_key=", ".join(f"{code} {dof}" for dof, code in DOF_CODES.items()),
+    )
+    plot_px, usage_px = motion_plot_px(draft), usage_plot_px(draft)
+    lines = _threshold_lines(data.thresholds)
+    spans = [_span([p], (c - th, c + th)) for p, (c, th) in zip(perceived, lines, strict=True)]
+    return replace(
+        draft,
+        perceived_ranges=tuple(labelled_range(sp, plot_px) for sp in spans),
+        raw_ranges=tuple(labelled_range(_span([r]), plot_px) for r in raw),
+        usage=tuple(replace(u, y_range=labelled_range(u.y_range, usage_px)) for u in draft.usage),
     )
 
 
@@ -895,7 +921,7 @@ def write_recording(path: Path, data: RecordingData, properties: Mapping[str, st
                 data.platform,
             )
             _send_text(rec, data)
-            _send_legend(rec, data)
+            _send_legend(rec, data, layout.legends)
             rrd.close()
         except BaseException:
             rrd.abandon()

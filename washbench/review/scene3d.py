@@ -29,9 +29,11 @@ __all__ = [
     "SCENE_RATE_HZ",
     "camera",
     "grid_shape",
+    "label_points",
     "object_offsets",
     "pose_samples",
     "relative_to_initial_heading",
+    "scene_extent",
     "scene_stride",
     "send_scene",
 ]
@@ -124,17 +126,83 @@ def object_offsets(n_washouts: int, travel_m: np.ndarray, diameter_m: float) -> 
     return offsets
 
 
-def camera(offsets: np.ndarray, diameter_m: float) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
-    """Eye and target (NED, m): behind (south of) the rows of objects and above them, looking north at their middle;
-    far enough back that the widest row fits a view about as wide as tall, high enough that a row's labels fall
-    between it and the row in front (screenshots at 1280x720 and 1920x1080)."""
-    width = float(offsets[:, 1].max() - offsets[:, 1].min()) + 2.0 * diameter_m
-    depth = float(offsets[:, 0].max() - offsets[:, 0].min())
-    centre_y = 0.5 * float(offsets[:, 1].min() + offsets[:, 1].max())
-    centre_x = 0.5 * float(offsets[:, 0].min() + offsets[:, 0].max())
-    back = 0.6 * width + 0.4 * depth
-    eye = (centre_x - back, centre_y, -0.6 * back)
-    return eye, (centre_x, centre_y, 0.0)
+FOV_Y_DEG = 55.0
+"""The vertical field of view of rerun's 3-D eye (``Eye::DEFAULT_FOV_Y`` in re_view_spatial), deg."""
+
+VIEW_ASPECT = 1.4
+"""Width / height of the 3-D tab's view, the narrower of 1920x1080 (about 1340 x 950 px) and 1280x720 (890 x 630):
+the camera frames the scene for it (a wider view shows more room at the sides)."""
+
+ELEVATION_DEG = 45.0
+"""The camera looks north and down by this angle: the rows behind one another stand apart, each row's labels fall
+between it and the row in front (screenshots at 1920x1080 and 1280x720)."""
+
+FILL = 0.92
+"""The scene's extremes reach this share of the view's half-angles (tangents): room for the labels' text, which
+the viewer draws in pixels around their points."""
+
+LABEL_GAP_M = 0.4
+"""A label's point lies this far in front of (south of) its object's front lower edge, m."""
+
+
+def _boxes(offsets: np.ndarray, travel_m: np.ndarray, diameter_m: float) -> np.ndarray:
+    """Half-sizes (n, 3) of each object's box, m: the aircraft's shape (half the sphere's diameter), a cockpit's
+    sphere or its stage's range box, whichever is larger on each axis."""
+    half = diameter_m / 2.0
+    boxes = np.tile(np.maximum(half, np.asarray(travel_m, dtype=np.float64)), (len(offsets), 1))
+    boxes[0] = half
+    return boxes
+
+
+def label_points(offsets: np.ndarray, travel_m: np.ndarray, diameter_m: float) -> np.ndarray:
+    """Where each object's label is drawn (n, 3), NED, m: in front of the middle of its box's front lower edge, the
+    lowest point of the object on the screen of a camera looking north and down (a label under the object, seen from
+    above, lay over its own box)."""
+    boxes = _boxes(offsets, travel_m, diameter_m)
+    return np.asarray(offsets, dtype=np.float64) + np.column_stack(
+        [-boxes[:, 0] - LABEL_GAP_M, np.zeros(len(boxes)), boxes[:, 2]]
+    )
+
+
+def scene_extent(offsets: np.ndarray, travel_m: np.ndarray, diameter_m: float) -> np.ndarray:
+    """Points that bound what the 3-D view shows (NED, m): the corners of each object's box (:func:`_boxes`) and each
+    label's point (:func:`label_points`)."""
+    corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=np.float64)
+    boxes = _boxes(offsets, travel_m, diameter_m)
+    points = [np.asarray(offsets, dtype=np.float64)[i] + corners * boxes[i] for i in range(len(boxes))]
+    return np.vstack([*points, label_points(offsets, travel_m, diameter_m)])
+
+
+def camera(offsets: np.ndarray, travel_m: np.ndarray, diameter_m: float
+           ) -> tuple[tuple[float, float, float], tuple[float, float, float]]:  # fmt: skip
+    """Eye and target (NED, m): looking north and down (:data:`ELEVATION_DEG`), as close as the view (rerun's
+    :data:`FOV_Y_DEG` field of view, :data:`VIEW_ASPECT`) holds every point of :func:`scene_extent` within
+    :data:`FILL` of its half-angles, centred (the camera set by hand cut the front row off under the view's edge
+    and left its top third empty).
+
+    With the view's axes r (right, east), u (up) and f (forward) and the eye E = e_r r + e_u u + e_f f, a point p is
+    inside when |p.r - e_r| <= k_r (p.f - e_f) and |p.u - e_u| <= k_u (p.f - e_f), k the half-angles' tangents times
+    FILL: e_f <= min_p (p.f - p.r / k_r) + e_r / k_r and e_f <= min_p (p.f + p.r / k_r) - e_r / k_r. The nearest eye
+    sideways is where both bounds meet, e_r = k_r (B - A) / 2, e_f = (A + B) / 2 (A, B the two minima); the same
+    upward; e_f the smaller of the two (the other direction then centred between its bounds). The target: the point
+    of the line of sight nearest the scene's centre."""
+    e = math.radians(ELEVATION_DEG)
+    fwd = np.array([math.cos(e), 0.0, math.sin(e)])  # north and down (NED: down is +z)
+    right = np.array([0.0, 1.0, 0.0])  # east
+    up = np.array([math.sin(e), 0.0, -math.cos(e)])  # perpendicular to both, pointing up
+    tan_half = math.tan(math.radians(FOV_Y_DEG) / 2.0) * FILL
+    points = scene_extent(offsets, travel_m, diameter_m)
+    pf = points @ fwd
+    eye_f, sideways = [], []
+    for axis, k in ((right, tan_half * VIEW_ASPECT), (up, tan_half)):
+        pa = points @ axis
+        a, b = float(np.min(pf - pa / k)), float(np.min(pf + pa / k))
+        eye_f.append(0.5 * (a + b))
+        sideways.append(0.5 * k * (b - a))
+    eye = sideways[0] * right + sideways[1] * up + min(eye_f) * fwd
+    centre = 0.5 * (points.min(axis=0) + points.max(axis=0))
+    target = eye + fwd * float((centre - eye) @ fwd)
+    return (float(eye[0]), float(eye[1]), float(eye[2])), (float(target[0]), float(target[1]), float(target[2]))
 
 
 def _shape(size: float) -> list[list[list[float]]]:
@@ -201,13 +269,12 @@ def send_scene(
         strict=True,
     )
     _log_object(rec, "/world/aircraft/body", half, AIRCRAFT_COLOR)
-    # one label per object, under it (z down), where it hides no shape; at most MAX_PER_ROW objects a row, so
-    # neighbours' labels do not run into one another (eight in one row did)
-    below = np.full(len(offsets), half + 0.5)
+    # one label per object, in front of its lower edge, where it hides no shape; at most MAX_PER_ROW objects a row,
+    # so neighbours' labels do not run into one another (eight in one row did)
     rec.log(
         "/world/labels",
         rr.Points3D(
-            offsets + np.column_stack([np.zeros(len(offsets)), np.zeros(len(offsets)), below]),
+            label_points(offsets, travel_m, diameter_m),
             labels=["aircraft", *washouts],
             colors=[AIRCRAFT_COLOR, *[series_color(w, washouts) for w in washouts]],
             radii=[0.05],

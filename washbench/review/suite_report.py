@@ -31,7 +31,7 @@ from washbench.io.atomic import write_text_atomic
 from washbench.io.outfolder import discard_stage, make_stage, refuse_links, replace_entries
 from washbench.io.readback import SuiteDoc, read_doc, suite_member
 from washbench.io.result_files import FIGURES_DIR, METRICS_FILE, RECORDING_FILE, REPORT_FILE, SUITE_FILE
-from washbench.review.bound_section import CEILING_NOTE, read_ceiling
+from washbench.review.bound_section import CEILING_NOTE, VACUOUS, read_ceiling
 from washbench.review.figures import score_heatmap, table4_figure
 from washbench.review.numbers import sig
 from washbench.review.report import (
@@ -39,6 +39,7 @@ from washbench.review.report import (
     FLAG,
     MSDV_NOTE,
     MSI_NOTE,
+    NO_PDF_NOTE,
     PERCEIVED_NOTE,
     SCORE_NOTE,
     _image,
@@ -53,11 +54,12 @@ from washbench.review.verdict import Entry, verdict_lines
 _HOW_TO_READ = [
     "Metrics compare the aircraft pilot's perceived motion with each simulator pilot's, per degree of freedom: NPC",
     "(normalized Pearson correlation, 1 perfect, larger worse), the integral and the maximum of |error|; surge, sway,",
-    "heave in m/s² (integral m/s²·s), roll, pitch, yaw in deg/s (integral deg). The score (lower is better) is the",
-    "weighted relative integral error of `washbench/analysis/ranking.py`: each DOF's error over the aircraft pilot's",
-    "own perceived motion in it (what a simulator standing still would get wrong), DOFs weighted by how much was felt",
-    "there (half the weight to specific force, half to rotation). Numbers have 3 significant digits; full precision",
-    "is in `metrics.csv`, `comparison.csv` and `ranking.csv`. Best values are bold.",
+    "heave in m/s² (integral m/s²·s), roll, pitch, yaw in deg/s (integral deg). The ranking's value (lower is",
+    "better) is by default the felt error of `washbench/analysis/felt.py` (docs/metrics.md): the perceived error",
+    "beyond the perception thresholds, its false part counted again and the jolts the platform adds at the head, in",
+    "threshold units, over what the aircraft pilot felt above threshold (1: a platform standing still; each DOF weighs",
+    "what was felt there). `--rank-by score` ranks by the rule before it. Numbers have 3 significant digits; full",
+    "precision is in `metrics.csv`, `comparison.csv` and `ranking.csv`. Best values are bold.",
     "",
 ]
 
@@ -71,7 +73,7 @@ def write_suite_json(
 ) -> None:
     """``suite.json``: one entry per manoeuvre file (file, ok, reason, aircraft, manoeuvre, result folder, checks),
     the provenance and, once the suite is complete, ``entries``: every top-level name it wrote (the marker by which
-    the next suite recognises what it may replace, :func:`washbench.runs.suite.previous_results`)."""
+    the next suite recognises what it may replace, :func:`washbench.runs.suite_place.previous_results`)."""
     doc: dict[str, Any] = {"washbench": "suite", "created_utc": created_utc, "provenance": provenance}
     doc["manoeuvres"] = entries
     if top_level is not None:
@@ -202,9 +204,8 @@ def _write_suite_report(
               metrics=d.metrics, motion=d.motion, ceiling=read_ceiling(d.folder))
         for d in loaded
     ]  # fmt: skip
-    lines += verdict_lines(verdict, washouts, reference)
     failed = [(e, d) for e, d in results if not e.get("ok", d.ok if d else False)]
-    if failed:
+    if failed:  # failures first: what did not run comes before any verdict on what did
         lines += ["## Failures", ""]
         for e, d in failed:
             name = e.get("file") or (d.title if d else "?")
@@ -212,6 +213,7 @@ def _write_suite_report(
             kept = f" (results kept in `{e['result']}/`)" if d is not None else ""
             lines.append(f"- `{name}`: {reason}{kept}")
         lines.append("")
+    lines += verdict_lines(verdict, washouts, reference, rule, failed=len(failed))
     lines += provenance_lines(doc.get("provenance"), doc.get("created_utc"))
     lines += ["## Summary", ""]
     head = ["aircraft", "manoeuvre", "status", "checks", "duration (s)", "best washout"]
@@ -262,7 +264,8 @@ def _write_suite_report(
     lines += ["## How to read the numbers", "", *_HOW_TO_READ, f"Ranked by {rule.label()}.", "",
               PERCEIVED_NOTE, "", CUE_NOTE, "", MSDV_NOTE, "", MSI_NOTE, ""]  # fmt: skip
     if any(e.ceiling for e in verdict):
-        lines += [CEILING_NOTE.format(measure=rule.by), ""]
+        name = "felt error" if rule.by == "felt" else rule.by
+        lines += [CEILING_NOTE.format(measure=name, vacuous=100 * VACUOUS), ""]
     for d in loaded:
         rel = _rel(d.folder, suite_dir)
         lines += [f"## {d.title}", ""]
@@ -271,6 +274,7 @@ def _write_suite_report(
         if d.ok is False:
             lines += [f"> **FAILED**: {d.reason or 'a check failed'}", ""]
         lines += result_sections(d, _existing_figures(d) if figures else {}, suite_dir, 3, brief=True)
+    lines += [NO_PDF_NOTE, ""] if figures and not regenerate_results else []  # once, not under every figure
     for future in drawing.values():  # drawn (or failed: raised here) before the report that shows them
         future.result()
     write_text_atomic(stage / REPORT_FILE, "\n".join(lines).rstrip() + "\n")

@@ -22,6 +22,7 @@ fallbacks and iterations), :func:`washbench.cueing.bank.CueingBank.algorithm_rep
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -55,15 +56,18 @@ def split_whole(specs: Sequence[Any]) -> tuple[list[Any], list[Any]]:
 
 
 def with_whole(
-    traces: Mapping[str, Any], motion: Any, whole: Sequence[Any], order: Sequence[str], limits: Any, filter_start: str
-) -> dict[str, Any]:
+    traces: Mapping[str, Any], motion: Any, whole: Sequence[Any], order: Sequence[str], limits: Any, filter_start: str,
+    reports: dict[str, Any] | None = None,
+) -> dict[str, Any]:  # fmt: skip
     """``traces`` (the lockstep's) and the whole-only washouts cued on ``motion`` (the flight read back), in the
-    order ``order`` (every washout's name, as listed)."""
+    order ``order`` (every washout's name, as listed); ``reports`` (when given) receives what those washouts report
+    of themselves (run.json ``algorithms``: the bound's solves, the MPC's with preview)."""
     from washbench.cueing import cue_trace  # deferred: numba
 
     if not whole:
         return dict(traces)
-    extra = cue_trace(motion.f_mps2, motion.omega_radps, motion.dt_s, whole, None, limits, filter_start)
+    extra = cue_trace(motion.f_mps2, motion.omega_radps, motion.dt_s, whole, None, limits, filter_start,
+                      reports=reports)  # fmt: skip
     both = {**traces, **extra}
     return {name: both[name] for name in order}
 
@@ -71,7 +75,8 @@ def with_whole(
 def lockstep_result(motion: Any, rows: list[Any], options: Any) -> Any:
     """:func:`washbench.runs.chain.from_lockstep` with the whole-only washouts of ``options`` (a
     :class:`washbench.runs.options.RunOptions`; they were not in the lockstep) cued here on ``motion``, the flight
-    read back, and put in their listed order."""
+    read back, and put in their listed order; the result's ``algorithms`` hold what those report of themselves (the
+    lockstep's own washouts report through the lockstep's ``reports``)."""
     from washbench.cueing import WashoutTrace  # deferred: numba
 
     stepped, whole = split_whole(options.washouts)
@@ -82,8 +87,10 @@ def lockstep_result(motion: Any, rows: list[Any], options: Any) -> Any:
     kind = platform_kind(options.limits)
     traces = {w.name: WashoutTrace.from_rows(block[i], platform=kind) for i, w in enumerate(stepped)}
     del block
-    traces = with_whole(traces, motion, whole, options.washout_order, options.limits, options.filter_start)
-    return analyse(motion, traces, options.vestibular_params, options.filter_start, options.rank_rule.measure)
+    reports: dict[str, Any] = {}
+    traces = with_whole(traces, motion, whole, options.washout_order, options.limits, options.filter_start, reports)
+    result = analyse(motion, traces, options.vestibular_params, options.filter_start, options.rank_rule.measure)
+    return dataclasses.replace(result, algorithms=reports)
 
 
 def bound_spec(specs: Sequence[Any]) -> Any | None:

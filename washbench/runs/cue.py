@@ -32,6 +32,7 @@ from washbench.io.metrics_csv import write_metrics_csv
 from washbench.io.motion import Motion
 from washbench.io.names import check_identifier
 from washbench.io.outfolder import check_out_path, result_set
+from washbench.io.paths import resolve_manoeuvre
 from washbench.io.plausibility import Finding, check_arrays
 from washbench.io.progress import Progress
 from washbench.io.provenance import file_record, flat_strings, parquet_metadata, read_parquet_provenance, utc_now
@@ -266,6 +267,21 @@ def _input_figure(input_path: Path, seg: Segment, folder: Path) -> None:
     draw_for_result(folder, title, seg.motion, seg.labels, seg.notes)
 
 
+def refuse_manoeuvre(input_path: Path) -> None:
+    """WashbenchError (one line) when ``input_path`` is a manoeuvre to fly, not a recorded trace: a YAML manoeuvre
+    file, a JSBSim script, or a bundled manoeuvre's name (``c172/takeoff``). ``washbench run`` flies those."""
+    text = str(input_path)
+    if input_path.suffix.lower() in (".yaml", ".yml", ".xml"):
+        what = "a JSBSim script" if input_path.suffix.lower() == ".xml" else "a manoeuvre file"
+    elif not input_path.exists() and resolve_manoeuvre(input_path).exists():
+        what = "a bundled manoeuvre's name"
+    else:
+        return
+    raise WashbenchError(f"{text}: {what}, which cue does not read (cue takes a recorded trace: CSV, Parquet, "
+                         f"X-Plane Data.txt, JSBSim CSV); fly it with the washouts: washbench run {text} "
+                         "--out DIR")  # fmt: skip
+
+
 def run_cue(
     input_path: Path,
     out_dir: Path,
@@ -282,6 +298,7 @@ def run_cue(
     Raises WashbenchError (one line) for bad names, parameter files or input; writes nothing then.
     """
     check_out_path(out_dir)
+    refuse_manoeuvre(input_path)
     opts = options or CueOptions()
     for flag, value in (("--max-gap-s", opts.max_gap_s), ("--resample", opts.resample_hz)):
         if value is not None and not (math.isfinite(value) and value > 0.0):

@@ -9,7 +9,7 @@ from pathlib import Path
 from washbench.errors import WashbenchError, located
 from washbench.flight.manoeuvre import load_manoeuvre
 from washbench.flight.scripts import is_runscript, is_script, load_script_info
-from washbench.io.paths import MANOEUVRES_DIR, bundled_names, resolve_manoeuvre
+from washbench.io.paths import MANOEUVRES_DIR, resolve_manoeuvre, unknown_manoeuvre
 
 
 def find_manoeuvres(inputs: Sequence[Path], scripts: Sequence[Path] = ()) -> list[Path]:
@@ -27,9 +27,7 @@ def find_manoeuvres(inputs: Sequence[Path], scripts: Sequence[Path] = ()) -> lis
         elif item.is_file():
             found.append(item)
         else:
-            raise WashbenchError(
-                located(item, f"no such file or folder, nor a bundled manoeuvre ({', '.join(bundled_names())})")
-            )
+            raise unknown_manoeuvre(item)
     found.extend(scripts)
     unique = list(dict.fromkeys(p.resolve() for p in found))
     if not unique:

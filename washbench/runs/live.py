@@ -168,12 +168,17 @@ class Session:
         self._others: set[Any] = set()
         self.unusable: str | None = None  # why the source's time cannot be cued (the session stops, saves, refuses)
         self.hints: list[str] = []
+        self.save_only = False  # the washouts were cut short by a signal: what is still received is saved, not cued
+        self.cued = 0  # samples cued (stepped through the washouts)
 
     # ------------------------------------------------------------------ the hot path
 
     def cue(self, o: Out) -> None:
-        """Save, cue and command one sample."""
+        """Save, cue and command one sample (only save it once the washouts were cut short: :attr:`save_only`)."""
         s = o.sample
+        if self.save_only:
+            self.writer.row(s, o.held, o.new_segment)
+            return
         self.busy[0] = True  # a plugin may block in here: a signal acts at once
         try:
             if o.new_segment or self.bank is None:
@@ -182,8 +187,12 @@ class Session:
             f[0], f[1], f[2] = s[1], s[2], s[3]
             w[0], w[1], w[2] = s[4], s[5], s[6]
             rows = self.rows = self.bank.step(f, np.radians(w))
+        except (KeyboardInterrupt, Terminated):  # a signal while a washout computed: the sample was received, kept
+            self.writer.row(s, o.held, o.new_segment)
+            raise
         finally:
             self.busy[0] = False
+        self.cued += 1
         flags = (commands.FLAG_HELD if o.held else 0) | (commands.FLAG_NEW_SEGMENT if o.new_segment else 0)
         self.sink.send(s[0], flags, rows)
         self.writer.row(s, o.held, o.new_segment)  # after the command: not on the latency path
@@ -219,8 +228,13 @@ class Session:
         except UnusableStepError as exc:
             self._unusable(exc)
             return
-        for o in outs:
-            self.cue(o)
+        for i, o in enumerate(outs):
+            try:
+                self.cue(o)
+            except (KeyboardInterrupt, Terminated):  # cut short: the rest of what arrived is saved, not lost
+                for rest in outs[i + 1 :]:
+                    self.writer.row(rest.sample, rest.held, rest.new_segment)
+                raise
         if outs:
             done = self.clock()
             last = outs[-1]
@@ -496,8 +510,10 @@ def run_live(opts: LiveOptions, run: RunOptions | None = None) -> int:
             if before is not None:
                 os.sched_setscheduler(0, *before)  # the final cue runs at the ordinary priority again
             gc.unfreeze()
-            if not cut:
-                session.finish()
+            if cut:  # what was received and not yet saved (the link's held samples, the socket's queue): saved only
+                session.save_only = True
+                session.drain()
+            session.finish()
             saved = writer.close()
             if session.viewer is not None:
                 session.viewer.close()
@@ -509,7 +525,8 @@ def run_live(opts: LiveOptions, run: RunOptions | None = None) -> int:
         kept = f"the {writer.rows} sample(s) received are in {saved}" if saved else "nothing was saved"
         raise WashbenchError(f"--listen {opts.listen[0]}:{opts.listen[1]}: {session.unusable}; {kept}")
     if cut:
-        kept = f"the {writer.rows} sample(s) cued so far are in {saved}" if saved else "fewer than 2 samples cued"
+        kept = (f"the {writer.rows} sample(s) received are in {saved} ({session.cued} cued before it)" if saved
+                else "fewer than 2 samples received")  # fmt: skip
         print(f"washbench: {session.stop}: {kept} (not cued again: a washout may not return; `washbench cue` "
               "that file)", file=sys.stderr)  # fmt: skip
         return status or 130

@@ -17,21 +17,21 @@ adaptation transient to wait for (checked against filtering a long sine in the t
 from __future__ import annotations
 
 import csv
+import dataclasses
 import io
 import math
 import sys
-import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 from washbench.analysis import omct
-from washbench.analysis.bound import MAX_BOUND_SAMPLES, BoundParams
-from washbench.analysis.bound_replay import replay
 from washbench.analysis.omct_boundaries import BoundaryFile
 from washbench.analysis.signals import SignalSpec, amplitude_unit, canonical_axis, generate
-from washbench.cueing.variants import Washout, check_platform, platform_refusal, select_washouts
+from washbench.cueing import registry
+from washbench.cueing.variants import Washout, check_platform, default_on, select_washouts
 from washbench.errors import WashbenchError, printable
+from washbench.io import cost
 from washbench.io.atomic import write_text_atomic
 from washbench.io.budget import check_samples
 from washbench.io.csv_numbers import csv_number
@@ -41,7 +41,7 @@ from washbench.io.progress import Progress
 from washbench.io.result_files import REPORT_FILE
 from washbench.io.yamlio import load_yaml_model
 from washbench.perception.vestibular import VestibularModel, VestibularParams
-from washbench.platform.model import PlatformModel, load_platform_model
+from washbench.platform.model import PlatformModel, load_platform_model, platform_kind
 from washbench.review.bode import write_bode_plots
 from washbench.review.omct_report import report_text
 
@@ -155,7 +155,7 @@ def measure(
     longest_s = max(omct.timing(w, sigma).duration_s for w in frequencies_radps)
     check_samples(longest_s * rate_hz * len(entries), f"--rate-hz {rate_hz:g}: {len(entries)} washout(s) x "
                   f"the longest OMCT run ({longest_s:.4g} s)")  # fmt: skip
-    _bound_estimate(entries, limits, tests, frequencies_radps, rate_hz, sigma, amplitude_scale)
+    _estimate(entries, limits, tests, frequencies_radps, rate_hz, sigma)
     model = VestibularModel(dt, vestibular)
     raw: dict[tuple[str, str], list[tuple[float, float, str, complex, float, tuple[str, ...], complex, complex]]] = {}
     shown = Progress("omct", len(tests) * len(frequencies_radps), "test points") if progress else None
@@ -165,7 +165,8 @@ def measure(
         sig = generate(spec)
         ref = omct.reference_fit(test, sig.f_mps2, sig.omega_radps, dt, w, tm.periods)
         aircraft = omct.response(test, ref, sig.f_mps2, sig.omega_radps, dt, w, tm.periods, _g(entries[0]))
-        traces = cue_trace(sig.f_mps2, sig.omega_radps, dt, entries, None, limits)
+        with cost.announced():  # (the runs' cost is announced once, above)
+            traces = cue_trace(sig.f_mps2, sig.omega_radps, dt, entries, None, limits)
         for m in entries:
             tr = traces[m.name]
             head = omct.platform_head_motion(tr.pos_m, tr.q, tr.omega_radps, m.params.head.offset_m, dt, _g(m))
@@ -186,31 +187,45 @@ def measure(
     return points, OmctSettings(rate_hz, omct.settle_time_s(sigma), sigma, amplitude_scale)
 
 
-def _bound_estimate(
-    entries: Sequence[Washout], limits: PlatformModel, tests: Sequence[omct.OmctTest],
-    frequencies_radps: Sequence[float], rate_hz: float, sigma: float, amplitude_scale: float,
-) -> None:  # fmt: skip
-    """With the oracle bound among ``entries``: its size and an estimated time on stderr before the runs (one
-    optimisation over each whole run: minutes), timed with the replay as the washout runs it on a 1,200-sample piece
-    of the first run, as sweep does."""
+def _run_cost(entry: Washout, limits: PlatformModel, dt_s: float) -> Callable[[int], cost.Estimate] | None:
+    """For a washout whose cost grows with a run's length or with its parameters (the bound; the MPC washouts), its
+    cost on a run of n samples (:mod:`washbench.io.cost`); None for the others (a few microseconds a sample)."""
+    if entry.kind == "bound":
+        return lambda n: cost.bound(n, dt_s, with_ceiling=False)  # (OMCT computes no ceiling)
+    if entry.kind not in ("mpc", "mpc-unrestricted"):
+        return None
+    p = registry.get(entry.kind).make_params(entry.params.sections.get(entry.kind), f"washout {entry.name}")
+    horizon = cost.horizon_intervals(p.horizon_steps, p.preview_s, p.prediction_step_s)
+    hexapod = platform_kind(limits) == "hexapod"
+    made = cost.mpc(entry.kind, horizon, dt_s, hexapod=hexapod)
+    step = cost.mpc_step_s(entry.kind, horizon, hexapod)
+    return lambda n: dataclasses.replace(made, seconds=made.seconds + n * step)  # made anew for each run
 
-    bounds = [e for e in entries if e.kind == "bound"]
-    if not bounds:
+
+def _estimate(
+    entries: Sequence[Washout], limits: PlatformModel, tests: Sequence[omct.OmctTest],
+    frequencies_radps: Sequence[float], rate_hz: float, sigma: float,
+) -> None:  # fmt: skip
+    """With a washout among ``entries`` whose cost grows with a run's length or its parameters (:func:`_run_cost`):
+    what all the runs will cost, from :mod:`washbench.io.cost`'s models before any run starts; refused in one line
+    when the longest run would not fit (the washouts of a run side by side, their peaks added), announced on stderr
+    when it takes long."""
+    dt = 1.0 / rate_hz
+    costly = [(e, fn) for e in entries if (fn := _run_cost(e, limits, dt)) is not None]
+    if not costly:
         return
     lengths = [round(omct.timing(w, sigma).duration_s * rate_hz) + 1 for _ in tests for w in frequencies_radps]
-    if max(lengths) > MAX_BOUND_SAMPLES:
-        raise WashbenchError(f"--rate-hz {rate_hz:g}: the OMCT's longest run has {max(lengths):,} samples, more than "
-                             f"the oracle bound's limit of {MAX_BOUND_SAMPLES:,}")  # fmt: skip
-    w0 = frequencies_radps[0]
-    sig = generate(omct.input_spec(tests[0], w0, rate_hz, omct.timing(w0, sigma).duration_s, amplitude_scale))
-    piece = min(1200, len(sig.t_s))
-    start = time.perf_counter()
-    replay(sig.f_mps2[:piece], sig.omega_radps[:piece], 1.0 / rate_hz, limits, _g(bounds[0]),
-           BoundParams())  # fmt: skip
-    per_sample = (time.perf_counter() - start) / piece
-    total = sum(lengths) * len(bounds)
-    print(f"omct: the oracle bound: {len(lengths) * len(bounds)} runs, {total:,} samples in all: about "
-          f"{per_sample * total / 60:.0f} min (timed on {piece} samples)", file=sys.stderr, flush=True)  # fmt: skip
+    longest = [fn(max(lengths)) for _, fn in costly]
+    peak = max(longest, key=lambda e: e.memory_bytes)
+    names = ", ".join(e.name for e, _ in costly)
+    est = cost.Estimate(
+        what=f"omct: washout {names}", size=f"{len(lengths)} runs, {sum(lengths):,} samples in all",
+        memory_bytes=sum(e.memory_bytes for e in longest),
+        seconds=sum(fn(n).seconds for _, fn in costly for n in lengths),
+        peak=f"the longest run, {max(lengths):,} samples: {peak.what}, {peak.peak}",
+        remedy="a lower --rate-hz, fewer washouts, or " + (peak.remedy or "smaller parameters"),
+    )  # fmt: skip
+    cost.check(est)
 
 
 def _g(entry: Washout) -> float:
@@ -314,8 +329,11 @@ def run_omct(
     """
     entries = select_washouts(washouts, variants, params_path)
     limits = load_platform_model(platform_path)
-    if washouts is None and not variants:  # the default set: those that can drive this platform
-        entries = [w for w in entries if platform_refusal(w, limits) is None]
+    if washouts is None and not variants:  # the default set: those that can drive this platform, never silently
+        kept, left_out = default_on(entries, limits)
+        entries = list(kept)
+        if left_out:
+            print(f"washbench: note: {left_out}", file=sys.stderr)
     check_platform(entries, limits)
     boundary = load_boundaries(boundaries_path) if boundaries_path is not None else None
     return run_entries(

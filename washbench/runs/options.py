@@ -12,6 +12,7 @@ files again.
 from __future__ import annotations
 
 import math
+import sys
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -21,11 +22,12 @@ from washbench.analysis.ranking import RankRule
 from washbench.cueing import registry
 from washbench.cueing.params import DEFAULT_PARAMS_PATH, WashoutParams, check_filter_start
 from washbench.cueing.variants import (
+    ALL_WASHOUTS,
     Washout,
     check_platform,
+    default_on,
     defaulted_sections,
     param_file_from_data,
-    platform_refusal,
     select_from,
 )
 from washbench.errors import WashbenchError
@@ -121,8 +123,11 @@ def load_options(
     chosen = select_from(washouts, variants, params, from_file)
     limits, resolved, platform_sha = resolve_platform(platform_path)
     platform_source = platform_path or resolved
-    if washouts is None and not variants:  # the default set: those of its washouts that can drive this platform
-        chosen = tuple(w for w in chosen if platform_refusal(w, limits) is None)
+    if (washouts is None and not variants) or ALL_WASHOUTS in (washouts or ()):
+        # the default set, or all: those of its washouts that can drive this platform, never silently (issue 52, item 8)
+        chosen, left_out = default_on(chosen, limits, "the default" if washouts is None else "all the")
+        if left_out:
+            print(f"washbench: note: {left_out}", file=sys.stderr)
     check_platform(chosen, limits)  # a washout named that cannot drive this platform: refused before anything is flown
     rule = rank_rule_from_data(params_path, data, lines, rank_by, thresholds)
     vestibular_params = model_params(vestibular)

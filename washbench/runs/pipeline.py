@@ -27,6 +27,7 @@ import dataclasses
 import functools
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -48,9 +49,10 @@ from washbench.io.budget import check_samples
 from washbench.io.lock import output_lock
 from washbench.io.motion_file import read_motion
 from washbench.io.outfolder import refuse_other_owner, result_entry
+from washbench.io.owners import announce, refuse_nested, suite_holding
 from washbench.io.provenance import flat_strings, utc_now
 from washbench.io.publish import check_replaceable
-from washbench.io.result_files import FLIGHT_FILE, RECORDING_FILE, REPORT_FILE, RUN_FILE
+from washbench.io.result_files import FLIGHT_FILE, RANKING_FILE, RECORDING_FILE, REPORT_FILE, RUN_FILE, SUITE_FILE
 from washbench.review.numbers import pct, sig
 from washbench.runs.beside import beside
 from washbench.runs.bound_stage import bound_outputs, lockstep_result, split_whole
@@ -72,6 +74,35 @@ from washbench.runs.result_folder import (
     write_run_recording,
     write_run_review,
 )
+
+
+def run_place_check(marker: dict[str, str], nested: bool = False) -> Callable[[Path], None]:
+    """What may stand where a run's result folder goes (``OUT/<aircraft>/<manoeuvre>``), checked before flying and
+    again before publishing (:mod:`washbench.io.owners`): nothing, or an earlier washbench run of the same thing
+    (``marker``; ``nested``: a JSBSim script's runs), which is replaced and said so once; never a result of a suite
+    in ``OUT`` (refused: the suite's report would describe a result that is gone). A run added beside a suite says
+    that the suite's report does not include it."""
+    said: list[bool] = []
+
+    def check(place: Path) -> None:
+        check_replaceable(place, RUN_MARKER, marker, nested)
+        suite = suite_holding(place)
+        if suite is not None:
+            raise WashbenchError(located(place, (
+                f"a result of the suite in {suite.parent} ({suite.name}): a run here would leave the suite's "
+                f"{REPORT_FILE}, {RANKING_FILE} and {suite.name} describing a result that is gone; not replaced; "
+                f"choose another --out, or run the suite again")))  # fmt: skip
+        if said:
+            return
+        said.append(True)
+        if place.exists():
+            announce(f"{place} holds an earlier run of {place.parent.name}/{place.name}: replaced when this one is "
+                     "complete (until then, and after a failure or Ctrl-C, it stays as it is)")  # fmt: skip
+        elif (place.parent.parent / SUITE_FILE).is_file():
+            announce(f"{place} is added beside the suite in {place.parent.parent}, whose report does not include "
+                     "it")  # fmt: skip
+
+    return check
 
 
 def run_manoeuvre(
@@ -98,7 +129,7 @@ def run_manoeuvre(
 
     stepped = split_whole(opts.washouts)[0]  # a whole-only washout (the bound) is cued after the flight
     # entered before flying: a folder or file in the way fails now, not after
-    with result_entry(final, lambda place: check_replaceable(place, RUN_MARKER, marker)) as folder:
+    with result_entry(final, run_place_check(marker)) as folder:
         rows, lockstep = lockstep_blocks(stepped, opts.limits, manoeuvre.dt_s, opts.filter_start)
         start = time.perf_counter()
         created = utc_now()
@@ -151,6 +182,10 @@ def write_cued_folder(
 
     motion = read_motion(folder / FLIGHT_FILE)
     result = lockstep_result(motion, rows, options)
+    if result.algorithms:  # the whole-only washouts' own statistics, beside the lockstep's, in the listed order
+        both = {**dict((extra or {}).get("algorithms") or {}), **result.algorithms}
+        order = [n for n in options.washout_order if n in both]
+        extra = {**(extra or {}), "algorithms": {n: both[n] for n in order}}
     write_results(folder, result, provenance)
     bound = bound_outputs(folder, result, options.washouts, options.limits, options.vestibular_params,
                           options.rank_rule, options.filter_start)  # fmt: skip
@@ -210,7 +245,7 @@ def run_script(script_path: Path, out_root: Path, options: RunOptions | None = N
 
     summaries = []
     # entered before flying: a folder or file in the way fails now, not after
-    with result_entry(final, lambda place: check_replaceable(place, RUN_MARKER, marker, nested=True)) as built:
+    with result_entry(final, run_place_check(marker, nested=True)) as built:
         start = time.perf_counter()
         flight = fly_script(script_path, max_time_s=max_time_s, segment_hook=segment_hook,
                             aircraft_dirs=opts.aircraft_dirs)  # fmt: skip
@@ -259,6 +294,7 @@ def run_command(manoeuvre_path: Path, out_root: Path, options: RunOptions, *, pr
     """
 
     start = time.perf_counter()
+    refuse_nested(out_root, "run")  # OUT inside other results (a suite's aircraft folder): before anything
     with output_lock(out_root) as out_dir:  # held while it runs: a second writer gets one line at once
         refuse_other_owner(out_dir, "run")  # a folder of fly, cue ... results is not mixed with runs
         if is_script(manoeuvre_path):

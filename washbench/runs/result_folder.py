@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import csv
 import io
-import json
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -39,6 +38,7 @@ from washbench.io.atomic import write_text_atomic
 from washbench.io.csv_numbers import csv_number
 from washbench.io.metrics_csv import MetricRow
 from washbench.io.publish import read_marker, result_path
+from washbench.io.readback import json_text
 from washbench.io.result_files import RANKING_FILE, RUN_FILE
 from washbench.platform.limits import wheel_jacobian
 from washbench.review.metrics_table import metrics_table_markdown
@@ -119,7 +119,7 @@ def write_run_json(path: Path, s: RunSummary, wall_s: float, extra: dict[str, ob
         "saturations": s.saturations,
     }
     doc |= extra or {}
-    write_text_atomic(path, json.dumps(doc, indent=2) + "\n")
+    write_text_atomic(path, json_text(doc))  # (a value that is not finite: null, as the reader reads it)
 
 
 def write_run_recording(

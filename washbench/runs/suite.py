@@ -53,27 +53,25 @@ from washbench.analysis.ranking import (
     rule_from_record,
 )
 from washbench.cueing import registry
-from washbench.errors import WashbenchError, located, printable
+from washbench.errors import Terminated, WashbenchError, printable
 from washbench.flight.scripts import bundled_script, is_script
+from washbench.io import interrupts
 from washbench.io.atomic import write_text_atomic
 from washbench.io.cpus import usable_cpus
 from washbench.io.csv_numbers import csv_number
 from washbench.io.lock import output_lock
 from washbench.io.metrics_csv import METRICS_COLUMNS, METRICS_TEXT_COLUMNS
-from washbench.io.outfolder import recover, recover_shared, refuse_other_owner, staged
+from washbench.io.outfolder import recover, recover_shared, staged
+from washbench.io.owners import announce, refuse_nested
 from washbench.io.progress import Progress
 from washbench.io.provenance import utc_now
-from washbench.io.publish import is_washbench_result, read_marker
+from washbench.io.publish import read_marker
 from washbench.io.result_files import (
     COMPARISON_FILE,
     METRICS_FILE,
     RANKING_FILE,
     REPORT_FILE,
     STAGE_PREFIX,
-    SUITE_FILE,
-    SUITE_FILES,
-    is_own_hidden,
-    publication_pid,
 )
 from washbench.review.suite_report import write_suite_json, write_suite_report
 from washbench.runs.cluster import dask_map
@@ -81,10 +79,8 @@ from washbench.runs.inputs import check_unique_names, find_manoeuvres
 from washbench.runs.options import RunOptions, load_options
 from washbench.runs.pipeline import announce_script, run_manoeuvre, run_script
 from washbench.runs.pool import start_server, submit_all, worker_pool
-from washbench.runs.result_folder import RUN_MARKER, RunSummary, csv_text, ranking_table
-
-#: The file that marks a folder as a suite's (it lists everything a suite wrote at the top level).
-SUITE_MARKER = SUITE_FILE
+from washbench.runs.result_folder import RunSummary, csv_text, ranking_table
+from washbench.runs.suite_place import SUITE_MARKER, previous_results, replacing
 
 
 @dataclass
@@ -128,12 +124,14 @@ def run_suite(
     progress: bool = True,
     dask: str | None = None,
     pool: ProcessPoolExecutor | None = None,
+    finished: list[Outcome] | None = None,
 ) -> list[Outcome]:
     """Run every file in parallel processes (or on the Dask cluster at ``dask``); outcomes in the order of ``files``
     (a JSBSim script that resets gives one outcome per run segment, in order). ``options``: the runs' options
     (:func:`washbench.runs.options.load_options`, handed to each worker as they are; None: the defaults).
     ``pool``: the worker processes to run them in (:func:`suite_pool`, kept for the report); None: a pool of
-    ``jobs`` started here and stopped on return.
+    ``jobs`` started here and stopped on return. ``finished``: a list the outcomes are appended to as they come
+    (what an interruption leaves to count).
 
     On any exception (KeyboardInterrupt and :class:`washbench.errors.Terminated` included) the local workers are
     stopped before it propagates, so no worker writes anything afterwards (a ``pool`` passed in: by the
@@ -150,17 +148,23 @@ def run_suite(
         loading = ", ".join(["JSBSim", *(["matplotlib"] if opts.outputs.figures else []),
                              *(["rerun"] if opts.outputs.recording else [])])  # fmt: skip
         print(
-            f"suite: {len(files)} manoeuvres on {jobs} process{'es' if jobs > 1 else ''} -> {_destination(out_dir)}\n"
+            f"suite: {len(files)} manoeuvre{'s' if len(files) != 1 else ''} on {jobs} "
+            f"process{'es' if jobs > 1 else ''} -> {_destination(out_dir)}\n"
             f"suite: loading {loading} and the compiled kernels",
             file=sys.stderr,
         )
+
+    def arrived(path: str, runs: list[Outcome], timed: bool = True) -> None:
+        outcomes[path] = runs  # counted before its line: a signal after the line finds it counted
+        _report(runs, len(outcomes), len(files), start, shown, timed=timed)
+
     try:
         if dask:
             for runs in dask_map(dask, _run_one, args):
-                outcomes[runs[0].path] = _report(runs, len(outcomes) + 1, len(files), start, shown, timed=False)
+                arrived(runs[0].path, runs, timed=False)
         elif jobs == 1:
             for a in args:
-                outcomes[a[0]] = _report(_run_one(*a), len(outcomes) + 1, len(files), start, shown)
+                arrived(a[0], _run_one(*a))
         else:
             with contextlib.ExitStack() as own:
                 if pool is None:
@@ -173,10 +177,10 @@ def run_suite(
                     except BrokenProcessPool:
                         lost.append(futures[fut])
                         continue
-                    outcomes[runs[0].path] = _report(runs, len(outcomes) + 1, len(files), start, shown)
+                    arrived(runs[0].path, runs)
                 for a in sorted(lost, key=args.index):  # each alone: the one whose worker dies again is the one
                     runs = _run_alone(a, opts)  # a fresh worker's start in its time: not a run's
-                    outcomes[a[0]] = _report(runs, len(outcomes) + 1, len(files), start, shown, timed=False)
+                    arrived(a[0], runs, timed=False)
                 if lost:  # what the dead workers were publishing (OUT/<aircraft>/.washbench-stage-PID)
                     for entry in sorted(out_dir.iterdir()):
                         if entry.is_dir() and not entry.is_symlink():
@@ -184,6 +188,8 @@ def run_suite(
     finally:
         if shown is not None:
             shown.close()
+        if finished is not None:
+            finished.extend(o for runs in outcomes.values() for o in runs)
     return [o for a in args for o in outcomes[a[0]]]
 
 
@@ -347,44 +353,6 @@ def write_suite_results(
     write_suite_json(out_dir / SUITE_MARKER, entries, dict(provenance or {}), created, top)
 
 
-def _is_run_folder(entry: Path, aircraft: str) -> bool:
-    """A ``run`` result of this aircraft (a JSBSim script that resets: a folder of such results)."""
-    return is_washbench_result(entry, RUN_MARKER, {"aircraft": aircraft}, nested=True)
-
-
-def previous_results(out_dir: Path) -> list[Path]:
-    """The entries of ``out_dir`` a new suite replaces: a previous suite's files and run result folders.
-
-    Raises WashbenchError naming the first entry washbench did not write (the suite then does not start).
-    """
-    refuse_other_owner(out_dir, "suite")
-    marker = read_marker(out_dir, SUITE_MARKER) or {}
-    listed = marker.get("entries", []) if marker.get("washbench") == "suite" else []
-    listed = {n for n in listed if isinstance(n, str) and "/" not in n and n not in ("", ".", "..")}
-    found: list[Path] = []
-    for entry in sorted(out_dir.iterdir()):
-        name = entry.name
-        if is_own_hidden(name):
-            continue
-        if entry.is_symlink():  # never followed, never replaced (nor anything deleted through it)
-            raise WashbenchError(located(entry, "is a symbolic link: washbench never follows or replaces a link in "
-                                         "its output folder; remove it or choose another --out"))  # fmt: skip
-        if name in SUITE_FILES or name == SUITE_MARKER or name in listed:
-            found.append(entry)
-            continue
-        if entry.is_dir():
-            subs = [e for e in entry.iterdir() if publication_pid(e.name) is None]
-            if subs and all(_is_run_folder(e, name) for e in subs):  # an empty folder is the user's
-                found.append(entry)
-                continue
-            entry = next((e for e in subs if not _is_run_folder(e, name)), entry)
-        raise WashbenchError(
-            located(entry, "washbench did not write this: a suite replaces only a previous washbench result as a "
-                    "whole; choose an empty or new --out folder")
-        )  # fmt: skip
-    return found
-
-
 def suite_command(
     inputs: Sequence[Path],
     out_dir: Path,
@@ -415,6 +383,7 @@ def suite_command(
         if is_script(f):
             announce_script(f, options)
     start = time.perf_counter()
+    refuse_nested(out_dir, "suite")  # not inside other results (a suite's results/c172p): before anything
     with output_lock(out_dir):
         # under the lock every leftover is stale; a publication cut by a kill is finished. In a folder that holds
         # no suite (no suite.json), only washbench's own leftovers: a hidden file there is the user's.
@@ -423,16 +392,27 @@ def suite_command(
         for entry in previous:  # what runs killed while publishing into OUT/<aircraft>/ left (all stale here)
             if entry.is_dir() and not entry.is_symlink():
                 recover_shared(entry, only_dead=False)
+        if previous:  # replacing is never silent (io.owners)
+            announce(replacing(out_dir, previous, len(files)))
         # the local workers, idle after the runs, draw the suite's figures too
         workers = suite_pool(options, n_jobs) if local_pool else contextlib.nullcontext()
+        finished: list[Outcome] = []
         # swapped in whole (journalled, signals held), or not at all
-        with staged(out_dir, previous) as stage, workers as pool:
-            outcomes = run_suite(files, stage, options, jobs=n_jobs, progress=progress, dask=dask, pool=pool)
-            for o in outcomes:  # a failure names the files where they were going, not the hidden stage
-                if not o.run.ok and str(stage) in o.run.reason:
-                    o.run = dataclasses.replace(o.run, reason=o.run.reason.replace(str(stage), str(out_dir)))
-            figure_pool = None if pool_broken(pool) else pool  # a worker died: the figures are drawn here
-            write_suite_results(outcomes, stage, dict(options.provenance), options.outputs.figures, figure_pool)
+        try:
+            with staged(out_dir, previous) as stage, workers as pool:
+                outcomes = run_suite(files, stage, options, jobs=n_jobs, progress=progress, dask=dask, pool=pool,
+                                     finished=finished)  # fmt: skip
+                for o in outcomes:  # a failure names the files where they were going, not the hidden stage
+                    if not o.run.ok and str(stage) in o.run.reason:
+                        o.run = dataclasses.replace(o.run, reason=o.run.reason.replace(str(stage), str(out_dir)))
+                figure_pool = None if pool_broken(pool) else pool  # a worker died: the figures are drawn here
+                write_suite_results(outcomes, stage, dict(options.provenance), options.outputs.figures, figure_pool)
+        except (KeyboardInterrupt, Terminated) as exc:  # what was lost, on the command's last line
+            done = len({o.path for o in finished})
+            kept = "its earlier results stay as they were" if previous else "nothing was left there"
+            interrupts.explain(exc, f"{done} of {len(files)} manoeuvres had finished; their runs are discarded and "
+                               f"nothing was written to {out_dir} ({kept})")  # fmt: skip
+            raise
     n_ok = sum(o.run.ok for o in outcomes)
     report = printable(str(out_dir / REPORT_FILE))
     print(f"suite: {n_ok}/{len(outcomes)} runs ok in {time.perf_counter() - start:.1f} s; report: {report}")

@@ -8,7 +8,11 @@ perception, metrics and score are recomputed, in one compiled call per flight. W
   (time at any platform limit);
 - ``DIR/sweep_metrics.csv``: the same rows times DOF with ``npc,integral_error,max_error`` (units of metrics.csv);
 - ``DIR/sweep.png``: the mean score over the manoeuvres against each swept key, one line per washout;
-- ``DIR/flights/``: the flights flown (reusable with ``--from DIR/flights``).
+- ``DIR/flights/``: the flights flown (reusable with ``--from DIR/flights``);
+- with ``--pilot TASK``, ``DIR/sweep_pilot.csv``: one row per grid point and washout: the swept keys,
+  ``washout``, and the pilot model's measures on the tracking task as its adaptation predicts them
+  (:mod:`washbench.pilot.surrogate`: error and control variances, crossovers and phase margins, its parameters,
+  the motion filter's gain at 1 rad/s, ``distance_pct`` from flight).
 """
 
 from __future__ import annotations
@@ -20,14 +24,26 @@ import sys
 import time
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
-from washbench.analysis.sweep import SweepRow, grid, parse_set, point_washouts, sweep_csv, sweep_metrics_csv
+from washbench.analysis.sweep import (
+    SweepRow,
+    format_value,
+    grid,
+    parse_set,
+    point_washouts,
+    sweep_csv,
+    sweep_metrics_csv,
+)
 from washbench.cueing.params import WASHOUT_NAMES
 from washbench.cueing.variants import Washout, check_platform, load_param_file
 from washbench.errors import WashbenchError, printable
 from washbench.io.atomic import write_text_atomic
+from washbench.io.csv_numbers import csv_number
 from washbench.io.outfolder import result_set
 from washbench.io.progress import Progress
+from washbench.pilot.surrogate import PREDICTED, PilotObjective
+from washbench.pilot.task import load_task
 from washbench.platform.model import load_platform_model
 from washbench.review.study_figures import sweep_figure
 from washbench.runs.inputs import find_manoeuvres
@@ -84,6 +100,23 @@ def say_estimate(flights: Sequence[StudyFlight], candidates: Sequence[Washout], 
     return estimate
 
 
+def pilot_rows(task: Path, keys: Sequence[str], points: Sequence[Any], kinds: Sequence[str],
+               candidates: Sequence[Washout], limits: Any, aircraft_dirs: Sequence[Path],
+               progress: bool) -> list[list[str]]:  # fmt: skip
+    """``sweep_pilot.csv``'s rows: the pilot model's predicted measures of every candidate on ``task``."""
+    if progress:
+        print(f"sweep: the pilot model on {task}: calibrating and flying the aircraft condition", file=sys.stderr,
+              flush=True)  # fmt: skip
+    objective = PilotObjective.prepare(task, aircraft_dirs)
+    rows = [[*keys, "washout", *PREDICTED]]
+    for i, c in enumerate(candidates):
+        m = objective.measures(c, limits)
+        point = points[i % len(points)]
+        rows.append([*(format_value(point[k]) for k in keys), kinds[i // len(points)],
+                     *(csv_number(m[k]) for k in PREDICTED)])  # fmt: skip
+    return rows
+
+
 def _duration(seconds: float) -> str:
     if seconds < 120:
         return f"{seconds:.0f} s"
@@ -106,6 +139,7 @@ def sweep_command(
     progress: bool = True,
     aircraft_dirs: Sequence[Path] = (),
     force: bool = False,
+    pilot: Path | None = None,
 ) -> int:
     """CLI entry of ``washbench sweep``; 0 when every flight ran and passed its checks, 1 otherwise.
 
@@ -124,6 +158,8 @@ def sweep_command(
     candidates = [w for k in kinds for w in point_washouts(k, base, points)]
     limits = load_platform_model(platform_path)
     check_platform(candidates, limits)
+    if pilot is not None:
+        load_task(pilot, aircraft_dirs)  # a bad task file fails before anything is flown
     with result_set(out_dir, "sweep") as stage:  # the whole set replaces the previous one at once
         flights = load_flights(files, stage, limits, from_dir=from_dir, jobs=jobs, dask=dask, progress=progress,
             aircraft_dirs=aircraft_dirs,
@@ -149,6 +185,9 @@ def sweep_command(
         write_text_atomic(stage / "sweep_metrics.csv", _csv(sweep_metrics_csv(keys, rows)))
 
         sweep_figure(stage / "sweep.png", keys, rows)
+        if pilot is not None:
+            table = pilot_rows(pilot, keys, points, kinds, candidates, limits, aircraft_dirs, progress)
+            write_text_atomic(stage / "sweep_pilot.csv", _csv(table))
     out_dir = Path(out_dir)
     n_eval = len(candidates) * len(flights)
     steps = sum(f.evaluator.n for f in flights) * len(candidates)
@@ -156,6 +195,7 @@ def sweep_command(
         f"sweep: {len(points)} grid point(s) x {len(kinds)} washout(s) x {len(flights)} flight(s) = {n_eval} "
         f"evaluations ({steps / max(t_eval, 1e-9) / 1e6:.2f} M steps/s) in {time.perf_counter() - start:.1f} s; "
         f"wrote {printable(str(out_dir / 'sweep.csv'))}, sweep_metrics.csv, sweep.png"
+        + (", sweep_pilot.csv" if pilot is not None else "")
     )
     failed = [f for f in flights if not f.ok]
     for f in failed:

@@ -10,12 +10,18 @@ batch member of one compiled call per flight. Writes, each atomically:
   over the training flights), ``saturated_s`` (summed over them), ``objective``;
 - ``DIR/report.md`` and ``DIR/convergence.png``: the base set (e.g. CW1) against the tuned set on the training and
   the test manoeuvres.
+
+With ``--pilot TASK`` the objective adds ``pilot_weight x D / 100``: the distance from flight of the pilot model's
+measures on the tracking task (:mod:`washbench.pilot.surrogate`, predicted by its adaptation, no flight per
+evaluation; an unstable loop counts as infinitely far); ``tune.csv`` gains a column ``pilot_distance_pct`` and the
+report the distance of the starting and the tuned set.
 """
 
 from __future__ import annotations
 
 import csv
 import io
+import sys
 import time
 from collections.abc import Sequence
 from datetime import UTC, datetime
@@ -26,7 +32,7 @@ import numpy as np
 import yaml
 
 from washbench.analysis.sweep import format_value
-from washbench.analysis.tune import Bound, minimise, parse_tune
+from washbench.analysis.tune import EDGE_FRACTION, Bound, at_edges, minimise, parse_tune
 from washbench.cueing import registry
 from washbench.cueing.params import WashoutParams
 from washbench.cueing.variants import (
@@ -38,11 +44,14 @@ from washbench.cueing.variants import (
     value_of,
 )
 from washbench.errors import WashbenchError, printable
+from washbench.io import cost
 from washbench.io.atomic import write_text_atomic
 from washbench.io.csv_numbers import csv_number
 from washbench.io.outfolder import result_set
-from washbench.io.progress import Progress
+from washbench.io.progress import Progress, duration_text
 from washbench.io.result_files import REPORT_FILE
+from washbench.pilot.surrogate import PilotObjective
+from washbench.pilot.task import load_task
 from washbench.platform.model import load_platform_model
 from washbench.review.study_figures import convergence_figure
 from washbench.runs.inputs import find_manoeuvres
@@ -81,6 +90,8 @@ def tune_command(
     dask: str | None = None,
     progress: bool = True,
     aircraft_dirs: Sequence[Path] = (),
+    pilot: Path | None = None,
+    pilot_weight: float = 1.0,
 ) -> int:
     """CLI entry of ``washbench tune``; 0 on success (the flights' own check results are reported, not fatal)."""
     start = time.perf_counter()
@@ -89,6 +100,10 @@ def tune_command(
         raise WashbenchError("tune: give at least one --tune KEY=LOW:HIGH")
     if not (saturation_weight >= 0.0 and np.isfinite(saturation_weight)):
         raise WashbenchError(f"--saturation-weight: expected a number >= 0, got {saturation_weight}")
+    if not (pilot_weight >= 0.0 and np.isfinite(pilot_weight)):
+        raise WashbenchError(f"--pilot-weight: expected a number >= 0, got {pilot_weight}")
+    if pilot is not None:
+        load_task(pilot, aircraft_dirs)  # a bad task file fails before anything is flown
     if budget < 6:
         raise WashbenchError(f"--budget: expected at least 6 evaluations (1 for the starting set), got {budget}")
     if not 0 <= seed < 2**32:
@@ -112,9 +127,15 @@ def tune_command(
     train_files = find_manoeuvres(manoeuvres)
     test_files = [p for p in (find_manoeuvres(test) if test else []) if p not in train_files]
     with result_set(out_dir, "tune") as stage:  # the whole set replaces the previous one at once
+        objective = None
+        if pilot is not None:
+            if progress:
+                print(f"tune: the pilot model on {pilot}: calibrating and flying the aircraft condition",
+                      file=sys.stderr, flush=True)  # fmt: skip
+            objective = (PilotObjective.prepare(pilot, aircraft_dirs), pilot_weight)
         best_x, best, base_obj, train, table = _tune(
             stage, base, kind, bounds, keys, train_files, test_files, limits, budget, seed, saturation_weight,
-            manoeuvres, from_dir, jobs, dask, progress, aircraft_dirs,
+            manoeuvres, from_dir, jobs, dask, progress, aircraft_dirs, objective,
         )  # fmt: skip
     print(
         f"tune: {kind}, {best[4]} evaluations on {len(train)} training flight(s) in "
@@ -124,14 +145,27 @@ def tune_command(
     )
     for line in score_lines(base.name, table):
         print(line)
+    for line in at_edges(bounds, best_x):  # the optimum may lie beyond what was searched: say so
+        print(f"tune: note: {line}: the best may lie outside it; widen --tune {line.split(' ')[0]}=LOW:HIGH")
     return 0
+
+
+def _announce(each_s: float, left: int, train: Sequence[Any]) -> None:
+    """Before the optimiser's evaluations, when they take long (:data:`washbench.io.cost.LONG_S`): how many, on how
+    much flight, and at most how long at the starting set's time each (a population is evaluated at once, on the
+    processes of ``--jobs``: less)."""
+    if each_s * left > cost.LONG_S:
+        samples = sum(f.evaluator.n for f in train)
+        cost.note(f"tune: {left} more evaluation(s) on {len(train)} training flight(s) ({samples:,} samples): at most "
+                  f"about {duration_text(each_s * left)} at the starting set's {each_s:.2g} s each (a population "
+                  "at once on the --jobs processes takes less; a smaller --budget, fewer or shorter flights, less)")
 
 
 def _tune(
     out_dir: Path, base: Any, kind: str, bounds: list[Any], keys: list[str], train_files: list[Path],
     test_files: list[Path], limits: Any, budget: int, seed: int, saturation_weight: float,
     manoeuvres: Sequence[Path], from_dir: Path | None, jobs: int | None, dask: str | None, progress: bool,
-    aircraft_dirs: Sequence[Path],
+    aircraft_dirs: Sequence[Path], pilot: tuple[PilotObjective, float] | None = None,
 ) -> tuple[Any, ...]:  # fmt: skip
     """Fly, tune and write into ``out_dir`` (the stage); (best_x, best history row + count, base objective, ...)."""
     flights = load_flights(
@@ -152,6 +186,7 @@ def _tune(
         return Washout(kind, kind, apply_overrides(base, point, "--tune"), registry.plugin_spec(kind))
 
     history: list[tuple[np.ndarray, float, float, float]] = []
+    pilot_distance: list[float] = []  # with --pilot: per evaluation, in the history's order
     shown = Progress("tune", budget, "evaluations") if progress else None
 
     def objective(xs: np.ndarray) -> np.ndarray:
@@ -160,6 +195,10 @@ def _tune(
         sat = np.sum([r.saturated_s for r in results], axis=0)
         frac = np.mean([r.saturated_s / d for r, d in zip(results, durations, strict=True)], axis=0)
         obj = score + saturation_weight * frac
+        if pilot is not None:
+            d = np.array([pilot[0].measures(candidate(x), limits)["distance_pct"] for x in xs])
+            pilot_distance.extend(float(v) for v in d)
+            obj = obj + pilot[1] * d / 100.0
         history.extend((x.copy(), float(s), float(t), float(o)) for x, s, t, o in zip(xs, score, sat, obj, strict=True))
         if shown is not None:
             shown.update(len(history), f"best objective {min(h[3] for h in history):.4f}")
@@ -167,7 +206,9 @@ def _tune(
 
     x0 = np.array([_value(base, k) for k in keys])
     try:
+        t0 = time.perf_counter()
         [base_obj] = objective(x0[None, :])  # evaluation 0: the starting set
+        _announce(time.perf_counter() - t0, budget - 1, train)
         best_x = minimise(objective, bounds, budget - 1, seed, x0)
     finally:
         if shown is not None:
@@ -175,7 +216,8 @@ def _tune(
     tuned = candidate(best_x).params
     label = f"{base.name} tuned for {kind}"
     tuned = tuned.model_copy(update={"name": label})
-    _write(out_dir, base, tuned, kind, bounds, history, budget, seed, saturation_weight, manoeuvres, base_obj)
+    _write(out_dir, base, tuned, kind, bounds, history, budget, seed, saturation_weight, manoeuvres, base_obj,
+           pilot_distance)  # fmt: skip
 
     spec = registry.plugin_spec(kind)
     both = [Washout(base.name, kind, base, spec), Washout("tuned", kind, tuned, spec)]
@@ -183,9 +225,24 @@ def _tune(
     for group, fl in (("training", train), ("test", tests)):
         for f, r in zip(fl, evaluate(fl, both, dask) if fl else [], strict=True):
             table.append((group, f.aircraft, f.manoeuvre, r))
-    _report(out_dir, base, tuned, kind, bounds, best_x, table, history, base_obj, budget, seed, saturation_weight)
+    _report(out_dir, base, tuned, kind, bounds, best_x, table, history, base_obj, budget, seed, saturation_weight,
+            _pilot_note(pilot, pilot_distance, history))  # fmt: skip
     best = (*min(history, key=lambda h: h[3]), len(history))
     return best_x, best, base_obj, train, table
+
+
+def _pilot_note(pilot: tuple[PilotObjective, float] | None, distances: list[float], history: list) -> list[str]:
+    """The report's lines on the pilot objective (none without ``--pilot``)."""
+    if pilot is None or not distances:
+        return []
+    best = min(range(len(history)), key=lambda i: history[i][3])
+    return [
+        f"Pilot objective: {pilot[1]:g} x the distance from flight (%) / 100 of the pilot model's measures on "
+        f"the tracking task {pilot[0].label} ({pilot[0].task_path}), as its adaptation predicts them "
+        "(washbench/pilot/surrogate.py; docs/pilot-model.md).",
+        f"Distance from flight: starting set {distances[0]:.3g} %, tuned set {distances[best]:.3g} %.",
+        "",
+    ]
 
 
 def score_lines(base_name: str, table: list) -> list[str]:
@@ -229,6 +286,7 @@ def _write(
     weight: float,
     manoeuvres: Sequence[Path],
     base_obj: float,
+    pilot_distance: Sequence[float] = (),
 ) -> None:
     keys = [b.key for b in bounds]
     header = (
@@ -241,9 +299,10 @@ def _write(
     )
     out_dir.mkdir(parents=True, exist_ok=True)
     write_text_atomic(out_dir / "tuned.yaml", params_yaml(tuned, header))
-    rows = [["index", *keys, "score", "saturated_s", "objective"]]
+    rows = [["index", *keys, "score", "saturated_s", "objective", *(["pilot_distance_pct"] if pilot_distance else [])]]
     for i, (x, s, t, o) in enumerate(history):
-        rows.append([str(i), *(csv_number(float(v)) for v in x), csv_number(s), csv_number(t), csv_number(o)])
+        extra = [csv_number(pilot_distance[i])] if pilot_distance else []
+        rows.append([str(i), *(csv_number(float(v)) for v in x), csv_number(s), csv_number(t), csv_number(o), *extra])
     buf = io.StringIO()
     csv.writer(buf, lineterminator="\n").writerows(rows)
     write_text_atomic(out_dir / "tune.csv", buf.getvalue())
@@ -262,6 +321,7 @@ def _report(
     budget: int,
     seed: int,
     weight: float,
+    pilot_lines: Sequence[str] = (),
 ) -> None:
 
     objective = np.array([h[3] for h in history])
@@ -274,11 +334,16 @@ def _report(
         "limit (a penalty: see washbench/analysis/tune.py). Score: the ranking rule (lower is better, 1 = no better",
         "than a simulator that stands still). Saturation: seconds at any platform limit.",
         "",
+        *pilot_lines,
         "| key | bounds | " + base.name + " | tuned |",
         "|---|---|---|---|",
     ]
     for b, x in zip(bounds, best_x, strict=True):
         lines.append(f"| `{b.key}` | {b.low:g} .. {b.high:g} | {_value(base, b.key):.6g} | {x:.6g} |")
+    edges = at_edges(bounds, best_x)
+    if edges:
+        lines += ["", f"**At an end of its interval** (within {100 * EDGE_FRACTION:g} % of its width): "
+                  + "; ".join(edges) + ". The best may lie outside the interval searched: widen it and tune again."]
     lines += [
         "",
         f"| set | aircraft | manoeuvre | score {base.name} | score tuned | saturated s {base.name} "

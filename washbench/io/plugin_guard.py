@@ -1,28 +1,33 @@
-"""One guard around every call into a user's washout plugin: whatever it raises becomes one line.
+"""One guard around every call into a user's plugin (a washout, a platform): whatever it raises becomes one line.
 
 A plugin is any Python code: besides exceptions it can call ``sys.exit()``, raise ``KeyboardInterrupt`` with no
 Ctrl-C pressed, return objects whose ``__float__``, ``__bool__``, ``__len__`` or ``__iter__`` raise (so converting
 the result raises too). :func:`plugin_call` runs the call *and the conversion of its result* and turns any
-:class:`BaseException` into a :class:`washbench.errors.WashbenchError` naming the washout and the call, except a
+:class:`BaseException` into a :class:`washbench.errors.WashbenchError` naming the plugin and the call, except a
 real SIGINT or SIGTERM (one this process's handlers received while the call ran,
-:func:`washbench.io.interrupts.received`): that one stops the command as a signal does.
+:func:`washbench.io.interrupts.received`): that one stops the command as a signal does. What a plugin is given to
+read it gets as read-only copies (:func:`read_only`).
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import TypeVar
+from typing import TYPE_CHECKING, TypeVar
 
 from washbench.errors import Terminated, WashbenchError
 from washbench.io import interrupts
 
+if TYPE_CHECKING:
+    import numpy as np
+
 R = TypeVar("R")
 
 
-def plugin_call(where: str, fn: Callable[[], R], passing: tuple[type[BaseException], ...] = ()) -> R:
+def plugin_call(where: str, fn: Callable[[], R], passing: tuple[type[BaseException], ...] = (),
+                what: str = "a washout") -> R:  # fmt: skip
     """``fn()`` (a plugin's call and the conversion of what it returned) with any BaseException as one line
     ``WHERE: raised TYPE: message`` (WashbenchError); a WashbenchError, one of ``passing`` (handled by the caller)
-    and a real signal pass unchanged."""
+    and a real signal pass unchanged. ``what``: the kind of plugin, for ``sys.exit()`` (``a platform``)."""
     seen = interrupts.received()
     try:
         return fn()
@@ -32,22 +37,22 @@ def plugin_call(where: str, fn: Callable[[], R], passing: tuple[type[BaseExcepti
         signalled = isinstance(exc, KeyboardInterrupt | Terminated) and interrupts.received() != seen
         if signalled or isinstance(exc, passing):
             raise  # the caller's to handle, or a real Ctrl-C or SIGTERM that arrived meanwhile
-        raise plugin_error(where, exc) from None
+        raise plugin_error(where, exc, what) from None
 
 
-def plugin_error(where: str, exc: BaseException) -> WashbenchError:
+def plugin_error(where: str, exc: BaseException, what: str = "a washout") -> WashbenchError:
     """The one line for ``exc`` raised by a plugin (not a signal): ``WHERE: raised TYPE: message``; ``sys.exit()``
     and a KeyboardInterrupt said as what they are."""
     if isinstance(exc, SystemExit):
-        code = _text(exc) if isinstance(exc.code, str | int | None) else "..."
-        return WashbenchError(f"{where}: called sys.exit({code}) (a washout may not end the command)")
+        code = exception_text(exc) if isinstance(exc.code, str | int | None) else "..."
+        return WashbenchError(f"{where}: called sys.exit({code}) ({what} may not end the command)")
     if isinstance(exc, KeyboardInterrupt | Terminated):
         return WashbenchError(f"{where}: raised {type(exc).__name__} (no signal was received)")
-    text = _text(exc)
+    text = exception_text(exc)
     return WashbenchError(f"{where}: raised {type(exc).__name__}" + (f": {text}" if text else ""))
 
 
-def _text(exc: BaseException) -> str:
+def exception_text(exc: BaseException) -> str:
     """``str(exc)`` on one line; a ``__str__`` that raises too gives ``""``."""
     try:
         return " ".join(str(exc).split())
@@ -55,4 +60,15 @@ def _text(exc: BaseException) -> str:
         return ""
 
 
-__all__ = ["plugin_call", "plugin_error"]
+def read_only(a: object) -> np.ndarray:
+    """A read-only float64 copy of ``a`` for a plugin: a view could be made writeable again (its base is the bench's
+    array) and written into, changing what the other washouts, the recorded set points and the metrics see; a copy
+    cannot."""
+    import numpy as np  # (numpy only where a plugin is run: the guard is loaded with the plugin registries)
+
+    v = np.array(a, dtype=np.float64, order="C")
+    v.flags.writeable = False
+    return v
+
+
+__all__ = ["exception_text", "plugin_call", "plugin_error", "read_only"]
