@@ -15,7 +15,7 @@ from scipy import signal
 from scipy.spatial.transform import Rotation
 from test_mpc import STRESS, _check_limits, _far_limits, _run
 
-from washbench.analysis.felt import DEFAULT_MEASURE, false_part, jolt
+from washbench.analysis.felt import DEFAULT_MEASURE, felt_errors, jolt
 from washbench.analysis.signals import SignalSpec, generate
 from washbench.cueing.algorithm import WashoutAlgorithm, WashoutContext
 from washbench.cueing.condensed import blocking_matrix, default_blocks, siso_prediction
@@ -135,8 +135,9 @@ def _felt_part(w: MpcUnrestrictedWashout, nodes: np.ndarray, a0: np.ndarray, f_a
     end of each move), the perceived error beyond the threshold and the false part against the aircraft pilot's
     start, each node standing for its move's duration; the jolt of the first move; plus the slacks' small
     quadratic (``slack_regularisation``) at the slacks' optimal values (a false-part slack that costs nothing is
-    left free: 0). ``nodes`` (K, 12): perceived error (force,
-    rate; SI), then the aircraft pilot's perceived motion (SI)."""
+    left free: 0). ``nodes`` (K, 12): perceived error (force, rate; SI), then the aircraft pilot's perceived motion
+    (SI). Each node's terms are the ranking's integrals over two samples, the aircraft pilot's start (where the
+    simulator pilot feels the same) and the node, 2 w_k apart: the trapezoid rule gives w_k times the node's value."""
     p = w.params
     to_dof = np.array([1.0, 1.0, 1.0, *(3 * [180.0 / math.pi])])  # the measure's units: m/s^2, deg/s
     err = nodes[:, :6] * to_dof
@@ -145,8 +146,12 @@ def _felt_part(w: MpcUnrestrictedWashout, nodes: np.ndarray, a0: np.ndarray, f_a
     band = DEFAULT_MEASURE.bands()
     seconds = w.tp * np.array(w.blocks)
     t = np.maximum(np.abs(err) - band, 0.0) / band
-    false = false_part(x, y, band)[1:] / band
-    cost = p.felt_weight * float(seconds @ (t + p.false_weight * false).sum(axis=1))
+    cost = 0.0
+    for k, wk in enumerate(seconds):
+        two = [0, k + 1]
+        rad = np.array([1.0, 1.0, 1.0, *(3 * [math.pi / 180.0])])  # felt_errors takes rates in rad/s
+        e_k, f_k = felt_errors(x[two, :3], x[two, 3:] * rad[3:], y[two, :3], y[two, 3:] * rad[3:], 2.0 * wk)
+        cost += p.felt_weight * float(np.sum((e_k + p.false_weight * f_k) / band))
     v = (y - x[:1])[1:] / band
     cue = (x - x[:1])[1:] / band  # the aircraft pilot's cue: a false-part slack that costs nothing is left free (0)
     slacks = [t, np.where(cue > 1.0, 0.0, np.maximum(v - 1.0, 0.0)),
@@ -437,8 +442,13 @@ def test_after_a_sway_doublet_it_returns_to_level_and_gives_no_false_cue(limits,
     y = model.perceive(f, om)
     cols = lambda p: np.column_stack([p.f_mps2, np.degrees(p.omega_radps)])  # noqa: E731
     band = DEFAULT_MEASURE.bands()
-    false = false_part(cols(x), cols(y), band)
-    assert false[after].max() == 0.0, false[after].max(axis=0)
+    # the ranking's false part over what follows, against the aircraft pilot's start (prepended: the simulator pilot
+    # is taken to feel the same there, so it adds nothing)
+    x_after = np.vstack([cols(x)[:1], cols(x)[after]])
+    y_after = np.vstack([cols(x)[:1], cols(y)[after]])
+    rad = np.radians
+    _, false = felt_errors(x_after[:, :3], rad(x_after[:, 3:]), y_after[:, :3], rad(y_after[:, 3:]), dt)
+    assert np.all(false == 0.0), false
     last = t >= t[-1] - 5.0
     assert np.all(np.abs(cols(y) - cols(x))[last] < band)
 
