@@ -1,5 +1,5 @@
-"""Ships the repository's top-level ``aircraft/``, ``manoeuvres/`` and ``tasks/`` inside the wheel, and compiles the numba
-kernels into it.
+"""Ships the repository's top-level ``aircraft/``, ``manoeuvres/`` and ``tasks/`` inside the wheel, and compiles the
+numba kernels into it.
 
 - The data folders live beside ``washbench/`` in the source tree (where a user looks for them) and are copied into
   ``washbench/data/`` of the built package, so an installed washbench finds them from any folder

@@ -119,9 +119,10 @@ def horizon_reference(
     returning to its recent ``mean`` as ``decay`` (N,: e^{-gamma tp j}); with a recording ``future`` (n, k) of which
     ``index`` is the current sample and ``preview_s`` > 0, the samples at the intervals' midpoints (at ``tp_s``,
     samples ``dt_s`` apart, the last one held past the end) as far as the preview reaches, and beyond it the last
-    previewed value returning to the mean the same way."""
+    previewed value returning to the mean the same way. ``decay`` may be (N, k): one per input."""
     n_int = decay.shape[0]
-    out = mean + np.outer(decay, current - mean)
+    d = decay if decay.ndim == 2 else decay[:, None]
+    out = mean + d * (current - mean)
     if future is None or preview_s <= 0.0:
         return out
     mid = tp_s * (np.arange(n_int) + 0.5)
@@ -130,7 +131,7 @@ def horizon_reference(
     out[seen] = future[idx[seen]]
     j = int(np.count_nonzero(seen))
     if 0 < j < n_int:
-        out[j:] = mean + np.outer(decay[: n_int - j], out[j - 1] - mean)
+        out[j:] = mean + d[: n_int - j] * (out[j - 1] - mean)
     return out
 
 
@@ -199,16 +200,20 @@ class DenseQp:
         if self._ready:
             self._model.settings = {"iter_limit": self.iter_limit}
 
-    def solve(
-        self, H: np.ndarray, f: np.ndarray, lo: np.ndarray, hi: np.ndarray, h_changed: bool = True
-    ) -> tuple[bool, np.ndarray, int]:
-        """Solve with this step's data (``lo``/``hi``: simple bounds then the rows of ``A``)."""
+    def solve(self, H: np.ndarray, f: np.ndarray, lo: np.ndarray, hi: np.ndarray, h_changed: bool = True,
+              A: np.ndarray | None = None) -> tuple[bool, np.ndarray, int]:  # fmt: skip
+        """Solve with this step's data (``lo``/``hi``: simple bounds then the rows of ``A``; ``A``: new rows' matrix,
+        the same shape, or None to keep the last)."""
+        if A is not None:
+            self.A = np.ascontiguousarray(A, dtype=np.float64)
         if not self._ready:
             flag, _ = self._model.setup(H, f, self.A, hi, lo, self.sense)
             self._model.settings = {"iter_limit": self.iter_limit}
             self._ready = flag >= 0
             if not self._ready:
                 return False, np.zeros(self.n), 0
+        elif A is not None:
+            self._model.update(H=H, f=f, A=self.A, bupper=hi, blower=lo)
         elif h_changed:
             self._model.update(H=H, f=f, bupper=hi, blower=lo)
         else:

@@ -10,23 +10,28 @@ rotation ``dtheta`` (body axes, rad) is, to first order,
 and ``d(dtheta)/dt = omega`` (the sphere's body rate, rad/s). The washout solves, by DAQP (a dual active-set solver
 for small dense QPs, warm-started: :class:`washbench.cueing.condensed.DenseQp`), over N intervals of ``tp``
 
-    minimise  sum_k  |e_oto,k|^2_Wo + |e_f,k|^2_Wd + |e_can,k|^2_Wc + |p_k|^2_Wp + |v_k|^2_Wv
-                     + r_a |a_k|^2 + r_w |omega_k|^2                            (times tp)
+    minimise  kappa F(z)  +  sum_k tp ( |e_oto,k|^2_Wo + |e_f,k|^2_Wd + |e_can,k|^2_Wc + |p_k|^2_Wp + |v_k|^2_Wv
+                                         + r_a |a_k|^2 + r_w |omega_k|^2 )
     subject to  |a| <= margin a_max per inertial axis, |p|, |v| likewise (nodes 1..N), v_N = 0 (optional),
                 |omega|_1 <= margin rate limit (inside the Atlas's 2-norm ball), and its change per move
                 (from the current rate over one sample for the first move) within margin alpha_max,
 
 where ``e_oto`` and ``e_can`` are the perceived errors (the paper's otolith and canal models, Eqs. 11-12, driven by
-simulator minus aircraft head signals in body axes), ``e_f`` the specific-force error at the head itself, and the
-aircraft input over the horizon returns from its last value to its recent mean as ``e^{-gamma t}``, or, with
-``preview_s`` > 0 and the recording known (``run``, ``suite``, ``cue``: :meth:`MpcUnrestrictedWashout.trace`), the
-aircraft's own future. Decisions are held over blocks of intervals (move blocking). There is no attitude cost and no
-tilt-rate limit: the sphere may turn without limit, and tilt is paid for only by what the canals perceive of it.
-The canal weights follow the ranking's score (``yardstick_weights``): multiplied by the squared ratio of the
-aircraft pilot's mean felt force to mean felt rate so far (to the power ``yardstick_power``). The first move is
-applied for one sample, exactly: the stage integrates ``a``, the attitude ``q <- q exp(omega dt / 2)``, and the error
-models are driven by the head signals of that exact motion. See docs/optimal-mpc.md ("mpc-unrestricted") for the
-derivation, the references and the choices.
+simulator minus aircraft head signals in body axes), ``e_f`` the specific-force error at the head itself, and
+``F(z)`` the ranking's felt error predicted over the horizon (:mod:`washbench.cueing.felt_qp`: at the end of each
+move, the perceived error beyond the perception thresholds and its false part against the aircraft pilot's own
+perceived motion, in threshold-seconds, and the jolt of the first move; slack variables represent it exactly). The
+quadratic terms are small (0.1 per threshold squared): they make the plan unique and bring the cockpit back to
+level and the stage to its centre where the felt error is indifferent (below the thresholds). The aircraft's
+specific force over the horizon returns from its last value to its recent mean as ``e^{-gamma t}``, its angular
+velocity likewise with ``gamma_w``, or, with ``preview_s`` > 0 and the recording known (``run``, ``suite``, ``cue``:
+:meth:`MpcUnrestrictedWashout.trace`), the aircraft's own future is used. Decisions are held over blocks of
+intervals (move blocking). There is no attitude cost and no tilt-rate limit: the sphere may turn without limit, a
+rotation is paid for by what the canals perceive of it beyond their threshold and by the force its tilt adds. The
+first move is applied for one sample: the stage integrates ``a`` as the platform does (semi-implicit Euler, so the
+head feels ``a`` in the same sample), the attitude ``q <- q exp(omega dt / 2)``, and the error models are driven by
+the head signals of that motion. See docs/optimal-mpc.md ("mpc-unrestricted") for the derivation, the references
+and the choices.
 """
 
 from __future__ import annotations
@@ -49,12 +54,14 @@ from washbench.cueing.condensed import (
     siso_state_space,
     stage_limits,
 )
+from washbench.cueing.felt_qp import INF, FeltSlacks
 from washbench.cueing.motion_model import discretise_zoh
 from washbench.cueing.mpc import MAX_WORK, SLOW_FACTOR, VestibularChoice
 from washbench.errors import WashbenchError
 from washbench.io import cost
 from washbench.io.yamlio import StrictModel
 from washbench.numerics.rotations import quat_from_euler
+from washbench.perception.thresholds import ZACHARIAS, Thresholds
 from washbench.perception.vestibular import canal_tf, otolith_tf
 from washbench.platform.kinematics import brake_speed
 
@@ -84,6 +91,13 @@ def _axes(x: float, y: float, z: float) -> AxisWeights:
     return AxisWeights(x=x, y=y, z=z)
 
 
+QUADRATIC_PER_THRESHOLD = 0.1
+"""rho: the quadratic terms' weight per threshold squared (chosen; docs/optimal-mpc.md shows its effect)"""
+_QUADRATIC = tuple(QUADRATIC_PER_THRESHOLD / u**2 for u in (
+    ZACHARIAS.f_x_mps2, ZACHARIAS.f_y_mps2, ZACHARIAS.f_z_mps2, *(math.radians(d) for d in (
+        ZACHARIAS.omega_x_degps, ZACHARIAS.omega_y_degps, ZACHARIAS.omega_z_degps))))  # fmt: skip
+
+
 # sign patterns of the 1-norm ball's facets |p| + |q| + |r| <= w, as |s . omega| <= w
 _FACETS = np.array([[1.0, 1.0, 1.0], [1.0, 1.0, -1.0], [1.0, -1.0, 1.0], [1.0, -1.0, -1.0]])
 
@@ -106,40 +120,31 @@ class MpcUnrestrictedParams(StrictModel):
     """how far ahead the aircraft's motion is known (s; 20 s needs prediction_step_s of at least 0.1 s, the horizon
     being at most 200 intervals): 0 none; > 0 needs the recording in advance"""
     reference_decay_per_s: Annotated[float, Field(ge=0.0, le=100.0, allow_inf_nan=False)] = 0.5
-    """gamma: beyond what is previewed, the aircraft's specific force and rate are predicted to return from the last
-    known value to their recent mean as e^{-gamma t} (0: held)"""
+    """gamma: beyond what is previewed, the aircraft's specific force is predicted to return from the last known value
+    to its recent mean as e^{-gamma t} (0: held)"""
+    rate_decay_per_s: Annotated[float, Field(ge=0.0, le=100.0, allow_inf_nan=False)] = 4.0
+    """gamma_w: the same for the aircraft's angular velocity (chosen faster: a rate is predicted to fade within about
+    0.25 s, so a tilt that following it would add is not overrated)"""
     reference_mean_s: Annotated[float, Field(gt=0.0, le=600.0, allow_inf_nan=False)] = 5.0
-    """the time constant of that recent mean (s): a first-order low-pass of the aircraft's input, started at the
+    """the time constant of those recent means (s): a first-order low-pass of the aircraft's input, started at the
     first sample, so a steady flight is predicted to stay as it is"""
     limit_margin: Annotated[float, Field(gt=0.0, le=1.0)] = 0.95
     """the QP's limits are this fraction of the platform's"""
     terminal_rest: bool = True
     """the plan ends with the stage at rest (velocity 0 at node N)"""
     vestibular: VestibularChoice = VestibularChoice()
-    force: AxisWeights = _axes(1.0, 1.0, 1.0)
-    """weights of the perceived specific-force error (otolith), body x, y, z, per (m/s^2)^2"""
-    direct_force: AxisWeights = _axes(1.0, 1.0, 1.0)
-    """weights of the specific-force error at the head (before the otolith), per (m/s^2)^2"""
-    rate: AxisWeights = _axes(1.0, 1.0, 1.0)
-    """weights of the perceived angular-velocity error (canals), body roll, pitch, yaw, per (rad/s)^2; with
-    ``yardstick_weights`` multiplied by (mean felt force / mean felt rate)^2 (see there)"""
-    yardstick_weights: bool = True
-    """weigh force against rate as the ranking's score does: the score divides each group's integral error by the
-    pilot's own felt motion in that group, so a quadratic proxy weighs errors normalised by each group's mean felt
-    magnitude; the rate weights are multiplied by (m_f / m_w)^2, m_f and m_w the aircraft pilot's mean perceived
-    force and rate so far (|perceived - perceived at the start|, summed over the axes, averaged over the time flown;
-    at least ``felt_floor``); false: the weights as given"""
-    yardstick_power: Annotated[float, Field(ge=0.0, le=1.0, allow_inf_nan=False)] = 0.75
-    """beta: the rate weights' factor is 10^(1 - beta) ((m_f / m_w)^2)^beta ((m/s^2)^2 per (rad/s)^2): 1 the score's
-    ratio, 0 a fixed 10 (the mpc washout's rate weight against its force weight 1)"""
-    felt_floor_mps2: Annotated[float, Field(gt=0.0, le=10.0, allow_inf_nan=False)] = 0.05
-    """the least mean felt force m_f (m/s^2)"""
-    felt_floor_degps: Annotated[float, Field(gt=0.0, le=100.0, allow_inf_nan=False)] = 0.3
-    """the least mean felt rate m_w (deg/s)"""
-    position: AxisWeights = _axes(0.4, 0.4, 4.0)
-    """stage position, inertial north, east, down, per m^2"""
-    velocity: AxisWeights = _axes(0.4, 0.4, 1.0)
-    """stage velocity, per (m/s)^2"""
+    force: AxisWeights = _axes(*_QUADRATIC[:3])
+    """quadratic weights of the perceived specific-force error (otolith), body x, y, z, per (m/s^2)^2 (default
+    0.1 / T^2 of the Zacharias thresholds: 0.1 per threshold squared)"""
+    direct_force: AxisWeights = _axes(*_QUADRATIC[:3])
+    """quadratic weights of the specific-force error at the head (before the otolith), per (m/s^2)^2"""
+    rate: AxisWeights = _axes(*_QUADRATIC[3:])
+    """quadratic weights of the perceived angular-velocity error (canals), body roll, pitch, yaw, per (rad/s)^2
+    (default 0.1 / T^2)"""
+    position: AxisWeights = _axes(0.1, 0.1, 0.5)
+    """quadratic weights of the stage's position, inertial north, east, down, per m^2"""
+    velocity: AxisWeights = _axes(0.1, 0.1, 0.125)
+    """quadratic weights of the stage's velocity, per (m/s)^2"""
     acceleration: PositiveWeight = 0.05
     """stage acceleration (control), per (m/s^2)^2"""
     angular_rate: PositiveWeight = 0.05
@@ -148,6 +153,23 @@ class MpcUnrestrictedParams(StrictModel):
     """the model is linearised again when the cockpit has turned more than this since the last linearisation (deg;
     0: every sample); in between the turn so far enters the prediction as an offset (first order: an error of at
     most g (1 - cos x) ~ 0.006 m/s^2 at 2 deg)"""
+    felt_weight: Weight = 1.0
+    """kappa: the weight of the felt error's prediction in the cost, per threshold-second (0: the quadratic terms
+    alone, a QP without slacks)"""
+    false_weight: Weight = 1.0
+    """lambda: the false part counted again (the ranking's: washbench.analysis.felt.FALSE_WEIGHT)"""
+    jolt_time_s: Weight = 1.0
+    """tau_j (s): a jolt counts as a felt error held this long (the ranking's: JOLT_TIME_S)"""
+    jerk_deadband_mps3: Weight = 50.0
+    """J_T (m/s^3): jerk the stage may add at the head beyond the aircraft's without cost (the ranking's:
+    JERK_DEADBAND_MPS3)"""
+    thresholds: Thresholds = ZACHARIAS
+    """the DOFs' perception thresholds (Zacharias 1978 by default, as the ranking's): the felt error's units and
+    dead bands"""
+    slack_regularisation: PositiveWeight = 1e-3
+    """eps: the slacks' quadratic cost, per (threshold units)^2 or (m/s^2)^2 for a jolt: keeps the Hessian
+    positive definite for the dual active-set solver (chosen small against the slacks' linear costs, 0.1-0.5 per
+    threshold unit: 10 thresholds beyond the dead band cost 2-10 % more)"""
     solver: DaqpSettings = DaqpSettings()
 
     @model_validator(mode="after")
@@ -248,8 +270,9 @@ class MpcUnrestrictedWashout:
     """``mpc-unrestricted`` per step (:class:`washbench.cueing.algorithm.WashoutAlgorithm`), see the module docstring.
 
     State: attitude ``q`` (body to inertial, scalar first), stage position ``p`` and velocity ``v`` (inertial, from
-    the centre), the applied rate ``w``, the otolith (2, 3) and canal (3, 3) error-model states per body axis.
-    Counters (:meth:`report`): solves, fallbacks (failed or unsafe solves: braking), iterations.
+    the centre), the applied rate ``w`` and acceleration, the otolith (2, 3) and canal (3, 3) error-model states per
+    body axis, and the aircraft pilot's own otolith and canal states (for the felt error's false part). Counters
+    (:meth:`report`): solves, fallbacks (failed or unsafe solves: braking), iterations, relinearisations.
     """
 
     Params = MpcUnrestrictedParams
@@ -325,8 +348,7 @@ class MpcUnrestrictedWashout:
                                      + np.kron(self._PvB.T @ self._PvB, np.diag(p.velocity.xyz))
                                      + np.kron(BtB, p.acceleration * np.eye(3)))  # fmt: skip
         h_fixed[3 * M :, 3 * M :] = np.kron(BtB, p.angular_rate * np.eye(3))
-        self._h_can = np.zeros((6 * M, 6 * M))  # the canal error's part, scaled by the rate weights' factor
-        self._h_can[3 * M :, 3 * M :] = np.kron(self._TcB.T @ self._TcB, np.diag(p.rate.xyz))
+        h_fixed[3 * M :, 3 * M :] += np.kron(self._TcB.T @ self._TcB, np.diag(p.rate.xyz))  # the canal error's
         self._h_fixed = h_fixed
         self._S = np.empty((8, 3, 3))
         self._relin_rad = math.radians(p.relinearise_deg)
@@ -338,8 +360,19 @@ class MpcUnrestrictedWashout:
         self._Wp = np.diag(p.position.xyz)
         self._Wv = np.diag(p.velocity.xyz)
         # constraints: rows [position (3N), velocity (3N), rate facets (4M), rate change facets (4M)] over
-        # z = [a_0..a_{M-1} (3 each), omega_0..omega_{M-1} (3 each)]
-        nz = 6 * M
+        # z = [a_0..a_{M-1} (3 each), omega_0..omega_{M-1} (3 each)], then the felt error's slacks and rows
+        nc = 6 * M
+        self._slacks: FeltSlacks | None = None
+        if p.felt_weight > 0.0:
+            th = p.thresholds
+            units = np.array([th.f_x_mps2, th.f_y_mps2, th.f_z_mps2,
+                              *np.radians([th.omega_x_degps, th.omega_y_degps, th.omega_z_degps])])  # fmt: skip
+            self._slacks = FeltSlacks(tp * np.array(self.blocks, dtype=np.float64), units, nc, np.arange(3),
+                                    weight=p.felt_weight, false_weight=p.false_weight, jolt_time_s=p.jolt_time_s,
+                                    jerk_deadband_mps3=p.jerk_deadband_mps3, dt_s=self.dt,
+                                    eps=p.slack_regularisation)  # fmt: skip
+        n_slack = self._slacks.n_slack if self._slacks is not None else 0
+        self.nz = nz = nc + n_slack
         # the stage's limits at the end of each move (velocity is linear within a move, so its box holds between;
         # position may bulge within a move by at most a_max tb^2 / 8, inside the margin for these moves)
         self._ends = ends = np.cumsum(self.blocks) - 1
@@ -349,40 +382,51 @@ class MpcUnrestrictedWashout:
         diff = np.eye(M) - np.eye(M, k=-1)
         A_rate = np.hstack([np.zeros((4 * M, 3 * M)), facets])
         A_dacc = np.hstack([np.zeros((4 * M, 3 * M)), np.kron(diff, _FACETS)])
-        A = np.vstack([A_pos, A_vel, A_rate, A_dacc])
+        A_ctrl = np.vstack([A_pos, A_vel, A_rate, A_dacc])
+        n_felt_rows = self._slacks.n_rows if self._slacks is not None else 0
+        A = np.zeros((A_ctrl.shape[0] + n_felt_rows, nz))
+        A[: A_ctrl.shape[0], :nc] = A_ctrl
+        self._A = A
+        self._n_felt = slice(nz + A_ctrl.shape[0], nz + A.shape[0])
         eq = np.zeros(A.shape[0], dtype=bool)
         if p.terminal_rest:
             eq[6 * M - 3 : 6 * M] = True
         self.qp = DenseQp(nz, A, eq, p.solver.iter_limit)
         w = mg * self.w_max
         self._hi = np.concatenate([
-            np.tile(mg * self.a_max, M), np.full(3 * M, w),  # simple bounds
+            np.tile(mg * self.a_max, M), np.full(3 * M, w), np.full(n_slack, INF),  # simple bounds
             np.tile(mg * self.p_max, M), np.tile(mg * self.v_max, M),
-            np.full(4 * M, w), np.full(4 * M, mg * self.alpha_max * tp),
+            np.full(4 * M, w), np.full(4 * M, mg * self.alpha_max * tp), np.full(n_felt_rows, INF),
         ])  # fmt: skip
         self._lo = -self._hi
+        self._lo[nc:nz] = 0.0
+        self._H_full = np.zeros((nz, nz))
+        if self._slacks is not None:
+            self._H_full[nc:, nc:] = np.eye(n_slack) * (2.0 * p.slack_regularisation)
         self._n_pos = slice(nz, nz + 3 * M)
         self._n_vel = slice(nz + 3 * M, nz + 6 * M)
         self._n_dacc0 = slice(nz + 6 * M + 4 * M, nz + 6 * M + 4 * M + 4)
         self._dw0 = mg * self.alpha_max * self.dt
-        self._decay = np.exp(-p.reference_decay_per_s * tp * np.arange(N))  # interval j, from its start
+        gam = np.array([p.reference_decay_per_s] * 3 + [p.rate_decay_per_s] * 3)
+        self._decay = np.exp(-np.outer(tp * np.arange(N), gam))  # interval j, from its start; (N, 6)
         self._mean_gain = -math.expm1(-self.dt / p.reference_mean_s)  # the recent mean's low-pass, per sample
         self._f_mean = np.array([0.0, 0.0, -self.g])
         self._w_mean = np.zeros(3)
-        # the aircraft pilot's own perception (for the yardstick weights): its models' states, start and integrals
+        # the aircraft pilot's own perception (for the felt error's false part): its models' states and start
         self._air_o = np.zeros((ao.shape[0], 3))
         self._air_c = np.zeros((ac.shape[0], 3))
         self._air_0 = (np.zeros(3), np.zeros(3))
-        self._felt = np.zeros(2)  # integral of |perceived - perceived at the start|: force (m/s), rate (rad)
-        self._scale_used = 1.0
         # state
         self.q = np.array([1.0, 0.0, 0.0, 0.0])
         self.p = np.zeros(3)
         self.v = np.zeros(3)
         self.w = np.zeros(3)
+        self._a_prev = np.zeros(3)
+        self._f_prev = np.array([0.0, 0.0, -self.g])
         self.xo = np.zeros((ao.shape[0], 3))
         self.xc = np.zeros((ac.shape[0], 3))
         self.solves = 0
+        self.relinearisations = 0
         self.fallbacks = 0
         self.iterations: list[int] = []
         self._sat_rot = False
@@ -395,26 +439,10 @@ class MpcUnrestrictedWashout:
         self.xo = np.outer(self._oto_gain, e_f)
         self.xc = np.outer(self._can_gain, e_w)
 
-    def _feel(self, f: np.ndarray, w: np.ndarray) -> None:
-        """Advance the aircraft pilot's perception by one sample and add |perceived - perceived at the start| to the
-        felt integrals (the ranking's M_d, summed per group)."""
+    def _perceive_aircraft(self, f: np.ndarray, w: np.ndarray) -> None:
+        """Advance the aircraft pilot's perception (otolith and canal states) by one sample."""
         self._air_o = self._phi_o @ self._air_o + np.outer(self._gam_o, f)
         self._air_c = self._phi_c @ self._air_c + np.outer(self._gam_c, w)
-        po = self._co @ self._air_o - self._air_0[0]
-        pc = self._cc @ self._air_c - self._air_0[1]
-        self._felt[0] += self.dt * float(np.abs(po).sum())
-        self._felt[1] += self.dt * float(np.abs(pc).sum())
-
-    def _rate_scale(self) -> float:
-        """The rate weights' factor (m_f / m_w)^2 (1 without ``yardstick_weights``)."""
-        p = self.params
-        if not p.yardstick_weights:
-            return 1.0
-        t = max(self._k, 1) * self.dt
-        m_f = max(self._felt[0] / t, p.felt_floor_mps2)
-        m_w = max(self._felt[1] / t, math.radians(p.felt_floor_degps))
-        beta = p.yardstick_power
-        return 10.0 ** (1.0 - beta) * ((m_f / m_w) ** 2) ** beta
 
     def _head_force(self, q: np.ndarray, a: np.ndarray) -> np.ndarray:
         return quat_matrix(q).T @ (a - np.array([0.0, 0.0, self.g]))
@@ -432,13 +460,13 @@ class MpcUnrestrictedWashout:
         self.p = np.zeros(3)
         self.v = np.zeros(3)
         self.w = np.zeros(3)
+        self._a_prev = np.zeros(3)
+        self._f_prev = np.array(f_mps2, dtype=np.float64)
         self._steady_states(self._head_force(self.q, np.zeros(3)) - f, -w)
         self._f_mean, self._w_mean = f.copy(), w.copy()
         self._air_o = np.outer(self._oto_gain, f)
         self._air_c = np.outer(self._can_gain, w)
         self._air_0 = (self._co @ self._air_o, self._cc @ self._air_c)
-        self._felt = np.zeros(2)
-        self._scale_used = 1.0
         self._k = 0
         self._H = None
         return self.p.copy(), self.q.copy()
@@ -455,9 +483,9 @@ class MpcUnrestrictedWashout:
         """Solve this sample's QP; (solved, a moves (M, 3) inertial, omega moves (M, 3) body)."""
         M = self.M
         d0 = rotation_vector(quat_mul(quat_conj(self._q_lin), self.q)) if self._H is not None else None
-        scale = self._rate_scale()
-        relinearise = d0 is None or float(_norm(d0)) > self._relin_rad or abs(scale / self._scale_used - 1.0) > 0.05
+        relinearise = d0 is None or float(_norm(d0)) > self._relin_rad
         if relinearise:  # a new linearisation point: the Hessian and its 3 x 3 factors are rebuilt
+            self.relinearisations += 1
             self._q_lin = self.q.copy()
             d0 = np.zeros(3)
             R0 = quat_matrix(self.q)
@@ -475,9 +503,16 @@ class MpcUnrestrictedWashout:
             S[6] = G.T @ Wo @ G
             S[7] = G.T @ Wd @ G
             H = (self._gram @ S.reshape(8, 9)).reshape(2 * M, 2 * M, 3, 3).transpose(0, 2, 1, 3)
-            self._H = 2.0 * self.tp * (H.reshape(6 * M, 6 * M) + self._h_fixed + scale * self._h_can)
-            self._scale_used = scale
+            self._H = 2.0 * self.tp * (H.reshape(6 * M, 6 * M) + self._h_fixed)
+            self._H_full[: 6 * M, : 6 * M] = self._H
             self._lin = (R0, gB, G)
+            if self._slacks is not None:  # the felt rows' coefficients: the errors at the nodes against the moves
+                e = self._ends
+                P = np.zeros((6 * len(e), 6 * M))
+                P[: 3 * len(e)] = np.hstack([np.kron(self._ToB[e], R0.T), np.kron(self._ToLmB[e], G)])
+                P[3 * len(e) :, 3 * M :] = np.kron(self._TcB[e], np.eye(3))
+                self._slacks.set_rows(P, R0.T)
+                self._A[-self._slacks.n_rows :] = self._slacks.A
         R0, gB, G = self._lin
         Wo, Wd = self._Wo, self._Wd
         F, Wr = self._reference(f, w)
@@ -492,7 +527,7 @@ class MpcUnrestrictedWashout:
             self._PvB.T @ (c_v @ self._Wv)
         )  # fmt: skip
         fw = (self._ToLmB.T @ (c_o @ Wo) + self._LmB.T @ (c_d @ Wd)) @ G
-        fw += self._TcB.T @ (c_c @ self._Wc) * self._scale_used
+        fw += self._TcB.T @ (c_c @ self._Wc)
         fz = np.concatenate([fa.ravel(), fw.ravel()])
         lo, hi = self._lo.copy(), self._hi.copy()
         cp_end = c_p[self._ends].ravel()
@@ -507,11 +542,21 @@ class MpcUnrestrictedWashout:
         s = _FACETS @ self.w
         lo[self._n_dacc0] = s - self._dw0
         hi[self._n_dacc0] = s + self._dw0
+        fz = 2.0 * self.tp * fz
+        if self._slacks is not None:
+            e = self._ends
+            x_o = self._Oo[e] @ self._air_o + self._To[e] @ F - self._air_0[0]
+            x_c = self._Oc[e] @ self._air_c + self._Tc[e] @ Wr - self._air_0[1]
+            c = np.concatenate([c_o[e].ravel(), c_c[e].ravel()])
+            dx = np.concatenate([x_o.ravel(), x_c.ravel()])
+            lo[self._n_felt], f_slack = self._slacks.data(c, dx, R0.T @ self._a_prev, f - self._f_prev)
+            fz = np.concatenate([fz, f_slack])
         # the whole cost doubled and times tp is 1/2 z' H z + f' z with H = 2 tp (J' W J), f = 2 tp J' W c
-        ok, z, it = self.qp.solve(self._H, 2.0 * self.tp * fz, lo, hi, h_changed=relinearise)
+        ok, z, it = self.qp.solve(self._H_full, fz, lo, hi, h_changed=relinearise,
+                                  A=self._A if relinearise and self._slacks is not None else None)  # fmt: skip
         self.solves += 1
         self.iterations.append(it)
-        return ok, z[: 3 * M].reshape(M, 3), z[3 * M :].reshape(M, 3)
+        return ok, z[: 3 * M].reshape(M, 3), z[3 * M : 6 * M].reshape(M, 3)
 
     def _safe(self, a: np.ndarray, w: np.ndarray) -> bool:
         """Whether the move keeps the stage within its limits after one sample and able to stop, and the rate
@@ -520,7 +565,7 @@ class MpcUnrestrictedWashout:
             return False
         dt = self.dt
         v1 = self.v + a * dt
-        p1 = self.p + self.v * dt + 0.5 * a * dt * dt
+        p1 = self.p + self.v * dt + a * dt * dt
         if np.any(np.abs(p1) > self.p_max) or np.any(np.abs(v1) > self.v_max) or np.any(np.abs(a) > self.a_max):
             return False
         for j in range(3):
@@ -540,7 +585,7 @@ class MpcUnrestrictedWashout:
     def _advance(self, f: np.ndarray, w_air: np.ndarray) -> SetPoint:
         if not (np.all(np.isfinite(f)) and np.all(np.isfinite(w_air))):
             raise ValueError("mpc-unrestricted: non-finite input")
-        self._feel(f, w_air)
+        self._perceive_aircraft(f, w_air)
         self._f_mean += self._mean_gain * (f - self._f_mean)
         self._w_mean += self._mean_gain * (w_air - self._w_mean)
         ok, a_plan, w_plan = self._plan(f, w_air)
@@ -553,9 +598,11 @@ class MpcUnrestrictedWashout:
         e_f = self._head_force(q_mid, a) - f
         self.xo = self._phi_o @ self.xo + np.outer(self._gam_o, e_f)
         self.xc = self._phi_c @ self.xc + np.outer(self._gam_c, w - w_air)
-        self.p = self.p + self.v * dt + 0.5 * a * dt * dt
+        self.p = self.p + self.v * dt + a * dt * dt  # semi-implicit Euler, as the platform integrates
         self.v = self.v + a * dt
         self.q = quat_step(self.q, w, dt)
+        self._a_prev = a
+        self._f_prev = f
         self._sat_rot = bool(np.sum(np.abs(w)) >= 0.999 * self.params.limit_margin * self.w_max)
         self.w = w
         self._k += 1
@@ -590,13 +637,15 @@ class MpcUnrestrictedWashout:
         return False, self._sat_rot
 
     def report(self) -> dict[str, float]:
-        """Solver statistics: solves, fallbacks (failed or unsafe solves: braking), iterations (median, max)."""
+        """Solver statistics: solves, fallbacks (failed or unsafe solves: braking), iterations (median, max),
+        relinearisations (new linearisation points: the QP's Hessian and rows rebuilt, DAQP factorised again)."""
         it = np.array(self.iterations) if self.iterations else np.zeros(1)
         return {
             "solves": float(self.solves),
             "fallbacks": float(self.fallbacks),
             "iterations_median": float(np.median(it)),
             "iterations_max": float(np.max(it)),
+            "relinearisations": float(self.relinearisations),
         }
 
 
