@@ -41,3 +41,31 @@ def write(tmp_path: Path, name: str, text: str) -> Path:
     path = tmp_path / name
     path.write_text(dedent(text))
     return path
+
+
+def short_rudder_doublet(name: str, free_s: float) -> str:
+    """The bundled C172 rudder doublet shortened (settle 1 s, doublet 2.8 s, free oscillation ``free_s`` s), as the
+    text of a manoeuvre file named ``name``."""
+    return f"""\
+name: {name}
+description: the C172 rudder doublet, shortened (settle 1 s, doublet 2.8 s, free oscillation {free_s:g} s)
+aircraft: c172p
+start:
+  air: {{altitude_ft: 4000, airspeed_kts: 95, heading_deg: 90}}
+phases:
+  - name: settle
+    hold: {{wings_level: true, altitude_ft: 4000, airspeed_kts: 95}}
+    until: {{duration_s: 1}}
+  - name: doublet
+    hold: {{altitude_ft: 4000, airspeed_kts: 95}}
+    inputs:
+      rudder: {{shape: doublet, amplitude_deg: 5, duration_s: 2.8, free: true}}
+      aileron: {{free: true}}
+    until: {{duration_s: 2.8}}
+  - name: free oscillation
+    hold: {{altitude_ft: 4000, airspeed_kts: 95}}
+    inputs:
+      rudder: {{free: true}}
+      aileron: {{free: true}}
+    until: {{duration_s: {free_s:g}}}
+"""

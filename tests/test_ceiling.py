@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from ceiling_helpers import check_ceiling_below_every_washout, response_matrix, trapezoid, washbench
+from flight_helpers import short_rudder_doublet
 from scipy.optimize import linprog
 
 from washbench.analysis.ceiling import EXACT, ceiling, rotational_floor, translational_floor
@@ -189,29 +190,7 @@ def test_no_washout_below_the_ceiling_on_stress_inputs(tmp_path: Path, shape: st
     assert doc["ceiling"][dof] > 0.0  # beyond the platform: not even the best motion follows it
 
 
-RUDDER = """\
-name: short_rudder
-description: the C172 rudder doublet, shortened (settle 1 s, doublet 2.8 s, free oscillation 5 s)
-aircraft: c172p
-start:
-  air: {altitude_ft: 4000, airspeed_kts: 95, heading_deg: 90}
-phases:
-  - name: settle
-    hold: {wings_level: true, altitude_ft: 4000, airspeed_kts: 95}
-    until: {duration_s: 1}
-  - name: doublet
-    hold: {altitude_ft: 4000, airspeed_kts: 95}
-    inputs:
-      rudder: {shape: doublet, amplitude_deg: 5, duration_s: 2.8, free: true}
-      aileron: {free: true}
-    until: {duration_s: 2.8}
-  - name: free oscillation
-    hold: {altitude_ft: 4000, airspeed_kts: 95}
-    inputs:
-      rudder: {free: true}
-      aileron: {free: true}
-    until: {duration_s: 5}
-"""
+RUDDER = short_rudder_doublet("short_rudder", 5)
 
 CRUISE = """\
 name: level_cruise

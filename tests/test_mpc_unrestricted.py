@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from ceiling_helpers import read_csv, washbench
+from flight_helpers import short_rudder_doublet
 from scipy import signal
 from scipy.spatial.transform import Rotation
 from test_mpc import STRESS, _check_limits, _far_limits, _run
@@ -500,29 +501,7 @@ def test_a_pure_yaw_is_followed(limits):
 
 
 SHORT_MANOEUVRES = {
-    "rudder_doublet_short": """\
-name: rudder_doublet_short
-description: the C172 rudder doublet, shortened (settle 1 s, doublet 2.8 s, free oscillation 8 s)
-aircraft: c172p
-start:
-  air: {altitude_ft: 4000, airspeed_kts: 95, heading_deg: 90}
-phases:
-  - name: settle
-    hold: {wings_level: true, altitude_ft: 4000, airspeed_kts: 95}
-    until: {duration_s: 1}
-  - name: doublet
-    hold: {altitude_ft: 4000, airspeed_kts: 95}
-    inputs:
-      rudder: {shape: doublet, amplitude_deg: 5, duration_s: 2.8, free: true}
-      aileron: {free: true}
-    until: {duration_s: 2.8}
-  - name: free oscillation
-    hold: {altitude_ft: 4000, airspeed_kts: 95}
-    inputs:
-      rudder: {free: true}
-      aileron: {free: true}
-    until: {duration_s: 8}
-""",
+    "rudder_doublet_short": short_rudder_doublet("rudder_doublet_short", 8),
     "aileron_3211_short": """\
 name: aileron_3211_short
 description: the Columbia 400 aileron 3-2-1-1, shortened (settle 1 s, multistep 2.8 s, response 5 s, level 3 s)
