@@ -9,7 +9,8 @@ Units and frames: inputs are the specific force at the aircraft pilot's head (ai
 :data:`CueingBank.FIELDS`: platform position/velocity/acceleration (inertial NED, m, m/s, m/s^2),
 attitude (body->inertial quaternion, scalar first), body angular velocity (rad/s), specific force (m/s^2)
 and angular velocity (rad/s) at the simulator pilot's head in simulator body axes, omni-wheel speeds
-(rad/s), the washout's set points, and 0/1 saturation flags per limit kind for the step.
+(rad/s), the washout's set points, 0/1 saturation flags per limit kind for the step, and the tilt-coordination
+rate the washout commanded (rad/s, after its tilt-rate limit; NaN for a washout outside the compiled kernel).
 """
 
 from __future__ import annotations
@@ -88,6 +89,7 @@ from washbench.cueing.kernel import (
     O_SAT,
     O_SP_POS,
     O_SP_Q,
+    O_TILT,
     O_VEL,
     O_WHEEL,
     PLAT_HEXAPOD,
@@ -273,7 +275,10 @@ class WashoutTrace:
     head_omega_radps (N, 3): simulator pilot-head specific force and angular velocity, simulator body axes.
     wheel_radps (N, 3): the Atlas's omni-wheel speeds ((N, 0) on another platform). sp_pos_m (N, 3), sp_q (N, 4):
     the washout's set points. saturated: limit kind -> bool (N,) (kinds in ``SAT_KINDS``); saturation_counts: kind
-    -> steps at it. leg_m (N, 6): a hexapod's leg lengths, m ((N, 0) on another platform).
+    -> steps at it. leg_m (N, 6): a hexapod's leg lengths, m ((N, 0) on another platform). tilt_rate_radps (N,): the
+    tilt-coordination rate the washout commanded, after its tilt-rate limit and measured as that limit measures it
+    (the norm, or the largest axis with ``rate_limit_mode: axis``), rad/s; NaN where the bench knows none (a washout
+    outside the compiled kernel: the references, the bound, the MPCs).
     """
 
     pos_m: np.ndarray
@@ -289,6 +294,7 @@ class WashoutTrace:
     saturated: dict[str, np.ndarray]
     saturation_counts: dict[str, int]
     leg_m: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    tilt_rate_radps: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     @classmethod
     def from_rows(cls, rows: np.ndarray, copy: bool = True, platform: str = "atlas") -> WashoutTrace:
@@ -335,6 +341,7 @@ class WashoutTrace:
             saturated=saturated,
             saturation_counts={k: int(v.sum()) for k, v in saturated.items()},
             leg_m=cols(O_LEG, 6 if platform == "hexapod" else 0),
+            tilt_rate_radps=cols(O_TILT, 1)[:, 0],
         )
 
 
@@ -714,6 +721,7 @@ class PluginPass:
             return
         sp = rows[:, O_SP_POS : O_SP_POS + 3].copy()
         sq = rows[:, O_SP_Q : O_SP_Q + 4].copy()
+        tilt = rows[:, O_TILT].copy()
         own = rows[:, O_SAT + 5 : O_SAT + 7].astype(np.int64)  # the washout's tilt-rate and rotational flags
         run = self.runs[i]
         if not self.started[i]:
@@ -724,6 +732,7 @@ class PluginPass:
                        self.state[i], self.counts[i], rows)  # fmt: skip
         rows[:, O_SP_POS : O_SP_POS + 3] = sp
         rows[:, O_SP_Q : O_SP_Q + 4] = sq
+        rows[:, O_TILT] = tilt
         rows[:, O_SAT : O_SAT + 5] = flags
         self.counts[i, :5] += flags.sum(axis=0)
 

@@ -14,6 +14,13 @@ Arrays (built by :mod:`washbench.cueing.bank`):
 - ``state`` (n_washouts, NSTATE): integrators, platform and filter states (``S_*`` offsets);
 - ``counts`` (n_washouts, 7) int64: saturation step counts in ``SAT_KINDS`` order;
 - ``out`` (n_washouts, NFIELDS): the latest output row of each washout.
+
+``tilt_rate_radps`` (one field of a row): the tilt-coordination rate the washout commanded on the step, after its
+tilt-rate limit, measured as that limit measures it (:func:`_tilt_measure`: the norm, or with
+``rate_limit_mode: axis`` the largest axis), rad/s; so it is at most the limit, and equal to it on a step flagged
+``sat_tilt_rate``. The small-angle washouts limit (and so measure) the Euler-angle rates, the quaternion washouts
+the body rate. NaN for a washout computed outside the kernel (:func:`setpoint_step`): the bench knows no tilt rate
+of it.
 """
 
 from __future__ import annotations
@@ -64,12 +71,14 @@ FIELDS: tuple[str, ...] = (
     "sp_pos_x_m", "sp_pos_y_m", "sp_pos_z_m",
     "sp_q_w", "sp_q_x", "sp_q_y", "sp_q_z",
     *(f"sat_{k}" for k in SAT_KINDS),
+    "tilt_rate_radps",
     *(f"leg_{i}_m" for i in range(1, 7)),
 )  # fmt: skip
 NFIELDS = len(FIELDS)
 O_POS, O_VEL, O_ACC, O_Q, O_OMEGA = 0, 3, 6, 9, 13
 O_HEAD_F, O_HEAD_OMEGA, O_WHEEL, O_SP_POS, O_SP_Q, O_SAT = 16, 19, 22, 25, 28, 32
-O_LEG = 39  # hexapod leg lengths (6), m; zero for other platforms
+O_TILT = 39  # the tilt-coordination rate commanded (after its limit), rad/s; NaN outside the kernel
+O_LEG = 40  # hexapod leg lengths (6), m; zero for other platforms
 
 # cfg offsets
 C_KIND, C_DT, C_G, C_SF, C_SW, C_TILT_K, C_TILT_RATE, C_ROT_SAT, C_COSMIN, C_FREEFALL = range(10)
@@ -176,6 +185,14 @@ def _limit_tilt(v, vmax, per_axis):
     out2 = min(vmax, max(-vmax, v[2]))
     hit = 1 if (out0 != v[0] or out1 != v[1] or out2 != v[2]) else 0
     return (out0, out1, out2), hit
+
+
+@njit(cache=True, inline="always")
+def _tilt_measure(v, per_axis):
+    """The size of a tilt rate as its limit (:func:`_limit_tilt`) measures it: the norm, or the largest |axis|."""
+    if per_axis == 0.0:
+        return norm3(v)
+    return max(abs(v[0]), max(abs(v[1]), abs(v[2])))
 
 
 @njit(cache=True, inline="always")
@@ -351,7 +368,8 @@ def washout_classical(f, om, c, coef, state, first, rest):
     """The classical-family washout (small-angle, large-angle, unrestricted) by one sample: scaling, the rotational
     saturation, tilt coordination, the rotational and translational channels. Updates the set points in
     ``state`` (S_PSP position, S_QSP attitude) and returns (sat_tilt, sat_rot): whether the tilt-rate and
-    rotational-rate limits acted; and the set points before this sample (q_sp_prev, p_sp_prev), which on the first
+    rotational-rate limits acted; the tilt rate commanded after its limit, as the limit measures it
+    (:func:`_tilt_measure`, rad/s); and the set points before this sample (q_sp_prev, p_sp_prev), which on the first
     sample are the washout's start state."""
     kind = int(c[C_KIND])
     adapt = c[C_ADAPT] != 0.0
@@ -389,6 +407,7 @@ def washout_classical(f, om, c, coef, state, first, rest):
             wt = _filt3(coef, state, F_TILT_LP, _tilt_rate(g_s, fs, c[C_TILT_K], c[C_FREEFALL]))
         wt_raw = wt
         bdot_t, sat_tilt = _limit_tilt(euler_rates(phi, theta, wt, c[C_COSMIN]), c[C_TILT_RATE], c[C_TILT_AXIS])
+        tilt_rate = _tilt_measure(bdot_t, c[C_TILT_AXIS])
         if sat_tilt:  # the limited tilt rate in body axes (for the adaptation's sensitivities)
             wt = body_rates(phi, theta, bdot_t)
         bdot_r = _filt3(coef, state, F_ROT_HP, euler_rates(phi, theta, ws, c[C_COSMIN]))
@@ -415,6 +434,7 @@ def washout_classical(f, om, c, coef, state, first, rest):
             wt = _filt3(coef, state, F_TILT_LP, _tilt_rate(g_s, fs, c[C_TILT_K], c[C_FREEFALL]))
         wt_raw = wt
         wt, sat_tilt = _limit_tilt(wt, c[C_TILT_RATE], c[C_TILT_AXIS])
+        tilt_rate = _tilt_measure(wt, c[C_TILT_AXIS])
         wr = _filt3(coef, state, F_ROT_HP, ws)
         q_sp = qintegrate(q_sp_prev, (wt[0] + wr[0], wt[1] + wr[1], wt[2] + wr[2]), dt)
     for j in range(4):
@@ -430,7 +450,7 @@ def washout_classical(f, om, c, coef, state, first, rest):
         state[S_PSP + j] += state[S_VSP + j] * dt
     if adapt:
         _adapt(c, coef, state, fs, ws, u, g_s, f_lp, wt_raw, wt, sat_tilt, a_hp, q_sp_prev, q_sp)
-    return q_sp_prev, p_sp_prev, sat_tilt, sat_rot
+    return q_sp_prev, p_sp_prev, sat_tilt, sat_rot, tilt_rate
 
 
 @njit(cache=True)
@@ -621,10 +641,11 @@ def step_one(f, om, c, coef, state, counts, row):
     washout -> set points -> platform -> head."""
     first = state[S_INIT] == 0.0
     rest = c[C_REST] != 0.0
-    q_sp_prev, p_sp_prev, sat_tilt, sat_rot = washout_classical(f, om, c, coef, state, first, rest)
+    q_sp_prev, p_sp_prev, sat_tilt, sat_rot, tilt_rate = washout_classical(f, om, c, coef, state, first, rest)
     q_sp = (state[S_QSP], state[S_QSP + 1], state[S_QSP + 2], state[S_QSP + 3])
     p_sp = (state[S_PSP], state[S_PSP + 1], state[S_PSP + 2])
     platform_head(p_sp_prev, p_sp, q_sp_prev, q_sp, first, rest, c, coef, state, counts, row, sat_tilt, sat_rot)
+    row[O_TILT] = tilt_rate
     state[S_INIT] = 1.0
 
 
@@ -633,7 +654,7 @@ def setpoint_step(p_sp, q_sp, sat_tilt, sat_rot, c, coef, state, counts, row):
     """One sample of a washout computed outside the kernel (a Python algorithm, :mod:`washbench.cueing.algorithm`):
     the platform tracks its new set point ``p_sp`` (3,) m and ``q_sp`` (4,) (unit quaternion) from the previous one,
     kept in ``state`` (S_PSP, S_QSP; before the first sample: the algorithm's start set point). ``sat_tilt``,
-    ``sat_rot``: the algorithm's own limit flags (0 or 1)."""
+    ``sat_rot``: the algorithm's own limit flags (0 or 1). Its tilt rate is not known here: NaN in the row."""
     first = state[S_INIT] == 0.0
     rest = c[C_REST] != 0.0
     q_prev = (state[S_QSP], state[S_QSP + 1], state[S_QSP + 2], state[S_QSP + 3])
@@ -641,6 +662,7 @@ def setpoint_step(p_sp, q_sp, sat_tilt, sat_rot, c, coef, state, counts, row):
     pn = (p_sp[0], p_sp[1], p_sp[2])
     qn = (q_sp[0], q_sp[1], q_sp[2], q_sp[3])
     platform_head(p_prev, pn, q_prev, qn, first, rest, c, coef, state, counts, row, sat_tilt, sat_rot)
+    row[O_TILT] = math.nan
     for j in range(3):
         state[S_PSP + j] = pn[j]
     for j in range(4):
@@ -754,6 +776,7 @@ __all__ = [
     "NFIELDS",
     "NFILT",
     "NSTATE",
+    "O_TILT",
     "SAT_KINDS",
     "bank_block",
     "bank_step",

@@ -23,6 +23,7 @@ path and part of file names. It must not be a built-in washout's name or ``aircr
 from __future__ import annotations
 
 import json
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -55,6 +56,14 @@ class Washout:
     params: WashoutParams
     source: str | None = None
     """For a plugin loaded from a file: its ``FILE.py:NAME`` (so a worker process can load it too)."""
+
+
+def tilt_rate_limit_radps(washout: Washout) -> float | None:
+    """The tilt-rate limit (rad/s) of a washout whose tilt rate the bench records (a compiled washout: the classical
+    and adaptive kinds, ``tilt.rate_limit_degps``); None when it has none (``off``) or is not compiled."""
+    if washout.kind not in WASHOUT_KINDS or washout.params.tilt.rate_limit_degps is None:
+        return None
+    return math.radians(washout.params.tilt.rate_limit_degps)
 
 
 @dataclass(frozen=True)

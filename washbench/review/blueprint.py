@@ -244,8 +244,9 @@ def _motion_tab(layout: Layout, prefix: str, ranges: Sequence[tuple[float, float
 
 
 def usage_columns(n_panels: int) -> int:
-    """Columns of the envelope tab's usage grid: three with more than four panels, else two."""
-    return 3 if n_panels > 4 else 2
+    """Columns of the envelope tab's usage grid: four with more than six panels (the Atlas's seven: two rows, as
+    tall as its six were before the tilt rate joined them), three with more than four, else two."""
+    return 4 if n_panels > 6 else 3 if n_panels > 4 else 2
 
 
 ENVELOPE_LANES_MAX = 0.5

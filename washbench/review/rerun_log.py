@@ -12,8 +12,11 @@ the nanosecond):
 - ``/envelope/<quantity>``: platform envelope usage, one scalar per washout, drawn with Max aggregation, and the
   limit line ``/envelope/<quantity>/limit`` at 1 (:func:`usage_panels`): max over the three axes of |value| / limit
   for position, velocity, acceleration and wheels, the cockpit's |omega| / rate limit (``rate``, the Atlas), a rig's
-  angles / its stops (``angle``); ``/envelope/tilt_rate_held``: the seconds each washout has been held at its
-  tilt-rate limit so far (no limit line);
+  angles / its stops (``angle``); ``/envelope/tilt_rate``: the tilt-coordination rate each washout with one
+  commanded (deg/s, after its tilt-rate limit, measured as the limit measures it: the norm, or the largest axis),
+  one scalar per such washout, and ``/envelope/tilt_rate/limit`` a line at each tilt-rate limit (deg/s);
+  ``/envelope/tilt_rate_held``: the seconds each washout has been held at its tilt-rate limit so far (no limit
+  line);
 - ``/platform/<washout>/<quantity>/axes``: the platform's stage position, velocity, acceleration (NED, SI) and
   omni-wheel speeds (rad/s), three scalars per row, with ``limit_max`` and ``limit_min`` lines where the platform has
   that limit;
@@ -187,6 +190,10 @@ class PlatformSeries:
     acc_mps2: np.ndarray  # (N,3) m/s^2
     wheel_radps: np.ndarray  # (N,3) omni-wheel speeds, rad/s
     saturated: dict[str, np.ndarray] = field(default_factory=dict)  # limit kind -> bool (N,)
+    # the tilt-coordination rate the washout commanded, after its tilt-rate limit, rad/s (N,); None (or all NaN): a
+    # washout without tilt coordination, or one whose tilt rate the bench does not know (no line)
+    tilt_rate_radps: np.ndarray | None = None
+    tilt_rate_limit_radps: float | None = None  # its tilt-rate limit, rad/s; None: none (no limit line)
 
 
 @dataclass(frozen=True)
@@ -361,6 +368,11 @@ def _check(data: RecordingData) -> int:
             _check_array(f"platforms[{w}].{fname}", getattr(p, fname), (n, 3))
         for kind, flags in p.saturated.items():
             _check_array(f"platforms[{w}].saturated[{kind}]", flags, (n,), "b")
+        if p.tilt_rate_radps is not None:
+            _check_array(f"platforms[{w}].tilt_rate_radps", p.tilt_rate_radps, (n,))
+        lim = p.tilt_rate_limit_radps
+        if lim is not None and not (isinstance(lim, int | float) and np.isfinite(lim) and lim > 0):
+            raise ValueError(f"platforms[{w}].tilt_rate_limit_radps: expected a positive number or None, got {lim!r}")
     extra = [f for f in ("rate_radps", "angle_rad") if getattr(data.envelope, f) is not None]
     for fname in [f for _, f, _ in envelope_quantities(data)] + ["sphere_diameter_m", *extra]:
         limit = np.asarray(getattr(data.envelope, fname))
@@ -494,12 +506,26 @@ def _send_motion(
 @dataclass(frozen=True)
 class UsagePanel:
     """One panel of the envelope tab: ``values`` (N, washouts) at ``/envelope/<key>``; ``limit``: the line at 1 (a
-    usage against a limit) or None (a time held, s)."""
+    usage against a limit) or None (a time held, s). A panel of a quantity in its own unit (the tilt rate) names
+    the washouts it has lines for (``names``; None: every washout), its limit ``lines`` (values of ``values``) and
+    the ``tolerance`` its lines are thinned with (None: the usage's or the time held's)."""
 
     key: str
     title: str
     values: np.ndarray
     limit: str | None
+    names: tuple[str, ...] | None = None
+    lines: tuple[float, ...] = (1.0,)
+    tolerance: float | None = None
+
+    def span(self) -> tuple[float, float]:
+        """The y range before its gridlines are fitted: 0 to 15 % above the highest limit line (and above every
+        value) for a quantity against a limit, the values' own range for a time held."""
+        if self.limit is None:
+            return _span([self.values], (0.0,))
+        finite = self.values[np.isfinite(self.values)]
+        top = max([*self.lines, float(finite.max()) if finite.size else 0.0])
+        return (0.0, 1.15 * top)
 
 
 def _max_ratio(values: np.ndarray, limit: np.ndarray) -> np.ndarray:
@@ -521,9 +547,10 @@ def usage_panels(data: RecordingData) -> list[UsagePanel]:
     """The envelope tab's panels (short titles: with nine washouts a panel is a third of the tab wide), each one line
     per washout: the stage's position, velocity and acceleration and the wheel speeds against their limits (max over
     the axes of |value| / limit); the cockpit's rate against its limit
-    (the Atlas sphere: |omega| / rate limit); a rig's angles against its stops; and the time each washout has been
-    held at its tilt-rate limit so far (the limit washouts reach most: a rate inside the washout, not a platform
-    quantity, so its time held, from the ``tilt_rate`` flags)."""
+    (the Atlas sphere: |omega| / rate limit); a rig's angles against its stops; the tilt-coordination rate each
+    washout that has one commanded against its tilt-rate limit (deg/s: a rate inside the washout, not a platform
+    quantity; :func:`tilt_rate_panel`); and the time each washout has been held at its tilt-rate limit so far (the
+    limit washouts reach most, from the ``tilt_rate`` flags)."""
     env, washouts = data.envelope, list(data.washouts)
     t_s = np.asarray(data.t_s, dtype=np.float64)
     panels = []
@@ -541,6 +568,9 @@ def usage_panels(data: RecordingData) -> list[UsagePanel]:
         values = np.column_stack([_max_ratio(_zyx_angles(data.washouts[w].q), limit) for w in washouts])
         shown = "/".join("-" if not np.isfinite(v) else f"{np.degrees(v):.3g}" for v in limit)
         panels.append(UsagePanel("angle", "rig angles / stops", values, f"{shown} deg"))
+    tilt = tilt_rate_panel(data)
+    if tilt is not None:
+        panels.append(tilt)
     if any("tilt_rate" in data.platforms[w].saturated for w in washouts):
         dt = float(t_s[1] - t_s[0]) if t_s.size > 1 else 0.0
         held = [np.cumsum(np.asarray(data.platforms[w].saturated.get("tilt_rate", np.zeros(t_s.size, bool)),
@@ -550,6 +580,29 @@ def usage_panels(data: RecordingData) -> list[UsagePanel]:
     return panels
 
 
+def tilt_rate_panel(data: RecordingData) -> UsagePanel | None:
+    """The tilt-coordination rate each washout commanded (deg/s; a washout whose tilt rate is unknown or NaN
+    throughout has no line), against its tilt-rate limit: one line at each limit the washouts drawn have (one for
+    all when they share it). None when no washout has a tilt rate."""
+    names, columns, limits = [], [], []
+    for w in data.washouts:
+        p = data.platforms[w]
+        rate = None if p.tilt_rate_radps is None else np.asarray(p.tilt_rate_radps, dtype=np.float64)
+        if rate is None or not np.isfinite(rate).any():
+            continue
+        names.append(w)
+        columns.append(np.degrees(rate))
+        if p.tilt_rate_limit_radps is not None:
+            limits.append(float(np.degrees(p.tilt_rate_limit_radps)))
+    if not names:
+        return None
+    lines = tuple(sorted(set(limits)))
+    text = "limit " + "/".join(f"{v:.3g}" for v in lines) + " deg/s" if lines else None
+    top = max(lines) if lines else max(float(np.nanmax(c)) for c in columns)
+    return UsagePanel("tilt_rate", "tilt rate [deg/s]", np.column_stack(columns), text, tuple(names), lines,
+                      ENVELOPE_TOLERANCE * max(top, 1e-3))  # fmt: skip
+
+
 def _send_platforms(rec: rr.RecordingStream, data: RecordingData, panels: list[UsagePanel]) -> None:
     t_s = np.asarray(data.t_s, dtype=np.float64)
     washouts = list(data.washouts)
@@ -557,7 +610,13 @@ def _send_platforms(rec: rr.RecordingStream, data: RecordingData, panels: list[U
     widths = [WASHOUT_WIDTH] * len(washouts)
     for panel in panels:
         path = envelope_usage_path(panel.key)
-        if panel.limit is not None:
+        if panel.names is not None:  # a quantity in its own unit, lines for some washouts, a line at each limit
+            if panel.lines:
+                _limit_line(rec, f"{path}/limit", t_s, list(panel.lines), [f"limit ({v:.3g})" for v in panel.lines])
+            shown = list(panel.names)
+            _series(rec, path, t_s, panel.values, shown, [series_color(w, washouts) for w in shown],
+                    [WASHOUT_WIDTH] * len(shown), panel.tolerance, "Max")  # fmt: skip
+        elif panel.limit is not None:
             _limit_line(rec, f"{path}/limit", t_s, [1.0], [f"limit ({panel.limit})"])
             _series(rec, path, t_s, panel.values, washouts, colors, widths, ENVELOPE_TOLERANCE, "Max")
         else:  # a time held: tolerance a tenth of a step
@@ -784,7 +843,7 @@ def _layout(data: RecordingData, perceived: list[np.ndarray], raw: list[np.ndarr
     """The blueprint's data: the panels' y ranges each labelled with two gridlines at least at the plot height the
     layout gives them in the design window (:func:`washbench.review.viewer_geometry.labelled_range`)."""
     offsets = scene3d.object_offsets(len(data.washouts), data.envelope.axes("pos_m"), data.envelope.sphere_diameter_m)
-    usage_spans = [(0.0, 1.15) if p.limit is not None else _span([p.values], (0.0,)) for p in panels]
+    usage_spans = [(0.0, 1.15) if p.limit is not None and p.names is None else p.span() for p in panels]
     kinds = [k for k in saturation_labels(data.platform)
              if any(np.any(data.platforms[w].saturated.get(k, False)) for w in data.washouts)]  # fmt: skip
     labels = saturation_labels(data.platform)

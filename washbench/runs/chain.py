@@ -387,6 +387,8 @@ def stream_cue(
     if bank.platform != "atlas":  # the ceiling's relaxation is widened to what each washout did (bound_stage)
         keep = tuple(dict.fromkeys(keep + _RELAXATION_FIELDS))
     kept = {w: {f: np.empty((n, _width(f, bank.platform))) for f in keep} for w in names}
+    tilt = CueingBank.FIELDS.index("tilt_rate_radps")
+    tilt_rates = {w: np.empty(n) for w in names}  # the tilt rate each commanded (the recording's envelope tab)
     flags: dict[str, dict[str, np.ndarray]] = {w: {} for w in names}
     # two chunk buffers filled in turn: the traces' writer thread still reads the one before (write_trace_chunks)
     bufs = [np.empty((len(names), min(chunk_rows, n), len(CueingBank.FIELDS))) for _ in range(2)]
@@ -401,7 +403,8 @@ def stream_cue(
             perceived = {AIRCRAFT: streams[AIRCRAFT].perceive(motion.f_mps2[rows], motion.omega_radps[rows])}
             sick[AIRCRAFT].update(motion.f_mps2[rows], motion.omega_radps[rows])
             fields, saturated = {}, {}
-            finite = bool(np.isfinite(block).all())  # one check of the chunk; the failing field named if not
+            # one check of the chunk (but the tilt rate, NaN for a washout without one); the failing field named if not
+            finite = bool(np.isfinite(block[..., :tilt]).all() and np.isfinite(block[..., tilt + 1 :]).all())
             for i, w in enumerate(names):
                 tr = WashoutTrace.from_rows(block[i], copy=False, platform=bank.platform)  # views, used in the chunk
                 fields[w] = {f: getattr(tr, f) for f in _TRACE_FIELDS} if finite else _checked_trace(w, tr, b - a, a)
@@ -411,6 +414,7 @@ def stream_cue(
                 sick[w].update(fields[w]["head_f_mps2"], fields[w]["head_omega_radps"])
                 for f in keep:
                     kept[w][f][rows] = fields[w][f]
+                tilt_rates[w][rows] = tr.tilt_rate_radps
                 for k, v in tr.saturated.items():
                     flags[w].setdefault(k, np.empty(n, dtype=bool))[rows] = v
             for pilot, per in perceived.items():
@@ -424,7 +428,8 @@ def stream_cue(
     heads[AIRCRAFT] = motion.f_mps2
     metrics = _metric_rows(felt, motion.dt_s, heads, {p: st.msi_pct for p, st in sick.items()}, measure)
     counts = bank.saturation_counts()
-    traces = {w: SimpleNamespace(**kept[w], saturated=flags[w], saturation_counts=counts[w]) for w in names}
+    traces = {w: SimpleNamespace(**kept[w], saturated=flags[w], saturation_counts=counts[w],
+                                 tilt_rate_radps=tilt_rates[w]) for w in names}  # fmt: skip
     return CueResult(motion=motion, traces=traces, perceived=felt, metrics=metrics, algorithms=bank.algorithm_reports())
 
 

@@ -25,6 +25,7 @@ import numpy as np
 from washbench.analysis.best_motion import Scoring
 from washbench.analysis.felt import DEFAULT_MEASURE, FeltMeasure
 from washbench.analysis.ranking import perceived_motion
+from washbench.cueing.variants import tilt_rate_limit_radps
 from washbench.errors import WashbenchError, located, printable
 from washbench.io.atomic import atomic_path
 from washbench.io.columns import AIRCRAFT
@@ -256,7 +257,8 @@ def write_outputs(
                             q = recorded_attitude(seg.motion)
                             props = flat_strings(provenance, created) if provenance else None
                             write_run_recording(rrd, title, seg.motion, result, run.limits, q, [], props,
-                                                run.rank_rule, bound)  # fmt: skip
+                                                run.rank_rule, bound,
+                                                {w.name: tilt_rate_limit_radps(w) for w in run.washouts})  # fmt: skip
                 done.append((summary, result))
     except OSError as exc:
         raise WashbenchError(located(out_dir, f"cannot write results: {exc.strerror or exc}")) from None

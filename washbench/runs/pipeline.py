@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 
 from washbench.analysis.ranking import perceived_motion
+from washbench.cueing.variants import tilt_rate_limit_radps
 from washbench.errors import WashbenchError, located, printable
 from washbench.flight.fly import fly, write_flight
 from washbench.flight.manoeuvre import load_manoeuvre
@@ -209,7 +210,8 @@ def write_cued_folder(
             title = f"{summary.aircraft} / {summary.manoeuvre}"
             props = flat_strings(provenance, str((extra or {}).get("created_utc") or "")) if provenance else None
             write_run_recording(folder / RECORDING_FILE, title, motion, result, options.limits, aircraft_q, phases,
-                                props, options.rank_rule, bound)  # fmt: skip
+                                props, options.rank_rule, bound,
+                                {w.name: tilt_rate_limit_radps(w) for w in options.washouts})  # fmt: skip
     return summary
 
 

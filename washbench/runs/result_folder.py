@@ -133,12 +133,15 @@ def write_run_recording(
     properties: dict[str, str] | None = None,
     rule: RankRule = DEFAULT_RULE,
     ceiling: Mapping[str, Any] | None = None,
+    tilt_limits: Mapping[str, float | None] | None = None,
 ) -> None:
     """The recording of one result folder (``run`` and ``cue`` alike): the one call of the recording writer.
 
     ``aircraft_q`` (N, 4) the aircraft's attitude, body -> NED, scalar first; ``phases`` (name, start, end) [s];
     ``properties``: the provenance as flat strings (:func:`washbench.io.provenance.flat_strings`); ``ceiling``:
-    run.json's ``bound`` record (:func:`washbench.runs.bound_stage.bound_outputs`), when the bound ran.
+    run.json's ``bound`` record (:func:`washbench.runs.bound_stage.bound_outputs`), when the bound ran;
+    ``tilt_limits``: washout -> its tilt-rate limit, rad/s, or None (:func:`washbench.cueing.variants.
+    tilt_rate_limit_radps`), drawn under the tilt rates the traces hold (``tilt_rate_radps``).
     """
     from washbench.review.rerun_log import (  # deferred: rerun
         HexapodDrawing,
@@ -162,7 +165,9 @@ def write_run_recording(
         )
         wheels = tr.wheel_radps if np.shape(tr.wheel_radps)[1:] == (3,) else np.zeros((len(tr.pos_m), 3))  # (unused)
         platforms[name] = PlatformSeries(
-            pos_m=tr.pos_m, vel_mps=tr.vel_mps, acc_mps2=tr.acc_mps2, wheel_radps=wheels, saturated=tr.saturated
+            pos_m=tr.pos_m, vel_mps=tr.vel_mps, acc_mps2=tr.acc_mps2, wheel_radps=wheels, saturated=tr.saturated,
+            tilt_rate_radps=getattr(tr, "tilt_rate_radps", None),
+            tilt_rate_limit_radps=(tilt_limits or {}).get(name),
         )
     hexapod = None
     kind = getattr(limits, "kind", "atlas")
