@@ -53,6 +53,19 @@ def test_worse_than_no_motion_is_said_and_marked() -> None:
     assert "beats the best reference on 1 of 2" in text and "c172p / turn (still 1.00 against 1.10)" in text
 
 
+def test_a_reference_within_the_margin_is_neither_beaten_nor_better() -> None:
+    # 0.975 against still's 0.993: 1.8 %, inside the 3 % margin (the C172 coordinated turn of the bundled suite)
+    entries = [_entry("c172p / turn", {"small-angle": 1.2, "mpc": 0.975, "still": 0.993}),
+               _entry("c172p / climb", {"small-angle": 0.3, "mpc": 0.2, "still": 1.0}),
+               _entry("c172p / roll", {"small-angle": 0.9, "mpc": 0.8, "still": 0.7})]  # fmt: skip
+    text = _text(entries, ["small-angle", "mpc", "still"])
+    assert "beats the best reference on 1 of 3" in text
+    assert "Within the ranking's margin of it (3 % or 0.005), neither better, on c172p / turn (still 0.993 against " \
+           "0.975)" in text  # fmt: skip
+    assert "A reference does better (◆ below) on c172p / roll (still 0.700 against 0.800)" in text
+    assert "◆" not in next(x for x in text.splitlines() if x.startswith("| c172p / turn"))
+
+
 def test_what_was_not_compared_and_the_command_that_does() -> None:
     text = _text([_entry("c172p / a", {"small-angle": 0.5, "large-angle": 0.4})], ["small-angle", "large-angle"])
     assert "Compared: 2 washouts (small-angle, large-angle)." in text

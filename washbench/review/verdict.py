@@ -227,16 +227,23 @@ def verdict_lines(
     # the references and the still platform
     marks: dict[str, list[str]] = {e.label: [] for e in ranked}
     if refs:
-        ref_wins = []
+        ref_wins, ref_ties = [], []
         for e in ranked:
             _, b = best_of(e, causal)
             rn, rv = best_of(e, refs)
-            if rn and math.isfinite(b) and rv < b:
+            if not (rn and math.isfinite(b)):
+                continue
+            if tie_groups([b, rv], rule.tie_relative, rule.tie_absolute) == [1, 1]:
+                ref_ties.append(f"{e.label} ({rn} {sig(rv)} against {sig(b)})")
+            elif rv < b:
                 ref_wins.append(f"{e.label} ({rn} {sig(rv)} against {sig(b)})")
                 marks[e.label].append(REFERENCE_MARK)
-        beaten = n - len(ref_wins)
+        beaten = n - len(ref_wins) - len(ref_ties)
         text = (f"Against the naive references ({_list(refs)}): the best washout of each manoeuvre beats the best "
                 f"reference on {beaten} of {n}.")
+        if ref_ties:
+            text += (f" Within the ranking's margin of it ({100 * rule.tie_relative:g} % or {rule.tie_absolute:g}), "
+                     "neither better, on " + "; ".join(ref_ties) + ".")  # fmt: skip
         if ref_wins:
             text += f" A reference does better ({REFERENCE_MARK} below) on " + "; ".join(ref_wins) + "."
         lines += [text, ""]
