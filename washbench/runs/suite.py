@@ -202,9 +202,12 @@ def _run_alone(a: tuple[str, str, RunOptions], opts: RunOptions) -> list[Outcome
         try:
             return fut.result()
         except BrokenProcessPool:
-            for p in processes:
-                p.join(5.0)
-            code = processes[0].exitcode if processes else None
+            pass
+    # the pool's own thread has joined its dead worker by now (leaving the block waits for it); joining it here while
+    # that thread does would race for the exit status (a forkserver's child reports it once: the loser reads 255)
+    for p in processes:
+        p.join(5.0)
+    code = processes[0].exitcode if processes else None
     return [Outcome(path=a[0], wall_s=0.0, run=RunSummary(ok=False, reason=worker_died(code)))]
 
 
