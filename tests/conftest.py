@@ -42,6 +42,25 @@ WARM_ENV = "WASHBENCH_TESTS_WARM_FOLDER"
 WARM_WAIT_S = 600.0
 
 
+SLOW_ENV = "WASHBENCH_SLOW"
+"""Set (to anything), the tests marked ``slow`` run too: the exhaustive and measuring ones that would take the README's
+test command past four minutes on two cores (``.ci/run`` runs them after it: ``WASHBENCH_SLOW=1 pytest -m slow``)."""
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    config.addinivalue_line("markers", f"slow: run only with {SLOW_ENV}=1 (.ci/run runs them after the test command)")
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Without :data:`SLOW_ENV`, the tests marked ``slow`` are skipped, saying how to run them."""
+    if os.environ.get(SLOW_ENV):
+        return
+    skip = pytest.mark.skip(reason=f"slow tier: {SLOW_ENV}=1 pytest -m slow (.ci/run runs it)")
+    for item in items:
+        if item.get_closest_marker("slow") is not None:
+            item.add_marker(skip)
+
+
 def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
     """``-n auto``: the CPUs this process may use (not the machine's) and :data:`EXTRA_WORKERS`, at most
     :data:`MAX_WORKERS`."""

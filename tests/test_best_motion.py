@@ -172,6 +172,7 @@ def test_the_programme_predicts_what_the_platform_flies_where_it_is_exact(flown)
     assert flown_value < yard.value(still.head_f_mps2, still.head_omega_radps)  # the stage's plan gains
 
 
+@pytest.mark.slow
 def test_the_search_s_model_is_above_what_a_programme_takes() -> None:
     """The cost model (washbench.io.cost.BOUND_SEARCH, with its margin) is an upper estimate of one programme's peak,
     measured in a fresh process as bench/cost_calibration.py measures it (2,400 samples: measured 0.78 of it)."""

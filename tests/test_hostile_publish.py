@@ -89,6 +89,7 @@ def _staged(out: Path) -> int:
     return count
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("command", ["sweep", "tune", "omct"])
 def test_a_signal_as_the_first_or_last_file_lands_leaves_one_whole_set(
     command: str, flights: Path, previous: dict[str, Path], tmp_path: Path

@@ -493,6 +493,7 @@ def test_a_ctrl_c_while_an_extension_module_initialises_is_one_line(tmp_path: Pa
     assert proc.stderr.strip() == "washbench: interrupted" and proc.stdout == "", (proc.stdout, proc.stderr)
 
 
+@pytest.mark.slow
 def test_run_signalled_as_its_recording_lands_keeps_the_previous_result(tmp_path: Path) -> None:
     """The real case (timing-dependent, so twice per signal): the previous result folder stays, one line, no
     traceback, status 130/143."""
@@ -540,6 +541,7 @@ def _stage_names(out: Path) -> set[str]:
     return {f"{s.name}/{p.name}" for s in out.glob(STAGE_PREFIX + "*") for p in s.iterdir()}
 
 
+@pytest.mark.slow
 def test_a_signal_whenever_a_file_lands_leaves_the_previous_set_whole(cued: Path, motion: Path, tmp_path: Path) -> None:
     """cue over its previous set, signalled (SIGINT, SIGTERM in turn) as the n-th new file lands in the stage, for
     n = 1, 2, ... until the run completes first: the folder then holds exactly the previous set (or, had the
@@ -695,6 +697,7 @@ def test_a_suite_killed_while_its_server_starts_leaves_no_process(tmp_path: Path
 # ------------------------------------------------------------------------------------------ bounds, inputs
 
 
+@pytest.mark.slow
 def test_what_a_command_would_allocate_is_bounded_before_allocating(motion: Path, tmp_path: Path) -> None:
     script = tmp_path / "long.xml"
     script.write_text(
@@ -845,6 +848,7 @@ def test_dask_address_that_is_no_scheduler_is_one_line_quickly(tmp_path: Path) -
 # ------------------------------------------------------------------------------------------ read back
 
 
+@pytest.mark.slow
 def test_report_on_tampered_result_files_rebuilds_or_refuses_cleanly(cued: Path, tmp_path: Path) -> None:
     """Hypothesis: washbench's own result files mutated (types, missing keys, text columns): `washbench report`
     either rebuilds the report (exit 0) or refuses with one line naming the file (exit 2); never a traceback."""

@@ -128,6 +128,7 @@ BAD_PLUGINS: dict[str, tuple[dict[str, str], str]] = {
 }
 
 
+@pytest.mark.slow
 def test_a_plugin_s_exit_interrupt_or_odd_values_are_one_line(step_csv: Path, tmp_path: Path) -> None:
     """sys.exit() anywhere in a plugin (module, factory, step, a value's __float__), a KeyboardInterrupt with no
     Ctrl-C, flags() giving an array or values whose __bool__ raises, trace() giving a dict: exit 2 and one line

@@ -404,6 +404,7 @@ def test_small_angle_yaw_to_yaw_is_the_rotational_high_pass(omct_run: tuple[Path
     assert checked == 10  # 0.1 .. 6.31 rad/s
 
 
+@pytest.mark.slow
 def test_a_bode_plot_drawn_after_others_has_the_pixels_of_one_drawn_alone(tmp_path: Path) -> None:
     """``write_bode_plots`` draws each test into the previous test's emptied figure (a new figure's tick marks are
     most of the drawing time): every PNG must have the bytes of the same plot drawn alone in a new figure, whatever

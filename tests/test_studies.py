@@ -289,6 +289,7 @@ def test_bad_study_options_are_one_line(capsys: pytest.CaptureFixture[str], tmp_
     assert not (tmp_path / "o").exists()
 
 
+@pytest.mark.slow
 def test_dask_cluster_gives_the_local_results(sweep_dir: Path, variant_run: Path, tuned: Path, tmp_path: Path) -> None:
     pytest.importorskip("dask.distributed")
     from dask.distributed import LocalCluster
