@@ -318,16 +318,17 @@ MPC_MEMORY = (32e6, 7_400.0)
 """mpc on the Atlas, a rig or a plugin's platform."""
 MPC_HEXAPOD_MEMORY = (42e6, 11_200.0)
 """mpc on a hexapod (the whitened QP and the legs' rows besides)."""
-MPC_UNRESTRICTED_MEMORY = (40e6, 200.0)
-"""mpc-unrestricted (its moves are blocked: a QP of a few dozen variables; N x N prediction matrices)."""
+MPC_UNRESTRICTED_MEMORY = (40e6, 400.0)
+"""mpc-unrestricted (its moves are blocked: a QP of a few dozen variables and the felt error's slacks, which grow with
+N; N x N prediction matrices)."""
 MPC_BUILD_S = ((20, 0.025), (50, 0.68), (100, 1.79), (200, 14.3), (300, 59.5), (500, 305.0))
 MPC_HEXAPOD_BUILD_S = ((50, 1.11), (100, 3.45), (200, 19.1), (300, 44.7), (500, 174.0))
-MPC_UNRESTRICTED_BUILD_S = ((50, 0.05), (100, 0.054), (200, 0.117))
+MPC_UNRESTRICTED_BUILD_S = ((50, 0.12), (100, 0.22), (200, 0.49))
 """Seconds to build the QP and set its solver up (mpc: the condensed Hessian's accumulation, then DAQP's
 factorisation at the first solve; on a hexapod the whitening, its first solve cheap)."""
 MPC_STEP_S = ((20, 0.00019), (50, 0.00047), (100, 0.0070), (200, 0.030), (300, 0.049), (500, 0.121))
 MPC_HEXAPOD_STEP_S = ((50, 0.00206), (100, 0.0327), (200, 0.0861), (300, 0.146), (500, 0.418))
-MPC_UNRESTRICTED_STEP_S = ((50, 0.00074), (100, 0.00145), (200, 0.00207))
+MPC_UNRESTRICTED_STEP_S = ((50, 0.0011), (100, 0.0011), (200, 0.0023))
 """Seconds per sample: this sample's QP data and a warm-started solve of a few iterations (a hard flight needs
 more; the washout times its first samples and says so, :mod:`washbench.cueing.mpc`)."""
 
