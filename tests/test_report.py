@@ -296,7 +296,7 @@ def test_flat_provenance_for_the_recording(run_dir: Path, inputs: dict[str, Path
 
 def test_time_beyond_the_threshold_counts_the_felt_samples(run_dir: Path) -> None:
     text = (run_dir / "report.md").read_text()
-    row = next(ln for ln in text.splitlines() if "beyond the perception threshold" in ln)
+    row = next(ln for ln in text.splitlines() if ln.startswith("|") and "beyond the perception threshold" in ln)
     values = [float(c) for c in row.strip("|").split("|")[1:]]
     roll = pq.read_table(run_dir / "traces.parquet").column("aircraft.perceived_omega_x_degps").to_numpy()
     # rolling into a 25 deg bank is felt (Zacharias roll threshold 3.0 deg/s around the rate perceived at the start),

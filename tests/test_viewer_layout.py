@@ -254,6 +254,17 @@ def test_without_the_bound_the_metrics_panel_does_not_speak_of_it() -> None:
     assert "(the oracle bound, in italics, is a reference)" in with_bound
 
 
+def test_a_blank_npc_is_said_to_be_undefined() -> None:
+    """A platform standing still gives the simulator pilot no perceived change: NPC (a correlation) is not defined
+    (NaN in metrics.csv), its cells are blank, and one line under the NPC table says why."""
+    rows = [MetricRow(w, d, 1.0, 2.0, 3.0) for w in THREE for d in DOFS]
+    assert "A blank NPC" not in metrics_table_markdown("c172p / steep_turn", rows, [], "felt")
+    rows += [MetricRow("still", d, math.nan, 2.0, 3.0) for d in DOFS]
+    text = metrics_table_markdown("c172p / steep_turn", rows, [], "felt")
+    assert "| still |" + "  |" * len(DOFS) in text
+    assert "A blank NPC: not defined" in text and text.index("A blank NPC") < text.index("integral of |error|")
+
+
 def test_the_metrics_panel_gives_the_ceiling_and_each_washouts_share_recovered() -> None:
     """With the bound's record (run.json ``bound``), the ranking ends with the ceiling, and each washout's recovered
     share is the record's: (still - score) / (still - ceiling), here with still = 1 (one DOF weighted 1)."""

@@ -99,4 +99,7 @@ def metrics_table_markdown(
                 else:
                     cells.append(f"**{_num(v)}**" if v == best[dof] else _num(v))
             lines.append("| " + " | ".join(cells) + " |")
+        if metric == "npc" and any(math.isnan(getattr(r, metric)) for r in rows if r.washout != BOUND_WASHOUT):
+            lines += ["", "A blank NPC: not defined (a simulator pilot who perceives no change there, as on a "
+                      "platform standing still, has nothing to correlate)."]  # fmt: skip
     return "\n".join(lines) + "\n"

@@ -47,7 +47,7 @@ from washbench.review.result_data import ResultData, load_result
 
 FLAG = SCORE_FLAG
 SCORE_NOTE = (
-    f"{FLAG} a score above 1: the washout's perceived error is larger than that of a simulator that stands still, "
+    f"{FLAG} a value above 1: the washout's perceived error is larger than that of a simulator that stands still, "
     "i.e. it gives more false cues than it gives true ones on this manoeuvre."
 )
 _UNITS = {
@@ -206,6 +206,19 @@ def end_stop_note(data: ResultData, washout: str) -> str:
             f"({pct(100.0 * steps / data.n, False)}), the score reflects its hard stops")  # fmt: skip
 
 
+_RULE_FORMULA = {
+    "felt": "Felt error: per DOF, the perceived error beyond the perception thresholds, its false part once more and "
+    "(surge, sway, heave) the jolts the platform adds, in threshold units, over the motion the aircraft pilot felt "
+    "above threshold; summed with each DOF weighted by what the pilot felt there (0 perfect, 1 no better than "
+    "standing still; docs/metrics.md).",
+    "score": "Score: sum over DOFs of weight x integral error / the aircraft pilot's own perceived motion in that DOF "
+    "(0 perfect, 1 no better than standing still).",
+    "weighted": "Weighted: sum over DOFs of the parameter file's weight x integral error / the aircraft pilot's own "
+    "perceived motion in that DOF (0 perfect, 1 no better than standing still).",
+}
+"""How each ranking rule's value is made, one sentence for the run report (its weights follow)."""
+
+
 def ranking_lines(
     data: ResultData, ranking: list[RankRow], rule: RankRule = DEFAULT_RULE, explain: bool = True
 ) -> list[str]:
@@ -213,7 +226,7 @@ def ranking_lines(
     margin and the DOF weights used. ``explain=False`` (the suite report, which explains once): the weights only."""
     if not ranking:
         return []
-    unit = "false-cue time (DOF lengths)" if rule.by == "false-cue" else "score (-)"
+    unit = {"false-cue": "false-cue time (DOF lengths)", "felt": "felt error (-)"}.get(rule.by, "score (-)")
     flag = rule.by != "false-cue"
     notes = {r.washout: end_stop_note(data, r.washout) for r in ranking}
     for r in ranking:
@@ -240,13 +253,8 @@ def ranking_lines(
     if undecided(ranking):
         lines += ["", "**The first place is a tie**: the best values differ by less than the tie margin."]
     if rule.by != "false-cue":
-        lines += [
-            "",
-            "Score: sum over DOFs of weight x integral error / the aircraft pilot's own perceived motion in that DOF "
-            "(0 perfect, 1 no better than standing still). Weights: "
-            + ", ".join(f"{d} {sig(weights[d], 2)}" for d in DOFS)
-            + ".",
-        ]
+        lines += ["", _RULE_FORMULA.get(rule.by, _RULE_FORMULA["score"]) + " Weights: "
+                  + ", ".join(f"{d} {sig(weights[d], 2)}" for d in DOFS) + "."]  # fmt: skip
     if flag and any(r.score > 1.0 for r in ranking):
         lines += ["", SCORE_NOTE]
     return [*lines, ""]
