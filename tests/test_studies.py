@@ -253,6 +253,29 @@ def test_tune_beats_cw1_and_tuned_yaml_reproduces_its_score(tuned: Path, sweep_d
     assert (tuned / "convergence.png").read_bytes()[:4] == b"\x89PNG"
 
 
+def test_tune_from_a_start_outside_its_interval_reports_the_tuned_set_s_own_objective(
+    sweep_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """CW1's tilt gain (0.4 /s) outside the interval searched (0.02..0.05 /s, a tilt too slow to give the sustained force):
+    the tuned objective printed is the tuned set's own evaluation in tune.csv, not the better start's, and a note
+    says that the start scores better and lies outside the interval (before, the start's objective was printed as
+    the tuned one)."""
+    out = tmp_path / "t"
+    args = ["tune", *map(str, MANOEUVRES), "--washout", "large-angle", "--tune", "tilt.gain_per_s=0.02:0.05", "--budget",
+            "6", "--seed", "3", "--from", str(sweep_dir / "flights"), "--out", str(out), "--quiet"]  # fmt: skip
+    assert main(args) == 0
+    printed = capsys.readouterr().out
+    rows = read_csv(out / "tune.csv")
+    tuned_gain = yaml.safe_load((out / "tuned.yaml").read_text())["tilt"]["gain_per_s"]
+    (tuned_row,) = [r for r in rows[1:] if float(r["tilt.gain_per_s"]) == tuned_gain][:1]
+    start = float(rows[0]["objective"])
+    assert start < min(float(r["objective"]) for r in rows[1:])  # the start is better than anything searched
+    assert f"-> tuned {float(tuned_row['objective']):.4f}" in printed, printed
+    assert f"-> tuned {start:.4f}" not in printed
+    assert "The starting set scores better" in printed and "tilt.gain_per_s = 0.4 outside 0.02..0.05" in printed
+    assert "The starting set scores better" in (out / "report.md").read_text()
+
+
 def test_tune_is_deterministic_for_a_seed(tuned: Path, sweep_dir: Path, tmp_path: Path) -> None:
     args = [
         "tune",

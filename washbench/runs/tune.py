@@ -145,6 +145,10 @@ def tune_command(
     )
     for line in score_lines(base.name, table):
         print(line)
+    x0 = np.array([_value(base, k) for k in keys])
+    for line in start_outside(bounds, x0, base_obj, best[3]):
+        if line:
+            print(f"tune: note: {line}")
     for line in at_edges(bounds, best_x):  # the optimum may lie beyond what was searched: say so
         print(f"tune: note: {line}: the best may lie outside it; widen --tune {line.split(' ')[0]}=LOW:HIGH")
     return 0
@@ -225,17 +229,39 @@ def _tune(
     for group, fl in (("training", train), ("test", tests)):
         for f, r in zip(fl, evaluate(fl, both, dask) if fl else [], strict=True):
             table.append((group, f.aircraft, f.manoeuvre, r))
+    chosen = tuned_index(history, best_x)
+    notes = [*_pilot_note(pilot, pilot_distance, chosen), *start_outside(bounds, x0, base_obj, history[chosen][3])]
     _report(out_dir, base, tuned, kind, bounds, best_x, table, history, base_obj, budget, seed, saturation_weight,
-            _pilot_note(pilot, pilot_distance, history))  # fmt: skip
-    best = (*min(history, key=lambda h: h[3]), len(history))
+            notes)  # fmt: skip
+    best = (*history[chosen], len(history))
     return best_x, best, base_obj, train, table
 
 
-def _pilot_note(pilot: tuple[PilotObjective, float] | None, distances: list[float], history: list) -> list[str]:
+def tuned_index(history: list, best_x: np.ndarray) -> int:
+    """The evaluation (index into ``history``, whose 0 is the starting set as given) of the tuned set ``best_x``:
+    the search's own evaluation of it (1 on), or its least objective when none is equal (not expected)."""
+    same = [i for i in range(1, len(history)) if np.array_equal(history[i][0], best_x)]
+    if same:
+        return same[0]
+    return min(range(1, len(history)), key=lambda i: history[i][3]) if len(history) > 1 else 0
+
+
+def start_outside(bounds: list[Bound], x0: np.ndarray, base_obj: float, tuned_obj: float) -> list[str]:
+    """A note when the starting set lies outside an interval searched and scores better than the tuned set (the
+    search starts from its nearest point inside the intervals, so the tuned set is never worse than that one, but
+    may be worse than the start itself); none otherwise."""
+    out = [f"{b.key} = {x:.6g} outside {b.low:g}..{b.high:g}" for b, x in zip(bounds, x0, strict=True)
+           if not b.low <= x <= b.high]  # fmt: skip
+    if not out or not base_obj < tuned_obj:
+        return []
+    return [f"The starting set scores better ({base_obj:.4f}) than the best set inside the intervals searched "
+            f"({tuned_obj:.4f}): it lies outside them ({'; '.join(out)}); widen the interval to include it.", ""]
+
+
+def _pilot_note(pilot: tuple[PilotObjective, float] | None, distances: list[float], best: int) -> list[str]:
     """The report's lines on the pilot objective (none without ``--pilot``)."""
     if pilot is None or not distances:
         return []
-    best = min(range(len(history)), key=lambda i: history[i][3])
     return [
         f"Pilot objective: {pilot[1]:g} x the distance from flight (%) / 100 of the pilot model's measures on "
         f"the tracking task {pilot[0].label} ({pilot[0].task_path}), as its adaptation predicts them "
