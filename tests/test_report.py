@@ -133,9 +133,9 @@ def test_every_linked_figure_exists_and_is_an_image(run_dir: Path) -> None:
 
 
 def test_every_table_is_well_formed(run_dir: Path) -> None:
-    # provenance, ranking, cue classification, motion sickness dose, three metric tables, time at a limit, checks,
-    # phases
-    assert check_tables(run_dir / "report.md") == 10
+    # provenance, ranking, where the felt error comes from, cue classification, motion sickness dose, three metric
+    # tables, time at a limit, checks, phases
+    assert check_tables(run_dir / "report.md") == 11
 
 
 def test_report_reads_like_a_table(run_dir: Path) -> None:
@@ -351,3 +351,31 @@ def test_false_cue_time_is_given_in_seconds(run_dir: Path) -> None:
         frac = sum(float(r["cue_false_frac"]) for r in rows if r["washout"] == washout)
         assert float(seconds) == pytest.approx(frac * length_s, rel=5e-3, abs=1e-9), washout
     assert "False-cue time (sum over DOFs" not in text
+
+
+def test_the_felt_error_s_parts_add_up_to_the_ranking_s_value(run_dir: Path) -> None:
+    """The report's "Where the felt error comes from": each row's DOF parts add up to the washout's felt error in
+    ranking.csv, and each part is its DOF's term worked by hand from metrics.csv and run.json (Zacharias 1978's
+    thresholds as the units, a false cue counted twice, 1 s per m/s^2 of jolt: docs/metrics.md)."""
+    units = {"surge": 0.17, "sway": 0.17, "heave": 0.28, "roll": 3.0, "pitch": 3.6, "yaw": 2.6}
+    text = (run_dir / "report.md").read_text()
+    head = text.index("**Where the felt error comes from**")
+    lines = text[head:].splitlines()[2:]
+    table = lines[: next(i for i, ln in enumerate(lines) if not ln.startswith("|"))]
+    columns = [c.strip() for c in table[0].strip("|").split("|")]
+    assert columns == ["washout", *units, "felt error", "false", "jolts"]
+    ranked = {r["washout"]: float(r["score"]) for r in csv.DictReader((run_dir / "ranking.csv").open())}
+    metrics = {(r["washout"], r["dof"]): r for r in csv.DictReader((run_dir / "metrics.csv").open())}
+    motion = json.loads((run_dir / "run.json").read_text())["perceived_motion"]
+    felt = sum(float(motion[f"felt_{d}"]["value"]) / u for d, u in units.items())
+    rows = [[c.strip() for c in ln.strip("|").split("|")] for ln in table[2:]]
+    assert {r[0] for r in rows} == set(ranked)
+    for name, *cells in rows:
+        parts = [0.0 if c == "< 0.0001" else float(c) for c in cells[:6]]
+        assert sum(parts) == pytest.approx(ranked[name], rel=5e-3, abs=6e-4)
+        assert float(cells[6]) == pytest.approx(ranked[name], rel=5e-3)
+        for (d, u), shown in zip(units.items(), parts, strict=True):
+            m = metrics[(name, d)]
+            jolt = float(m["jolt"] or 0.0) if d in ("surge", "sway", "heave") else 0.0
+            term = (float(m["felt_error"]) + float(m["felt_false"]) + 1.0 * jolt) / u / felt
+            assert shown == pytest.approx(term, rel=5e-3, abs=1e-4), (name, d)

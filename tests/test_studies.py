@@ -256,13 +256,14 @@ def test_tune_beats_cw1_and_tuned_yaml_reproduces_its_score(tuned: Path, sweep_d
 def test_tune_from_a_start_outside_its_interval_reports_the_tuned_set_s_own_objective(
     sweep_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    """CW1's tilt gain (0.4 /s) outside the interval searched (0.02..0.05 /s, a tilt too slow to give the sustained force):
-    the tuned objective printed is the tuned set's own evaluation in tune.csv, not the better start's, and a note
-    says that the start scores better and lies outside the interval (before, the start's objective was printed as
-    the tuned one)."""
+    """CW1's tilt gain (0.4 /s) outside the interval searched (0.02..0.05 /s, a tilt too slow to give the
+    sustained force): the tuned objective printed is the tuned set's own evaluation in tune.csv, not the better
+    start's, and a note says that the start scores better and lies outside the interval (before, the start's
+    objective was printed as the tuned one)."""
     out = tmp_path / "t"
-    args = ["tune", *map(str, MANOEUVRES), "--washout", "large-angle", "--tune", "tilt.gain_per_s=0.02:0.05", "--budget",
-            "6", "--seed", "3", "--from", str(sweep_dir / "flights"), "--out", str(out), "--quiet"]  # fmt: skip
+    args = ["tune", *map(str, MANOEUVRES), "--washout", "large-angle", "--tune", "tilt.gain_per_s=0.02:0.05",
+            "--budget", "6", "--seed", "3", "--from", str(sweep_dir / "flights"), "--out", str(out),
+            "--quiet"]  # fmt: skip
     assert main(args) == 0
     printed = capsys.readouterr().out
     rows = read_csv(out / "tune.csv")

@@ -40,6 +40,7 @@ from washbench.io.outfolder import discard_stage, make_stage, replace_entries
 from washbench.io.result_files import FIGURES_DIR, RECORDING_FILE, REPORT_FILE
 from washbench.review.bound_section import algorithm_lines, bound_lines
 from washbench.review.cue_figures import cue_classes, cue_lane_figure
+from washbench.review.felt_breakdown import felt_breakdown_lines
 from washbench.review.figures import envelope_figure, perceived_figure, saturation_labels
 from washbench.review.input_figure import input_section
 from washbench.review.numbers import SCORE_FLAG, pct, sig
@@ -524,6 +525,8 @@ def result_sections(
     rule = result_rule(data)
     ranking = rank(data.metrics, data.motion, rule) if data.metrics else []
     lines += [f"{h} Ranking", "", *ranking_lines(data, ranking, rule, explain=not brief)]
+    if rule.by == "felt" and not brief:
+        lines += felt_breakdown_lines(data.metrics, data.motion, rule.measure, ranking)
 
     if bounded := bound_lines(data.folder, [r.washout for r in ranking], explain=not brief):
         lines += [f"{h} Against the ceiling", "", *bounded]
