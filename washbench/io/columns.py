@@ -21,7 +21,7 @@ unchanged to ``traces.parquet`` (e.g. the flight pipeline's state columns).
     W.wheel_{1,2,3}_radps                                    Atlas omni-wheel speeds (the Atlas only)
     W.leg_{1..6}_m                                           hexapod leg lengths, joint to joint (a hexapod only)
     W.sp_pos_{x,y,z}_m, W.sp_q_{w,x,y,z}                     the washout's set points for the platform
-    W.tilt_rate_degps                                        tilt-coordination rate commanded (NaN: none known)
+    W.tilt_rate_degps                                        tilt-coordination rate commanded (empty: none known)
     W.sat_<kind>                                             saturation flags, 0/1 (int8)
     <extra input columns, unchanged>
 
@@ -120,7 +120,8 @@ def sp_q_columns(washout: str) -> tuple[str, str, str, str]:
 
 def tilt_rate_column(washout: str) -> str:
     """The tilt-coordination rate the washout commanded [deg/s], after its tilt-rate limit and measured as that limit
-    measures it (``WashoutTrace.tilt_rate_radps``); NaN for a washout that reports none."""
+    measures it (``WashoutTrace.tilt_rate_radps``); empty (null, NaN when read by numpy) for a washout that reports
+    none."""
     return f"{washout}.tilt_rate_degps"
 
 

@@ -300,8 +300,11 @@ def _table_rows(
         _put(table, leg_columns(name), f["leg_m"])
         _put(table, sp_pos_columns(name), f["sp_pos_m"])
         _put(table, sp_q_columns(name), f["sp_q"])
-        tilt = f.get("tilt_rate_radps")  # (NaN where the washout reports none; absent from an older trace: NaN)
-        table[tilt_rate_column(name)] = np.full(len(table[TIME_COLUMN]), np.nan) if tilt is None else tilt * _DEG
+        # empty (null) where the washout reports none (NaN in the trace; no trace field: none), so the column compares
+        # equal to itself as the others do (Arrow's NaN is unequal to NaN); read back as NaN (read_traces)
+        tilt = f.get("tilt_rate_radps")
+        table[tilt_rate_column(name)] = np.ma.masked_invalid(np.full(len(table[TIME_COLUMN]), np.nan) if tilt is None
+                                                             else tilt * _DEG)  # fmt: skip
         for kind, flags in saturated[name].items():
             table[sat_column(name, kind)] = flags.astype(np.int8)
     for col, values in m.extra.items():
