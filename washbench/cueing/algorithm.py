@@ -33,7 +33,8 @@ as the steps; the bench uses it for recorded files, studies and the OMCT).
 Optionally an algorithm has ``steps(f_mps2 (M, 3), omega_radps (M, 3)) -> (pos_m (M, 3), q (M, 4))``: the block
 form, the next M samples from where it is (after :meth:`~WashoutAlgorithm.start` or earlier steps), the same
 numbers as M steps; the bench then calls it once per block of samples (a flight's lockstep takes 120 at a time)
-instead of ``step`` per sample. Its set points are checked as a step's are; it gives no flags.
+instead of ``step`` per sample. Its set points are checked as a step's are; it gives no flags (but see
+``block_tilt`` below).
 
 Optionally a whole-recording algorithm (``whole_only``) has ``consider(alongside)``: before its ``trace`` the bench
 gives it an :class:`Alongside`, the motions the run's other washouts made on the same recording, a way to fly set
@@ -43,6 +44,16 @@ The bound (the best achieved, :mod:`washbench.analysis.best_motion`) is such an 
 
 Optionally an algorithm has ``flags() -> tuple[bool, bool]``: whether its own tilt-rate and rotational-rate limits
 acted on the last step (the ``sat_tilt_rate`` and ``sat_rot_rate`` columns); without it both are False.
+
+Optionally an algorithm has ``tilt_rate() -> float``: the tilt-coordination rate it commanded on the last step,
+rad/s, after its own tilt-rate limit and measured as that limit measures it (the ``mpc`` washout limits the roll
+and pitch tilt rates each: the larger of the two); NaN when it commanded none. The bench records it (the
+``tilt_rate_radps`` field, the recording's ``/envelope/tilt_rate``); without it the field is NaN.
+
+A block form (``trace``, ``steps``) gives no flags and no tilt rate unless the algorithm also has ``block_tilt() ->
+(tilt_rate_radps (M,), at_limit (M,))``: for each of the M samples of its last ``trace`` or ``steps`` call, what
+``tilt_rate()`` and the first of ``flags()`` would have said after that sample's step (the rotational flag of a
+block stays False).
 
 A plugin is a class (or any callable) ``factory(params, context) -> WashoutAlgorithm``; ``params`` is the validated
 section of the parameter file named after the plugin (an instance of the class's ``Params`` pydantic model, or

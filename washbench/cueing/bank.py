@@ -10,7 +10,8 @@ Units and frames: inputs are the specific force at the aircraft pilot's head (ai
 attitude (body->inertial quaternion, scalar first), body angular velocity (rad/s), specific force (m/s^2)
 and angular velocity (rad/s) at the simulator pilot's head in simulator body axes, omni-wheel speeds
 (rad/s), the washout's set points, 0/1 saturation flags per limit kind for the step, and the tilt-coordination
-rate the washout commanded (rad/s, after its tilt-rate limit; NaN for a washout outside the compiled kernel).
+rate the washout commanded (rad/s, after its tilt-rate limit; NaN for a washout outside the compiled kernel unless
+it reports one: ``tilt_rate()``, :mod:`washbench.cueing.algorithm`).
 """
 
 from __future__ import annotations
@@ -277,8 +278,9 @@ class WashoutTrace:
     the washout's set points. saturated: limit kind -> bool (N,) (kinds in ``SAT_KINDS``); saturation_counts: kind
     -> steps at it. leg_m (N, 6): a hexapod's leg lengths, m ((N, 0) on another platform). tilt_rate_radps (N,): the
     tilt-coordination rate the washout commanded, after its tilt-rate limit and measured as that limit measures it
-    (the norm, or the largest axis with ``rate_limit_mode: axis``), rad/s; NaN where the bench knows none (a washout
-    outside the compiled kernel: the references, the bound, the MPCs).
+    (the norm, or the largest axis with ``rate_limit_mode: axis``; the ``mpc`` washout: the larger of its roll and
+    pitch tilt rates), rad/s; NaN where the bench knows none (a washout outside the compiled kernel that reports none:
+    the references, the bound, ``optimal``, ``mpc-unrestricted``).
     """
 
     pos_m: np.ndarray
@@ -433,10 +435,12 @@ class CueingBank:
         self._k = 0  # samples stepped so far
         self._whole = self._whole_setpoints(future)
         self._sources = self._py  # every Python washout (its report())
+        self._tilted = {i: src.tilted for i, src in self._py}  # those that report a tilt rate (the row's field)
         self._py = [(i, src) for i, src in self._py if i not in self._whole]
 
     def _whole_setpoints(self, future: tuple[np.ndarray, np.ndarray] | None) -> dict[int, tuple[np.ndarray, ...]]:
-        """index -> (start pos, start q, pos (N, 3), q (N, 4), flags (N, 2)) of every whole-only washout, and, given
+        """index -> (start pos, start q, pos (N, 3), q (N, 4), flags (N, 2), tilt rates (N,)) of every whole-only
+        washout, and, given
         the whole recording (``future``), of every Python washout with a whole-trace form (``trace()``: used for
         recorded files, as the interface promises, in :func:`cue_trace` and here alike). A washout that considers the
         others (``consider``) is told none here (a stream does not fly the others first: :func:`cue_trace` does) and
@@ -489,16 +493,20 @@ class CueingBank:
             if not self._started:
                 self._start(f, w)
             for i, src in self._py:
-                pos, q, ft, fr = src.step(f, w)
+                pos, q, ft, fr, tilt = src.step(f, w)
                 c, st = self._cfg[i], self._state[i]
                 setpoint_step(pos, q, ft, fr, c, self._coef[i], st, self._counts[i], self._out[i])
+                if self._tilted[i]:
+                    self._out[i, O_TILT] = tilt
             if self._whole:
                 self._whole_block(1)
-            for i, (_, _, pos_a, q_a, fl) in self._whole.items():
+            for i, (_, _, pos_a, q_a, fl, tilt_a) in self._whole.items():
                 k = self._k
                 c, st = self._cfg[i], self._state[i]
                 setpoint_step(pos_a[k], q_a[k], int(fl[k, 0]), int(fl[k, 1]), c, self._coef[i], st, self._counts[i],
                               self._out[i])  # fmt: skip
+                if self._tilted[i]:
+                    self._out[i, O_TILT] = tilt_a[k]
         if self._plugin:
             for i in range(len(self.washouts)):
                 self._plugin.rows(i, self._out[i : i + 1], self._cfg[i], self._coef[i])
@@ -531,15 +539,19 @@ class CueingBank:
             if not self._started:
                 self._start(f[0], w[0])
             for i, src in self._py:
-                pos, q, flags = src.run(f, w)
+                pos, q, flags, tilt = src.run(f, w)
                 setpoint_block(pos, q, flags, self._cfg[i], self._coef[i], self._state[i], self._counts[i], out[i])
+                if self._tilted[i]:
+                    out[i, :, O_TILT] = tilt
             if self._whole:
                 self._whole_block(m)
             k = self._k
-            for i, (_, _, pos, q, flags) in self._whole.items():
+            for i, (_, _, pos, q, flags, tilt) in self._whole.items():
                 setpoint_block(np.ascontiguousarray(pos[k : k + m]), np.ascontiguousarray(q[k : k + m]),
                                np.ascontiguousarray(flags[k : k + m]), self._cfg[i], self._coef[i], self._state[i],
                                self._counts[i], out[i])  # fmt: skip
+                if self._tilted[i]:
+                    out[i, :, O_TILT] = tilt[k : k + m]
         if self._plugin and m:
             for i in range(len(self.washouts)):
                 self._plugin.rows(i, out[i], self._cfg[i], self._coef[i])
@@ -640,12 +652,14 @@ def cue_trace(
                 flown = {**(motions or {}), **{names[j]: WashoutTrace.from_fields(out[j], kind)
                                                for j in range(len(names)) if j not in considering}}  # fmt: skip
                 src.consider(Alongside(flown, flyer(specs[i], limits, dt, filter_start), scoring))
-                pos, q, flags = src.run(f, w, whole=True)
+                pos, q, flags, tilt = src.run(f, w, whole=True)
                 _set_start(state[i], *src.start(f[0], w[0]))
             else:
                 _set_start(state[i], *src.start(f[0], w[0]))
-                pos, q, flags = src.run(f, w, whole=True)
+                pos, q, flags, tilt = src.run(f, w, whole=True)
             setpoint_trace(pos, q, flags, cfg[i], coef[i], state[i], counts[i], out[i])
+            if src.tilted:  # (the kernel's row has NaN: it knows no tilt rate of a set-point washout)
+                out[i][O_TILT] = tilt
             reported = src.report() if reports is not None else None
             if reported is not None:
                 reports[src.name] = reported

@@ -332,6 +332,8 @@ class MpcWashout:
         self.iterations: list[int] = []
         self._sat_tilt = False
         self._sat_rot = False
+        self._tilt_rate = 0.0
+        self._block: tuple[np.ndarray, np.ndarray] = (np.zeros(0), np.zeros(0, dtype=bool))
         self._timed_steps = 0
         self._timed_s = 0.0
         self._first_done = False
@@ -656,7 +658,8 @@ class MpcWashout:
             self.fallbacks += 1
             move = self._fallback_move()
         self._plan_age += 1
-        self._sat_tilt = bool(np.any(np.abs(move[self.model.j_tilt]) >= 0.999 * self._tilt_max))
+        self._tilt_rate = float(np.max(np.abs(move[self.model.j_tilt])))  # as the limit measures it: per axis
+        self._sat_tilt = bool(self._tilt_rate >= 0.999 * self._tilt_max)
         self._sat_rot = bool(np.sum(np.abs(self._total_rates(move))) >= 0.999 * self.params.limit_margin * self.w_max)
         self.u = move
         self.x = self.phi_f @ self.x + self.gam_f @ move + self._r_term
@@ -670,11 +673,14 @@ class MpcWashout:
         w = np.asarray(omega_radps, float)
         pos = np.empty((len(f), 3))
         q = np.empty((len(f), 4))
+        rate, at = np.full(len(f), math.nan), np.zeros(len(f), dtype=bool)
+        self._block = (rate, at)
         self._future = stacked_inputs(f, w, self.g)
         self._announce(len(f))
         try:
             for i in range(len(f)):
                 pos[i], q[i] = self._timed_step(f[i], w[i])
+                rate[i], at[i] = self._tilt_rate, self._sat_tilt
         finally:
             self._future = None
         return pos, q
@@ -682,6 +688,16 @@ class MpcWashout:
     def flags(self) -> tuple[bool, bool]:
         """(tilt-rate limit reached, rotational-rate limit reached) on the last step."""
         return self._sat_tilt, self._sat_rot
+
+    def tilt_rate(self) -> float:
+        """The tilt rate commanded on the last step, rad/s: the larger of the roll and pitch tilt parts' rates (the
+        QP limits each to ``tilt_rate_limit_degps``); its flag (:meth:`flags`) is set at 0.999 of that limit."""
+        return self._tilt_rate
+
+    def block_tilt(self) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`tilt_rate` and the tilt-rate flag after each sample of the last :meth:`trace` (rad/s (M,), bool
+        (M,))."""
+        return self._block
 
     def report(self) -> dict[str, float]:
         """Solver statistics so far: solves, fallbacks (failed or unsafe solves), of which brakes (no usable previous

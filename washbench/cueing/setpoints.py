@@ -4,7 +4,8 @@
 and checks every set point it returns: a tuple (pos_m, q) of 3 and 4 finite numbers, q not zero (it is normalised
 here). Anything else, or an exception raised inside the algorithm, becomes one line naming the washout, the plugin,
 the step and the time (:class:`washbench.errors.WashbenchError`), so no command shows a traceback or writes a
-result made of a plugin's garbage.
+result made of a plugin's garbage. With the set points come the algorithm's own limit flags (``flags()``, or a block
+form's ``block_tilt()``) and the tilt rate it commanded (``tilt_rate()``; NaN without one), checked alike.
 """
 
 from __future__ import annotations
@@ -45,16 +46,19 @@ class SetPointSource:
         where = self._where("making it")
         self.algo = plugin_call(where, lambda: algo.factory(section, self.context))
 
-        def methods() -> tuple[bool, bool, bool, bool]:  # attribute look-ups run the plugin's code too (__getattr__)
+        def methods() -> tuple[bool, ...]:  # attribute look-ups run the plugin's code too (__getattr__)
             missing = [m for m in ("start", "step") if not callable(getattr(self.algo, m, None))]
             if missing:
                 raise WashbenchError(f"{where}: the algorithm has no {missing[0]}() method")
             whole = registry.needs_whole(algo.factory, params.sections.get(washout.kind))
-            return (callable(getattr(self.algo, "flags", None)), callable(getattr(self.algo, "trace", None)),
-                    callable(getattr(self.algo, "steps", None)), whole)  # fmt: skip
+            return (*(callable(getattr(self.algo, m, None)) for m in ("flags", "trace", "steps", "tilt_rate",
+                                                                         "block_tilt")), whole)  # fmt: skip
 
-        self.has_flags, self.has_trace, self.has_steps, whole = plugin_call(where, methods)
+        has = plugin_call(where, methods)
+        self.has_flags, self.has_trace, self.has_steps, self.has_tilt, self.has_block_tilt, whole = has
         self.whole_only = whole and self.has_trace
+        self.tilted = self.has_tilt or self.has_block_tilt
+        """Whether the algorithm reports the tilt rate it commanded (``tilt_rate()`` or ``block_tilt()``)."""
         self.considers = self.whole_only and plugin_call(where, lambda: callable(getattr(self.algo, "consider", None)))
         """Whether the algorithm is told the run's other motions before its trace (``consider``, an
         :class:`washbench.cueing.algorithm.Alongside`; its start is then asked after its trace)."""
@@ -119,6 +123,25 @@ class SetPointSource:
 
         return plugin_call(f"{self._where()}: flags()", flags)
 
+    def _tilt(self) -> float:
+        """The tilt rate the algorithm commanded on the last step (its ``tilt_rate()``), rad/s; NaN without one."""
+        if not self.has_tilt:
+            return math.nan
+
+        def tilt() -> float:  # called and converted inside the guard
+            out = self.algo.tilt_rate()
+            try:
+                rate = float(out)
+            except (TypeError, ValueError) as exc:
+                raise WashbenchError(f"{self._where()}: tilt_rate() returned {_shown(out)}, expected a number "
+                                     f"(rad/s) or NaN: {type(exc).__name__}: {exc}") from None  # fmt: skip
+            if not (math.isnan(rate) or (math.isfinite(rate) and rate >= 0.0)):
+                raise WashbenchError(f"{self._where()}: tilt_rate() returned {rate!r}, expected a rate >= 0 (rad/s) "
+                                     "or NaN")  # fmt: skip
+            return rate
+
+        return plugin_call(f"{self._where()}: tilt_rate()", tilt)
+
     def start(self, f0: np.ndarray, om0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The start set point, from the first sample (or rest, with ``filter_start="rest"``)."""
         self.k = -1
@@ -127,30 +150,35 @@ class SetPointSource:
             om0 = np.zeros(3)
         return plugin_call(self._where(), lambda: self._check(self.algo.start(_ro(f0), _ro(om0))))
 
-    def step(self, f: np.ndarray, om: np.ndarray) -> tuple[np.ndarray, np.ndarray, int, int]:
-        """The next set point and the algorithm's two limit flags."""
+    def step(self, f: np.ndarray, om: np.ndarray) -> tuple[np.ndarray, np.ndarray, int, int, float]:
+        """The next set point, the algorithm's two limit flags and the tilt rate it commanded (rad/s, or NaN)."""
         self.k += 1
         pos, q = plugin_call(self._where(), lambda: self._check(self.algo.step(_ro(f), _ro(om))))
-        return pos, q, *self._flags()
+        return pos, q, *self._flags(), self._tilt()
 
-    def run(self, f: np.ndarray, om: np.ndarray, whole: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Set points for samples f, om (M, 3) in order: pos (M, 3), q (M, 4), flags (M, 2) int64. ``whole``: these
-        are all the samples there will be (the algorithm's ``trace`` form may then be used)."""
+    def run(self, f: np.ndarray, om: np.ndarray, whole: bool = False
+            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+        """Set points for samples f, om (M, 3) in order: pos (M, 3), q (M, 4), flags (M, 2) int64, tilt rates (M,)
+        rad/s (NaN: none). ``whole``: these are all the samples there will be (the algorithm's ``trace`` form may then
+        be used)."""
         m = f.shape[0]
         pos = np.empty((m, 3))
         q = np.empty((m, 4))
         flags = np.zeros((m, 2), dtype=np.int64)
+        tilt = np.full(m, math.nan)
         if whole and self.has_trace and self.k == -1 and m > 0:
             return self._block(f, om, "trace")
         if self.has_steps and m > 0:
             return self._block(f, om, "steps")
         for i in range(m):
-            pos[i], q[i], flags[i, 0], flags[i, 1] = self.step(f[i], om[i])
-        return pos, q, flags
+            pos[i], q[i], flags[i, 0], flags[i, 1], tilt[i] = self.step(f[i], om[i])
+        return pos, q, flags, tilt
 
-    def _block(self, f: np.ndarray, om: np.ndarray, method: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _block(self, f: np.ndarray, om: np.ndarray, method: str
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
         """The algorithm's block form: ``trace`` (the whole recording from its start) or ``steps`` (the next M
-        samples from where it is), checked as :meth:`step` checks one set point; no flags (zeros)."""
+        samples from where it is), checked as :meth:`step` checks one set point; its tilt rates and tilt-rate flags
+        from ``block_tilt()`` (:meth:`_block_tilt`), else NaN and zeros; no rotational flags (zeros)."""
         first = 0 if method == "trace" else self.k + 1
         self.k = first
         m = f.shape[0]
@@ -175,7 +203,35 @@ class SetPointSource:
             self.k = first + int(np.argmax(bad))
             raise WashbenchError(f"{self._where()}: set point is not finite or q is zero")
         self.k = first + m - 1
-        return pos, q / norms[:, None], np.zeros((m, 2), dtype=np.int64)
+        flags = np.zeros((m, 2), dtype=np.int64)
+        tilt = np.full(m, math.nan)
+        if self.has_block_tilt:
+            tilt[:], flags[:, 0] = self._block_tilt(m, method)
+        return pos, q / norms[:, None], flags, tilt
+
+    def _block_tilt(self, m: int, method: str) -> tuple[np.ndarray, np.ndarray]:
+        """The tilt rates (M,) rad/s and tilt-rate flags (M,) 0/1 of the last block form call (``block_tilt()``),
+        checked: M rates each NaN or finite >= 0, M flags."""
+        where = self._where(f"block_tilt() after {method}")
+
+        def converted() -> tuple[np.ndarray, np.ndarray]:  # called and converted inside the guard
+            out = self.algo.block_tilt()
+            try:
+                rate, at = out
+                rate = np.array(rate, dtype=np.float64)
+                at = np.array(at, dtype=bool).astype(np.int64)
+            except (TypeError, ValueError) as exc:
+                raise WashbenchError(f"{where}: returned {_shown(out)}, expected (tilt rates (M,), flags (M,)): "
+                                     f"{type(exc).__name__}: {exc}") from None  # fmt: skip
+            if rate.shape != (m,) or at.shape != (m,):
+                raise WashbenchError(f"{where}: shapes {rate.shape} and {at.shape}, expected ({m},) and ({m},)")
+            bad = ~(np.isnan(rate) | (np.isfinite(rate) & (rate >= 0.0)))
+            if bad.any():
+                raise WashbenchError(f"{where}: tilt rate {rate[np.argmax(bad)]!r} at its sample "
+                                     f"{int(np.argmax(bad))}, expected a rate >= 0 (rad/s) or NaN")  # fmt: skip
+            return rate, at
+
+        return plugin_call(where, converted)
 
 
 def _number(v: object) -> float | int:

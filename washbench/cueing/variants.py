@@ -59,8 +59,14 @@ class Washout:
 
 
 def tilt_rate_limit_radps(washout: Washout) -> float | None:
-    """The tilt-rate limit (rad/s) of a washout whose tilt rate the bench records (a compiled washout: the classical
-    and adaptive kinds, ``tilt.rate_limit_degps``); None when it has none (``off``) or is not compiled."""
+    """The tilt-rate limit (rad/s) of a washout whose tilt rate the bench records: a compiled washout (the classical
+    and adaptive kinds, ``tilt.rate_limit_degps``) or the ``mpc`` washout (``mpc.tilt_rate_limit_degps``, per axis);
+    None when it has none (``off``, ``null``) or is another kind."""
+    if washout.kind == "mpc":
+        algo = registry.get("mpc")
+        section = algo.make_params(washout.params.sections.get("mpc"), f"washout {washout.name}")
+        limit = getattr(section, "tilt_rate_limit_degps", None)
+        return None if limit is None else math.radians(limit)
     if washout.kind not in WASHOUT_KINDS or washout.params.tilt.rate_limit_degps is None:
         return None
     return math.radians(washout.params.tilt.rate_limit_degps)

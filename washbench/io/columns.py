@@ -21,6 +21,7 @@ unchanged to ``traces.parquet`` (e.g. the flight pipeline's state columns).
     W.wheel_{1,2,3}_radps                                    Atlas omni-wheel speeds (the Atlas only)
     W.leg_{1..6}_m                                           hexapod leg lengths, joint to joint (a hexapod only)
     W.sp_pos_{x,y,z}_m, W.sp_q_{w,x,y,z}                     the washout's set points for the platform
+    W.tilt_rate_degps                                        tilt-coordination rate commanded (empty: none known)
     W.sat_<kind>                                             saturation flags, 0/1 (int8)
     <extra input columns, unchanged>
 
@@ -117,6 +118,13 @@ def sp_q_columns(washout: str) -> tuple[str, str, str, str]:
     return tuple(f"{washout}.sp_q_{c}" for c in ("w", "x", "y", "z"))  # type: ignore[return-value]
 
 
+def tilt_rate_column(washout: str) -> str:
+    """The tilt-coordination rate the washout commanded [deg/s], after its tilt-rate limit and measured as that limit
+    measures it (``WashoutTrace.tilt_rate_radps``); empty (null, NaN when read by numpy) for a washout that reports
+    none."""
+    return f"{washout}.tilt_rate_degps"
+
+
 def sat_column(washout: str, kind: str) -> str:
     """Saturation flag column (0/1) of one limit ``kind``."""
     return f"{washout}.sat_{kind}"
@@ -134,5 +142,6 @@ def washout_columns(washout: str, sat_kinds: Iterable[str]) -> tuple[str, ...]:
         *wheel_columns(washout),
         *sp_pos_columns(washout),
         *sp_q_columns(washout),
+        tilt_rate_column(washout),
         *(sat_column(washout, k) for k in sat_kinds),
     )

@@ -34,10 +34,16 @@ def parquet_writer(path: str | Path, schema: pa.Schema) -> pq.ParquetWriter:
     return pq.ParquetWriter(path, schema, compression="zstd", use_dictionary=others, use_byte_stream_split=floats)
 
 
+def _arrow(col: np.ndarray) -> pa.Array:
+    """One column as Arrow (a masked array's masked values as nulls)."""
+    return pa.array(col if isinstance(col, np.ma.MaskedArray) else np.asarray(col))
+
+
 def write_trace_chunks(
     path: str | Path, chunks: Iterable[Mapping[str, np.ndarray]], metadata: Mapping[bytes, bytes] | None = None
 ) -> None:
-    """Write consecutive row ranges of the traces table (each column name -> 1-D array, the same columns in each)
+    """Write consecutive row ranges of the traces table (each column name -> 1-D array, the same columns in each; a
+    numpy masked array's masked values written empty, null)
     to Parquet at ``path`` (not atomic by itself), one row group each, with :func:`write_parquet`'s settings.
 
     ``metadata``: the schema's key-value metadata (provenance, :func:`washbench.io.provenance.parquet_metadata`).
@@ -55,7 +61,7 @@ def write_trace_chunks(
         with ThreadPoolExecutor(max_workers=1, thread_name_prefix="washbench-traces") as pool:
             pending: Future[None] | None = None
             for chunk in chunks:  # made here while the writer writes the one before
-                arrow = pa.table({name: pa.array(np.asarray(col)) for name, col in chunk.items()})
+                arrow = pa.table({name: _arrow(col) for name, col in chunk.items()})
                 if writer is None:
                     schema = arrow.schema.with_metadata(dict(metadata)) if metadata else arrow.schema
                     writer = parquet_writer(path, schema)
@@ -84,6 +90,7 @@ def write_traces(
 
 
 def read_traces(path: str | Path) -> dict[str, np.ndarray]:
-    """Read a traces.parquet back as column name -> numpy array."""
+    """Read a traces.parquet back as column name -> numpy array (an empty float value, e.g. ``W.tilt_rate_degps`` of
+    a washout that reports no tilt rate, as NaN)."""
     t = pq.read_table(path)
     return {name: t.column(name).to_numpy(zero_copy_only=False) for name in t.column_names}

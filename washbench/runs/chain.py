@@ -50,6 +50,7 @@ from washbench.io.columns import (
     sat_column,
     sp_pos_columns,
     sp_q_columns,
+    tilt_rate_column,
     vel_columns,
     wheel_columns,
 )
@@ -120,6 +121,9 @@ class CueResult:
         for name, tr in self.traces.items():
             arr = self.arrays.get(name) or {f: getattr(tr, f) for f in _TRACE_FIELDS}
             fields[name] = {f: a[rows] for f, a in arr.items()}
+            tilt = getattr(tr, "tilt_rate_radps", None)  # (not checked finite: NaN where none is known)
+            if tilt is not None and len(tilt):
+                fields[name]["tilt_rate_radps"] = np.asarray(tilt, dtype=np.float64)[rows]
         saturated = {w: {k: np.asarray(v)[rows] for k, v in tr.saturated.items()} for w, tr in self.traces.items()}
         return _table_rows(self.motion, rows, perceived, fields, saturated)
 
@@ -296,6 +300,11 @@ def _table_rows(
         _put(table, leg_columns(name), f["leg_m"])
         _put(table, sp_pos_columns(name), f["sp_pos_m"])
         _put(table, sp_q_columns(name), f["sp_q"])
+        # empty (null) where the washout reports none (NaN in the trace; no trace field: none), so the column compares
+        # equal to itself as the others do (Arrow's NaN is unequal to NaN); read back as NaN (read_traces)
+        tilt = f.get("tilt_rate_radps")
+        table[tilt_rate_column(name)] = np.ma.masked_invalid(np.full(len(table[TIME_COLUMN]), np.nan) if tilt is None
+                                                             else tilt * _DEG)  # fmt: skip
         for kind, flags in saturated[name].items():
             table[sat_column(name, kind)] = flags.astype(np.int8)
     for col, values in m.extra.items():
@@ -408,6 +417,7 @@ def stream_cue(
             for i, w in enumerate(names):
                 tr = WashoutTrace.from_rows(block[i], copy=False, platform=bank.platform)  # views, used in the chunk
                 fields[w] = {f: getattr(tr, f) for f in _TRACE_FIELDS} if finite else _checked_trace(w, tr, b - a, a)
+                fields[w]["tilt_rate_radps"] = tr.tilt_rate_radps  # (not checked finite: NaN where none is known)
                 saturated[w] = tr.saturated
                 perceived[w] = streams[w].perceive(fields[w]["head_f_mps2"], fields[w]["head_omega_radps"])
                 heads[w][rows] = fields[w]["head_f_mps2"]
