@@ -22,7 +22,7 @@ import pytest
 from test_rerun_log import _containers, _views, make_data
 
 from washbench.analysis.metrics import DOFS
-from washbench.analysis.ranking import RankRow
+from washbench.analysis.ranking import RankRow, RankRule
 from washbench.io.metrics_csv import MetricRow
 from washbench.review import scene3d
 from washbench.review.lane_bars import bars
@@ -252,6 +252,15 @@ def test_without_the_bound_the_metrics_panel_does_not_speak_of_it() -> None:
     rows += [MetricRow("bound", d, 0.5, 0.5, 0.5) for d in DOFS]
     with_bound = metrics_table_markdown("c172p / steep_turn", rows, [*ranking, RankRow("bound", 0.4, 0, {})], "score")
     assert "(the oracle bound, in italics, is a reference)" in with_bound
+
+
+def test_the_metrics_panel_names_the_felt_error_column_by_its_rule() -> None:
+    rows = [MetricRow(w, d, 1.0, 2.0, 3.0) for w in THREE for d in DOFS]
+    ranking = [RankRow(w, 0.9 + 0.1 * i, i + 1, {}) for i, w in enumerate(THREE)]
+    felt = metrics_table_markdown("c172p / steep_turn", rows, ranking, RankRule().label())
+    assert "| rank | washout | felt error |" in felt and "| rank | washout | score |" not in felt
+    assert "| rank | washout | score |" in metrics_table_markdown("c172p / steep_turn", rows, ranking,
+                                                                  RankRule(by="score").label())  # fmt: skip
 
 
 def test_a_blank_npc_is_said_to_be_undefined() -> None:

@@ -41,7 +41,8 @@ def _ranking_lines(ranking: Sequence[RankRow], rule_label: str, ceiling: Mapping
     score = ((ceiling or {}).get("ceiling") or {}).get("score")
     recovered = (ceiling or {}).get("recovered") or {}
     with_ceiling = isinstance(score, int | float) and math.isfinite(score)
-    head = "| rank | washout | score | recovered |" if with_ceiling else "| rank | washout | score |"
+    column = "felt error" if rule_label.startswith("felt error") else "score"
+    head = f"| rank | washout | {column} | recovered |" if with_ceiling else f"| rank | washout | {column} |"
     lines = ["", f"**Ranking** by {rule_label}; lower is better", "", head, "|---" * (head.count("|") - 1) + "|"]
     for r in ranking:
         got = _recovered((recovered.get(r.washout) or {}).get("score")) if with_ceiling else None
