@@ -31,12 +31,11 @@ from typing import Any
 from pydantic import BaseModel
 
 from washbench.cueing.params import WASHOUT_KINDS
-from washbench.errors import Terminated, WashbenchError, located
-from washbench.io import interrupts
+from washbench.errors import WashbenchError, located
 from washbench.io.entry_points import entry_points as installed_entry_points
 from washbench.io.names import identifier_problem
 from washbench.io.paths import plugin_file
-from washbench.io.plugin_guard import plugin_call, plugin_error
+from washbench.io.plugin_guard import load_module, plugin_call
 from washbench.io.yamlio import line_of
 
 ENTRY_POINT_GROUP = "washbench.washouts"
@@ -130,33 +129,7 @@ def load_plugin(spec: str) -> Algorithm:
     for kind, loaded in _PLUGIN_SPECS.items():
         if loaded == text:
             return _LOADED[kind]
-    # the same name in every process (str hashes are salted per process): a worker loads the module the parent did
-    module_name = f"washbench_plugin_{hashlib.sha256(str(path.resolve()).encode()).hexdigest()[:16]}"
-    seen = interrupts.received()
-    try:
-        mod_spec = importlib.util.spec_from_file_location(module_name, path)
-        if mod_spec is None or mod_spec.loader is None:
-            raise WashbenchError(f"{where}: {path}: not a Python file")
-        module = importlib.util.module_from_spec(mod_spec)
-        sys.modules[module_name] = module
-        mod_spec.loader.exec_module(module)
-    except WashbenchError:
-        raise
-    except BaseException as exc:  # a user's file: whatever it raises (sys.exit() too) becomes one line
-        if isinstance(exc, KeyboardInterrupt | Terminated) and interrupts.received() != seen:
-            raise  # a real Ctrl-C or SIGTERM while it loaded
-        sys.modules.pop(module_name, None)
-        line = ""
-        tb = exc.__traceback__
-        while tb is not None:
-            if tb.tb_frame.f_code.co_filename == str(path):
-                line = f":{tb.tb_lineno}"
-            tb = tb.tb_next
-        if isinstance(exc, SyntaxError) and exc.lineno:
-            line = f":{exc.lineno}"
-        if isinstance(exc, Exception):
-            raise WashbenchError(f"{where}: {path}{line}: {type(exc).__name__}: {exc}") from None
-        raise plugin_error(f"{where}: {path}{line}", exc) from None  # sys.exit(), a KeyboardInterrupt without a signal
+    module = load_module(path, "washbench_plugin", where)
 
     def named() -> tuple[Any, str]:
         if not hasattr(module, name):

@@ -11,7 +11,12 @@ read it gets as read-only copies (:func:`read_only`).
 
 from __future__ import annotations
 
+import hashlib
+import importlib.util
+import sys
 from collections.abc import Callable
+from pathlib import Path
+from types import ModuleType
 from typing import TYPE_CHECKING, TypeVar
 
 from washbench.errors import Terminated, WashbenchError
@@ -50,6 +55,40 @@ def plugin_error(where: str, exc: BaseException, what: str = "a washout") -> Was
         return WashbenchError(f"{where}: raised {type(exc).__name__} (no signal was received)")
     text = exception_text(exc)
     return WashbenchError(f"{where}: raised {type(exc).__name__}" + (f": {text}" if text else ""))
+
+
+def load_module(path: Path, prefix: str, where: str) -> ModuleType:
+    """Import a user's plugin file ``path`` as module ``PREFIX_<hash of its resolved path>`` (the same name in every
+    process: a worker loads the module its parent did); whatever importing it raises (``sys.exit()`` too) becomes
+    one line ``WHERE: PATH[:LINE]: TYPE: message``, except a real SIGINT or SIGTERM received meanwhile."""
+    module_name = f"{prefix}_{hashlib.sha256(str(path.resolve()).encode()).hexdigest()[:16]}"
+    seen = interrupts.received()
+    try:
+        mod_spec = importlib.util.spec_from_file_location(module_name, path)
+        if mod_spec is None or mod_spec.loader is None:
+            raise WashbenchError(f"{where}: {path}: not a Python file")
+        module = importlib.util.module_from_spec(mod_spec)
+        sys.modules[module_name] = module
+        mod_spec.loader.exec_module(module)
+    except WashbenchError:
+        sys.modules.pop(module_name, None)
+        raise
+    except BaseException as exc:  # a user's file: whatever it raises (sys.exit() too) becomes one line
+        if isinstance(exc, KeyboardInterrupt | Terminated) and interrupts.received() != seen:
+            raise  # a real Ctrl-C or SIGTERM while it loaded
+        sys.modules.pop(module_name, None)
+        line = ""
+        tb = exc.__traceback__
+        while tb is not None:
+            if tb.tb_frame.f_code.co_filename == str(path):
+                line = f":{tb.tb_lineno}"
+            tb = tb.tb_next
+        if isinstance(exc, SyntaxError) and exc.lineno:
+            line = f":{exc.lineno}"
+        if isinstance(exc, Exception):
+            raise WashbenchError(f"{where}: {path}{line}: {type(exc).__name__}: {exception_text(exc)}") from None
+        raise plugin_error(f"{where}: {path}{line}", exc) from None  # sys.exit(), a KeyboardInterrupt without a signal
+    return module
 
 
 def exception_text(exc: BaseException) -> str:

@@ -13,8 +13,6 @@ parameters): the plugin flies every condition as it is made. Every call into it 
 from __future__ import annotations
 
 import hashlib
-import importlib.util
-import sys
 from dataclasses import dataclass
 from typing import Any
 
@@ -22,7 +20,7 @@ from pydantic import BaseModel
 
 from washbench.errors import WashbenchError
 from washbench.io.paths import plugin_file
-from washbench.io.plugin_guard import plugin_call, plugin_error
+from washbench.io.plugin_guard import load_module, plugin_call
 from washbench.pilot.model import PilotContext
 
 
@@ -69,20 +67,7 @@ def load_pilot_plugin(spec: str) -> PilotPlugin:
     """Load ``FILE.py:NAME``; WashbenchError (one line) if it cannot be loaded."""
     where, path, name = plugin_file(spec, "--pilot-plugin")
     data = path.read_bytes()
-    module_name = f"washbench_pilot_plugin_{hashlib.sha256(str(path).encode()).hexdigest()[:16]}"
-    try:
-        mod_spec = importlib.util.spec_from_file_location(module_name, path)
-        if mod_spec is None or mod_spec.loader is None:
-            raise WashbenchError(f"{where}: {path}: not a Python file")
-        module = importlib.util.module_from_spec(mod_spec)
-        sys.modules[module_name] = module
-        plugin_call(where, lambda: mod_spec.loader.exec_module(module))  # type: ignore[union-attr]
-    except WashbenchError:
-        sys.modules.pop(module_name, None)
-        raise
-    except BaseException as exc:  # pragma: no cover - plugin_call turns everything but a signal into one line
-        sys.modules.pop(module_name, None)
-        raise plugin_error(where, exc) from None
+    module = load_module(path, "washbench_pilot_plugin", where)
     if not hasattr(module, name):
         raise WashbenchError(f"{where}: {path} has no {name!r}")
     obj = getattr(module, name)

@@ -18,11 +18,7 @@ NAME) and, without ``--platform``, makes it the run's platform with no parameter
 from __future__ import annotations
 
 import functools
-import hashlib
-import importlib.metadata
-import importlib.util
 import math
-import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -31,7 +27,7 @@ from washbench.errors import WashbenchError
 from washbench.io.entry_points import entry_points as installed_entry_points
 from washbench.io.names import identifier_problem
 from washbench.io.paths import plugin_file
-from washbench.io.plugin_guard import plugin_call, read_only
+from washbench.io.plugin_guard import load_module, plugin_call, read_only
 
 ENTRY_POINT_GROUP = "washbench.platforms"
 BUILTIN_KINDS = frozenset({"atlas", "hexapod", "rig"})
@@ -269,19 +265,7 @@ def load_source(source: str, where: str | None = None) -> tuple[Any, str]:
     where = where or f"platform plugin {source}"
     file, _, name = source.rpartition(":")
     path = Path(file)
-    module_name = f"washbench_platform_{hashlib.sha256(str(path).encode()).hexdigest()[:16]}"
-    try:
-        spec = importlib.util.spec_from_file_location(module_name, path)
-        if spec is None or spec.loader is None:
-            raise WashbenchError(f"{where}: {path}: not a Python file")
-        module = importlib.util.module_from_spec(spec)
-        sys.modules[module_name] = module
-        spec.loader.exec_module(module)
-    except WashbenchError:
-        raise
-    except Exception as exc:  # a user's file: whatever it raises becomes one line
-        line = f":{exc.lineno}" if isinstance(exc, SyntaxError) and exc.lineno else ""
-        raise WashbenchError(f"{where}: {path}{line}: {type(exc).__name__}: {exc}") from None
+    module = load_module(path, "washbench_platform", where)
     if not hasattr(module, name):
         raise WashbenchError(f"{where}: {path} has no {name!r}")
     return getattr(module, name), source
